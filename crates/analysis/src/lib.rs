@@ -1,0 +1,2 @@
+//! streaks-analysis (skeleton).
+#![deny(missing_docs)]

@@ -1,0 +1,1 @@
+//! (skeleton: film, filled in by its owner)

@@ -1,0 +1,129 @@
+//! Rays, shading frames and robust ray offsets.
+
+use glam::Vec3;
+
+/// A ray `origin + t * direction` for `t` in `[0, t_max)`; `direction` is unit length.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ray {
+    /// Where the ray starts (already offset off any surface it leaves).
+    pub origin: Vec3,
+    /// Unit direction.
+    pub direction: Vec3,
+    /// Largest parameter of interest (`f32::INFINITY` for an unbounded ray).
+    pub t_max: f32,
+}
+
+impl Ray {
+    /// A ray with unbounded extent.
+    #[inline]
+    pub fn new(origin: Vec3, direction: Vec3) -> Self {
+        Self {
+            origin,
+            direction,
+            t_max: f32::INFINITY,
+        }
+    }
+
+    /// The point at parameter `t`.
+    #[inline]
+    pub fn at(&self, t: f32) -> Vec3 {
+        self.origin + t * self.direction
+    }
+}
+
+/// An orthonormal frame; `n` is the local +Z axis (the shading normal).
+///
+/// BSDFs work in this local frame: `cos(theta) = w.z`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Frame {
+    /// Local +X.
+    pub s: Vec3,
+    /// Local +Y.
+    pub t: Vec3,
+    /// Local +Z, the normal.
+    pub n: Vec3,
+}
+
+impl Frame {
+    /// A frame around the unit normal `n` (Duff et al. 2017, branchless ONB).
+    #[inline]
+    pub fn from_normal(n: Vec3) -> Self {
+        let (s, t) = n.any_orthonormal_pair();
+        Self { s, t, n }
+    }
+
+    /// World to local coordinates.
+    #[inline]
+    pub fn to_local(&self, v: Vec3) -> Vec3 {
+        Vec3::new(v.dot(self.s), v.dot(self.t), v.dot(self.n))
+    }
+
+    /// Local to world coordinates.
+    #[inline]
+    pub fn to_world(&self, v: Vec3) -> Vec3 {
+        self.s * v.x + self.t * v.y + self.n * v.z
+    }
+}
+
+/// Offsets a ray origin at surface point `p` with geometric normal `ng` to the side of `w`,
+/// so that the new ray does not hit the surface it leaves (Wächter and Binder, Ray Tracing
+/// Gems ch. 6: an integer ULP offset that scales with the magnitude of `p`).
+#[inline]
+pub fn offset_ray_origin(p: Vec3, ng: Vec3, w: Vec3) -> Vec3 {
+    const ORIGIN: f32 = 1.0 / 32.0;
+    const FLOAT_SCALE: f32 = 1.0 / 65536.0;
+    const INT_SCALE: f32 = 256.0;
+    let n = if ng.dot(w) < 0.0 { -ng } else { ng };
+    let of_i = [
+        (INT_SCALE * n.x) as i32,
+        (INT_SCALE * n.y) as i32,
+        (INT_SCALE * n.z) as i32,
+    ];
+    let pc = [p.x, p.y, p.z];
+    let nc = [n.x, n.y, n.z];
+    let mut out = [0.0f32; 3];
+    for k in 0..3 {
+        let bits = pc[k].to_bits() as i32;
+        let moved = f32::from_bits((bits + if pc[k] < 0.0 { -of_i[k] } else { of_i[k] }) as u32);
+        out[k] = if pc[k].abs() < ORIGIN {
+            pc[k] + FLOAT_SCALE * nc[k]
+        } else {
+            moved
+        };
+    }
+    Vec3::from_array(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frame_round_trip() {
+        for n in [
+            Vec3::Z,
+            -Vec3::Z,
+            Vec3::new(0.3, -0.4, 0.866).normalize(),
+            Vec3::Y,
+        ] {
+            let f = Frame::from_normal(n);
+            let v = Vec3::new(0.2, -0.7, 0.5);
+            assert!((f.to_world(f.to_local(v)) - v).length() < 1e-6);
+            assert!((f.to_local(n) - Vec3::Z).length() < 1e-6);
+            assert!(f.s.dot(f.t).abs() < 1e-6 && f.s.cross(f.t).dot(n) > 0.999);
+        }
+    }
+
+    #[test]
+    fn offset_moves_to_the_right_side() {
+        for p in [
+            Vec3::ZERO,
+            Vec3::new(1e4, 0.0, -3e3),
+            Vec3::new(-0.01, 0.0, 12.0),
+        ] {
+            let up = offset_ray_origin(p, Vec3::Y, Vec3::Y);
+            let down = offset_ray_origin(p, Vec3::Y, -Vec3::Y);
+            assert!(up.y > p.y && down.y < p.y, "{p} -> {up} {down}");
+        }
+    }
+}

@@ -1,0 +1,1 @@
+//! (skeleton: integrator, filled in by its owner)

@@ -1,0 +1,34 @@
+//! # streaks-render
+//!
+//! A physically based, BVH-accelerated path tracer for wet night streets.
+//!
+//! The main types, by concept (one module each, after pbrt-v4's division):
+//!
+//! - [`geometry`]: [`geometry::Ray`], the shading [`geometry::Frame`], robust ray offsets.
+//! - [`sampling`]: warps with their pdfs and inverses, MIS weights, discrete distributions and
+//!   the Owen-scrambled Sobol sampler.
+//! - [`bsdf`]: the closed set of reflectance models ([`bsdf::Bsdf`]): diffuse, the paper's
+//!   `ggx`, `ward` and `blinn_phong`, and the glTF metallic-roughness BRDF.
+//! - [`material`] and [`texture`]: what a scene stores; a material turns into a [`bsdf::Bsdf`]
+//!   at a surface point.
+//! - [`light`]: point, spot, directional lights and emissive triangles, with light selection.
+//! - [`accel`]: the only module that sees obvhs; closest-hit and shadow queries.
+//! - [`scene`]: loading glTF 2.0 and OBJ into a [`scene::Scene`], with errors that name the file
+//!   and the element.
+//! - [`camera`]: the pinhole camera of DESIGN.md (pixel centres at `i + 0.5`, `f = (H/2)/tan(yfov/2)`).
+//! - [`integrator`]: unidirectional path tracing with next-event estimation and MIS.
+//! - [`film`] and [`output`]: the box-filtered film with its layers, EXR and PNG writing.
+#![deny(missing_docs)]
+
+pub mod accel;
+pub mod bsdf;
+pub mod camera;
+pub mod film;
+pub mod geometry;
+pub mod integrator;
+pub mod light;
+pub mod material;
+pub mod output;
+pub mod sampling;
+pub mod scene;
+pub mod texture;

@@ -1,0 +1,1 @@
+//! (skeleton: output, filled in by its owner)

@@ -1,0 +1,1 @@
+//! (skeleton: sampling, filled in by its owner)

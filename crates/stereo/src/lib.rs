@@ -1,0 +1,2 @@
+//! streaks-stereo (skeleton).
+#![deny(missing_docs)]
