@@ -1,1 +1,30 @@
-fn main() {}
+//! The `streaks` command: one module per subcommand, each thin over the library crates.
+//!
+//! Each subcommand module exposes an `Args` struct (clap) and `run(args) -> anyhow::Result<()>`.
+//! Errors are printed with their whole chain and the process exits non-zero.
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// Render rainy night streets in stereo and measure what specular streaks do to depth.
+#[derive(Parser, Debug)]
+#[command(name = "streaks", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result: anyhow::Result<()> = match cli.command {};
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(err) => {
+            eprintln!("error: {err:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,126 @@
+//! PFM maps (disparity, depth) in the Middlebury convention: greyscale `Pf`, little-endian
+//! (negative scale), rows stored bottom to top, `inf` for "no value".
+//! Written atomically: a temporary file beside the target, then a rename.
+
+use crate::image::{GrayImage, ImageError};
+use std::io::Write;
+use std::path::Path;
+
+/// Writes `img` as a little-endian greyscale PFM.
+pub fn write_pfm(path: &Path, img: &GrayImage) -> Result<(), ImageError> {
+    let err = |reason: String| ImageError::Write {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let mut bytes = format!("Pf\n{} {}\n-1.0\n", img.width, img.height).into_bytes();
+    bytes.reserve(img.data.len() * 4);
+    for y in (0..img.height).rev() {
+        for &v in &img.data[y * img.width..(y + 1) * img.width] {
+            bytes.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    let tmp = path.with_extension("pfm.tmp");
+    let write = || -> std::io::Result<()> {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(&bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    };
+    write().map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        err(e.to_string())
+    })
+}
+
+/// Reads a greyscale PFM (either byte order); rows are returned top row first.
+pub fn read_pfm(path: &Path) -> Result<GrayImage, ImageError> {
+    let err = |reason: String| ImageError::Read {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let bytes = std::fs::read(path).map_err(|e| err(e.to_string()))?;
+    // Header: three whitespace-separated tokens after the magic, then one whitespace byte.
+    let mut pos = 0usize;
+    let mut token = || -> Result<String, ImageError> {
+        while pos < bytes.len() && bytes[pos].is_ascii_whitespace() {
+            pos += 1;
+        }
+        let start = pos;
+        while pos < bytes.len() && !bytes[pos].is_ascii_whitespace() {
+            pos += 1;
+        }
+        if start == pos {
+            return Err(err("truncated header".into()));
+        }
+        Ok(String::from_utf8_lossy(&bytes[start..pos]).into_owned())
+    };
+    let magic = token()?;
+    if magic != "Pf" {
+        return Err(err(format!(
+            "not a greyscale PFM (magic {magic:?}, expected \"Pf\")"
+        )));
+    }
+    let width: usize = token()?.parse().map_err(|_| err("bad width".into()))?;
+    let height: usize = token()?.parse().map_err(|_| err("bad height".into()))?;
+    let scale: f32 = token()?.parse().map_err(|_| err("bad scale".into()))?;
+    if scale == 0.0 || !scale.is_finite() {
+        return Err(err("scale must be a non-zero number".into()));
+    }
+    let data_start = pos + 1;
+    let mut img = GrayImage::new(width, height, 0.0).map_err(|e| err(e.to_string()))?;
+    let need = width * height * 4;
+    if bytes.len() < data_start + need {
+        return Err(err(format!(
+            "truncated data: {} bytes for {width}x{height}, expected {need}",
+            bytes.len().saturating_sub(data_start)
+        )));
+    }
+    let little = scale < 0.0;
+    for (i, chunk) in bytes[data_start..data_start + need]
+        .chunks_exact(4)
+        .enumerate()
+    {
+        let b = [chunk[0], chunk[1], chunk[2], chunk[3]];
+        let v = if little {
+            f32::from_le_bytes(b)
+        } else {
+            f32::from_be_bytes(b)
+        };
+        let (x, row_from_bottom) = (i % width, i / width);
+        img.set(x, height - 1 - row_from_bottom, v);
+    }
+    Ok(img)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_trip_keeps_rows_and_inf() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("d.pfm");
+        let img = GrayImage::from_vec(3, 2, vec![1.0, 2.0, f32::INFINITY, -4.0, 5.5, 6.0]).unwrap();
+        write_pfm(&p, &img).unwrap();
+        let raw = std::fs::read(&p).unwrap();
+        // The first stored row is the bottom one.
+        let body = &raw[raw.len() - 24..];
+        assert_eq!(
+            f32::from_le_bytes([body[0], body[1], body[2], body[3]]),
+            -4.0
+        );
+        assert_eq!(read_pfm(&p).unwrap(), img);
+        assert!(!p.with_extension("pfm.tmp").exists());
+    }
+
+    #[test]
+    fn bad_files_are_errors() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("x.pfm");
+        std::fs::write(&p, b"P6\n1 1\n255\n\0\0\0").unwrap();
+        assert!(read_pfm(&p).is_err());
+        std::fs::write(&p, b"Pf\n4 4\n-1.0\n\0\0").unwrap();
+        assert!(read_pfm(&p).unwrap_err().to_string().contains("truncated"));
+        assert!(read_pfm(&dir.path().join("missing.pfm")).is_err());
+    }
+}
