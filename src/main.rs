@@ -6,6 +6,8 @@
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
+mod render;
+
 /// Render rainy night streets in stereo and measure what specular streaks do to depth.
 #[derive(Parser, Debug)]
 #[command(name = "streaks", version, about, long_about = None)]
@@ -15,11 +17,16 @@ struct Cli {
 }
 
 #[derive(Subcommand, Debug)]
-enum Command {}
+enum Command {
+    /// Path-trace one camera of a scene to EXR (and PNG).
+    Render(render::Args),
+}
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let result: anyhow::Result<()> = match cli.command {};
+    let result: anyhow::Result<()> = match cli.command {
+        Command::Render(args) => render::run(args),
+    };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
