@@ -466,3 +466,257 @@ impl Sampler {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testing::{chi_square_plane, chi_square_sphere, ChiSquareConfig};
+
+    const WARP_TESTS: usize = 5;
+
+    fn config() -> ChiSquareConfig {
+        ChiSquareConfig {
+            num_tests: WARP_TESTS,
+            ..ChiSquareConfig::default()
+        }
+    }
+
+    fn grid(n: usize) -> impl Iterator<Item = Vec2> {
+        (0..n * n).map(move |i| {
+            Vec2::new(
+                ((i / n) as f32 + 0.37) / n as f32,
+                ((i % n) as f32 + 0.61) / n as f32,
+            )
+        })
+    }
+
+    #[test]
+    fn warps_invert() {
+        for u in grid(40) {
+            let checks = [
+                (
+                    "disk",
+                    uniform_disk_to_square_concentric(square_to_uniform_disk_concentric(u)),
+                ),
+                (
+                    "cosine",
+                    cosine_hemisphere_to_square(square_to_cosine_hemisphere(u)),
+                ),
+                (
+                    "sphere",
+                    uniform_sphere_to_square(square_to_uniform_sphere(u)),
+                ),
+                (
+                    "cone",
+                    uniform_cone_to_square(square_to_uniform_cone(u, 0.9), 0.9),
+                ),
+                (
+                    "triangle",
+                    uniform_triangle_to_square(square_to_uniform_triangle(u)),
+                ),
+            ];
+            for (name, back) in checks {
+                assert!(
+                    (back - u).abs().max_element() < 2e-4,
+                    "{name}: {u} -> {back}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn warps_land_in_their_domains() {
+        for u in grid(30) {
+            assert!(square_to_uniform_disk_concentric(u).length() <= 1.0 + 1e-6);
+            let v = square_to_cosine_hemisphere(u);
+            assert!((v.length() - 1.0).abs() < 1e-5 && v.z >= 0.0);
+            assert!((square_to_uniform_sphere(u).length() - 1.0).abs() < 1e-5);
+            let c = square_to_uniform_cone(u, 0.5);
+            assert!((c.length() - 1.0).abs() < 1e-5 && c.z >= 0.5 - 1e-6);
+            let b = square_to_uniform_triangle(u);
+            assert!(b.x >= 0.0 && b.y >= 0.0 && b.x + b.y <= 1.0 + 1e-6);
+        }
+    }
+
+    #[test]
+    fn chi_square_direction_warps() {
+        let c = config();
+        let r = chi_square_sphere(
+            "cosine hemisphere",
+            &c,
+            |rng| Some(square_to_cosine_hemisphere(rng.next_2d())),
+            square_to_cosine_hemisphere_pdf,
+        );
+        assert!(r.passed && (r.pdf_integral - 1.0).abs() < 1e-3, "{r}");
+        let r = chi_square_sphere(
+            "uniform sphere",
+            &c,
+            |rng| Some(square_to_uniform_sphere(rng.next_2d())),
+            square_to_uniform_sphere_pdf,
+        );
+        assert!(r.passed && (r.pdf_integral - 1.0).abs() < 1e-3, "{r}");
+        let r = chi_square_sphere(
+            "uniform cone 0.8",
+            &c,
+            |rng| Some(square_to_uniform_cone(rng.next_2d(), 0.8)),
+            |v| square_to_uniform_cone_pdf(v, 0.8),
+        );
+        assert!(r.passed && (r.pdf_integral - 1.0).abs() < 1e-3, "{r}");
+    }
+
+    #[test]
+    fn chi_square_plane_warps() {
+        let c = ChiSquareConfig {
+            cells: (32, 32),
+            ..config()
+        };
+        let r = chi_square_plane(
+            "concentric disk",
+            &c,
+            (-1.0, 1.0),
+            (-1.0, 1.0),
+            |rng| Some(square_to_uniform_disk_concentric(rng.next_2d())),
+            square_to_uniform_disk_concentric_pdf,
+        );
+        assert!(r.passed && (r.pdf_integral - 1.0).abs() < 1e-3, "{r}");
+        let r = chi_square_plane(
+            "triangle",
+            &c,
+            (0.0, 1.0),
+            (0.0, 1.0),
+            |rng| Some(square_to_uniform_triangle(rng.next_2d())),
+            square_to_uniform_triangle_pdf,
+        );
+        assert!(r.passed && (r.pdf_integral - 1.0).abs() < 1e-3, "{r}");
+    }
+
+    #[test]
+    fn power_heuristic_cases() {
+        assert_eq!(power_heuristic(1.0, 1.0, 1.0, 1.0), 0.5);
+        assert!((power_heuristic(1.0, 3.0, 1.0, 1.0) - 0.9).abs() < 1e-6);
+        assert_eq!(power_heuristic(1.0, f32::INFINITY, 1.0, 5.0), 1.0);
+        assert_eq!(power_heuristic(1.0, 5.0, 1.0, f32::INFINITY), 0.0);
+        assert_eq!(power_heuristic(1.0, 0.0, 1.0, 0.0), 0.0);
+        let w = power_heuristic(1.0, 1e30, 1.0, 1e29);
+        assert!((w - 100.0 / 101.0).abs() < 1e-5 && w.is_finite());
+        let sum = power_heuristic(1.0, 0.3, 2.0, 0.7) + power_heuristic(2.0, 0.7, 1.0, 0.3);
+        assert!((sum - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn discrete_distribution_rejects_bad_weights() {
+        assert!(DiscreteDistribution::new(&[]).is_none());
+        assert!(DiscreteDistribution::new(&[0.0, 0.0]).is_none());
+        assert!(DiscreteDistribution::new(&[1.0, -1.0]).is_none());
+        assert!(DiscreteDistribution::new(&[1.0, f32::NAN]).is_none());
+        assert!(DiscreteDistribution::new(&[1.0, f32::INFINITY]).is_none());
+    }
+
+    #[test]
+    fn discrete_distribution_samples_its_pmf() {
+        let w = [0.0, 1.0, 3.0, 0.0, 6.0, 0.0];
+        let d = DiscreteDistribution::new(&w).unwrap();
+        assert_eq!(d.len(), 6);
+        assert!(!d.is_empty());
+        assert_eq!(d.pmf(2), 0.3);
+        assert_eq!(d.pmf(17), 0.0);
+        let n = 100_000;
+        let mut counts = [0usize; 6];
+        let mut rng = Pcg32::new(7, 1);
+        for _ in 0..n {
+            let (i, p, r) = d.sample_reuse(rng.next_f32());
+            assert_eq!(p, d.pmf(i));
+            assert!((0.0..1.0).contains(&r));
+            counts[i] += 1;
+        }
+        for (i, &c) in counts.iter().enumerate() {
+            let expect = d.pmf(i) as f64 * n as f64;
+            let sigma = (expect * (1.0 - d.pmf(i) as f64)).sqrt().max(1.0);
+            assert!(
+                (c as f64 - expect).abs() < 5.0 * sigma,
+                "index {i}: {c} vs {expect}"
+            );
+        }
+        // Edge values of u never pick a zero weight.
+        for u in [0.0, 1e-9, 0.1, 0.1 + 1e-8, 0.4, ONE_MINUS_EPSILON, 1.0] {
+            let (i, p) = d.sample(u);
+            assert!(p > 0.0 && w[i] > 0.0, "u = {u} picked {i}");
+        }
+    }
+
+    #[test]
+    fn sampler_is_deterministic_and_in_range() {
+        let mut a = Sampler::new(42);
+        let mut b = Sampler::new(42);
+        let mut c = Sampler::new(43);
+        let mut differs = false;
+        for s in [
+            0u32,
+            1,
+            77,
+            SOBOL_MAX_SAMPLES - 1,
+            SOBOL_MAX_SAMPLES,
+            1 << 20,
+        ] {
+            a.start_pixel_sample((3, 5), s);
+            b.start_pixel_sample((3, 5), s);
+            c.start_pixel_sample((3, 5), s);
+            for _ in 0..300 {
+                let (x, y) = (a.next_1d(), b.next_1d());
+                assert_eq!(x, y);
+                assert!((0.0..1.0).contains(&x));
+                let (p, q) = (a.next_2d(), b.next_2d());
+                assert_eq!(p, q);
+                assert!(p.min_element() >= 0.0 && p.max_element() < 1.0);
+                differs |= c.next_1d() != x;
+                c.next_2d();
+            }
+        }
+        assert!(differs, "the seed changes nothing");
+    }
+
+    #[test]
+    fn sampler_decorrelates_pixels_and_dimensions() {
+        let mut s = Sampler::new(1);
+        s.start_pixel_sample((0, 0), 3);
+        let a = (s.next_2d(), s.next_2d());
+        s.start_pixel_sample((1, 0), 3);
+        let b = (s.next_2d(), s.next_2d());
+        assert_ne!(a.0, b.0);
+        assert_ne!(a.0, a.1);
+    }
+
+    #[test]
+    fn sampler_2d_is_stratified() {
+        // Each of the 16 cells of a 4x4 grid gets exactly one of the first 16 points, in every
+        // dimension slot and pixel; 64 points fill an 8x8 grid the same way.
+        let mut s = Sampler::new(9);
+        for pixel in [(0, 0), (17, 3), (640, 480)] {
+            for slot in 0..6 {
+                for (n, k) in [(16u32, 4usize), (64, 8)] {
+                    let mut hit = vec![0u32; k * k];
+                    for i in 0..n {
+                        s.start_pixel_sample(pixel, i);
+                        for _ in 0..slot {
+                            s.next_2d();
+                        }
+                        let p = s.next_2d();
+                        let cell = (p.x * k as f32) as usize * k + (p.y * k as f32) as usize;
+                        hit[cell] += 1;
+                    }
+                    assert!(
+                        hit.iter().all(|&h| h == 1),
+                        "pixel {pixel:?} slot {slot}: {hit:?}"
+                    );
+                }
+            }
+        }
+        // 1D: the first 16 values fall one in each sixteenth.
+        let mut hit = [0u32; 16];
+        for i in 0..16 {
+            s.start_pixel_sample((2, 2), i);
+            hit[(s.next_1d() * 16.0) as usize] += 1;
+        }
+        assert!(hit.iter().all(|&h| h == 1), "{hit:?}");
+    }
+}
