@@ -146,6 +146,10 @@ pub enum Bsdf {
 // ---------------------------------------------------------------------------------------------
 // Shared pieces
 
+/// Smallest microfacet alpha the models use: a smaller (or zero) alpha is raised to it, so a
+/// mirror-like material stays finite. Mitsuba's principled BSDF uses the same floor.
+pub const MIN_ALPHA: f32 = 1e-4;
+
 /// Bounds of the glossy-lobe probability when both lobes are non-zero.
 const MIN_LOBE_PROBABILITY: f32 = 0.05;
 
@@ -264,15 +268,21 @@ impl Diffuse {
 }
 
 impl Ggx {
+    /// `alpha`, kept at or above [`MIN_ALPHA`].
+    #[inline]
+    fn alpha(&self) -> f32 {
+        self.alpha.max(MIN_ALPHA)
+    }
+
     #[inline]
     fn eval_lobes(&self, wo: Vec3, wi: Vec3) -> LobeValues {
         if !above(wo, wi) {
             return LobeValues::default();
         }
         let h = half_vector(wo, wi);
-        let spec = ggx_d(h, self.alpha)
-            * ggx_smith_g1(wo, h, self.alpha)
-            * ggx_smith_g1(wi, h, self.alpha)
+        let spec = ggx_d(h, self.alpha())
+            * ggx_smith_g1(wo, h, self.alpha())
+            * ggx_smith_g1(wi, h, self.alpha())
             / (4.0 * wo.z * wi.z);
         LobeValues {
             diffuse: self.kd * FRAC_1_PI,
@@ -282,12 +292,18 @@ impl Ggx {
 
     #[inline]
     fn glossy_probability(&self, wo: Vec3) -> f32 {
-        let factor = ggx_albedo_factor(wo.z, self.alpha);
+        let factor = ggx_albedo_factor(wo.z, self.alpha());
         glossy_probability(luminance(self.ks), factor, luminance(self.kd))
     }
 }
 
 impl Ward {
+    /// `alpha`, kept at or above [`MIN_ALPHA`].
+    #[inline]
+    fn alpha(&self) -> f32 {
+        self.alpha.max(MIN_ALPHA)
+    }
+
     /// The normalised slope density's solid-angle form `exp(-tan^2/alpha^2) / (pi alpha^2 cos^3)`
     /// (density of the sampled half vector).
     #[inline]
@@ -295,7 +311,7 @@ impl Ward {
         if h.z <= 0.0 {
             return 0.0;
         }
-        let a2 = self.alpha * self.alpha;
+        let a2 = self.alpha() * self.alpha();
         let tan2 = (h.x * h.x + h.y * h.y) / (h.z * h.z);
         (-tan2 / a2).exp() / (PI * a2 * h.z * h.z * h.z)
     }
@@ -306,7 +322,7 @@ impl Ward {
             return LobeValues::default();
         }
         let h = half_vector(wo, wi);
-        let a2 = self.alpha * self.alpha;
+        let a2 = self.alpha() * self.alpha();
         let tan2 = (h.x * h.x + h.y * h.y) / (h.z * h.z);
         let spec = (-tan2 / a2).exp() / (4.0 * PI * a2 * (wo.z * wi.z).sqrt());
         LobeValues {
@@ -324,7 +340,7 @@ impl Ward {
     #[inline]
     fn sample_glossy(&self, wo: Vec3, u: Vec2) -> Option<Vec3> {
         // tan^2(delta) = -alpha^2 ln(1 - u): 1 - u is in (0, 1], so the log is finite.
-        let tan2 = -self.alpha * self.alpha * (1.0 - u.x).ln();
+        let tan2 = -self.alpha() * self.alpha() * (1.0 - u.x).ln();
         let cos_d = 1.0 / (1.0 + tan2).sqrt();
         let sin_d = (tan2 * cos_d * cos_d).sqrt();
         let (s, c) = (TAU * u.y).sin_cos();
@@ -336,18 +352,28 @@ impl Ward {
     fn glossy_probability(&self, wo: Vec3) -> f32 {
         // For a narrow lobe the glossy albedo of this Ward form is ~ ks cos(theta_o); a lobe of
         // width alpha keeps about ks alpha above the horizon at grazing angles.
-        glossy_probability(luminance(self.ks), wo.z.max(self.alpha), luminance(self.kd))
+        glossy_probability(
+            luminance(self.ks),
+            wo.z.max(self.alpha()),
+            luminance(self.kd),
+        )
     }
 }
 
 impl BlinnPhong {
+    /// The exponent, kept non-negative.
+    #[inline]
+    fn shininess(&self) -> f32 {
+        self.shininess.max(0.0)
+    }
+
     #[inline]
     fn eval_lobes(&self, wo: Vec3, wi: Vec3) -> LobeValues {
         if !above(wo, wi) {
             return LobeValues::default();
         }
         let h = half_vector(wo, wi);
-        let s = self.shininess;
+        let s = self.shininess();
         let spec = (s + 8.0) / (8.0 * PI) * h.z.powf(s);
         LobeValues {
             diffuse: self.kd * FRAC_1_PI,
@@ -358,13 +384,13 @@ impl BlinnPhong {
     #[inline]
     fn glossy_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let h = half_vector(wo, wi);
-        let s = self.shininess;
+        let s = self.shininess();
         (s + 1.0) / TAU * h.z.max(0.0).powf(s) / (4.0 * wo.dot(h))
     }
 
     #[inline]
     fn sample_glossy(&self, wo: Vec3, u: Vec2) -> Option<Vec3> {
-        let cos_t = (1.0 - u.x).powf(1.0 / (self.shininess + 1.0));
+        let cos_t = (1.0 - u.x).powf(1.0 / (self.shininess() + 1.0));
         let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
         let (s, c) = (TAU * u.y).sin_cos();
         let h = Vec3::new(sin_t * c, sin_t * s, cos_t);
@@ -375,7 +401,7 @@ impl BlinnPhong {
     fn glossy_probability(&self, wo: Vec3) -> f32 {
         // Glossy albedo ~ ks cos^2(theta_o) (s + 8) / (s + 1) for a narrow lobe; the cosine is
         // kept above the lobe's angular width sqrt(2 / (s + 2)) for grazing angles.
-        let s = self.shininess;
+        let s = self.shininess();
         let mu = wo.z.max((2.0 / (s + 2.0)).sqrt());
         let factor = mu * mu * (s + 8.0) / (s + 1.0);
         glossy_probability(luminance(self.ks), factor, luminance(self.kd))
@@ -383,10 +409,10 @@ impl BlinnPhong {
 }
 
 impl GltfPbr {
-    /// `alpha = roughness^2`, kept above 1e-4 as Mitsuba's principled BSDF does.
+    /// `alpha = roughness^2`, kept at or above [`MIN_ALPHA`] (as Mitsuba's principled BSDF does).
     #[inline]
     fn alpha(&self) -> f32 {
-        (self.roughness * self.roughness).max(1e-4)
+        (self.roughness * self.roughness).max(MIN_ALPHA)
     }
 
     #[inline]
@@ -473,7 +499,7 @@ impl Bsdf {
     fn glossy_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         match self {
             Bsdf::Diffuse(_) => 0.0,
-            Bsdf::Ggx(m) => ggx_visible_pdf(wo, wi, m.alpha),
+            Bsdf::Ggx(m) => ggx_visible_pdf(wo, wi, m.alpha()),
             Bsdf::Ward(m) => m.glossy_pdf(wo, wi),
             Bsdf::BlinnPhong(m) => m.glossy_pdf(wo, wi),
             Bsdf::GltfPbr(m) => ggx_visible_pdf(wo, wi, m.alpha()),
@@ -485,7 +511,7 @@ impl Bsdf {
     fn sample_glossy(&self, wo: Vec3, u: Vec2) -> Option<Vec3> {
         match self {
             Bsdf::Diffuse(_) => None,
-            Bsdf::Ggx(m) => sample_ggx_visible_normal(wo, m.alpha, u).map(|h| reflect(wo, h)),
+            Bsdf::Ggx(m) => sample_ggx_visible_normal(wo, m.alpha(), u).map(|h| reflect(wo, h)),
             Bsdf::Ward(m) => m.sample_glossy(wo, u),
             Bsdf::BlinnPhong(m) => m.sample_glossy(wo, u),
             Bsdf::GltfPbr(m) => sample_ggx_visible_normal(wo, m.alpha(), u).map(|h| reflect(wo, h)),
@@ -520,6 +546,10 @@ impl Bsdf {
     /// `None` when no valid direction results (a failed sample is not an error).
     #[inline]
     pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
+        debug_assert!(
+            (wo.length() - 1.0).abs() < 1e-3,
+            "wo {wo} is not a unit vector"
+        );
         if wo.z <= 0.0 {
             return None;
         }
@@ -986,5 +1016,80 @@ mod identity_tests {
             roughness: 0.5,
         };
         assert_eq!(Bsdf::GltfPbr(g).albedo(), kd);
+    }
+}
+
+#[cfg(test)]
+mod value_tests {
+    //! Values worked out by hand from the formulas.
+    use super::*;
+
+    #[test]
+    fn gltf_at_normal_incidence() {
+        // wo = wi = n: h = n, F = F0, D = 1 / (pi alpha^2), G1 = 1, so
+        // glossy = F0 / (4 pi alpha^2) and diffuse = (1 - F0) c_diff / pi.
+        let g = GltfPbr {
+            base_color: Vec3::new(0.5, 0.25, 1.0),
+            metallic: 0.5,
+            roughness: 0.6,
+        };
+        let l = Bsdf::GltfPbr(g).eval_lobes(Vec3::Z, Vec3::Z);
+        let alpha2 = 0.36f32 * 0.36;
+        let f0 = Vec3::new(0.27, 0.145, 0.52);
+        let c_diff = Vec3::new(0.25, 0.125, 0.5);
+        assert!(
+            (l.glossy - f0 / (4.0 * PI * alpha2)).abs().max_element() < 1e-5,
+            "{l:?}"
+        );
+        assert!(
+            (l.diffuse - (Vec3::ONE - f0) * c_diff / PI)
+                .abs()
+                .max_element()
+                < 1e-6,
+            "{l:?}"
+        );
+    }
+
+    #[test]
+    fn paper_models_at_normal_incidence() {
+        // h = n: Ward glossy = ks / (4 pi alpha^2), Blinn-Phong = ks (s + 8) / (8 pi),
+        // GGX = ks / (4 pi alpha^2) (D = 1 / (pi alpha^2), G1 = 1).
+        let (kd, ks) = (Vec3::splat(0.2), Vec3::splat(0.5));
+        let w = Bsdf::Ward(Ward { kd, ks, alpha: 0.2 }).eval_lobes(Vec3::Z, Vec3::Z);
+        assert!((w.glossy.x - 0.5 / (4.0 * PI * 0.04)).abs() < 1e-5);
+        assert!((w.diffuse.x - 0.2 / PI).abs() < 1e-7);
+        let b = Bsdf::BlinnPhong(BlinnPhong {
+            kd,
+            ks,
+            shininess: 100.0,
+        })
+        .eval(Vec3::Z, Vec3::Z);
+        assert!((b.x - (0.2 / PI + 0.5 * 108.0 / (8.0 * PI))).abs() < 1e-5);
+        let g = Bsdf::Ggx(Ggx { kd, ks, alpha: 0.2 }).eval_lobes(Vec3::Z, Vec3::Z);
+        assert!((g.glossy.x - 0.5 / (4.0 * PI * 0.04)).abs() < 1e-5);
+    }
+
+    #[test]
+    fn zero_alpha_stays_finite() {
+        let wo = Vec3::new(0.6, 0.0, 0.8);
+        for b in [
+            Bsdf::Ggx(Ggx {
+                kd: Vec3::ZERO,
+                ks: Vec3::ONE,
+                alpha: 0.0,
+            }),
+            Bsdf::Ward(Ward {
+                kd: Vec3::ZERO,
+                ks: Vec3::ONE,
+                alpha: 0.0,
+            }),
+        ] {
+            let s = b.sample(wo, 0.5, Vec2::new(0.3, 0.7)).expect("a sample");
+            assert!(
+                s.f.is_finite() && s.pdf.is_finite() && s.pdf > 0.0,
+                "{b:?}: {s:?}"
+            );
+            assert!((s.wi - Vec3::new(-0.6, 0.0, 0.8)).length() < 1e-3);
+        }
     }
 }

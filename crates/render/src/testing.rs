@@ -66,7 +66,7 @@ impl Default for ChiSquareConfig {
             num_tests: 1,
             seed: 0x5eed,
             min_expected: 5.0,
-            min_depth: 3,
+            min_depth: 2,
             max_depth: 14,
         }
     }
