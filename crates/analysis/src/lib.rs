@@ -29,4 +29,6 @@
 //! ```
 #![deny(missing_docs)]
 
+pub mod figures;
 pub mod model;
+pub mod plot;
