@@ -382,8 +382,9 @@ impl ColumnModel {
     }
 
     /// The locus of `L_virtual` for the `h_X = 0` family: `samples` ground depths equally
-    /// spaced over [`Self::depth_range`] (both ends included; one sample is the mirror
-    /// point), nearest first.
+    /// spaced over [`Self::depth_range`], nearest first, both ends included except the
+    /// viewer's own depth (then the samples are `lo + k (hi - lo) / samples`, k = 1..=samples).
+    /// One sample is the mirror point.
     pub fn locus(
         &self,
         max_tilt_deg: Option<f64>,
@@ -393,9 +394,14 @@ impl ColumnModel {
             return Err(ModelError::NoSamples);
         }
         let (lo, hi) = self.depth_range(max_tilt_deg)?;
+        // The viewer's own depth is left out: L_virtual is then straight below the viewer,
+        // at zero depth, and has no disparity.
+        let skip_near = lo == self.viewer.z;
         let depth = |i: usize| {
             if samples == 1 {
                 self.mirror_point().z
+            } else if skip_near {
+                lo + (hi - lo) * (i + 1) as f64 / samples as f64
             } else {
                 lo + (hi - lo) * i as f64 / (samples - 1) as f64
             }
@@ -853,6 +859,12 @@ mod tests {
         assert!((m.reflection_at(0.0, hi).tilt_deg - 4.0).abs() < 1e-9);
         assert_eq!(m.depth_range(None).unwrap(), (0.0, 15.0));
         assert_eq!(m.locus(None, 1).unwrap()[0].ground.z, 7.5);
+        let all = m.locus_profile(None, 3, 0.065).unwrap();
+        let z: Vec<f64> = all.iter().map(|p| p.reflection.ground.z).collect();
+        assert_eq!(z, [5.0, 10.0, 15.0], "the viewer's own depth is left out");
+        assert!(all
+            .iter()
+            .all(|p| p.disparity_deg > 0.2 && p.disparity_deg < 0.3));
         assert_eq!(m.locus(Some(4.0), 0), Err(ModelError::NoSamples));
         assert!(matches!(
             m.locus(Some(0.0), 3),
