@@ -6,6 +6,8 @@
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
+mod figure;
+mod locus;
 mod render;
 
 /// Render rainy night streets in stereo and measure what specular streaks do to depth.
@@ -20,12 +22,18 @@ struct Cli {
 enum Command {
     /// Path-trace one camera of a scene to EXR (and PNG).
     Render(render::Args),
+    /// Print the virtual light column (Eq. 4) of a light seen from a viewer.
+    Locus(locus::Args),
+    /// Draw one of the paper's figures from the model as a PNG.
+    Figure(figure::Args),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result: anyhow::Result<()> = match cli.command {
         Command::Render(args) => render::run(args),
+        Command::Locus(args) => locus::run(args),
+        Command::Figure(args) => figure::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
