@@ -538,6 +538,46 @@ mod tests {
     }
 
     #[test]
+    fn mis_combines_light_and_bsdf_sampling_of_an_area_light() {
+        // A diffuse floor under a huge one-sided emitting ceiling (facing down, 1 m above):
+        // the floor's radiance is kd * L (the ceiling fills the hemisphere up to 1e-6).
+        let (kd, le) = (Vec3::new(0.5, 0.25, 0.8), Vec3::new(2.0, 1.0, 0.5));
+        let mut ceiling = Material::diffuse("ceiling", Vec3::ZERO);
+        ceiling.emission = le;
+        let mut parts = SceneParts {
+            materials: vec![Material::diffuse("floor", kd), ceiling],
+            ..Default::default()
+        };
+        floor(&mut parts);
+        let s = 1000.0;
+        quad(
+            &mut parts,
+            [
+                Vec3::new(-s, 1.0, -s),
+                Vec3::new(s, 1.0, -s),
+                Vec3::new(s, 1.0, s),
+                Vec3::new(-s, 1.0, s),
+            ],
+            1,
+        );
+        let scene = Scene::from_parts(parts).unwrap();
+        let cam = camera(Vec3::new(0.0, 0.5, 0.0), -std::f32::consts::FRAC_PI_2, 0.5);
+        let (w, h) = (12, 8);
+        let out = render(&scene, &cam, &settings(w, h, 64, 2), &|_| {});
+        let expected = kd * le;
+        let mut mean = Vec3::ZERO;
+        for p in &out.image.pixels {
+            assert!(
+                ((*p - expected) / expected).abs().max_element() < 0.1,
+                "{p}"
+            );
+            mean += *p / (w * h) as f32;
+        }
+        let err = ((mean - expected) / expected).abs().max_element();
+        assert!(err < 0.01, "{mean} vs {expected}");
+    }
+
+    #[test]
     fn non_finite_samples_are_dropped_and_counted() {
         let scene = emitter_scene(Vec3::new(f32::NAN, 1.0, 1.0), true, false);
         let cam = camera(Vec3::ZERO, 0.0, 0.8);

@@ -123,12 +123,6 @@ fn triangle_vertices(scene: &Scene, triangle: u32) -> [Vec3; 3] {
     ]
 }
 
-/// `(p1 - p0) x (p2 - p0)`: the front-face normal times twice the area.
-#[inline]
-fn triangle_cross(v: &[Vec3; 3]) -> Vec3 {
-    (v[1] - v[0]).cross(v[2] - v[0])
-}
-
 /// Radiance emitted from `hit` toward `wo` (unit, pointing away from the surface): the
 /// material's emission on the front face (by winding), on both faces if it is double-sided,
 /// zero otherwise.
@@ -181,9 +175,7 @@ impl Light {
             }),
             Light::Triangle { triangle } => {
                 let v = triangle_vertices(scene, triangle);
-                let cross = triangle_cross(&v);
-                let area = 0.5 * cross.length();
-                let n = cross.normalize_or_zero();
+                let (n, area) = scene.triangle_normal_area(triangle);
                 let b = square_to_uniform_triangle(u);
                 let b0 = 1.0 - b.x - b.y;
                 let q = b0 * v[0] + b.x * v[1] + b.y * v[2];
@@ -222,8 +214,7 @@ impl Light {
     pub fn pdf_li(&self, scene: &Scene, p: Vec3, hit: &SurfaceHit) -> f32 {
         match *self {
             Light::Triangle { triangle } => {
-                let cross = triangle_cross(&triangle_vertices(scene, triangle));
-                let area = 0.5 * cross.length();
+                let (_, area) = scene.triangle_normal_area(triangle);
                 let d = hit.p - p;
                 let dist2 = d.length_squared();
                 let cos_light = hit.ng.dot(d).abs() / dist2.sqrt();
@@ -255,7 +246,7 @@ impl Light {
                 PI * r * r * luminance(irradiance)
             }
             Light::Triangle { triangle } => {
-                let area = 0.5 * triangle_cross(&triangle_vertices(scene, triangle)).length();
+                let (_, area) = scene.triangle_normal_area(triangle);
                 let material =
                     &scene.materials[scene.triangle_materials[triangle as usize] as usize];
                 let sides = if material.double_sided { 2.0 } else { 1.0 };
@@ -564,7 +555,7 @@ mod tests {
         };
         let s = scene(false, vec![point, spot, sun, dark]);
         let (_, r) = s.bounding_sphere();
-        let area = 0.5 * triangle_cross(&triangle_vertices(&s, 0)).length();
+        let (_, area) = s.triangle_normal_area(0);
         let expected = [
             4.0 * PI * 2.0,
             2.0 * PI * (1.0 - 0.85) * 30.0,
