@@ -337,3 +337,171 @@ impl Scene {
         self.accel.occluded(ray)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// SplitMix64: a tiny fixed-seed generator for test data.
+    struct Rng(u64);
+    impl Rng {
+        fn next(&mut self) -> f32 {
+            self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = self.0;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
+        }
+        fn vec(&mut self, scale: f32) -> Vec3 {
+            Vec3::new(self.next(), self.next(), self.next()) * 2.0 * scale - scale
+        }
+    }
+
+    /// Random triangle soup of `n` triangles in a cube of half-size 10.
+    fn soup(rng: &mut Rng, n: usize) -> SceneParts {
+        let mut parts = SceneParts {
+            source: "soup".into(),
+            materials: vec![Material::diffuse("grey", Vec3::splat(0.5))],
+            ..SceneParts::default()
+        };
+        for i in 0..n {
+            let c = rng.vec(10.0);
+            for _ in 0..3 {
+                parts.positions.push(c + rng.vec(1.0));
+            }
+            let k = 3 * i as u32;
+            parts.triangles.push([k, k + 1, k + 2]);
+            parts.triangle_materials.push(0);
+        }
+        parts
+    }
+
+    /// Möller-Trumbore without culling: `(t, b1, b2)`.
+    fn brute_hit(p: [Vec3; 3], ray: &Ray) -> Option<(f32, f32, f32)> {
+        let e1 = p[1] - p[0];
+        let e2 = p[2] - p[0];
+        let q = ray.direction.cross(e2);
+        let det = e1.dot(q);
+        if det.abs() < 1e-12 {
+            return None;
+        }
+        let s = ray.origin - p[0];
+        let b1 = s.dot(q) / det;
+        let r = s.cross(e1);
+        let b2 = ray.direction.dot(r) / det;
+        let t = e2.dot(r) / det;
+        (b1 >= 0.0 && b2 >= 0.0 && b1 + b2 <= 1.0 && t > 1e-4 && t < ray.t_max)
+            .then_some((t, b1, b2))
+    }
+
+    #[test]
+    fn intersect_and_occluded_agree_with_brute_force() {
+        let mut rng = Rng(7);
+        let scene = Scene::from_parts(soup(&mut rng, 3000)).unwrap();
+        let (mut hits, mut mismatches) = (0, 0);
+        for k in 0..2000 {
+            let mut ray = Ray::new(rng.vec(12.0), rng.vec(1.0).normalize());
+            if k % 2 == 1 {
+                ray.t_max = 6.0 * rng.next();
+            }
+            let brute = scene
+                .triangles
+                .iter()
+                .enumerate()
+                .filter_map(|(i, t)| {
+                    brute_hit(t.map(|v| scene.positions[v as usize]), &ray).map(|h| (i, h))
+                })
+                .min_by(|a, b| a.1 .0.total_cmp(&b.1 .0));
+            let got = scene.intersect(&ray);
+            assert_eq!(scene.occluded(&ray), got.is_some(), "ray {k}");
+            match (brute, got) {
+                (None, None) => {}
+                (Some((i, (t, b1, b2))), Some(h)) => {
+                    hits += 1;
+                    assert!(
+                        (h.t - t).abs() < 1e-4 * t.max(1.0),
+                        "ray {k}: {} vs {t}",
+                        h.t
+                    );
+                    if h.triangle as usize == i {
+                        let tri = scene.triangles[i].map(|v| scene.positions[v as usize]);
+                        let p = tri[0] * (1.0 - b1 - b2) + tri[1] * b1 + tri[2] * b2;
+                        assert!((h.p - p).length() < 1e-3, "ray {k}");
+                        assert!((h.p - ray.at(h.t)).length() < 1e-3, "ray {k}");
+                        let ng = (tri[1] - tri[0]).cross(tri[2] - tri[0]).normalize();
+                        assert!((h.ng - ng).length() < 1e-5 && h.ns == h.ng);
+                    }
+                }
+                // Only rays grazing an edge may disagree.
+                _ => mismatches += 1,
+            }
+        }
+        assert!(hits > 300, "too few hits to test anything: {hits}");
+        assert!(mismatches <= 2, "{mismatches} mismatches");
+    }
+
+    #[test]
+    fn empty_scene_misses_everything() {
+        let scene = Scene::from_parts(SceneParts::default()).unwrap();
+        let ray = Ray::new(Vec3::ONE, Vec3::X);
+        assert!(scene.intersect(&ray).is_none() && !scene.occluded(&ray));
+        assert_eq!(scene.bounding_sphere(), (Vec3::ZERO, 0.0));
+        let err = scene.camera(None).unwrap_err().to_string();
+        assert!(err.contains("scene has no camera"), "{err}");
+    }
+
+    #[test]
+    fn from_parts_checks_indices_and_adds_triangle_lights() {
+        let mut rng = Rng(3);
+        let mut parts = soup(&mut rng, 4);
+        let mut glow = Material::diffuse("glow", Vec3::ZERO);
+        glow.emission = Vec3::ONE;
+        parts.materials.push(glow);
+        parts.triangle_materials[2] = 1;
+        let scene = Scene::from_parts(parts.clone()).unwrap();
+        assert_eq!(scene.lights, vec![Light::Triangle { triangle: 2 }]);
+        let (c, r) = scene.bounding_sphere();
+        assert!(scene
+            .positions
+            .iter()
+            .all(|p| (*p - c).length() <= r * 1.0001));
+
+        let mut bad = parts.clone();
+        bad.triangles[1][2] = 99;
+        let err = Scene::from_parts(bad).unwrap_err().to_string();
+        assert!(err.contains("soup: triangle 1"), "{err}");
+        let mut bad = parts.clone();
+        bad.triangle_materials[3] = 5;
+        let err = Scene::from_parts(bad).unwrap_err().to_string();
+        assert!(
+            err.contains("triangle 3") && err.contains("material 5"),
+            "{err}"
+        );
+        let mut bad = parts;
+        bad.positions[0].x = f32::NAN;
+        assert!(Scene::from_parts(bad).is_err());
+    }
+
+    #[test]
+    fn shading_normal_is_interpolated_and_flipped_to_the_geometric_side() {
+        let parts = SceneParts {
+            source: "tri".into(),
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+            // Authored pointing away from the winding's normal (+Z).
+            normals: vec![-Vec3::Z, Vec3::new(0.6, 0.0, -0.8), -Vec3::Z],
+            uvs: vec![Vec2::ZERO, Vec2::X, Vec2::Y],
+            triangles: vec![[0, 1, 2]],
+            triangle_materials: vec![0],
+            materials: vec![Material::diffuse("m", Vec3::ONE)],
+            ..SceneParts::default()
+        };
+        let scene = Scene::from_parts(parts).unwrap();
+        let h = scene
+            .intersect(&Ray::new(Vec3::new(0.5, 0.25, -1.0), Vec3::Z))
+            .unwrap();
+        assert_eq!(h.ng, Vec3::Z);
+        let expected = -(Vec3::new(0.3, 0.0, -0.4) - 0.5 * Vec3::Z).normalize();
+        assert!((h.ns - expected).length() < 1e-5, "{}", h.ns);
+        assert!((h.uv - Vec2::new(0.5, 0.25)).length() < 1e-6);
+    }
+}

@@ -204,3 +204,126 @@ fn load_texture(
     textures.push(texture);
     Ok((textures.len() - 1) as TextureId)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::light::Light;
+
+    const OBJ: &str = "mtllib road.mtl
+v 0 0 0
+v 1 0 0
+v 1 0 -1
+v 0 0 -1
+v 0 2 0
+v 1 2 0
+v 0 3 0
+vt 0 0
+vt 1 0
+vt 1 1
+vt 0 1
+vn 0 1 0
+o road
+usemtl wet
+f 1/1/1 2/2/1 3/3/1 4/4/1
+o lamp
+usemtl glow
+f 5 6 7
+o kerb
+usemtl plain
+f 1 2 5
+";
+
+    const MTL: &str = "newmtl wet
+Kd 0.1 0.1 0.1
+Ks 0.6 0.6 0.6
+Ns 200
+illum 2
+newmtl glow
+Kd 0 0 0
+Ke 4 3 2
+newmtl plain
+Kd 0.7 0.6 0.5
+Ks 0.5 0.5 0.5
+illum 1
+";
+
+    #[test]
+    fn loads_obj_with_mtl() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("street.obj");
+        std::fs::write(&path, OBJ).unwrap();
+        std::fs::write(dir.path().join("road.mtl"), MTL).unwrap();
+        let scene = Scene::load(&path).unwrap();
+        assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+        assert_eq!(scene.triangles.len(), 4);
+        assert!(scene.cameras.is_empty());
+        let wet = &scene.materials[scene.triangle_materials[0] as usize];
+        assert_eq!(wet.name, "wet");
+        assert!(matches!(wet.reflectance, Reflectance::Paper {
+            model: PaperModel::BlinnPhong, shininess, ks, ..
+        } if shininess == 200.0 && ks == Vec3::splat(0.6)));
+        let plain = &scene.materials[scene.triangle_materials[3] as usize];
+        assert!(
+            matches!(plain.reflectance, Reflectance::Diffuse { kd, kd_texture: None }
+            if kd == Vec3::new(0.7, 0.6, 0.5))
+        );
+        let glow = &scene.materials[scene.triangle_materials[2] as usize];
+        assert_eq!(glow.emission, Vec3::new(4.0, 3.0, 2.0));
+        assert_eq!(scene.lights, vec![Light::Triangle { triangle: 2 }]);
+        // The road faces up, with flipped v, and normals from the file.
+        let h = scene
+            .intersect(&crate::geometry::Ray::new(
+                Vec3::new(0.75, 1.0, -0.5),
+                -Vec3::Y,
+            ))
+            .unwrap();
+        assert_eq!((h.ng, h.ns), (Vec3::Y, Vec3::Y));
+        assert!((h.uv - Vec2::new(0.75, 0.5)).length() < 1e-5, "{}", h.uv);
+    }
+
+    #[test]
+    fn missing_mtl_is_a_warning() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("street.obj");
+        std::fs::write(&path, OBJ).unwrap();
+        let scene = Scene::load(&path).unwrap();
+        assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+        assert!(scene.warnings[0].contains("street.obj"));
+        assert!(scene.lights.is_empty());
+        assert!(scene.triangle_materials.iter().all(|&m| m == 0));
+        assert!(
+            matches!(scene.materials[0].reflectance, Reflectance::Diffuse { kd, .. }
+            if kd == Vec3::splat(DEFAULT_GREY))
+        );
+    }
+
+    #[test]
+    fn malformed_obj_is_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("bad.obj");
+        std::fs::write(&path, "v 0 0 0\nv 1 0 0\nf 1 2 9\n").unwrap();
+        let err = Scene::load(&path).unwrap_err().to_string();
+        assert!(err.contains("bad.obj"), "{err}");
+        let err = Scene::load(&dir.path().join("none.obj"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("none.obj"), "{err}");
+        // A map_Kd that does not exist names the material and the file.
+        std::fs::write(
+            &path,
+            "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n",
+        )
+        .unwrap();
+        std::fs::write(
+            dir.path().join("m.mtl"),
+            "newmtl a\nKd 1 1 1\nmap_Kd gone.png\n",
+        )
+        .unwrap();
+        let err = Scene::load(&path).unwrap_err().to_string();
+        assert!(
+            err.contains("material \"a\"") && err.contains("gone.png"),
+            "{err}"
+        );
+    }
+}
