@@ -120,6 +120,36 @@ fn mesh_label(mesh: &gltf::Mesh) -> String {
     }
 }
 
+/// Whether the gltf crate can decode `uri` without panicking: it unwraps the UTF-8 decoding
+/// of percent-escaped relative URIs, so a URI whose escapes decode to invalid UTF-8 (`%FF`)
+/// must be rejected first.
+fn uri_is_decodable(uri: &str) -> bool {
+    if uri.contains(':') {
+        return true;
+    }
+    let b = uri.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        let hex = |c: u8| (c as char).to_digit(16);
+        match (
+            b[i],
+            b.get(i + 1).copied().and_then(hex),
+            b.get(i + 2).copied().and_then(hex),
+        ) {
+            (b'%', Some(h), Some(l)) => {
+                out.push((h * 16 + l) as u8);
+                i += 3;
+            }
+            (c, _, _) => {
+                out.push(c);
+                i += 1;
+            }
+        }
+    }
+    std::str::from_utf8(&out).is_ok()
+}
+
 /// Describes where a URI points, for messages.
 fn uri_label(base: &Path, uri: &str) -> String {
     if uri.starts_with("data:") {
@@ -143,6 +173,15 @@ fn load_buffers(
                 format!("buffer {} ({})", buffer.index(), uri_label(base, uri))
             }
         };
+        if let gltf::buffer::Source::Uri(uri) = buffer.source() {
+            if !uri_is_decodable(uri) {
+                return Err(SceneError::invalid(
+                    path,
+                    element,
+                    "URI escapes are not UTF-8",
+                ));
+            }
+        }
         let data = gltf::buffer::Data::from_source_and_blob(buffer.source(), Some(base), &mut blob)
             .map_err(|e| match e {
                 gltf::Error::Io(source) => SceneError::Io {
@@ -216,7 +255,8 @@ impl Loader<'_> {
                 scale,
             } => Mat4::from_scale_rotation_translation(
                 Vec3::from(scale),
-                Quat::from_array(rotation),
+                // A zero quaternion becomes NaN here and fails the check below.
+                Quat::from_array(rotation).normalize(),
                 Vec3::from(translation),
             ),
         };
@@ -645,6 +685,16 @@ impl Loader<'_> {
                 info.tex_coord()
             ));
         }
+        let sampler = info.texture().sampler();
+        let repeat = gltf::texture::WrappingMode::Repeat;
+        if sampler.wrap_s() != repeat || sampler.wrap_t() != repeat {
+            self.warn(format!(
+                "{material}: texture {} asks for {:?}/{:?} wrapping; repeat is used",
+                info.texture().index(),
+                sampler.wrap_s(),
+                sampler.wrap_t()
+            ));
+        }
         let image = info.texture().source();
         let key = (image.index(), space);
         if let Some(&id) = self.textures.get(&key) {
@@ -662,6 +712,11 @@ impl Loader<'_> {
                 view.index()
             ),
         };
+        if let gltf::image::Source::Uri { uri, .. } = image.source() {
+            if !uri_is_decodable(uri) {
+                return Err(self.bad(element, "URI escapes are not UTF-8"));
+            }
+        }
         let data = gltf::image::Data::from_source(image.source(), Some(&self.base), &self.buffers)
             .map_err(|e| match e {
                 gltf::Error::Io(source) => SceneError::Io {
@@ -1018,6 +1073,26 @@ mod tests {
             err.contains("scene.gltf") && err.contains("invalid glTF"),
             "{err}"
         );
+    }
+
+    #[test]
+    fn truncated_glb_and_bad_uris_are_errors() {
+        let dir = tempfile::tempdir().unwrap();
+        let (doc, bin) = test_doc();
+        let path = write_glb(dir.path(), &doc, &bin);
+        let bytes = std::fs::read(&path).unwrap();
+        for cut in [bytes.len() - 8, bytes.len() / 2, 30, 10] {
+            std::fs::write(&path, &bytes[..cut]).unwrap();
+            let err = Scene::load(&path).unwrap_err().to_string();
+            assert!(err.contains("scene.glb"), "{err}");
+        }
+        let (mut doc, _) = test_doc();
+        doc["buffers"][0]["uri"] = json!("%FF%FE.bin");
+        let path = dir.path().join("bad uri.gltf");
+        std::fs::write(&path, serde_json::to_vec(&doc).unwrap()).unwrap();
+        let err = Scene::load(&path).unwrap_err().to_string();
+        assert!(err.contains("buffer 0") && err.contains("UTF-8"), "{err}");
+        assert!(uri_is_decodable("a%20b.bin") && uri_is_decodable("%zz.bin"));
     }
 
     #[test]
