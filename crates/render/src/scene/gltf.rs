@@ -1186,6 +1186,21 @@ mod tests {
     }
 
     #[test]
+    fn scene_zero_is_used_without_a_default_and_cycles_are_errors() {
+        let dir = tempfile::tempdir().unwrap();
+        let (mut doc, bin) = test_doc();
+        doc.as_object_mut().unwrap().remove("scene");
+        check_test_scene(&Scene::load(&write_embedded(dir.path(), doc, &bin)).unwrap());
+        let (mut doc, bin) = test_doc();
+        doc["nodes"][1]["children"] = json!([0]);
+        let err = load_err(doc, &bin);
+        assert!(
+            err.contains("node \"parent\" (0)") && err.contains("cycle"),
+            "{err}"
+        );
+    }
+
+    #[test]
     fn mirrored_nodes_keep_the_front_face() {
         let dir = tempfile::tempdir().unwrap();
         let (mut doc, bin) = test_doc();
