@@ -293,7 +293,8 @@ impl Scene {
         ((lo + hi) * 0.5, (hi - lo).length() * 0.5)
     }
 
-    /// Unit geometric normal of triangle `triangle` from its winding, and its area.
+    /// Unit geometric normal of triangle `triangle` from its winding, and its area (the normal
+    /// is NaN for a zero-area triangle; [`Light::Triangle`] entries never are).
     #[inline]
     pub fn triangle_normal_area(&self, triangle: u32) -> (Vec3, f32) {
         let [a, b, c] = self.triangles[triangle as usize].map(|v| self.positions[v as usize]);
