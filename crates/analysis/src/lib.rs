@@ -1,2 +1,5 @@
 //! streaks-analysis (skeleton).
 #![deny(missing_docs)]
+
+pub mod lk;
+pub mod synth;
