@@ -2,4 +2,5 @@
 #![deny(missing_docs)]
 
 pub mod lk;
+pub mod sgm;
 pub mod synth;

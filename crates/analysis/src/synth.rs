@@ -62,8 +62,9 @@ pub struct SynthPair {
 }
 
 impl SynthScene {
-    /// A textured scene of the given size: a background sloping from `width / 64` to `width /
-    /// 16` pixels of disparity, and three boxes at larger, non-integer disparities. No noise and
+    /// A textured scene of the given size: with `s = min(width / 64, 8)`, a background sloping
+    /// from `s` to `4 s` pixels of disparity, and three boxes at larger, non-integer
+    /// disparities (up to `7 s + 0.25`, so at most 56.25). No noise and
     /// no exposure difference (set `gain`, `offset`, `noise` to add them).
     pub fn textured(width: usize, height: usize, seed: u64) -> Self {
         let (w, h) = (width as f32, height as f32);
@@ -74,7 +75,7 @@ impl SynthScene {
             y1: (fy1 * h) as usize,
             disparity: d,
         };
-        let s = w / 64.0;
+        let s = (w / 64.0).min(8.0);
         Self {
             width,
             height,
