@@ -6,6 +6,9 @@
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
+mod disparity;
+mod lk;
+
 /// Render rainy night streets in stereo and measure what specular streaks do to depth.
 #[derive(Parser, Debug)]
 #[command(name = "streaks", version, about, long_about = None)]
@@ -15,11 +18,19 @@ struct Cli {
 }
 
 #[derive(Subcommand, Debug)]
-enum Command {}
+enum Command {
+    /// Per-row 1D Lucas-Kanade disparity over a region (the paper's estimator).
+    Lk(lk::Args),
+    /// Dense disparity by semi-global matching (census cost), written as PFM.
+    Disparity(disparity::Args),
+}
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let result: anyhow::Result<()> = match cli.command {};
+    let result: anyhow::Result<()> = match cli.command {
+        Command::Lk(args) => lk::run(args),
+        Command::Disparity(args) => disparity::run(args),
+    };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {

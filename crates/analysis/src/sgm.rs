@@ -21,7 +21,7 @@
 //! include negative values (photographs aligned by hand).
 
 use rayon::prelude::*;
-use streaks_stereo::image::GrayImage;
+use streaks_stereo::image::{GrayImage, ImageError};
 
 /// Errors of the dense matcher (about user-supplied sizes and parameters).
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -80,6 +80,14 @@ impl Census {
         }
     }
 
+    /// Default penalties (P1, P2) for this window's cost range.
+    pub fn default_penalties(self) -> (u16, u16) {
+        match self {
+            Census::Census5x5 => (4, 43),
+            Census::Census7x7 => (7, 86),
+        }
+    }
+
     /// Number of bits of a code (the largest possible cost).
     pub fn bits(self) -> u32 {
         let n = 2 * self.radius() as u32 + 1;
@@ -129,8 +137,8 @@ impl Default for SgmParams {
             max_disp: 63,
             census: Census::Census7x7,
             paths: Paths::Eight,
-            p1: 7,
-            p2: 86,
+            p1: Census::Census7x7.default_penalties().0,
+            p2: Census::Census7x7.default_penalties().1,
             p2_gradient: 0.0,
             subpixel: true,
             lr_tolerance: Some(1.0),
@@ -601,6 +609,26 @@ pub fn disparity_preview(disp: &GrayImage, range: Option<(f32, f32)>) -> image::
     })
 }
 
+/// Writes [`disparity_preview`] as a PNG, through a temporary file renamed into place.
+pub fn write_disparity_png(
+    path: &std::path::Path,
+    disp: &GrayImage,
+    range: Option<(f32, f32)>,
+) -> Result<(), ImageError> {
+    let tmp = path.with_extension("png.tmp");
+    let result = disparity_preview(disp, range)
+        .save_with_format(&tmp, image::ImageFormat::Png)
+        .map_err(|e| e.to_string())
+        .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| e.to_string()));
+    result.map_err(|reason| {
+        let _ = std::fs::remove_file(&tmp);
+        ImageError::Write {
+            path: path.to_path_buf(),
+            reason,
+        }
+    })
+}
+
 /// Google's turbo colour map (the polynomial approximation by Mikhailov, 2019).
 fn turbo(t: f32) -> [u8; 3] {
     let t = t as f64;
@@ -655,7 +683,7 @@ mod tests {
             paths: Paths::Four,
             census: Census::Census5x5,
             p1: 4,
-            p2: 48,
+            p2: 43,
             p2_gradient: 4.0,
             ..SgmParams::default()
         };
@@ -700,6 +728,11 @@ mod tests {
         assert!(compare_disparity(&img, &small, 2.0).is_err());
         let preview = disparity_preview(&img, None);
         assert_eq!(preview.get_pixel(0, 0).0, [0, 0, 0]);
+        let dir = tempfile::tempdir().unwrap();
+        let png = dir.path().join("d.png");
+        write_disparity_png(&png, &img, Some((0.0, 10.0))).unwrap();
+        assert_eq!(::image::open(&png).unwrap().width(), 3);
+        assert!(write_disparity_png(&dir.path().join("no/d.png"), &img, None).is_err());
     }
 
     /// Timing of a megapixel pair: `cargo test --release -p streaks-analysis -- --ignored

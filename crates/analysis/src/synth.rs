@@ -9,7 +9,9 @@
 //! surface (largest disparity), so occlusions are physically consistent. Pixels are sampled at
 //! their centres; disparity follows DESIGN.md: `d = x_left - x_right`.
 
+use std::path::Path;
 use streaks_stereo::image::{GrayImage, ImageError};
+use streaks_stereo::pfm::write_pfm;
 
 /// A fronto-parallel rectangle in front of the background, in left-image pixel indices
 /// (half-open `[x0, x1) x [y0, y1)`), with a constant disparity.
@@ -59,6 +61,33 @@ pub struct SynthPair {
     pub right: GrayImage,
     /// Ground-truth disparity of every left pixel (`d = x_left - x_right`).
     pub disparity: GrayImage,
+}
+
+impl SynthPair {
+    /// Writes `left.png` and `right.png` (16-bit grey, values clipped to [0, 1]) and
+    /// `disparity_left.pfm` into `dir`, the layout `streaks stereo` writes.
+    pub fn save(&self, dir: &Path) -> Result<(), ImageError> {
+        for (name, img) in [("left.png", &self.left), ("right.png", &self.right)] {
+            let path = dir.join(name);
+            let tmp = dir.join(format!("{name}.tmp"));
+            let buf = ::image::ImageBuffer::<::image::Luma<u16>, Vec<u16>>::from_fn(
+                img.width as u32,
+                img.height as u32,
+                |x, y| {
+                    let v = img.get(x as usize, y as usize).clamp(0.0, 1.0);
+                    ::image::Luma([(v * 65535.0).round() as u16])
+                },
+            );
+            buf.save_with_format(&tmp, ::image::ImageFormat::Png)
+                .map_err(|e| e.to_string())
+                .and_then(|()| std::fs::rename(&tmp, &path).map_err(|e| e.to_string()))
+                .map_err(|reason| {
+                    let _ = std::fs::remove_file(&tmp);
+                    ImageError::Write { path, reason }
+                })?;
+        }
+        write_pfm(&dir.join("disparity_left.pfm"), &self.disparity)
+    }
 }
 
 impl SynthScene {
@@ -269,5 +298,37 @@ mod tests {
             .iter()
             .fold((1.0f32, 0.0f32), |(lo, hi), &v| (lo.min(v), hi.max(v)));
         assert!(spread.0 >= 0.0 && spread.1 <= 1.0 && spread.1 - spread.0 > 0.5);
+    }
+
+    #[test]
+    fn saved_pairs_load_back() {
+        let dir = tempfile::tempdir().unwrap();
+        let pair = SynthScene::textured(40, 20, 4).render().unwrap();
+        pair.save(dir.path()).unwrap();
+        let left = GrayImage::load(&dir.path().join("left.png")).unwrap();
+        assert!(left
+            .data
+            .iter()
+            .zip(&pair.left.data)
+            .all(|(a, b)| (a - b).abs() < 1e-4));
+        let d = streaks_stereo::pfm::read_pfm(&dir.path().join("disparity_left.pfm")).unwrap();
+        assert_eq!(d, pair.disparity);
+        assert!(pair.save(&dir.path().join("missing")).is_err());
+    }
+
+    /// Writes a megapixel pair for trying the commands: `STREAKS_SYNTH_DIR=/tmp/synth cargo
+    /// test -p streaks-analysis -- --ignored write_megapixel_pair`.
+    #[test]
+    #[ignore]
+    fn write_megapixel_pair() {
+        let dir = std::env::var("STREAKS_SYNTH_DIR").unwrap_or_else(|_| "/tmp/synth".into());
+        let dir = Path::new(&dir);
+        std::fs::create_dir_all(dir).unwrap();
+        let scene = SynthScene {
+            gain: 0.8,
+            noise: 0.005,
+            ..SynthScene::textured(1280, 800, 21)
+        };
+        scene.render().unwrap().save(dir).unwrap();
     }
 }
