@@ -4,6 +4,9 @@
 //! Errors are printed with their whole chain and the process exits non-zero.
 
 use clap::{Parser, Subcommand};
+
+mod figure;
+mod locus;
 use std::process::ExitCode;
 
 mod disparity;
@@ -19,6 +22,10 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// Print the virtual light column (Eq. 4) of a light seen from a viewer.
+    Locus(locus::Args),
+    /// Draw one of the paper's figures from the model as a PNG.
+    Figure(figure::Args),
     /// Per-row 1D Lucas-Kanade disparity over a region (the paper's estimator).
     Lk(lk::Args),
     /// Dense disparity by semi-global matching (census cost), written as PFM.
@@ -28,6 +35,8 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result: anyhow::Result<()> = match cli.command {
+        Command::Locus(args) => locus::run(args),
+        Command::Figure(args) => figure::run(args),
         Command::Lk(args) => lk::run(args),
         Command::Disparity(args) => disparity::run(args),
     };
