@@ -1,8 +1,12 @@
-//! `streaks lk`: the paper's per-row 1D Lucas-Kanade disparity over an image region.
+//! `streaks lk`: the paper's per-row 1D Lucas-Kanade disparity over an image region, or along
+//! the centre of every streak detected in the left image (`--streaks`).
 
 use anyhow::{bail, Context};
 use std::path::PathBuf;
-use streaks_analysis::lk::{lk_region, Interp, LkParams, Photometric, Region};
+use streaks_analysis::detect::{detect_streaks, DetectParams};
+use streaks_analysis::lk::{
+    lk_region, lk_rows, Interp, LkParams, Photometric, Region, RowDisparity,
+};
 use streaks_stereo::image::GrayImage;
 
 /// Output format.
@@ -16,6 +20,7 @@ pub enum Format {
 
 /// Arguments of `streaks lk`.
 #[derive(clap::Args, Debug)]
+#[command(group(clap::ArgGroup::new("where").required(true).args(["region", "streaks"])))]
 pub struct Args {
     /// Left image (PNG, JPEG; converted to luminance).
     pub left: PathBuf,
@@ -23,7 +28,14 @@ pub struct Args {
     pub right: PathBuf,
     /// Region of the left image, pixel indices x0,y0,x1,y1 (half-open: x0 <= x < x1).
     #[arg(long, value_parser = parse_region)]
-    pub region: Region,
+    pub region: Option<Region>,
+    /// Instead of a region: detect streaks in the left image and estimate along each one's
+    /// centre (adds a `streak` column: the streak's index).
+    #[arg(long)]
+    pub streaks: bool,
+    /// Horizon row (image y) for --streaks; default: the image centre (pitch-0 rig).
+    #[arg(long)]
+    pub horizon: Option<f32>,
     /// Window width in pixels (odd).
     #[arg(long, default_value_t = 15)]
     pub window: usize,
@@ -87,12 +99,45 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         },
         ..LkParams::default()
     };
-    let rows = lk_region(&left, &right, args.region, &params).context("estimating disparities")?;
+    // (streak index, estimate) pairs.
+    let rows: Vec<(Option<usize>, RowDisparity)> = match args.region {
+        Some(region) => lk_region(&left, &right, region, &params)
+            .context("estimating disparities")?
+            .into_iter()
+            .map(|r| (None, r))
+            .collect(),
+        None => {
+            let detect = DetectParams {
+                horizon: args.horizon,
+                ..DetectParams::default()
+            };
+            let found = detect_streaks(&left, &detect).context("detecting streaks")?;
+            eprintln!(
+                "{} streaks, {} lamps (horizon y = {})",
+                found.streaks.len(),
+                found.lamps.len(),
+                found.horizon
+            );
+            let mut rows = Vec::new();
+            for (i, streak) in found.streaks.iter().enumerate() {
+                let est = lk_rows(&left, &right, &streak.centres, &params)
+                    .with_context(|| format!("estimating disparities along streak {i}"))?;
+                rows.extend(est.into_iter().map(|r| (Some(i), r)));
+            }
+            rows
+        }
+    };
     let mut out = String::new();
     match args.format {
         Format::Csv => {
+            if args.streaks {
+                out.push_str("streak,");
+            }
             out.push_str("row,x,disparity,ncc,gradient_energy,residual,converged\n");
-            for r in &rows {
+            for (streak, r) in &rows {
+                if let Some(i) = streak {
+                    out.push_str(&format!("{i},"));
+                }
                 out.push_str(&format!(
                     "{},{},{},{},{},{},{}\n",
                     r.row, r.x, r.disparity, r.ncc, r.gradient_energy, r.residual, r.converged
@@ -100,7 +145,17 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             }
         }
         Format::Json => {
-            out = serde_json::to_string_pretty(&rows)?;
+            let values: Vec<serde_json::Value> = rows
+                .iter()
+                .map(|(streak, r)| {
+                    let mut v = serde_json::to_value(r)?;
+                    if let (Some(i), Some(obj)) = (streak, v.as_object_mut()) {
+                        obj.insert("streak".into(), (*i).into());
+                    }
+                    Ok(v)
+                })
+                .collect::<Result<_, serde_json::Error>>()?;
+            out = serde_json::to_string_pretty(&values)?;
             out.push('\n');
         }
     }

@@ -469,6 +469,11 @@ mod tests {
     /// it, a low headlight with its own streak, and noise. Returns the image and the truth mask
     /// (streak contribution above 0.1).
     fn scene(exposure: f32) -> (GrayImage, GrayImage, Vec<(f32, f32)>) {
+        scene_shifted(exposure, 0.0)
+    }
+
+    /// The scene seen with everything shifted left by `disparity` pixels (a right image).
+    fn scene_shifted(exposure: f32, disparity: f32) -> (GrayImage, GrayImage, Vec<(f32, f32)>) {
         let (w, h) = (320, 240);
         let streaks = [
             (60.0f32, 0.05f32, 124.0f32, 236.0f32, 0.5f32),
@@ -484,10 +489,10 @@ mod tests {
         ];
         let mut img = GrayImage::new(w, h, 0.0).unwrap();
         let mut truth = GrayImage::new(w, h, 0.0).unwrap();
-        let mut rng = SplitMix(5);
+        let mut rng = SplitMix(5 + disparity.to_bits() as u64);
         for y in 0..h {
             for x in 0..w {
-                let (xc, yc) = (x as f32 + 0.5, y as f32 + 0.5);
+                let (xc, yc) = (x as f32 + 0.5 + disparity, y as f32 + 0.5);
                 let mut s = 0.0f32;
                 for &(a, b, y0, y1, amp) in &streaks {
                     if (y0..=y1).contains(&yc) {
@@ -542,6 +547,31 @@ mod tests {
             eprintln!("detection at exposure {exposure}: {score:?}");
             assert!(score.precision > 0.9 && score.recall > 0.85, "{score:?}");
         }
+    }
+
+    #[test]
+    fn lucas_kanade_along_detected_streaks() {
+        use crate::lk::{lk_rows, LkParams};
+        let (left, _, _) = scene_shifted(1.0, 0.0);
+        let (right, _, _) = scene_shifted(1.0, 6.35);
+        let det = detect_streaks(&left, &DetectParams::default()).unwrap();
+        let params = LkParams {
+            window: 21,
+            max_disp: 16,
+            ..LkParams::default()
+        };
+        // Independent noise (0.01, streak amplitudes 0.35-0.6) limits single rows to ~0.1 px.
+        let (mut worst, mut sum, mut n) = (0.0f32, 0.0f32, 0);
+        for s in &det.streaks {
+            for e in lk_rows(&left, &right, &s.centres, &params).unwrap() {
+                worst = worst.max((e.disparity - 6.35).abs());
+                sum += e.disparity - 6.35;
+                n += 1;
+            }
+        }
+        let bias = sum / n as f32;
+        eprintln!("LK along detected streaks: {n} rows, bias {bias} px, worst {worst} px");
+        assert!(bias.abs() < 0.02 && worst < 0.3, "{bias} {worst}");
     }
 
     #[test]
