@@ -159,6 +159,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             out.push('\n');
         }
     }
-    print!("{out}");
-    Ok(())
+    use std::io::Write;
+    match std::io::stdout().lock().write_all(out.as_bytes()) {
+        // A closed pipe (`| head`) is the reader's choice, not an error.
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        other => other.context("writing the estimates"),
+    }
 }

@@ -331,4 +331,15 @@ mod tests {
         };
         scene.render().unwrap().save(dir).unwrap();
     }
+
+    #[test]
+    fn openexr_images_load_as_linear_luminance() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("l.exr");
+        let img =
+            ::image::Rgb32FImage::from_fn(4, 2, |x, _| ::image::Rgb([x as f32 * 2.5, 0.0, 0.0]));
+        img.save(&path).unwrap();
+        let gray = GrayImage::load(&path).unwrap();
+        assert!((gray.get(3, 1) - 0.2126 * 7.5).abs() < 1e-5, "{gray:?}");
+    }
 }
