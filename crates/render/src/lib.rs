@@ -35,4 +35,5 @@ pub mod mitsuba;
 pub mod output;
 pub mod sampling;
 pub mod scene;
+pub mod testing;
 pub mod texture;
