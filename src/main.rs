@@ -5,6 +5,7 @@
 
 use clap::{Parser, Subcommand};
 
+mod export_mitsuba;
 mod figure;
 mod locus;
 use std::process::ExitCode;
@@ -23,6 +24,8 @@ enum Command {
     Locus(locus::Args),
     /// Draw one of the paper's figures from the model as a PNG.
     Figure(figure::Args),
+    /// Write a scene as a Mitsuba 3 scene (XML, PLY, EXR textures) for the cross-check.
+    ExportMitsuba(export_mitsuba::Args),
 }
 
 fn main() -> ExitCode {
@@ -30,6 +33,7 @@ fn main() -> ExitCode {
     let result: anyhow::Result<()> = match cli.command {
         Command::Locus(args) => locus::run(args),
         Command::Figure(args) => figure::run(args),
+        Command::ExportMitsuba(args) => export_mitsuba::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

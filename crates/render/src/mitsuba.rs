@@ -34,7 +34,7 @@
 use crate::camera::Camera;
 use crate::light::Light;
 use crate::material::{Material, PaperModel, Reflectance};
-use crate::scene::Scene;
+use crate::scene::{Scene, SceneError};
 use crate::texture::{Texture, TextureId};
 use glam::{Vec2, Vec3};
 use std::collections::HashMap;
@@ -46,15 +46,8 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, thiserror::Error)]
 pub enum MitsubaError {
     /// The scene has no camera of the requested name (or no camera at all).
-    #[error("{file}: no camera {name:?} (cameras: {available})")]
-    NoCamera {
-        /// The scene file.
-        file: PathBuf,
-        /// The requested name, or `None` for the default (first) camera.
-        name: Option<String>,
-        /// The camera names the scene has, comma separated.
-        available: String,
-    },
+    #[error(transparent)]
+    Camera(#[from] SceneError),
     /// An option is out of range.
     #[error("invalid export option: {0}")]
     InvalidOption(String),
@@ -252,7 +245,6 @@ pub(crate) struct SceneParts<'a> {
     pub(crate) materials: &'a [Material],
     pub(crate) textures: &'a [Texture],
     pub(crate) lights: &'a [Light],
-    pub(crate) cameras: &'a [Camera],
 }
 
 /// Converts `scene` to Mitsuba 3 with the render settings `opts`.
@@ -268,8 +260,8 @@ pub fn export(scene: &Scene, opts: &ExportOptions) -> Result<MitsubaExport, Mits
             materials: &scene.materials,
             textures: &scene.textures,
             lights: &scene.lights,
-            cameras: &scene.cameras,
         },
+        scene.camera(opts.camera.as_deref())?,
         opts,
     )
 }
@@ -592,26 +584,10 @@ fn meshes_by_material(parts: &SceneParts<'_>) -> Vec<(usize, PlyMesh)> {
         .collect()
 }
 
-/// Picks the camera named `name` (or the first one).
-fn pick_camera<'a>(parts: &SceneParts<'a>, name: Option<&str>) -> Result<&'a Camera, MitsubaError> {
-    let found = match name {
-        Some(n) => parts.cameras.iter().find(|c| c.name == n),
-        None => parts.cameras.first(),
-    };
-    found.ok_or_else(|| MitsubaError::NoCamera {
-        file: parts.source.to_path_buf(),
-        name: name.map(str::to_owned),
-        available: parts
-            .cameras
-            .iter()
-            .map(|c| c.name.as_str())
-            .collect::<Vec<_>>()
-            .join(", "),
-    })
-}
-
+/// [`export`] on the parts of a scene, with the camera already chosen.
 pub(crate) fn export_parts(
     parts: &SceneParts<'_>,
+    camera: &Camera,
     opts: &ExportOptions,
 ) -> Result<MitsubaExport, MitsubaError> {
     if opts.width == 0 || opts.height == 0 || opts.spp == 0 || opts.max_depth == 0 {
@@ -620,7 +596,6 @@ pub(crate) fn export_parts(
             opts.width, opts.height, opts.spp, opts.max_depth
         )));
     }
-    let camera = pick_camera(parts, opts.camera.as_deref())?;
     let mut warnings = Vec::new();
     let mut textures = Vec::new();
     let mut xml = String::new();
@@ -801,7 +776,6 @@ mod tests {
                 materials: &self.materials,
                 textures: &self.textures,
                 lights: &self.lights,
-                cameras: &self.cameras,
             }
         }
     }
@@ -824,7 +798,7 @@ mod tests {
     #[test]
     fn xml_is_well_formed_and_has_the_mapped_elements() {
         let fx = Fixture::new();
-        let ex = export_parts(&fx.parts(), &opts()).unwrap();
+        let ex = export_parts(&fx.parts(), &fx.cameras[0], &opts()).unwrap();
         let doc = roxmltree::Document::parse(&ex.xml).unwrap();
         let root = doc.root_element();
         assert_eq!(root.tag_name().name(), "scene");
@@ -911,19 +885,12 @@ mod tests {
     }
 
     #[test]
-    fn unknown_camera_and_bad_options_are_errors() {
+    fn bad_options_are_errors() {
         let fx = Fixture::new();
-        let mut o = opts();
-        o.camera = Some("nope".into());
-        let err = export_parts(&fx.parts(), &o).unwrap_err().to_string();
-        assert!(
-            err.contains("test.gltf") && err.contains("nope") && err.contains("cam"),
-            "{err}"
-        );
         let mut o = opts();
         o.spp = 0;
         assert!(matches!(
-            export_parts(&fx.parts(), &o),
+            export_parts(&fx.parts(), &fx.cameras[0], &o),
             Err(MitsubaError::InvalidOption(_))
         ));
     }
@@ -978,7 +945,7 @@ mod tests {
     #[test]
     fn ply_round_trips_and_groups_by_material() {
         let fx = Fixture::new();
-        let ex = export_parts(&fx.parts(), &opts()).unwrap();
+        let ex = export_parts(&fx.parts(), &fx.cameras[0], &opts()).unwrap();
         assert_eq!(ex.meshes.len(), 3);
         let road = &ex.meshes[0];
         assert_eq!(road.positions.len(), 4);
@@ -1000,7 +967,7 @@ mod tests {
     #[test]
     fn write_creates_all_files() {
         let fx = Fixture::new();
-        let ex = export_parts(&fx.parts(), &opts()).unwrap();
+        let ex = export_parts(&fx.parts(), &fx.cameras[0], &opts()).unwrap();
         let dir = tempfile::tempdir().unwrap();
         ex.write(dir.path()).unwrap();
         assert!(dir.path().join("scene.xml").is_file());
