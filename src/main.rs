@@ -10,6 +10,9 @@ mod figure;
 mod locus;
 use std::process::ExitCode;
 
+mod disparity;
+mod lk;
+
 /// Render rainy night streets in stereo and measure what specular streaks do to depth.
 #[derive(Parser, Debug)]
 #[command(name = "streaks", version, about, long_about = None)]
@@ -26,6 +29,10 @@ enum Command {
     Figure(figure::Args),
     /// Write a scene as a Mitsuba 3 scene (XML, PLY, EXR textures) for the cross-check.
     ExportMitsuba(export_mitsuba::Args),
+    /// Per-row 1D Lucas-Kanade disparity over a region (the paper's estimator).
+    Lk(lk::Args),
+    /// Dense disparity by semi-global matching (census cost), written as PFM.
+    Disparity(disparity::Args),
 }
 
 fn main() -> ExitCode {
@@ -34,6 +41,8 @@ fn main() -> ExitCode {
         Command::Locus(args) => locus::run(args),
         Command::Figure(args) => figure::run(args),
         Command::ExportMitsuba(args) => export_mitsuba::run(args),
+        Command::Lk(args) => lk::run(args),
+        Command::Disparity(args) => disparity::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
