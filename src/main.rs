@@ -4,11 +4,13 @@
 //! Errors are printed with their whole chain and the process exits non-zero.
 
 use clap::{Parser, Subcommand};
+use std::process::ExitCode;
 
+mod compare;
 mod export_mitsuba;
 mod figure;
 mod locus;
-use std::process::ExitCode;
+mod render;
 
 mod disparity;
 mod lk;
@@ -23,12 +25,16 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// Path-trace one camera of a scene to EXR (and PNG).
+    Render(render::Args),
     /// Print the virtual light column (Eq. 4) of a light seen from a viewer.
     Locus(locus::Args),
     /// Draw one of the paper's figures from the model as a PNG.
     Figure(figure::Args),
     /// Write a scene as a Mitsuba 3 scene (XML, PLY, EXR textures) for the cross-check.
     ExportMitsuba(export_mitsuba::Args),
+    /// Compare a render with a reference: relative RMSE and bias per region, noise test.
+    Compare(compare::Args),
     /// Per-row 1D Lucas-Kanade disparity over a region (the paper's estimator).
     Lk(lk::Args),
     /// Dense disparity by semi-global matching (census cost), written as PFM.
@@ -38,9 +44,11 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result: anyhow::Result<()> = match cli.command {
+        Command::Render(args) => render::run(args),
         Command::Locus(args) => locus::run(args),
         Command::Figure(args) => figure::run(args),
         Command::ExportMitsuba(args) => export_mitsuba::run(args),
+        Command::Compare(args) => compare::run(args),
         Command::Lk(args) => lk::run(args),
         Command::Disparity(args) => disparity::run(args),
     };

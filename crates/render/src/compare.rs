@@ -23,11 +23,11 @@
 //! (`k` = 4 by default: a false alarm rate of 6e-5 per region when the renderers agree).
 //! A bias that noise cannot explain is a real difference between the renderers.
 
-use crate::output::RgbImage;
+use crate::output::{write_atomically, OutputError, RgbImage, WriteFailure};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
-use std::io::Cursor;
-use std::path::{Path, PathBuf};
+use std::io::Write as _;
+use std::path::Path;
 use std::str::FromStr;
 
 /// Errors of the comparison.
@@ -78,13 +78,8 @@ pub enum CompareError {
         height: u32,
     },
     /// Writing the difference image failed.
-    #[error("cannot write {path}: {message}")]
-    Write {
-        /// The file.
-        path: PathBuf,
-        /// The cause.
-        message: String,
-    },
+    #[error(transparent)]
+    Write(#[from] OutputError),
 }
 
 /// A named rectangle of pixels `[x0, x1) x [y0, y1)`.
@@ -514,17 +509,19 @@ pub fn write_diff_png(
     b: &RgbImage,
     scale: f64,
 ) -> Result<(), CompareError> {
+    use image::ImageEncoder;
     let img = diff_image(a, b, scale)?;
-    let mut bytes = Vec::new();
-    img.write_to(&mut Cursor::new(&mut bytes), image::ImageFormat::Png)
-        .map_err(|e| CompareError::Write {
-            path: path.to_path_buf(),
-            message: e.to_string(),
-        })?;
-    crate::mitsuba::write_atomic(path, &bytes).map_err(|e| CompareError::Write {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    })
+    write_atomically(path, |w| {
+        image::codecs::png::PngEncoder::new(w.by_ref())
+            .write_image(
+                img.as_raw(),
+                img.width(),
+                img.height(),
+                image::ExtendedColorType::Rgb8,
+            )
+            .map_err(WriteFailure::Png)
+    })?;
+    Ok(())
 }
 
 #[cfg(test)]

@@ -34,6 +34,7 @@
 use crate::camera::Camera;
 use crate::light::Light;
 use crate::material::{Material, PaperModel, Reflectance};
+use crate::output::{write_atomically, OutputError, WriteFailure};
 use crate::scene::{Scene, SceneError};
 use crate::texture::{Texture, TextureId};
 use glam::{Vec2, Vec3};
@@ -61,22 +62,17 @@ pub enum MitsubaError {
         /// The texture index.
         texture: TextureId,
     },
-    /// Writing a file failed.
-    #[error("cannot write {path}: {source}")]
+    /// Creating the output folder failed.
+    #[error("cannot create {path}: {source}")]
     Io {
-        /// The file.
+        /// The folder.
         path: PathBuf,
         /// The cause.
         source: std::io::Error,
     },
-    /// Writing an EXR texture failed.
-    #[error("cannot write {path}: {message}")]
-    Exr {
-        /// The file.
-        path: PathBuf,
-        /// The encoder's message.
-        message: String,
-    },
+    /// Writing a file failed.
+    #[error(transparent)]
+    Output(#[from] OutputError),
 }
 
 /// Render settings written into the Mitsuba scene (the same as `streaks render`'s).
@@ -178,60 +174,32 @@ impl MitsubaExport {
             std::fs::create_dir_all(&d).map_err(|source| MitsubaError::Io { path: d, source })?;
         }
         for mesh in &self.meshes {
-            write_atomic(&dir.join(&mesh.file_name), &mesh.to_bytes())?;
+            write_bytes(&dir.join(&mesh.file_name), &mesh.to_bytes())?;
         }
         for tex in &self.textures {
-            write_exr_atomic(&dir.join(&tex.file_name), tex)?;
+            write_texture_exr(&dir.join(&tex.file_name), tex)?;
         }
-        write_atomic(&dir.join("scene.xml"), self.xml.as_bytes())
+        Ok(write_bytes(&dir.join("scene.xml"), self.xml.as_bytes())?)
     }
 }
 
-/// Path of the temporary file a write to `path` goes through.
-fn temp_path(path: &Path) -> PathBuf {
-    let mut name = std::ffi::OsString::from(".");
-    name.push(path.file_name().unwrap_or_default());
-    name.push(format!(".tmp{}", std::process::id()));
-    path.with_file_name(name)
+fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
+    write_atomically(path, |w| w.write_all(bytes).map_err(WriteFailure::Io))
 }
 
-/// Writes `bytes` to `path` through a temporary file in the same folder and a rename.
-pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), MitsubaError> {
-    let tmp = temp_path(path);
-    let io = |source| MitsubaError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let result = std::fs::File::create(&tmp)
-        .and_then(|mut f| f.write_all(bytes).and_then(|()| f.sync_all()))
-        .and_then(|()| std::fs::rename(&tmp, path));
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result.map_err(io)
-}
-
-fn write_exr_atomic(path: &Path, tex: &BakedTexture) -> Result<(), MitsubaError> {
-    let tmp = temp_path(path).with_extension("exr");
+fn write_texture_exr(path: &Path, tex: &BakedTexture) -> Result<(), OutputError> {
+    use exr::prelude::{Image, SpecificChannels, WritableImage};
     let w = tex.width as usize;
-    let result = exr::prelude::write_rgb_file(&tmp, w, tex.height as usize, |x, y| {
-        let t = tex.texels[y * w + x];
-        (t.x, t.y, t.z)
+    let image = Image::from_channels(
+        (w, tex.height as usize),
+        SpecificChannels::rgb(|pos: exr::math::Vec2<usize>| {
+            let t = tex.texels[pos.y() * w + pos.x()];
+            (t.x, t.y, t.z)
+        }),
+    );
+    write_atomically(path, |out| {
+        image.write().to_buffered(out).map_err(WriteFailure::Exr)
     })
-    .map_err(|e| MitsubaError::Exr {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    })
-    .and_then(|()| {
-        std::fs::rename(&tmp, path).map_err(|source| MitsubaError::Io {
-            path: path.to_path_buf(),
-            source,
-        })
-    });
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
 }
 
 /// The parts of a scene the exporter reads (everything but the BVH).
