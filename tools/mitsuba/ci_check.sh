@@ -3,6 +3,7 @@
 # tools/mitsuba/README.md. Exits 0 on agreement, 1 on disagreement, 2 when it cannot run.
 # Environment: STREAKS (the binary; default target/debug/streaks, built with cargo build),
 # CROSSCHECK_SPP (default 64), CROSSCHECK_WIDTH/HEIGHT (default 160x120), CROSSCHECK_K (4).
+# Extra arguments go to crosscheck.py (e.g. another scene path).
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 repo="$(cd "$here/../.." && pwd)"
@@ -18,4 +19,4 @@ streaks="${STREAKS:-$repo/target/debug/streaks}"
 exec python3 "$here/crosscheck.py" --ci --streaks "$streaks" \
     --spp "${CROSSCHECK_SPP:-64}" --width "${CROSSCHECK_WIDTH:-160}" \
     --height "${CROSSCHECK_HEIGHT:-120}" --k "${CROSSCHECK_K:-4}" \
-    --out "$repo/target/crosscheck/ci"
+    --out "$repo/target/crosscheck/ci" "$@"
