@@ -6,6 +6,8 @@
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
+mod compare;
+mod export_mitsuba;
 mod figure;
 mod locus;
 mod render;
@@ -29,6 +31,10 @@ enum Command {
     Locus(locus::Args),
     /// Draw one of the paper's figures from the model as a PNG.
     Figure(figure::Args),
+    /// Write a scene as a Mitsuba 3 scene (XML, PLY, EXR textures) for the cross-check.
+    ExportMitsuba(export_mitsuba::Args),
+    /// Compare a render with a reference: relative RMSE and bias per region, noise test.
+    Compare(compare::Args),
     /// Per-row 1D Lucas-Kanade disparity over a region (the paper's estimator).
     Lk(lk::Args),
     /// Dense disparity by semi-global matching (census cost), written as PFM.
@@ -41,6 +47,8 @@ fn main() -> ExitCode {
         Command::Render(args) => render::run(args),
         Command::Locus(args) => locus::run(args),
         Command::Figure(args) => figure::run(args),
+        Command::ExportMitsuba(args) => export_mitsuba::run(args),
+        Command::Compare(args) => compare::run(args),
         Command::Lk(args) => lk::run(args),
         Command::Disparity(args) => disparity::run(args),
     };
