@@ -63,7 +63,7 @@ pub enum MitsubaError {
         texture: TextureId,
     },
     /// Creating the output folder failed.
-    #[error("cannot create {path}: {source}")]
+    #[error("cannot create {path}")]
     Io {
         /// The folder.
         path: PathBuf,
