@@ -1,0 +1,176 @@
+//! Generates the glTF scenes shipped in `scenes/`: the paper's configurations (Fig. 2 in three
+//! reflectance variants, Fig. 6), realistic rainy streets (full and small) and the Mitsuba 3
+//! cross-check scene. Each scene is written as `NAME.gltf` + `NAME.bin` (+ PNG textures),
+//! byte-for-byte deterministic; `scenes/README.md` describes them and the scene contract.
+//!
+//! ```no_run
+//! let written = streaks_scenes::generate_all(std::path::Path::new("scenes"))?;
+//! # Ok::<(), streaks_scenes::Error>(())
+//! ```
+#![deny(missing_docs)]
+
+pub mod crosscheck;
+pub mod doc;
+pub mod estimate;
+pub mod mesh;
+pub mod paper;
+pub mod street;
+pub mod wetness;
+
+use std::path::{Path, PathBuf};
+
+/// What can go wrong while generating scenes.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// Writing a file failed.
+    #[error("cannot write {}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A scene element could not be built.
+    #[error("scene {scene}, {element}: {reason}")]
+    Scene {
+        /// Scene name.
+        scene: String,
+        /// Element (node, material, ...).
+        element: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// Encoding a texture failed.
+    #[error("cannot encode texture: {0}")]
+    Texture(String),
+}
+
+/// Builds every shipped scene (in memory).
+pub fn build_all() -> Result<Vec<doc::Doc>, Error> {
+    Ok(vec![
+        paper::fig2(paper::Fig2::BlinnPhong)?,
+        paper::fig2(paper::Fig2::Ward)?,
+        paper::fig2(paper::Fig2::Sphere)?,
+        paper::fig6()?,
+        street::Street::full().build()?,
+        street::Street::small().build()?,
+        crosscheck::crosscheck()?,
+    ])
+}
+
+/// Writes every shipped scene into `dir` (which must exist); returns the files written.
+pub fn generate_all(dir: &Path) -> Result<Vec<PathBuf>, Error> {
+    let mut written = Vec::new();
+    for d in build_all()? {
+        written.extend(d.write(dir)?);
+    }
+    Ok(written)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn committed_dir() -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_default()
+    }
+
+    /// Regenerating gives exactly the committed files, and every committed scene file is
+    /// generated (none is stale).
+    #[test]
+    fn committed_scenes_are_up_to_date() {
+        let tmp = tempfile::tempdir().unwrap();
+        let written = generate_all(tmp.path()).unwrap();
+        let dir = committed_dir();
+        for path in &written {
+            let name = path.file_name().unwrap();
+            let fresh = std::fs::read(path).unwrap();
+            let committed = std::fs::read(dir.join(name)).unwrap_or_else(|_| {
+                panic!("{name:?} is not in scenes/: run `cargo run -p streaks-scenes`")
+            });
+            assert!(
+                fresh == committed,
+                "{name:?} differs from scenes/: run `cargo run -p streaks-scenes` and commit"
+            );
+        }
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let p = entry.unwrap().path();
+            if matches!(p.extension().and_then(|e| e.to_str()), Some("gltf" | "bin")) {
+                assert!(
+                    written.iter().any(|w| w.file_name() == p.file_name()),
+                    "{p:?} is not generated"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn generation_is_deterministic() {
+        let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+        let wa = generate_all(a.path()).unwrap();
+        let wb = generate_all(b.path()).unwrap();
+        assert_eq!(wa.len(), wb.len());
+        for (x, y) in wa.iter().zip(&wb) {
+            assert_eq!(std::fs::read(x).unwrap(), std::fs::read(y).unwrap());
+        }
+    }
+
+    /// The scenes load with the `gltf` crate the renderer uses, with named cameras, the
+    /// lights, emissive strengths and extras visible, and the expected sizes.
+    #[test]
+    fn scenes_load_with_the_gltf_crate() {
+        let tmp = tempfile::tempdir().unwrap();
+        generate_all(tmp.path()).unwrap();
+        let expect = [
+            ("paper_fig2_blinn_phong", "viewer", 3, 2, 0),
+            ("paper_fig2_ward", "viewer", 3, 2, 0),
+            ("paper_fig2_sphere", "viewer", 0, 2500, 3),
+            ("paper_fig6", "rig", 1, 2, 0),
+            ("rainy_street", "driver", 15, 50_000, 5),
+            ("rainy_street_small", "driver", 3, 2_000, 4),
+            ("crosscheck", "cam", 1, 1000, 1),
+        ];
+        for (name, cam, lights, max_tris, emitters) in expect {
+            let (doc, buffers, images) =
+                gltf::import(tmp.path().join(format!("{name}.gltf"))).unwrap();
+            let cams: Vec<_> = doc
+                .nodes()
+                .filter(|n| n.camera().is_some())
+                .map(|n| n.name().unwrap_or("").to_owned())
+                .collect();
+            assert_eq!(cams, [cam], "{name}");
+            let n_lights = doc.lights().map(|l| l.count()).unwrap_or(0);
+            if name.starts_with("rainy") {
+                assert!(n_lights >= lights.min(3), "{name}: {n_lights} lights");
+            } else {
+                assert_eq!(n_lights, lights, "{name}");
+            }
+            let mut tris = 0;
+            for m in doc.meshes() {
+                for p in m.primitives() {
+                    let r = p.reader(|b| Some(&buffers[b.index()]));
+                    tris += r.read_indices().unwrap().into_u32().count() / 3;
+                }
+            }
+            assert!(tris <= max_tris, "{name}: {tris} triangles");
+            let strong = doc
+                .materials()
+                .filter(|m| m.emissive_strength().unwrap_or(1.0) > 1.0)
+                .count();
+            assert!(strong >= emitters, "{name}");
+            assert!(
+                doc.materials()
+                    .filter(|m| m.emissive_strength().is_none())
+                    .all(|m| m.extras().is_some()),
+                "{name}: a reflecting material without extras.streaks"
+            );
+            if name.starts_with("rainy") {
+                assert_eq!(images.len(), 1);
+            }
+        }
+    }
+}
