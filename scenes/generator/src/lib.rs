@@ -108,6 +108,55 @@ mod tests {
         }
     }
 
+    /// One-sided emitters meant to be seen by the driver (windows, signals, lamp lenses, the
+    /// car ahead's tail lights, the oncoming car's headlamps) face the driver's eye.
+    #[test]
+    fn street_emitters_face_the_driver() {
+        let tmp = tempfile::tempdir().unwrap();
+        generate_all(tmp.path()).unwrap();
+        for name in ["rainy_street", "rainy_street_small"] {
+            let (doc, buffers, _) = gltf::import(tmp.path().join(format!("{name}.gltf"))).unwrap();
+            let eye = glam::Vec3::from(
+                doc.nodes()
+                    .find(|n| n.name() == Some("driver"))
+                    .unwrap()
+                    .transform()
+                    .decomposed()
+                    .0,
+            );
+            let mut checked = 0;
+            for node in doc.nodes() {
+                let (Some(mesh), Some(node_name)) = (node.mesh(), node.name()) else {
+                    continue;
+                };
+                let seen = node_name.starts_with("windows_lit")
+                    || node_name.starts_with("signal_")
+                    || node_name == "lamp_lenses"
+                    || node_name == "car_0_tail_lights"
+                    || node_name == "car_1_headlamps";
+                if !seen {
+                    continue;
+                }
+                for p in mesh.primitives() {
+                    let r = p.reader(|b| Some(&buffers[b.index()]));
+                    let pos: Vec<glam::Vec3> =
+                        r.read_positions().unwrap().map(glam::Vec3::from).collect();
+                    let idx: Vec<u32> = r.read_indices().unwrap().into_u32().collect();
+                    for t in idx.chunks(3) {
+                        let [a, b, c] = [0, 1, 2].map(|k| pos[t[k] as usize]);
+                        let n = (b - a).cross(c - a);
+                        assert!(n.dot(eye - a) > 0.0, "{name}: {node_name} faces away");
+                        checked += 1;
+                    }
+                }
+            }
+            assert!(
+                checked >= 8,
+                "{name}: only {checked} emitter triangles checked"
+            );
+        }
+    }
+
     #[test]
     fn generation_is_deterministic() {
         let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
