@@ -1,8 +1,11 @@
 //! Peak streak radiance of a point light over a glossy ground plane, used to choose light
-//! intensities: at the mirror point of the light (where the half vector is the surface
-//! normal) the reflected radiance is `L = f(wi, wo) * I * cos_i / r^2`, with `f` the BRDF of
-//! the scene contract at h = n. The streak's peak is close to that point, so intensities
-//! are chosen to put it near 1 (exposure 0).
+//! intensities. A point light of radiant intensity I lights a ground point p with reflected
+//! radiance `L(p) = f(wi, wo) * I * cos_i / r^2` (f the BRDF of the scene contract, r the
+//! distance from the light to p). By symmetry the streak's centre line lies in the vertical
+//! plane through the eye and the light, so its peak is the maximum of L along the ground
+//! segment from the eye's foot to the light's foot; [`peak_radiance`] finds it by dense
+//! sampling. It lies beyond the mirror point (where h = n): going towards the lamp, r
+//! shrinks faster than the lobe falls off.
 
 use glam::DVec3;
 
@@ -39,24 +42,49 @@ pub enum Brdf {
 }
 
 impl Brdf {
-    /// The BRDF at h = n (mirror configuration) for the given cosines.
-    pub fn at_mirror(&self, cos_i: f64, cos_o: f64) -> f64 {
+    /// The BRDF (without the cosine) for unit directions `wi` (to the light) and `wo` (to
+    /// the viewer) above the ground plane with normal +Y.
+    pub fn eval(&self, wi: DVec3, wo: DVec3) -> f64 {
         let pi = std::f64::consts::PI;
+        let (ci, co) = (wi.y, wo.y);
+        if ci <= 0.0 || co <= 0.0 {
+            return 0.0;
+        }
+        let h = (wi + wo).normalize();
+        let nh = h.y;
         match *self {
             Brdf::Ggx { kd, ks, alpha } => {
-                let g1 = |c: f64| {
-                    let tan2 = (1.0 - c * c) / (c * c);
-                    2.0 / (1.0 + (1.0 + alpha * alpha * tan2).sqrt())
+                let a2 = alpha * alpha;
+                let d = a2 / (pi * (nh * nh * (a2 - 1.0) + 1.0).powi(2));
+                let g1 = |w: DVec3| {
+                    if w.dot(h) <= 0.0 {
+                        return 0.0;
+                    }
+                    let tan2 = (1.0 - w.y * w.y) / (w.y * w.y);
+                    2.0 / (1.0 + (1.0 + a2 * tan2).sqrt())
                 };
-                let d = 1.0 / (pi * alpha * alpha);
-                kd / pi + ks * d * g1(cos_i) * g1(cos_o) / (4.0 * cos_i * cos_o)
+                kd / pi + ks * d * g1(wi) * g1(wo) / (4.0 * ci * co)
             }
             Brdf::Ward { kd, ks, alpha } => {
-                kd / pi + ks / (4.0 * pi * alpha * alpha * (cos_i * cos_o).sqrt())
+                let tan2 = (1.0 - nh * nh) / (nh * nh);
+                kd / pi
+                    + ks * (-tan2 / (alpha * alpha)).exp()
+                        / (4.0 * pi * alpha * alpha * (ci * co).sqrt())
             }
-            Brdf::BlinnPhong { kd, ks, shininess } => kd / pi + ks * (shininess + 8.0) / (8.0 * pi),
+            Brdf::BlinnPhong { kd, ks, shininess } => {
+                kd / pi + ks * (shininess + 8.0) / (8.0 * pi) * nh.max(0.0).powf(shininess)
+            }
         }
     }
+}
+
+/// Radiance reflected towards `eye` at ground point `p` from a point light of intensity
+/// `intensity` at `light`.
+pub fn radiance_at(brdf: Brdf, eye: DVec3, light: DVec3, intensity: f64, p: DVec3) -> f64 {
+    let to_light = light - p;
+    let r2 = to_light.length_squared();
+    let wi = to_light.normalize();
+    brdf.eval(wi, (eye - p).normalize()) * intensity * wi.y / r2
 }
 
 /// The point on the plane Y = 0 where the mirror image of `light` is seen from `eye`.
@@ -66,15 +94,18 @@ pub fn mirror_point(eye: DVec3, light: DVec3) -> DVec3 {
     DVec3::new(p.x, 0.0, p.z)
 }
 
-/// Estimated peak streak radiance of a point light of radiant intensity `intensity` (W/sr)
-/// at `light`, seen from `eye` over the ground plane Y = 0 with reflectance `brdf`.
+/// Peak streak radiance of a point light of radiant intensity `intensity` (W/sr) at `light`,
+/// seen from `eye` over the ground plane Y = 0 with reflectance `brdf`: the maximum over
+/// 4000 points of the ground segment between the eye's and the light's feet.
 pub fn peak_radiance(brdf: Brdf, eye: DVec3, light: DVec3, intensity: f64) -> f64 {
-    let p = mirror_point(eye, light);
-    let to_light = light - p;
-    let r2 = to_light.length_squared();
-    let cos_i = to_light.normalize().y;
-    let cos_o = (eye - p).normalize().y;
-    brdf.at_mirror(cos_i, cos_o) * intensity * cos_i / r2
+    let a = DVec3::new(eye.x, 0.0, eye.z);
+    let b = DVec3::new(light.x, 0.0, light.z);
+    let n = 4000;
+    (1..n)
+        .map(|k| a + (b - a) * (k as f64 / n as f64))
+        .chain(std::iter::once(mirror_point(eye, light)))
+        .map(|p| radiance_at(brdf, eye, light, intensity, p))
+        .fold(0.0, f64::max)
 }
 
 /// The radiant intensity that gives a peak streak radiance `target`, rounded to two
@@ -115,8 +146,8 @@ mod tests {
     }
 
     #[test]
-    fn ward_peak_matches_closed_form() {
-        // At the mirror point cos_i = cos_o, so L = ks I / (4 pi alpha^2 r^2).
+    fn at_the_mirror_point_ward_matches_its_closed_form() {
+        // At the mirror point h = n and cos_i = cos_o, so L = ks I / (4 pi alpha^2 r^2).
         let brdf = Brdf::Ward {
             kd: 0.0,
             ks: 1.0,
@@ -126,7 +157,38 @@ mod tests {
         let light = DVec3::new(0.0, 2.0, -50.0);
         let r2 = 25.0f64 * 25.0 + 4.0;
         let want = 10.0 / (4.0 * std::f64::consts::PI * 0.0025 * r2);
-        assert!((peak_radiance(brdf, eye, light, 10.0) - want).abs() < 1e-9 * want);
+        let p = mirror_point(eye, light);
+        let got = radiance_at(brdf, eye, light, 10.0, p);
+        assert!((got - want).abs() < 1e-9 * want, "{got} {want}");
+        // The streak's peak lies beyond the mirror point, towards the lamp.
+        let peak = peak_radiance(brdf, eye, light, 10.0);
+        assert!(peak > 1.5 * want, "{peak} {want}");
+    }
+
+    #[test]
+    fn ggx_and_blinn_phong_at_the_mirror_point() {
+        let (ci, co) = (0.3f64, 0.3f64);
+        let wi = DVec3::new(0.0, ci, -(1.0 - ci * ci).sqrt());
+        let wo = DVec3::new(0.0, co, (1.0 - co * co).sqrt());
+        let a = 0.1f64;
+        let ggx = Brdf::Ggx {
+            kd: 0.0,
+            ks: 1.0,
+            alpha: a,
+        };
+        let tan2 = (1.0 - ci * ci) / (ci * ci);
+        let g1 = 2.0 / (1.0 + (1.0 + a * a * tan2).sqrt());
+        let want = g1 * g1 / (std::f64::consts::PI * a * a * 4.0 * ci * co);
+        assert!((ggx.eval(wi, wo) - want).abs() < 1e-9 * want);
+        let bp = Brdf::BlinnPhong {
+            kd: 0.0,
+            ks: 1.0,
+            shininess: 1000.0,
+        };
+        let want = 1008.0 / (8.0 * std::f64::consts::PI);
+        assert!((bp.eval(wi, wo) - want).abs() < 1e-9 * want);
+        // Below the horizon nothing is reflected.
+        assert_eq!(bp.eval(-wi, wo), 0.0);
     }
 
     #[test]

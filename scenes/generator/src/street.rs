@@ -23,7 +23,9 @@ pub const LAMP_H: f32 = 5.9;
 /// Street lamp radiant intensity (W/sr).
 pub const LAMP_INTENSITY: f64 = 250.0;
 /// Headlight radiant intensity on axis (W/sr).
-pub const HEADLIGHT_INTENSITY: f64 = 60.0;
+pub const HEADLIGHT_INTENSITY: f64 = 20.0;
+/// Red signal light radiant intensity on axis (W/sr).
+pub const SIGNAL_INTENSITY: f64 = 60.0;
 /// Asphalt: wet (w = 0, puddle) and dry (w = 1) parameters.
 pub const ASPHALT_KD: f64 = 0.04;
 /// Specular reflectance of standing water (w = 0).
@@ -610,7 +612,7 @@ fn add_traffic_light(doc: &mut Doc, z: f32) -> Result<(), Error> {
             outer: 0.7,
         },
         color: [1.0, 0.05, 0.02],
-        intensity: 30.0,
+        intensity: SIGNAL_INTENSITY,
         position: Vec3::new(x, 3.95, z + 0.06),
         direction: Vec3::new(-0.05, -0.1, 1.0),
     });
@@ -631,6 +633,7 @@ mod tests {
         let eye = EYE.as_dvec3();
         let lamp = DVec3::new(f64::from(ROAD_HALF) - 0.9, f64::from(LAMP_H), -40.0);
         let l = peak_radiance(brdf, eye, lamp, LAMP_INTENSITY);
+        println!("lamp 40 m ahead, w = 0.2: peak {l}");
         assert!(l > 0.5 && l < 5.0, "peak {l}");
     }
 
