@@ -3,9 +3,16 @@
 //! cross-check scene. Each scene is written as `NAME.gltf` + `NAME.bin` (+ PNG textures),
 //! byte-for-byte deterministic; `scenes/README.md` describes them and the scene contract.
 //!
-//! ```no_run
-//! let written = streaks_scenes::generate_all(std::path::Path::new("scenes"))?;
-//! # Ok::<(), streaks_scenes::Error>(())
+//! The pieces: [`mesh::Mesh`] builds triangle meshes from simple solids, [`doc::Doc`] turns
+//! meshes, [`doc::Material`]s, [`doc::Light`]s and cameras into a glTF document,
+//! [`estimate`] chooses light intensities from the streak's peak radiance, [`wetness`] makes
+//! the road's dryness map, and [`paper`], [`street`] and [`crosscheck`] lay out the scenes.
+//!
+//! ```
+//! let dir = tempfile::tempdir()?;
+//! let written = streaks_scenes::generate_all(dir.path())?;
+//! assert!(written.iter().any(|p| p.ends_with("rainy_street.gltf")));
+//! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 #![deny(missing_docs)]
 
