@@ -119,6 +119,14 @@ impl Material {
         }
     }
 
+    /// The same paper material with a dryness map (no effect on other reflectances).
+    pub fn with_dryness(mut self, d: Dryness) -> Self {
+        if let Reflect::Paper { dryness, .. } = &mut self.reflect {
+            *dryness = Some(d);
+        }
+        self
+    }
+
     /// A Mitsuba-style diffuse material: `ggx` with ks = 0.
     pub fn diffuse(name: &str, kd: [f64; 3]) -> Self {
         Self::paper(name, PaperBsdf::Ggx { alpha: 0.5 }, kd, [0.0; 3])
@@ -308,7 +316,8 @@ impl Doc {
             }));
             attributes["TEXCOORD_0"] = json!(self.accessors.len() - 1);
         }
-        let (bytes, component): (Vec<u8>, u32) = if mesh.positions.len() <= usize::from(u16::MAX) {
+        // 16-bit indices up to 65534 (65535 is the primitive-restart value in some APIs).
+        let (bytes, component): (Vec<u8>, u32) = if mesh.positions.len() < usize::from(u16::MAX) {
             let b = mesh
                 .indices
                 .iter()

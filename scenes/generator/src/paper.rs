@@ -69,12 +69,19 @@ fn to_v(p: DVec3) -> Vec3 {
     p.as_vec3()
 }
 
-fn ground(doc: &mut Doc, name: &str, material: &Material, half_x: f32, near: f32, far: f32) {
+/// A ground plane at Y = 0, X in [-half_x, half_x], Z in [far, near], facing up.
+fn ground(
+    doc: &mut Doc,
+    name: &str,
+    material: &Material,
+    half_x: f32,
+    near: f32,
+    far: f32,
+) -> Result<(), Error> {
     let mut m = Mesh::new();
     let c = Vec3::new(0.0, 0.0, (near + far) * 0.5);
     m.rect(c, Vec3::Z * (near - far) * 0.5, Vec3::X * half_x);
-    // add_mesh only fails on an empty mesh.
-    let _ = doc.add_mesh(name, &m, material);
+    doc.add_mesh(name, &m, material)
 }
 
 /// Builds one Fig. 2 variant.
@@ -98,7 +105,7 @@ pub fn fig2(v: Fig2) -> Result<Doc, Error> {
         Brdf::Ggx { alpha, .. } => PaperBsdf::Ggx { alpha },
     };
     let road = Material::paper("glossy_ground", bsdf, [0.0; 3], [1.0; 3]);
-    ground(&mut doc, "ground", &road, 200.0, 10.0, -1000.0);
+    ground(&mut doc, "ground", &road, 200.0, 10.0, -1000.0)?;
     let eye = fig2_eye();
     let lamps = fig2_lamps();
     let mid = lamps[1];
@@ -160,7 +167,7 @@ pub fn fig6() -> Result<Doc, Error> {
         [0.0; 3],
         [1.0; 3],
     );
-    ground(&mut doc, "ground", &road, 200.0, 10.0, -1000.0);
+    ground(&mut doc, "ground", &road, 200.0, 10.0, -1000.0)?;
     let i = intensity_for_peak(FIG6_BRDF, fig6_eye(), fig6_lamp(), 1.0);
     doc.add_light(&Light {
         name: "lamp".to_owned(),

@@ -191,21 +191,19 @@ impl Street {
     fn road(&self, doc: &mut Doc) -> Result<(), Error> {
         let (png, _, _) = dryness_png(ROAD_HALF, self.near, self.far, self.texture, self.seed)?;
         let image = doc.add_png("dryness", png);
-        let mut asphalt = Material::paper(
+        let asphalt = Material::paper(
             "wet_asphalt",
             PaperBsdf::Ggx {
                 alpha: ASPHALT_ALPHA_WET,
             },
             [ASPHALT_KD; 3],
             [ASPHALT_KS_WET; 3],
-        );
-        if let crate::doc::Reflect::Paper { dryness, .. } = &mut asphalt.reflect {
-            *dryness = Some(Dryness {
-                image,
-                alpha_dry: ASPHALT_ALPHA_DRY,
-                ks_dry: [ASPHALT_KS_DRY; 3],
-            });
-        }
+        )
+        .with_dryness(Dryness {
+            image,
+            alpha_dry: ASPHALT_ALPHA_DRY,
+            ks_dry: [ASPHALT_KS_DRY; 3],
+        });
         let (h, n, f) = (ROAD_HALF, self.near, self.far);
         let mut road = Mesh::new();
         road.quad_uv(
