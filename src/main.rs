@@ -4,6 +4,9 @@
 //! Errors are printed with their whole chain and the process exits non-zero.
 
 use clap::{Parser, Subcommand};
+
+mod figure;
+mod locus;
 use std::process::ExitCode;
 
 /// Render rainy night streets in stereo and measure what specular streaks do to depth.
@@ -15,11 +18,19 @@ struct Cli {
 }
 
 #[derive(Subcommand, Debug)]
-enum Command {}
+enum Command {
+    /// Print the virtual light column (Eq. 4) of a light seen from a viewer.
+    Locus(locus::Args),
+    /// Draw one of the paper's figures from the model as a PNG.
+    Figure(figure::Args),
+}
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let result: anyhow::Result<()> = match cli.command {};
+    let result: anyhow::Result<()> = match cli.command {
+        Command::Locus(args) => locus::run(args),
+        Command::Figure(args) => figure::run(args),
+    };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
