@@ -520,12 +520,8 @@ impl Doc {
             root["extensionsUsed"] = json!(used);
         }
         if !self.textures_used.is_empty() {
-            root["samplers"] = json!([{
-                "magFilter": 9729,
-                "minFilter": 9729,
-                "wrapS": 33071,
-                "wrapT": 33071,
-            }]);
+            // Bilinear, with glTF's default repeat wrapping (what the project's loader does).
+            root["samplers"] = json!([{ "magFilter": 9729, "minFilter": 9729 }]);
             root["images"] = json!(self
                 .textures_used
                 .iter()

@@ -164,6 +164,57 @@ mod tests {
         }
     }
 
+    /// The committed scenes load with the project's renderer without warnings, with the named
+    /// camera, the punctual and emissive lights, and (streets) a road whose alpha follows the
+    /// dryness map between the wet and dry values.
+    #[test]
+    fn committed_scenes_load_in_the_renderer() {
+        use streaks_render::bsdf::Bsdf;
+        use streaks_render::light::Light;
+        use streaks_render::scene::Scene;
+        let expect = [
+            ("paper_fig2_blinn_phong", "viewer", 3, false),
+            ("paper_fig2_ward", "viewer", 3, false),
+            ("paper_fig2_sphere", "viewer", 0, true),
+            ("paper_fig6", "rig", 1, false),
+            ("rainy_street", "driver", 15, true),
+            ("rainy_street_small", "driver", 3, true),
+            ("crosscheck", "cam", 1, true),
+        ];
+        for (name, cam, punctual, emissive) in expect {
+            let path = committed_dir().join(format!("{name}.gltf"));
+            let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert!(scene.warnings.is_empty(), "{name}: {:?}", scene.warnings);
+            let cams: Vec<&str> = scene.cameras.iter().map(|c| c.name.as_str()).collect();
+            assert_eq!(cams, [cam], "{name}");
+            let n_punctual = scene
+                .lights
+                .iter()
+                .filter(|l| matches!(l, Light::Point { .. } | Light::Spot { .. }))
+                .count();
+            assert_eq!(n_punctual, punctual, "{name}");
+            let n_area = scene.lights.len() - n_punctual;
+            assert_eq!(n_area > 0, emissive, "{name}: {n_area} emissive triangles");
+            if name.starts_with("rainy") {
+                let road = scene
+                    .materials
+                    .iter()
+                    .find(|m| m.name == "wet_asphalt")
+                    .unwrap();
+                let (mut lo, mut hi) = (f32::INFINITY, 0.0f32);
+                for k in 0..400 {
+                    let uv = glam::Vec2::new((k % 20) as f32 / 20.0, (k / 20) as f32 / 20.0);
+                    let Bsdf::Ggx(g) = road.bsdf_at(uv, &scene.textures) else {
+                        panic!("{name}: the road is not ggx");
+                    };
+                    lo = lo.min(g.alpha);
+                    hi = hi.max(g.alpha);
+                }
+                assert!(lo < 0.03 && hi > 0.25, "{name}: road alpha in [{lo}, {hi}]");
+            }
+        }
+    }
+
     #[test]
     fn generation_is_deterministic() {
         let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
