@@ -4,10 +4,14 @@
 //! Errors are printed with their whole chain and the process exits non-zero.
 
 use clap::{Parser, Subcommand};
+use std::process::ExitCode;
 
 mod figure;
 mod locus;
-use std::process::ExitCode;
+mod render;
+
+mod disparity;
+mod lk;
 
 /// Render rainy night streets in stereo and measure what specular streaks do to depth.
 #[derive(Parser, Debug)]
@@ -19,17 +23,26 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// Path-trace one camera of a scene to EXR (and PNG).
+    Render(render::Args),
     /// Print the virtual light column (Eq. 4) of a light seen from a viewer.
     Locus(locus::Args),
     /// Draw one of the paper's figures from the model as a PNG.
     Figure(figure::Args),
+    /// Per-row 1D Lucas-Kanade disparity over a region (the paper's estimator).
+    Lk(lk::Args),
+    /// Dense disparity by semi-global matching (census cost), written as PFM.
+    Disparity(disparity::Args),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result: anyhow::Result<()> = match cli.command {
+        Command::Render(args) => render::run(args),
         Command::Locus(args) => locus::run(args),
         Command::Figure(args) => figure::run(args),
+        Command::Lk(args) => lk::run(args),
+        Command::Disparity(args) => disparity::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
