@@ -3,6 +3,9 @@
 //! Each subcommand module exposes an `Args` struct (clap) and `run(args) -> anyhow::Result<()>`.
 //! Errors are printed with their whole chain and the process exits non-zero.
 
+mod prepare;
+mod texture_map;
+
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
@@ -15,11 +18,19 @@ struct Cli {
 }
 
 #[derive(Subcommand, Debug)]
-enum Command {}
+enum Command {
+    /// Resample an image of a rendered or photographed pair onto the road plane (paper Fig. 3).
+    TextureMap(texture_map::Args),
+    /// Grey level, histogram equalisation and a disparity shift for a photographed pair (Fig. 7).
+    Prepare(prepare::Args),
+}
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let result: anyhow::Result<()> = match cli.command {};
+    let result: anyhow::Result<()> = match cli.command {
+        Command::TextureMap(args) => texture_map::run(args),
+        Command::Prepare(args) => prepare::run(args),
+    };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {

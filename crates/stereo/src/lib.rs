@@ -13,6 +13,7 @@
 //! - [`pair`]: side-by-side and anaglyph views; the paper's Fig. 7 treatment of photographs.
 //! - [`streak_mask`]: which pixels are specular streaks, from the renderer's specular layer.
 //! - [`texture_map`]: the paper's Fig. 3 ground-plane texture map.
+//! - [`font`]: the bundled plot font (plotters + `ab_glyph`, no system fonts).
 //! - [`render`] (feature `render`): rendering a pair with ground-truth disparity and depth.
 //!
 //! ```
@@ -32,6 +33,7 @@
 #![deny(missing_docs)]
 
 pub mod error;
+pub mod font;
 pub mod image;
 pub mod pair;
 pub mod pfm;

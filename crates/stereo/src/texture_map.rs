@@ -19,7 +19,6 @@ use crate::rig::{Eye, Rig};
 use glam::{Vec2, Vec3};
 use plotters::prelude::*;
 use std::path::Path;
-use std::sync::OnceLock;
 
 /// Largest map, in cells.
 const MAX_CELLS: usize = 1 << 26;
@@ -167,40 +166,21 @@ pub fn road_to_pixel(rig: &Rig, eye: Eye, x: f32, z: f32) -> Option<Vec2> {
         .project(road.world_from_road_point(Vec3::new(x, 0.0, z)))
 }
 
-fn register_font() -> Result<(), StereoError> {
-    static FONT: OnceLock<bool> = OnceLock::new();
-    let ok = *FONT.get_or_init(|| {
-        plotters::style::register_font(
-            "sans-serif",
-            FontStyle::Normal,
-            include_bytes!("../fonts/DejaVuSans.ttf"),
-        )
-        .is_ok()
-    });
-    if ok {
-        Ok(())
-    } else {
-        Err(StereoError::Parameter {
-            name: "font",
-            reason: "the bundled DejaVu Sans font did not load".into(),
-        })
-    }
-}
-
 /// Colour of cells outside the view.
 const OUTSIDE: [u8; 3] = [40, 40, 64];
 
 /// Draws `map` as a PNG with its axes labelled in metres (X across, Z up, the rig at the
 /// bottom), the values clipped to [0, 1], out-of-view cells dark blue-grey.
 pub fn plot_texture_map(map: &TextureMap, path: &Path, title: &str) -> Result<(), StereoError> {
-    register_font()?;
+    crate::font::register_sans_serif()?;
     let spec = &map.spec;
     let (nx, nz) = (spec.nx, spec.nz);
     // Magnify small maps (nearest cell) so the labels fit.
     let scale = (400usize.div_ceil(nx.min(nz))).clamp(1, 8);
     let (pw, ph) = (nx * scale, nz * scale);
-    let (left, bottom, top, right) = (70usize, 55usize, 40usize, 25usize);
-    let (cw, ch) = (pw + left + right, ph + bottom + top);
+    let (left, bottom, top, right) = (80usize, 55usize, 40usize, 25usize);
+    let margin_left = 30usize;
+    let (cw, ch) = (pw + margin_left + left + right, ph + bottom + top);
     let mut buf = vec![255u8; cw * ch * 3];
     let plot_err = |e: String| StereoError::Parameter {
         name: "plot",
@@ -212,6 +192,7 @@ pub fn plot_texture_map(map: &TextureMap, path: &Path, title: &str) -> Result<()
         let mut chart = ChartBuilder::on(&root)
             .caption(title, ("sans-serif", 18))
             .margin_top(8)
+            .margin_left(margin_left as u32)
             .margin_right(right as u32)
             .x_label_area_size(bottom as u32)
             .y_label_area_size(left as u32)
