@@ -31,4 +31,5 @@ pub mod material;
 pub mod output;
 pub mod sampling;
 pub mod scene;
+pub mod testing;
 pub mod texture;
