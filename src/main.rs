@@ -3,6 +3,8 @@
 //! Each subcommand module exposes an `Args` struct (clap) and `run(args) -> anyhow::Result<()>`.
 //! Errors are printed with their whole chain and the process exits non-zero.
 
+mod figure;
+mod locus;
 mod prepare;
 mod texture_map;
 
@@ -23,6 +25,10 @@ enum Command {
     TextureMap(texture_map::Args),
     /// Grey level, histogram equalisation and a disparity shift for a photographed pair (Fig. 7).
     Prepare(prepare::Args),
+    /// Print the virtual light column (Eq. 4) of a light seen from a viewer.
+    Locus(locus::Args),
+    /// Draw one of the paper's figures from the model as a PNG.
+    Figure(figure::Args),
 }
 
 fn main() -> ExitCode {
@@ -30,6 +36,8 @@ fn main() -> ExitCode {
     let result: anyhow::Result<()> = match cli.command {
         Command::TextureMap(args) => texture_map::run(args),
         Command::Prepare(args) => prepare::run(args),
+        Command::Locus(args) => locus::run(args),
+        Command::Figure(args) => figure::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,2 +1,34 @@
-//! streaks-analysis (skeleton).
+//! # streaks-analysis
+//!
+//! What specular streaks do to stereo depth: the paper's virtual light column model and the
+//! plots that show it. Works on geometry and images only; it never depends on the renderer.
+//!
+//! - [`model`]: Eq. 2 and Eq. 4 in the road frame ([`model::ColumnModel`]: a light and a
+//!   viewer; the locus of `L_virtual`, the proposition's invariance check), pinhole cameras
+//!   and a rectified rig ([`model::RoadCamera`], [`model::StereoRig`]) with the disparity of
+//!   Eq. 5 in pixels and degrees, and the prediction per image row of a streak
+//!   ([`model::streak_rows`]).
+//! - [`plot`]: line, scatter and arrow plots with labelled axes and legends, written
+//!   atomically to PNG (plotters, with a font bundled in the crate).
+//! - [`figures`]: the paper's figures made from the model (Fig. 4, Fig. 5).
+//!
+//! ```
+//! use glam::DVec3;
+//! use streaks_analysis::model::ColumnModel;
+//!
+//! // The paper's Fig. 6 set-up: light 15 m ahead at 1.5 m, viewer at 1.5 m, 6.5 cm baseline.
+//! let model = ColumnModel::new(DVec3::new(0.0, 1.5, 15.0), DVec3::new(0.0, 1.5, 0.0))?;
+//! let locus = model.locus_profile(Some(4.0), 101, 0.065)?;
+//! // The virtual column lies below the road, near the light's depth...
+//! assert!(locus.iter().all(|p| p.reflection.virtual_light.y < 0.0));
+//! // ...so its disparity barely changes along the streak (0.0078 degrees over 8 degrees).
+//! let (near, far) = (locus[0], locus[100]);
+//! assert!((near.elevation_deg - far.elevation_deg - 8.0).abs() < 1e-9);
+//! assert!((near.disparity_deg - far.disparity_deg) < 0.008);
+//! # Ok::<(), streaks_analysis::model::ModelError>(())
+//! ```
 #![deny(missing_docs)]
+
+pub mod figures;
+pub mod model;
+pub mod plot;
