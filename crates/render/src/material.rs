@@ -1,9 +1,17 @@
-//! Materials (INTERFACE SKELETON, filled in by the scene-loading work): what a scene stores;
-//! [`Material::bsdf_at`] turns one into a [`Bsdf`] at a surface point.
+//! Materials: what a scene stores; [`Material::bsdf_at`] turns one into a [`Bsdf`] at a
+//! surface point, reading the material's textures there.
+//!
+//! Textures modulate parameters as follows:
+//! - [`Reflectance::Diffuse`] and [`Reflectance::Paper`]: the texture's RGB multiplies `kd`.
+//! - [`Reflectance::Paper`] with [`Wetness`]: the dryness `w` (green channel of the dryness map)
+//!   interpolates `alpha` (or, for blinn_phong, the shininess) and `ks` linearly between the
+//!   wet and the dry values.
+//! - [`Reflectance::GltfPbr`]: RGB multiplies the base colour; the metallic-roughness texture's
+//!   blue channel multiplies `metallic` and its green channel `roughness` (glTF 2.0).
 
-use crate::bsdf::Bsdf;
+use crate::bsdf::{self, Bsdf};
 use crate::texture::{Texture, TextureId};
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 
 /// Which of the paper's models an `extras.streaks` material uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -40,7 +48,7 @@ pub enum Reflectance {
         shininess: f32,
         /// Optional texture multiplying `kd` (the glTF baseColorTexture).
         kd_texture: Option<TextureId>,
-        /// Optional wet/dry modulation (see scenes/README.md).
+        /// Optional wet/dry modulation (see [`Wetness`] and the `scene` module documentation).
         wetness: Option<Wetness>,
     },
     /// glTF metallic-roughness.
@@ -85,21 +93,198 @@ pub struct Material {
     pub double_sided: bool,
 }
 
+/// The texture's value at `uv`, or one where there is no texture (or the id is out of range,
+/// which [`crate::scene::Scene::from_parts`] rules out).
+#[inline]
+fn sample_or_one(texture: Option<TextureId>, uv: Vec2, textures: &[Texture]) -> Vec4 {
+    texture
+        .and_then(|t| textures.get(t as usize))
+        .map_or(Vec4::ONE, |t| t.sample(uv))
+}
+
 impl Material {
+    /// A non-emissive, one-sided Lambertian material of albedo `kd`.
+    pub fn diffuse(name: impl Into<String>, kd: Vec3) -> Self {
+        Self {
+            name: name.into(),
+            reflectance: Reflectance::Diffuse {
+                kd,
+                kd_texture: None,
+            },
+            emission: Vec3::ZERO,
+            emission_texture: None,
+            double_sided: false,
+        }
+    }
+
+    /// Every texture the material refers to.
+    pub fn texture_ids(&self) -> impl Iterator<Item = TextureId> + '_ {
+        let r = match &self.reflectance {
+            Reflectance::Diffuse { kd_texture, .. } => [*kd_texture, None],
+            Reflectance::Paper {
+                kd_texture,
+                wetness,
+                ..
+            } => [*kd_texture, wetness.as_ref().map(|w| w.texture)],
+            Reflectance::GltfPbr {
+                base_color_texture,
+                metallic_roughness_texture,
+                ..
+            } => [*base_color_texture, *metallic_roughness_texture],
+        };
+        r.into_iter().chain([self.emission_texture]).flatten()
+    }
+
     /// The BSDF at texture coordinate `uv`.
     pub fn bsdf_at(&self, uv: Vec2, textures: &[Texture]) -> Bsdf {
-        let _ = (uv, textures);
-        unimplemented!("skeleton")
+        match &self.reflectance {
+            Reflectance::Diffuse { kd, kd_texture } => Bsdf::Diffuse(bsdf::Diffuse {
+                kd: *kd * sample_or_one(*kd_texture, uv, textures).truncate(),
+            }),
+            Reflectance::Paper {
+                model,
+                kd,
+                ks,
+                alpha,
+                shininess,
+                kd_texture,
+                wetness,
+            } => {
+                let kd = *kd * sample_or_one(*kd_texture, uv, textures).truncate();
+                let (mut ks, mut alpha, mut shininess) = (*ks, *alpha, *shininess);
+                if let Some(w) = wetness {
+                    let dry = sample_or_one(Some(w.texture), uv, textures)
+                        .y
+                        .clamp(0.0, 1.0);
+                    ks = ks.lerp(w.ks_dry, dry);
+                    match model {
+                        PaperModel::BlinnPhong => shininess += (w.alpha_dry - shininess) * dry,
+                        PaperModel::Ggx | PaperModel::Ward => alpha += (w.alpha_dry - alpha) * dry,
+                    }
+                }
+                match model {
+                    PaperModel::Ggx => Bsdf::Ggx(bsdf::Ggx { kd, ks, alpha }),
+                    PaperModel::Ward => Bsdf::Ward(bsdf::Ward { kd, ks, alpha }),
+                    PaperModel::BlinnPhong => {
+                        Bsdf::BlinnPhong(bsdf::BlinnPhong { kd, ks, shininess })
+                    }
+                }
+            }
+            Reflectance::GltfPbr {
+                base_color,
+                base_color_texture,
+                metallic,
+                roughness,
+                metallic_roughness_texture,
+            } => {
+                let mr = sample_or_one(*metallic_roughness_texture, uv, textures);
+                Bsdf::GltfPbr(bsdf::GltfPbr {
+                    base_color: *base_color
+                        * sample_or_one(*base_color_texture, uv, textures).truncate(),
+                    metallic: (*metallic * mr.z).clamp(0.0, 1.0),
+                    roughness: (*roughness * mr.y).clamp(0.0, 1.0),
+                })
+            }
+        }
     }
 
     /// Emitted radiance at `uv` (front face; the caller checks sidedness).
+    #[inline]
     pub fn emission_at(&self, uv: Vec2, textures: &[Texture]) -> Vec3 {
-        let _ = (uv, textures);
-        unimplemented!("skeleton")
+        if self.emission_texture.is_none() {
+            return self.emission;
+        }
+        self.emission * sample_or_one(self.emission_texture, uv, textures).truncate()
     }
 
     /// Whether the material emits at all.
     pub fn is_emissive(&self) -> bool {
         self.emission.max_element() > 0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::texture::ColorSpace;
+
+    #[test]
+    fn wetness_interpolates_alpha_and_ks_and_texture_multiplies_kd() {
+        // Dryness map: left texel wet (G = 0), right texel dry (G = 1).
+        let dry_map = Texture::from_rgba(
+            2,
+            1,
+            vec![Vec4::new(0.0, 0.0, 0.0, 1.0), Vec4::new(0.0, 1.0, 0.0, 1.0)],
+            ColorSpace::Linear,
+        )
+        .unwrap();
+        let kd_map = Texture::from_rgba(
+            1,
+            1,
+            vec![Vec4::new(0.5, 1.0, 0.25, 1.0)],
+            ColorSpace::Linear,
+        )
+        .unwrap();
+        let m = Material {
+            name: "road".into(),
+            reflectance: Reflectance::Paper {
+                model: PaperModel::Ggx,
+                kd: Vec3::splat(0.4),
+                ks: Vec3::splat(0.8),
+                alpha: 0.05,
+                shininess: 0.0,
+                kd_texture: Some(1),
+                wetness: Some(Wetness {
+                    texture: 0,
+                    alpha_dry: 0.45,
+                    ks_dry: Vec3::splat(0.1),
+                }),
+            },
+            emission: Vec3::ZERO,
+            emission_texture: None,
+            double_sided: false,
+        };
+        let textures = [dry_map, kd_map];
+        let Bsdf::Ggx(wet) = m.bsdf_at(Vec2::new(0.25, 0.5), &textures) else {
+            panic!("not ggx")
+        };
+        assert!((wet.alpha - 0.05).abs() < 1e-6 && (wet.ks.x - 0.8).abs() < 1e-6);
+        assert!((wet.kd - Vec3::new(0.2, 0.4, 0.1)).length() < 1e-6);
+        let Bsdf::Ggx(dry) = m.bsdf_at(Vec2::new(0.75, 0.5), &textures) else {
+            panic!("not ggx")
+        };
+        assert!((dry.alpha - 0.45).abs() < 1e-6 && (dry.ks.x - 0.1).abs() < 1e-6);
+        let Bsdf::Ggx(half) = m.bsdf_at(Vec2::new(0.5, 0.5), &textures) else {
+            panic!("not ggx")
+        };
+        assert!((half.alpha - 0.25).abs() < 1e-6, "{}", half.alpha);
+        assert_eq!(m.texture_ids().collect::<Vec<_>>(), vec![1, 0]);
+    }
+
+    #[test]
+    fn pbr_texture_channels_and_emission() {
+        let mr = Texture::from_rgba(
+            1,
+            1,
+            vec![Vec4::new(0.0, 0.5, 0.25, 1.0)],
+            ColorSpace::Linear,
+        )
+        .unwrap();
+        let mut m = Material::diffuse("m", Vec3::ONE);
+        m.reflectance = Reflectance::GltfPbr {
+            base_color: Vec3::splat(0.5),
+            base_color_texture: None,
+            metallic: 1.0,
+            roughness: 0.8,
+            metallic_roughness_texture: Some(0),
+        };
+        m.emission = Vec3::new(2.0, 0.0, 1.0);
+        m.emission_texture = Some(0);
+        let Bsdf::GltfPbr(b) = m.bsdf_at(Vec2::ZERO, std::slice::from_ref(&mr)) else {
+            panic!("not pbr")
+        };
+        assert!((b.metallic - 0.25).abs() < 1e-6 && (b.roughness - 0.4).abs() < 1e-6);
+        assert_eq!(m.emission_at(Vec2::ZERO, &[mr]), Vec3::new(0.0, 0.0, 0.25));
+        assert!(m.is_emissive());
     }
 }

@@ -1,0 +1,1304 @@
+//! The glTF 2.0 loader (`.gltf` with external or base64-embedded buffers, and `.glb`).
+//!
+//! Every accessor is checked (type, bounds within its buffer view and buffer) before it is
+//! read, so malformed files give a [`SceneError`] naming the element instead of a panic.
+//! Sparse accessors are not supported (an error names them).
+
+use super::{Scene, SceneError, SceneParts};
+use crate::camera::Camera;
+use crate::light::Light;
+use crate::material::{Material, PaperModel, Reflectance, Wetness};
+use crate::texture::{ColorSpace, Texture, TextureId};
+use glam::{Affine3A, Mat3, Mat4, Quat, Vec2, Vec3, Vec4};
+use gltf::accessor::{DataType, Dimensions};
+use gltf::mesh::Mode;
+use serde::Deserialize;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+/// `extras.streaks` of a material (see the `scene` module documentation).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct StreaksExtras {
+    bsdf: StreaksBsdf,
+    #[serde(default)]
+    kd: Option<[f32; 3]>,
+    #[serde(default)]
+    ks: Option<[f32; 3]>,
+    #[serde(default)]
+    alpha: Option<f32>,
+    #[serde(default)]
+    shininess: Option<f32>,
+    #[serde(default)]
+    alpha_dry: Option<f32>,
+    #[serde(default)]
+    ks_dry: Option<[f32; 3]>,
+}
+
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(rename_all = "snake_case")]
+enum StreaksBsdf {
+    Ggx,
+    Ward,
+    BlinnPhong,
+}
+
+/// Loads a `.gltf` or `.glb` file.
+pub(super) fn load(path: &Path) -> Result<Scene, SceneError> {
+    let gltf::Gltf { document, blob } = gltf::Gltf::open(path).map_err(|e| match e {
+        gltf::Error::Io(source) => SceneError::Io {
+            path: path.to_path_buf(),
+            element: "the file".into(),
+            source,
+        },
+        source => SceneError::Gltf {
+            path: path.to_path_buf(),
+            source,
+        },
+    })?;
+    let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+    let buffers = load_buffers(path, &base, &document, blob)?;
+    let mut loader = Loader {
+        path,
+        base,
+        buffers,
+        parts: SceneParts {
+            source: path.to_path_buf(),
+            ..SceneParts::default()
+        },
+        textures: HashMap::new(),
+        default_material: None,
+    };
+    for (i, m) in document.materials().enumerate() {
+        let material = loader.material(&m, i)?;
+        loader.parts.materials.push(material);
+    }
+    let scene = document
+        .default_scene()
+        .or_else(|| document.scenes().next());
+    match scene {
+        Some(scene) => {
+            // Depth-first in file order with an explicit stack; a depth beyond the node count
+            // can only come from a cycle.
+            let node_count = document.nodes().len();
+            let mut stack: Vec<(gltf::Node, Mat4, usize)> =
+                scene.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
+            stack.reverse();
+            while let Some((node, parent, depth)) = stack.pop() {
+                if depth > node_count {
+                    return Err(SceneError::invalid(
+                        path,
+                        node_label(&node),
+                        "the node hierarchy has a cycle",
+                    ));
+                }
+                let world = loader.node(&node, parent)?;
+                let first_child = stack.len();
+                stack.extend(node.children().map(|c| (c, world, depth + 1)));
+                stack[first_child..].reverse();
+            }
+        }
+        None => loader
+            .parts
+            .warnings
+            .push(format!("{}: the file has no scene", path.display())),
+    }
+    Scene::from_parts(loader.parts)
+}
+
+fn node_label(node: &gltf::Node) -> String {
+    match node.name() {
+        Some(n) => format!("node {n:?} ({})", node.index()),
+        None => format!("node {}", node.index()),
+    }
+}
+
+fn mesh_label(mesh: &gltf::Mesh) -> String {
+    match mesh.name() {
+        Some(n) => format!("mesh {n:?} ({})", mesh.index()),
+        None => format!("mesh {}", mesh.index()),
+    }
+}
+
+/// Whether the gltf crate can decode `uri` without panicking: it unwraps the UTF-8 decoding
+/// of percent-escaped relative URIs, so a URI whose escapes decode to invalid UTF-8 (`%FF`)
+/// must be rejected first.
+fn uri_is_decodable(uri: &str) -> bool {
+    if uri.contains(':') {
+        return true;
+    }
+    let b = uri.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        let hex = |c: u8| (c as char).to_digit(16);
+        match (
+            b[i],
+            b.get(i + 1).copied().and_then(hex),
+            b.get(i + 2).copied().and_then(hex),
+        ) {
+            (b'%', Some(h), Some(l)) => {
+                out.push((h * 16 + l) as u8);
+                i += 3;
+            }
+            (c, _, _) => {
+                out.push(c);
+                i += 1;
+            }
+        }
+    }
+    std::str::from_utf8(&out).is_ok()
+}
+
+/// Describes where a URI points, for messages.
+fn uri_label(base: &Path, uri: &str) -> String {
+    if uri.starts_with("data:") {
+        "embedded data URI".into()
+    } else {
+        format!("{uri:?} -> {}", base.join(uri).display())
+    }
+}
+
+fn load_buffers(
+    path: &Path,
+    base: &Path,
+    document: &gltf::Document,
+    mut blob: Option<Vec<u8>>,
+) -> Result<Vec<gltf::buffer::Data>, SceneError> {
+    let mut buffers = Vec::new();
+    for buffer in document.buffers() {
+        let element = match buffer.source() {
+            gltf::buffer::Source::Bin => format!("buffer {} (GLB binary chunk)", buffer.index()),
+            gltf::buffer::Source::Uri(uri) => {
+                format!("buffer {} ({})", buffer.index(), uri_label(base, uri))
+            }
+        };
+        if let gltf::buffer::Source::Uri(uri) = buffer.source() {
+            if !uri_is_decodable(uri) {
+                return Err(SceneError::invalid(
+                    path,
+                    element,
+                    "URI escapes are not UTF-8",
+                ));
+            }
+        }
+        let data = gltf::buffer::Data::from_source_and_blob(buffer.source(), Some(base), &mut blob)
+            .map_err(|e| match e {
+                gltf::Error::Io(source) => SceneError::Io {
+                    path: path.to_path_buf(),
+                    element: element.clone(),
+                    source,
+                },
+                e => SceneError::invalid(path, &element, e.to_string()),
+            })?;
+        if data.len() < buffer.length() {
+            return Err(SceneError::invalid(
+                path,
+                element,
+                format!(
+                    "holds {} bytes but byteLength is {}",
+                    data.len(),
+                    buffer.length()
+                ),
+            ));
+        }
+        buffers.push(data);
+    }
+    for view in document.views() {
+        let end = view.offset().checked_add(view.length());
+        let have = buffers[view.buffer().index()].len();
+        if end.is_none_or(|e| e > have) {
+            return Err(SceneError::invalid(
+                path,
+                format!("bufferView {}", view.index()),
+                format!(
+                    "bytes {}..+{} exceed buffer {} ({have} bytes)",
+                    view.offset(),
+                    view.length(),
+                    view.buffer().index()
+                ),
+            ));
+        }
+    }
+    Ok(buffers)
+}
+
+struct Loader<'a> {
+    path: &'a Path,
+    base: PathBuf,
+    buffers: Vec<gltf::buffer::Data>,
+    parts: SceneParts,
+    /// Decoded textures by (image index, colour space).
+    textures: HashMap<(usize, ColorSpace), TextureId>,
+    /// Index of the glTF default material, once a primitive needs it.
+    default_material: Option<u32>,
+}
+
+impl Loader<'_> {
+    fn bad(&self, element: impl Into<String>, reason: impl Into<String>) -> SceneError {
+        SceneError::invalid(self.path, element, reason)
+    }
+
+    fn warn(&mut self, msg: String) {
+        self.parts
+            .warnings
+            .push(format!("{}: {msg}", self.path.display()));
+    }
+
+    /// Adds what `node` carries (mesh, camera, light); returns its world transform.
+    fn node(&mut self, node: &gltf::Node, parent: Mat4) -> Result<Mat4, SceneError> {
+        let local = match node.transform() {
+            gltf::scene::Transform::Matrix { matrix } => Mat4::from_cols_array_2d(&matrix),
+            gltf::scene::Transform::Decomposed {
+                translation,
+                rotation,
+                scale,
+            } => Mat4::from_scale_rotation_translation(
+                Vec3::from(scale),
+                // A zero quaternion becomes NaN here and fails the check below.
+                Quat::from_array(rotation).normalize(),
+                Vec3::from(translation),
+            ),
+        };
+        let world = parent * local;
+        let det = world.determinant();
+        if !world.is_finite() || !det.is_finite() || det.abs() < 1e-30 {
+            return Err(self.bad(
+                node_label(node),
+                format!("world transform is not invertible or not finite: {world:?}"),
+            ));
+        }
+        if let Some(mesh) = node.mesh() {
+            self.mesh(&mesh, world)?;
+        }
+        if let Some(camera) = node.camera() {
+            self.camera(node, &camera, world)?;
+        }
+        if let Some(light) = node.light() {
+            self.light(&light, world);
+        }
+        Ok(world)
+    }
+
+    fn camera(
+        &mut self,
+        node: &gltf::Node,
+        camera: &gltf::Camera,
+        world: Mat4,
+    ) -> Result<(), SceneError> {
+        let name = camera
+            .name()
+            .or(node.name())
+            .map_or_else(|| format!("camera{}", camera.index()), str::to_string);
+        let element = format!(
+            "camera {name:?} ({}) on {}",
+            camera.index(),
+            node_label(node)
+        );
+        let gltf::camera::Projection::Perspective(p) = camera.projection() else {
+            return Err(self.bad(element, "orthographic cameras are not supported"));
+        };
+        let yfov = p.yfov();
+        if !(yfov > 0.0 && yfov < std::f32::consts::PI) {
+            return Err(self.bad(element, format!("yfov {yfov} is not in (0, pi)")));
+        }
+        let (_, rotation, translation) = world.to_scale_rotation_translation();
+        self.parts.cameras.push(Camera {
+            name,
+            world_from_camera: Affine3A::from_rotation_translation(
+                rotation.normalize(),
+                translation,
+            ),
+            yfov,
+            aspect_ratio: p.aspect_ratio().filter(|a| a.is_finite() && *a > 0.0),
+        });
+        Ok(())
+    }
+
+    fn light(&mut self, light: &gltf::khr_lights_punctual::Light, world: Mat4) {
+        use gltf::khr_lights_punctual::Kind;
+        let power = Vec3::from(light.color()) * light.intensity();
+        let position = world.transform_point3(Vec3::ZERO);
+        let direction = world.transform_vector3(-Vec3::Z).normalize();
+        let range = light.range().filter(|r| r.is_finite() && *r > 0.0);
+        self.parts.lights.push(match light.kind() {
+            Kind::Point => Light::Point {
+                position,
+                intensity: power,
+                range,
+            },
+            Kind::Spot {
+                inner_cone_angle,
+                outer_cone_angle,
+            } => Light::Spot {
+                position,
+                direction,
+                intensity: power,
+                cos_inner: inner_cone_angle.cos(),
+                cos_outer: outer_cone_angle.cos(),
+                range,
+            },
+            Kind::Directional => Light::Directional {
+                direction,
+                irradiance: power,
+            },
+        });
+    }
+
+    /// Checks that `accessor` has one of the `allowed` layouts and lies within its view.
+    fn check_accessor(
+        &self,
+        accessor: &gltf::Accessor,
+        element: &str,
+        allowed: &[(Dimensions, DataType)],
+    ) -> Result<(), SceneError> {
+        let element = format!("{element} (accessor {})", accessor.index());
+        if accessor.sparse().is_some() {
+            return Err(self.bad(element, "sparse accessors are not supported"));
+        }
+        let layout = (accessor.dimensions(), accessor.data_type());
+        if !allowed.contains(&layout) {
+            return Err(self.bad(
+                element,
+                format!("unexpected layout {layout:?} (allowed: {allowed:?})"),
+            ));
+        }
+        let count = accessor.count();
+        if count == 0 {
+            return Err(self.bad(element, "count is 0"));
+        }
+        let Some(view) = accessor.view() else {
+            return Err(self.bad(element, "has no bufferView"));
+        };
+        let size = accessor.size();
+        let stride = view.stride().unwrap_or(size);
+        if stride < size {
+            return Err(self.bad(
+                element,
+                format!("byteStride {stride} is smaller than an element ({size} bytes)"),
+            ));
+        }
+        let end = (count - 1)
+            .checked_mul(stride)
+            .and_then(|x| x.checked_add(size))
+            .and_then(|x| x.checked_add(accessor.offset()));
+        if end.is_none_or(|e| e > view.length()) {
+            return Err(self.bad(
+                element,
+                format!(
+                    "{count} elements from byte {} (stride {stride}) overrun bufferView {} \
+                     ({} bytes)",
+                    accessor.offset(),
+                    view.index(),
+                    view.length()
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    fn mesh(&mut self, mesh: &gltf::Mesh, world: Mat4) -> Result<(), SceneError> {
+        let normal_matrix = Mat3::from_mat4(world).inverse().transpose();
+        let flip = world.determinant() < 0.0;
+        for prim in mesh.primitives() {
+            let element = format!("{}, primitive {}", mesh_label(mesh), prim.index());
+            let mode = prim.mode();
+            if !matches!(
+                mode,
+                Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+            ) {
+                self.warn(format!("{element}: skipped {mode:?} primitive"));
+                continue;
+            }
+            let Some(pos_acc) = prim.get(&gltf::Semantic::Positions) else {
+                return Err(self.bad(element, "has no POSITION attribute"));
+            };
+            let f32x3 = [(Dimensions::Vec3, DataType::F32)];
+            self.check_accessor(&pos_acc, &format!("{element}, POSITION"), &f32x3)?;
+            let normal_acc = prim.get(&gltf::Semantic::Normals);
+            if let Some(a) = &normal_acc {
+                self.check_accessor(a, &format!("{element}, NORMAL"), &f32x3)?;
+            }
+            let uv_acc = prim.get(&gltf::Semantic::TexCoords(0));
+            if let Some(a) = &uv_acc {
+                self.check_accessor(
+                    a,
+                    &format!("{element}, TEXCOORD_0"),
+                    &[
+                        (Dimensions::Vec2, DataType::F32),
+                        (Dimensions::Vec2, DataType::U8),
+                        (Dimensions::Vec2, DataType::U16),
+                    ],
+                )?;
+            }
+            if let Some(a) = prim.indices() {
+                self.check_accessor(
+                    &a,
+                    &format!("{element}, indices"),
+                    &[
+                        (Dimensions::Scalar, DataType::U8),
+                        (Dimensions::Scalar, DataType::U16),
+                        (Dimensions::Scalar, DataType::U32),
+                    ],
+                )?;
+            }
+            let buffers = &self.buffers;
+            let reader = prim.reader(|b| buffers.get(b.index()).map(|d| d.0.as_slice()));
+            let short = |what: &str| self.bad(format!("{element}, {what}"), "cannot be read");
+            let positions: Vec<Vec3> = reader
+                .read_positions()
+                .ok_or_else(|| short("POSITION"))?
+                .map(Vec3::from)
+                .collect();
+            let n = positions.len();
+            if n != pos_acc.count() {
+                return Err(short("POSITION"));
+            }
+            if positions.iter().any(|p| !p.is_finite()) {
+                return Err(self.bad(
+                    format!("{element}, POSITION"),
+                    "contains a non-finite value",
+                ));
+            }
+            let normals: Vec<Vec3> = match reader.read_normals() {
+                Some(it) => it
+                    .map(|v| {
+                        (normal_matrix * Vec3::from(v))
+                            .try_normalize()
+                            .unwrap_or(Vec3::ZERO)
+                    })
+                    .collect(),
+                None => vec![Vec3::ZERO; n],
+            };
+            let uvs: Vec<Vec2> = match reader.read_tex_coords(0) {
+                Some(it) => it.into_f32().map(Vec2::from).collect(),
+                None => vec![Vec2::ZERO; n],
+            };
+            if normals.len() != n || uvs.len() != n {
+                return Err(self.bad(
+                    element,
+                    "NORMAL or TEXCOORD_0 count differs from POSITION count",
+                ));
+            }
+            let indices: Vec<u32> = match reader.read_indices() {
+                Some(it) => it.into_u32().collect(),
+                None => (0..n as u32).collect(),
+            };
+            if let Some(bad) = indices.iter().find(|&&i| i as usize >= n) {
+                return Err(self.bad(
+                    format!("{element}, indices"),
+                    format!("index {bad} out of range ({n} vertices)"),
+                ));
+            }
+            let mut tris = triangulate(mode, &indices);
+            if mode == Mode::Triangles && indices.len() % 3 != 0 {
+                self.warn(format!(
+                    "{element}: {} indices is not a multiple of 3; the rest is ignored",
+                    indices.len()
+                ));
+            }
+            let material = match prim.material().index() {
+                Some(i) => i as u32,
+                None => self.default_material(),
+            };
+            let first = self.parts.positions.len();
+            if first + n > u32::MAX as usize {
+                return Err(self.bad(element, "the scene has more than 2^32 - 1 vertices"));
+            }
+            let first = first as u32;
+            for t in &mut tris {
+                if flip {
+                    t.swap(1, 2);
+                }
+                *t = t.map(|i| i + first);
+            }
+            self.parts
+                .positions
+                .extend(positions.iter().map(|&p| world.transform_point3(p)));
+            self.parts.normals.extend(normals);
+            self.parts.uvs.extend(uvs);
+            self.parts
+                .triangle_materials
+                .extend(std::iter::repeat_n(material, tris.len()));
+            self.parts.triangles.extend(tris);
+        }
+        Ok(())
+    }
+
+    /// The glTF default material (white, metallic 1, roughness 1), added once when needed.
+    fn default_material(&mut self) -> u32 {
+        *self.default_material.get_or_insert_with(|| {
+            self.parts.materials.push(Material {
+                name: "default".into(),
+                reflectance: Reflectance::GltfPbr {
+                    base_color: Vec3::ONE,
+                    base_color_texture: None,
+                    metallic: 1.0,
+                    roughness: 1.0,
+                    metallic_roughness_texture: None,
+                },
+                emission: Vec3::ZERO,
+                emission_texture: None,
+                double_sided: false,
+            });
+            (self.parts.materials.len() - 1) as u32
+        })
+    }
+
+    fn material(&mut self, m: &gltf::Material, index: usize) -> Result<Material, SceneError> {
+        let name = m
+            .name()
+            .map_or_else(|| format!("material{index}"), str::to_string);
+        let element = format!("material {name:?} ({index})");
+        let pbr = m.pbr_metallic_roughness();
+        let base_color_texture = match pbr.base_color_texture() {
+            Some(info) => Some(self.texture(&info, ColorSpace::Srgb, &element)?),
+            None => None,
+        };
+        let mr_texture = match pbr.metallic_roughness_texture() {
+            Some(info) => Some(self.texture(&info, ColorSpace::Linear, &element)?),
+            None => None,
+        };
+        let emission_texture = match m.emissive_texture() {
+            Some(info) => Some(self.texture(&info, ColorSpace::Srgb, &element)?),
+            None => None,
+        };
+        let emission = Vec3::from(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0);
+        if !emission.is_finite() || emission.min_element() < 0.0 {
+            return Err(self.bad(element, format!("emission {emission} is invalid")));
+        }
+        let base = Vec4::from(pbr.base_color_factor());
+        let reflectance = match self.streaks_extras(m, &element)? {
+            Some(x) => self.paper(x, base_color_texture, mr_texture, &element)?,
+            None => Reflectance::GltfPbr {
+                base_color: base.truncate(),
+                base_color_texture,
+                metallic: pbr.metallic_factor(),
+                roughness: pbr.roughness_factor(),
+                metallic_roughness_texture: mr_texture,
+            },
+        };
+        Ok(Material {
+            name,
+            reflectance,
+            emission,
+            emission_texture,
+            double_sided: m.double_sided(),
+        })
+    }
+
+    fn streaks_extras(
+        &self,
+        m: &gltf::Material,
+        element: &str,
+    ) -> Result<Option<StreaksExtras>, SceneError> {
+        let Some(raw) = m.extras() else {
+            return Ok(None);
+        };
+        let value: serde_json::Value = serde_json::from_str(raw.get())
+            .map_err(|e| self.bad(element, format!("extras: {e}")))?;
+        let Some(streaks) = value.get("streaks") else {
+            return Ok(None);
+        };
+        serde_json::from_value(streaks.clone())
+            .map(Some)
+            .map_err(|e| self.bad(element, format!("extras.streaks: {e}")))
+    }
+
+    fn paper(
+        &self,
+        x: StreaksExtras,
+        kd_texture: Option<TextureId>,
+        mr_texture: Option<TextureId>,
+        element: &str,
+    ) -> Result<Reflectance, SceneError> {
+        let bad = |reason: String| self.bad(element, format!("extras.streaks: {reason}"));
+        let colour = |c: Option<[f32; 3]>, key: &str| {
+            let v = Vec3::from(c.unwrap_or([0.0; 3]));
+            if v.is_finite() && v.min_element() >= 0.0 {
+                Ok(v)
+            } else {
+                Err(bad(format!("{key} {v} must be finite and non-negative")))
+            }
+        };
+        let kd = colour(x.kd, "kd")?;
+        let ks = colour(x.ks, "ks")?;
+        let ks_dry = colour(x.ks_dry.or(x.ks), "ks_dry")?;
+        let model = match x.bsdf {
+            StreaksBsdf::Ggx => PaperModel::Ggx,
+            StreaksBsdf::Ward => PaperModel::Ward,
+            StreaksBsdf::BlinnPhong => PaperModel::BlinnPhong,
+        };
+        let (alpha, shininess) = match model {
+            PaperModel::Ggx | PaperModel::Ward => match x.alpha {
+                Some(a) if a.is_finite() && a > 0.0 => (a, 0.0),
+                Some(a) => return Err(bad(format!("alpha {a} must be positive"))),
+                None => return Err(bad(format!("{model:?} needs \"alpha\""))),
+            },
+            PaperModel::BlinnPhong => match x.shininess {
+                Some(s) if s.is_finite() && s >= 0.0 => (0.0, s),
+                Some(s) => return Err(bad(format!("shininess {s} must be non-negative"))),
+                None => return Err(bad("blinn_phong needs \"shininess\"".into())),
+            },
+        };
+        let wetness = match x.alpha_dry {
+            None => None,
+            Some(a)
+                if !(a.is_finite() && a >= 0.0)
+                    || (a == 0.0 && model != PaperModel::BlinnPhong) =>
+            {
+                return Err(bad(format!("alpha_dry {a} is invalid")));
+            }
+            Some(alpha_dry) => {
+                let Some(texture) = mr_texture else {
+                    return Err(bad(
+                        "alpha_dry needs a metallicRoughnessTexture (the dryness map)".into(),
+                    ));
+                };
+                Some(Wetness {
+                    texture,
+                    alpha_dry,
+                    ks_dry,
+                })
+            }
+        };
+        Ok(Reflectance::Paper {
+            model,
+            kd,
+            ks,
+            alpha,
+            shininess,
+            kd_texture,
+            wetness,
+        })
+    }
+
+    fn texture(
+        &mut self,
+        info: &gltf::texture::Info,
+        space: ColorSpace,
+        material: &str,
+    ) -> Result<TextureId, SceneError> {
+        if info.tex_coord() != 0 {
+            self.warn(format!(
+                "{material}: texture uses TEXCOORD_{}; TEXCOORD_0 is used instead",
+                info.tex_coord()
+            ));
+        }
+        let sampler = info.texture().sampler();
+        let repeat = gltf::texture::WrappingMode::Repeat;
+        if sampler.wrap_s() != repeat || sampler.wrap_t() != repeat {
+            self.warn(format!(
+                "{material}: texture {} asks for {:?}/{:?} wrapping; repeat is used",
+                info.texture().index(),
+                sampler.wrap_s(),
+                sampler.wrap_t()
+            ));
+        }
+        let image = info.texture().source();
+        let key = (image.index(), space);
+        if let Some(&id) = self.textures.get(&key) {
+            return Ok(id);
+        }
+        let element = match image.source() {
+            gltf::image::Source::Uri { uri, .. } => format!(
+                "{material}, image {} ({})",
+                image.index(),
+                uri_label(&self.base, uri)
+            ),
+            gltf::image::Source::View { view, .. } => format!(
+                "{material}, image {} (bufferView {})",
+                image.index(),
+                view.index()
+            ),
+        };
+        if let gltf::image::Source::Uri { uri, .. } = image.source() {
+            if !uri_is_decodable(uri) {
+                return Err(self.bad(element, "URI escapes are not UTF-8"));
+            }
+        }
+        let data = gltf::image::Data::from_source(image.source(), Some(&self.base), &self.buffers)
+            .map_err(|e| match e {
+                gltf::Error::Io(source) => SceneError::Io {
+                    path: self.path.to_path_buf(),
+                    element: element.clone(),
+                    source,
+                },
+                e => self.bad(&element, e.to_string()),
+            })?;
+        let texture = decode_image(&data, space)
+            .ok_or_else(|| self.bad(&element, "pixel data does not match its size"))?;
+        let id = self.parts.textures.len() as TextureId;
+        self.parts.textures.push(texture);
+        self.textures.insert(key, id);
+        Ok(id)
+    }
+}
+
+/// Triangles (local vertex indices) of a triangle, strip or fan primitive (glTF 2.0 section
+/// 3.7.2.1); degenerate strip and fan triangles are kept (they are never hit).
+fn triangulate(mode: Mode, idx: &[u32]) -> Vec<[u32; 3]> {
+    match mode {
+        Mode::Triangles => idx.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+        Mode::TriangleStrip => (0..idx.len().saturating_sub(2))
+            .map(|i| {
+                if i % 2 == 0 {
+                    [idx[i], idx[i + 1], idx[i + 2]]
+                } else {
+                    [idx[i + 1], idx[i], idx[i + 2]]
+                }
+            })
+            .collect(),
+        Mode::TriangleFan => (1..idx.len().saturating_sub(1))
+            .map(|i| [idx[i], idx[i + 1], idx[0]])
+            .collect(),
+        _ => Vec::new(),
+    }
+}
+
+/// Converts decoded glTF image data to a linear RGBA texture.
+fn decode_image(data: &gltf::image::Data, space: ColorSpace) -> Option<Texture> {
+    use gltf::image::Format;
+    let p = &data.pixels;
+    let u16s = |c: &[u8]| -> Vec<f32> {
+        c.chunks_exact(2)
+            .map(|b| f32::from(u16::from_ne_bytes([b[0], b[1]])) / 65535.0)
+            .collect()
+    };
+    let f32s = |c: &[u8]| -> Vec<f32> {
+        c.chunks_exact(4)
+            .map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]))
+            .collect()
+    };
+    let (values, channels): (Vec<f32>, usize) = match data.format {
+        Format::R8 => (p.iter().map(|&b| f32::from(b) / 255.0).collect(), 1),
+        Format::R8G8 => (p.iter().map(|&b| f32::from(b) / 255.0).collect(), 2),
+        Format::R8G8B8 => (p.iter().map(|&b| f32::from(b) / 255.0).collect(), 3),
+        Format::R8G8B8A8 => (p.iter().map(|&b| f32::from(b) / 255.0).collect(), 4),
+        Format::R16 => (u16s(p), 1),
+        Format::R16G16 => (u16s(p), 2),
+        Format::R16G16B16 => (u16s(p), 3),
+        Format::R16G16B16A16 => (u16s(p), 4),
+        Format::R32G32B32FLOAT => (f32s(p), 3),
+        Format::R32G32B32A32FLOAT => (f32s(p), 4),
+    };
+    let rgba = values
+        .chunks_exact(channels)
+        .map(|c| match channels {
+            // Grey (and grey-alpha) images replicate their value, as image viewers do.
+            1 => Vec4::new(c[0], c[0], c[0], 1.0),
+            2 => Vec4::new(c[0], c[0], c[0], c[1]),
+            3 => Vec4::new(c[0], c[1], c[2], 1.0),
+            _ => Vec4::new(c[0], c[1], c[2], c[3]),
+        })
+        .collect();
+    Texture::from_rgba(data.width, data.height, rgba, space)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::{json, Value};
+    use std::f32::consts::FRAC_1_SQRT_2;
+
+    /// A glTF document under construction: one binary buffer, views and accessors.
+    #[derive(Default)]
+    struct Doc {
+        bin: Vec<u8>,
+        views: Vec<Value>,
+        accessors: Vec<Value>,
+    }
+
+    impl Doc {
+        fn view(&mut self, bytes: &[u8]) -> usize {
+            while self.bin.len() % 4 != 0 {
+                self.bin.push(0);
+            }
+            self.views.push(
+                json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len()}),
+            );
+            self.bin.extend_from_slice(bytes);
+            self.views.len() - 1
+        }
+
+        fn floats(&mut self, data: &[f32], ty: &str, width: usize) -> usize {
+            let bytes: Vec<u8> = data.iter().flat_map(|f| f.to_le_bytes()).collect();
+            let view = self.view(&bytes);
+            let mut acc = json!({"bufferView": view, "componentType": 5126,
+                "count": data.len() / width, "type": ty});
+            if ty == "VEC3" {
+                let col = |k: usize| data.iter().skip(k).step_by(3).copied();
+                let min: Vec<f32> = (0..3).map(|k| col(k).fold(f32::MAX, f32::min)).collect();
+                let max: Vec<f32> = (0..3).map(|k| col(k).fold(f32::MIN, f32::max)).collect();
+                acc["min"] = json!(min);
+                acc["max"] = json!(max);
+            }
+            self.accessors.push(acc);
+            self.accessors.len() - 1
+        }
+
+        fn indices(&mut self, data: &[u16]) -> usize {
+            let bytes: Vec<u8> = data.iter().flat_map(|i| i.to_le_bytes()).collect();
+            let view = self.view(&bytes);
+            self.accessors
+                .push(json!({"bufferView": view, "componentType": 5123,
+                "count": data.len(), "type": "SCALAR"}));
+            self.accessors.len() - 1
+        }
+    }
+
+    /// The test scene: a quad (indexed, normals, uvs) under a TRS parent and a matrix child, a
+    /// non-indexed emissive triangle without normals, a camera, and three punctual lights.
+    fn test_doc() -> (Value, Vec<u8>) {
+        let mut d = Doc::default();
+        let quad_pos = d.floats(&[0., 0., 0., 0., 0., 1., 1., 0., 1., 1., 0., 0.], "VEC3", 3);
+        let quad_nrm = d.floats(&[0., 1., 0.].repeat(4), "VEC3", 3);
+        let quad_uv = d.floats(&[0., 0., 0., 1., 1., 1., 1., 0.], "VEC2", 2);
+        let quad_idx = d.indices(&[0, 1, 2, 0, 2, 3]);
+        let tri_pos = d.floats(&[0., 0., 0., 1., 0., 0., 0., 1., 0.], "VEC3", 3);
+        let s = FRAC_1_SQRT_2;
+        let doc = json!({
+            "asset": {"version": "2.0"},
+            "extensionsUsed": ["KHR_lights_punctual", "KHR_materials_emissive_strength"],
+            "scene": 0,
+            "scenes": [{"nodes": [0, 2, 3, 4, 5, 6]}],
+            "nodes": [
+                {"name": "parent", "translation": [0, 1, 0], "scale": [2, 2, 2], "children": [1]},
+                {"name": "child", "mesh": 0,
+                 "matrix": [1,0,0,0, 0,1,0,0, 0,0,1,0, 10,0,0,1]},
+                {"name": "lamp", "mesh": 1, "translation": [0, 0, -3]},
+                {"name": "cam_node", "camera": 0, "translation": [0, 2, 5], "scale": [3, 3, 3],
+                 "rotation": [0, s, 0, s]},
+                {"name": "bulb", "translation": [1, 2, 3],
+                 "extensions": {"KHR_lights_punctual": {"light": 0}}},
+                {"name": "spot", "translation": [0, 5, 0], "rotation": [-s, 0, 0, s],
+                 "extensions": {"KHR_lights_punctual": {"light": 1}}},
+                {"name": "sun", "extensions": {"KHR_lights_punctual": {"light": 2}}}
+            ],
+            "meshes": [
+                {"name": "quad", "primitives": [{"attributes":
+                    {"POSITION": quad_pos, "NORMAL": quad_nrm, "TEXCOORD_0": quad_uv},
+                    "indices": quad_idx, "material": 0}]},
+                {"name": "tri", "primitives": [{"attributes": {"POSITION": tri_pos}, "material": 1}]}
+            ],
+            "materials": [
+                {"name": "asphalt", "extras": {"streaks": {"bsdf": "ggx", "kd": [0.1, 0.1, 0.1],
+                    "ks": [0.5, 0.5, 0.5], "alpha": 0.05}}},
+                {"name": "glow", "emissiveFactor": [1, 0.5, 0], "doubleSided": true,
+                 "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 5}}}
+            ],
+            "cameras": [{"type": "perspective", "perspective": {"yfov": 0.7, "znear": 0.1, "aspectRatio": 1.5}}],
+            "extensions": {"KHR_lights_punctual": {"lights": [
+                {"type": "point", "color": [1, 0.5, 0.25], "intensity": 10, "range": 20},
+                {"type": "spot", "intensity": 3, "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.5}},
+                {"type": "directional", "intensity": 2}
+            ]}},
+            "buffers": [{"byteLength": d.bin.len()}],
+            "bufferViews": d.views,
+            "accessors": d.accessors
+        });
+        (doc, d.bin)
+    }
+
+    fn write_embedded(dir: &Path, mut doc: Value, bin: &[u8]) -> PathBuf {
+        doc["buffers"][0]["uri"] = json!(format!(
+            "data:application/octet-stream;base64,{}",
+            base64::encode(bin)
+        ));
+        let path = dir.join("scene.gltf");
+        std::fs::write(&path, serde_json::to_vec_pretty(&doc).unwrap()).unwrap();
+        path
+    }
+
+    fn write_external(dir: &Path, mut doc: Value, bin: &[u8]) -> PathBuf {
+        doc["buffers"][0]["uri"] = json!("scene data.bin");
+        std::fs::write(dir.join("scene data.bin"), bin).unwrap();
+        let path = dir.join("external.gltf");
+        std::fs::write(&path, serde_json::to_vec(&doc).unwrap()).unwrap();
+        path
+    }
+
+    fn write_glb(dir: &Path, doc: &Value, bin: &[u8]) -> PathBuf {
+        let mut json = serde_json::to_vec(doc).unwrap();
+        while json.len() % 4 != 0 {
+            json.push(b' ');
+        }
+        let mut bin = bin.to_vec();
+        while bin.len() % 4 != 0 {
+            bin.push(0);
+        }
+        let total = 12 + 8 + json.len() + 8 + bin.len();
+        let mut out = Vec::new();
+        out.extend_from_slice(b"glTF");
+        out.extend_from_slice(&2u32.to_le_bytes());
+        out.extend_from_slice(&(total as u32).to_le_bytes());
+        out.extend_from_slice(&(json.len() as u32).to_le_bytes());
+        out.extend_from_slice(&0x4E4F_534Au32.to_le_bytes());
+        out.extend_from_slice(&json);
+        out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+        out.extend_from_slice(&0x004E_4942u32.to_le_bytes());
+        out.extend_from_slice(&bin);
+        let path = dir.join("scene.glb");
+        std::fs::write(&path, out).unwrap();
+        path
+    }
+
+    fn approx(a: Vec3, b: Vec3) -> bool {
+        (a - b).length() < 1e-5
+    }
+
+    fn check_test_scene(scene: &Scene) {
+        assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+        // Quad: world = T(0,1,0) S(2) T(10,0,0).
+        assert_eq!(scene.triangles.len(), 3);
+        assert!(approx(scene.positions[2], Vec3::new(22.0, 1.0, 2.0)));
+        assert!(approx(scene.positions[0], Vec3::new(20.0, 1.0, 0.0)));
+        assert!(approx(scene.normals[1], Vec3::Y));
+        assert_eq!(scene.uvs[2], Vec2::new(1.0, 1.0));
+        // The emissive triangle has face normals (stored as zero) and sits at z = -3.
+        assert_eq!(scene.normals[5], Vec3::ZERO);
+        assert!(approx(scene.positions[5], Vec3::new(1.0, 0.0, -3.0)));
+        // A ray down onto the quad hits it with the right uv and normal.
+        let hit = scene
+            .intersect(&crate::geometry::Ray::new(
+                Vec3::new(21.0, 5.0, 0.5),
+                -Vec3::Y,
+            ))
+            .expect("hits the quad");
+        assert!((hit.t - 4.0).abs() < 1e-5 && approx(hit.ng, Vec3::Y) && approx(hit.ns, Vec3::Y));
+        assert!(
+            (hit.uv - Vec2::new(0.5, 0.25)).length() < 1e-5,
+            "{}",
+            hit.uv
+        );
+        assert_eq!(scene.materials[hit.material as usize].name, "asphalt");
+        // The triangle: ng = +Z from its winding, ns falls back to ng.
+        let hit = scene
+            .intersect(&crate::geometry::Ray::new(
+                Vec3::new(0.2, 0.2, 1.0),
+                -Vec3::Z,
+            ))
+            .unwrap();
+        assert!(approx(hit.ng, Vec3::Z) && approx(hit.ns, Vec3::Z));
+        // Materials.
+        let Reflectance::Paper {
+            model, ks, alpha, ..
+        } = &scene.materials[0].reflectance
+        else {
+            panic!("asphalt is not a paper material")
+        };
+        assert_eq!((*model, *alpha), (PaperModel::Ggx, 0.05));
+        assert!(approx(*ks, Vec3::splat(0.5)));
+        let glow = &scene.materials[1];
+        assert!(approx(glow.emission, Vec3::new(5.0, 2.5, 0.0)) && glow.double_sided);
+        assert!(matches!(
+            glow.reflectance,
+            Reflectance::GltfPbr { metallic: 1.0, .. }
+        ));
+        // Camera: named after the node, scale removed, looking along world -X.
+        let cam = scene.camera(None).unwrap();
+        assert_eq!(cam.name, "cam_node");
+        assert_eq!(scene.camera(Some("cam_node")).unwrap().name, "cam_node");
+        assert!((cam.yfov - 0.7).abs() < 1e-6 && cam.aspect_ratio == Some(1.5));
+        assert!(approx(cam.position(), Vec3::new(0.0, 2.0, 5.0)));
+        let fwd = cam.world_from_camera.transform_vector3(-Vec3::Z);
+        assert!(approx(fwd, -Vec3::X), "{fwd}");
+        assert!((cam.world_from_camera.matrix3.determinant() - 1.0).abs() < 1e-5);
+        let err = scene.camera(Some("nope")).unwrap_err().to_string();
+        assert!(
+            err.contains("nope") && err.contains("\"cam_node\""),
+            "{err}"
+        );
+        // Lights: three punctual ones, then the emissive triangle.
+        assert_eq!(scene.lights.len(), 4);
+        assert_eq!(
+            scene.lights[0],
+            Light::Point {
+                position: Vec3::new(1.0, 2.0, 3.0),
+                intensity: Vec3::new(10.0, 5.0, 2.5),
+                range: Some(20.0)
+            }
+        );
+        let Light::Spot {
+            position,
+            direction,
+            cos_inner,
+            cos_outer,
+            range,
+            ..
+        } = scene.lights[1]
+        else {
+            panic!("not a spot")
+        };
+        assert!(approx(position, Vec3::new(0.0, 5.0, 0.0)) && approx(direction, -Vec3::Y));
+        assert!((cos_inner - 0.2f32.cos()).abs() < 1e-6 && (cos_outer - 0.5f32.cos()).abs() < 1e-6);
+        assert_eq!(range, None);
+        assert!(
+            matches!(scene.lights[2], Light::Directional { direction, irradiance }
+            if approx(direction, -Vec3::Z) && approx(irradiance, Vec3::splat(2.0)))
+        );
+        assert_eq!(scene.lights[3], Light::Triangle { triangle: 2 });
+    }
+
+    #[test]
+    fn loads_embedded_external_and_glb() {
+        let dir = tempfile::tempdir().unwrap();
+        let (doc, bin) = test_doc();
+        let embedded = write_embedded(dir.path(), doc.clone(), &bin);
+        check_test_scene(&Scene::load(&embedded).unwrap());
+        let external = write_external(dir.path(), doc.clone(), &bin);
+        check_test_scene(&Scene::load(&external).unwrap());
+        let glb = write_glb(dir.path(), &doc, &bin);
+        check_test_scene(&Scene::load(&glb).unwrap());
+    }
+
+    /// Loads `doc` (embedded) and returns the error message; panics if it loads.
+    fn load_err(doc: Value, bin: &[u8]) -> String {
+        let dir = tempfile::tempdir().unwrap();
+        let path = write_embedded(dir.path(), doc, bin);
+        let err = Scene::load(&path).expect_err("should fail").to_string();
+        assert!(err.contains("scene.gltf"), "no file name in: {err}");
+        err
+    }
+
+    #[test]
+    fn truncated_json_is_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let (doc, bin) = test_doc();
+        let path = write_embedded(dir.path(), doc, &bin);
+        let text = std::fs::read(&path).unwrap();
+        std::fs::write(&path, &text[..text.len() / 2]).unwrap();
+        let err = Scene::load(&path).unwrap_err().to_string();
+        assert!(
+            err.contains("scene.gltf") && err.contains("invalid glTF"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn truncated_glb_and_bad_uris_are_errors() {
+        let dir = tempfile::tempdir().unwrap();
+        let (doc, bin) = test_doc();
+        let path = write_glb(dir.path(), &doc, &bin);
+        let bytes = std::fs::read(&path).unwrap();
+        for cut in [bytes.len() - 8, bytes.len() / 2, 30, 10] {
+            std::fs::write(&path, &bytes[..cut]).unwrap();
+            let err = Scene::load(&path).unwrap_err().to_string();
+            assert!(err.contains("scene.glb"), "{err}");
+        }
+        let (mut doc, _) = test_doc();
+        doc["buffers"][0]["uri"] = json!("%FF%FE.bin");
+        let path = dir.path().join("bad uri.gltf");
+        std::fs::write(&path, serde_json::to_vec(&doc).unwrap()).unwrap();
+        let err = Scene::load(&path).unwrap_err().to_string();
+        assert!(err.contains("buffer 0") && err.contains("UTF-8"), "{err}");
+        assert!(uri_is_decodable("a%20b.bin") && uri_is_decodable("%zz.bin"));
+    }
+
+    #[test]
+    fn missing_bin_names_the_buffer_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let (doc, bin) = test_doc();
+        let path = write_external(dir.path(), doc, &bin);
+        std::fs::remove_file(dir.path().join("scene data.bin")).unwrap();
+        let err = Scene::load(&path).unwrap_err().to_string();
+        assert!(
+            err.contains("external.gltf") && err.contains("buffer 0"),
+            "{err}"
+        );
+        assert!(err.contains("scene data.bin"), "{err}");
+    }
+
+    #[test]
+    fn accessor_out_of_range_names_mesh_and_primitive() {
+        let (mut doc, bin) = test_doc();
+        doc["accessors"][0]["count"] = json!(400);
+        let err = load_err(doc, &bin);
+        assert!(
+            err.contains("mesh \"quad\" (0), primitive 0, POSITION") && err.contains("overrun"),
+            "{err}"
+        );
+        let (mut doc, bin) = test_doc();
+        doc["bufferViews"][0]["byteLength"] = json!(100_000);
+        let err = load_err(doc, &bin);
+        assert!(err.contains("bufferView 0"), "{err}");
+        let (mut doc, bin) = test_doc();
+        doc["accessors"][3]["componentType"] = json!(5126); // float indices
+        let err = load_err(doc, &bin);
+        assert!(err.contains("primitive 0, indices"), "{err}");
+    }
+
+    #[test]
+    fn index_out_of_range_is_an_error() {
+        let (doc, mut bin) = test_doc();
+        // The quad's indices follow positions (48 bytes), normals (48) and uvs (32).
+        bin[128..130].copy_from_slice(&7u16.to_le_bytes());
+        let err = load_err(doc, &bin);
+        assert!(
+            err.contains("mesh \"quad\" (0), primitive 0, indices") && err.contains("index 7"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn points_primitive_is_skipped_with_a_warning() {
+        let dir = tempfile::tempdir().unwrap();
+        let (mut doc, bin) = test_doc();
+        doc["meshes"][1]["primitives"][0]["mode"] = json!(0);
+        let path = write_embedded(dir.path(), doc, &bin);
+        let scene = Scene::load(&path).unwrap();
+        assert_eq!(scene.triangles.len(), 2);
+        assert_eq!(scene.warnings.len(), 1);
+        assert!(
+            scene.warnings[0].contains("mesh \"tri\" (1), primitive 0"),
+            "{:?}",
+            scene.warnings
+        );
+        assert!(scene.warnings[0].contains("Points"));
+    }
+
+    #[test]
+    fn strips_and_fans_are_triangulated() {
+        assert_eq!(
+            triangulate(Mode::TriangleStrip, &[0, 1, 2, 3]),
+            vec![[0, 1, 2], [2, 1, 3]]
+        );
+        assert_eq!(
+            triangulate(Mode::TriangleFan, &[0, 1, 2, 3]),
+            vec![[1, 2, 0], [2, 3, 0]]
+        );
+    }
+
+    #[test]
+    fn bad_transforms_name_the_node() {
+        let (mut doc, bin) = test_doc();
+        // JSON has no NaN: a value beyond f32 range becomes infinite.
+        doc["nodes"][1]["matrix"][0] = json!(1e39);
+        let err = load_err(doc, &bin);
+        assert!(
+            err.contains("node \"child\" (1)") && err.contains("not invertible"),
+            "{err}"
+        );
+        let (mut doc, bin) = test_doc();
+        doc["nodes"][0]["scale"] = json!([1, 0, 1]);
+        let err = load_err(doc, &bin);
+        assert!(err.contains("node \"parent\" (0)"), "{err}");
+    }
+
+    #[test]
+    fn scene_zero_is_used_without_a_default_and_cycles_are_errors() {
+        let dir = tempfile::tempdir().unwrap();
+        let (mut doc, bin) = test_doc();
+        doc.as_object_mut().unwrap().remove("scene");
+        check_test_scene(&Scene::load(&write_embedded(dir.path(), doc, &bin)).unwrap());
+        let (mut doc, bin) = test_doc();
+        doc["nodes"][1]["children"] = json!([0]);
+        let err = load_err(doc, &bin);
+        assert!(
+            err.contains("node \"parent\" (0)") && err.contains("cycle"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn mirrored_nodes_keep_the_front_face() {
+        let dir = tempfile::tempdir().unwrap();
+        let (mut doc, bin) = test_doc();
+        doc["nodes"][2]["scale"] = json!([-1, 1, 1]);
+        let scene = Scene::load(&write_embedded(dir.path(), doc, &bin)).unwrap();
+        let hit = scene
+            .intersect(&crate::geometry::Ray::new(
+                Vec3::new(-0.2, 0.2, 1.0),
+                -Vec3::Z,
+            ))
+            .unwrap();
+        assert!(approx(hit.ng, Vec3::Z), "{}", hit.ng);
+    }
+
+    #[test]
+    fn bad_materials_and_cameras_are_named() {
+        let (mut doc, bin) = test_doc();
+        doc["materials"][0]["extras"]["streaks"]["bsdf"] = json!("phong");
+        let err = load_err(doc, &bin);
+        assert!(
+            err.contains("material \"asphalt\" (0)") && err.contains("phong"),
+            "{err}"
+        );
+        let (mut doc, bin) = test_doc();
+        doc["materials"][0]["extras"]["streaks"]["alpha"] = json!(-1);
+        let err = load_err(doc, &bin);
+        assert!(
+            err.contains("material \"asphalt\" (0)") && err.contains("alpha"),
+            "{err}"
+        );
+        let (mut doc, bin) = test_doc();
+        doc["materials"][0]["extras"]["streaks"]["alpha_dry"] = json!(0.3);
+        let err = load_err(doc, &bin);
+        assert!(err.contains("metallicRoughnessTexture"), "{err}");
+        let (mut doc, bin) = test_doc();
+        doc["cameras"][0] = json!({"name": "ortho", "type": "orthographic",
+            "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 10}});
+        let err = load_err(doc, &bin);
+        assert!(
+            err.contains("camera \"ortho\"") && err.contains("orthographic"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn unsupported_inputs_are_errors() {
+        let (mut doc, bin) = test_doc();
+        doc["extensionsRequired"] = json!(["KHR_draco_mesh_compression"]);
+        doc["extensionsUsed"] = json!(["KHR_draco_mesh_compression"]);
+        let err = load_err(doc, &bin);
+        assert!(err.contains("invalid glTF"), "{err}");
+        let err = Scene::load(Path::new("road.ply")).unwrap_err().to_string();
+        assert!(
+            err.contains("road.ply") && err.contains("unsupported"),
+            "{err}"
+        );
+        let err = Scene::load(Path::new("/nonexistent/road.glb"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("road.glb"), "{err}");
+    }
+
+    #[test]
+    fn wet_dry_material_reads_the_dryness_map() {
+        // A 2x1 PNG: left texel G = 0 (wet), right texel G = 255 (dry).
+        let mut png = Vec::new();
+        image::RgbaImage::from_raw(2, 1, vec![0, 0, 0, 255, 0, 255, 0, 255])
+            .unwrap()
+            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+            .unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("dry.png"), &png).unwrap();
+        let (mut doc, bin) = test_doc();
+        doc["images"] = json!([{"uri": "dry.png"}]);
+        doc["textures"] = json!([{"source": 0}]);
+        doc["materials"][0]["pbrMetallicRoughness"] =
+            json!({"metallicRoughnessTexture": {"index": 0}});
+        doc["materials"][0]["extras"]["streaks"]["alpha_dry"] = json!(0.45);
+        doc["materials"][0]["extras"]["streaks"]["ks_dry"] = json!([0.1, 0.1, 0.1]);
+        let scene = Scene::load(&write_embedded(dir.path(), doc.clone(), &bin)).unwrap();
+        assert_eq!(scene.textures.len(), 1);
+        let m = &scene.materials[0];
+        let crate::bsdf::Bsdf::Ggx(wet) = m.bsdf_at(Vec2::new(0.25, 0.5), &scene.textures) else {
+            panic!("not ggx")
+        };
+        let crate::bsdf::Bsdf::Ggx(dry) = m.bsdf_at(Vec2::new(0.75, 0.5), &scene.textures) else {
+            panic!("not ggx")
+        };
+        assert!((wet.alpha - 0.05).abs() < 1e-6 && (dry.alpha - 0.45).abs() < 1e-6);
+        assert!((dry.ks.x - 0.1).abs() < 1e-6);
+        // A missing image names the material, the image and the file.
+        std::fs::remove_file(dir.path().join("dry.png")).unwrap();
+        let err = Scene::load(&write_embedded(dir.path(), doc, &bin))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("material \"asphalt\" (0), image 0") && err.contains("dry.png"),
+            "{err}"
+        );
+    }
+}

@@ -1,0 +1,329 @@
+//! The OBJ/MTL loader (through tobj, triangulated, one index per vertex).
+//!
+//! Materials: `Kd` with a non-zero `Ks` (unless `illum` is 0 or 1) is the paper's
+//! normalised blinn_phong with shininess `Ns` (default 1); otherwise Lambertian `Kd`, with
+//! `map_Kd` (sRGB) multiplying it. `Ke` is emitted radiance. A missing or unreadable MTL file is
+//! a warning: every material becomes the default grey diffuse (albedo 0.5), as do faces without
+//! a material. OBJ texture coordinates have v pointing up; they are stored as `(u, 1 - v)` to
+//! match the glTF convention of [`crate::texture::Texture`].
+
+use super::{Scene, SceneError, SceneParts};
+use crate::material::{Material, PaperModel, Reflectance};
+use crate::texture::{ColorSpace, Texture, TextureId};
+use glam::{Vec2, Vec3};
+use std::path::Path;
+
+/// Albedo of the material used where the MTL gives none.
+const DEFAULT_GREY: f32 = 0.5;
+
+/// Loads an `.obj` file and its MTL.
+pub(super) fn load(path: &Path) -> Result<Scene, SceneError> {
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ..Default::default()
+    };
+    let (models, mtl) = tobj::load_obj(path, &options).map_err(|source| match source {
+        tobj::LoadError::OpenFileFailed | tobj::LoadError::ReadError => SceneError::Io {
+            path: path.to_path_buf(),
+            element: "the file".into(),
+            source: std::io::Error::other(source.to_string()),
+        },
+        source => SceneError::Obj {
+            path: path.to_path_buf(),
+            source,
+        },
+    })?;
+    let mut parts = SceneParts {
+        source: path.to_path_buf(),
+        ..SceneParts::default()
+    };
+    let base = path.parent().unwrap_or(Path::new("."));
+    let mtl = match mtl {
+        Ok(m) => m,
+        Err(e) => {
+            parts.warnings.push(format!(
+                "{}: material library not loaded ({e}); using grey diffuse",
+                path.display()
+            ));
+            Vec::new()
+        }
+    };
+    for m in &mtl {
+        let material = convert_material(path, base, m, &mut parts.textures)?;
+        parts.materials.push(material);
+    }
+    let default = parts.materials.len() as u32;
+    parts
+        .materials
+        .push(Material::diffuse("default", Vec3::splat(DEFAULT_GREY)));
+    for model in &models {
+        let mesh = &model.mesh;
+        let element = format!("object {:?}", model.name);
+        let n = mesh.positions.len() / 3;
+        let first = parts.positions.len();
+        if first + n > u32::MAX as usize {
+            return Err(SceneError::invalid(
+                path,
+                element,
+                "the scene has more than 2^32 - 1 vertices",
+            ));
+        }
+        let material = match mesh.material_id {
+            Some(i) if i < mtl.len() => i as u32,
+            Some(i) if !mtl.is_empty() => {
+                return Err(SceneError::invalid(
+                    path,
+                    element,
+                    format!("material {i} out of range ({} materials)", mtl.len()),
+                ))
+            }
+            _ => default,
+        };
+        parts.positions.extend(
+            mesh.positions
+                .chunks_exact(3)
+                .map(|c| Vec3::new(c[0], c[1], c[2])),
+        );
+        if mesh.normals.len() == 3 * n {
+            parts.normals.extend(
+                mesh.normals
+                    .chunks_exact(3)
+                    .map(|c| Vec3::new(c[0], c[1], c[2]).normalize_or_zero()),
+            );
+        } else {
+            parts.normals.extend(std::iter::repeat_n(Vec3::ZERO, n));
+        }
+        if mesh.texcoords.len() == 2 * n {
+            parts.uvs.extend(
+                mesh.texcoords
+                    .chunks_exact(2)
+                    .map(|c| Vec2::new(c[0], 1.0 - c[1])),
+            );
+        } else {
+            parts.uvs.extend(std::iter::repeat_n(Vec2::ZERO, n));
+        }
+        for (k, t) in mesh.indices.chunks_exact(3).enumerate() {
+            if t.iter().any(|&i| i as usize >= n) {
+                return Err(SceneError::invalid(
+                    path,
+                    format!("{element}, face {k}"),
+                    format!("vertex index out of range ({n} vertices)"),
+                ));
+            }
+            let first = first as u32;
+            parts
+                .triangles
+                .push([t[0] + first, t[1] + first, t[2] + first]);
+            parts.triangle_materials.push(material);
+        }
+    }
+    Scene::from_parts(parts)
+}
+
+fn convert_material(
+    path: &Path,
+    base: &Path,
+    m: &tobj::Material,
+    textures: &mut Vec<Texture>,
+) -> Result<Material, SceneError> {
+    let element = format!("material {:?}", m.name);
+    let colour = |c: Option<[f32; 3]>, key: &str| -> Result<Vec3, SceneError> {
+        let v = Vec3::from(c.unwrap_or([0.0; 3]));
+        if v.is_finite() && v.min_element() >= 0.0 {
+            Ok(v)
+        } else {
+            Err(SceneError::invalid(
+                path,
+                &element,
+                format!("{key} {v} must be finite and non-negative"),
+            ))
+        }
+    };
+    let kd = match m.diffuse {
+        Some(c) => colour(Some(c), "Kd")?,
+        None => Vec3::splat(DEFAULT_GREY),
+    };
+    let ks = colour(m.specular, "Ks")?;
+    let emission = colour(m.emissive, "Ke")?;
+    let kd_texture = match &m.diffuse_texture {
+        Some(file) => Some(load_texture(path, base, file, &element, textures)?),
+        None => None,
+    };
+    let specular = ks.max_element() > 0.0 && !matches!(m.illumination_model, Some(0 | 1));
+    let reflectance = if specular {
+        let shininess = m.shininess.unwrap_or(1.0);
+        if !(shininess.is_finite() && shininess >= 0.0) {
+            return Err(SceneError::invalid(
+                path,
+                element,
+                format!("Ns {shininess} must be finite and non-negative"),
+            ));
+        }
+        Reflectance::Paper {
+            model: PaperModel::BlinnPhong,
+            kd,
+            ks,
+            alpha: 0.0,
+            shininess,
+            kd_texture,
+            wetness: None,
+        }
+    } else {
+        Reflectance::Diffuse { kd, kd_texture }
+    };
+    Ok(Material {
+        name: m.name.clone(),
+        reflectance,
+        emission,
+        emission_texture: None,
+        double_sided: false,
+    })
+}
+
+fn load_texture(
+    path: &Path,
+    base: &Path,
+    file: &str,
+    material: &str,
+    textures: &mut Vec<Texture>,
+) -> Result<TextureId, SceneError> {
+    let file_path = base.join(file);
+    let element = format!("{material}, map_Kd {}", file_path.display());
+    let img = image::open(&file_path).map_err(|e| match e {
+        image::ImageError::IoError(source) => SceneError::Io {
+            path: path.to_path_buf(),
+            element: element.clone(),
+            source,
+        },
+        e => SceneError::invalid(path, &element, e.to_string()),
+    })?;
+    let rgba = img.to_rgba8();
+    let texture = Texture::from_rgba8(rgba.width(), rgba.height(), rgba.as_raw(), ColorSpace::Srgb)
+        .ok_or_else(|| SceneError::invalid(path, &element, "empty image"))?;
+    textures.push(texture);
+    Ok((textures.len() - 1) as TextureId)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::light::Light;
+
+    const OBJ: &str = "mtllib road.mtl
+v 0 0 0
+v 1 0 0
+v 1 0 -1
+v 0 0 -1
+v 0 2 0
+v 1 2 0
+v 0 3 0
+vt 0 0
+vt 1 0
+vt 1 1
+vt 0 1
+vn 0 1 0
+o road
+usemtl wet
+f 1/1/1 2/2/1 3/3/1 4/4/1
+o lamp
+usemtl glow
+f 5 6 7
+o kerb
+usemtl plain
+f 1 2 5
+";
+
+    const MTL: &str = "newmtl wet
+Kd 0.1 0.1 0.1
+Ks 0.6 0.6 0.6
+Ns 200
+illum 2
+newmtl glow
+Kd 0 0 0
+Ke 4 3 2
+newmtl plain
+Kd 0.7 0.6 0.5
+Ks 0.5 0.5 0.5
+illum 1
+";
+
+    #[test]
+    fn loads_obj_with_mtl() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("street.obj");
+        std::fs::write(&path, OBJ).unwrap();
+        std::fs::write(dir.path().join("road.mtl"), MTL).unwrap();
+        let scene = Scene::load(&path).unwrap();
+        assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+        assert_eq!(scene.triangles.len(), 4);
+        assert!(scene.cameras.is_empty());
+        let wet = &scene.materials[scene.triangle_materials[0] as usize];
+        assert_eq!(wet.name, "wet");
+        assert!(matches!(wet.reflectance, Reflectance::Paper {
+            model: PaperModel::BlinnPhong, shininess, ks, ..
+        } if shininess == 200.0 && ks == Vec3::splat(0.6)));
+        let plain = &scene.materials[scene.triangle_materials[3] as usize];
+        assert!(
+            matches!(plain.reflectance, Reflectance::Diffuse { kd, kd_texture: None }
+            if kd == Vec3::new(0.7, 0.6, 0.5))
+        );
+        let glow = &scene.materials[scene.triangle_materials[2] as usize];
+        assert_eq!(glow.emission, Vec3::new(4.0, 3.0, 2.0));
+        assert_eq!(scene.lights, vec![Light::Triangle { triangle: 2 }]);
+        // The road faces up, with flipped v, and normals from the file.
+        let h = scene
+            .intersect(&crate::geometry::Ray::new(
+                Vec3::new(0.75, 1.0, -0.5),
+                -Vec3::Y,
+            ))
+            .unwrap();
+        assert_eq!((h.ng, h.ns), (Vec3::Y, Vec3::Y));
+        assert!((h.uv - Vec2::new(0.75, 0.5)).length() < 1e-5, "{}", h.uv);
+    }
+
+    #[test]
+    fn missing_mtl_is_a_warning() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("street.obj");
+        std::fs::write(&path, OBJ).unwrap();
+        let scene = Scene::load(&path).unwrap();
+        assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+        assert!(scene.warnings[0].contains("street.obj"));
+        assert!(scene.lights.is_empty());
+        assert!(scene.triangle_materials.iter().all(|&m| m == 0));
+        assert!(
+            matches!(scene.materials[0].reflectance, Reflectance::Diffuse { kd, .. }
+            if kd == Vec3::splat(DEFAULT_GREY))
+        );
+    }
+
+    #[test]
+    fn malformed_obj_is_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("bad.obj");
+        std::fs::write(&path, "v 0 0 0\nv 1 0 0\nf 1 2 9\n").unwrap();
+        let err = Scene::load(&path).unwrap_err().to_string();
+        assert!(err.contains("bad.obj"), "{err}");
+        let err = Scene::load(&dir.path().join("none.obj"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("none.obj"), "{err}");
+        // A map_Kd that does not exist names the material and the file.
+        std::fs::write(
+            &path,
+            "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n",
+        )
+        .unwrap();
+        std::fs::write(
+            dir.path().join("m.mtl"),
+            "newmtl a\nKd 1 1 1\nmap_Kd gone.png\n",
+        )
+        .unwrap();
+        let err = Scene::load(&path).unwrap_err().to_string();
+        assert!(
+            err.contains("material \"a\"") && err.contains("gone.png"),
+            "{err}"
+        );
+    }
+}
