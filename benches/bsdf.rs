@@ -2,13 +2,15 @@
 //! directions, and the closed-enum dispatch of [`Bsdf`] against a trait-object version of the
 //! same calls (DESIGN.md and STYLE.md choose the enum; this measures the choice).
 //!
+//! The Owen-scrambled Sobol sampler's `next_1d` and `next_2d` are measured here too.
+//!
 //! Run: `cargo bench --bench bsdf`. Throughput is reported in calls per second.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use glam::{Vec2, Vec3};
 use std::hint::black_box;
 use streaks_render::bsdf::{BlinnPhong, Bsdf, BsdfSample, Diffuse, Ggx, GltfPbr, Ward};
-use streaks_render::sampling::{square_to_cosine_hemisphere, Pcg32};
+use streaks_render::sampling::{square_to_cosine_hemisphere, Pcg32, Sampler};
 
 /// Calls per iteration: large enough to hide the loop, small enough to stay in L1.
 const BATCH: usize = 1024;
@@ -214,5 +216,38 @@ fn bench_dispatch(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench_models, bench_dispatch);
+/// The sampler's per-dimension cost: one pixel sample drawing `BATCH` dimensions (a path
+/// tracer draws about 2 + 5 per bounce).
+fn bench_sampler(c: &mut Criterion) {
+    let mut group = c.benchmark_group("sampler");
+    group.throughput(Throughput::Elements(BATCH as u64));
+    let mut sampler = Sampler::new(1);
+    group.bench_function("next_2d", |b| {
+        let mut index = 0u32;
+        b.iter(|| {
+            index = (index + 1) % 1024;
+            sampler.start_pixel_sample((index, 7), index);
+            let mut acc = Vec2::ZERO;
+            for _ in 0..BATCH {
+                acc += sampler.next_2d();
+            }
+            acc
+        })
+    });
+    group.bench_function("next_1d", |b| {
+        let mut index = 0u32;
+        b.iter(|| {
+            index = (index + 1) % 1024;
+            sampler.start_pixel_sample((index, 7), index);
+            let mut acc = 0.0f32;
+            for _ in 0..BATCH {
+                acc += sampler.next_1d();
+            }
+            acc
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench_models, bench_dispatch, bench_sampler);
 criterion_main!(benches);
