@@ -9,6 +9,9 @@ mod figure;
 mod locus;
 use std::process::ExitCode;
 
+mod disparity;
+mod lk;
+
 /// Render rainy night streets in stereo and measure what specular streaks do to depth.
 #[derive(Parser, Debug)]
 #[command(name = "streaks", version, about, long_about = None)]
@@ -23,6 +26,10 @@ enum Command {
     Locus(locus::Args),
     /// Draw one of the paper's figures from the model as a PNG.
     Figure(figure::Args),
+    /// Per-row 1D Lucas-Kanade disparity over a region (the paper's estimator).
+    Lk(lk::Args),
+    /// Dense disparity by semi-global matching (census cost), written as PFM.
+    Disparity(disparity::Args),
 }
 
 fn main() -> ExitCode {
@@ -30,6 +37,8 @@ fn main() -> ExitCode {
     let result: anyhow::Result<()> = match cli.command {
         Command::Locus(args) => locus::run(args),
         Command::Figure(args) => figure::run(args),
+        Command::Lk(args) => lk::run(args),
+        Command::Disparity(args) => disparity::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -29,6 +29,10 @@
 //! ```
 #![deny(missing_docs)]
 
+pub mod detect;
 pub mod figures;
+pub mod lk;
 pub mod model;
 pub mod plot;
+pub mod sgm;
+pub mod synth;

@@ -84,7 +84,7 @@ impl GrayImage {
         self.data[y * self.width + x] = v;
     }
 
-    /// Loads any image the `image` crate reads (PNG, JPEG; 8/16-bit or float) as luminance
+    /// Loads any image the `image` crate reads (PNG, JPEG, EXR; 8/16-bit or float) as luminance
     /// (Rec. 709 weights) in [0, 1] for integer formats.
     pub fn load(path: &Path) -> Result<Self, ImageError> {
         let img = ::image::open(path).map_err(|e| ImageError::Read {

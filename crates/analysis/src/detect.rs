@@ -1,0 +1,591 @@
+//! Specular streak detection: bright, vertically elongated regions below the horizon.
+//!
+//! 1. **Thresholds relative to the image** (robust to exposure): with `m` the median and `t`
+//!    a high percentile of the intensities, pixels above `m + low (t - m)` are candidates and a
+//!    region is kept only if it reaches `m + high (t - m)` (hysteresis).
+//! 2. **Regions** are 8-connected, but never across the horizon (given, or the principal
+//!    point's row, the image centre, for a pitch-0 rig): a street lamp above the horizon and its
+//!    streak below it come apart. A region below the horizon is further **cut at brightness
+//!    gaps**: a row whose peak is below `gap` times the smaller of the peaks above and below it
+//!    (a low headlight and its streak), and a bright compact **head** is split off its top
+//!    (leading rows brighter than `head_ratio` times the region's median row peak).
+//! 3. **Classification**: a region spanning at least `min_rows` rows and `min_elongation` times
+//!    taller than its mean width is a streak; the others are lamps.
+//! 4. **Per streak**: its centre per row (intensity-weighted, weights above the low threshold),
+//!    the axis `x = a + b y` fitted to the centres (weighted least squares), row extent, peak,
+//!    elongation.
+//!
+//! [`score_mask`] compares a detection mask with a ground-truth mask (precision and recall).
+//! Coordinates follow DESIGN.md: image x and y with pixel centres at `i + 0.5`; rows are indices.
+
+use streaks_stereo::image::GrayImage;
+
+/// Errors of streak detection.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum DetectError {
+    /// A parameter is out of range.
+    #[error("invalid streak detection parameter {name}: {reason}")]
+    Param {
+        /// The parameter.
+        name: &'static str,
+        /// Why.
+        reason: &'static str,
+    },
+    /// Two masks differ in size.
+    #[error("masks differ in size: {w1}x{h1} and {w2}x{h2}")]
+    SizeMismatch {
+        /// First width.
+        w1: usize,
+        /// First height.
+        h1: usize,
+        /// Second width.
+        w2: usize,
+        /// Second height.
+        h2: usize,
+    },
+}
+
+/// Parameters of the detector.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DetectParams {
+    /// Image y coordinate of the horizon; `None`: the image centre (pitch-0 rig).
+    pub horizon: Option<f32>,
+    /// The reference percentile (0..1) of the intensities.
+    pub percentile: f32,
+    /// High (seed) threshold as a fraction of the way from the median to the percentile.
+    pub high: f32,
+    /// Low (growth) threshold, likewise.
+    pub low: f32,
+    /// Brightness-gap ratio for cutting a region (0 disables).
+    pub gap: f32,
+    /// A region's leading rows brighter than this many times its median row peak, if compact,
+    /// are a lamp touching its streak (0 disables).
+    pub head_ratio: f32,
+    /// Fewest rows of a streak.
+    pub min_rows: usize,
+    /// Smallest ratio of height to mean width of a streak.
+    pub min_elongation: f32,
+}
+
+impl Default for DetectParams {
+    fn default() -> Self {
+        Self {
+            horizon: None,
+            percentile: 0.999,
+            high: 0.3,
+            low: 0.12,
+            gap: 0.5,
+            head_ratio: 2.0,
+            min_rows: 8,
+            min_elongation: 2.0,
+        }
+    }
+}
+
+impl DetectParams {
+    /// Checks the parameters.
+    pub fn validate(&self) -> Result<(), DetectError> {
+        let bad = |name, reason| Err(DetectError::Param { name, reason });
+        if !(0.5..=1.0).contains(&self.percentile) {
+            return bad("percentile", "must be in [0.5, 1]");
+        }
+        if !(self.low > 0.0 && self.low <= self.high && self.high <= 1.0) {
+            return bad("low", "need 0 < low <= high <= 1");
+        }
+        if self.head_ratio.is_nan() || self.head_ratio < 0.0 {
+            return bad("head_ratio", "must be non-negative");
+        }
+        if !(0.0..1.0).contains(&self.gap) {
+            return bad("gap", "must be in [0, 1)");
+        }
+        if self.horizon.is_some_and(|h| !h.is_finite()) {
+            return bad("horizon", "must be a finite number");
+        }
+        if self.min_elongation.is_nan() || self.min_elongation < 0.0 {
+            return bad("min_elongation", "must be non-negative");
+        }
+        Ok(())
+    }
+}
+
+/// A detected streak.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Streak {
+    /// First row (index).
+    pub first_row: usize,
+    /// Last row (index, inclusive).
+    pub last_row: usize,
+    /// Per row: (row index, intensity-weighted centre as an image x coordinate).
+    pub centres: Vec<(usize, f32)>,
+    /// Axis `x = a + b y` (image coordinates): `a`.
+    pub axis_a: f32,
+    /// Axis slope `b` (pixels of x per pixel of y).
+    pub axis_b: f32,
+    /// Highest intensity.
+    pub peak: f32,
+    /// Rows spanned divided by the mean width in pixels.
+    pub elongation: f32,
+    /// Number of pixels.
+    pub pixels: usize,
+}
+
+/// A bright compact region (a lamp, a headlight).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Lamp {
+    /// Intensity-weighted centre, image x.
+    pub x: f32,
+    /// Intensity-weighted centre, image y.
+    pub y: f32,
+    /// Highest intensity.
+    pub peak: f32,
+    /// Number of pixels.
+    pub pixels: usize,
+}
+
+/// The result of [`detect_streaks`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Detection {
+    /// Streaks, by first row.
+    pub streaks: Vec<Streak>,
+    /// Lamps.
+    pub lamps: Vec<Lamp>,
+    /// 1 on streak pixels, 0 elsewhere.
+    pub mask: GrayImage,
+    /// The horizon used (image y).
+    pub horizon: f32,
+    /// The low and high thresholds used.
+    pub thresholds: (f32, f32),
+}
+
+/// The `p`-quantile (0..1) of the finite values.
+fn quantile(values: &[f32], p: f32) -> f32 {
+    let mut v: Vec<f32> = values.iter().copied().filter(|v| v.is_finite()).collect();
+    if v.is_empty() {
+        return 0.0;
+    }
+    let i = ((v.len() - 1) as f32 * p).round() as usize;
+    *v.select_nth_unstable_by(i, f32::total_cmp).1
+}
+
+/// Finds streaks and lamps in `img`.
+pub fn detect_streaks(img: &GrayImage, params: &DetectParams) -> Result<Detection, DetectError> {
+    params.validate()?;
+    let (w, h) = (img.width, img.height);
+    let horizon = params.horizon.unwrap_or(0.5 * h as f32);
+    // Rows with centre below the horizon (y + 0.5 > horizon) are "below".
+    let below = |y: usize| y as f32 + 0.5 > horizon;
+    let med = quantile(&img.data, 0.5);
+    let top = quantile(&img.data, params.percentile);
+    let t_lo = med + params.low * (top - med);
+    let t_hi = med + params.high * (top - med);
+    let mut mask = GrayImage::new(w, h, 0.0).map_err(|_| DetectError::Param {
+        name: "image",
+        reason: "empty image",
+    })?;
+    let mut det = Detection {
+        streaks: Vec::new(),
+        lamps: Vec::new(),
+        mask: mask.clone(),
+        horizon,
+        thresholds: (t_lo, t_hi),
+    };
+    if top <= med {
+        return Ok(det);
+    }
+    let on = |i: usize| img.data[i].is_finite() && img.data[i] >= t_lo;
+    let mut label = vec![false; w * h];
+    let mut stack = Vec::new();
+    let mut region: Vec<usize> = Vec::new();
+    for start in 0..w * h {
+        if label[start] || !on(start) {
+            continue;
+        }
+        // Flood fill (8-connected, not across the horizon).
+        region.clear();
+        label[start] = true;
+        stack.push(start);
+        while let Some(i) = stack.pop() {
+            region.push(i);
+            let (x, y) = (i % w, i / w);
+            for ny in y.saturating_sub(1)..(y + 2).min(h) {
+                if below(ny) != below(y) {
+                    continue;
+                }
+                for nx in x.saturating_sub(1)..(x + 2).min(w) {
+                    let j = ny * w + nx;
+                    if !label[j] && on(j) {
+                        label[j] = true;
+                        stack.push(j);
+                    }
+                }
+            }
+        }
+        region.sort_unstable();
+        if below(start / w) {
+            for part in split_at_gaps(img, &region, params.gap) {
+                let (head, rest) = split_head(img, part, params.head_ratio);
+                for p in [head, rest] {
+                    classify(img, p, t_lo, t_hi, params, &mut det, &mut mask);
+                }
+            }
+        } else {
+            classify(img, &region, t_lo, t_hi, params, &mut det, &mut mask);
+        }
+    }
+    det.streaks.sort_by_key(|s| (s.first_row, s.pixels));
+    det.mask = mask;
+    Ok(det)
+}
+
+/// Cuts a region (pixel indices sorted by row) at rows whose peak is below `gap` times the
+/// smaller of the highest peaks above and below; the cut rows are dropped.
+fn split_at_gaps<'a>(img: &GrayImage, region: &'a [usize], gap: f32) -> Vec<&'a [usize]> {
+    let w = img.width;
+    // Row starts within `region`.
+    let mut rows: Vec<(usize, usize, f32)> = Vec::new(); // (row, start index, peak)
+    for (k, &i) in region.iter().enumerate() {
+        let y = i / w;
+        match rows.last_mut() {
+            Some(r) if r.0 == y => r.2 = r.2.max(img.data[i]),
+            _ => rows.push((y, k, img.data[i])),
+        }
+    }
+    let n = rows.len();
+    let mut above_max = vec![0.0f32; n];
+    let mut below_max = vec![0.0f32; n];
+    for k in 1..n {
+        above_max[k] = above_max[k - 1].max(rows[k - 1].2);
+        below_max[n - 1 - k] = below_max[n - k].max(rows[n - k].2);
+    }
+    let mut parts = Vec::new();
+    let mut part_start = Some(0usize);
+    for k in 0..n {
+        let end = if k + 1 < n {
+            rows[k + 1].1
+        } else {
+            region.len()
+        };
+        let cut = gap > 0.0 && rows[k].2 < gap * above_max[k].min(below_max[k]);
+        if cut {
+            if let Some(s) = part_start.take() {
+                if rows[k].1 > s {
+                    parts.push(&region[s..rows[k].1]);
+                }
+            }
+        } else if part_start.is_none() {
+            part_start = Some(rows[k].1);
+        }
+        if k + 1 == n {
+            if let Some(s) = part_start {
+                parts.push(&region[s..end]);
+            }
+        }
+    }
+    parts
+}
+
+/// Splits off a bright compact head (a lamp touching the top of its streak): rows rising to a
+/// run of rows whose peak exceeds `ratio` times the median row peak, and the falling tail
+/// after it, if they are at most twice as many as their widest row is wide. Returns (head, rest); the head may be empty.
+fn split_head<'a>(img: &GrayImage, region: &'a [usize], ratio: f32) -> (&'a [usize], &'a [usize]) {
+    let w = img.width;
+    if ratio <= 0.0 || region.is_empty() {
+        return (&[], region);
+    }
+    // (start index, peak, width) per row.
+    let mut rows: Vec<(usize, f32, usize)> = Vec::new();
+    let mut last_row = usize::MAX;
+    for (k, &i) in region.iter().enumerate() {
+        if i / w != last_row {
+            last_row = i / w;
+            rows.push((k, img.data[i], 0));
+        }
+        let r = rows.last_mut().expect("a row was pushed");
+        r.1 = r.1.max(img.data[i]);
+        r.2 += 1;
+    }
+    let mut peaks: Vec<f32> = rows.iter().map(|r| r.1).collect();
+    let mid = peaks.len() / 2;
+    let median = *peaks.select_nth_unstable_by(mid, f32::total_cmp).1;
+    // The first bright row must be the top of a blob (peaks rising to it), the head runs
+    // through the bright rows and on down the blob's falling tail.
+    let Some(first_bright) = rows.iter().position(|r| r.1 > ratio * median) else {
+        return (&[], region);
+    };
+    if rows[..=first_bright].windows(2).any(|p| p[1].1 < p[0].1) {
+        return (&[], region);
+    }
+    let mut head_rows = first_bright;
+    while head_rows < rows.len() && rows[head_rows].1 > ratio * median {
+        head_rows += 1;
+    }
+    while head_rows + 1 < rows.len() && rows[head_rows + 1].1 < rows[head_rows].1 {
+        head_rows += 1;
+    }
+    if head_rows + 1 >= rows.len() {
+        return (&[], region);
+    }
+    let widest = rows[..head_rows].iter().map(|r| r.2).max().unwrap_or(0);
+    if head_rows > 2 * widest {
+        return (&[], region);
+    }
+    region.split_at(rows[head_rows].0)
+}
+
+/// Measures a region and records it as a streak (below the horizon, elongated) or a lamp.
+fn classify(
+    img: &GrayImage,
+    region: &[usize],
+    t_lo: f32,
+    t_hi: f32,
+    params: &DetectParams,
+    det: &mut Detection,
+    mask: &mut GrayImage,
+) {
+    let w = img.width;
+    let peak = region.iter().map(|&i| img.data[i]).fold(f32::MIN, f32::max);
+    if peak < t_hi || region.is_empty() {
+        return;
+    }
+    let first_row = region[0] / w;
+    let last_row = region[region.len() - 1] / w;
+    let nrows = last_row - first_row + 1;
+    let mean_width = region.len() as f32 / nrows as f32;
+    let elongation = nrows as f32 / mean_width;
+    let below = first_row as f32 + 0.5 > det.horizon;
+    if !below || nrows < params.min_rows || elongation < params.min_elongation {
+        let (mut sw, mut sx, mut sy) = (0.0f64, 0.0f64, 0.0f64);
+        for &i in region {
+            let wgt = (img.data[i] - t_lo).max(0.0) as f64 + 1e-12;
+            sw += wgt;
+            sx += wgt * ((i % w) as f64 + 0.5);
+            sy += wgt * ((i / w) as f64 + 0.5);
+        }
+        det.lamps.push(Lamp {
+            x: (sx / sw) as f32,
+            y: (sy / sw) as f32,
+            peak,
+            pixels: region.len(),
+        });
+        return;
+    }
+    // Per-row weighted centres, then the weighted line fit x = a + b y.
+    let mut centres = Vec::with_capacity(nrows);
+    let (mut s, mut sy, mut sx, mut syy, mut sxy) = (0.0f64, 0.0, 0.0, 0.0, 0.0);
+    let mut k = 0;
+    while k < region.len() {
+        let y = region[k] / w;
+        let (mut rw, mut rx) = (0.0f64, 0.0f64);
+        while k < region.len() && region[k] / w == y {
+            let i = region[k];
+            let wgt = (img.data[i] - t_lo).max(0.0) as f64 + 1e-12;
+            rw += wgt;
+            rx += wgt * ((i % w) as f64 + 0.5);
+            mask.data[i] = 1.0;
+            k += 1;
+        }
+        let xc = rx / rw;
+        let yc = y as f64 + 0.5;
+        centres.push((y, xc as f32));
+        s += rw;
+        sy += rw * yc;
+        sx += rw * xc;
+        syy += rw * yc * yc;
+        sxy += rw * xc * yc;
+    }
+    let den = s * syy - sy * sy;
+    let b = if den > 0.0 {
+        (s * sxy - sx * sy) / den
+    } else {
+        0.0
+    };
+    let a = (sx - b * sy) / s;
+    det.streaks.push(Streak {
+        first_row,
+        last_row,
+        centres,
+        axis_a: a as f32,
+        axis_b: b as f32,
+        peak,
+        elongation,
+        pixels: region.len(),
+    });
+}
+
+/// Precision and recall of a detection mask against a ground-truth mask.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct MaskScore {
+    /// Detected pixels that are true streak pixels, as a fraction of the detected ones.
+    pub precision: f64,
+    /// True streak pixels detected, as a fraction of the true ones.
+    pub recall: f64,
+    /// Harmonic mean of the two.
+    pub f1: f64,
+    /// Detected pixels.
+    pub detected: usize,
+    /// True pixels.
+    pub truth: usize,
+}
+
+/// Scores `detected` against `truth` (a pixel is "on" when its value exceeds 0.5).
+pub fn score_mask(detected: &GrayImage, truth: &GrayImage) -> Result<MaskScore, DetectError> {
+    if (detected.width, detected.height) != (truth.width, truth.height) {
+        return Err(DetectError::SizeMismatch {
+            w1: detected.width,
+            h1: detected.height,
+            w2: truth.width,
+            h2: truth.height,
+        });
+    }
+    let (mut tp, mut nd, mut nt) = (0usize, 0usize, 0usize);
+    for (&d, &t) in detected.data.iter().zip(&truth.data) {
+        let (d, t) = (d > 0.5, t > 0.5);
+        nd += d as usize;
+        nt += t as usize;
+        tp += (d && t) as usize;
+    }
+    let precision = if nd > 0 { tp as f64 / nd as f64 } else { 0.0 };
+    let recall = if nt > 0 { tp as f64 / nt as f64 } else { 0.0 };
+    let f1 = if precision + recall > 0.0 {
+        2.0 * precision * recall / (precision + recall)
+    } else {
+        0.0
+    };
+    Ok(MaskScore {
+        precision,
+        recall,
+        f1,
+        detected: nd,
+        truth: nt,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::synth::SplitMix;
+
+    /// Streak axes (a, b, first y, last y, amplitude) below a horizon at y = 120, lamps above
+    /// it, a low headlight with its own streak, and noise. Returns the image and the truth mask
+    /// (streak contribution above 0.1).
+    fn scene(exposure: f32) -> (GrayImage, GrayImage, Vec<(f32, f32)>) {
+        scene_shifted(exposure, 0.0)
+    }
+
+    /// The scene seen with everything shifted left by `disparity` pixels (a right image).
+    fn scene_shifted(exposure: f32, disparity: f32) -> (GrayImage, GrayImage, Vec<(f32, f32)>) {
+        let (w, h) = (320, 240);
+        let streaks = [
+            (60.0f32, 0.05f32, 124.0f32, 236.0f32, 0.5f32),
+            (170.0, -0.02, 126.0, 230.0, 0.4),
+            (200.0, 0.30, 122.0, 200.0, 0.6),
+            (280.0, 0.0, 149.0, 235.0, 0.35),
+        ];
+        let lamps = [
+            (66.0f32, 100.0f32),
+            (168.0, 110.0),
+            (240.0, 90.0),
+            (280.5, 146.0),
+        ];
+        let mut img = GrayImage::new(w, h, 0.0).unwrap();
+        let mut truth = GrayImage::new(w, h, 0.0).unwrap();
+        let mut rng = SplitMix(5 + disparity.to_bits() as u64);
+        for y in 0..h {
+            for x in 0..w {
+                let (xc, yc) = (x as f32 + 0.5 + disparity, y as f32 + 0.5);
+                let mut s = 0.0f32;
+                for &(a, b, y0, y1, amp) in &streaks {
+                    if (y0..=y1).contains(&yc) {
+                        let dx = xc - (a + b * yc);
+                        s += amp * (-dx * dx / (2.0 * 2.5 * 2.5)).exp();
+                    }
+                }
+                let mut l = 0.0f32;
+                for &(lx, ly) in &lamps {
+                    let r2 = (xc - lx).powi(2) + (yc - ly).powi(2);
+                    l += 1.0 * (-r2 / (2.0 * 2.0 * 2.0)).exp();
+                }
+                let v = 0.03 + 0.01 * rng.gaussian() + s + l;
+                img.set(x, y, exposure * v);
+                truth.set(x, y, if s > 0.1 { 1.0 } else { 0.0 });
+            }
+        }
+        let axes = streaks.iter().map(|s| (s.0, s.1)).collect();
+        (img, truth, axes)
+    }
+
+    #[test]
+    fn streaks_are_found_and_separated_from_lamps() {
+        for exposure in [1.0f32, 0.2, 5.0] {
+            let (img, truth, axes) = scene(exposure);
+            let det = detect_streaks(&img, &DetectParams::default()).unwrap();
+            assert_eq!(
+                det.streaks.len(),
+                4,
+                "exposure {exposure}: {:?}",
+                det.streaks
+            );
+            assert_eq!(det.lamps.len(), 4, "{:?}", det.lamps);
+            for (a, b) in axes {
+                // The detected streak whose axis passes closest at y = 180.
+                let s = det
+                    .streaks
+                    .iter()
+                    .min_by(|p, q| {
+                        let e = |s: &&Streak| (s.axis_a + s.axis_b * 180.0 - (a + b * 180.0)).abs();
+                        e(p).total_cmp(&e(q))
+                    })
+                    .unwrap();
+                assert!(
+                    (s.axis_a + s.axis_b * 180.0 - (a + b * 180.0)).abs() < 0.3,
+                    "{s:?}"
+                );
+                assert!((s.axis_b - b).abs() < 0.01, "{s:?}");
+                assert!(s.first_row >= 120 && s.elongation > 5.0);
+            }
+            let score = score_mask(&det.mask, &truth).unwrap();
+            eprintln!("detection at exposure {exposure}: {score:?}");
+            assert!(score.precision > 0.9 && score.recall > 0.85, "{score:?}");
+        }
+    }
+
+    #[test]
+    fn lucas_kanade_along_detected_streaks() {
+        use crate::lk::{lk_rows, LkParams};
+        let (left, _, _) = scene_shifted(1.0, 0.0);
+        let (right, _, _) = scene_shifted(1.0, 6.35);
+        let det = detect_streaks(&left, &DetectParams::default()).unwrap();
+        let params = LkParams {
+            window: 21,
+            max_disp: 16,
+            ..LkParams::default()
+        };
+        // Independent noise (0.01, streak amplitudes 0.35-0.6) limits single rows to ~0.1 px.
+        let (mut worst, mut sum, mut n) = (0.0f32, 0.0f32, 0);
+        for s in &det.streaks {
+            for e in lk_rows(&left, &right, &s.centres, &params).unwrap() {
+                worst = worst.max((e.disparity - 6.35).abs());
+                sum += e.disparity - 6.35;
+                n += 1;
+            }
+        }
+        let bias = sum / n as f32;
+        eprintln!("LK along detected streaks: {n} rows, bias {bias} px, worst {worst} px");
+        assert!(bias.abs() < 0.02 && worst < 0.3, "{bias} {worst}");
+    }
+
+    #[test]
+    fn bad_input_is_an_error_and_a_flat_image_has_nothing() {
+        let flat = GrayImage::new(20, 10, 0.3).unwrap();
+        let det = detect_streaks(&flat, &DetectParams::default()).unwrap();
+        assert!(det.streaks.is_empty() && det.lamps.is_empty());
+        let p = DetectParams {
+            low: 0.5,
+            high: 0.2,
+            ..DetectParams::default()
+        };
+        assert!(detect_streaks(&flat, &p).is_err());
+        let other = GrayImage::new(20, 11, 0.0).unwrap();
+        assert!(score_mask(&flat, &other).is_err());
+    }
+}

@@ -1,0 +1,761 @@
+//! Dense disparity by semi-global matching (Hirschmüller 2008) with a census-transform cost,
+//! the method driver-assistance stereo cameras use.
+//!
+//! 1. **Census transform** of both images (5x5 or 7x7 window; bit set when a neighbour is darker
+//!    than the centre): only the order of intensities matters, so a gain or an offset between
+//!    the cameras changes nothing. The matching cost of left pixel `x` at disparity `d` is the
+//!    Hamming distance of the census codes of `x` and `x - d` (a `u8`).
+//! 2. **Aggregation** along 4 (horizontal and vertical) or 8 (and diagonal) paths:
+//!    `L_r(p, d) = C(p, d) + min(L_r(p-r, d), L_r(p-r, d±1) + P1, min_k L_r(p-r, k) + P2) -
+//!    min_k L_r(p-r, k)`, summed into `S(p, d)` (`u16`, the one `W x H x D` array). P2 may be
+//!    lowered across intensity edges: `P2 / (1 + p2_gradient |ΔI| / range)`, at least P1.
+//!    Rows of the horizontal paths run in parallel; the vertical and diagonal paths sweep down
+//!    and then up, the pixels of a row in parallel.
+//! 3. **Winner-take-all** with a parabola through the three costs around the minimum (sub-pixel),
+//!    a **left-right consistency check** against the right image's winners (read from the same
+//!    `S`), and an optional 3x3 median of the valid disparities. Invalid pixels are `inf`, as in
+//!    the PFM convention.
+//!
+//! Memory: `2 W H D` bytes (128 MB for a megapixel at D = 64) plus row buffers.
+//! Disparity follows DESIGN.md: `d = x_left - x_right`; the range `[min_disp, max_disp]` may
+//! include negative values (photographs aligned by hand).
+
+use rayon::prelude::*;
+use streaks_stereo::image::{GrayImage, ImageError};
+
+/// Errors of the dense matcher (about user-supplied sizes and parameters).
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum SgmError {
+    /// Left and right images (or an estimate and its ground truth) differ in size.
+    #[error("images differ in size: {lw}x{lh} and {rw}x{rh}")]
+    SizeMismatch {
+        /// First width.
+        lw: usize,
+        /// First height.
+        lh: usize,
+        /// Second width.
+        rw: usize,
+        /// Second height.
+        rh: usize,
+    },
+    /// A parameter is out of range.
+    #[error("invalid semi-global matching parameter {name}: {reason}")]
+    Param {
+        /// The parameter.
+        name: &'static str,
+        /// Why.
+        reason: String,
+    },
+    /// The volume would be too large.
+    #[error("a {width}x{height} image with {disparities} disparities needs {bytes} bytes (limit {limit})")]
+    TooLarge {
+        /// Image width.
+        width: usize,
+        /// Image height.
+        height: usize,
+        /// Number of disparities.
+        disparities: usize,
+        /// Bytes needed.
+        bytes: u64,
+        /// The limit.
+        limit: u64,
+    },
+}
+
+/// Census window.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Census {
+    /// 5x5 window, 24 bits.
+    Census5x5,
+    /// 7x7 window, 48 bits.
+    #[default]
+    Census7x7,
+}
+
+impl Census {
+    fn radius(self) -> isize {
+        match self {
+            Census::Census5x5 => 2,
+            Census::Census7x7 => 3,
+        }
+    }
+
+    /// Default penalties (P1, P2) for this window's cost range.
+    pub fn default_penalties(self) -> (u16, u16) {
+        match self {
+            Census::Census5x5 => (4, 43),
+            Census::Census7x7 => (7, 86),
+        }
+    }
+
+    /// Number of bits of a code (the largest possible cost).
+    pub fn bits(self) -> u32 {
+        let n = 2 * self.radius() as u32 + 1;
+        n * n - 1
+    }
+}
+
+/// Aggregation paths.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Paths {
+    /// Left-right, right-left, top-down, bottom-up.
+    Four,
+    /// The four plus the four diagonals.
+    #[default]
+    Eight,
+}
+
+/// Parameters of semi-global matching.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SgmParams {
+    /// Smallest disparity.
+    pub min_disp: i32,
+    /// Largest disparity (the volume has `max_disp - min_disp + 1` disparities).
+    pub max_disp: i32,
+    /// Census window.
+    pub census: Census,
+    /// Aggregation paths.
+    pub paths: Paths,
+    /// Penalty of a disparity change of one pixel between neighbours.
+    pub p1: u16,
+    /// Penalty of a larger change.
+    pub p2: u16,
+    /// Lowering of P2 across intensity edges (0: constant P2).
+    pub p2_gradient: f32,
+    /// Parabola sub-pixel refinement.
+    pub subpixel: bool,
+    /// Largest left-right disagreement in pixels; `None` skips the check.
+    pub lr_tolerance: Option<f32>,
+    /// 3x3 median filter of the valid disparities.
+    pub median: bool,
+}
+
+impl Default for SgmParams {
+    fn default() -> Self {
+        Self {
+            min_disp: 0,
+            max_disp: 63,
+            census: Census::Census7x7,
+            paths: Paths::Eight,
+            p1: Census::Census7x7.default_penalties().0,
+            p2: Census::Census7x7.default_penalties().1,
+            p2_gradient: 0.0,
+            subpixel: true,
+            lr_tolerance: Some(1.0),
+            median: true,
+        }
+    }
+}
+
+/// Largest aggregation volume accepted (bytes).
+pub const MAX_VOLUME_BYTES: u64 = 4 << 30;
+
+impl SgmParams {
+    /// The number of disparities.
+    pub fn disparities(&self) -> usize {
+        (self.max_disp as i64 - self.min_disp as i64 + 1).max(0) as usize
+    }
+
+    /// Checks the parameters.
+    pub fn validate(&self) -> Result<(), SgmError> {
+        let bad = |name, reason: &str| {
+            Err(SgmError::Param {
+                name,
+                reason: reason.to_string(),
+            })
+        };
+        if self.min_disp > self.max_disp {
+            return bad("min_disp", "must not exceed max_disp");
+        }
+        if self.disparities() < 3 || self.disparities() > 1024 {
+            return bad("max_disp", "the range must hold from 3 to 1024 disparities");
+        }
+        if self.p1 == 0 || self.p1 > self.p2 || self.p2 > 1000 {
+            return bad("p2", "need 0 < P1 <= P2 <= 1000");
+        }
+        if !self.p2_gradient.is_finite() || self.p2_gradient < 0.0 {
+            return bad("p2_gradient", "must be a non-negative number");
+        }
+        if let Some(t) = self.lr_tolerance {
+            if !t.is_finite() || t < 0.0 {
+                return bad("lr_tolerance", "must be a non-negative number");
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Census codes of an image (bit set when the neighbour is darker than the centre; the window
+/// is clamped at the borders).
+pub fn census_transform(img: &GrayImage, census: Census) -> Vec<u64> {
+    let (w, h) = (img.width as isize, img.height as isize);
+    let r = census.radius();
+    let mut out = vec![0u64; img.data.len()];
+    out.par_chunks_mut(img.width)
+        .enumerate()
+        .for_each(|(y, row)| {
+            let y = y as isize;
+            for (x, code) in row.iter_mut().enumerate() {
+                let x = x as isize;
+                let c = img.data[(y * w + x) as usize];
+                let mut bits = 0u64;
+                for dy in -r..=r {
+                    let yy = (y + dy).clamp(0, h - 1);
+                    let line = &img.data[(yy * w) as usize..((yy + 1) * w) as usize];
+                    for dx in -r..=r {
+                        if dx == 0 && dy == 0 {
+                            continue;
+                        }
+                        let v = line[(x + dx).clamp(0, w - 1) as usize];
+                        bits = (bits << 1) | u64::from(v < c);
+                    }
+                }
+                *code = bits;
+            }
+        });
+    out
+}
+
+/// Everything the passes share.
+struct Ctx<'a> {
+    width: usize,
+    height: usize,
+    nd: usize,
+    min_disp: i32,
+    p1: u16,
+    p2: u16,
+    p2_gradient: f32,
+    out_cost: u8,
+    left_census: &'a [u64],
+    right_census: &'a [u64],
+    /// Left intensities divided by their 1-99 % range (for the adaptive P2).
+    left_norm: Vec<f32>,
+}
+
+impl Ctx<'_> {
+    /// The matching costs of left pixel (x, y) for every disparity.
+    #[inline]
+    fn costs(&self, x: usize, y: usize, out: &mut [u8]) {
+        let row = y * self.width;
+        let cl = self.left_census[row + x];
+        for (k, c) in out.iter_mut().enumerate() {
+            let xr = x as i64 - (self.min_disp as i64 + k as i64);
+            *c = if xr >= 0 && (xr as usize) < self.width {
+                (cl ^ self.right_census[row + xr as usize]).count_ones() as u8
+            } else {
+                self.out_cost
+            };
+        }
+    }
+
+    /// P2 for the step from pixel index `from` to pixel index `to`.
+    #[inline]
+    fn p2_between(&self, from: usize, to: usize) -> u16 {
+        if self.p2_gradient == 0.0 {
+            return self.p2;
+        }
+        let di = (self.left_norm[to] - self.left_norm[from]).abs();
+        let p2 = self.p2 as f32 / (1.0 + self.p2_gradient * di);
+        (p2.round() as u16).max(self.p1)
+    }
+}
+
+/// One step along a path: `out = cost + min(prev, prev±1 + P1, min(prev) + P2) - min(prev)`.
+#[inline]
+fn path_step(cost: &[u8], prev: &[u16], out: &mut [u16], p1: u16, p2: u16) {
+    let n = cost.len();
+    let min_prev = prev.iter().copied().min().unwrap_or(0);
+    let cap = min_prev + p2;
+    let first = prev[0].min(prev[1] + p1).min(cap);
+    out[0] = cost[0] as u16 + first - min_prev;
+    for ((o, &c), w) in out[1..n - 1]
+        .iter_mut()
+        .zip(&cost[1..n - 1])
+        .zip(prev.windows(3))
+    {
+        let m = w[1].min(w[0] + p1).min(w[2] + p1).min(cap);
+        *o = c as u16 + m - min_prev;
+    }
+    let last = prev[n - 1].min(prev[n - 2] + p1).min(cap);
+    out[n - 1] = cost[n - 1] as u16 + last - min_prev;
+}
+
+#[inline]
+fn start_path(cost: &[u8], out: &mut [u16]) {
+    for (o, &c) in out.iter_mut().zip(cost) {
+        *o = c as u16;
+    }
+}
+
+#[inline]
+fn accumulate(sum: &mut [u16], l: &[u16]) {
+    for (s, &v) in sum.iter_mut().zip(l) {
+        *s += v;
+    }
+}
+
+/// Left-to-right and right-to-left paths of every row, written (not added) into `sum`.
+fn horizontal_paths(ctx: &Ctx, sum: &mut [u16]) {
+    let (w, nd) = (ctx.width, ctx.nd);
+    sum.par_chunks_mut(w * nd).enumerate().for_each_init(
+        || (vec![0u8; w * nd], vec![0u16; 2 * nd]),
+        |(cost, lbuf), (y, srow)| {
+            for x in 0..w {
+                ctx.costs(x, y, &mut cost[x * nd..(x + 1) * nd]);
+            }
+            let (prev, cur) = lbuf.split_at_mut(nd);
+            for x in 0..w {
+                let c = &cost[x * nd..(x + 1) * nd];
+                if x == 0 {
+                    start_path(c, cur);
+                } else {
+                    let p2 = ctx.p2_between(y * w + x - 1, y * w + x);
+                    path_step(c, prev, cur, ctx.p1, p2);
+                }
+                srow[x * nd..(x + 1) * nd].copy_from_slice(cur);
+                prev.copy_from_slice(cur);
+            }
+            for x in (0..w).rev() {
+                let c = &cost[x * nd..(x + 1) * nd];
+                if x == w - 1 {
+                    start_path(c, cur);
+                } else {
+                    let p2 = ctx.p2_between(y * w + x + 1, y * w + x);
+                    path_step(c, prev, cur, ctx.p1, p2);
+                }
+                accumulate(&mut srow[x * nd..(x + 1) * nd], cur);
+                prev.copy_from_slice(cur);
+            }
+        },
+    );
+}
+
+/// Pixels per parallel task in the vertical sweeps.
+const CHUNK: usize = 32;
+
+/// The vertical path (and with `diagonals` the two diagonal ones) sweeping down (`down`) or up,
+/// added into `sum`.
+fn vertical_paths(ctx: &Ctx, sum: &mut [u16], down: bool, diagonals: bool) {
+    let (w, h, nd) = (ctx.width, ctx.height, ctx.nd);
+    // Path p comes from column x + DX[p] of the previous row.
+    const DX: [isize; 3] = [0, -1, 1];
+    let np = if diagonals { 3 } else { 1 };
+    let mut prev = vec![0u16; w * np * nd];
+    let mut cur = vec![0u16; w * np * nd];
+    for i in 0..h {
+        let y = if down { i } else { h - 1 - i };
+        let y_prev = if down { y.wrapping_sub(1) } else { y + 1 };
+        let srow = &mut sum[y * w * nd..(y + 1) * w * nd];
+        let prev_ref = &prev;
+        srow.par_chunks_mut(CHUNK * nd)
+            .zip(cur.par_chunks_mut(CHUNK * np * nd))
+            .enumerate()
+            .for_each_init(
+                || vec![0u8; nd],
+                |cost, (chunk, (schunk, cchunk))| {
+                    for j in 0..schunk.len() / nd {
+                        let x = chunk * CHUNK + j;
+                        ctx.costs(x, y, cost);
+                        for (p, &dx) in DX.iter().enumerate().take(np) {
+                            let px = x as isize + dx;
+                            let out = &mut cchunk[(j * np + p) * nd..(j * np + p + 1) * nd];
+                            if i == 0 || px < 0 || px >= w as isize {
+                                start_path(cost, out);
+                            } else {
+                                let px = px as usize;
+                                let p2 = ctx.p2_between(y_prev * w + px, y * w + x);
+                                let from = &prev_ref[(px * np + p) * nd..(px * np + p + 1) * nd];
+                                path_step(cost, from, out, ctx.p1, p2);
+                            }
+                            accumulate(&mut schunk[j * nd..(j + 1) * nd], out);
+                        }
+                    }
+                },
+            );
+        std::mem::swap(&mut prev, &mut cur);
+    }
+}
+
+/// Winner-take-all, sub-pixel refinement and the left-right check on the aggregated costs.
+fn select(ctx: &Ctx, sum: &[u16], params: &SgmParams) -> Vec<f32> {
+    let (w, nd) = (ctx.width, ctx.nd);
+    let mut out = vec![f32::INFINITY; w * ctx.height];
+    out.par_chunks_mut(w)
+        .zip(sum.par_chunks(w * nd))
+        .for_each_init(
+            || vec![0i64; w],
+            |right_best, (orow, srow)| {
+                // Right image winners: x_r matches left x = x_r + d.
+                for (xr, rb) in right_best.iter_mut().enumerate() {
+                    let mut best = (u16::MAX, i64::MIN);
+                    for k in 0..nd {
+                        let x = xr as i64 + ctx.min_disp as i64 + k as i64;
+                        if x >= 0 && (x as usize) < w && srow[x as usize * nd + k] < best.0 {
+                            best = (srow[x as usize * nd + k], k as i64);
+                        }
+                    }
+                    *rb = best.1;
+                }
+                for (x, o) in orow.iter_mut().enumerate() {
+                    let s = &srow[x * nd..(x + 1) * nd];
+                    let mut k = 0;
+                    for (j, &v) in s.iter().enumerate() {
+                        if v < s[k] {
+                            k = j;
+                        }
+                    }
+                    let mut d = k as f32;
+                    if params.subpixel && k > 0 && k + 1 < nd {
+                        let (a, b, c) = (s[k - 1] as f32, s[k] as f32, s[k + 1] as f32);
+                        let den = a - 2.0 * b + c;
+                        if den > 0.0 {
+                            d += (0.5 * (a - c) / den).clamp(-0.5, 0.5);
+                        }
+                    }
+                    let disparity = ctx.min_disp as f32 + d;
+                    if let Some(tol) = params.lr_tolerance {
+                        let xr = x as i64 - (ctx.min_disp as i64 + k as i64);
+                        if xr < 0 || xr as usize >= w {
+                            continue;
+                        }
+                        let kr = right_best[xr as usize];
+                        if kr == i64::MIN || ((kr - k as i64).abs() as f32) > tol {
+                            continue;
+                        }
+                    }
+                    *o = disparity;
+                }
+            },
+        );
+    out
+}
+
+/// 3x3 median of the finite values around each finite pixel (invalid pixels stay invalid).
+pub fn median3x3(img: &GrayImage) -> GrayImage {
+    let (w, h) = (img.width, img.height);
+    let mut out = img.clone();
+    out.data.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        for (x, o) in row.iter_mut().enumerate() {
+            if !img.get(x, y).is_finite() {
+                continue;
+            }
+            let mut vals = [0.0f32; 9];
+            let mut n = 0;
+            for yy in y.saturating_sub(1)..(y + 2).min(h) {
+                for xx in x.saturating_sub(1)..(x + 2).min(w) {
+                    let v = img.get(xx, yy);
+                    if v.is_finite() {
+                        vals[n] = v;
+                        n += 1;
+                    }
+                }
+            }
+            let vals = &mut vals[..n];
+            vals.sort_unstable_by(f32::total_cmp);
+            *o = vals[n / 2];
+        }
+    });
+    out
+}
+
+/// The `p`-quantile (0..1) of the finite values, by sorting a copy.
+fn quantile(values: &[f32], p: f32) -> f32 {
+    let mut v: Vec<f32> = values.iter().copied().filter(|v| v.is_finite()).collect();
+    if v.is_empty() {
+        return 0.0;
+    }
+    let i = ((v.len() - 1) as f32 * p).round() as usize;
+    let (_, q, _) = v.select_nth_unstable_by(i, f32::total_cmp);
+    *q
+}
+
+/// Dense disparity of the left image by semi-global matching; invalid pixels are `inf`.
+pub fn sgm(left: &GrayImage, right: &GrayImage, params: &SgmParams) -> Result<GrayImage, SgmError> {
+    if (left.width, left.height) != (right.width, right.height) {
+        return Err(SgmError::SizeMismatch {
+            lw: left.width,
+            lh: left.height,
+            rw: right.width,
+            rh: right.height,
+        });
+    }
+    params.validate()?;
+    let (w, h, nd) = (left.width, left.height, params.disparities());
+    let bytes = (w * h) as u64 * nd as u64 * 2;
+    if bytes > MAX_VOLUME_BYTES {
+        return Err(SgmError::TooLarge {
+            width: w,
+            height: h,
+            disparities: nd,
+            bytes,
+            limit: MAX_VOLUME_BYTES,
+        });
+    }
+    let left_census = census_transform(left, params.census);
+    let right_census = census_transform(right, params.census);
+    let left_norm = if params.p2_gradient > 0.0 {
+        let (lo, hi) = (quantile(&left.data, 0.01), quantile(&left.data, 0.99));
+        let scale = if hi > lo { 1.0 / (hi - lo) } else { 1.0 };
+        left.data.iter().map(|&v| v * scale).collect()
+    } else {
+        Vec::new()
+    };
+    let ctx = Ctx {
+        width: w,
+        height: h,
+        nd,
+        min_disp: params.min_disp,
+        p1: params.p1,
+        p2: params.p2,
+        p2_gradient: params.p2_gradient,
+        out_cost: params.census.bits() as u8,
+        left_census: &left_census,
+        right_census: &right_census,
+        left_norm,
+    };
+    let mut sum = vec![0u16; w * h * nd];
+    horizontal_paths(&ctx, &mut sum);
+    let diagonals = params.paths == Paths::Eight;
+    vertical_paths(&ctx, &mut sum, true, diagonals);
+    vertical_paths(&ctx, &mut sum, false, diagonals);
+    let disp = select(&ctx, &sum, params);
+    drop(sum);
+    let disp = GrayImage::from_vec(w, h, disp).map_err(|e| SgmError::Param {
+        name: "size",
+        reason: e.to_string(),
+    })?;
+    Ok(if params.median {
+        median3x3(&disp)
+    } else {
+        disp
+    })
+}
+
+/// Errors of an estimate against ground truth.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct DisparityErrors {
+    /// Pixels with a finite ground truth.
+    pub truth_pixels: usize,
+    /// Fraction of those with a finite estimate (density).
+    pub density: f64,
+    /// Fraction of the estimated ones off by more than the threshold (bad-T).
+    pub bad: f64,
+    /// Fraction of all ground-truth pixels that are missing or off by more than the threshold.
+    pub bad_all: f64,
+    /// Mean absolute error over estimated pixels.
+    pub mean_abs: f64,
+    /// Root-mean-square error over estimated pixels.
+    pub rms: f64,
+    /// The threshold in pixels.
+    pub threshold: f32,
+}
+
+/// Compares an estimate with ground truth (both `inf` where there is no value).
+pub fn compare_disparity(
+    estimate: &GrayImage,
+    truth: &GrayImage,
+    threshold: f32,
+) -> Result<DisparityErrors, SgmError> {
+    if (estimate.width, estimate.height) != (truth.width, truth.height) {
+        return Err(SgmError::SizeMismatch {
+            lw: estimate.width,
+            lh: estimate.height,
+            rw: truth.width,
+            rh: truth.height,
+        });
+    }
+    let (mut n, mut m, mut bad, mut sa, mut ss) = (0usize, 0usize, 0usize, 0.0f64, 0.0f64);
+    for (&e, &t) in estimate.data.iter().zip(&truth.data) {
+        if !t.is_finite() {
+            continue;
+        }
+        n += 1;
+        if !e.is_finite() {
+            continue;
+        }
+        m += 1;
+        let err = (e - t).abs() as f64;
+        if err > threshold as f64 {
+            bad += 1;
+        }
+        sa += err;
+        ss += err * err;
+    }
+    let frac = |a: usize, b: usize| if b > 0 { a as f64 / b as f64 } else { 0.0 };
+    Ok(DisparityErrors {
+        truth_pixels: n,
+        density: frac(m, n),
+        bad: frac(bad, m),
+        bad_all: frac(bad + n - m, n),
+        mean_abs: if m > 0 { sa / m as f64 } else { 0.0 },
+        rms: if m > 0 { (ss / m as f64).sqrt() } else { 0.0 },
+        threshold,
+    })
+}
+
+/// A colour preview of a disparity map (turbo colour map over `range`, or over the 1-99 %
+/// range of the finite values; invalid pixels black).
+pub fn disparity_preview(disp: &GrayImage, range: Option<(f32, f32)>) -> image::RgbImage {
+    let (lo, hi) =
+        range.unwrap_or_else(|| (quantile(&disp.data, 0.01), quantile(&disp.data, 0.99)));
+    let span = if hi > lo { hi - lo } else { 1.0 };
+    image::RgbImage::from_fn(disp.width as u32, disp.height as u32, |x, y| {
+        let d = disp.get(x as usize, y as usize);
+        if !d.is_finite() {
+            return image::Rgb([0, 0, 0]);
+        }
+        let t = ((d - lo) / span).clamp(0.0, 1.0);
+        image::Rgb(turbo(t))
+    })
+}
+
+/// Writes [`disparity_preview`] as a PNG, through a temporary file renamed into place.
+pub fn write_disparity_png(
+    path: &std::path::Path,
+    disp: &GrayImage,
+    range: Option<(f32, f32)>,
+) -> Result<(), ImageError> {
+    let tmp = path.with_extension("png.tmp");
+    let result = disparity_preview(disp, range)
+        .save_with_format(&tmp, image::ImageFormat::Png)
+        .map_err(|e| e.to_string())
+        .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| e.to_string()));
+    result.map_err(|reason| {
+        let _ = std::fs::remove_file(&tmp);
+        ImageError::Write {
+            path: path.to_path_buf(),
+            reason,
+        }
+    })
+}
+
+/// Google's turbo colour map (the polynomial approximation by Mikhailov, 2019).
+fn turbo(t: f32) -> [u8; 3] {
+    let t = t as f64;
+    let (t2, t3, t4, t5) = (t * t, t * t * t, t * t * t * t, t * t * t * t * t);
+    let r = 0.13572138 + 4.61539260 * t - 42.66032258 * t2 + 132.13108234 * t3 - 152.94239396 * t4
+        + 59.28637943 * t5;
+    let g = 0.09140261 + 2.19418839 * t + 4.84296658 * t2 - 14.18503333 * t3
+        + 4.27729857 * t4
+        + 2.82956604 * t5;
+    let b = 0.10667330 + 12.64194608 * t - 60.58204836 * t2 + 110.36276771 * t3 - 89.90310912 * t4
+        + 27.34824973 * t5;
+    let c = |v: f64| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
+    [c(r), c(g), c(b)]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::synth::SynthScene;
+
+    fn run(scene: &SynthScene, params: &SgmParams) -> DisparityErrors {
+        let pair = scene.render().unwrap();
+        let disp = sgm(&pair.left, &pair.right, params).unwrap();
+        compare_disparity(&disp, &pair.disparity, 2.0).unwrap()
+    }
+
+    #[test]
+    fn textured_pair_is_matched() {
+        let scene = SynthScene::textured(256, 160, 11);
+        let params = SgmParams {
+            max_disp: 47,
+            ..SgmParams::default()
+        };
+        let e = run(&scene, &params);
+        eprintln!("SGM 8 paths, 7x7 census, 256x160: {e:?}");
+        assert!(
+            e.bad < 0.05 && e.mean_abs < 0.5 && e.density > 0.85,
+            "{e:?}"
+        );
+    }
+
+    #[test]
+    fn exposure_difference_noise_and_four_paths() {
+        let scene = SynthScene {
+            gain: 0.6,
+            offset: 0.1,
+            noise: 0.01,
+            ..SynthScene::textured(256, 160, 12)
+        };
+        let params = SgmParams {
+            max_disp: 47,
+            paths: Paths::Four,
+            census: Census::Census5x5,
+            p1: 4,
+            p2: 43,
+            p2_gradient: 4.0,
+            ..SgmParams::default()
+        };
+        let e = run(&scene, &params);
+        eprintln!("SGM 4 paths, 5x5 census, gain 0.6, noise 0.01: {e:?}");
+        assert!(e.bad < 0.06 && e.mean_abs < 0.9 && e.density > 0.8, "{e:?}");
+    }
+
+    #[test]
+    fn negative_disparities() {
+        let scene = SynthScene {
+            boxes: vec![],
+            disparity_top: -6.3,
+            disparity_bottom: -2.2,
+            ..SynthScene::textured(160, 96, 13)
+        };
+        let params = SgmParams {
+            min_disp: -16,
+            max_disp: 15,
+            ..SgmParams::default()
+        };
+        let e = run(&scene, &params);
+        assert!(e.bad < 0.03 && e.mean_abs < 0.3 && e.density > 0.9, "{e:?}");
+    }
+
+    #[test]
+    fn median_keeps_invalid_pixels_and_bad_input_is_an_error() {
+        let mut img = GrayImage::new(3, 3, 1.0).unwrap();
+        img.set(1, 1, 9.0);
+        img.set(0, 0, f32::INFINITY);
+        let m = median3x3(&img);
+        assert_eq!(m.get(1, 1), 1.0);
+        assert!(m.get(0, 0).is_infinite());
+        let small = GrayImage::new(3, 2, 0.0).unwrap();
+        assert!(sgm(&img, &small, &SgmParams::default()).is_err());
+        let p = SgmParams {
+            p1: 100,
+            p2: 10,
+            ..SgmParams::default()
+        };
+        assert!(sgm(&img, &img, &p).is_err());
+        assert!(compare_disparity(&img, &small, 2.0).is_err());
+        let preview = disparity_preview(&img, None);
+        assert_eq!(preview.get_pixel(0, 0).0, [0, 0, 0]);
+        let dir = tempfile::tempdir().unwrap();
+        let png = dir.path().join("d.png");
+        write_disparity_png(&png, &img, Some((0.0, 10.0))).unwrap();
+        assert_eq!(::image::open(&png).unwrap().width(), 3);
+        assert!(write_disparity_png(&dir.path().join("no/d.png"), &img, None).is_err());
+    }
+
+    /// Timing of a megapixel pair: `cargo test --release -p streaks-analysis -- --ignored
+    /// --nocapture megapixel` (RAYON_NUM_THREADS sets the threads).
+    #[test]
+    #[ignore]
+    fn megapixel_timing() {
+        let scene = SynthScene::textured(1280, 800, 21);
+        let pair = scene.render().unwrap();
+        for (max_disp, paths) in [(63, Paths::Eight), (127, Paths::Eight), (63, Paths::Four)] {
+            let params = SgmParams {
+                max_disp,
+                paths,
+                ..SgmParams::default()
+            };
+            let t = std::time::Instant::now();
+            let disp = sgm(&pair.left, &pair.right, &params).unwrap();
+            let secs = t.elapsed().as_secs_f64();
+            let e = compare_disparity(&disp, &pair.disparity, 2.0).unwrap();
+            eprintln!(
+                "SGM 1280x800, D={} {paths:?}: {secs:.2} s, {e:?}",
+                max_disp + 1
+            );
+        }
+    }
+}
