@@ -4,10 +4,11 @@
 //! Errors are printed with their whole chain and the process exits non-zero.
 
 use clap::{Parser, Subcommand};
+use std::process::ExitCode;
 
 mod figure;
 mod locus;
-use std::process::ExitCode;
+mod render;
 
 mod disparity;
 mod lk;
@@ -22,6 +23,8 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// Path-trace one camera of a scene to EXR (and PNG).
+    Render(render::Args),
     /// Print the virtual light column (Eq. 4) of a light seen from a viewer.
     Locus(locus::Args),
     /// Draw one of the paper's figures from the model as a PNG.
@@ -35,6 +38,7 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result: anyhow::Result<()> = match cli.command {
+        Command::Render(args) => render::run(args),
         Command::Locus(args) => locus::run(args),
         Command::Figure(args) => figure::run(args),
         Command::Lk(args) => lk::run(args),
