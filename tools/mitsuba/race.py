@@ -67,7 +67,7 @@ def mitsuba_worker(xml: str, out: str, spp: int, seed: int, variant: str) -> Non
     scene = mi.load_file(xml)
     img = mi.render(scene, spp=spp, seed=seed)
     tmp = out + ".tmp.exr"
-    mi.util.write_bitmap(tmp, img)
+    mi.util.write_bitmap(tmp, img, write_async=False)
     os.replace(tmp, out)
 
 
@@ -101,7 +101,7 @@ def parse_region(text: str) -> tuple[str, tuple[float, ...]]:
 
 def main() -> int:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("scene", type=Path)
+    p.add_argument("scene", type=Path, nargs="?", help="glTF or OBJ scene")
     p.add_argument("--camera", default=None)
     p.add_argument("--width", type=int, default=320)
     p.add_argument("--height", type=int, default=240)
@@ -114,6 +114,8 @@ def main() -> int:
                    help="name=x0,y0,x1,y1 in image fractions (default road=0,0.6,1,1)")
     p.add_argument("--variant", default="llvm_ad_rgb")
     p.add_argument("--streaks", default=None, help="streaks binary (default target/release/streaks)")
+    p.add_argument("--exporter", default=None,
+                   help="streaks binary that runs export-mitsuba (default: the --streaks one)")
     p.add_argument("--out", type=Path, default=None, help="work folder (default target/race/<scene>)")
     p.add_argument("--json", type=Path, default=None, help="also write the results here")
     p.add_argument("--mitsuba-worker", nargs=5, metavar=("XML", "OUT", "SPP", "SEED", "VARIANT"),
@@ -123,6 +125,8 @@ def main() -> int:
         xml, out, spp, seed, variant = args.mitsuba_worker
         mitsuba_worker(xml, out, int(spp), int(seed), variant)
         return 0
+    if args.scene is None:
+        p.error("the scene is required")
     if args.runs < 2:
         raise SystemExit("--runs must be at least 2 (the bias's standard error needs a spread)")
 
@@ -140,7 +144,7 @@ def main() -> int:
     xml_dir = out / "mitsuba"
     if xml_dir.exists():
         shutil.rmtree(xml_dir)
-    timed([streaks, "export-mitsuba", args.scene, "-o", xml_dir, "--spp", args.spp, *common, *cam])
+    timed([args.exporter or streaks, "export-mitsuba", args.scene, "-o", xml_dir, "--spp", args.spp, *common, *cam])
     xml = xml_dir / "scene.xml"
 
     def ours(spp: int, seed: int, path: Path) -> list:
