@@ -125,7 +125,8 @@ pub fn image_size(
     Ok((w, h))
 }
 
-fn progress_bar(total: u64) -> ProgressBar {
+/// A progress bar over `total` pixel samples on stderr (hidden in CI and when not a terminal).
+pub fn progress_bar(total: u64) -> ProgressBar {
     let in_ci = std::env::var("CI").is_ok_and(|v| v == "true" || v == "1");
     if in_ci || !std::io::stderr().is_terminal() {
         return ProgressBar::hidden();

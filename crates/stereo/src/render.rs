@@ -1,0 +1,372 @@
+//! Rendering a rectified stereo pair with ground truth (feature `render`).
+//!
+//! The scene is loaded once (one BVH) and both eyes are path-traced from it. Ground truth
+//! comes from the renderer's `depth` layer, the camera-space depth `Z` of the first hit of each
+//! pixel's centre ray (`inf` on a miss): the disparity of that pixel is `d = f b / Z` pixels
+//! (`inf` on a miss). For the right view this is the Middlebury `disp1` convention: the pixel's
+//! match in the left view is at `x + d`. The streak masks use the `specular` layer (see
+//! [`crate::streak_mask`]) with road pixels from the `normal` layer.
+//!
+//! The left eye is rendered with the given seed and the right eye with `seed + 1`, so that
+//! the two views' sampling noise is independent and cannot pull a matcher toward zero disparity.
+//!
+//! Files written by [`write_pair`] into the output folder: `left.exr`, `right.exr` (linear,
+//! with `depth`, `normal` and `specular` layers), `left.png`, `right.png` (sRGB with the
+//! exposure), `side_by_side.png`, `anaglyph.png`, `disparity_left.pfm`, `depth_left.pfm`,
+//! `disparity_right.pfm`, `depth_right.pfm`, `streak_mask_left.png`, `streak_mask_right.png`
+//! and `rig.json`.
+//!
+//! The rendered-scene tests (ground truth against an analytic road plane, and the disparity
+//! of a rendered textured plane measured with the project's Lucas-Kanade estimator) are in
+//! `tests/stereo_cli.rs`.
+
+use crate::error::StereoError;
+use crate::image::GrayImage;
+use crate::pair::write_pair_views;
+use crate::pfm::write_pfm;
+use crate::rig::{Eye, Intrinsics, Rig, RoadFrame};
+use crate::rigfile::{LightRecord, Placed, RigFile};
+use crate::streak_mask::{streak_mask, StreakMaskParams};
+use glam::Vec3;
+use std::collections::HashMap;
+use std::path::Path;
+use streaks_render::camera::Camera;
+use streaks_render::integrator::{render, Layers, RenderOutput, RenderSettings};
+use streaks_render::light::Light;
+use streaks_render::output::{to_srgb8, write_exr, write_png, RgbImage};
+use streaks_render::scene::Scene;
+
+/// A road pixel's first-hit normal is within this angle's cosine of +Y (10 degrees).
+const ROAD_COS: f32 = 0.984_807_7;
+
+/// The rig of a scene camera: the camera is the rig centre, its `yfov` gives the focal length
+/// for an image of `height` pixels (`f = (H/2) / tan(yfov/2)`).
+pub fn rig_from_camera(
+    camera: &Camera,
+    width: u32,
+    height: u32,
+    baseline: f32,
+) -> Result<Rig, StereoError> {
+    let intrinsics = Intrinsics::from_yfov(width, height, camera.yfov)?;
+    Rig::new(intrinsics, baseline, camera.world_from_camera).map_err(|e| match e {
+        StereoError::Pose(reason) => {
+            StereoError::Pose(format!("camera {:?}: {reason}", camera.name))
+        }
+        other => other,
+    })
+}
+
+/// One eye of `rig` as a renderer camera (same pose, field of view and aspect ratio).
+pub fn eye_camera(rig: &Rig, eye: Eye) -> Camera {
+    let i = rig.intrinsics();
+    Camera {
+        name: format!("{eye} eye"),
+        world_from_camera: rig.world_from_eye(eye),
+        yfov: i.yfov(),
+        aspect_ratio: Some(i.width() as f32 / i.height() as f32),
+    }
+}
+
+/// How to render a pair.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PairSettings {
+    /// Samples per pixel.
+    pub spp: u32,
+    /// Longest path (Mitsuba's meaning).
+    pub max_depth: u32,
+    /// Seed of the left eye (the right eye uses `seed + 1`).
+    pub seed: u32,
+    /// Exposure of the PNGs in stops.
+    pub exposure_ev: f32,
+    /// The streak-mask definition.
+    pub mask: StreakMaskParams,
+}
+
+/// One rendered eye with its ground truth.
+#[derive(Clone, Debug)]
+pub struct EyeView {
+    /// The renderer's output (beauty image with `depth`, `normal` and `specular` layers).
+    pub output: RenderOutput,
+    /// Camera-space depth `Z` of each pixel's first hit (`inf` on a miss).
+    pub depth: GrayImage,
+    /// Ground-truth disparity `f b / Z` in pixels (`inf` on a miss).
+    pub disparity: GrayImage,
+    /// Which pixels see an upward-facing surface (the road).
+    pub road: Vec<bool>,
+    /// The streak mask (1 = streak).
+    pub streak_mask: GrayImage,
+    /// The specular-luminance threshold the mask used.
+    pub streak_threshold: f32,
+}
+
+fn luminance(rgb: Vec3) -> f32 {
+    0.2126 * rgb.x + 0.7152 * rgb.y + 0.0722 * rgb.z
+}
+
+fn luminance_image(img: &RgbImage) -> Result<GrayImage, StereoError> {
+    Ok(GrayImage::from_vec(
+        img.width as usize,
+        img.height as usize,
+        img.pixels.iter().map(|&p| luminance(p)).collect(),
+    )?)
+}
+
+/// Renders one eye and derives its ground truth and streak mask.
+pub fn render_eye(
+    scene: &Scene,
+    rig: &Rig,
+    eye: Eye,
+    settings: &PairSettings,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<EyeView, StereoError> {
+    if settings.spp == 0 || settings.max_depth == 0 {
+        return Err(StereoError::Parameter {
+            name: "spp/max-depth",
+            reason: "both must be at least 1".into(),
+        });
+    }
+    let i = rig.intrinsics();
+    let (w, h) = (i.width(), i.height());
+    let render_settings = RenderSettings {
+        width: w,
+        height: h,
+        spp: settings.spp,
+        max_depth: settings.max_depth,
+        seed: match eye {
+            Eye::Left => settings.seed,
+            Eye::Right => settings.seed.wrapping_add(1),
+        },
+        layers: Layers {
+            depth: true,
+            normal: true,
+            albedo: false,
+            specular: true,
+        },
+    };
+    let output = render(scene, &eye_camera(rig, eye), &render_settings, progress);
+    let missing =
+        |what: &str| StereoError::Render(format!("the renderer returned no {what} layer"));
+    let z = output.depth.clone().ok_or_else(|| missing("depth"))?;
+    let normals = output.normal.as_ref().ok_or_else(|| missing("normal"))?;
+    let specular = output
+        .specular
+        .as_ref()
+        .ok_or_else(|| missing("specular"))?;
+    let (wu, hu) = (w as usize, h as usize);
+    let disparity: Vec<f32> = z
+        .iter()
+        .map(|&z| {
+            if z.is_finite() && z > 0.0 {
+                rig.disparity_px(z)
+            } else {
+                f32::INFINITY
+            }
+        })
+        .collect();
+    let road: Vec<bool> = normals
+        .pixels
+        .iter()
+        .zip(&z)
+        .map(|(n, z)| z.is_finite() && n.y > ROAD_COS)
+        .collect();
+    let (streak_mask, streak_threshold) = streak_mask(
+        &luminance_image(specular)?,
+        &luminance_image(&output.image)?,
+        Some(&road),
+        &settings.mask,
+    )?;
+    Ok(EyeView {
+        depth: GrayImage::from_vec(wu, hu, z)?,
+        disparity: GrayImage::from_vec(wu, hu, disparity)?,
+        road,
+        streak_mask,
+        streak_threshold,
+        output,
+    })
+}
+
+/// Renders both eyes (left first) with one `progress` over both: it receives increments of
+/// pixel samples, `2 * width * height * spp` in all.
+pub fn render_pair(
+    scene: &Scene,
+    rig: &Rig,
+    settings: &PairSettings,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<[EyeView; 2], StereoError> {
+    let left = render_eye(scene, rig, Eye::Left, settings, progress)?;
+    let right = render_eye(scene, rig, Eye::Right, settings, progress)?;
+    Ok([left, right])
+}
+
+/// The scene's lights as `rig.json` records: point, spot and directional lights as they are;
+/// emissive triangles grouped into lamps (triangles of one material that share vertex
+/// positions), each with its area-weighted centroid.
+pub fn light_records(scene: &Scene, road: Option<&RoadFrame>) -> Vec<LightRecord> {
+    let mut out = Vec::new();
+    let mut emissive = Vec::new();
+    for light in &scene.lights {
+        match *light {
+            Light::Point {
+                position,
+                intensity,
+                range,
+            } => out.push(LightRecord::Point {
+                position: Placed::point(position, road),
+                intensity: intensity.into(),
+                range,
+            }),
+            Light::Spot {
+                position,
+                direction,
+                intensity,
+                cos_inner,
+                cos_outer,
+                range,
+            } => out.push(LightRecord::Spot {
+                position: Placed::point(position, road),
+                direction: Placed::vector(direction, road),
+                intensity: intensity.into(),
+                cos_inner,
+                cos_outer,
+                range,
+            }),
+            Light::Directional {
+                direction,
+                irradiance,
+            } => out.push(LightRecord::Directional {
+                direction: Placed::vector(direction, road),
+                irradiance: irradiance.into(),
+            }),
+            Light::Triangle { triangle } => emissive.push(triangle as usize),
+        }
+    }
+    out.extend(emissive_groups(scene, &emissive, road));
+    out
+}
+
+/// Union-find root with path halving.
+fn find(parent: &mut [usize], mut i: usize) -> usize {
+    while parent[i] != i {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    i
+}
+
+fn emissive_groups(scene: &Scene, tris: &[usize], road: Option<&RoadFrame>) -> Vec<LightRecord> {
+    let valid: Vec<usize> = tris
+        .iter()
+        .copied()
+        .filter(|&t| t < scene.triangles.len())
+        .collect();
+    let mut parent: Vec<usize> = (0..valid.len()).collect();
+    // Triangles touching the same vertex position with the same material are one lamp.
+    let mut first_at: HashMap<([u32; 3], u32), usize> = HashMap::new();
+    for (k, &t) in valid.iter().enumerate() {
+        let material = scene.triangle_materials.get(t).copied().unwrap_or(u32::MAX);
+        for &v in &scene.triangles[t] {
+            let p = scene.positions[v as usize];
+            let key = ([p.x.to_bits(), p.y.to_bits(), p.z.to_bits()], material);
+            let other = *first_at.entry(key).or_insert(k);
+            let (a, b) = (find(&mut parent, k), find(&mut parent, other));
+            parent[a] = b;
+        }
+    }
+    // Accumulate per root, in order of first appearance.
+    let mut order: Vec<usize> = Vec::new();
+    let mut acc: HashMap<usize, (Vec3, f32, usize, u32)> = HashMap::new();
+    for (k, &t) in valid.iter().enumerate() {
+        let root = find(&mut parent, k);
+        let [a, b, c] = scene.triangles[t].map(|v| scene.positions[v as usize]);
+        let area = 0.5 * (b - a).cross(c - a).length();
+        let material = scene.triangle_materials.get(t).copied().unwrap_or(u32::MAX);
+        let e = acc.entry(root).or_insert_with(|| {
+            order.push(root);
+            (Vec3::ZERO, 0.0, 0, material)
+        });
+        e.0 += area * (a + b + c) / 3.0;
+        e.1 += area;
+        e.2 += 1;
+    }
+    order
+        .into_iter()
+        .map(|root| {
+            let (weighted, area, n, material) = acc[&root];
+            let m = scene.materials.get(material as usize);
+            LightRecord::Emissive {
+                centroid: Placed::point(weighted / area.max(f32::MIN_POSITIVE), road),
+                area,
+                triangles: n,
+                radiance: m.map(|m| m.emission.into()).unwrap_or([0.0; 3]),
+                material: m.map(|m| m.name.clone()).unwrap_or_default(),
+            }
+        })
+        .collect()
+}
+
+fn output_err(e: impl std::fmt::Display) -> StereoError {
+    StereoError::Render(e.to_string())
+}
+
+/// Writes a rendered pair and its ground truth into `dir` (which must exist); see the module
+/// documentation for the files.
+pub fn write_pair(
+    dir: &Path,
+    scene: &Scene,
+    rig: &Rig,
+    views: &[EyeView; 2],
+    exposure_ev: f32,
+) -> Result<(), StereoError> {
+    let mut srgb = Vec::with_capacity(2);
+    for (eye, view) in Eye::BOTH.into_iter().zip(views) {
+        let name = eye.name();
+        write_exr(&dir.join(format!("{name}.exr")), &view.output).map_err(output_err)?;
+        let img = &view.output.image;
+        write_png(&dir.join(format!("{name}.png")), img, exposure_ev).map_err(output_err)?;
+        srgb.push(
+            image::RgbImage::from_raw(img.width, img.height, to_srgb8(img, exposure_ev))
+                .ok_or_else(|| output_err("image size does not match its pixels"))?,
+        );
+        write_pfm(&dir.join(format!("disparity_{name}.pfm")), &view.disparity)?;
+        write_pfm(&dir.join(format!("depth_{name}.pfm")), &view.depth)?;
+        view.streak_mask
+            .save_png(&dir.join(format!("streak_mask_{name}.png")))?;
+    }
+    write_pair_views(dir, &srgb[0], &srgb[1])?;
+    let road = rig.road_frame().ok();
+    RigFile::new(rig, light_records(scene, road.as_ref())).save(&dir.join("rig.json"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Affine3A;
+
+    #[test]
+    fn bad_inputs_are_errors() {
+        let cam = Camera {
+            name: "c".into(),
+            world_from_camera: Affine3A::from_scale(Vec3::splat(2.0)),
+            yfov: 0.5,
+            aspect_ratio: None,
+        };
+        let e = rig_from_camera(&cam, 64, 48, 0.065).unwrap_err();
+        assert!(e.to_string().contains("\"c\""), "{e}");
+        let cam = Camera {
+            world_from_camera: Affine3A::IDENTITY,
+            ..cam
+        };
+        assert!(matches!(
+            rig_from_camera(&cam, 64, 48, 0.0),
+            Err(StereoError::Baseline(_))
+        ));
+        assert!(rig_from_camera(&cam, 0, 48, 0.065).is_err());
+        let rig = rig_from_camera(&cam, 64, 48, 0.065).unwrap();
+        let eye = eye_camera(&rig, Eye::Right);
+        assert!((eye.focal_px(48) - rig.focal_px()).abs() < 1e-3);
+        let p = Vec3::new(0.3, -0.2, -4.0);
+        let a = eye.project(p, 64, 48).unwrap();
+        let b = rig.eye(Eye::Right).project(p).unwrap();
+        assert!((a - b).length() < 1e-3, "{a} {b}");
+    }
+}
