@@ -20,8 +20,9 @@ Against it the script reports, on the road region (`--region`, fractions of the 
   own noise makes both MSEs slightly larger by the same amount (it is independent of the runs).
 
 Usage:
-    python3 tools/mitsuba/race.py scenes/rainy_street_small.gltf --camera driver \
-        --width 320 --height 240 --spp 64 --max-depth 4 --runs 3 --ref-spp 4096
+    python3 tools/mitsuba/race.py scenes/crosscheck.gltf --camera cam --region road=0,0.7,1,1 \
+        --width 320 --height 240 --spp 64 --max-depth 4 --runs 3 \
+        --ref-renderer mitsuba --ref-spp 4096
 
 Needs mitsuba (pip install -r tools/mitsuba/requirements.txt) and, for llvm_ad_rgb, Debian's
 libllvm19 (DRJIT_LIBLLVM_PATH is set from the usual locations when unset).
