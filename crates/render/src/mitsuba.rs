@@ -14,7 +14,7 @@
 //! | spot light | `spot`, `intensity`, `cutoff_angle` = outer, `beam_width` = inner (degrees) | no: Mitsuba's falloff is linear in angle, glTF's smooth in cosine (warning) |
 //! | directional light | `directional`, same `irradiance` | yes |
 //! | emissive material | its mesh gets an `area` emitter of the same `radiance` | yes for one-sided emission; `doubleSided` emission is one-sided in Mitsuba (warning) |
-//! | `ggx` | `blendbsdf` weight 0.5 of `diffuse` (reflectance 2 kd) and `roughconductor` (ggx, material none, alpha, specular_reflectance 2 ks) | yes |
+//! | `ggx` | `blendbsdf` weight 0.5 of `diffuse` (reflectance 2 kd) and `roughconductor` (ggx, material none, alpha, specular_reflectance 2 ks); when 2 kd or 2 ks would exceed 1 (Mitsuba rejects it), the equivalent weight w = ks/(kd+ks) with reflectances kd/(1-w) and ks/w | yes (if kd + ks <= 1) |
 //! | `ward` | the same blend with `beckmann` and the same alpha | no (warning) |
 //! | `blinn_phong` | the same blend with `beckmann`, alpha = sqrt(2 / (s + 2)) | no (warning) |
 //! | glTF metallic-roughness | `principled` (base_color, metallic, roughness) | no: different Fresnel and diffuse models (warning); metallicRoughnessTexture ignored (warning) |
@@ -264,6 +264,20 @@ fn v3(v: Vec3) -> String {
     format!("{:?}, {:?}, {:?}", v.x, v.y, v.z)
 }
 
+/// The `blendbsdf` weight `w` (the roughconductor's share) for a paper material with largest
+/// diffuse and specular reflectance `kd_max` and `ks_max`, so that `(1 - w) diffuse(kd / (1 - w))
+/// + w roughconductor(ks / w)` equals ours with both reflectances at most 1, as Mitsuba requires.
+/// DESIGN.md's mapping (w = 0.5: diffuse 2 kd, conductor 2 ks) is used whenever it is valid;
+/// otherwise w = ks_max / (kd_max + ks_max). The flag is false when kd_max + ks_max > 1, where
+/// no weight is exact.
+fn blend_weight(kd_max: f32, ks_max: f32) -> (f32, bool) {
+    if 2.0 * kd_max <= 1.0 && 2.0 * ks_max <= 1.0 {
+        return (0.5, true);
+    }
+    let total = kd_max + ks_max;
+    (ks_max / total, total <= 1.0)
+}
+
 fn rgb(name: &str, v: Vec3) -> String {
     format!(
         "<rgb name=\"{name}\" value=\"{:?}, {:?}, {:?}\"/>",
@@ -363,16 +377,32 @@ impl MaterialWriter<'_> {
                         m.name
                     ));
                 }
-                let diffuse = self.colour(m, &stem, "reflectance", 2.0 * *kd, *kd_texture)?;
+                let (w, exact) = blend_weight(kd.max_element(), ks.max_element());
+                if !exact {
+                    self.warnings.push(format!(
+                        "material {:?}: kd + ks exceeds 1, which Mitsuba's blendbsdf cannot \
+                         express; the exported reflectances are clipped to 1 (darker)",
+                        m.name
+                    ));
+                }
+                let scale = |c: Vec3, share: f32| {
+                    if share > 0.0 {
+                        (c / share).min(Vec3::ONE)
+                    } else {
+                        Vec3::ZERO
+                    }
+                };
+                let diffuse =
+                    self.colour(m, &stem, "reflectance", scale(*kd, 1.0 - w), *kd_texture)?;
                 let _ = write!(
                     out,
-                    "<bsdf type=\"blendbsdf\"><float name=\"weight\" value=\"0.5\"/>\
+                    "<bsdf type=\"blendbsdf\"><float name=\"weight\" value=\"{w:?}\"/>\
                      <bsdf type=\"diffuse\">{diffuse}</bsdf>\
                      <bsdf type=\"roughconductor\">\
                      <string name=\"distribution\" value=\"{distribution}\"/>\
                      <string name=\"material\" value=\"none\"/>\
                      <float name=\"alpha\" value=\"{a:?}\"/>{}</bsdf></bsdf>",
-                    rgb("specular_reflectance", 2.0 * *ks)
+                    rgb("specular_reflectance", scale(*ks, w))
                 );
             }
             Reflectance::GltfPbr {
@@ -952,5 +982,15 @@ mod tests {
         )
         .unwrap();
         assert_eq!(img.layer_data.channel_data.pixels[0], [0.1, 0.05, 0.025]);
+    }
+
+    #[test]
+    fn blend_weight_keeps_reflectances_at_most_one() {
+        assert_eq!(blend_weight(0.05, 0.5), (0.5, true));
+        let (w, exact) = blend_weight(0.55, 0.1);
+        assert!(exact && (0.55 / (1.0 - w) - 0.65).abs() < 1e-6 && 0.1 / w <= 1.0 + 1e-6);
+        assert_eq!(blend_weight(0.8, 0.0), (0.0, true));
+        assert_eq!(blend_weight(0.0, 0.9), (1.0, true));
+        assert!(!blend_weight(0.9, 0.4).1);
     }
 }
