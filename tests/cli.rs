@@ -188,3 +188,45 @@ fn unwritable_output_leaves_no_file() {
     );
     assert!(t.files_in("taken.exr").is_empty());
 }
+
+/// Every shipped scene renders through the real command, with light in it and no dropped
+/// samples (tiny size and spp: this checks the scenes and the loader together, not quality).
+#[test]
+fn every_shipped_scene_renders() {
+    let scenes = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let mut names: Vec<_> = std::fs::read_dir(&scenes)
+        .expect("scenes/ exists")
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "gltf"))
+        .collect();
+    names.sort();
+    assert!(
+        names.len() >= 7,
+        "expected the shipped scenes, found {names:?}"
+    );
+    let dir = TestDir::new();
+    for path in names {
+        let stem = path.file_stem().unwrap().to_string_lossy().into_owned();
+        let out = dir.join(&format!("{stem}.exr"));
+        let run = dir.streaks(&[
+            "render",
+            path.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--height",
+            "48",
+            "--spp",
+            "2",
+            "--max-depth",
+            "3",
+        ]);
+        run.assert_success();
+        let stderr = run.stderr();
+        assert!(!stderr.contains("warning"), "{stem}: {stderr}");
+        assert!(stderr.contains(" 0 samples dropped"), "{stem}: {stderr}");
+        let img = read_exr_rgb(&out).unwrap();
+        let mean: f32 =
+            img.pixels.iter().map(|p| p.x + p.y + p.z).sum::<f32>() / (3 * img.pixels.len()) as f32;
+        assert!(mean.is_finite() && mean > 0.0, "{stem}: mean {mean}");
+    }
+}
