@@ -3,10 +3,12 @@
 //! Each subcommand module exposes an `Args` struct (clap) and `run(args) -> anyhow::Result<()>`.
 //! Errors are printed with their whole chain and the process exits non-zero.
 
-use clap::{Parser, Subcommand};
-
 mod figure;
 mod locus;
+mod prepare;
+mod texture_map;
+
+use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 mod disparity;
@@ -22,6 +24,10 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// Resample an image of a rendered or photographed pair onto the road plane (paper Fig. 3).
+    TextureMap(texture_map::Args),
+    /// Grey level, histogram equalisation and a disparity shift for a photographed pair (Fig. 7).
+    Prepare(prepare::Args),
     /// Print the virtual light column (Eq. 4) of a light seen from a viewer.
     Locus(locus::Args),
     /// Draw one of the paper's figures from the model as a PNG.
@@ -35,6 +41,8 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result: anyhow::Result<()> = match cli.command {
+        Command::TextureMap(args) => texture_map::run(args),
+        Command::Prepare(args) => prepare::run(args),
         Command::Locus(args) => locus::run(args),
         Command::Figure(args) => figure::run(args),
         Command::Lk(args) => lk::run(args),

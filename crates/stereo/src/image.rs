@@ -1,5 +1,6 @@
 //! A single-channel float image, the currency of the stereo and analysis code.
 
+use std::io::Write;
 use std::path::Path;
 
 /// Errors reading or writing images.
@@ -84,6 +85,49 @@ impl GrayImage {
         self.data[y * self.width + x] = v;
     }
 
+    /// Bilinear interpolation at continuous pixel coordinates (pixel centres at `i + 0.5`),
+    /// clamped to the edge pixels; `None` outside `[0, width] x [0, height]`.
+    #[inline]
+    pub fn sample_bilinear(&self, x: f32, y: f32) -> Option<f32> {
+        if !(x >= 0.0 && y >= 0.0 && x <= self.width as f32 && y <= self.height as f32) {
+            return None;
+        }
+        let (u, v) = (x - 0.5, y - 0.5);
+        let (x0, y0) = (u.floor(), v.floor());
+        let (tx, ty) = (u - x0, v - y0);
+        let clamp_x = |i: f32| (i.max(0.0) as usize).min(self.width - 1);
+        let clamp_y = |i: f32| (i.max(0.0) as usize).min(self.height - 1);
+        let (xa, xb, ya, yb) = (
+            clamp_x(x0),
+            clamp_x(x0 + 1.0),
+            clamp_y(y0),
+            clamp_y(y0 + 1.0),
+        );
+        let top = self.get(xa, ya) * (1.0 - tx) + self.get(xb, ya) * tx;
+        let bottom = self.get(xa, yb) * (1.0 - tx) + self.get(xb, yb) * tx;
+        Some(top * (1.0 - ty) + bottom * ty)
+    }
+
+    /// The image as 8-bit grey levels: values in [0, 1] are scaled to [0, 255], rounded, and
+    /// clipped (NaN becomes 0).
+    pub fn to_gray8(&self) -> ::image::GrayImage {
+        let data = self.data.iter().map(|&v| to_u8(v)).collect();
+        ::image::GrayImage::from_raw(self.width as u32, self.height as u32, data)
+            .expect("size checked at construction")
+    }
+
+    /// The grey levels repeated in three channels, as [`GrayImage::to_gray8`].
+    pub fn to_rgb8(&self) -> ::image::RgbImage {
+        let data = self.data.iter().flat_map(|&v| [to_u8(v); 3]).collect();
+        ::image::RgbImage::from_raw(self.width as u32, self.height as u32, data)
+            .expect("size checked at construction")
+    }
+
+    /// Writes the image as an 8-bit greyscale PNG (see [`GrayImage::to_gray8`]), atomically.
+    pub fn save_png(&self, path: &Path) -> Result<(), ImageError> {
+        encode_and_write(path, &self.to_gray8())
+    }
+
     /// Loads any image the `image` crate reads (PNG, JPEG, EXR; 8/16-bit or float) as luminance
     /// (Rec. 709 weights) in [0, 1] for integer formats.
     pub fn load(path: &Path) -> Result<Self, ImageError> {
@@ -104,6 +148,48 @@ impl GrayImage {
     }
 }
 
+/// Writes `bytes` to `path` atomically: a temporary file beside it, synced, then renamed, so an
+/// interrupted run never leaves a half-written file. The temporary file is removed on failure.
+pub fn write_file_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let mut name = path.file_name().unwrap_or_default().to_os_string();
+    name.push(".tmp");
+    let tmp = path.with_file_name(name);
+    let write = || -> std::io::Result<()> {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    };
+    write().inspect_err(|_| {
+        let _ = std::fs::remove_file(&tmp);
+    })
+}
+
+/// Encodes an 8-bit RGB image as PNG and writes it atomically.
+pub fn save_rgb8_png(path: &Path, img: &::image::RgbImage) -> Result<(), ImageError> {
+    encode_and_write(path, img)
+}
+
+fn encode_and_write<P: ::image::PixelWithColorType, C: std::ops::Deref<Target = [P::Subpixel]>>(
+    path: &Path,
+    img: &::image::ImageBuffer<P, C>,
+) -> Result<(), ImageError>
+where
+    [P::Subpixel]: ::image::EncodableLayout,
+{
+    let err = |reason: String| ImageError::Write {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let mut bytes = Vec::new();
+    img.write_to(
+        &mut std::io::Cursor::new(&mut bytes),
+        ::image::ImageFormat::Png,
+    )
+    .map_err(|e| err(e.to_string()))?;
+    write_file_atomic(path, &bytes).map_err(|e| err(e.to_string()))
+}
+
 fn checked_len(width: usize, height: usize) -> Result<usize, ImageError> {
     let size = |reason| ImageError::Size {
         width: width as u64,
@@ -119,6 +205,12 @@ fn checked_len(width: usize, height: usize) -> Result<usize, ImageError> {
     }
 }
 
+#[inline]
+fn to_u8(v: f32) -> u8 {
+    // NaN fails both comparisons of clamp's inputs and becomes 0 through `as`.
+    (v.clamp(0.0, 1.0) * 255.0).round() as u8
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -132,5 +224,35 @@ mod tests {
         g.set(2, 1, 7.0);
         assert_eq!(g.get(2, 1), 7.0);
         assert_eq!(g.data[5], 7.0);
+    }
+
+    #[test]
+    fn bilinear_sampling_hits_pixel_centres_and_interpolates() {
+        let g = GrayImage::from_vec(2, 2, vec![0.0, 1.0, 2.0, 3.0]).unwrap();
+        assert_eq!(g.sample_bilinear(0.5, 0.5), Some(0.0));
+        assert_eq!(g.sample_bilinear(1.5, 1.5), Some(3.0));
+        assert_eq!(g.sample_bilinear(1.0, 0.5), Some(0.5));
+        assert_eq!(g.sample_bilinear(1.0, 1.0), Some(1.5));
+        assert_eq!(
+            g.sample_bilinear(0.0, 0.0),
+            Some(0.0),
+            "clamped at the edge"
+        );
+        assert_eq!(g.sample_bilinear(2.1, 1.0), None);
+        assert_eq!(g.sample_bilinear(f32::NAN, 1.0), None);
+    }
+
+    #[test]
+    fn png_round_trip_and_atomic_write() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("g.png");
+        let g = GrayImage::from_vec(3, 1, vec![0.0, 0.5, 2.0]).unwrap();
+        g.save_png(&p).unwrap();
+        assert!(!dir.path().join("g.png.tmp").exists());
+        let back = GrayImage::load(&p).unwrap();
+        assert_eq!(back.data[0], 0.0);
+        assert!((back.data[1] - 128.0 / 255.0).abs() < 1e-6);
+        assert_eq!(back.data[2], 1.0);
+        assert!(g.save_png(&dir.path().join("no/such/dir.png")).is_err());
     }
 }

@@ -1,10 +1,43 @@
 //! # streaks-stereo
 //!
-//! Stereo geometry and images (skeleton; the stereo work fills it in).
+//! Rectified stereo for the streaks project: the rig geometry, ground truth, viewing aids and
+//! the ground-plane texture map. Everything but [`render`] works without the renderer (build
+//! with `--no-default-features`), so the analysis can use it on photographs.
 //!
-//! - [`image`]: the single-channel float image used by the stereo and analysis code.
+//! - [`rig`]: [`rig::Rig`] (intrinsics, baseline, pose), its eyes ([`rig::EyeCamera`]:
+//!   projection, back-projection), disparity <-> depth (Eq. 5) and the road frame.
+//! - [`rigfile`]: `rig.json` ([`rigfile::RigFile`]), with the scene's lights in world and road
+//!   coordinates.
+//! - [`image`]: the single-channel float image [`image::GrayImage`]; PNG and atomic writing.
 //! - [`pfm`]: PFM disparity and depth maps (Middlebury convention).
+//! - [`pair`]: side-by-side and anaglyph views; the paper's Fig. 7 treatment of photographs.
+//! - [`streak_mask`]: which pixels are specular streaks, from the renderer's specular layer.
+//! - [`texture_map`]: the paper's Fig. 3 ground-plane texture map.
+//! - [`font`]: the bundled plot font (plotters + `ab_glyph`, no system fonts).
+//! - [`render`] (feature `render`): rendering a pair with ground-truth disparity and depth.
+//!
+//! ```
+//! use streaks_stereo::rig::{Eye, Intrinsics, Rig};
+//! use glam::{Affine3A, Vec2, Vec3};
+//!
+//! let rig = Rig::new(
+//!     Intrinsics::new(640, 480, 500.0)?,
+//!     0.065,
+//!     Affine3A::from_translation(Vec3::new(0.0, 1.5, 0.0)),
+//! )?;
+//! let p = rig.eye(Eye::Left).back_project(Vec2::new(100.0, 300.0), 15.0);
+//! let d = rig.eye(Eye::Left).project(p).unwrap().x - rig.eye(Eye::Right).project(p).unwrap().x;
+//! assert!((d - rig.disparity_px(15.0)).abs() < 1e-3); // f b / Z
+//! # Ok::<(), streaks_stereo::error::StereoError>(())
+//! ```
 #![deny(missing_docs)]
 
+pub mod error;
+pub mod font;
 pub mod image;
+pub mod pair;
 pub mod pfm;
+pub mod rig;
+pub mod rigfile;
+pub mod streak_mask;
+pub mod texture_map;

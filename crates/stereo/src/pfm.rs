@@ -2,8 +2,7 @@
 //! (negative scale), rows stored bottom to top, `inf` for "no value".
 //! Written atomically: a temporary file beside the target, then a rename.
 
-use crate::image::{GrayImage, ImageError};
-use std::io::Write;
+use crate::image::{write_file_atomic, GrayImage, ImageError};
 use std::path::Path;
 
 /// Writes `img` as a little-endian greyscale PFM.
@@ -19,17 +18,7 @@ pub fn write_pfm(path: &Path, img: &GrayImage) -> Result<(), ImageError> {
             bytes.extend_from_slice(&v.to_le_bytes());
         }
     }
-    let tmp = path.with_extension("pfm.tmp");
-    let write = || -> std::io::Result<()> {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(&bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    };
-    write().map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        err(e.to_string())
-    })
+    write_file_atomic(path, &bytes).map_err(|e| err(e.to_string()))
 }
 
 /// Reads a greyscale PFM (either byte order); rows are returned top row first.
@@ -110,7 +99,7 @@ mod tests {
             -4.0
         );
         assert_eq!(read_pfm(&p).unwrap(), img);
-        assert!(!p.with_extension("pfm.tmp").exists());
+        assert!(!dir.path().join("d.pfm.tmp").exists());
     }
 
     #[test]

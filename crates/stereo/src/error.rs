@@ -1,0 +1,60 @@
+//! The crate's error type.
+
+use crate::image::ImageError;
+use std::path::PathBuf;
+
+/// Errors from the stereo rig, its files and the image treatments.
+#[derive(Debug, thiserror::Error)]
+pub enum StereoError {
+    /// The baseline is not a positive finite number of metres.
+    #[error("invalid stereo baseline {0} m: it must be a positive finite number")]
+    Baseline(f32),
+    /// The intrinsics are unusable (zero or overflowing size, bad focal length).
+    #[error("invalid camera intrinsics: {0}")]
+    Intrinsics(String),
+    /// The rig pose is not a rigid transform (finite, orthonormal, right-handed).
+    #[error("invalid rig pose: {0}")]
+    Pose(String),
+    /// The road frame cannot be built (the camera looks straight up or down).
+    #[error("no road frame: {0}")]
+    RoadFrame(String),
+    /// A rig.json file could not be read, parsed or written.
+    #[error("rig file {path}: {reason}")]
+    RigFile {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        reason: String,
+    },
+    /// The scene has no camera to build the rig from, or not the one asked for.
+    #[error("no camera for the rig: {0}")]
+    Camera(String),
+    /// Two images that must have the same size do not.
+    #[error("{what}: sizes differ ({left_w}x{left_h} and {right_w}x{right_h})")]
+    SizeMismatch {
+        /// Which operation.
+        what: &'static str,
+        /// Width of the first image.
+        left_w: usize,
+        /// Height of the first image.
+        left_h: usize,
+        /// Width of the second image.
+        right_w: usize,
+        /// Height of the second image.
+        right_h: usize,
+    },
+    /// A parameter out of its range (texture-map ranges, resolution, shift, thresholds).
+    #[error("invalid parameter {name}: {reason}")]
+    Parameter {
+        /// The parameter.
+        name: &'static str,
+        /// Why.
+        reason: String,
+    },
+    /// Reading or writing an image failed.
+    #[error(transparent)]
+    Image(#[from] ImageError),
+    /// Rendering failed (scene errors are reported by the renderer).
+    #[error("rendering failed: {0}")]
+    Render(String),
+}
