@@ -1,0 +1,632 @@
+//! A small glTF 2.0 document builder: meshes in world coordinates, materials following the
+//! project's scene contract (`extras.streaks`, emissive strength, the dryness texture),
+//! KHR_lights_punctual lights and named perspective cameras; written as `NAME.gltf` with one
+//! external `NAME.bin` buffer and PNG images beside it.
+//!
+//! Output is byte-for-byte deterministic: JSON objects are built with `serde_json` (keys in a
+//! fixed order), floats written to the buffer are quantised (see [`quantise`]) so that a
+//! last-bit difference in a platform's `sin`/`cos` does not change the files.
+
+use crate::mesh::Mesh;
+use crate::Error;
+use glam::{Quat, Vec3};
+use serde_json::{json, Value};
+use std::path::{Path, PathBuf};
+
+/// glTF `ARRAY_BUFFER` target.
+const ARRAY_BUFFER: u32 = 34962;
+/// glTF `ELEMENT_ARRAY_BUFFER` target.
+const ELEMENT_ARRAY_BUFFER: u32 = 34963;
+/// glTF component type FLOAT.
+const FLOAT: u32 = 5126;
+/// glTF component type UNSIGNED_SHORT.
+const UNSIGNED_SHORT: u32 = 5123;
+/// glTF component type UNSIGNED_INT.
+const UNSIGNED_INT: u32 = 5125;
+
+/// Rounds `x` to a multiple of 2^-`bits` (ties away from zero), so computed geometry does not
+/// depend on the last bit of the platform's libm.
+pub fn quantise(x: f32, bits: i32) -> f32 {
+    let s = (2.0f32).powi(bits);
+    (x * s).round() / s
+}
+
+/// Rounds a JSON number to 7 decimals (see [`quantise`]); keeps the JSON short and stable.
+/// Negative zero becomes zero.
+pub fn round7(x: f64) -> f64 {
+    (x * 1e7).round() / 1e7 + 0.0
+}
+
+/// One of the paper's reflectance models, written as `extras.streaks`.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PaperBsdf {
+    /// GGX microfacet (Mitsuba's blend of diffuse and roughconductor); `alpha` is the
+    /// microfacet alpha.
+    Ggx {
+        /// Microfacet alpha.
+        alpha: f64,
+    },
+    /// The paper's isotropic Ward model.
+    Ward {
+        /// Ward alpha.
+        alpha: f64,
+    },
+    /// Normalised Blinn-Phong.
+    BlinnPhong {
+        /// Shininess exponent s.
+        shininess: f64,
+    },
+}
+
+/// Wet/dry modulation of a paper material: the green channel of the material's
+/// metallicRoughnessTexture is the dryness w (see scenes/README.md).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Dryness {
+    /// Index of the image (from [`Doc::add_png`]) holding the dryness map.
+    pub image: usize,
+    /// Alpha where fully dry (w = 1).
+    pub alpha_dry: f64,
+    /// Specular reflectance where fully dry (w = 1).
+    pub ks_dry: [f64; 3],
+}
+
+/// How a material reflects.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Reflect {
+    /// A paper model from `extras.streaks`.
+    Paper {
+        /// The model and its roughness parameter.
+        bsdf: PaperBsdf,
+        /// Diffuse reflectance.
+        kd: [f64; 3],
+        /// Specular reflectance (no Fresnel).
+        ks: [f64; 3],
+        /// Optional wet/dry map.
+        dryness: Option<Dryness>,
+    },
+    /// A black, non-reflecting surface (glTF metallic-roughness with base colour 0): used
+    /// for emitters, whose look is their emission.
+    Black,
+}
+
+/// A material: reflectance plus optional emission.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    /// Name written to the glTF.
+    pub name: String,
+    /// How it reflects.
+    pub reflect: Reflect,
+    /// Emitted radiance (linear RGB, W m^-2 sr^-1), written as emissiveFactor (max
+    /// component 1) times KHR_materials_emissive_strength.
+    pub emission: Option<[f64; 3]>,
+    /// Whether both faces are shaded (and emit).
+    pub double_sided: bool,
+}
+
+impl Material {
+    /// A paper-model material without emission.
+    pub fn paper(name: &str, bsdf: PaperBsdf, kd: [f64; 3], ks: [f64; 3]) -> Self {
+        Self {
+            name: name.to_owned(),
+            reflect: Reflect::Paper {
+                bsdf,
+                kd,
+                ks,
+                dryness: None,
+            },
+            emission: None,
+            double_sided: false,
+        }
+    }
+
+    /// The same paper material with a dryness map (no effect on other reflectances).
+    pub fn with_dryness(mut self, d: Dryness) -> Self {
+        if let Reflect::Paper { dryness, .. } = &mut self.reflect {
+            *dryness = Some(d);
+        }
+        self
+    }
+
+    /// A Mitsuba-style diffuse material: `ggx` with ks = 0.
+    pub fn diffuse(name: &str, kd: [f64; 3]) -> Self {
+        Self::paper(name, PaperBsdf::Ggx { alpha: 0.5 }, kd, [0.0; 3])
+    }
+
+    /// A black, one-sided emitter of radiance `radiance`.
+    pub fn emitter(name: &str, radiance: [f64; 3]) -> Self {
+        Self {
+            name: name.to_owned(),
+            reflect: Reflect::Black,
+            emission: Some(radiance),
+            double_sided: false,
+        }
+    }
+}
+
+/// A punctual light (KHR_lights_punctual).
+#[derive(Clone, Debug, PartialEq)]
+pub enum LightKind {
+    /// Point light.
+    Point,
+    /// Spot light along the node's -Z with the glTF cone angles (radians).
+    Spot {
+        /// innerConeAngle.
+        inner: f64,
+        /// outerConeAngle.
+        outer: f64,
+    },
+}
+
+/// A point or spot light: `color * intensity` is the radiant intensity (W/sr).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Light {
+    /// Node and light name.
+    pub name: String,
+    /// Point or spot.
+    pub kind: LightKind,
+    /// Colour, max component 1.
+    pub color: [f64; 3],
+    /// Intensity, W/sr.
+    pub intensity: f64,
+    /// Position in world space.
+    pub position: Vec3,
+    /// Spot direction (ignored for point lights).
+    pub direction: Vec3,
+}
+
+/// A glTF document under construction.
+pub struct Doc {
+    name: String,
+    bin: Vec<u8>,
+    accessors: Vec<Value>,
+    views: Vec<Value>,
+    meshes: Vec<Value>,
+    nodes: Vec<Value>,
+    materials: Vec<Value>,
+    cameras: Vec<Value>,
+    lights: Vec<Value>,
+    images: Vec<(String, Vec<u8>)>,
+    textures_used: Vec<usize>,
+    triangles: usize,
+    description: String,
+}
+
+impl Doc {
+    /// A new empty document that will be written as `name.gltf` and `name.bin`.
+    pub fn new(name: &str, description: &str) -> Self {
+        Self {
+            name: name.to_owned(),
+            bin: Vec::new(),
+            accessors: Vec::new(),
+            views: Vec::new(),
+            meshes: Vec::new(),
+            nodes: Vec::new(),
+            materials: Vec::new(),
+            cameras: Vec::new(),
+            lights: Vec::new(),
+            images: Vec::new(),
+            textures_used: Vec::new(),
+            triangles: 0,
+            description: description.to_owned(),
+        }
+    }
+
+    /// Number of triangles added so far.
+    pub fn triangle_count(&self) -> usize {
+        self.triangles
+    }
+
+    /// Number of punctual lights added so far.
+    pub fn light_count(&self) -> usize {
+        self.lights.len()
+    }
+
+    /// Adds an encoded PNG image written as `NAME_suffix.png`; returns its image index.
+    pub fn add_png(&mut self, suffix: &str, png: Vec<u8>) -> usize {
+        let file = format!("{}_{}.png", self.name, suffix);
+        self.images.push((file, png));
+        self.images.len() - 1
+    }
+
+    fn push_view(&mut self, bytes: &[u8], target: u32) -> usize {
+        let offset = self.bin.len();
+        self.bin.extend_from_slice(bytes);
+        while self.bin.len() % 4 != 0 {
+            self.bin.push(0);
+        }
+        self.views.push(json!({
+            "buffer": 0,
+            "byteOffset": offset,
+            "byteLength": bytes.len(),
+            "target": target,
+        }));
+        self.views.len() - 1
+    }
+
+    fn push_vec_accessor(&mut self, data: &[[f32; 3]], with_bounds: bool) -> usize {
+        let bytes: Vec<u8> = data
+            .iter()
+            .flat_map(|v| v.iter().flat_map(|c| c.to_le_bytes()))
+            .collect();
+        let view = self.push_view(&bytes, ARRAY_BUFFER);
+        let mut acc = json!({
+            "bufferView": view,
+            "componentType": FLOAT,
+            "count": data.len(),
+            "type": "VEC3",
+        });
+        if with_bounds {
+            let mut min = [f32::INFINITY; 3];
+            let mut max = [f32::NEG_INFINITY; 3];
+            for v in data {
+                for k in 0..3 {
+                    min[k] = min[k].min(v[k]);
+                    max[k] = max[k].max(v[k]);
+                }
+            }
+            acc["min"] = json!(min);
+            acc["max"] = json!(max);
+        }
+        self.accessors.push(acc);
+        self.accessors.len() - 1
+    }
+
+    /// Adds `mesh` (world coordinates) as a node named `name` with material `material`.
+    pub fn add_mesh(&mut self, name: &str, mesh: &Mesh, material: &Material) -> Result<(), Error> {
+        if mesh.indices.is_empty() {
+            return Err(Error::Scene {
+                scene: self.name.clone(),
+                element: name.to_owned(),
+                reason: "empty mesh".to_owned(),
+            });
+        }
+        let positions: Vec<[f32; 3]> = mesh
+            .positions
+            .iter()
+            .map(|p| p.to_array().map(|c| quantise(c, 16)))
+            .collect();
+        let normals: Vec<[f32; 3]> = mesh
+            .normals
+            .iter()
+            .map(|n| n.to_array().map(|c| quantise(c, 22)))
+            .collect();
+        let pos = self.push_vec_accessor(&positions, true);
+        let nor = self.push_vec_accessor(&normals, false);
+        let mut attributes = json!({ "POSITION": pos, "NORMAL": nor });
+        let textured = matches!(
+            &material.reflect,
+            Reflect::Paper {
+                dryness: Some(_),
+                ..
+            }
+        );
+        if textured {
+            let bytes: Vec<u8> = mesh
+                .uvs
+                .iter()
+                .flat_map(|t| t.to_array().map(|c| quantise(c, 20)))
+                .flat_map(|c| c.to_le_bytes())
+                .collect();
+            let view = self.push_view(&bytes, ARRAY_BUFFER);
+            self.accessors.push(json!({
+                "bufferView": view,
+                "componentType": FLOAT,
+                "count": mesh.uvs.len(),
+                "type": "VEC2",
+            }));
+            attributes["TEXCOORD_0"] = json!(self.accessors.len() - 1);
+        }
+        // 16-bit indices up to 65534 (65535 is the primitive-restart value in some APIs).
+        let (bytes, component): (Vec<u8>, u32) = if mesh.positions.len() < usize::from(u16::MAX) {
+            let b = mesh
+                .indices
+                .iter()
+                .flat_map(|&i| (i as u16).to_le_bytes())
+                .collect();
+            (b, UNSIGNED_SHORT)
+        } else {
+            let b = mesh.indices.iter().flat_map(|&i| i.to_le_bytes()).collect();
+            (b, UNSIGNED_INT)
+        };
+        let view = self.push_view(&bytes, ELEMENT_ARRAY_BUFFER);
+        self.accessors.push(json!({
+            "bufferView": view,
+            "componentType": component,
+            "count": mesh.indices.len(),
+            "type": "SCALAR",
+        }));
+        let indices = self.accessors.len() - 1;
+        let mat = self.material_index(material);
+        self.meshes.push(json!({
+            "name": name,
+            "primitives": [{ "attributes": attributes, "indices": indices, "material": mat }],
+        }));
+        self.nodes
+            .push(json!({ "name": name, "mesh": self.meshes.len() - 1 }));
+        self.triangles += mesh.indices.len() / 3;
+        Ok(())
+    }
+
+    fn material_index(&mut self, m: &Material) -> usize {
+        let mut v = json!({ "name": m.name });
+        match &m.reflect {
+            Reflect::Black => {
+                v["pbrMetallicRoughness"] = json!({
+                    "baseColorFactor": [0.0, 0.0, 0.0, 1.0],
+                    "metallicFactor": 0.0,
+                    "roughnessFactor": 1.0,
+                });
+            }
+            Reflect::Paper {
+                bsdf,
+                kd,
+                ks,
+                dryness,
+            } => {
+                let mut s = json!({ "kd": kd, "ks": ks });
+                // glTF fallback for other viewers: roughness = sqrt(alpha).
+                let fallback_alpha = match bsdf {
+                    PaperBsdf::Ggx { alpha } => {
+                        s["bsdf"] = json!("ggx");
+                        s["alpha"] = json!(alpha);
+                        *alpha
+                    }
+                    PaperBsdf::Ward { alpha } => {
+                        s["bsdf"] = json!("ward");
+                        s["alpha"] = json!(alpha);
+                        *alpha
+                    }
+                    PaperBsdf::BlinnPhong { shininess } => {
+                        s["bsdf"] = json!("blinn_phong");
+                        s["shininess"] = json!(shininess);
+                        // Blinn-Phong s ~ 2 / alpha^2 - 2.
+                        (2.0 / (shininess + 2.0)).sqrt()
+                    }
+                };
+                let mut pbr = json!({
+                    "baseColorFactor": [kd[0], kd[1], kd[2], 1.0],
+                    "metallicFactor": 0.0,
+                    "roughnessFactor": round7(fallback_alpha.sqrt()),
+                });
+                if let Some(d) = dryness {
+                    s["alpha_dry"] = json!(d.alpha_dry);
+                    s["ks_dry"] = json!(d.ks_dry);
+                    pbr["roughnessFactor"] = json!(round7(d.alpha_dry.sqrt()));
+                    let tex = match self.textures_used.iter().position(|&i| i == d.image) {
+                        Some(t) => t,
+                        None => {
+                            self.textures_used.push(d.image);
+                            self.textures_used.len() - 1
+                        }
+                    };
+                    pbr["metallicRoughnessTexture"] = json!({ "index": tex });
+                }
+                v["pbrMetallicRoughness"] = pbr;
+                v["extras"] = json!({ "streaks": s });
+            }
+        }
+        if let Some(e) = m.emission {
+            let peak = e[0].max(e[1]).max(e[2]);
+            if peak > 0.0 {
+                v["emissiveFactor"] = json!([
+                    round7(e[0] / peak),
+                    round7(e[1] / peak),
+                    round7(e[2] / peak)
+                ]);
+                if peak != 1.0 {
+                    v["extensions"] = json!({
+                        "KHR_materials_emissive_strength": { "emissiveStrength": peak }
+                    });
+                }
+            }
+        }
+        if m.double_sided {
+            v["doubleSided"] = json!(true);
+        }
+        match self.materials.iter().position(|x| *x == v) {
+            Some(i) => i,
+            None => {
+                self.materials.push(v);
+                self.materials.len() - 1
+            }
+        }
+    }
+
+    /// Adds a punctual light as a node.
+    pub fn add_light(&mut self, l: &Light) {
+        let mut v = json!({
+            "name": l.name,
+            "color": l.color,
+            "intensity": l.intensity,
+        });
+        let mut node = json!({
+            "name": l.name,
+            "translation": round_vec(l.position),
+            "extensions": { "KHR_lights_punctual": { "light": self.lights.len() } },
+        });
+        match l.kind {
+            LightKind::Point => v["type"] = json!("point"),
+            LightKind::Spot { inner, outer } => {
+                v["type"] = json!("spot");
+                v["spot"] = json!({
+                    "innerConeAngle": round7(inner),
+                    "outerConeAngle": round7(outer),
+                });
+                let q = Quat::from_rotation_arc(Vec3::NEG_Z, l.direction.normalize());
+                node["rotation"] = round_quat(q);
+            }
+        }
+        self.lights.push(v);
+        self.nodes.push(node);
+    }
+
+    /// Adds a perspective camera node named `name` at `eye` looking at `target` (+Y up).
+    pub fn add_camera(&mut self, name: &str, eye: Vec3, target: Vec3, yfov_deg: f64, aspect: f64) {
+        let forward = (target - eye).normalize();
+        // Right-handed basis with local -Z = forward, local +Y as close to world +Y as possible.
+        let right = forward.cross(Vec3::Y).normalize();
+        let up = right.cross(forward);
+        let q = Quat::from_mat3(&glam::Mat3::from_cols(right, up, -forward));
+        self.cameras.push(json!({
+            "name": name,
+            "type": "perspective",
+            "perspective": {
+                "yfov": round7(yfov_deg.to_radians()),
+                "aspectRatio": round7(aspect),
+                "znear": 0.01,
+            },
+        }));
+        self.nodes.push(json!({
+            "name": name,
+            "camera": self.cameras.len() - 1,
+            "translation": round_vec(eye),
+            "rotation": round_quat(q),
+        }));
+    }
+
+    /// Writes `NAME.gltf`, `NAME.bin` and the PNGs into `dir`; returns the written paths.
+    pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>, Error> {
+        let bin_name = format!("{}.bin", self.name);
+        let mut root = json!({
+            "asset": {
+                "version": "2.0",
+                "generator": "streaks-scenes (scenes/generator)",
+            },
+            "scene": 0,
+            "scenes": [{
+                "name": self.name,
+                "nodes": (0..self.nodes.len()).collect::<Vec<_>>(),
+                "extras": { "description": self.description },
+            }],
+            "nodes": self.nodes,
+            "meshes": self.meshes,
+            "materials": self.materials,
+            "accessors": self.accessors,
+            "bufferViews": self.views,
+            "buffers": [{ "uri": bin_name, "byteLength": self.bin.len() }],
+        });
+        if !self.cameras.is_empty() {
+            root["cameras"] = json!(self.cameras);
+        }
+        let mut used = Vec::new();
+        if !self.lights.is_empty() {
+            used.push("KHR_lights_punctual");
+            root["extensions"] = json!({ "KHR_lights_punctual": { "lights": self.lights } });
+        }
+        if self.materials.iter().any(|m| m.get("extensions").is_some()) {
+            used.push("KHR_materials_emissive_strength");
+        }
+        if !used.is_empty() {
+            root["extensionsUsed"] = json!(used);
+        }
+        if !self.textures_used.is_empty() {
+            // Bilinear, with glTF's default repeat wrapping (what the project's loader does).
+            root["samplers"] = json!([{ "magFilter": 9729, "minFilter": 9729 }]);
+            root["images"] = json!(self
+                .textures_used
+                .iter()
+                .map(|&i| json!({ "uri": self.images[i].0, "mimeType": "image/png" }))
+                .collect::<Vec<_>>());
+            root["textures"] = json!((0..self.textures_used.len())
+                .map(|i| json!({ "source": i, "sampler": 0 }))
+                .collect::<Vec<_>>());
+        }
+        let mut text = serde_json::to_string_pretty(&root).map_err(|e| Error::Scene {
+            scene: self.name.clone(),
+            element: "JSON".to_owned(),
+            reason: e.to_string(),
+        })?;
+        text.push('\n');
+        let mut written = Vec::new();
+        written.push(write_atomic(
+            dir,
+            &format!("{}.gltf", self.name),
+            text.as_bytes(),
+        )?);
+        written.push(write_atomic(dir, &bin_name, &self.bin)?);
+        for &i in &self.textures_used {
+            let (file, png) = &self.images[i];
+            written.push(write_atomic(dir, file, png)?);
+        }
+        Ok(written)
+    }
+}
+
+fn round_vec(v: Vec3) -> Value {
+    json!([
+        round7(f64::from(v.x)),
+        round7(f64::from(v.y)),
+        round7(f64::from(v.z))
+    ])
+}
+
+fn round_quat(q: Quat) -> Value {
+    let q = q.normalize();
+    json!([
+        round7(f64::from(q.x)),
+        round7(f64::from(q.y)),
+        round7(f64::from(q.z)),
+        round7(f64::from(q.w))
+    ])
+}
+
+/// Writes `bytes` to `dir/file` through a temporary file renamed into place, so an
+/// interrupted run never leaves a truncated scene.
+pub fn write_atomic(dir: &Path, file: &str, bytes: &[u8]) -> Result<PathBuf, Error> {
+    let path = dir.join(file);
+    let tmp = dir.join(format!(".{file}.tmp"));
+    let io = |e: std::io::Error| Error::Io {
+        path: path.clone(),
+        source: e,
+    };
+    std::fs::write(&tmp, bytes).map_err(io)?;
+    std::fs::rename(&tmp, &path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        io(e)
+    })?;
+    Ok(path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn camera_looks_along_minus_z_of_its_node() {
+        let mut d = Doc::new("t", "");
+        let eye = Vec3::new(1.0, 2.0, 3.0);
+        let target = Vec3::new(4.0, 0.0, -7.0);
+        d.add_camera("c", eye, target, 40.0, 1.5);
+        let r = &d.nodes[0]["rotation"];
+        let q = Quat::from_xyzw(
+            r[0].as_f64().unwrap() as f32,
+            r[1].as_f64().unwrap() as f32,
+            r[2].as_f64().unwrap() as f32,
+            r[3].as_f64().unwrap() as f32,
+        );
+        let f = q * Vec3::NEG_Z;
+        assert!((f - (target - eye).normalize()).length() < 1e-5);
+        let up = q * Vec3::Y;
+        assert!(up.y > 0.0 && (q * Vec3::X).y.abs() < 1e-6);
+    }
+
+    #[test]
+    fn identical_materials_are_shared() {
+        let mut d = Doc::new("t", "");
+        let a = Material::diffuse("wall", [0.5; 3]);
+        let b = Material::emitter("lamp", [3.0, 2.0, 1.0]);
+        assert_eq!(d.material_index(&a), 0);
+        assert_eq!(d.material_index(&b), 1);
+        assert_eq!(d.material_index(&a), 0);
+        assert_eq!(
+            d.materials[1]["emissiveFactor"][2].as_f64(),
+            Some(round7(1.0 / 3.0))
+        );
+    }
+
+    #[test]
+    fn quantise_is_exact_on_the_grid() {
+        assert_eq!(quantise(0.5 + 1e-9, 16), 0.5);
+        assert_eq!(quantise(-1.25, 16), -1.25);
+    }
+}

@@ -1,0 +1,221 @@
+//! Triangle meshes in world coordinates built from simple solids (quads, boxes, vertical
+//! cylinders, UV spheres). Every triangle is wound counter-clockwise seen from the side its
+//! normals point to (the glTF front face), which matters for one-sided emitters.
+
+use glam::{Vec2, Vec3};
+
+/// An indexed triangle mesh with per-vertex normals and texture coordinates.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    /// Vertex positions (metres, world space).
+    pub positions: Vec<Vec3>,
+    /// Unit vertex normals.
+    pub normals: Vec<Vec3>,
+    /// Texture coordinates (glTF convention: v down the image).
+    pub uvs: Vec<Vec2>,
+    /// Triangle vertex indices.
+    pub indices: Vec<u32>,
+}
+
+impl Mesh {
+    /// An empty mesh.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Number of triangles.
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len() / 3
+    }
+
+    fn vertex(&mut self, p: Vec3, n: Vec3, uv: Vec2) -> u32 {
+        self.positions.push(p);
+        self.normals.push(n.normalize());
+        self.uvs.push(uv);
+        (self.positions.len() - 1) as u32
+    }
+
+    /// Pushes triangle (a, b, c), swapping two vertices if needed so that its geometric
+    /// normal points along `outward`.
+    fn triangle(&mut self, a: u32, b: u32, c: u32, outward: Vec3) {
+        let [pa, pb, pc] = [a, b, c].map(|i| self.positions[i as usize]);
+        if (pb - pa).cross(pc - pa).dot(outward) >= 0.0 {
+            self.indices.extend([a, b, c]);
+        } else {
+            self.indices.extend([a, c, b]);
+        }
+    }
+
+    /// A flat quad with corners `p` (in order around it) and texture coordinates `uv`,
+    /// facing `normal`.
+    pub fn quad_uv(&mut self, p: [Vec3; 4], uv: [Vec2; 4], normal: Vec3) {
+        let i: Vec<u32> = (0..4).map(|k| self.vertex(p[k], normal, uv[k])).collect();
+        self.triangle(i[0], i[1], i[2], normal);
+        self.triangle(i[0], i[2], i[3], normal);
+    }
+
+    /// A rectangle centred at `c` spanned by half-axes `u` and `v`, facing `u x v`.
+    pub fn rect(&mut self, c: Vec3, u: Vec3, v: Vec3) {
+        let p = [c - u - v, c + u - v, c + u + v, c - u + v];
+        let uv = [
+            Vec2::new(0.0, 1.0),
+            Vec2::ONE,
+            Vec2::new(1.0, 0.0),
+            Vec2::ZERO,
+        ];
+        self.quad_uv(p, uv, u.cross(v).normalize());
+    }
+
+    /// An axis-aligned box from `min` to `max` with outward faces.
+    pub fn cuboid(&mut self, min: Vec3, max: Vec3) {
+        let c = (min + max) * 0.5;
+        let h = (max - min) * 0.5;
+        let (x, y, z) = (Vec3::X * h.x, Vec3::Y * h.y, Vec3::Z * h.z);
+        self.rect(c + x, y, z);
+        self.rect(c - x, z, y);
+        self.rect(c + y, z, x);
+        self.rect(c - y, x, z);
+        self.rect(c + z, x, y);
+        self.rect(c - z, y, x);
+    }
+
+    /// A vertical cylinder (smooth sides, flat top cap, open bottom) standing on `base`.
+    pub fn cylinder(&mut self, base: Vec3, radius: f32, height: f32, segments: u32) {
+        let top = base + Vec3::Y * height;
+        let ring = |k: u32| {
+            let a = std::f32::consts::TAU * (k % segments) as f32 / segments as f32;
+            Vec3::new(a.cos(), 0.0, -a.sin())
+        };
+        for k in 0..segments {
+            let (d0, d1) = (ring(k), ring(k + 1));
+            let u0 = k as f32 / segments as f32;
+            let u1 = (k + 1) as f32 / segments as f32;
+            let b0 = self.vertex(base + d0 * radius, d0, Vec2::new(u0, 1.0));
+            let b1 = self.vertex(base + d1 * radius, d1, Vec2::new(u1, 1.0));
+            let t1 = self.vertex(top + d1 * radius, d1, Vec2::new(u1, 0.0));
+            let t0 = self.vertex(top + d0 * radius, d0, Vec2::new(u0, 0.0));
+            let out = (d0 + d1).normalize();
+            self.triangle(b0, b1, t1, out);
+            self.triangle(b0, t1, t0, out);
+        }
+        let c = self.vertex(top, Vec3::Y, Vec2::splat(0.5));
+        for k in 0..segments {
+            let a = self.vertex(top + ring(k) * radius, Vec3::Y, Vec2::splat(0.5));
+            let b = self.vertex(top + ring(k + 1) * radius, Vec3::Y, Vec2::splat(0.5));
+            self.triangle(c, a, b, Vec3::Y);
+        }
+    }
+
+    /// A UV sphere with `rings` latitude bands and `segments` longitude sectors, outward
+    /// normals; the poles are single vertices (no degenerate triangles).
+    pub fn sphere(&mut self, centre: Vec3, radius: f32, rings: u32, segments: u32) {
+        let dir = |r: u32, s: u32| {
+            let phi = std::f32::consts::PI * r as f32 / rings as f32;
+            let th = std::f32::consts::TAU * (s % segments) as f32 / segments as f32;
+            Vec3::new(phi.sin() * th.cos(), phi.cos(), -phi.sin() * th.sin())
+        };
+        let first = self.positions.len() as u32;
+        let uv = |r: u32, s: u32| Vec2::new(s as f32 / segments as f32, r as f32 / rings as f32);
+        let north = self.vertex(centre + Vec3::Y * radius, Vec3::Y, Vec2::new(0.5, 0.0));
+        // Rings 1..rings-1, each with `segments` vertices.
+        for r in 1..rings {
+            for s in 0..segments {
+                let d = dir(r, s);
+                self.vertex(centre + d * radius, d, uv(r, s));
+            }
+        }
+        let south = self.vertex(centre - Vec3::Y * radius, -Vec3::Y, Vec2::new(0.5, 1.0));
+        let at = |r: u32, s: u32| first + 1 + (r - 1) * segments + s % segments;
+        for s in 0..segments {
+            let out = dir(1, s) + dir(1, s + 1);
+            self.triangle(north, at(1, s), at(1, s + 1), out);
+            let out = dir(rings - 1, s) + dir(rings - 1, s + 1);
+            self.triangle(south, at(rings - 1, s + 1), at(rings - 1, s), out);
+        }
+        for r in 1..rings - 1 {
+            for s in 0..segments {
+                let out = dir(r, s) + dir(r + 1, s + 1);
+                let (a, b, c, d) = (at(r, s), at(r, s + 1), at(r + 1, s + 1), at(r + 1, s));
+                self.triangle(a, b, c, out);
+                self.triangle(a, c, d, out);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every triangle's geometric normal agrees with its vertex normals and has non-zero area.
+    fn check_winding(m: &Mesh) {
+        for t in m.indices.chunks(3) {
+            let p = [0, 1, 2].map(|k| m.positions[t[k] as usize]);
+            let g = (p[1] - p[0]).cross(p[2] - p[0]);
+            assert!(g.length() > 1e-9, "degenerate triangle {t:?}");
+            for &i in t {
+                assert!(
+                    g.dot(m.normals[i as usize]) > 0.0,
+                    "triangle {t:?} wound backwards"
+                );
+                assert!((m.normals[i as usize].length() - 1.0).abs() < 1e-5);
+            }
+        }
+    }
+
+    #[test]
+    fn box_faces_point_outward() {
+        let mut m = Mesh::new();
+        let (min, max) = (Vec3::new(-1.0, 0.0, -2.0), Vec3::new(1.0, 3.0, 0.5));
+        m.cuboid(min, max);
+        check_winding(&m);
+        assert_eq!(m.triangle_count(), 12);
+        let c = (min + max) * 0.5;
+        for t in m.indices.chunks(3) {
+            let p = [0, 1, 2].map(|k| m.positions[t[k] as usize]);
+            let g = (p[1] - p[0]).cross(p[2] - p[0]);
+            assert!(g.dot(p[0] - c) > 0.0);
+        }
+    }
+
+    #[test]
+    fn sphere_is_closed_outward_and_not_degenerate() {
+        let mut m = Mesh::new();
+        let c = Vec3::new(0.0, 2.0, -5.0);
+        m.sphere(c, 0.3, 8, 12);
+        check_winding(&m);
+        assert_eq!(m.triangle_count(), 2 * 12 * (8 - 1));
+        for t in m.indices.chunks(3) {
+            let p = [0, 1, 2].map(|k| m.positions[t[k] as usize]);
+            let g = (p[1] - p[0]).cross(p[2] - p[0]);
+            assert!(g.dot((p[0] + p[1] + p[2]) / 3.0 - c) > 0.0);
+        }
+        // Closed: every edge is used exactly twice, once in each direction.
+        let mut edges = std::collections::HashMap::new();
+        for t in m.indices.chunks(3) {
+            for k in 0..3 {
+                *edges.entry((t[k], t[(k + 1) % 3])).or_insert(0) += 1;
+            }
+        }
+        for (&(a, b), &n) in &edges {
+            assert_eq!(n, 1);
+            assert_eq!(edges.get(&(b, a)), Some(&1));
+        }
+    }
+
+    #[test]
+    fn cylinder_sides_point_outward() {
+        let mut m = Mesh::new();
+        m.cylinder(Vec3::new(2.0, 0.0, 1.0), 0.1, 5.0, 10);
+        check_winding(&m);
+        assert_eq!(m.triangle_count(), 30);
+    }
+
+    #[test]
+    fn rect_faces_u_cross_v() {
+        let mut m = Mesh::new();
+        m.rect(Vec3::ZERO, Vec3::Z, Vec3::X);
+        check_winding(&m);
+        assert!(m.normals.iter().all(|n| *n == Vec3::Y));
+    }
+}

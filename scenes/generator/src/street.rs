@@ -1,0 +1,657 @@
+//! Realistic rainy night streets: a two-lane road (X in [-3.5, 3.5], running along -Z from the
+//! driver at Z = 0) with a wet/dry dryness map, lane markings, kerbs, sidewalks, street lamps,
+//! telephone poles, cars, a traffic light and building facades with lit windows.
+//! [`Street::full`] is `rainy_street`; [`Street::small`] is `rainy_street_small` for tests.
+
+use crate::doc::{Doc, Dryness, Light, LightKind, Material, PaperBsdf};
+use crate::estimate::Brdf;
+use crate::mesh::Mesh;
+use crate::wetness::dryness_png;
+use crate::Error;
+use glam::{Vec2, Vec3};
+
+/// Half width of the carriageway (two 3.5 m lanes).
+pub const ROAD_HALF: f32 = 3.5;
+/// Kerb width and height.
+pub const KERB: f32 = 0.15;
+/// X of the building facades.
+pub const FACADE_X: f32 = 6.5;
+/// Driver's eye.
+pub const EYE: Vec3 = Vec3::new(1.35, 1.25, 0.0);
+/// Height of the street lamps' light.
+pub const LAMP_H: f32 = 5.9;
+/// Street lamp radiant intensity (W/sr).
+pub const LAMP_INTENSITY: f64 = 250.0;
+/// Headlight radiant intensity on axis (W/sr).
+pub const HEADLIGHT_INTENSITY: f64 = 20.0;
+/// Red signal light radiant intensity on axis (W/sr).
+pub const SIGNAL_INTENSITY: f64 = 60.0;
+/// Asphalt: wet (w = 0, puddle) and dry (w = 1) parameters.
+pub const ASPHALT_KD: f64 = 0.04;
+/// Specular reflectance of standing water (w = 0).
+pub const ASPHALT_KS_WET: f64 = 0.1;
+/// Alpha of standing water (w = 0).
+pub const ASPHALT_ALPHA_WET: f64 = 0.02;
+/// Specular reflectance of dry asphalt (w = 1).
+pub const ASPHALT_KS_DRY: f64 = 0.04;
+/// Alpha of dry asphalt (w = 1).
+pub const ASPHALT_ALPHA_DRY: f64 = 0.35;
+
+/// The asphalt's reflectance at dryness `w` (the linear mix of the scene contract).
+pub fn asphalt_at(w: f64) -> Brdf {
+    Brdf::Ggx {
+        kd: ASPHALT_KD,
+        ks: ASPHALT_KS_WET + (ASPHALT_KS_DRY - ASPHALT_KS_WET) * w,
+        alpha: ASPHALT_ALPHA_WET + (ASPHALT_ALPHA_DRY - ASPHALT_ALPHA_WET) * w,
+    }
+}
+
+/// A car: centre (x, z), and whether it faces +Z (towards the driver).
+#[derive(Clone, Copy, Debug)]
+pub struct Car {
+    /// Centre across the road.
+    pub x: f32,
+    /// Centre along the road.
+    pub z: f32,
+    /// Faces the driver (oncoming) rather than driving away.
+    pub oncoming: bool,
+    /// Body colour.
+    pub color: [f64; 3],
+    /// Whether its headlights are spot lights (lenses are always emissive).
+    pub headlights: bool,
+}
+
+/// The layout of a street scene.
+#[derive(Clone, Debug)]
+pub struct Street {
+    /// Scene name.
+    pub name: &'static str,
+    /// Description written to the glTF.
+    pub description: &'static str,
+    /// Z of the road's near end (behind the driver).
+    pub near: f32,
+    /// Z of the road's far end.
+    pub far: f32,
+    /// Z of the street lamps on the right (+X) side.
+    pub lamps_right: Vec<f32>,
+    /// Z of the street lamps on the left side.
+    pub lamps_left: Vec<f32>,
+    /// Z of the telephone poles (left sidewalk).
+    pub poles: Vec<f32>,
+    /// Cars.
+    pub cars: Vec<Car>,
+    /// Z of the traffic light (right sidewalk), if any.
+    pub traffic_light: Option<f32>,
+    /// Building blocks per side as (length along Z, height), from the near end.
+    pub blocks: Vec<(f32, f32)>,
+    /// Whether facades get windows.
+    pub windows: bool,
+    /// Noise seed of the dryness map.
+    pub seed: u32,
+    /// Dryness map size in pixels (across, along the road); powers of two.
+    pub texture: (u32, u32),
+}
+
+impl Street {
+    /// `rainy_street`: 160 m of street, ten lamps, two cars, a traffic light, facades.
+    pub fn full() -> Self {
+        Self {
+            name: "rainy_street",
+            description: "Rainy night street: wet two-lane road with puddles, street lamps, \
+                          cars, a traffic light, poles and facades",
+            near: 10.0,
+            far: -150.0,
+            lamps_right: vec![-12.0, -40.0, -68.0, -96.0, -124.0],
+            lamps_left: vec![-26.0, -54.0, -82.0, -110.0, -138.0],
+            poles: vec![-8.0, -33.0, -58.0, -83.0, -108.0, -133.0],
+            cars: vec![
+                Car {
+                    x: 1.75,
+                    z: -24.0,
+                    oncoming: false,
+                    color: [0.2, 0.02, 0.02],
+                    headlights: true,
+                },
+                Car {
+                    x: -1.75,
+                    z: -45.0,
+                    oncoming: true,
+                    color: [0.04, 0.06, 0.12],
+                    headlights: true,
+                },
+            ],
+            traffic_light: Some(-60.0),
+            blocks: vec![
+                (14.0, 12.0),
+                (9.0, 9.0),
+                (20.0, 15.0),
+                (12.0, 10.0),
+                (16.0, 18.0),
+                (11.0, 9.0),
+                (18.0, 13.0),
+                (22.0, 16.0),
+                (15.0, 10.0),
+                (23.0, 14.0),
+            ],
+            windows: true,
+            seed: 2024,
+            texture: (64, 1024),
+        }
+    }
+
+    /// `rainy_street_small`: 65 m of street, two lamps and a traffic light (3 lights), one
+    /// car with emissive tail lights, a few blocks; for tests and CI.
+    pub fn small() -> Self {
+        Self {
+            name: "rainy_street_small",
+            description: "Small rainy street for tests: two lamps, a traffic light, one car",
+            near: 5.0,
+            far: -60.0,
+            lamps_right: vec![-15.0],
+            lamps_left: vec![-32.0],
+            poles: vec![-10.0, -40.0],
+            cars: vec![Car {
+                x: 1.75,
+                z: -20.0,
+                oncoming: false,
+                color: [0.2, 0.02, 0.02],
+                headlights: false,
+            }],
+            traffic_light: Some(-45.0),
+            blocks: vec![(25.0, 10.0), (20.0, 14.0), (20.0, 9.0)],
+            windows: false,
+            seed: 2024,
+            texture: (64, 512),
+        }
+    }
+
+    /// Builds the scene.
+    pub fn build(&self) -> Result<Doc, Error> {
+        let mut doc = Doc::new(self.name, self.description);
+        self.road(&mut doc)?;
+        self.lamps(&mut doc)?;
+        self.poles(&mut doc)?;
+        for (k, car) in self.cars.iter().enumerate() {
+            add_car(&mut doc, k, car)?;
+        }
+        if let Some(z) = self.traffic_light {
+            add_traffic_light(&mut doc, z)?;
+        }
+        self.buildings(&mut doc)?;
+        doc.add_camera(
+            "driver",
+            EYE,
+            EYE + Vec3::new(0.0, -0.035, -1.0),
+            45.0,
+            16.0 / 9.0,
+        );
+        Ok(doc)
+    }
+
+    fn road(&self, doc: &mut Doc) -> Result<(), Error> {
+        let (png, _, _) = dryness_png(ROAD_HALF, self.near, self.far, self.texture, self.seed)?;
+        let image = doc.add_png("dryness", png);
+        let asphalt = Material::paper(
+            "wet_asphalt",
+            PaperBsdf::Ggx {
+                alpha: ASPHALT_ALPHA_WET,
+            },
+            [ASPHALT_KD; 3],
+            [ASPHALT_KS_WET; 3],
+        )
+        .with_dryness(Dryness {
+            image,
+            alpha_dry: ASPHALT_ALPHA_DRY,
+            ks_dry: [ASPHALT_KS_DRY; 3],
+        });
+        let (h, n, f) = (ROAD_HALF, self.near, self.far);
+        let mut road = Mesh::new();
+        road.quad_uv(
+            [
+                Vec3::new(-h, 0.0, n),
+                Vec3::new(h, 0.0, n),
+                Vec3::new(h, 0.0, f),
+                Vec3::new(-h, 0.0, f),
+            ],
+            [
+                Vec2::new(0.0, 0.0),
+                Vec2::new(1.0, 0.0),
+                Vec2::new(1.0, 1.0),
+                Vec2::new(0.0, 1.0),
+            ],
+            Vec3::Y,
+        );
+        doc.add_mesh("road", &road, &asphalt)?;
+
+        // Markings: a dashed centre line (3 m dashes, 9 m gaps) and solid edge lines, 2 mm
+        // above the asphalt.
+        let paint = Material::paper(
+            "road_paint",
+            PaperBsdf::Ggx { alpha: 0.15 },
+            [0.55; 3],
+            [0.05; 3],
+        );
+        let mut marks = Mesh::new();
+        let y = 0.002;
+        let mut z = n - 2.0;
+        while z - 3.0 > f {
+            marks.rect(Vec3::new(0.0, y, z - 1.5), Vec3::Z * 1.5, Vec3::X * 0.06);
+            z -= 12.0;
+        }
+        for side in [-1.0f32, 1.0] {
+            marks.rect(
+                Vec3::new(side * (h - 0.2), y, (n + f) * 0.5),
+                Vec3::Z * (n - f) * 0.5,
+                Vec3::X * 0.06,
+            );
+        }
+        doc.add_mesh("lane_markings", &marks, &paint)?;
+
+        // Kerbs and sidewalks (top at 0.15 m) up to the facades.
+        let stone = Material::paper(
+            "kerb_granite",
+            PaperBsdf::Ggx { alpha: 0.25 },
+            [0.22; 3],
+            [0.04; 3],
+        );
+        let pavement = Material::paper(
+            "wet_pavement",
+            PaperBsdf::Ggx { alpha: 0.12 },
+            [0.1; 3],
+            [0.06; 3],
+        );
+        let mut kerbs = Mesh::new();
+        let mut walks = Mesh::new();
+        for side in [-1.0f32, 1.0] {
+            let (a, b) = (side * h, side * (h + KERB));
+            kerbs.cuboid(Vec3::new(a.min(b), 0.0, f), Vec3::new(a.max(b), KERB, n));
+            let (c, d) = (side * (h + KERB), side * FACADE_X);
+            walks.rect(
+                Vec3::new((c + d) * 0.5, KERB, (n + f) * 0.5),
+                Vec3::Z * (n - f) * 0.5,
+                Vec3::X * (d - c).abs() * 0.5,
+            );
+        }
+        doc.add_mesh("kerbs", &kerbs, &stone)?;
+        doc.add_mesh("sidewalks", &walks, &pavement)?;
+        Ok(())
+    }
+
+    fn lamps(&self, doc: &mut Doc) -> Result<(), Error> {
+        let metal = Material::paper(
+            "painted_metal",
+            PaperBsdf::Ggx { alpha: 0.3 },
+            [0.06; 3],
+            [0.05; 3],
+        );
+        // The visible lens is a marker (radiance 40); the light is the point light 5 cm below.
+        let lens = Material::emitter("lamp_lens", [40.0, 30.0, 18.0]);
+        let mut poles = Mesh::new();
+        let mut lenses = Mesh::new();
+        let sides = self
+            .lamps_right
+            .iter()
+            .map(|&z| (1.0f32, z))
+            .chain(self.lamps_left.iter().map(|&z| (-1.0f32, z)));
+        for (k, (side, z)) in sides.enumerate() {
+            let pole_x = side * (ROAD_HALF + KERB + 0.5);
+            let head_x = side * (ROAD_HALF - 0.9);
+            poles.cylinder(Vec3::new(pole_x, KERB, z), 0.09, 6.5 - KERB, 12);
+            let (a, b) = (pole_x, head_x);
+            poles.cuboid(
+                Vec3::new(a.min(b), 6.3, z - 0.05),
+                Vec3::new(a.max(b), 6.4, z + 0.05),
+            );
+            let head_min = Vec3::new(head_x - 0.3, 6.0, z - 0.15);
+            let head_max = Vec3::new(head_x + 0.3, 6.3, z + 0.15);
+            poles.cuboid(head_min, head_max);
+            lenses.rect(Vec3::new(head_x, 5.999, z), Vec3::Z * 0.12, Vec3::X * 0.25);
+            doc.add_light(&Light {
+                name: format!("street_lamp_{k}"),
+                kind: LightKind::Point,
+                color: [1.0, 0.78, 0.5],
+                intensity: LAMP_INTENSITY,
+                position: Vec3::new(head_x, LAMP_H, z),
+                direction: Vec3::NEG_Y,
+            });
+        }
+        doc.add_mesh("lamp_posts", &poles, &metal)?;
+        // rect(c, Z, X) faces Z x X = +Y; the lens must face down.
+        flip(&mut lenses);
+        doc.add_mesh("lamp_lenses", &lenses, &lens)?;
+        Ok(())
+    }
+
+    fn poles(&self, doc: &mut Doc) -> Result<(), Error> {
+        let wood = Material::paper(
+            "wet_wood",
+            PaperBsdf::Ggx { alpha: 0.35 },
+            [0.1, 0.07, 0.045],
+            [0.03; 3],
+        );
+        let mut m = Mesh::new();
+        let x = -(ROAD_HALF + KERB + 0.9);
+        for &z in &self.poles {
+            m.cylinder(Vec3::new(x, KERB, z), 0.13, 9.0, 12);
+            m.cuboid(
+                Vec3::new(x - 0.9, 8.3, z - 0.06),
+                Vec3::new(x + 0.9, 8.42, z + 0.06),
+            );
+        }
+        if !self.poles.is_empty() {
+            doc.add_mesh("telephone_poles", &m, &wood)?;
+        }
+        Ok(())
+    }
+
+    fn buildings(&self, doc: &mut Doc) -> Result<(), Error> {
+        let facades = [
+            Material::paper(
+                "facade_brick",
+                PaperBsdf::Ggx { alpha: 0.4 },
+                [0.16, 0.09, 0.07],
+                [0.02; 3],
+            ),
+            Material::paper(
+                "facade_render",
+                PaperBsdf::Ggx { alpha: 0.4 },
+                [0.3, 0.28, 0.24],
+                [0.02; 3],
+            ),
+            Material::paper(
+                "facade_concrete",
+                PaperBsdf::Ggx { alpha: 0.4 },
+                [0.18, 0.18, 0.19],
+                [0.02; 3],
+            ),
+        ];
+        let glass = Material::paper(
+            "window_glass",
+            PaperBsdf::Ggx { alpha: 0.02 },
+            [0.01; 3],
+            [0.3; 3],
+        );
+        let warm = Material::emitter("window_warm", [1.6, 1.2, 0.7]);
+        let cool = Material::emitter("window_cool", [0.8, 0.95, 1.2]);
+        let mut by_material: Vec<Mesh> = vec![Mesh::new(); 3];
+        let (mut dark, mut lit_warm, mut lit_cool) = (Mesh::new(), Mesh::new(), Mesh::new());
+        let mut counter = 0u32;
+        for side in [1.0f32, -1.0] {
+            let mut z0 = self.near;
+            for (k, &(len, height)) in self.blocks.iter().enumerate() {
+                // Offset the two sides so blocks do not line up.
+                let len = if side < 0.0 {
+                    self.blocks[(k + 3) % self.blocks.len()].0
+                } else {
+                    len
+                };
+                let z1 = (z0 - len).max(self.far);
+                let (xa, xb) = (side * FACADE_X, side * (FACADE_X + 10.0));
+                by_material[k % 3].cuboid(
+                    Vec3::new(xa.min(xb), 0.0, z1),
+                    Vec3::new(xa.max(xb), height, z0),
+                );
+                if self.windows {
+                    // 1.2 x 1.5 m windows on a 3 m grid, 1 cm in front of the facade,
+                    // facing the road; ground floors get wide shop windows.
+                    let x = side * (FACADE_X - 0.01);
+                    let normal_u = Vec3::Z * side; // u x v = Z x Y * side = -X * side
+                    let mut zc = z0 - 2.0;
+                    while zc > z1 + 1.5 {
+                        let mut yc = 4.5;
+                        while yc + 1.5 < height {
+                            counter += 1;
+                            let h = hash01(counter, self.seed);
+                            let target = if h < 0.22 {
+                                &mut lit_warm
+                            } else if h < 0.3 {
+                                &mut lit_cool
+                            } else {
+                                &mut dark
+                            };
+                            target.rect(Vec3::new(x, yc, zc), normal_u * 0.6, Vec3::Y * 0.75);
+                            yc += 3.0;
+                        }
+                        zc -= 3.0;
+                    }
+                    let mut zc = z0 - 3.5;
+                    while zc > z1 + 3.0 {
+                        counter += 1;
+                        let target = if hash01(counter, self.seed) < 0.5 {
+                            &mut lit_warm
+                        } else {
+                            &mut dark
+                        };
+                        target.rect(Vec3::new(x, 1.5, zc), normal_u * 1.3, Vec3::Y * 0.9);
+                        zc -= 5.0;
+                    }
+                }
+                z0 = z1;
+                if z0 <= self.far {
+                    break;
+                }
+            }
+        }
+        // A block across the far end closes the street.
+        let end = self.far;
+        by_material[0].cuboid(
+            Vec3::new(-FACADE_X - 10.0, 0.0, end - 10.0),
+            Vec3::new(FACADE_X + 10.0, 16.0, end),
+        );
+        if self.windows {
+            for ix in -4..=4 {
+                for iy in 0..4 {
+                    counter += 1;
+                    let target = if hash01(counter, self.seed) < 0.3 {
+                        &mut lit_warm
+                    } else {
+                        &mut dark
+                    };
+                    target.rect(
+                        Vec3::new(ix as f32 * 3.0, 4.5 + iy as f32 * 3.0, end + 0.01),
+                        Vec3::X * 0.6,
+                        Vec3::Y * 0.75,
+                    );
+                }
+            }
+        }
+        for (k, m) in by_material.iter().enumerate() {
+            if !m.indices.is_empty() {
+                doc.add_mesh(&format!("buildings_{k}"), m, &facades[k])?;
+            }
+        }
+        for (name, m, mat) in [
+            ("windows_dark", &dark, &glass),
+            ("windows_lit_warm", &lit_warm, &warm),
+            ("windows_lit_cool", &lit_cool, &cool),
+        ] {
+            if !m.indices.is_empty() {
+                doc.add_mesh(name, m, mat)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A deterministic pseudo-random number in [0, 1) for window `k`.
+fn hash01(k: u32, seed: u32) -> f32 {
+    let mut x = k.wrapping_mul(0x9e37_79b9) ^ seed;
+    x ^= x >> 16;
+    x = x.wrapping_mul(0x7feb_352d);
+    x ^= x >> 15;
+    x = x.wrapping_mul(0x846c_a68b);
+    x ^= x >> 16;
+    (x >> 8) as f32 / (1u32 << 24) as f32
+}
+
+/// Reverses every triangle and normal of `m` (turns it to face the other way).
+fn flip(m: &mut Mesh) {
+    for t in m.indices.chunks_mut(3) {
+        t.swap(1, 2);
+    }
+    for n in &mut m.normals {
+        *n = -*n;
+    }
+}
+
+/// A car: body, cabin and wheels as boxes; headlights (spot lights and emissive lenses) at
+/// the front, emissive red tail lights at the back.
+fn add_car(doc: &mut Doc, k: usize, car: &Car) -> Result<(), Error> {
+    let dir = if car.oncoming { 1.0f32 } else { -1.0 }; // direction the car faces, along Z
+    let (x, z) = (car.x, car.z);
+    let paint = Material::paper(
+        &format!("car_paint_{k}"),
+        PaperBsdf::Ggx { alpha: 0.05 },
+        car.color,
+        [0.3; 3],
+    );
+    let rubber = Material::paper("tyre", PaperBsdf::Ggx { alpha: 0.4 }, [0.02; 3], [0.02; 3]);
+    let mut body = Mesh::new();
+    body.cuboid(
+        Vec3::new(x - 0.9, 0.3, z - 2.2),
+        Vec3::new(x + 0.9, 1.0, z + 2.2),
+    );
+    // The cabin sits towards the back.
+    let cz = z - dir * 0.3;
+    body.cuboid(
+        Vec3::new(x - 0.8, 1.0, cz - 1.2),
+        Vec3::new(x + 0.8, 1.45, cz + 1.2),
+    );
+    doc.add_mesh(&format!("car_{k}_body"), &body, &paint)?;
+    let mut wheels = Mesh::new();
+    for sx in [-1.0f32, 1.0] {
+        for sz in [-1.0f32, 1.0] {
+            let (wx, wz) = (x + sx * 0.8, z + sz * 1.4);
+            wheels.cuboid(
+                Vec3::new(wx - 0.12, 0.0, wz - 0.32),
+                Vec3::new(wx + 0.12, 0.62, wz + 0.32),
+            );
+        }
+    }
+    doc.add_mesh(&format!("car_{k}_wheels"), &wheels, &rubber)?;
+    let front = z + dir * 2.2;
+    let back = z - dir * 2.2;
+    let mut heads = Mesh::new();
+    let mut tails = Mesh::new();
+    for (j, sx) in [-1.0f32, 1.0].into_iter().enumerate() {
+        let hx = x + sx * 0.6;
+        heads.rect(
+            Vec3::new(hx, 0.72, front + dir * 0.002),
+            Vec3::X * dir * 0.15,
+            Vec3::Y * 0.06,
+        );
+        tails.rect(
+            Vec3::new(hx + sx * 0.1, 0.85, back - dir * 0.002),
+            Vec3::X * -dir * 0.1,
+            Vec3::Y * 0.06,
+        );
+        if !car.headlights {
+            continue;
+        }
+        doc.add_light(&Light {
+            name: format!("car_{k}_headlight_{j}"),
+            kind: LightKind::Spot {
+                inner: 0.15,
+                outer: 0.4,
+            },
+            color: [1.0, 0.95, 0.85],
+            intensity: HEADLIGHT_INTENSITY,
+            position: Vec3::new(hx, 0.72, front + dir * 0.05),
+            direction: Vec3::new(0.0, -0.03, dir),
+        });
+    }
+    doc.add_mesh(
+        &format!("car_{k}_headlamps"),
+        &heads,
+        &Material::emitter("headlamp_lens", [30.0, 28.5, 25.5]),
+    )?;
+    doc.add_mesh(
+        &format!("car_{k}_tail_lights"),
+        &tails,
+        &Material::emitter("tail_light", [6.0, 0.3, 0.15]),
+    )?;
+    Ok(())
+}
+
+/// A traffic light on the right sidewalk at `z`, facing the driver: red lit (emissive lens
+/// plus a red spot light), amber and green dark.
+fn add_traffic_light(doc: &mut Doc, z: f32) -> Result<(), Error> {
+    let x = ROAD_HALF + KERB + 0.6;
+    let mut m = Mesh::new();
+    m.cylinder(Vec3::new(x, KERB, z), 0.07, 3.2, 12);
+    m.cuboid(
+        Vec3::new(x - 0.17, 3.2, z - 0.25),
+        Vec3::new(x + 0.17, 4.2, z),
+    );
+    doc.add_mesh(
+        "traffic_light",
+        &m,
+        &Material::paper(
+            "traffic_light_housing",
+            PaperBsdf::Ggx { alpha: 0.3 },
+            [0.02; 3],
+            [0.04; 3],
+        ),
+    )?;
+    let lenses = [
+        ("signal_red", 3.95, [40.0, 2.0, 0.8]),
+        ("signal_amber", 3.7, [0.15, 0.08, 0.0]),
+        ("signal_green", 3.45, [0.0, 0.12, 0.06]),
+    ];
+    for (name, y, radiance) in lenses {
+        let mut q = Mesh::new();
+        q.rect(Vec3::new(x, y, z + 0.002), Vec3::X * 0.1, Vec3::Y * 0.1);
+        doc.add_mesh(name, &q, &Material::emitter(name, radiance))?;
+    }
+    doc.add_light(&Light {
+        name: "signal_red_light".to_owned(),
+        kind: LightKind::Spot {
+            inner: 0.3,
+            outer: 0.7,
+        },
+        color: [1.0, 0.05, 0.02],
+        intensity: SIGNAL_INTENSITY,
+        position: Vec3::new(x, 3.95, z + 0.06),
+        direction: Vec3::new(-0.05, -0.1, 1.0),
+    });
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::estimate::peak_radiance;
+    use crate::wetness::WET_ROAD_W;
+    use glam::DVec3;
+
+    #[test]
+    fn lamp_streaks_are_bright_but_sensible() {
+        // A lamp 40 m ahead over ordinary wet asphalt gives a streak peak of order 1.
+        let brdf = asphalt_at(f64::from(WET_ROAD_W));
+        let eye = EYE.as_dvec3();
+        let lamp = DVec3::new(f64::from(ROAD_HALF) - 0.9, f64::from(LAMP_H), -40.0);
+        let l = peak_radiance(brdf, eye, lamp, LAMP_INTENSITY);
+        println!("lamp 40 m ahead, w = 0.2: peak {l}");
+        assert!(l > 0.5 && l < 5.0, "peak {l}");
+    }
+
+    #[test]
+    fn full_street_is_moderate_and_small_is_small() {
+        let full = Street::full().build().unwrap();
+        assert!(full.triangle_count() < 50_000);
+        assert!(full.light_count() >= 10);
+        let small = Street::small().build().unwrap();
+        assert!(small.triangle_count() < 2_000, "{}", small.triangle_count());
+        assert!((2..=3).contains(&small.light_count()));
+    }
+
+    #[test]
+    fn flip_reverses_winding() {
+        let mut m = Mesh::new();
+        m.rect(Vec3::ZERO, Vec3::Z, Vec3::X);
+        flip(&mut m);
+        let p = [0, 1, 2].map(|k| m.positions[m.indices[k] as usize]);
+        assert!((p[1] - p[0]).cross(p[2] - p[0]).y < 0.0);
+        assert_eq!(m.normals[0], Vec3::NEG_Y);
+    }
+}

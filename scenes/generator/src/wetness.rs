@@ -1,0 +1,130 @@
+//! The road's dryness map: deterministic value noise (fixed seed) shaped into puddles (w = 0),
+//! ordinary wet asphalt (w ~ 0.2) and drier patches (w -> 1), with wetter gutters along the
+//! kerbs and drier wheel tracks, as on a real street after rain. Stored in the green channel
+//! of an RGB PNG (the material's metallicRoughnessTexture; see scenes/README.md).
+
+use crate::Error;
+use image::{ImageEncoder, RgbImage};
+
+/// Dryness w of ordinary wet asphalt (between puddles and dry patches).
+pub const WET_ROAD_W: f32 = 0.2;
+
+/// A 32-bit integer hash (Chris Wellons' "lowbias32").
+fn hash(mut x: u32) -> u32 {
+    x ^= x >> 16;
+    x = x.wrapping_mul(0x7feb_352d);
+    x ^= x >> 15;
+    x = x.wrapping_mul(0x846c_a68b);
+    x ^= x >> 16;
+    x
+}
+
+/// Lattice value in [0, 1) at integer point (i, j) for `seed`.
+fn lattice(i: i32, j: i32, seed: u32) -> f32 {
+    let h = hash(seed ^ hash((i as u32) ^ hash(j as u32)));
+    (h >> 8) as f32 / (1u32 << 24) as f32
+}
+
+/// Smooth value noise in [0, 1) with a quintic fade between lattice points.
+pub fn value_noise(x: f32, y: f32, seed: u32) -> f32 {
+    let (xi, yi) = (x.floor(), y.floor());
+    let (fx, fy) = (x - xi, y - yi);
+    let fade = |t: f32| t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
+    let (u, v) = (fade(fx), fade(fy));
+    let (i, j) = (xi as i32, yi as i32);
+    let a = lattice(i, j, seed);
+    let b = lattice(i + 1, j, seed);
+    let c = lattice(i, j + 1, seed);
+    let d = lattice(i + 1, j + 1, seed);
+    let top = a + (b - a) * u;
+    let bottom = c + (d - c) * u;
+    top + (bottom - top) * v
+}
+
+fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
+    let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
+/// Dryness w in [0, 1] at road position (x across, z along; metres) for a road of half
+/// width `half_width` with two lanes (centres at +-half_width/2).
+pub fn dryness(x: f32, z: f32, half_width: f32, seed: u32) -> f32 {
+    let n = 0.6 * value_noise(x / 2.5, z / 4.0, seed)
+        + 0.3 * value_noise(x / 1.0, z / 1.4, seed.wrapping_add(1))
+        + 0.1 * value_noise(x / 0.35, z / 0.35, seed.wrapping_add(2));
+    // Wheel tracks 0.8 m either side of each lane centre are drier.
+    let lane = half_width * 0.5;
+    let track_dist = [-lane - 0.8, -lane + 0.8, lane - 0.8, lane + 0.8]
+        .iter()
+        .map(|t| (x - t).abs())
+        .fold(f32::INFINITY, f32::min);
+    let track = (-(track_dist / 0.35).powi(2)).exp();
+    // Water collects in the gutters along the kerbs.
+    let gutter = (-((half_width - x.abs()) / 0.6).powi(2)).exp();
+    let s = n + 0.22 * track - 0.3 * gutter;
+    WET_ROAD_W * smoothstep(0.33, 0.37, s) + (1.0 - WET_ROAD_W) * smoothstep(0.56, 0.8, s)
+}
+
+/// The `w` x `h` pixel dryness map of a road spanning x in [-half_width, half_width] and z in
+/// [z_far, z_near]: row 0 is the near end (v = 0), column 0 is x = -half_width.
+/// Returns the PNG bytes and the fractions of puddle (w < 0.05) and dry (w > 0.6) pixels.
+pub fn dryness_png(
+    half_width: f32,
+    z_near: f32,
+    z_far: f32,
+    (w, h): (u32, u32),
+    seed: u32,
+) -> Result<(Vec<u8>, f32, f32), Error> {
+    let mut img = RgbImage::new(w, h);
+    let (mut puddle, mut dry) = (0usize, 0usize);
+    for (i, j, p) in img.enumerate_pixels_mut() {
+        let x = -half_width + (i as f32 + 0.5) / w as f32 * 2.0 * half_width;
+        let z = z_near - (j as f32 + 0.5) / h as f32 * (z_near - z_far);
+        let d = dryness(x, z, half_width, seed);
+        puddle += usize::from(d < 0.05);
+        dry += usize::from(d > 0.6);
+        p.0 = [0, (d * 255.0).round() as u8, 0];
+    }
+    let mut png = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut png)
+        .write_image(img.as_raw(), w, h, image::ExtendedColorType::Rgb8)
+        .map_err(|e| Error::Texture(e.to_string()))?;
+    let n = (w * h) as f32;
+    Ok((png, puddle as f32 / n, dry as f32 / n))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn noise_is_continuous_and_in_range() {
+        let mut prev = value_noise(0.0, 0.3, 7);
+        for k in 1..2000 {
+            let x = k as f32 * 0.01;
+            let v = value_noise(x, 0.3, 7);
+            assert!((0.0..1.0).contains(&v));
+            assert!((v - prev).abs() < 0.05, "jump at {x}");
+            prev = v;
+        }
+        assert_ne!(value_noise(0.5, 0.5, 1), value_noise(0.5, 0.5, 2));
+    }
+
+    #[test]
+    fn road_has_puddles_wet_and_dry_patches() {
+        let (png, puddle, dry) = dryness_png(3.5, 10.0, -60.0, (64, 512), 4).unwrap();
+        assert!(puddle > 0.03 && puddle < 0.4, "puddles {puddle}");
+        assert!(dry > 0.03 && dry < 0.5, "dry {dry}");
+        let img = image::load_from_memory(&png).unwrap().to_rgb8();
+        assert_eq!(img.dimensions(), (64, 512));
+        assert!(img.pixels().all(|p| p.0[0] == 0 && p.0[2] == 0));
+        // Gutters are wetter than wheel tracks on average.
+        let mean_at = |x: f32| {
+            (0..400)
+                .map(|k| dryness(x, -k as f32 * 0.15, 3.5, 4))
+                .sum::<f32>()
+                / 400.0
+        };
+        assert!(mean_at(3.4) < mean_at(2.55));
+    }
+}
