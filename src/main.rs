@@ -6,6 +6,8 @@
 mod figure;
 mod locus;
 mod prepare;
+mod render;
+mod stereo;
 mod texture_map;
 
 use clap::{Parser, Subcommand};
@@ -28,6 +30,10 @@ enum Command {
     TextureMap(texture_map::Args),
     /// Grey level, histogram equalisation and a disparity shift for a photographed pair (Fig. 7).
     Prepare(prepare::Args),
+    /// Render a rectified stereo pair with ground-truth disparity, depth and streak masks.
+    Stereo(stereo::Args),
+    /// Path-trace one camera of a scene to EXR (and PNG).
+    Render(render::Args),
     /// Print the virtual light column (Eq. 4) of a light seen from a viewer.
     Locus(locus::Args),
     /// Draw one of the paper's figures from the model as a PNG.
@@ -43,6 +49,8 @@ fn main() -> ExitCode {
     let result: anyhow::Result<()> = match cli.command {
         Command::TextureMap(args) => texture_map::run(args),
         Command::Prepare(args) => prepare::run(args),
+        Command::Stereo(args) => stereo::run(args),
+        Command::Render(args) => render::run(args),
         Command::Locus(args) => locus::run(args),
         Command::Figure(args) => figure::run(args),
         Command::Lk(args) => lk::run(args),

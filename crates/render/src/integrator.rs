@@ -1,1 +1,705 @@
-//! (skeleton: integrator, filled in by its owner)
+//! Unidirectional path tracing with next-event estimation and multiple importance sampling.
+//!
+//! At every surface vertex the path tracer
+//!
+//! 1. adds the emission of the surface it hit (seen directly: in full; reached by a BSDF
+//!    sample: weighted by the power heuristic against light sampling),
+//! 2. samples one light with the [`LightSampler`] and one point on it (next-event estimation):
+//!    area lights are weighted by the power heuristic against BSDF sampling, delta lights
+//!    (point, spot, directional) cannot be hit by BSDF samples and are added unweighted,
+//! 3. samples the BSDF for the next direction.
+//!
+//! `max_depth` has Mitsuba 3's meaning (`path.cpp`): the longest path, counted in segments
+//! from the camera; 1 renders only emitters seen directly, 2 direct illumination, 3 one
+//! indirect bounce, and so on; `u32::MAX` means no limit. Russian roulette follows Mitsuba's
+//! rule too: from depth [`RR_DEPTH`] = 5 on, a path survives with probability
+//! `q = min(max component of the throughput, 0.95)` and its throughput is divided by `q`,
+//! which keeps the estimate unbiased while ending paths whose contribution has become small.
+//!
+//! Shading uses the interpolated shading normal's frame; a direction must also lie on the
+//! outgoing side of the *geometric* normal (for both light samples and BSDF samples), so that
+//! interpolated normals never let light leak through a surface. Surfaces reflect on both
+//! faces (the frame is flipped toward the viewer); emission is one-sided unless the material
+//! is double-sided.
+//!
+//! Determinism: each pixel sample draws its random numbers from the [`Sampler`] positioned by
+//! `(pixel, sample index)` and the seed, never by thread; rows are rendered in parallel with
+//! rayon, each pixel accumulated by one thread in sample order, so the image is bit-identical
+//! whatever the thread count. The hot loop does not allocate.
+//!
+//! Layers (all optional, [`Layers`]):
+//! - `depth`: distance along the camera's -Z axis (view-space depth, the `Z` of Eq. 5) to the
+//!   first hit of the pixel-centre ray; `inf` on a miss.
+//! - `normal`: the first hit's shading normal for the pixel-centre ray, world space, flipped
+//!   to face the camera; zero on a miss.
+//! - `albedo`: the first hit's [`crate::bsdf::Bsdf::albedo`] for the pixel-centre ray.
+//! - `specular`: the part of the pixel's radiance that reached the camera by exactly one
+//!   reflection of an emitter off the glossy lobe at the first surface hit: the glossy part
+//!   (`eval_lobes(..).glossy`) of the next-event estimate at the first hit, plus, for the BSDF
+//!   sample from the first hit that hits an emitter directly, `L_e * glossy(wi) * cos / pdf`
+//!   with the same MIS weight as in the beauty image. Using the glossy part of `f` at the
+//!   sampled direction (rather than "the sample came from the glossy lobe") makes the layer an
+//!   unbiased estimate of the single-glossy-bounce direct light, the same quantity the
+//!   next-event part estimates. It is box-filtered like the beauty image; a streak mask is a
+//!   threshold on it.
+
+use crate::bsdf::Bsdf;
+use crate::camera::Camera;
+use crate::film::{Film, Pixel};
+use crate::geometry::{offset_ray_origin, Frame, Ray};
+use crate::light::{emitted_radiance, LightSampler};
+use crate::output::RgbImage;
+use crate::sampling::{power_heuristic, Sampler};
+use crate::scene::Scene;
+use glam::{Vec2, Vec3};
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
+
+/// Depth from which Russian roulette may end a path (Mitsuba 3's default `rr_depth`).
+pub const RR_DEPTH: u32 = 5;
+
+/// A shadow ray stops this fraction short of the light point, so that it does not hit the
+/// emitter it is aimed at.
+const SHADOW_EPSILON: f32 = 1e-4;
+
+/// Which layers to compute besides the beauty image.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Layers {
+    /// View-space depth of the pixel-centre ray's first hit.
+    pub depth: bool,
+    /// First-hit shading normal.
+    pub normal: bool,
+    /// First-hit albedo.
+    pub albedo: bool,
+    /// Single-glossy-bounce emitter light (streaks).
+    pub specular: bool,
+}
+
+/// What to render.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RenderSettings {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Samples per pixel.
+    pub spp: u32,
+    /// Longest path (Mitsuba's `max_depth`; see the module documentation).
+    pub max_depth: u32,
+    /// Seed of the sampler.
+    pub seed: u32,
+    /// Extra layers.
+    pub layers: Layers,
+}
+
+/// Counters of one render.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RenderStats {
+    /// Wall-clock seconds of the render.
+    pub seconds: f64,
+    /// Pixel samples traced (dropped ones included).
+    pub samples: u64,
+    /// Rays traced (camera, continuation and shadow rays).
+    pub rays: u64,
+    /// Samples dropped because they were NaN or infinite.
+    pub nonfinite_dropped: u64,
+}
+
+/// A rendered image with its requested layers.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderOutput {
+    /// Linear RGB radiance.
+    pub image: RgbImage,
+    /// View-space depth per pixel, row-major (if requested).
+    pub depth: Option<Vec<f32>>,
+    /// Shading normals (if requested).
+    pub normal: Option<RgbImage>,
+    /// Albedo (if requested).
+    pub albedo: Option<RgbImage>,
+    /// Specular part (if requested).
+    pub specular: Option<RgbImage>,
+    /// Counters.
+    pub stats: RenderStats,
+}
+
+/// Radiance and specular part of one camera path, and the number of rays it traced.
+#[derive(Clone, Copy, Debug, Default)]
+struct PathResult {
+    radiance: Vec3,
+    specular: Vec3,
+    rays: u64,
+}
+
+/// Renders `camera`'s view of `scene` on the current rayon thread pool.
+///
+/// `progress` is called with increments of completed pixel samples (the total is
+/// `width * height * spp`).
+pub fn render(
+    scene: &Scene,
+    camera: &Camera,
+    settings: &RenderSettings,
+    progress: &(dyn Fn(u64) + Sync),
+) -> RenderOutput {
+    let start = Instant::now();
+    let lights = LightSampler::new(scene);
+    let (width, height) = (settings.width, settings.height);
+    let mut film = Film::new(width, height);
+    let rays = AtomicU64::new(0);
+    let forward = camera
+        .world_from_camera
+        .transform_vector3(-Vec3::Z)
+        .normalize();
+    let need_centre = settings.layers.depth || settings.layers.normal || settings.layers.albedo;
+
+    film.par_rows_mut().enumerate().for_each(|(y, row)| {
+        let y = y as u32;
+        let mut sampler = Sampler::new(settings.seed);
+        let mut row_rays = 0u64;
+        for (x, pixel) in row.iter_mut().enumerate() {
+            let x = x as u32;
+            if need_centre {
+                let centre = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+                let ray = camera.generate_ray(centre, width, height);
+                row_rays += 1;
+                first_hit_layers(scene, &ray, camera.position(), forward, pixel);
+            }
+            for s in 0..settings.spp {
+                sampler.start_pixel_sample((x, y), s);
+                let film_pos = Vec2::new(x as f32, y as f32) + sampler.next_2d();
+                let ray = camera.generate_ray(film_pos, width, height);
+                let path = trace_path(
+                    scene,
+                    &lights,
+                    ray,
+                    &mut sampler,
+                    settings.max_depth,
+                    settings.layers.specular,
+                );
+                row_rays += path.rays;
+                pixel.add_sample(path.radiance, path.specular);
+            }
+        }
+        rays.fetch_add(row_rays, Ordering::Relaxed);
+        progress(width as u64 * settings.spp as u64);
+    });
+
+    let layers = settings.layers;
+    RenderOutput {
+        image: film.image(),
+        depth: layers.depth.then(|| film.depth()),
+        normal: layers.normal.then(|| film.normal()),
+        albedo: layers.albedo.then(|| film.albedo()),
+        specular: layers.specular.then(|| film.specular()),
+        stats: RenderStats {
+            seconds: start.elapsed().as_secs_f64(),
+            samples: width as u64 * height as u64 * settings.spp as u64,
+            rays: rays.into_inner(),
+            nonfinite_dropped: film.dropped(),
+        },
+    }
+}
+
+/// Fills the depth, normal and albedo of `pixel` from the pixel-centre ray.
+fn first_hit_layers(scene: &Scene, ray: &Ray, origin: Vec3, forward: Vec3, pixel: &mut Pixel) {
+    if let Some(hit) = scene.intersect(ray) {
+        pixel.depth = (hit.p - origin).dot(forward);
+        pixel.normal = if hit.ns.dot(ray.direction) > 0.0 {
+            -hit.ns
+        } else {
+            hit.ns
+        };
+        let material = &scene.materials[hit.material as usize];
+        pixel.albedo = material.bsdf_at(hit.uv, &scene.textures).albedo();
+    }
+}
+
+/// Traces one camera path (see the module documentation).
+fn trace_path(
+    scene: &Scene,
+    lights: &LightSampler,
+    mut ray: Ray,
+    sampler: &mut Sampler,
+    max_depth: u32,
+    want_specular: bool,
+) -> PathResult {
+    let mut out = PathResult::default();
+    let mut throughput = Vec3::ONE;
+    // Number of segments before the current one (Mitsuba's `depth`).
+    let mut depth = 0u32;
+    // The previous vertex and the BSDF-sampling density of the current direction, for MIS.
+    let mut prev_p = ray.origin;
+    let mut prev_bsdf_pdf = 0.0f32;
+    // At the first hit: the BSDF and frame, for the specular layer of a hit emitter.
+    let mut first_bsdf: Option<(Bsdf, Frame, Vec3)> = None;
+
+    while depth < max_depth {
+        out.rays += 1;
+        let Some(hit) = scene.intersect(&ray) else {
+            break;
+        };
+        let wo = -ray.direction;
+
+        // 1. Emission of the surface hit.
+        let le = emitted_radiance(scene, &hit, wo);
+        if le.max_element() > 0.0 {
+            if depth == 0 {
+                out.radiance += throughput * le;
+            } else {
+                let light_pdf = lights.light_of_triangle(hit.triangle).map_or(0.0, |i| {
+                    lights.pmf(prev_p, i) * scene.lights[i].pdf_li(scene, prev_p, &hit)
+                });
+                let weight = power_heuristic(1.0, prev_bsdf_pdf, 1.0, light_pdf);
+                out.radiance += throughput * le * weight;
+                if let (1, Some((bsdf, frame, wo_local))) = (depth, first_bsdf) {
+                    let wi_local = frame.to_local(ray.direction);
+                    let glossy = bsdf.eval_lobes(wo_local, wi_local).glossy;
+                    out.specular += le * glossy * (wi_local.z * weight / prev_bsdf_pdf);
+                }
+            }
+        }
+        if depth + 1 >= max_depth {
+            break;
+        }
+
+        // Shading frame, flipped toward the viewer; geometric normal on the same side.
+        let material = &scene.materials[hit.material as usize];
+        let bsdf = material.bsdf_at(hit.uv, &scene.textures);
+        let ng = if hit.ng.dot(wo) < 0.0 {
+            -hit.ng
+        } else {
+            hit.ng
+        };
+        let ns = if hit.ns.dot(ng) < 0.0 {
+            -hit.ns
+        } else {
+            hit.ns
+        };
+        let frame = Frame::from_normal(ns);
+        let wo_local = frame.to_local(wo);
+
+        // 2. Next-event estimation (always draws 3 numbers, so the dimensions stay aligned).
+        let u_light = sampler.next_1d();
+        let u_point = sampler.next_2d();
+        if let Some((index, pmf)) = lights.sample(hit.p, u_light) {
+            let light = &scene.lights[index];
+            if let Some(ls) = light.sample_li(scene, hit.p, u_point) {
+                let wi_local = frame.to_local(ls.wi);
+                if wi_local.z > 0.0 && ng.dot(ls.wi) > 0.0 {
+                    let f = bsdf.eval_lobes(wo_local, wi_local);
+                    let total = f.total();
+                    if total.max_element() > 0.0 {
+                        let origin = offset_ray_origin(hit.p, ng, ls.wi);
+                        let t_max = if ls.dist.is_finite() {
+                            (ls.dist - (origin - hit.p).length()) * (1.0 - SHADOW_EPSILON)
+                        } else {
+                            f32::INFINITY
+                        };
+                        out.rays += 1;
+                        let shadow = Ray {
+                            origin,
+                            direction: ls.wi,
+                            t_max,
+                        };
+                        if !scene.occluded(&shadow) {
+                            let light_pdf = pmf * ls.pdf;
+                            let weight = if ls.delta {
+                                1.0
+                            } else {
+                                power_heuristic(1.0, light_pdf, 1.0, bsdf.pdf(wo_local, wi_local))
+                            };
+                            let scale = ls.li * (wi_local.z * weight / light_pdf);
+                            out.radiance += throughput * total * scale;
+                            if depth == 0 && want_specular {
+                                out.specular += f.glossy * scale;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+
+        // 3. BSDF sampling.
+        let u_lobe = sampler.next_1d();
+        let u_dir = sampler.next_2d();
+        let Some(bs) = bsdf.sample(wo_local, u_lobe, u_dir) else {
+            break;
+        };
+        let wi = frame.to_world(bs.wi);
+        if bs.pdf <= 0.0 || bs.wi.z <= 0.0 || ng.dot(wi) <= 0.0 {
+            break;
+        }
+        throughput *= bs.f * (bs.wi.z / bs.pdf);
+        if depth == 0 && want_specular {
+            first_bsdf = Some((bsdf, frame, wo_local));
+        }
+        prev_p = hit.p;
+        prev_bsdf_pdf = bs.pdf;
+        ray = Ray::new(offset_ray_origin(hit.p, ng, wi), wi);
+        depth += 1;
+
+        // Russian roulette (Mitsuba's rule).
+        if depth >= RR_DEPTH {
+            let q = throughput.max_element().min(0.95);
+            if sampler.next_1d() >= q {
+                break;
+            }
+            throughput /= q;
+        }
+        if throughput.max_element() <= 0.0 {
+            break;
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::light::Light;
+    use crate::material::Material;
+    use crate::scene::SceneParts;
+    use glam::{Affine3A, Quat};
+    use std::f32::consts::PI;
+
+    fn camera(position: Vec3, pitch: f32, yfov: f32) -> Camera {
+        Camera {
+            name: "cam".into(),
+            world_from_camera: Affine3A::from_rotation_translation(
+                Quat::from_rotation_x(pitch),
+                position,
+            ),
+            yfov,
+            aspect_ratio: Some(1.5),
+        }
+    }
+
+    /// A quad (two triangles) with the given corners, counter-clockwise seen from its front.
+    fn quad(parts: &mut SceneParts, corners: [Vec3; 4], material: u32) {
+        let base = parts.positions.len() as u32;
+        parts.positions.extend_from_slice(&corners);
+        parts.triangles.push([base, base + 1, base + 2]);
+        parts.triangles.push([base, base + 2, base + 3]);
+        parts.triangle_materials.extend([material, material]);
+    }
+
+    /// A 200 m floor at Y = 0 facing up, made of material 0.
+    fn floor(parts: &mut SceneParts) {
+        let s = 100.0;
+        quad(
+            parts,
+            [
+                Vec3::new(-s, 0.0, -s),
+                Vec3::new(-s, 0.0, s),
+                Vec3::new(s, 0.0, s),
+                Vec3::new(s, 0.0, -s),
+            ],
+            0,
+        );
+    }
+
+    fn settings(width: u32, height: u32, spp: u32, max_depth: u32) -> RenderSettings {
+        RenderSettings {
+            width,
+            height,
+            spp,
+            max_depth,
+            seed: 1,
+            layers: Layers::default(),
+        }
+    }
+
+    #[test]
+    fn diffuse_plane_under_point_light_matches_the_analytic_value() {
+        let kd = Vec3::new(0.5, 0.4, 0.3);
+        let light_pos = Vec3::new(0.3, 2.0, -1.0);
+        let intensity = Vec3::splat(10.0);
+        let mut parts = SceneParts {
+            materials: vec![Material::diffuse("floor", kd)],
+            lights: vec![Light::Point {
+                position: light_pos,
+                intensity,
+                range: None,
+            }],
+            ..Default::default()
+        };
+        floor(&mut parts);
+        let scene = Scene::from_parts(parts).unwrap();
+        let cam = camera(Vec3::new(0.0, 1.5, 2.0), -0.6, 0.6);
+        let (w, h) = (24, 16);
+        let mut set = settings(w, h, 64, 2);
+        set.layers.depth = true;
+        set.layers.specular = true;
+        let out = render(&scene, &cam, &set, &|_| {});
+        assert_eq!(out.stats.samples, (w * h * 64) as u64);
+        assert_eq!(out.stats.nonfinite_dropped, 0);
+        // Radiance at film position `f`: I cos(theta) / r^2 * kd / pi.
+        let analytic = |f: Vec2| {
+            let ray = cam.generate_ray(f, w, h);
+            let t = -ray.origin.y / ray.direction.y;
+            let p = ray.at(t);
+            let d = light_pos - p;
+            intensity * kd * (d.y / d.length() / d.length_squared() / PI)
+        };
+        let k = 8;
+        for y in 0..h {
+            for x in 0..w {
+                // The box filter's mean over the pixel, by a k x k grid.
+                let mut expected = Vec3::ZERO;
+                for i in 0..k {
+                    for j in 0..k {
+                        let o = Vec2::new((i as f32 + 0.5) / k as f32, (j as f32 + 0.5) / k as f32);
+                        expected += analytic(Vec2::new(x as f32, y as f32) + o);
+                    }
+                }
+                expected /= (k * k) as f32;
+                let got = out.image.get(x, y);
+                let err = ((got - expected) / expected).abs().max_element();
+                assert!(err < 0.01, "pixel ({x}, {y}): {got} vs {expected}");
+            }
+        }
+        // Depth of the pixel-centre ray along the camera axis; no glossy lobe, no specular.
+        let fwd = cam.world_from_camera.transform_vector3(-Vec3::Z);
+        let ray = cam.generate_ray(Vec2::new(3.5, 10.5), w, h);
+        let z = (ray.at(-ray.origin.y / ray.direction.y) - ray.origin).dot(fwd);
+        let depth = out.depth.unwrap()[10 * w as usize + 3];
+        assert!((depth - z).abs() < 1e-4 * z, "{depth} vs {z}");
+        assert!(out
+            .specular
+            .unwrap()
+            .pixels
+            .iter()
+            .all(|s| *s == Vec3::ZERO));
+        // max_depth 1: only emitters seen directly, so black.
+        let out = render(&scene, &cam, &settings(w, h, 2, 1), &|_| {});
+        assert!(out.image.pixels.iter().all(|p| *p == Vec3::ZERO));
+    }
+
+    /// A wall of emission `le` at z = -2 in front of a camera at the origin, whose front faces
+    /// the camera if `facing`, and a floor of material 0.
+    fn emitter_scene(le: Vec3, facing: bool, double_sided: bool) -> Scene {
+        let mut wall = Material::diffuse("wall", Vec3::ZERO);
+        wall.emission = le;
+        wall.double_sided = double_sided;
+        let mut parts = SceneParts {
+            materials: vec![Material::diffuse("floor", Vec3::splat(0.5)), wall],
+            ..Default::default()
+        };
+        let (a, b, c, d) = (
+            Vec3::new(-50.0, -50.0, -2.0),
+            Vec3::new(50.0, -50.0, -2.0),
+            Vec3::new(50.0, 50.0, -2.0),
+            Vec3::new(-50.0, 50.0, -2.0),
+        );
+        let corners = if facing { [a, b, c, d] } else { [a, d, c, b] };
+        quad(&mut parts, corners, 1);
+        Scene::from_parts(parts).unwrap()
+    }
+
+    #[test]
+    fn emitter_seen_directly_has_exactly_its_radiance() {
+        let le = Vec3::new(3.0, 2.0, 0.25);
+        let cam = camera(Vec3::ZERO, 0.0, 0.8);
+        for max_depth in [1, 2, 5] {
+            let scene = emitter_scene(le, true, false);
+            let mut set = settings(12, 8, 4, max_depth);
+            set.layers.specular = true;
+            let out = render(&scene, &cam, &set, &|_| {});
+            for p in &out.image.pixels {
+                assert!((*p - le).abs().max_element() < 1e-6, "{p}");
+            }
+            // A black emitter reflects nothing: no specular part.
+            assert!(out
+                .specular
+                .unwrap()
+                .pixels
+                .iter()
+                .all(|s| *s == Vec3::ZERO));
+        }
+        // Seen from behind: black if one-sided, `le` if double-sided.
+        let out = render(
+            &emitter_scene(le, false, false),
+            &cam,
+            &settings(6, 4, 2, 3),
+            &|_| {},
+        );
+        assert!(out.image.pixels.iter().all(|p| *p == Vec3::ZERO));
+        let out = render(
+            &emitter_scene(le, false, true),
+            &cam,
+            &settings(6, 4, 2, 3),
+            &|_| {},
+        );
+        assert!(out
+            .image
+            .pixels
+            .iter()
+            .all(|p| (*p - le).abs().max_element() < 1e-6));
+    }
+
+    #[test]
+    fn mis_combines_light_and_bsdf_sampling_of_an_area_light() {
+        // A diffuse floor under a huge one-sided emitting ceiling (facing down, 1 m above):
+        // the floor's radiance is kd * L (the ceiling fills the hemisphere up to 1e-6).
+        let (kd, le) = (Vec3::new(0.5, 0.25, 0.8), Vec3::new(2.0, 1.0, 0.5));
+        let mut ceiling = Material::diffuse("ceiling", Vec3::ZERO);
+        ceiling.emission = le;
+        let mut parts = SceneParts {
+            materials: vec![Material::diffuse("floor", kd), ceiling],
+            ..Default::default()
+        };
+        floor(&mut parts);
+        let s = 1000.0;
+        quad(
+            &mut parts,
+            [
+                Vec3::new(-s, 1.0, -s),
+                Vec3::new(s, 1.0, -s),
+                Vec3::new(s, 1.0, s),
+                Vec3::new(-s, 1.0, s),
+            ],
+            1,
+        );
+        let scene = Scene::from_parts(parts).unwrap();
+        let cam = camera(Vec3::new(0.0, 0.5, 0.0), -std::f32::consts::FRAC_PI_2, 0.5);
+        let (w, h) = (12, 8);
+        let out = render(&scene, &cam, &settings(w, h, 64, 2), &|_| {});
+        let expected = kd * le;
+        let mut mean = Vec3::ZERO;
+        for p in &out.image.pixels {
+            assert!(
+                ((*p - expected) / expected).abs().max_element() < 0.1,
+                "{p}"
+            );
+            mean += *p / (w * h) as f32;
+        }
+        let err = ((mean - expected) / expected).abs().max_element();
+        assert!(err < 0.01, "{mean} vs {expected}");
+    }
+
+    #[test]
+    fn non_finite_samples_are_dropped_and_counted() {
+        let scene = emitter_scene(Vec3::new(f32::NAN, 1.0, 1.0), true, false);
+        let cam = camera(Vec3::ZERO, 0.0, 0.8);
+        let out = render(&scene, &cam, &settings(6, 4, 3, 3), &|_| {});
+        assert_eq!(out.stats.nonfinite_dropped, 6 * 4 * 3);
+        assert!(out.image.pixels.iter().all(|p| *p == Vec3::ZERO));
+    }
+
+    /// A glossy floor, an emissive sign (above the view of the test camera, seen only in
+    /// reflection) and two punctual lights, for the determinism and specular-layer tests.
+    fn street(kd: Vec3, ks: Vec3) -> Scene {
+        let mut sign = Material::diffuse("sign", Vec3::ZERO);
+        sign.emission = Vec3::new(4.0, 2.0, 1.0);
+        let road = Material {
+            name: "road".into(),
+            reflectance: crate::material::Reflectance::Paper {
+                model: crate::material::PaperModel::Ggx,
+                kd,
+                ks,
+                alpha: 0.15,
+                shininess: 0.0,
+                kd_texture: None,
+                wetness: None,
+            },
+            emission: Vec3::ZERO,
+            emission_texture: None,
+            double_sided: false,
+        };
+        let mut parts = SceneParts {
+            materials: vec![road, sign],
+            lights: vec![
+                Light::Point {
+                    position: Vec3::new(-1.0, 3.0, -6.0),
+                    intensity: Vec3::splat(30.0),
+                    range: None,
+                },
+                Light::Spot {
+                    position: Vec3::new(2.0, 4.0, -10.0),
+                    direction: -Vec3::Y,
+                    intensity: Vec3::new(80.0, 60.0, 40.0),
+                    cos_inner: 0.9,
+                    cos_outer: 0.6,
+                    range: Some(20.0),
+                },
+            ],
+            ..Default::default()
+        };
+        floor(&mut parts);
+        quad(
+            &mut parts,
+            [
+                Vec3::new(-1.0, 5.4, -12.0),
+                Vec3::new(1.0, 5.4, -12.0),
+                Vec3::new(1.0, 6.6, -12.0),
+                Vec3::new(-1.0, 6.6, -12.0),
+            ],
+            1,
+        );
+        Scene::from_parts(parts).unwrap()
+    }
+
+    #[test]
+    fn same_image_with_one_and_two_threads() {
+        let scene = street(Vec3::splat(0.2), Vec3::splat(0.3));
+        let cam = camera(Vec3::new(0.0, 1.5, 0.0), -0.1, 0.7);
+        let mut set = settings(20, 12, 4, 4);
+        set.layers = Layers {
+            depth: true,
+            normal: true,
+            albedo: true,
+            specular: true,
+        };
+        let run = |threads| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| render(&scene, &cam, &set, &|_| {}))
+        };
+        let (one, two) = (run(1), run(2));
+        assert_eq!(one.image, two.image);
+        assert_eq!(one.specular, two.specular);
+        assert_eq!(one.depth, two.depth);
+        assert!(one.image.pixels.iter().any(|p| p.max_element() > 0.0));
+        // Another seed gives another image.
+        set.seed = 2;
+        let other = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap()
+            .install(|| render(&scene, &cam, &set, &|_| {}));
+        assert_ne!(one.image, other.image);
+    }
+
+    #[test]
+    fn specular_layer_is_the_glossy_direct_light() {
+        let cam = camera(Vec3::new(0.0, 1.5, 0.0), -0.1, 0.7);
+        let mut set = settings(16, 10, 8, 2);
+        set.layers.specular = true;
+        let progress = AtomicU64::new(0);
+        // No diffuse lobe: at max depth 2 everything is single-glossy-bounce light.
+        let out = render(&street(Vec3::ZERO, Vec3::splat(0.5)), &cam, &set, &|n| {
+            progress.fetch_add(n, Ordering::Relaxed);
+        });
+        assert_eq!(progress.into_inner(), 16 * 10 * 8);
+        let spec = out.specular.unwrap();
+        let mut lit = 0;
+        for (s, p) in spec.pixels.iter().zip(&out.image.pixels) {
+            assert!(
+                (*s - *p).abs().max_element() <= 1e-5 * p.max_element().max(1.0),
+                "{s} {p}"
+            );
+            lit += (p.max_element() > 0.0) as usize;
+        }
+        assert!(lit > 0);
+        // No glossy lobe: no specular part.
+        let out = render(&street(Vec3::splat(0.5), Vec3::ZERO), &cam, &set, &|_| {});
+        assert!(out
+            .specular
+            .unwrap()
+            .pixels
+            .iter()
+            .all(|s| *s == Vec3::ZERO));
+    }
+}

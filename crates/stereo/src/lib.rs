@@ -37,6 +37,8 @@ pub mod font;
 pub mod image;
 pub mod pair;
 pub mod pfm;
+#[cfg(feature = "render")]
+pub mod render;
 pub mod rig;
 pub mod rigfile;
 pub mod streak_mask;

@@ -1,0 +1,266 @@
+//! `streaks render`: path-trace one camera of a glTF/OBJ scene to EXR (and PNG).
+
+use anyhow::{bail, Context, Result};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use streaks_render::integrator::{self, Layers, RenderOutput, RenderSettings};
+use streaks_render::output;
+use streaks_render::scene::Scene;
+
+/// Largest image accepted, in pixels (the film keeps about 60 bytes per pixel).
+const MAX_PIXELS: u64 = 1 << 28;
+
+/// Default image height when neither `--width` nor `--height` is given.
+const DEFAULT_HEIGHT: u32 = 480;
+
+/// A layer that `--layers` can ask for.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Layer {
+    /// View-space depth (distance along the camera's -Z axis) of the first hit.
+    Depth,
+    /// First-hit shading normal (world space, facing the camera).
+    Normal,
+    /// First-hit albedo.
+    Albedo,
+    /// Light reflected once by the glossy lobe at the first hit (streaks).
+    Specular,
+}
+
+/// Path-trace a scene's camera to a linear EXR (and optionally an sRGB PNG).
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// The scene (.gltf, .glb or .obj).
+    pub scene: PathBuf,
+    /// Output image: .exr (linear float32 with layers) or .png (sRGB).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Samples per pixel.
+    #[arg(long, default_value_t = 64)]
+    pub spp: u32,
+    /// Image width in pixels [default: from the height and the camera's aspect ratio].
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Image height in pixels [default: 480, or from the width and the aspect ratio].
+    #[arg(long)]
+    pub height: Option<u32>,
+    /// Longest path, Mitsuba's meaning: 1 = emitters only, 2 = direct light, 3 = one bounce...
+    #[arg(long, default_value_t = 8)]
+    pub max_depth: u32,
+    /// Sampler seed (the same seed gives the same image on any number of threads).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u32,
+    /// Camera name [default: the scene's first camera].
+    #[arg(long)]
+    pub camera: Option<String>,
+    /// Worker threads [default: all cores].
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Exposure of the PNG in stops (linear * 2^EV before the sRGB curve).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub exposure: f32,
+    /// Also write an sRGB PNG here.
+    #[arg(long)]
+    pub png: Option<PathBuf>,
+    /// Extra EXR layers, comma-separated.
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub layers: Vec<Layer>,
+}
+
+/// The output format, from the file extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Format {
+    Exr,
+    Png,
+}
+
+fn format_of(path: &Path) -> Result<Format> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("exr") => Ok(Format::Exr),
+        Some("png") => Ok(Format::Png),
+        _ => bail!("output {} must end in .exr or .png", path.display()),
+    }
+}
+
+/// Image size from the flags and the camera's aspect ratio (see the flags' help).
+pub fn image_size(
+    width: Option<u32>,
+    height: Option<u32>,
+    aspect: Option<f32>,
+) -> Result<(u32, u32)> {
+    let aspect = aspect
+        .filter(|a| a.is_finite() && *a > 0.0)
+        .unwrap_or(4.0 / 3.0) as f64;
+    for (flag, value) in [("--width", width), ("--height", height)] {
+        if value == Some(0) {
+            bail!("the image size must be positive, got {flag} 0");
+        }
+    }
+    let derive = |v: f64, what: &str| -> Result<u32> {
+        let r = v.round();
+        if !(1.0..=u32::MAX as f64).contains(&r) {
+            bail!(
+                "the derived image size ({what} {v:.1}) is out of range; give --width and --height"
+            );
+        }
+        Ok(r as u32)
+    };
+    let (w, h) = match (width, height) {
+        (Some(w), Some(h)) => (w, h),
+        (Some(w), None) => (w, derive(w as f64 / aspect, "height")?),
+        (None, Some(h)) => (derive(h as f64 * aspect, "width")?, h),
+        (None, None) => (
+            derive(DEFAULT_HEIGHT as f64 * aspect, "width")?,
+            DEFAULT_HEIGHT,
+        ),
+    };
+    if w as u64 * h as u64 > MAX_PIXELS {
+        bail!("the image size {w}x{h} is too large (at most {MAX_PIXELS} pixels)");
+    }
+    Ok((w, h))
+}
+
+/// A progress bar over `total` pixel samples on stderr (hidden in CI and when not a terminal).
+pub fn progress_bar(total: u64) -> ProgressBar {
+    let in_ci = std::env::var("CI").is_ok_and(|v| v == "true" || v == "1");
+    if in_ci || !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
+    if let Ok(style) = ProgressStyle::with_template(
+        "{elapsed_precise} [{wide_bar}] {percent:>3}% samples, eta {eta}",
+    ) {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar
+}
+
+/// Creates the parent folder of an output file.
+fn create_parent(path: &Path) -> Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("cannot create the folder {}", dir.display()))?;
+    }
+    Ok(())
+}
+
+/// Runs the subcommand.
+pub fn run(args: Args) -> Result<()> {
+    // Phase 1: check everything that needs no scene.
+    let format = format_of(&args.output)?;
+    if let Some(png) = &args.png {
+        if format_of(png)? != Format::Png {
+            bail!("--png {} must end in .png", png.display());
+        }
+    }
+    if args.spp == 0 {
+        bail!("--spp must be at least 1");
+    }
+    if args.max_depth == 0 {
+        bail!("--max-depth must be at least 1 (1 renders only emitters seen directly)");
+    }
+    if !args.exposure.is_finite() {
+        bail!("--exposure must be a finite number of stops");
+    }
+    let layers = Layers {
+        depth: args.layers.contains(&Layer::Depth),
+        normal: args.layers.contains(&Layer::Normal),
+        albedo: args.layers.contains(&Layer::Albedo),
+        specular: args.layers.contains(&Layer::Specular),
+    };
+    if format == Format::Png && !args.layers.is_empty() {
+        eprintln!(
+            "warning: --layers are written only to EXR outputs; {} is a PNG",
+            args.output.display()
+        );
+    }
+
+    // Phase 2: the scene and the camera.
+    let scene = Scene::load(&args.scene)
+        .with_context(|| format!("cannot load the scene {}", args.scene.display()))?;
+    for warning in &scene.warnings {
+        eprintln!("warning: {warning}");
+    }
+    let camera = scene
+        .camera(args.camera.as_deref())
+        .with_context(|| format!("in the scene {}", args.scene.display()))?;
+    let (width, height) = image_size(args.width, args.height, camera.aspect_ratio)?;
+    let total = (width as u64 * height as u64)
+        .checked_mul(args.spp as u64)
+        .context("width * height * spp overflows")?;
+    let settings = RenderSettings {
+        width,
+        height,
+        spp: args.spp,
+        max_depth: args.max_depth,
+        seed: args.seed,
+        layers,
+    };
+    create_parent(&args.output)?;
+    if let Some(png) = &args.png {
+        create_parent(png)?;
+    }
+
+    // Phase 3: render and write.
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads.unwrap_or(0))
+        .build()
+        .context("cannot start the worker threads")?;
+    let bar = progress_bar(total);
+    let out: RenderOutput =
+        pool.install(|| integrator::render(&scene, camera, &settings, &|n| bar.inc(n)));
+    bar.finish_and_clear();
+
+    match format {
+        Format::Exr => output::write_exr(&args.output, &out)?,
+        Format::Png => output::write_png(&args.output, &out.image, args.exposure)?,
+    }
+    if let Some(png) = &args.png {
+        output::write_png(png, &out.image, args.exposure)?;
+    }
+    let s = &out.stats;
+    let secs = s.seconds.max(1e-9);
+    eprintln!(
+        "rendered {width}x{height} at {} spp, max depth {} in {:.2} s: {:.3} M samples/s, {:.3} M rays/s, {} samples dropped (NaN/inf)",
+        args.spp,
+        args.max_depth,
+        s.seconds,
+        s.samples as f64 / secs / 1e6,
+        s.rays as f64 / secs / 1e6,
+        s.nonfinite_dropped
+    );
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_follow_the_aspect_ratio() {
+        assert_eq!(
+            image_size(None, None, Some(16.0 / 9.0)).unwrap(),
+            (853, 480)
+        );
+        assert_eq!(image_size(None, None, None).unwrap(), (640, 480));
+        assert_eq!(image_size(Some(320), None, Some(2.0)).unwrap(), (320, 160));
+        assert_eq!(image_size(None, Some(100), Some(1.5)).unwrap(), (150, 100));
+        assert_eq!(image_size(Some(7), Some(9), Some(2.0)).unwrap(), (7, 9));
+        assert!(image_size(Some(0), None, None).is_err());
+        assert!(image_size(Some(1), None, Some(100.0)).is_err());
+        assert!(image_size(Some(u32::MAX), Some(u32::MAX), None).is_err());
+        assert!(image_size(None, Some(u32::MAX), Some(4.0)).is_err());
+    }
+
+    #[test]
+    fn formats_from_extensions() {
+        assert_eq!(format_of(Path::new("a/b.EXR")).unwrap(), Format::Exr);
+        assert_eq!(format_of(Path::new("b.png")).unwrap(), Format::Png);
+        assert!(format_of(Path::new("b.jpg")).is_err());
+        assert!(format_of(Path::new("b")).is_err());
+    }
+}

@@ -1,0 +1,190 @@
+//! End-to-end tests: the real `streaks` executable, run in a fresh temporary folder per test.
+
+mod common;
+
+use common::TestDir;
+use streaks_render::output::{read_exr_layer, read_exr_rgb};
+
+#[test]
+fn render_writes_exr_with_layers_and_png() {
+    let t = TestDir::new();
+    t.write_tiny_gltf();
+    let run = t.streaks(&[
+        "render",
+        "scene.gltf",
+        "-o",
+        "out/img.exr",
+        "--png",
+        "out/img.png",
+        "--spp",
+        "4",
+        "--height",
+        "20",
+        "--max-depth",
+        "3",
+        "--layers",
+        "depth,normal,albedo,specular",
+    ]);
+    run.assert_success();
+    let err = run.stderr();
+    assert!(err.contains("samples/s") && err.contains("rays/s"), "{err}");
+    assert_eq!(t.files_in("out"), ["img.exr", "img.png"]);
+
+    let img = read_exr_rgb(&t.join("out/img.exr")).unwrap();
+    // Width from the camera's aspect ratio 1.5.
+    assert_eq!((img.width, img.height), (30, 20));
+    assert!(img
+        .pixels
+        .iter()
+        .all(|p| p.is_finite() && p.min_element() >= 0.0));
+    // The lit floor fills the bottom row; the sky (top row) is black except for the sign.
+    let bottom = img.get(15, 19);
+    assert!(bottom.min_element() > 0.0, "{bottom}");
+    assert_eq!(img.get(0, 0), glam::Vec3::ZERO);
+    // The emissive sign is seen directly: radiance (1, 0.5, 0.2) * 4 somewhere in the image.
+    let sign = glam::Vec3::new(4.0, 2.0, 0.8);
+    assert!(
+        img.pixels
+            .iter()
+            .any(|p| (*p - sign).abs().max_element() < 1e-4),
+        "the emissive sign is missing"
+    );
+
+    let depth = read_exr_layer(&t.join("out/img.exr"), "depth").unwrap();
+    assert_eq!(depth.get(0, 0).x, f32::INFINITY);
+    let d = depth.get(15, 19).x;
+    assert!(d.is_finite() && d > 0.5 && d < 5.0, "{d}");
+    let normal = read_exr_layer(&t.join("out/img.exr"), "normal").unwrap();
+    assert!((normal.get(15, 19) - glam::Vec3::Y).length() < 1e-4);
+    let albedo = read_exr_layer(&t.join("out/img.exr"), "albedo").unwrap();
+    assert!(albedo.get(15, 19).min_element() > 0.0);
+    let specular = read_exr_layer(&t.join("out/img.exr"), "specular").unwrap();
+    // The specular part never exceeds the whole.
+    for (s, p) in specular.pixels.iter().zip(&img.pixels) {
+        assert!(
+            s.min_element() >= 0.0 && (*s - *p).max_element() <= 1e-4 * p.max_element().max(1.0)
+        );
+    }
+    assert!(specular.pixels.iter().any(|s| s.max_element() > 0.0));
+
+    let png = std::fs::read(t.join("out/img.png")).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+}
+
+#[test]
+fn png_output_and_explicit_size() {
+    let t = TestDir::new();
+    t.write_tiny_gltf();
+    t.streaks(&[
+        "render",
+        "scene.gltf",
+        "-o",
+        "a.png",
+        "--spp",
+        "1",
+        "--width",
+        "12",
+        "--height",
+        "5",
+        "--exposure",
+        "-1",
+        "--threads",
+        "1",
+    ])
+    .assert_success();
+    assert_eq!(t.files_in("."), ["a.png", "scene.bin", "scene.gltf"]);
+}
+
+#[test]
+fn same_image_whatever_the_thread_count() {
+    let t = TestDir::new();
+    t.write_tiny_gltf();
+    for (threads, out) in [("1", "one.exr"), ("2", "two.exr")] {
+        t.streaks(&[
+            "render",
+            "scene.gltf",
+            "-o",
+            out,
+            "--spp",
+            "3",
+            "--height",
+            "12",
+            "--threads",
+            threads,
+            "--seed",
+            "7",
+        ])
+        .assert_success();
+    }
+    let one = read_exr_rgb(&t.join("one.exr")).unwrap();
+    let two = read_exr_rgb(&t.join("two.exr")).unwrap();
+    assert_eq!(one, two);
+}
+
+#[test]
+fn bad_arguments_fail_clearly() {
+    let t = TestDir::new();
+    t.write_tiny_gltf();
+    let base = ["render", "scene.gltf", "-o", "x.exr"];
+    let with = |extra: &[&str]| {
+        let mut args = base.to_vec();
+        args.extend_from_slice(extra);
+        t.streaks(&args)
+    };
+    with(&["--spp", "0"]).assert_failure_mentioning("--spp");
+    with(&["--width", "0"]).assert_failure_mentioning("size");
+    with(&["--width", "4294967295", "--height", "4294967295"])
+        .assert_failure_mentioning("too large");
+    with(&["--max-depth", "0"]).assert_failure_mentioning("--max-depth");
+    with(&["--layers", "depth,sparkle"]).assert_failure_mentioning("sparkle");
+    with(&["--spp", "-3"]).assert_failure_mentioning("-3");
+    with(&["--spp=-3"]).assert_failure_mentioning("--spp");
+    with(&["--spp", "many"]).assert_failure_mentioning("many");
+    with(&["--camera", "nope"]).assert_failure_mentioning("nope");
+    t.streaks(&["render", "scene.gltf", "-o", "x.jpg"])
+        .assert_failure_mentioning("x.jpg");
+    t.streaks(&["render", "missing.gltf", "-o", "x.exr"])
+        .assert_failure_mentioning("missing.gltf");
+    std::fs::write(t.join("broken.gltf"), "{ not json").unwrap();
+    t.streaks(&["render", "broken.gltf", "-o", "x.exr"])
+        .assert_failure_mentioning("broken.gltf");
+    // Nothing was written by any of them.
+    assert_eq!(t.files_in("."), ["broken.gltf", "scene.bin", "scene.gltf"]);
+}
+
+#[test]
+fn unwritable_output_leaves_no_file() {
+    let t = TestDir::new();
+    t.write_tiny_gltf();
+    // The output's folder cannot be created: a file is in the way.
+    std::fs::write(t.join("blocker"), "").unwrap();
+    t.streaks(&[
+        "render",
+        "scene.gltf",
+        "-o",
+        "blocker/img.exr",
+        "--spp",
+        "1",
+        "--height",
+        "4",
+    ])
+    .assert_failure_mentioning("blocker");
+    // The output is an existing folder: the final rename fails, and no temporary file remains.
+    std::fs::create_dir(t.join("taken.exr")).unwrap();
+    t.streaks(&[
+        "render",
+        "scene.gltf",
+        "-o",
+        "taken.exr",
+        "--spp",
+        "1",
+        "--height",
+        "4",
+    ])
+    .assert_failure_mentioning("taken.exr");
+    assert_eq!(
+        t.files_in("."),
+        ["blocker", "scene.bin", "scene.gltf", "taken.exr"]
+    );
+    assert!(t.files_in("taken.exr").is_empty());
+}
