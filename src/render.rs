@@ -8,8 +8,9 @@ use streaks_render::integrator::{self, Layers, RenderOutput, RenderSettings};
 use streaks_render::output;
 use streaks_render::scene::Scene;
 
-/// Largest image accepted, in pixels (the film keeps about 60 bytes per pixel).
-const MAX_PIXELS: u64 = 1 << 28;
+/// Largest image accepted, in pixels (2^26, twice 8K UHD; the film keeps about 64 bytes per
+/// pixel, so 4 GiB).
+const MAX_PIXELS: u64 = 1 << 26;
 
 /// Default image height when neither `--width` nor `--height` is given.
 const DEFAULT_HEIGHT: u32 = 480;

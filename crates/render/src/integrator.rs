@@ -277,6 +277,10 @@ fn trace_path(
         };
         let frame = Frame::from_normal(ns);
         let wo_local = frame.to_local(wo);
+        if wo_local.z <= 0.0 {
+            // The interpolated normal faces away from the viewer: no BSDF value either way.
+            break;
+        }
 
         // 2. Next-event estimation (always draws 3 numbers, so the dimensions stay aligned).
         let u_light = sampler.next_1d();
