@@ -3,6 +3,7 @@
 //! Each subcommand module exposes an `Args` struct (clap) and `run(args) -> anyhow::Result<()>`.
 //! Errors are printed with their whole chain and the process exits non-zero.
 
+mod analyze;
 mod figure;
 mod locus;
 mod prepare;
@@ -34,6 +35,8 @@ enum Command {
     Stereo(stereo::Args),
     /// Path-trace one camera of a scene to EXR (and PNG).
     Render(render::Args),
+    /// Analyse a stereo pair: streak disparity per row against Eq. 4, depth below the road.
+    Analyze(analyze::Args),
     /// Print the virtual light column (Eq. 4) of a light seen from a viewer.
     Locus(locus::Args),
     /// Draw one of the paper's figures from the model as a PNG.
@@ -51,6 +54,7 @@ fn main() -> ExitCode {
         Command::Prepare(args) => prepare::run(args),
         Command::Stereo(args) => stereo::run(args),
         Command::Render(args) => render::run(args),
+        Command::Analyze(args) => analyze::run(args),
         Command::Locus(args) => locus::run(args),
         Command::Figure(args) => figure::run(args),
         Command::Lk(args) => lk::run(args),
