@@ -6,6 +6,7 @@
 mod analyze;
 mod figure;
 mod locus;
+mod paper;
 mod prepare;
 mod render;
 mod stereo;
@@ -37,6 +38,8 @@ enum Command {
     Render(render::Args),
     /// Analyse a stereo pair: streak disparity per row against Eq. 4, depth below the road.
     Analyze(analyze::Args),
+    /// Reproduce the paper's Figs. 2-6 with our renderer and model, with an index.md.
+    Paper(paper::Args),
     /// Print the virtual light column (Eq. 4) of a light seen from a viewer.
     Locus(locus::Args),
     /// Draw one of the paper's figures from the model as a PNG.
@@ -55,6 +58,7 @@ fn main() -> ExitCode {
         Command::Stereo(args) => stereo::run(args),
         Command::Render(args) => render::run(args),
         Command::Analyze(args) => analyze::run(args),
+        Command::Paper(args) => paper::run(args),
         Command::Locus(args) => locus::run(args),
         Command::Figure(args) => figure::run(args),
         Command::Lk(args) => lk::run(args),

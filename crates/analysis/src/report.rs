@@ -303,8 +303,7 @@ pub struct Comparison {
     pub measured_fit: Option<LineFit>,
     /// Line fit of predicted disparity (px) against row.
     pub predicted_fit: Option<LineFit>,
-    /// Whether the slopes agree within twice their combined standard error (or 0.002 px per
-    /// row, the resolution of the estimator over a streak, whichever is larger).
+    /// Whether the slopes agree within twice their combined standard error.
     pub slope_agrees: bool,
 }
 
@@ -351,8 +350,7 @@ pub fn compare(rows: &[RowRecord]) -> Option<Comparison> {
     let slope_agrees = match (mf, pf) {
         (Some(m), Some(p)) => {
             let se = (m.slope_se.powi(2) + p.slope_se.powi(2)).sqrt();
-            let tol = if se.is_finite() { 2.0 * se } else { 0.0 };
-            (m.slope - p.slope).abs() <= tol.max(0.002)
+            se.is_finite() && (m.slope - p.slope).abs() <= 2.0 * se
         }
         _ => false,
     };
