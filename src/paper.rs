@@ -248,6 +248,13 @@ fn fig6(args: &Args, out: &Path, index: &mut String) -> Result<Report> {
         v.iter().copied().fold(f64::NEG_INFINITY, f64::max)
             - v.iter().copied().fold(f64::INFINITY, f64::min)
     };
+    // Where the two fitted lines meet: (a_p - a_m) / (b_m - b_p) with y = a + b row.
+    let crossing = match (c.measured_fit, c.predicted_fit) {
+        (Some(m), Some(p)) if (m.slope - p.slope).abs() > 1e-12 => {
+            Some((p.intercept - m.intercept) / (m.slope - p.slope))
+        }
+        _ => None,
+    };
     let elev = span_deg(&|r| r.predicted_px.map(|_| r.elevation_deg));
     let _ = writeln!(
         index,
@@ -264,7 +271,8 @@ fn fig6(args: &Args, out: &Path, index: &mut String) -> Result<Report> {
          | RMS difference | {:.4} px = {:.5} deg (mean {:+.4} px) | |\n\
          | slope agrees (within 2 combined standard errors) | {} | |\n\
          | a matte road over the same rows would span | {} px | |\n\
-         | median depth stereo assigns / median height of the implied points | {:.2} m / {:.2} m | light at Z = 15 m, mirror image at Y = -1.5 m |\n\n\
+         | median depth stereo assigns / median height of the implied points | {:.2} m / {:.2} m | light at Z = 15 m, mirror image at Y = -1.5 m |\n\
+         | row where the fitted lines cross (paper: at the mirror image) | {} | mirror image at row {:.1} |\n\n\
          ![](fig6_deg.png)\n\n![](fig6_px.png)\n\nThe whole analysis (report.json, plots, depth map, \
          side view of the point cloud) is in [fig6/analysis](fig6/analysis/).\n",
         rig.focal_px(),
@@ -283,6 +291,8 @@ fn fig6(args: &Args, out: &Path, index: &mut String) -> Result<Report> {
         streak.road_span_px.map_or("-".into(), |v| format!("{v:.3}")),
         streak.median_depth_m,
         streak.median_road_y_m,
+        crossing.map_or("-".into(), |y| format!("{y:.1}")),
+        streak.light.as_ref().map_or(f64::NAN, |l| l.mirror_px[1]),
     );
     Ok(report)
 }
