@@ -141,7 +141,7 @@ fn fig4_and_5(out: &Path, index: &mut String) -> Result<()> {
 fn fmt_fit(c: &Comparison) -> (String, String) {
     let f = |fit: Option<streaks_analysis::report::LineFit>| {
         fit.map_or("-".to_string(), |f| {
-            format!("{:.5} +- {:.5} px/row", f.slope, f.slope_se)
+            format!("{:.2e} +- {:.1e} px/row", f.slope, f.slope_se)
         })
     };
     (f(c.measured_fit), f(c.predicted_fit))
