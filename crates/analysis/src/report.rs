@@ -1110,6 +1110,11 @@ pub fn write_outputs(
             other.push((p.z as f64, p.y as f64));
         }
     });
+    let z_max = other
+        .iter()
+        .chain(&streak)
+        .map(|p| p.0)
+        .fold(1.0f64, f64::max);
     let mut plot = Plot::new(
         "side view of the SGM point cloud (road frame)",
         "Z forward (m)",
@@ -1200,6 +1205,46 @@ mod tests {
     use crate::synth::SynthScene;
     use glam::Affine3A;
     use streaks_stereo::rig::Intrinsics;
+
+    #[test]
+    fn streaks_are_matched_to_the_light_whose_mirror_image_is_on_their_axis() {
+        let rig = Rig::new(
+            Intrinsics::new(320, 240, 300.0).unwrap(),
+            0.065,
+            Affine3A::from_translation(Vec3::new(0.0, 1.5, 0.0)),
+        )
+        .unwrap();
+        let geo = Geometry::new(&rig).unwrap();
+        let light = |x: f32, y: f32, z: f32| LightRecord::Point {
+            // World -Z is road +Z for a rig looking along -Z.
+            position: streaks_stereo::rigfile::Placed::point(Vec3::new(x, y, -z), Some(&geo.road)),
+            intensity: [1.0; 3],
+            range: None,
+        };
+        let lights = vec![light(-3.0, 5.0, 30.0), light(1.0, 4.0, 20.0)];
+        // The second light's mirror image (1, -4, 20) seen from (0, 1.5, 0): x = 160 + 15,
+        // y = 120 + 300 * 5.5 / 20 = 202.5. A vertical streak through it.
+        let streak = Streak {
+            first_row: 150,
+            last_row: 220,
+            centres: (150..=220).map(|y| (y, 175.5)).collect(),
+            axis_a: 175.5,
+            axis_b: 0.0,
+            peak: 1.0,
+            elongation: 10.0,
+            pixels: 500,
+        };
+        let m = match_light(&streak, &lights, &geo, 4.0).expect("matched");
+        assert_eq!(m.index, 1);
+        assert!(m.distance_px < 1.5, "{m:?}");
+        assert!((m.mirror_px[1] - 202.5).abs() < 1e-3);
+        // Too far from every axis: no match.
+        let off = Streak {
+            axis_a: 260.0,
+            ..streak
+        };
+        assert!(match_light(&off, &lights, &geo, 4.0).is_none());
+    }
 
     #[test]
     fn line_fit_recovers_a_line_and_its_uncertainty() {
