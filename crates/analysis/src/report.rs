@@ -1139,7 +1139,7 @@ pub fn write_outputs(
     .with(Series::line(
         "road surface",
         BLACK_RGB,
-        vec![(0.0, 0.0), (80.0, 0.0)],
+        vec![(0.0, 0.0), (z_max, 0.0)],
     ));
     plot.size = (1200, 600);
     let path = dir.join("side_view.png");
