@@ -177,7 +177,7 @@ pub struct NamedRegion {
 /// Parameters of [`analyze`].
 #[derive(Clone, Debug)]
 pub struct AnalyzeParams {
-    /// The per-row estimator (its largest disparity is replaced by the scene's, from the ground
+    /// The per-row estimator, 21 x 5 pixels by default (its largest disparity is replaced by the scene's, from the ground
     /// truth or the road at the bottom row).
     pub lk: LkParams,
     /// The streak detector (its horizon defaults to the rig's).
@@ -197,7 +197,12 @@ pub struct AnalyzeParams {
 impl Default for AnalyzeParams {
     fn default() -> Self {
         Self {
-            lk: LkParams::default(),
+            // 21 x 5 windows: one estimate per row, averaged over 5 rows against render noise.
+            lk: LkParams {
+                window: 21,
+                rows: 5,
+                ..LkParams::default()
+            },
             detect: DetectParams::default(),
             sgm: SgmParams::default(),
             regions: Vec::new(),
