@@ -4,7 +4,11 @@
 //! Errors are printed with their whole chain and the process exits non-zero.
 
 mod analyze;
+mod compare;
+mod disparity;
+mod export_mitsuba;
 mod figure;
+mod lk;
 mod locus;
 mod paper;
 mod prepare;
@@ -14,9 +18,6 @@ mod texture_map;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
-
-mod disparity;
-mod lk;
 
 /// Render rainy night streets in stereo and measure what specular streaks do to depth.
 #[derive(Parser, Debug)]
@@ -28,26 +29,30 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Resample an image of a rendered or photographed pair onto the road plane (paper Fig. 3).
-    TextureMap(texture_map::Args),
-    /// Grey level, histogram equalisation and a disparity shift for a photographed pair (Fig. 7).
-    Prepare(prepare::Args),
-    /// Render a rectified stereo pair with ground-truth disparity, depth and streak masks.
-    Stereo(stereo::Args),
     /// Path-trace one camera of a scene to EXR (and PNG).
     Render(render::Args),
+    /// Render a rectified stereo pair with ground-truth disparity, depth and streak masks.
+    Stereo(stereo::Args),
     /// Analyse a stereo pair: streak disparity per row against Eq. 4, depth below the road.
     Analyze(analyze::Args),
     /// Reproduce the paper's Figs. 2-6 with our renderer and model, with an index.md.
     Paper(paper::Args),
-    /// Print the virtual light column (Eq. 4) of a light seen from a viewer.
-    Locus(locus::Args),
-    /// Draw one of the paper's figures from the model as a PNG.
-    Figure(figure::Args),
     /// Per-row 1D Lucas-Kanade disparity over a region (the paper's estimator).
     Lk(lk::Args),
     /// Dense disparity by semi-global matching (census cost), written as PFM.
     Disparity(disparity::Args),
+    /// Print the virtual light column (Eq. 4) of a light seen from a viewer.
+    Locus(locus::Args),
+    /// Draw one of the paper's figures from the model as a PNG.
+    Figure(figure::Args),
+    /// Resample an image of a rendered or photographed pair onto the road plane (paper Fig. 3).
+    TextureMap(texture_map::Args),
+    /// Grey level, histogram equalisation and a disparity shift for a photographed pair (Fig. 7).
+    Prepare(prepare::Args),
+    /// Write a scene as a Mitsuba 3 scene (XML, PLY, EXR textures) for the cross-check.
+    ExportMitsuba(export_mitsuba::Args),
+    /// Compare a render with a reference: relative RMSE and bias per region, noise test.
+    Compare(compare::Args),
 }
 
 fn main() -> ExitCode {
@@ -61,6 +66,8 @@ fn main() -> ExitCode {
         Command::Paper(args) => paper::run(args),
         Command::Locus(args) => locus::run(args),
         Command::Figure(args) => figure::run(args),
+        Command::ExportMitsuba(args) => export_mitsuba::run(args),
+        Command::Compare(args) => compare::run(args),
         Command::Lk(args) => lk::run(args),
         Command::Disparity(args) => disparity::run(args),
     };

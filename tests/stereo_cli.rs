@@ -144,3 +144,276 @@ fn bad_inputs_are_clear_errors() {
     t.streaks(&["prepare", "a.png", "a.png", "-o", "p"])
         .assert_failure_mentioning("a.png");
 }
+
+// Rendered scenes: ground truth and measured disparity (the renderer and the analysis together).
+
+use glam::Vec3;
+use std::path::{Path, PathBuf};
+use streaks_analysis::lk::{lk_region, LkParams, Region};
+use streaks_render::output::RgbImage;
+use streaks_render::scene::Scene;
+use streaks_stereo::image::GrayImage;
+use streaks_stereo::render::{render_pair, rig_from_camera, write_pair, EyeView, PairSettings};
+use streaks_stereo::rig::Eye;
+use streaks_stereo::streak_mask::StreakMaskParams;
+
+fn luminance_image(img: &RgbImage) -> GrayImage {
+    let data = img
+        .pixels
+        .iter()
+        .map(|p| 0.2126 * p.x + 0.7152 * p.y + 0.0722 * p.z)
+        .collect();
+    GrayImage::from_vec(img.width as usize, img.height as usize, data).unwrap()
+}
+
+/// Writes a glTF scene: a camera at `camera` (looking along -Z, pitched by `pitch`
+/// radians), one quad (4 corners, with UVs) carrying `texture` as its baseColorTexture (or
+/// a plain grey), and a directional light shining along `light_dir`.
+fn write_scene(
+    dir: &Path,
+    camera: Vec3,
+    pitch: f32,
+    yfov: f32,
+    corners: [Vec3; 4],
+    texture: Option<&image::RgbImage>,
+    light_dir: Vec3,
+) -> PathBuf {
+    let mut bin: Vec<u8> = Vec::new();
+    for c in corners {
+        for v in c.to_array() {
+            bin.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    for uv in [[0.0f32, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]] {
+        for v in uv {
+            bin.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    for i in [0u16, 1, 2, 0, 2, 3] {
+        bin.extend_from_slice(&i.to_le_bytes());
+    }
+    std::fs::write(dir.join("scene.bin"), &bin).unwrap();
+    let (lo, hi) = corners.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(a, b), &c| (a.min(c), b.max(c)),
+    );
+    let mut material = serde_json::json!({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1.0], "metallicFactor": 0.0, "roughnessFactor": 1.0}});
+    let mut extra = serde_json::json!({});
+    if let Some(tex) = texture {
+        tex.save(dir.join("texture.png")).unwrap();
+        material["pbrMetallicRoughness"]["baseColorFactor"] =
+            serde_json::json!([1.0, 1.0, 1.0, 1.0]);
+        material["pbrMetallicRoughness"]["baseColorTexture"] = serde_json::json!({"index": 0});
+        extra = serde_json::json!({
+            "textures": [{"source": 0, "sampler": 0}],
+            "images": [{"uri": "texture.png"}],
+            "samplers": [{"magFilter": 9729, "minFilter": 9729}]
+        });
+    }
+    // The light's node rotation: local -Z onto light_dir.
+    let q = glam::Quat::from_rotation_arc(-Vec3::Z, light_dir.normalize());
+    let cq = glam::Quat::from_rotation_x(pitch);
+    let mut gltf = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_lights_punctual"],
+        "extensions": {"KHR_lights_punctual": {"lights": [{"type": "directional", "color": [1.0, 1.0, 1.0], "intensity": 3.0}]}},
+        "scene": 0,
+        "scenes": [{"nodes": [0, 1, 2]}],
+        "nodes": [
+            {"mesh": 0},
+            {"camera": 0, "name": "cam", "translation": camera.to_array(), "rotation": cq.to_array()},
+            {"rotation": q.to_array(), "extensions": {"KHR_lights_punctual": {"light": 0}}}
+        ],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": yfov, "znear": 0.01, "aspectRatio": 4.0 / 3.0}}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "indices": 2, "material": 0}]}],
+        "materials": [material],
+        "buffers": [{"uri": "scene.bin", "byteLength": bin.len()}],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": 48},
+            {"buffer": 0, "byteOffset": 48, "byteLength": 32},
+            {"buffer": 0, "byteOffset": 80, "byteLength": 12}
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": lo.to_array(), "max": hi.to_array()},
+            {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC2"},
+            {"bufferView": 2, "componentType": 5123, "count": 6, "type": "SCALAR"}
+        ]
+    });
+    if let serde_json::Value::Object(extra) = extra {
+        for (k, v) in extra {
+            gltf[k] = v;
+        }
+    }
+    let path = dir.join("scene.gltf");
+    std::fs::write(&path, serde_json::to_string_pretty(&gltf).unwrap()).unwrap();
+    path
+}
+
+fn settings(spp: u32) -> PairSettings {
+    PairSettings {
+        spp,
+        max_depth: 2,
+        seed: 7,
+        exposure_ev: 0.0,
+        mask: StreakMaskParams::default(),
+    }
+}
+
+#[test]
+fn road_plane_disparity_matches_the_analytic_plane() {
+    let dir = tempfile::tempdir().unwrap();
+    let h = 1.5f32;
+    let road = [
+        Vec3::new(-50.0, 0.0, 10.0),
+        Vec3::new(50.0, 0.0, 10.0),
+        Vec3::new(50.0, 0.0, -200.0),
+        Vec3::new(-50.0, 0.0, -200.0),
+    ];
+    let path = write_scene(
+        dir.path(),
+        Vec3::new(0.0, h, 0.0),
+        0.0,
+        0.6,
+        road,
+        None,
+        Vec3::new(0.0, -1.0, -0.2),
+    );
+    let scene = Scene::load(&path).unwrap();
+    let cam = scene.camera(None).unwrap();
+    let rig = rig_from_camera(cam, 64, 48, 0.065).unwrap();
+    let views = render_pair(&scene, &rig, &settings(1), &|_| {}).unwrap();
+    let f = rig.focal_px();
+    let cy = 24.0;
+    let mut checked = 0;
+    for (eye, view) in Eye::BOTH.into_iter().zip(&views) {
+        for y in 0..48 {
+            for x in 0..64 {
+                let d = view.disparity.get(x, y);
+                let yc = y as f32 + 0.5 - cy;
+                if yc <= 0.0 {
+                    assert!(d.is_infinite(), "{eye} sky ({x}, {y}): {d}");
+                    continue;
+                }
+                // A level rig of height h sees the road at Z = f h / (y - cy): d = b (y - cy) / h.
+                let z = f * h / yc;
+                if z > 190.0 {
+                    continue;
+                }
+                let expect = 0.065 * yc / h;
+                assert!(
+                    (d - expect).abs() < 1e-4 * expect.max(1.0),
+                    "{eye} ({x}, {y}): {d} vs {expect}"
+                );
+                assert!(view.road[y * 64 + x]);
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 2000, "{checked}");
+    // Write the whole pair and read a few files back.
+    write_pair(dir.path(), &scene, &rig, &views, 0.0).unwrap();
+    for name in [
+        "left.exr",
+        "right.exr",
+        "left.png",
+        "right.png",
+        "side_by_side.png",
+        "anaglyph.png",
+        "disparity_left.pfm",
+        "depth_left.pfm",
+        "streak_mask_left.png",
+        "streak_mask_right.png",
+        "rig.json",
+    ] {
+        assert!(dir.path().join(name).exists(), "{name}");
+    }
+    let disp = streaks_stereo::pfm::read_pfm(&dir.path().join("disparity_left.pfm")).unwrap();
+    assert_eq!(disp, views[0].disparity);
+    let file = RigFile::load(&dir.path().join("rig.json")).unwrap();
+    assert_eq!(file.rig().unwrap().intrinsics(), rig.intrinsics());
+    assert!(matches!(file.lights[0], LightRecord::Directional { .. }));
+    let sbs = image::open(dir.path().join("side_by_side.png")).unwrap();
+    assert_eq!((sbs.width(), sbs.height()), (128, 48));
+}
+
+#[test]
+fn rendered_fronto_parallel_plane_has_disparity_f_b_over_z() {
+    let dir = tempfile::tempdir().unwrap();
+    // A smooth procedural texture: sinusoids with periods of 16-50 image pixels at 5 m.
+    let n = 256u32;
+    let tex = image::RgbImage::from_fn(n, n, |i, j| {
+        let (u, v) = (i as f32 / n as f32, j as f32 / n as f32);
+        let tau = std::f32::consts::TAU;
+        let s = 0.5
+            + 0.18 * (tau * 6.0 * u).sin()
+            + 0.12 * (tau * 11.0 * u + 1.0).sin()
+            + 0.08 * (tau * 17.0 * u + 2.0).sin()
+            + 0.1 * (tau * 5.0 * v).sin();
+        let g = (s.clamp(0.0, 1.0) * 255.0).round() as u8;
+        image::Rgb([g, g, g])
+    });
+    let z = 5.0f32;
+    let plane = [
+        Vec3::new(-3.0, -3.0, -z),
+        Vec3::new(3.0, -3.0, -z),
+        Vec3::new(3.0, 3.0, -z),
+        Vec3::new(-3.0, 3.0, -z),
+    ];
+    let path = write_scene(
+        dir.path(),
+        Vec3::ZERO,
+        0.0,
+        0.5,
+        plane,
+        Some(&tex),
+        -Vec3::Z,
+    );
+    let scene = Scene::load(&path).unwrap();
+    let rig = rig_from_camera(scene.camera(None).unwrap(), 160, 120, 0.065).unwrap();
+    let views = render_pair(&scene, &rig, &settings(16), &|_| {}).unwrap();
+    let expect = rig.disparity_px(z);
+    // Ground truth first: the whole view sees the plane at depth Z.
+    for v in &views {
+        assert!(v
+            .disparity
+            .data
+            .iter()
+            .all(|&d| (d - expect).abs() < 1e-3 * expect));
+    }
+    let lum = |v: &EyeView| luminance_image(&v.output.image);
+    let (l, r) = (lum(&views[0]), lum(&views[1]));
+    // The project's estimator, one window per row at the image centre, averaged over rows.
+    let params = LkParams {
+        window: 101,
+        min_disp: 0,
+        max_disp: 8,
+        ..LkParams::default()
+    };
+    let rows = lk_region(
+        &l,
+        &r,
+        Region {
+            x0: 20,
+            y0: 10,
+            x1: 140,
+            y1: 110,
+        },
+        &params,
+    )
+    .unwrap();
+    assert!(
+        rows.iter().all(|r| r.converged && r.ncc > 0.99),
+        "{:?}",
+        rows[0]
+    );
+    let d = rows.iter().map(|r| r.disparity).sum::<f32>() / rows.len() as f32;
+    let worst = rows
+        .iter()
+        .map(|r| (r.disparity - expect).abs())
+        .fold(0.0f32, f32::max);
+    assert!(
+        (d - expect).abs() < 0.05,
+        "measured {d} px, f b / Z = {expect} px"
+    );
+    assert!(worst < 0.1, "worst row off by {worst} px");
+}

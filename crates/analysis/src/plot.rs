@@ -2,8 +2,9 @@
 //! coordinates, with a title, labelled axes and a legend, rendered with `plotters` and written
 //! atomically to PNG (a temporary file beside the target, then a rename).
 //!
-//! Text uses DejaVu Sans, bundled in the crate (`fonts/`, Bitstream Vera licence alongside)
-//! and registered with plotters' `ab_glyph` backend, so no system font libraries are needed.
+//! Text uses DejaVu Sans, bundled in streaks-stereo (`crates/stereo/fonts/`, Bitstream Vera
+//! licence alongside) and registered with plotters' `ab_glyph` backend, so no system font
+//! libraries are needed.
 //!
 //! ```
 //! use streaks_analysis::plot::{Plot, Series, BLUE};
@@ -24,7 +25,6 @@ type Range = (f64, f64);
 type BackendCoord = (i32, i32);
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
 
 /// What went wrong making a plot.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -252,19 +252,9 @@ pub struct Plot {
     pub series: Vec<Series>,
 }
 
-/// The bundled font, registered once as plotters' "sans-serif".
-static FONT: &[u8] = include_bytes!("../fonts/DejaVuSans.ttf");
-
+/// Registers the bundled font (streaks-stereo's DejaVu Sans) as plotters' "sans-serif".
 fn register_font() -> Result<(), PlotError> {
-    static REGISTERED: OnceLock<bool> = OnceLock::new();
-    let ok = *REGISTERED.get_or_init(|| {
-        plotters::style::register_font("sans-serif", FontStyle::Normal, FONT).is_ok()
-    });
-    if ok {
-        Ok(())
-    } else {
-        Err(PlotError::Font)
-    }
+    streaks_stereo::font::register_sans_serif().map_err(|_| PlotError::Font)
 }
 
 const MARGIN: u32 = 20;
@@ -520,22 +510,9 @@ impl Plot {
     /// Renders the plot and writes it as PNG to `path`, atomically.
     pub fn write_png(&self, path: &Path) -> Result<(), PlotError> {
         let img = self.render()?;
-        let tmp = path.with_extension("png.tmp");
-        let write = || -> Result<(), String> {
-            let file = std::fs::File::create(&tmp).map_err(|e| e.to_string())?;
-            let mut out = std::io::BufWriter::new(file);
-            img.write_to(&mut out, image::ImageFormat::Png)
-                .map_err(|e| e.to_string())?;
-            let file = out.into_inner().map_err(|e| e.to_string())?;
-            file.sync_all().map_err(|e| e.to_string())?;
-            std::fs::rename(&tmp, path).map_err(|e| e.to_string())
-        };
-        write().map_err(|reason| {
-            let _ = std::fs::remove_file(&tmp);
-            PlotError::Write {
-                path: path.to_path_buf(),
-                reason,
-            }
+        streaks_stereo::image::write_png_atomic(path, &img).map_err(|e| PlotError::Write {
+            path: path.to_path_buf(),
+            reason: e.to_string(),
         })
     }
 }

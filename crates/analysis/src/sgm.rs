@@ -615,18 +615,7 @@ pub fn write_disparity_png(
     disp: &GrayImage,
     range: Option<(f32, f32)>,
 ) -> Result<(), ImageError> {
-    let tmp = path.with_extension("png.tmp");
-    let result = disparity_preview(disp, range)
-        .save_with_format(&tmp, image::ImageFormat::Png)
-        .map_err(|e| e.to_string())
-        .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| e.to_string()));
-    result.map_err(|reason| {
-        let _ = std::fs::remove_file(&tmp);
-        ImageError::Write {
-            path: path.to_path_buf(),
-            reason,
-        }
-    })
+    streaks_stereo::image::write_png_atomic(path, &disparity_preview(disp, range))
 }
 
 /// Google's turbo colour map (the polynomial approximation by Mikhailov, 2019).

@@ -69,7 +69,6 @@ impl SynthPair {
     pub fn save(&self, dir: &Path) -> Result<(), ImageError> {
         for (name, img) in [("left.png", &self.left), ("right.png", &self.right)] {
             let path = dir.join(name);
-            let tmp = dir.join(format!("{name}.tmp"));
             let buf = ::image::ImageBuffer::<::image::Luma<u16>, Vec<u16>>::from_fn(
                 img.width as u32,
                 img.height as u32,
@@ -78,13 +77,7 @@ impl SynthPair {
                     ::image::Luma([(v * 65535.0).round() as u16])
                 },
             );
-            buf.save_with_format(&tmp, ::image::ImageFormat::Png)
-                .map_err(|e| e.to_string())
-                .and_then(|()| std::fs::rename(&tmp, &path).map_err(|e| e.to_string()))
-                .map_err(|reason| {
-                    let _ = std::fs::remove_file(&tmp);
-                    ImageError::Write { path, reason }
-                })?;
+            streaks_stereo::image::write_png_atomic(&path, &buf)?;
         }
         write_pfm(&dir.join("disparity_left.pfm"), &self.disparity)
     }

@@ -48,7 +48,7 @@ impl RgbImage {
 #[derive(Debug, thiserror::Error)]
 pub enum OutputError {
     /// Creating, writing or renaming a file failed.
-    #[error("cannot write {path}: {source}")]
+    #[error("cannot write {path}")]
     Io {
         /// The destination.
         path: PathBuf,
@@ -56,7 +56,7 @@ pub enum OutputError {
         source: std::io::Error,
     },
     /// The EXR encoder or decoder failed (also: the file is not an EXR).
-    #[error("EXR error in {path}: {source}")]
+    #[error("EXR error in {path}")]
     Exr {
         /// The file.
         path: PathBuf,
@@ -64,7 +64,7 @@ pub enum OutputError {
         source: exr::error::Error,
     },
     /// The PNG encoder failed.
-    #[error("PNG error in {path}: {source}")]
+    #[error("PNG error in {path}")]
     Png {
         /// The file.
         path: PathBuf,

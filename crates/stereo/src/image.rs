@@ -125,7 +125,7 @@ impl GrayImage {
 
     /// Writes the image as an 8-bit greyscale PNG (see [`GrayImage::to_gray8`]), atomically.
     pub fn save_png(&self, path: &Path) -> Result<(), ImageError> {
-        encode_and_write(path, &self.to_gray8())
+        write_png_atomic(path, &self.to_gray8())
     }
 
     /// Loads any image the `image` crate reads (PNG, JPEG, EXR; 8/16-bit or float) as luminance
@@ -167,10 +167,15 @@ pub fn write_file_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
 
 /// Encodes an 8-bit RGB image as PNG and writes it atomically.
 pub fn save_rgb8_png(path: &Path, img: &::image::RgbImage) -> Result<(), ImageError> {
-    encode_and_write(path, img)
+    write_png_atomic(path, img)
 }
 
-fn encode_and_write<P: ::image::PixelWithColorType, C: std::ops::Deref<Target = [P::Subpixel]>>(
+/// Encodes any `image` crate buffer (8- or 16-bit grey or colour) as PNG and writes it with
+/// [`write_file_atomic`]: the one way the stereo and analysis crates write PNG files.
+pub fn write_png_atomic<
+    P: ::image::PixelWithColorType,
+    C: std::ops::Deref<Target = [P::Subpixel]>,
+>(
     path: &Path,
     img: &::image::ImageBuffer<P, C>,
 ) -> Result<(), ImageError>

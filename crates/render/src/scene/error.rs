@@ -14,7 +14,7 @@ pub enum SceneError {
         path: PathBuf,
     },
     /// The file (or one it refers to) could not be read.
-    #[error("{path}: cannot read {element}: {source}")]
+    #[error("{path}: cannot read {element}")]
     Io {
         /// The scene file.
         path: PathBuf,
@@ -24,7 +24,7 @@ pub enum SceneError {
         source: std::io::Error,
     },
     /// The glTF JSON or GLB container is malformed or fails validation.
-    #[error("{path}: invalid glTF: {source}")]
+    #[error("{path}: invalid glTF")]
     Gltf {
         /// The file.
         path: PathBuf,
@@ -32,7 +32,7 @@ pub enum SceneError {
         source: gltf::Error,
     },
     /// The OBJ file could not be parsed.
-    #[error("{path}: invalid OBJ: {source}")]
+    #[error("{path}: invalid OBJ")]
     Obj {
         /// The file.
         path: PathBuf,

@@ -1,0 +1,956 @@
+//! Export of a [`Scene`] to Mitsuba 3 (XML `version="3.0.0"` with binary PLY meshes and EXR
+//! textures), so that the reference renderer can render the same picture as ours.
+//!
+//! [`export`] builds a [`MitsubaExport`] in memory (the XML text, one [`PlyMesh`] per material
+//! group, the baked textures and the list of warnings); [`MitsubaExport::write`] writes it to a
+//! folder (`scene.xml`, `meshes/*.ply`, `textures/*.exr`), each file through a temporary file
+//! and a rename.
+//!
+//! # Mapping (DESIGN.md, "Mitsuba 3 as the reference")
+//!
+//! | ours | Mitsuba 3 | exact? |
+//! |---|---|---|
+//! | point light (W/sr) | `point`, same `intensity` | yes; glTF `range` is ignored (warning) |
+//! | spot light | `spot`, `intensity`, `cutoff_angle` = outer, `beam_width` = inner (degrees) | no: Mitsuba's falloff is linear in angle, glTF's smooth in cosine (warning) |
+//! | directional light | `directional`, same `irradiance` | yes |
+//! | emissive material | its mesh gets an `area` emitter of the same `radiance` | yes for one-sided emission; `doubleSided` emission is one-sided in Mitsuba (warning) |
+//! | `ggx` | `blendbsdf` weight 0.5 of `diffuse` (reflectance 2 kd) and `roughconductor` (ggx, material none, alpha, specular_reflectance 2 ks) | yes |
+//! | `ward` | the same blend with `beckmann` and the same alpha | no (warning) |
+//! | `blinn_phong` | the same blend with `beckmann`, alpha = sqrt(2 / (s + 2)) | no (warning) |
+//! | glTF metallic-roughness | `principled` (base_color, metallic, roughness) | no: different Fresnel and diffuse models (warning); metallicRoughnessTexture ignored (warning) |
+//! | diffuse | `diffuse` | yes |
+//! | kd / base colour / emission texture | `bitmap` (an EXR of texture x factor, so the factor is baked in) | yes (bilinear, repeat) |
+//! | wet/dry map ([`Wetness`](crate::material::Wetness)) | the wet `alpha` and `ks` everywhere | no (warning) |
+//! | double-sided material | BSDF wrapped in `twosided` | yes |
+//! | camera | `perspective`, `fov_axis` y, `fov` in degrees, `to_world` as a `lookat` | yes |
+//! | film, filter | `hdrfilm` (rgb, float32) with a `box` filter | yes |
+//! | integrator | `path` with the same `max_depth` | yes (Russian roulette differs: unbiased either way) |
+//! | sampler | `independent` with `sample_count` and `seed` | noise differs, expectation the same |
+//!
+//! Mitsuba's camera looks along +Z in its local frame with +X to the *left*; `lookat` with our
+//! camera's origin, a target along its -Z and its +Y as up gives the same picture as ours
+//! (checked by rendering: see tools/mitsuba/README.md).
+
+use crate::camera::Camera;
+use crate::light::Light;
+use crate::material::{Material, PaperModel, Reflectance};
+use crate::output::{write_atomically, OutputError, WriteFailure};
+use crate::scene::{Scene, SceneError};
+use crate::texture::{Texture, TextureId};
+use glam::{Vec2, Vec3};
+use std::collections::HashMap;
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Errors of the Mitsuba export.
+#[derive(Debug, thiserror::Error)]
+pub enum MitsubaError {
+    /// The scene has no camera of the requested name (or no camera at all).
+    #[error(transparent)]
+    Camera(#[from] SceneError),
+    /// An option is out of range.
+    #[error("invalid export option: {0}")]
+    InvalidOption(String),
+    /// A material refers to a texture the scene does not have.
+    #[error("{file}: material {material:?} refers to texture {texture}, which does not exist")]
+    MissingTexture {
+        /// The scene file.
+        file: PathBuf,
+        /// The material's name.
+        material: String,
+        /// The texture index.
+        texture: TextureId,
+    },
+    /// Creating the output folder failed.
+    #[error("cannot create {path}")]
+    Io {
+        /// The folder.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// Writing a file failed.
+    #[error(transparent)]
+    Output(#[from] OutputError),
+}
+
+/// Render settings written into the Mitsuba scene (the same as `streaks render`'s).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExportOptions {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Samples per pixel.
+    pub spp: u32,
+    /// Maximum path depth, Mitsuba's meaning (1: emitters only, 2: direct light, ...).
+    pub max_depth: u32,
+    /// Sampler seed.
+    pub seed: u32,
+    /// Camera name (`None`: the first camera).
+    pub camera: Option<String>,
+}
+
+/// A triangle mesh in a binary little-endian PLY file (positions, normals, uvs).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlyMesh {
+    /// File name relative to the export folder (e.g. `meshes/road.ply`).
+    pub file_name: String,
+    /// Vertex positions (world space).
+    pub positions: Vec<Vec3>,
+    /// Unit vertex normals.
+    pub normals: Vec<Vec3>,
+    /// Texture coordinates (glTF convention, (0, 0) at the image's top-left).
+    pub uvs: Vec<Vec2>,
+    /// Vertex indices of each triangle.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl PlyMesh {
+    /// The PLY file's bytes: an ASCII header, then `float x y z nx ny nz u v` per vertex and
+    /// `uchar 3, int i j k` per face, little-endian.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut out =
+            Vec::with_capacity(256 + self.positions.len() * 32 + self.triangles.len() * 13);
+        let header = format!(
+            "ply\nformat binary_little_endian 1.0\ncomment written by streaks export-mitsuba\n\
+             element vertex {}\nproperty float x\nproperty float y\nproperty float z\n\
+             property float nx\nproperty float ny\nproperty float nz\n\
+             property float u\nproperty float v\n\
+             element face {}\nproperty list uchar int vertex_indices\nend_header\n",
+            self.positions.len(),
+            self.triangles.len()
+        );
+        out.extend_from_slice(header.as_bytes());
+        for ((p, n), uv) in self.positions.iter().zip(&self.normals).zip(&self.uvs) {
+            for v in [p.x, p.y, p.z, n.x, n.y, n.z, uv.x, uv.y] {
+                out.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+        for t in &self.triangles {
+            out.push(3);
+            for &i in t {
+                out.extend_from_slice(&(i as i32).to_le_bytes());
+            }
+        }
+        out
+    }
+}
+
+/// A texture multiplied by a constant factor, written as a linear float EXR for a `bitmap`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BakedTexture {
+    /// File name relative to the export folder (e.g. `textures/mat0_kd.exr`).
+    pub file_name: String,
+    /// Width in texels.
+    pub width: u32,
+    /// Height in texels.
+    pub height: u32,
+    /// Row-major linear RGB texels, top row first.
+    pub texels: Vec<Vec3>,
+}
+
+/// A Mitsuba scene ready to be written: the XML, its meshes and textures, and the warnings
+/// about every approximation made.
+#[derive(Clone, Debug)]
+pub struct MitsubaExport {
+    /// The scene XML (`scene.xml`).
+    pub xml: String,
+    /// One mesh per material that has triangles.
+    pub meshes: Vec<PlyMesh>,
+    /// Textures referenced by `bitmap` elements.
+    pub textures: Vec<BakedTexture>,
+    /// Every approximation, one sentence each.
+    pub warnings: Vec<String>,
+}
+
+impl MitsubaExport {
+    /// Writes `scene.xml`, `meshes/*.ply` and `textures/*.exr` into `dir` (created if needed).
+    /// Each file is written to a temporary file in its folder and renamed.
+    pub fn write(&self, dir: &Path) -> Result<(), MitsubaError> {
+        for sub in ["meshes", "textures"] {
+            let d = dir.join(sub);
+            std::fs::create_dir_all(&d).map_err(|source| MitsubaError::Io { path: d, source })?;
+        }
+        for mesh in &self.meshes {
+            write_bytes(&dir.join(&mesh.file_name), &mesh.to_bytes())?;
+        }
+        for tex in &self.textures {
+            write_texture_exr(&dir.join(&tex.file_name), tex)?;
+        }
+        Ok(write_bytes(&dir.join("scene.xml"), self.xml.as_bytes())?)
+    }
+}
+
+fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
+    write_atomically(path, |w| w.write_all(bytes).map_err(WriteFailure::Io))
+}
+
+fn write_texture_exr(path: &Path, tex: &BakedTexture) -> Result<(), OutputError> {
+    use exr::prelude::{Image, SpecificChannels, WritableImage};
+    let w = tex.width as usize;
+    let image = Image::from_channels(
+        (w, tex.height as usize),
+        SpecificChannels::rgb(|pos: exr::math::Vec2<usize>| {
+            let t = tex.texels[pos.y() * w + pos.x()];
+            (t.x, t.y, t.z)
+        }),
+    );
+    write_atomically(path, |out| {
+        image.write().to_buffered(out).map_err(WriteFailure::Exr)
+    })
+}
+
+/// The parts of a scene the exporter reads (everything but the BVH).
+pub(crate) struct SceneParts<'a> {
+    pub(crate) source: &'a Path,
+    pub(crate) positions: &'a [Vec3],
+    pub(crate) normals: &'a [Vec3],
+    pub(crate) uvs: &'a [Vec2],
+    pub(crate) triangles: &'a [[u32; 3]],
+    pub(crate) triangle_materials: &'a [u32],
+    pub(crate) materials: &'a [Material],
+    pub(crate) textures: &'a [Texture],
+    pub(crate) lights: &'a [Light],
+}
+
+/// Converts `scene` to Mitsuba 3 with the render settings `opts`.
+pub fn export(scene: &Scene, opts: &ExportOptions) -> Result<MitsubaExport, MitsubaError> {
+    export_parts(
+        &SceneParts {
+            source: &scene.source,
+            positions: &scene.positions,
+            normals: &scene.normals,
+            uvs: &scene.uvs,
+            triangles: &scene.triangles,
+            triangle_materials: &scene.triangle_materials,
+            materials: &scene.materials,
+            textures: &scene.textures,
+            lights: &scene.lights,
+        },
+        scene.camera(opts.camera.as_deref())?,
+        opts,
+    )
+}
+
+/// Escapes text for an XML attribute value.
+fn esc(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&apos;"),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// A file-name-safe version of a material name.
+fn file_stem(index: usize, name: &str) -> String {
+    let clean: String = name
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+        .take(40)
+        .collect();
+    format!("m{index}_{clean}")
+}
+
+fn v3(v: Vec3) -> String {
+    format!("{:?}, {:?}, {:?}", v.x, v.y, v.z)
+}
+
+fn rgb(name: &str, v: Vec3) -> String {
+    format!(
+        "<rgb name=\"{name}\" value=\"{:?}, {:?}, {:?}\"/>",
+        v.x, v.y, v.z
+    )
+}
+
+/// Context for one material's conversion: collects warnings and baked textures.
+struct MaterialWriter<'a> {
+    parts: &'a SceneParts<'a>,
+    warnings: &'a mut Vec<String>,
+    textures: &'a mut Vec<BakedTexture>,
+}
+
+impl MaterialWriter<'_> {
+    /// A colour parameter: an `rgb`, or a `bitmap` of `texture x factor`.
+    fn colour(
+        &mut self,
+        material: &Material,
+        stem: &str,
+        name: &str,
+        factor: Vec3,
+        texture: Option<TextureId>,
+    ) -> Result<String, MitsubaError> {
+        let Some(id) = texture else {
+            return Ok(rgb(name, factor));
+        };
+        let tex =
+            self.parts
+                .textures
+                .get(id as usize)
+                .ok_or_else(|| MitsubaError::MissingTexture {
+                    file: self.parts.source.to_path_buf(),
+                    material: material.name.clone(),
+                    texture: id,
+                })?;
+        let file_name = format!("textures/{stem}_{name}.exr");
+        self.textures.push(BakedTexture {
+            file_name: file_name.clone(),
+            width: tex.width,
+            height: tex.height,
+            texels: tex.texels.iter().map(|t| t.truncate() * factor).collect(),
+        });
+        Ok(format!(
+            "<texture type=\"bitmap\" name=\"{name}\">\
+             <string name=\"filename\" value=\"{}\"/>\
+             <string name=\"filter_type\" value=\"bilinear\"/>\
+             <string name=\"wrap_mode\" value=\"repeat\"/>\
+             <boolean name=\"raw\" value=\"true\"/></texture>",
+            esc(&file_name)
+        ))
+    }
+
+    /// The `<bsdf>` element of a material.
+    fn bsdf(&mut self, index: usize, m: &Material) -> Result<String, MitsubaError> {
+        let stem = file_stem(index, &m.name);
+        let mut out = String::new();
+        match &m.reflectance {
+            Reflectance::Diffuse { kd, kd_texture } => {
+                let refl = self.colour(m, &stem, "reflectance", *kd, *kd_texture)?;
+                let _ = write!(out, "<bsdf type=\"diffuse\">{refl}</bsdf>");
+            }
+            Reflectance::Paper {
+                model,
+                kd,
+                ks,
+                alpha,
+                shininess,
+                kd_texture,
+                wetness,
+            } => {
+                let (distribution, a) = match model {
+                    PaperModel::Ggx => ("ggx", *alpha),
+                    PaperModel::Ward => {
+                        self.warnings.push(format!(
+                            "material {:?}: Mitsuba has no Ward model; exported as a beckmann \
+                             roughconductor with the same alpha ({alpha}) (approximation)",
+                            m.name
+                        ));
+                        ("beckmann", *alpha)
+                    }
+                    PaperModel::BlinnPhong => {
+                        let a = (2.0 / (shininess + 2.0)).sqrt();
+                        self.warnings.push(format!(
+                            "material {:?}: Mitsuba has no Blinn-Phong model; exported as a \
+                             beckmann roughconductor with alpha = sqrt(2/(s+2)) = {a} \
+                             (approximation)",
+                            m.name
+                        ));
+                        ("beckmann", a)
+                    }
+                };
+                if wetness.is_some() {
+                    self.warnings.push(format!(
+                        "material {:?}: the wet/dry map is not exported; the wet alpha and ks \
+                         are used everywhere (dry patches will differ)",
+                        m.name
+                    ));
+                }
+                let diffuse = self.colour(m, &stem, "reflectance", 2.0 * *kd, *kd_texture)?;
+                let _ = write!(
+                    out,
+                    "<bsdf type=\"blendbsdf\"><float name=\"weight\" value=\"0.5\"/>\
+                     <bsdf type=\"diffuse\">{diffuse}</bsdf>\
+                     <bsdf type=\"roughconductor\">\
+                     <string name=\"distribution\" value=\"{distribution}\"/>\
+                     <string name=\"material\" value=\"none\"/>\
+                     <float name=\"alpha\" value=\"{a:?}\"/>{}</bsdf></bsdf>",
+                    rgb("specular_reflectance", 2.0 * *ks)
+                );
+            }
+            Reflectance::GltfPbr {
+                base_color,
+                base_color_texture,
+                metallic,
+                roughness,
+                metallic_roughness_texture,
+            } => {
+                self.warnings.push(format!(
+                    "material {:?}: glTF metallic-roughness exported as Mitsuba's principled BSDF \
+                     (different Fresnel, diffuse and multiple-scattering terms: approximation)",
+                    m.name
+                ));
+                if metallic_roughness_texture.is_some() {
+                    self.warnings.push(format!(
+                        "material {:?}: metallicRoughnessTexture is not exported; the factors \
+                         metallic = {metallic}, roughness = {roughness} are used everywhere",
+                        m.name
+                    ));
+                }
+                let base = self.colour(m, &stem, "base_color", *base_color, *base_color_texture)?;
+                let _ = write!(
+                    out,
+                    "<bsdf type=\"principled\">{base}\
+                     <float name=\"metallic\" value=\"{metallic:?}\"/>\
+                     <float name=\"roughness\" value=\"{roughness:?}\"/></bsdf>"
+                );
+            }
+        }
+        if m.double_sided {
+            out = format!("<bsdf type=\"twosided\">{out}</bsdf>");
+        }
+        Ok(out)
+    }
+}
+
+/// The light elements for the non-triangle lights.
+fn light_xml(light: &Light, warnings: &mut Vec<String>) -> Option<String> {
+    match *light {
+        Light::Point {
+            position,
+            intensity,
+            range,
+        } => {
+            if range.is_some() {
+                warnings.push(format!(
+                    "point light at {position}: glTF range is not exported (Mitsuba's point \
+                     light has no range)"
+                ));
+            }
+            Some(format!(
+                "<emitter type=\"point\"><point name=\"position\" value=\"{}\"/>{}</emitter>",
+                v3(position),
+                rgb("intensity", intensity)
+            ))
+        }
+        Light::Spot {
+            position,
+            direction,
+            intensity,
+            cos_inner,
+            cos_outer,
+            range,
+        } => {
+            warnings.push(format!(
+                "spot light at {position}: Mitsuba's spot falloff is linear in angle between \
+                 beam_width and cutoff_angle, glTF's is smooth in cosine (approximation)"
+            ));
+            if range.is_some() {
+                warnings.push(format!(
+                    "spot light at {position}: glTF range is not exported"
+                ));
+            }
+            let outer = cos_outer.clamp(-1.0, 1.0).acos().to_degrees();
+            let inner = cos_inner.clamp(-1.0, 1.0).acos().to_degrees().min(outer);
+            let up = if direction.y.abs() < 0.9 {
+                Vec3::Y
+            } else {
+                Vec3::X
+            };
+            Some(format!(
+                "<emitter type=\"spot\"><transform name=\"to_world\">\
+                 <lookat origin=\"{}\" target=\"{}\" up=\"{}\"/></transform>{}\
+                 <float name=\"cutoff_angle\" value=\"{outer:?}\"/>\
+                 <float name=\"beam_width\" value=\"{inner:?}\"/></emitter>",
+                v3(position),
+                v3(position + direction),
+                v3(up),
+                rgb("intensity", intensity)
+            ))
+        }
+        Light::Directional {
+            direction,
+            irradiance,
+        } => Some(format!(
+            "<emitter type=\"directional\"><vector name=\"direction\" value=\"{}\"/>{}</emitter>",
+            v3(direction),
+            rgb("irradiance", irradiance)
+        )),
+        Light::Triangle { .. } => None,
+    }
+}
+
+/// The `<sensor>` element: our camera as a Mitsuba `perspective` camera.
+fn sensor_xml(cam: &Camera, opts: &ExportOptions) -> String {
+    let origin = cam.position();
+    let forward = cam
+        .world_from_camera
+        .transform_vector3(-Vec3::Z)
+        .normalize();
+    let up = cam.world_from_camera.transform_vector3(Vec3::Y).normalize();
+    format!(
+        "<sensor type=\"perspective\">\
+         <string name=\"fov_axis\" value=\"y\"/>\
+         <float name=\"fov\" value=\"{:?}\"/>\
+         <transform name=\"to_world\"><lookat origin=\"{}\" target=\"{}\" up=\"{}\"/></transform>\
+         <sampler type=\"independent\"><integer name=\"sample_count\" value=\"{}\"/>\
+         <integer name=\"seed\" value=\"{}\"/></sampler>\
+         <film type=\"hdrfilm\"><integer name=\"width\" value=\"{}\"/>\
+         <integer name=\"height\" value=\"{}\"/>\
+         <string name=\"pixel_format\" value=\"rgb\"/>\
+         <string name=\"component_format\" value=\"float32\"/>\
+         <rfilter type=\"box\"/></film></sensor>",
+        cam.yfov.to_degrees(),
+        v3(origin),
+        v3(origin + forward),
+        v3(up),
+        opts.spp,
+        opts.seed,
+        opts.width,
+        opts.height
+    )
+}
+
+/// Splits the triangle soup into one mesh per material, with compact vertex arrays.
+fn meshes_by_material(parts: &SceneParts<'_>) -> Vec<(usize, PlyMesh)> {
+    let mut groups: Vec<Option<(HashMap<u32, u32>, PlyMesh)>> =
+        (0..parts.materials.len()).map(|_| None).collect();
+    for (tri, &mat) in parts.triangles.iter().zip(parts.triangle_materials) {
+        let Some(slot) = groups.get_mut(mat as usize) else {
+            continue;
+        };
+        let (remap, mesh) = slot.get_or_insert_with(|| {
+            (
+                HashMap::new(),
+                PlyMesh {
+                    file_name: format!(
+                        "meshes/{}.ply",
+                        file_stem(mat as usize, &parts.materials[mat as usize].name)
+                    ),
+                    positions: Vec::new(),
+                    normals: Vec::new(),
+                    uvs: Vec::new(),
+                    triangles: Vec::new(),
+                },
+            )
+        });
+        let mut local = [0u32; 3];
+        for (k, &v) in tri.iter().enumerate() {
+            local[k] = *remap.entry(v).or_insert_with(|| {
+                let i = v as usize;
+                mesh.positions.push(parts.positions[i]);
+                mesh.normals
+                    .push(parts.normals.get(i).copied().unwrap_or(Vec3::ZERO));
+                mesh.uvs
+                    .push(parts.uvs.get(i).copied().unwrap_or(Vec2::ZERO));
+                (mesh.positions.len() - 1) as u32
+            });
+        }
+        mesh.triangles.push(local);
+    }
+    groups
+        .into_iter()
+        .enumerate()
+        .filter_map(|(i, g)| g.map(|(_, mesh)| (i, mesh)))
+        .collect()
+}
+
+/// [`export`] on the parts of a scene, with the camera already chosen.
+pub(crate) fn export_parts(
+    parts: &SceneParts<'_>,
+    camera: &Camera,
+    opts: &ExportOptions,
+) -> Result<MitsubaExport, MitsubaError> {
+    if opts.width == 0 || opts.height == 0 || opts.spp == 0 || opts.max_depth == 0 {
+        return Err(MitsubaError::InvalidOption(format!(
+            "width, height, spp and max_depth must be positive (got {}x{}, {} spp, depth {})",
+            opts.width, opts.height, opts.spp, opts.max_depth
+        )));
+    }
+    let mut warnings = Vec::new();
+    let mut textures = Vec::new();
+    let mut xml = String::new();
+    let _ = writeln!(
+        xml,
+        "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n\
+         <!-- Exported by streaks export-mitsuba from {} -->\n<scene version=\"3.0.0\">",
+        esc(&parts.source.display().to_string()).replace("--", "- -")
+    );
+    let _ = writeln!(
+        xml,
+        "<integrator type=\"path\"><integer name=\"max_depth\" value=\"{}\"/></integrator>",
+        opts.max_depth
+    );
+    let _ = writeln!(xml, "{}", sensor_xml(camera, opts));
+    for light in parts.lights {
+        if let Some(e) = light_xml(light, &mut warnings) {
+            let _ = writeln!(xml, "{e}");
+        }
+    }
+    let meshes = meshes_by_material(parts);
+    let mut mw = MaterialWriter {
+        parts,
+        warnings: &mut warnings,
+        textures: &mut textures,
+    };
+    for (index, mesh) in &meshes {
+        let m = &parts.materials[*index];
+        let bsdf = mw.bsdf(*index, m)?;
+        let mut emitter = String::new();
+        if m.is_emissive() {
+            if m.double_sided {
+                mw.warnings.push(format!(
+                    "material {:?}: doubleSided emission; Mitsuba's area emitters are one-sided \
+                     (only the front face emits)",
+                    m.name
+                ));
+            }
+            let stem = file_stem(*index, &m.name);
+            let radiance = mw.colour(m, &stem, "radiance", m.emission, m.emission_texture)?;
+            emitter = format!("<emitter type=\"area\">{radiance}</emitter>");
+        }
+        let _ = writeln!(
+            xml,
+            "<shape type=\"ply\"><string name=\"filename\" value=\"{}\"/>\
+             <boolean name=\"face_normals\" value=\"false\"/>{bsdf}{emitter}</shape>",
+            esc(&mesh.file_name)
+        );
+    }
+    xml.push_str("</scene>\n");
+    Ok(MitsubaExport {
+        xml,
+        meshes: meshes.into_iter().map(|(_, m)| m).collect(),
+        textures,
+        warnings,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::Wetness;
+    use glam::{Affine3A, Vec4};
+
+    fn mat(name: &str, reflectance: Reflectance, emission: Vec3) -> Material {
+        Material {
+            name: name.into(),
+            reflectance,
+            emission,
+            emission_texture: None,
+            double_sided: false,
+        }
+    }
+
+    struct Fixture {
+        positions: Vec<Vec3>,
+        normals: Vec<Vec3>,
+        uvs: Vec<Vec2>,
+        triangles: Vec<[u32; 3]>,
+        triangle_materials: Vec<u32>,
+        materials: Vec<Material>,
+        textures: Vec<Texture>,
+        lights: Vec<Light>,
+        cameras: Vec<Camera>,
+    }
+
+    impl Fixture {
+        fn new() -> Self {
+            // Two quads (road at y = 0, lamp at y = 3) and a wall triangle.
+            let positions = vec![
+                Vec3::new(-1.0, 0.0, -1.0),
+                Vec3::new(1.0, 0.0, -1.0),
+                Vec3::new(1.0, 0.0, 1.0),
+                Vec3::new(-1.0, 0.0, 1.0),
+                Vec3::new(0.0, 3.0, 0.0),
+                Vec3::new(0.1, 3.0, 0.0),
+                Vec3::new(0.0, 3.0, 0.1),
+                Vec3::new(0.0, 0.0, -2.0),
+                Vec3::new(1.0, 0.0, -2.0),
+                Vec3::new(0.0, 1.0, -2.0),
+            ];
+            let n = positions.len();
+            let ggx = Reflectance::Paper {
+                model: PaperModel::Ggx,
+                kd: Vec3::splat(0.05),
+                ks: Vec3::splat(0.04),
+                alpha: 0.1,
+                shininess: 0.0,
+                kd_texture: Some(0),
+                wetness: Some(Wetness {
+                    texture: 0,
+                    alpha_dry: 0.5,
+                    ks_dry: Vec3::splat(0.02),
+                }),
+            };
+            let lamp = Reflectance::Diffuse {
+                kd: Vec3::ZERO,
+                kd_texture: None,
+            };
+            let wall = Reflectance::Paper {
+                model: PaperModel::Ward,
+                kd: Vec3::splat(0.3),
+                ks: Vec3::splat(0.1),
+                alpha: 0.2,
+                shininess: 0.0,
+                kd_texture: None,
+                wetness: None,
+            };
+            Fixture {
+                positions,
+                normals: vec![Vec3::Y; n],
+                uvs: vec![Vec2::new(0.25, 0.75); n],
+                triangles: vec![[0, 2, 1], [0, 3, 2], [4, 6, 5], [7, 8, 9]],
+                triangle_materials: vec![0, 0, 1, 2],
+                materials: vec![
+                    mat("road & <wet>", ggx, Vec3::ZERO),
+                    mat("lamp", lamp, Vec3::new(10.0, 9.0, 8.0)),
+                    mat("wall", wall, Vec3::ZERO),
+                ],
+                textures: vec![Texture {
+                    width: 2,
+                    height: 1,
+                    texels: vec![Vec4::new(1.0, 0.5, 0.25, 1.0), Vec4::ONE],
+                }],
+                lights: vec![
+                    Light::Point {
+                        position: Vec3::new(0.0, 5.0, -3.0),
+                        intensity: Vec3::new(100.0, 90.0, 80.0),
+                        range: None,
+                    },
+                    Light::Spot {
+                        position: Vec3::new(2.0, 5.0, 0.0),
+                        direction: Vec3::NEG_Y,
+                        intensity: Vec3::splat(50.0),
+                        cos_inner: 0.9,
+                        cos_outer: 0.8,
+                        range: Some(20.0),
+                    },
+                    Light::Triangle { triangle: 2 },
+                ],
+                cameras: vec![Camera {
+                    name: "cam".into(),
+                    world_from_camera: Affine3A::from_translation(Vec3::new(0.0, 1.5, 4.0)),
+                    yfov: 0.7,
+                    aspect_ratio: None,
+                }],
+            }
+        }
+
+        fn parts(&self) -> SceneParts<'_> {
+            SceneParts {
+                source: Path::new("test.gltf"),
+                positions: &self.positions,
+                normals: &self.normals,
+                uvs: &self.uvs,
+                triangles: &self.triangles,
+                triangle_materials: &self.triangle_materials,
+                materials: &self.materials,
+                textures: &self.textures,
+                lights: &self.lights,
+            }
+        }
+    }
+
+    fn opts() -> ExportOptions {
+        ExportOptions {
+            width: 64,
+            height: 48,
+            spp: 16,
+            max_depth: 5,
+            seed: 7,
+            camera: Some("cam".into()),
+        }
+    }
+
+    fn floats(s: &str) -> Vec<f32> {
+        s.split(',').map(|x| x.trim().parse().unwrap()).collect()
+    }
+
+    #[test]
+    fn xml_is_well_formed_and_has_the_mapped_elements() {
+        let fx = Fixture::new();
+        let ex = export_parts(&fx.parts(), &fx.cameras[0], &opts()).unwrap();
+        let doc = roxmltree::Document::parse(&ex.xml).unwrap();
+        let root = doc.root_element();
+        assert_eq!(root.tag_name().name(), "scene");
+        assert_eq!(root.attribute("version"), Some("3.0.0"));
+        let find = |tag: &str, ty: &str| {
+            doc.descendants()
+                .filter(|n| n.has_tag_name(tag) && n.attribute("type") == Some(ty))
+                .collect::<Vec<_>>()
+        };
+        let param = |n: roxmltree::Node, name: &str| {
+            n.children()
+                .find(|c| c.attribute("name") == Some(name))
+                .and_then(|c| c.attribute("value"))
+                .map(str::to_owned)
+        };
+        let integ = find("integrator", "path")[0];
+        assert_eq!(param(integ, "max_depth").as_deref(), Some("5"));
+        let sensor = find("sensor", "perspective")[0];
+        assert_eq!(param(sensor, "fov_axis").as_deref(), Some("y"));
+        let fov: f32 = param(sensor, "fov").unwrap().parse().unwrap();
+        assert!((fov - 0.7f32.to_degrees()).abs() < 1e-4);
+        let lookat = sensor
+            .descendants()
+            .find(|n| n.has_tag_name("lookat"))
+            .unwrap();
+        assert_eq!(floats(lookat.attribute("origin").unwrap()), [0.0, 1.5, 4.0]);
+        assert_eq!(floats(lookat.attribute("target").unwrap()), [0.0, 1.5, 3.0]);
+        assert_eq!(floats(lookat.attribute("up").unwrap()), [0.0, 1.0, 0.0]);
+        let sampler = find("sampler", "independent")[0];
+        assert_eq!(param(sampler, "sample_count").as_deref(), Some("16"));
+        assert_eq!(param(sampler, "seed").as_deref(), Some("7"));
+        let film = find("film", "hdrfilm")[0];
+        assert_eq!(param(film, "width").as_deref(), Some("64"));
+        assert_eq!(param(film, "height").as_deref(), Some("48"));
+        assert_eq!(find("rfilter", "box").len(), 1);
+
+        let point = find("emitter", "point")[0];
+        assert_eq!(
+            floats(&param(point, "intensity").unwrap()),
+            [100.0, 90.0, 80.0]
+        );
+        let spot = find("emitter", "spot")[0];
+        let cutoff: f32 = param(spot, "cutoff_angle").unwrap().parse().unwrap();
+        let beam: f32 = param(spot, "beam_width").unwrap().parse().unwrap();
+        assert!((cutoff - 0.8f32.acos().to_degrees()).abs() < 1e-4);
+        assert!((beam - 0.9f32.acos().to_degrees()).abs() < 1e-4);
+
+        let shapes = find("shape", "ply");
+        assert_eq!(shapes.len(), 3);
+        // Road: blend of diffuse (bitmap of 2 kd) and a ggx roughconductor with 2 ks.
+        let blend = shapes[0]
+            .children()
+            .find(|c| c.has_tag_name("bsdf"))
+            .unwrap();
+        assert_eq!(blend.attribute("type"), Some("blendbsdf"));
+        assert_eq!(param(blend, "weight").as_deref(), Some("0.5"));
+        let cond = find("bsdf", "roughconductor");
+        assert_eq!(param(cond[0], "distribution").as_deref(), Some("ggx"));
+        assert_eq!(param(cond[0], "material").as_deref(), Some("none"));
+        assert_eq!(param(cond[0], "alpha").as_deref(), Some("0.1"));
+        assert_eq!(
+            floats(&param(cond[0], "specular_reflectance").unwrap()),
+            [0.08; 3]
+        );
+        assert_eq!(param(cond[1], "distribution").as_deref(), Some("beckmann"));
+        assert_eq!(find("texture", "bitmap").len(), 1);
+        assert_eq!(ex.textures.len(), 1);
+        assert_eq!(ex.textures[0].texels[0], Vec3::new(0.1, 0.05, 0.025));
+        // Lamp: an area emitter of the same radiance.
+        let area = find("emitter", "area");
+        assert_eq!(area.len(), 1);
+        assert_eq!(
+            floats(&param(area[0], "radiance").unwrap()),
+            [10.0, 9.0, 8.0]
+        );
+        // Warnings: wetness, Ward, spot falloff, spot range.
+        for needle in ["wet/dry", "Ward", "falloff", "range"] {
+            assert!(
+                ex.warnings.iter().any(|w| w.contains(needle)),
+                "no warning about {needle}: {:?}",
+                ex.warnings
+            );
+        }
+    }
+
+    #[test]
+    fn bad_options_are_errors() {
+        let fx = Fixture::new();
+        let mut o = opts();
+        o.spp = 0;
+        assert!(matches!(
+            export_parts(&fx.parts(), &fx.cameras[0], &o),
+            Err(MitsubaError::InvalidOption(_))
+        ));
+    }
+
+    /// Parses a PLY written by [`PlyMesh::to_bytes`] back (test-only reader).
+    fn read_ply(bytes: &[u8]) -> PlyMesh {
+        let end = b"end_header\n";
+        let h = bytes.windows(end.len()).position(|w| w == end).unwrap() + end.len();
+        let header = std::str::from_utf8(&bytes[..h]).unwrap();
+        assert!(header.starts_with("ply\nformat binary_little_endian 1.0\n"));
+        let count = |el: &str| -> usize {
+            header
+                .lines()
+                .find_map(|l| l.strip_prefix(&format!("element {el} ")))
+                .unwrap()
+                .parse()
+                .unwrap()
+        };
+        let (nv, nf) = (count("vertex"), count("face"));
+        let mut rest = &bytes[h..];
+        let mut f32s = |n: usize| -> Vec<f32> {
+            let v = rest[..4 * n]
+                .chunks(4)
+                .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+                .collect();
+            rest = &rest[4 * n..];
+            v
+        };
+        let verts = f32s(nv * 8);
+        let mut mesh = PlyMesh {
+            file_name: String::new(),
+            positions: Vec::new(),
+            normals: Vec::new(),
+            uvs: Vec::new(),
+            triangles: Vec::new(),
+        };
+        for v in verts.chunks(8) {
+            mesh.positions.push(Vec3::new(v[0], v[1], v[2]));
+            mesh.normals.push(Vec3::new(v[3], v[4], v[5]));
+            mesh.uvs.push(Vec2::new(v[6], v[7]));
+        }
+        for _ in 0..nf {
+            assert_eq!(rest[0], 3);
+            let i = |k: usize| i32::from_le_bytes(rest[1 + 4 * k..5 + 4 * k].try_into().unwrap());
+            mesh.triangles.push([i(0) as u32, i(1) as u32, i(2) as u32]);
+            rest = &rest[13..];
+        }
+        assert!(rest.is_empty());
+        mesh
+    }
+
+    #[test]
+    fn ply_round_trips_and_groups_by_material() {
+        let fx = Fixture::new();
+        let ex = export_parts(&fx.parts(), &fx.cameras[0], &opts()).unwrap();
+        assert_eq!(ex.meshes.len(), 3);
+        let road = &ex.meshes[0];
+        assert_eq!(road.positions.len(), 4);
+        assert_eq!(road.triangles.len(), 2);
+        let mut back = read_ply(&road.to_bytes());
+        back.file_name = road.file_name.clone();
+        assert_eq!(&back, road);
+        // The compact mesh reproduces the original triangles.
+        for (t, orig) in road.triangles.iter().zip(&fx.triangles[..2]) {
+            for k in 0..3 {
+                assert_eq!(
+                    road.positions[t[k] as usize],
+                    fx.positions[orig[k] as usize]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn write_creates_all_files() {
+        let fx = Fixture::new();
+        let ex = export_parts(&fx.parts(), &fx.cameras[0], &opts()).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        ex.write(dir.path()).unwrap();
+        assert!(dir.path().join("scene.xml").is_file());
+        for m in &ex.meshes {
+            assert!(dir.path().join(&m.file_name).is_file());
+        }
+        let tex = dir.path().join(&ex.textures[0].file_name);
+        let img = exr::prelude::read_first_rgba_layer_from_file(
+            &tex,
+            |res, _| vec![[0.0f32; 3]; res.width() * res.height()],
+            |px: &mut Vec<[f32; 3]>, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+                px[pos.y() * 2 + pos.x()] = [r, g, b];
+            },
+        )
+        .unwrap();
+        assert_eq!(img.layer_data.channel_data.pixels[0], [0.1, 0.05, 0.025]);
+    }
+}

@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# CI check: streaks render against Mitsuba 3 on scenes/crosscheck.gltf, with the noise test of
+# tools/mitsuba/README.md. Exits 0 on agreement, 1 on disagreement, 2 when it cannot run.
+# Environment: STREAKS (the binary; default target/debug/streaks, built with cargo build),
+# CROSSCHECK_SPP (default 64), CROSSCHECK_WIDTH/HEIGHT (default 160x120), CROSSCHECK_K (4).
+# Extra arguments go to crosscheck.py (e.g. another scene path).
+set -euo pipefail
+here="$(cd "$(dirname "$0")" && pwd)"
+repo="$(cd "$here/../.." && pwd)"
+cd "$repo"
+if ! python3 -c "import mitsuba" 2>/dev/null; then
+    echo "ci_check: mitsuba is not installed (pip install -r tools/mitsuba/requirements.txt)" >&2
+    exit 2
+fi
+if [ -z "${STREAKS:-}" ]; then
+    cargo build --bin streaks >&2
+fi
+streaks="${STREAKS:-$repo/target/debug/streaks}"
+exec python3 "$here/crosscheck.py" --ci --streaks "$streaks" \
+    --spp "${CROSSCHECK_SPP:-64}" --width "${CROSSCHECK_WIDTH:-160}" \
+    --height "${CROSSCHECK_HEIGHT:-120}" --k "${CROSSCHECK_K:-4}" \
+    --out "$repo/target/crosscheck/ci" "$@"
