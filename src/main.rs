@@ -3,12 +3,14 @@
 //! Each subcommand module exposes an `Args` struct (clap) and `run(args) -> anyhow::Result<()>`.
 //! Errors are printed with their whole chain and the process exits non-zero.
 
+mod analyze;
 mod compare;
 mod disparity;
 mod export_mitsuba;
 mod figure;
 mod lk;
 mod locus;
+mod paper;
 mod prepare;
 mod render;
 mod stereo;
@@ -31,6 +33,10 @@ enum Command {
     Render(render::Args),
     /// Render a rectified stereo pair with ground-truth disparity, depth and streak masks.
     Stereo(stereo::Args),
+    /// Analyse a stereo pair: streak disparity per row against Eq. 4, depth below the road.
+    Analyze(analyze::Args),
+    /// Reproduce the paper's Figs. 2-6 with our renderer and model, with an index.md.
+    Paper(paper::Args),
     /// Per-row 1D Lucas-Kanade disparity over a region (the paper's estimator).
     Lk(lk::Args),
     /// Dense disparity by semi-global matching (census cost), written as PFM.
@@ -56,6 +62,8 @@ fn main() -> ExitCode {
         Command::Prepare(args) => prepare::run(args),
         Command::Stereo(args) => stereo::run(args),
         Command::Render(args) => render::run(args),
+        Command::Analyze(args) => analyze::run(args),
+        Command::Paper(args) => paper::run(args),
         Command::Locus(args) => locus::run(args),
         Command::Figure(args) => figure::run(args),
         Command::ExportMitsuba(args) => export_mitsuba::run(args),

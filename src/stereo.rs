@@ -40,6 +40,9 @@ pub struct Args {
     /// Exposure of the PNGs in stops (linear * 2^EV before the sRGB curve).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
+    /// Then analyse the pair (as `streaks analyze OUTPUT`), writing OUTPUT/analysis/.
+    #[arg(long)]
+    pub analyze: bool,
 }
 
 /// Runs the subcommand.
@@ -110,5 +113,9 @@ pub fn run(args: Args) -> Result<()> {
         streak(1),
         args.output.display()
     );
+    if args.analyze {
+        let params = crate::analyze::Args::for_dir(&args.output).params();
+        crate::analyze::analyze_dir(&args.output, &params)?;
+    }
     Ok(())
 }

@@ -11,6 +11,8 @@
 //! - [`plot`]: line, scatter and arrow plots with labelled axes and legends, written
 //!   atomically to PNG (plotters, with a font bundled in the crate).
 //! - [`figures`]: the paper's figures made from the model (Fig. 4, Fig. 5).
+//! - [`report`]: the per-streak analysis of a rendered or photographed pair (Fig. 6, Fig. 8):
+//!   measured against predicted disparity per row, implied depths, plots and `report.json`.
 //!
 //! ```
 //! use glam::DVec3;
@@ -34,5 +36,6 @@ pub mod figures;
 pub mod lk;
 pub mod model;
 pub mod plot;
+pub mod report;
 pub mod sgm;
 pub mod synth;

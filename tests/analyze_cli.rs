@@ -1,0 +1,127 @@
+//! End-to-end tests of `streaks analyze` (on a tiny `streaks stereo` render of
+//! rainy_street_small) and `streaks paper` (at tiny sizes).
+
+mod common;
+
+use common::TestDir;
+use std::path::PathBuf;
+
+fn scenes() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes")
+}
+
+fn finite(v: &serde_json::Value) -> bool {
+    v.as_f64().is_some_and(f64::is_finite)
+}
+
+#[test]
+fn analyze_reports_streaks_matched_to_lights_with_depths_below_the_road() {
+    let t = TestDir::new();
+    let scene = scenes().join("rainy_street_small.gltf");
+    t.streaks(&[
+        "stereo",
+        scene.to_str().unwrap(),
+        "-o",
+        "out",
+        "--spp",
+        "4",
+        "--height",
+        "120",
+    ])
+    .assert_success();
+    let run = t.streaks(&["analyze", "out", "--region", "left_half=20,70,35,110"]);
+    run.assert_success();
+    assert!(run.stderr().contains("RMS px"), "{}", run.stderr());
+    let files = t.files_in("out/analysis");
+    for f in ["report.json", "depth.png", "side_view.png", "left_half.png"] {
+        assert!(files.contains(&f.to_string()), "{f} missing from {files:?}");
+    }
+    let text = std::fs::read_to_string(t.join("out/analysis/report.json")).unwrap();
+    let r: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(r["rig"]["height"], 120);
+    assert!((r["rig"]["baseline_m"].as_f64().unwrap() - 0.065).abs() < 1e-6);
+    let streaks = r["streaks"].as_array().unwrap();
+    assert!(!streaks.is_empty(), "no streak detected");
+    // At least one streak comes from a light: its Eq. 4 prediction is about f b / Z_L and its
+    // implied points lie below the road.
+    let matched: Vec<&serde_json::Value> =
+        streaks.iter().filter(|s| !s["light"].is_null()).collect();
+    assert!(!matched.is_empty(), "no streak matched to a light");
+    let f = r["rig"]["focal_px"].as_f64().unwrap();
+    for s in &matched {
+        let light_z = s["light"]["road"][2].as_f64().unwrap();
+        let c = &s["comparison"];
+        assert!(finite(&c["rms_px"]) && finite(&c["rms_deg"]), "{c}");
+        for row in s["rows"].as_array().unwrap() {
+            if let Some(p) = row["predicted_px"].as_f64() {
+                // The virtual light is within a few metres of the light's depth.
+                let z = f * 0.065 / p;
+                assert!((z - light_z).abs() < 0.3 * light_z, "{z} vs {light_z}");
+            }
+        }
+        assert!(s["median_road_y_m"].as_f64().unwrap() < 0.0, "{s}");
+    }
+    let n_named = r["regions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|g| g["name"] == "left_half")
+        .count();
+    assert_eq!(n_named, 1);
+    assert!(r["dense"]["density"].as_f64().unwrap() > 0.2);
+    // Bad inputs are errors, not panics.
+    let bad = t.streaks(&["analyze", "out", "--region", "x=1,2,3"]);
+    assert!(!bad.output.status.success());
+    let missing = t.streaks(&["analyze", "nowhere"]);
+    assert!(!missing.output.status.success());
+    assert!(missing.stderr().contains("nowhere"), "{}", missing.stderr());
+}
+
+#[test]
+fn paper_writes_every_figure_and_the_fig6_numbers() {
+    let t = TestDir::new();
+    let scenes = scenes();
+    t.streaks(&[
+        "paper",
+        "-o",
+        "paper",
+        "--scenes",
+        scenes.to_str().unwrap(),
+        "--fig2-width",
+        "40",
+        "--fig2-spp",
+        "2",
+        "--fig6-size",
+        "200",
+        "--fig6-spp",
+        "8",
+    ])
+    .assert_success();
+    let files = t.files_in("paper");
+    for f in [
+        "fig2_blinn_phong.png",
+        "fig2_ward.png",
+        "fig2_sphere.png",
+        "fig3_ward.png",
+        "fig4.png",
+        "fig5.png",
+        "fig6_deg.png",
+        "fig6_px.png",
+        "index.md",
+    ] {
+        assert!(files.contains(&f.to_string()), "{f} missing from {files:?}");
+    }
+    let text = std::fs::read_to_string(t.join("paper/fig6/analysis/report.json")).unwrap();
+    let r: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let s = r["streaks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|s| s["light"]["index"] == 0)
+        .expect("the Fig. 6 streak is matched to its light");
+    // Eq. 4 predicts f b / 15 m or so; LK must be close to it.
+    let rms = s["comparison"]["rms_px"].as_f64().unwrap();
+    assert!(rms < 0.1, "Fig. 6 RMS {rms} px");
+    let index = std::fs::read_to_string(t.join("paper/index.md")).unwrap();
+    assert!(index.contains("RMS difference"), "{index}");
+}
