@@ -1,8 +1,6 @@
-//! End-to-end tests: the real `streaks` executable, run in a fresh temporary folder per test.
+//! End-to-end tests of `streaks render`, and of every shipped scene through it.
 
-mod common;
-
-use common::TestDir;
+use crate::common::TestDir;
 use streaks_render::output::{read_exr_layer, read_exr_rgb};
 
 #[test]

@@ -1,8 +1,6 @@
 //! End-to-end tests of `streaks stereo`, `streaks texture-map` and `streaks prepare`.
 
-mod common;
-
-use common::TestDir;
+use crate::common::TestDir;
 use streaks_stereo::rigfile::{LightRecord, RigFile};
 
 #[test]

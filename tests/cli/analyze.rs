@@ -1,9 +1,7 @@
 //! End-to-end tests of `streaks analyze` (on a tiny `streaks stereo` render of
 //! rainy_street_small) and `streaks paper` (at tiny sizes).
 
-mod common;
-
-use common::TestDir;
+use crate::common::TestDir;
 use std::path::PathBuf;
 
 fn scenes() -> PathBuf {

@@ -1,7 +1,5 @@
 //! Helpers for the end-to-end tests: a fresh folder per test, the real executable, tiny scenes.
 
-#![allow(dead_code)]
-
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 

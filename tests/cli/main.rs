@@ -1,0 +1,8 @@
+//! End-to-end tests: the real `streaks` executable, run in a fresh temporary folder per test,
+//! on tiny scenes written by the tests and on the shipped scenes. One test binary (ripgrep's
+//! habit), one module per group of subcommands.
+
+mod analyze;
+mod common;
+mod render;
+mod stereo;
