@@ -18,7 +18,7 @@
 //!
 //! The rendered-scene tests (ground truth against an analytic road plane, and the disparity
 //! of a rendered textured plane measured with the project's Lucas-Kanade estimator) are in
-//! `tests/stereo_cli.rs`.
+//! `tests/cli/stereo.rs`.
 
 use crate::error::StereoError;
 use crate::image::GrayImage;
