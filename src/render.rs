@@ -4,6 +4,7 @@ use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
+use streaks_render::camera::Camera;
 use streaks_render::integrator::{self, Layers, RenderOutput, RenderSettings};
 use streaks_render::output;
 use streaks_render::scene::Scene;
@@ -28,15 +29,10 @@ pub enum Layer {
     Specular,
 }
 
-/// Path-trace a scene's camera to a linear EXR (and optionally an sRGB PNG).
+/// The rendering flags that `streaks render` and `streaks stereo` share.
 #[derive(clap::Args, Debug)]
-pub struct Args {
-    /// The scene (.gltf, .glb or .obj).
-    pub scene: PathBuf,
-    /// Output image: .exr (linear float32 with layers) or .png (sRGB).
-    #[arg(short, long)]
-    pub output: PathBuf,
-    /// Samples per pixel.
+pub struct RenderOpts {
+    /// Samples per pixel (per eye for a stereo pair).
     #[arg(long, default_value_t = 64)]
     pub spp: u32,
     /// Image width in pixels [default: from the height and the camera's aspect ratio].
@@ -48,7 +44,8 @@ pub struct Args {
     /// Longest path, Mitsuba's meaning: 1 = emitters only, 2 = direct light, 3 = one bounce...
     #[arg(long, default_value_t = 8)]
     pub max_depth: u32,
-    /// Sampler seed (the same seed gives the same image on any number of threads).
+    /// Sampler seed: the same seed gives the same image on any number of threads (a stereo
+    /// pair's right eye uses seed + 1).
     #[arg(long, default_value_t = 0)]
     pub seed: u32,
     /// Camera name [default: the scene's first camera].
@@ -57,9 +54,86 @@ pub struct Args {
     /// Worker threads [default: all cores].
     #[arg(long)]
     pub threads: Option<usize>,
-    /// Exposure of the PNG in stops (linear * 2^EV before the sRGB curve).
+    /// Exposure of the PNGs in stops (linear * 2^EV before the sRGB curve).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
+}
+
+/// A scene loaded for rendering, with the chosen camera and the image size.
+pub struct Loaded {
+    /// The scene (one BVH, shared by every view).
+    pub scene: Scene,
+    /// The chosen camera.
+    pub camera: Camera,
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+}
+
+impl RenderOpts {
+    /// Phase 1: checks the flags that need no scene.
+    pub fn check(&self) -> Result<()> {
+        if self.spp == 0 {
+            bail!("--spp must be at least 1");
+        }
+        if self.max_depth == 0 {
+            bail!("--max-depth must be at least 1 (1 renders only emitters seen directly)");
+        }
+        if !self.exposure.is_finite() {
+            bail!("--exposure must be a finite number of stops");
+        }
+        Ok(())
+    }
+
+    /// Phase 2: loads the scene (printing its warnings), picks the camera and sizes the image.
+    pub fn load(&self, path: &Path) -> Result<Loaded> {
+        let scene = Scene::load(path)
+            .with_context(|| format!("cannot load the scene {}", path.display()))?;
+        for warning in &scene.warnings {
+            eprintln!("warning: {warning}");
+        }
+        let camera = scene
+            .camera(self.camera.as_deref())
+            .with_context(|| format!("in the scene {}", path.display()))?
+            .clone();
+        let (width, height) = image_size(self.width, self.height, camera.aspect_ratio)?;
+        Ok(Loaded {
+            scene,
+            camera,
+            width,
+            height,
+        })
+    }
+
+    /// The worker pool of `--threads` (all cores by default).
+    pub fn thread_pool(&self) -> Result<rayon::ThreadPool> {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(self.threads.unwrap_or(0))
+            .build()
+            .context("cannot start the worker threads")
+    }
+
+    /// A progress bar over `views` renders of `width` x `height` pixels at `--spp`.
+    pub fn progress(&self, views: u64, width: u32, height: u32) -> Result<ProgressBar> {
+        let total = (views * width as u64 * height as u64)
+            .checked_mul(self.spp as u64)
+            .context("the number of samples (views x width x height x spp) overflows")?;
+        Ok(progress_bar(total))
+    }
+}
+
+/// Path-trace a scene's camera to a linear EXR (and optionally an sRGB PNG).
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// The scene (.gltf, .glb or .obj).
+    pub scene: PathBuf,
+    /// Output image: .exr (linear float32 with layers) or .png (sRGB).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// The rendering flags.
+    #[command(flatten)]
+    pub render: RenderOpts,
     /// Also write an sRGB PNG here.
     #[arg(long)]
     pub png: Option<PathBuf>,
@@ -158,15 +232,8 @@ pub fn run(args: Args) -> Result<()> {
             bail!("--png {} must end in .png", png.display());
         }
     }
-    if args.spp == 0 {
-        bail!("--spp must be at least 1");
-    }
-    if args.max_depth == 0 {
-        bail!("--max-depth must be at least 1 (1 renders only emitters seen directly)");
-    }
-    if !args.exposure.is_finite() {
-        bail!("--exposure must be a finite number of stops");
-    }
+    let opts = &args.render;
+    opts.check()?;
     let layers = Layers {
         depth: args.layers.contains(&Layer::Depth),
         normal: args.layers.contains(&Layer::Normal),
@@ -181,24 +248,18 @@ pub fn run(args: Args) -> Result<()> {
     }
 
     // Phase 2: the scene and the camera.
-    let scene = Scene::load(&args.scene)
-        .with_context(|| format!("cannot load the scene {}", args.scene.display()))?;
-    for warning in &scene.warnings {
-        eprintln!("warning: {warning}");
-    }
-    let camera = scene
-        .camera(args.camera.as_deref())
-        .with_context(|| format!("in the scene {}", args.scene.display()))?;
-    let (width, height) = image_size(args.width, args.height, camera.aspect_ratio)?;
-    let total = (width as u64 * height as u64)
-        .checked_mul(args.spp as u64)
-        .context("width * height * spp overflows")?;
+    let Loaded {
+        scene,
+        camera,
+        width,
+        height,
+    } = opts.load(&args.scene)?;
     let settings = RenderSettings {
         width,
         height,
-        spp: args.spp,
-        max_depth: args.max_depth,
-        seed: args.seed,
+        spp: opts.spp,
+        max_depth: opts.max_depth,
+        seed: opts.seed,
         layers,
     };
     create_parent(&args.output)?;
@@ -207,28 +268,25 @@ pub fn run(args: Args) -> Result<()> {
     }
 
     // Phase 3: render and write.
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads.unwrap_or(0))
-        .build()
-        .context("cannot start the worker threads")?;
-    let bar = progress_bar(total);
+    let pool = opts.thread_pool()?;
+    let bar = opts.progress(1, width, height)?;
     let out: RenderOutput =
-        pool.install(|| integrator::render(&scene, camera, &settings, &|n| bar.inc(n)));
+        pool.install(|| integrator::render(&scene, &camera, &settings, &|n| bar.inc(n)));
     bar.finish_and_clear();
 
     match format {
         Format::Exr => output::write_exr(&args.output, &out)?,
-        Format::Png => output::write_png(&args.output, &out.image, args.exposure)?,
+        Format::Png => output::write_png(&args.output, &out.image, opts.exposure)?,
     }
     if let Some(png) = &args.png {
-        output::write_png(png, &out.image, args.exposure)?;
+        output::write_png(png, &out.image, opts.exposure)?;
     }
     let s = &out.stats;
     let secs = s.seconds.max(1e-9);
     eprintln!(
         "rendered {width}x{height} at {} spp, max depth {} in {:.2} s: {:.3} M samples/s, {:.3} M rays/s, {} samples dropped (NaN/inf)",
-        args.spp,
-        args.max_depth,
+        opts.spp,
+        opts.max_depth,
         s.seconds,
         s.samples as f64 / secs / 1e6,
         s.rays as f64 / secs / 1e6,

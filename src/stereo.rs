@@ -1,9 +1,9 @@
 //! `streaks stereo`: render a scene's camera as a rectified stereo pair with ground truth
 //! (disparity and depth maps, streak masks, rig.json), an anaglyph and a side-by-side view.
 
+use crate::render::{Loaded, RenderOpts};
 use anyhow::{bail, Context, Result};
 use std::path::PathBuf;
-use streaks_render::scene::Scene;
 use streaks_stereo::render::{render_pair, rig_from_camera, write_pair, PairSettings};
 use streaks_stereo::rig::Rig;
 use streaks_stereo::streak_mask::StreakMaskParams;
@@ -19,27 +19,9 @@ pub struct Args {
     /// Baseline in metres (left eye at -b/2, right eye at +b/2 along the camera's +X).
     #[arg(long, default_value_t = Rig::DEFAULT_BASELINE)]
     pub baseline: f32,
-    /// Samples per pixel (per eye).
-    #[arg(long, default_value_t = 64)]
-    pub spp: u32,
-    /// Image width in pixels [default: from the height and the camera's aspect ratio].
-    #[arg(long)]
-    pub width: Option<u32>,
-    /// Image height in pixels [default: 480, or from the width and the aspect ratio].
-    #[arg(long)]
-    pub height: Option<u32>,
-    /// Camera name [default: the scene's first camera].
-    #[arg(long)]
-    pub camera: Option<String>,
-    /// Sampler seed of the left eye (the right eye uses seed + 1).
-    #[arg(long, default_value_t = 0)]
-    pub seed: u32,
-    /// Longest path, Mitsuba's meaning: 1 = emitters only, 2 = direct light, 3 = one bounce...
-    #[arg(long, default_value_t = 8)]
-    pub max_depth: u32,
-    /// Exposure of the PNGs in stops (linear * 2^EV before the sRGB curve).
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    pub exposure: f32,
+    /// The rendering flags (as `streaks render`).
+    #[command(flatten)]
+    pub render: RenderOpts,
     /// Then analyse the pair (as `streaks analyze OUTPUT`), writing OUTPUT/analysis/.
     #[arg(long)]
     pub analyze: bool,
@@ -48,15 +30,8 @@ pub struct Args {
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<()> {
     // Phase 1: everything that needs no scene.
-    if args.spp == 0 {
-        bail!("--spp must be at least 1");
-    }
-    if args.max_depth == 0 {
-        bail!("--max-depth must be at least 1 (1 renders only emitters seen directly)");
-    }
-    if !args.exposure.is_finite() {
-        bail!("--exposure must be a finite number of stops");
-    }
+    let opts = &args.render;
+    opts.check()?;
     if !(args.baseline.is_finite() && args.baseline > 0.0) {
         bail!(
             "--baseline must be a positive number of metres, got {}",
@@ -64,34 +39,29 @@ pub fn run(args: Args) -> Result<()> {
         );
     }
     // Phase 2: the scene (loaded once, one BVH for both eyes) and the rig.
-    let scene = Scene::load(&args.scene)
-        .with_context(|| format!("cannot load the scene {}", args.scene.display()))?;
-    for warning in &scene.warnings {
-        eprintln!("warning: {warning}");
-    }
-    let camera = scene
-        .camera(args.camera.as_deref())
-        .with_context(|| format!("in the scene {}", args.scene.display()))?;
-    let (width, height) = crate::render::image_size(args.width, args.height, camera.aspect_ratio)?;
-    let rig = rig_from_camera(camera, width, height, args.baseline)
+    let Loaded {
+        scene,
+        camera,
+        width,
+        height,
+    } = opts.load(&args.scene)?;
+    let rig = rig_from_camera(&camera, width, height, args.baseline)
         .with_context(|| format!("the stereo rig of {}", args.scene.display()))?;
     std::fs::create_dir_all(&args.output)
         .with_context(|| format!("cannot create the folder {}", args.output.display()))?;
     let settings = PairSettings {
-        spp: args.spp,
-        max_depth: args.max_depth,
-        seed: args.seed,
-        exposure_ev: args.exposure,
+        spp: opts.spp,
+        max_depth: opts.max_depth,
+        seed: opts.seed,
+        exposure_ev: opts.exposure,
         mask: StreakMaskParams::default(),
     };
     // Phase 3: render both eyes under one progress bar and write everything.
-    let total = (2 * width as u64 * height as u64)
-        .checked_mul(args.spp as u64)
-        .context("2 * width * height * spp overflows")?;
-    let bar = crate::render::progress_bar(total);
-    let views = render_pair(&scene, &rig, &settings, &|n| bar.inc(n))?;
+    let pool = opts.thread_pool()?;
+    let bar = opts.progress(2, width, height)?;
+    let views = pool.install(|| render_pair(&scene, &rig, &settings, &|n| bar.inc(n)))?;
     bar.finish_and_clear();
-    write_pair(&args.output, &scene, &rig, &views, args.exposure)
+    write_pair(&args.output, &scene, &rig, &views, opts.exposure)
         .with_context(|| format!("writing the pair into {}", args.output.display()))?;
     let seconds: f64 = views.iter().map(|v| v.output.stats.seconds).sum();
     let dropped: u64 = views.iter().map(|v| v.output.stats.nonfinite_dropped).sum();
@@ -106,7 +76,7 @@ pub fn run(args: Args) -> Result<()> {
     eprintln!(
         "rendered {width}x{height}, {} spp per eye, baseline {} m, f = {:.1} px in {seconds:.2} s \
          ({dropped} non-finite samples dropped); streak pixels: {} left, {} right; wrote {}",
-        args.spp,
+        opts.spp,
         args.baseline,
         rig.focal_px(),
         streak(0),

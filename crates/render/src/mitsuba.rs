@@ -264,12 +264,12 @@ fn v3(v: Vec3) -> String {
     format!("{:?}, {:?}, {:?}", v.x, v.y, v.z)
 }
 
-/// The `blendbsdf` weight `w` (the roughconductor's share) for a paper material with largest
-/// diffuse and specular reflectance `kd_max` and `ks_max`, so that `(1 - w) diffuse(kd / (1 - w))
-/// + w roughconductor(ks / w)` equals ours with both reflectances at most 1, as Mitsuba requires.
-/// DESIGN.md's mapping (w = 0.5: diffuse 2 kd, conductor 2 ks) is used whenever it is valid;
-/// otherwise w = ks_max / (kd_max + ks_max). The flag is false when kd_max + ks_max > 1, where
-/// no weight is exact.
+/// The `blendbsdf` weight `w` (the roughconductor's share) for a paper material whose largest
+/// diffuse and specular reflectances are `kd_max` and `ks_max`. The blend of diffuse with
+/// reflectance `kd / (1 - w)` and roughconductor with `ks / w` equals ours, and Mitsuba requires
+/// both reflectances to be at most 1. DESIGN.md's mapping (w = 0.5: diffuse 2 kd, conductor
+/// 2 ks) is used whenever it is valid; otherwise w = ks_max / (kd_max + ks_max). The flag is
+/// false when kd_max + ks_max > 1, where no weight is exact.
 fn blend_weight(kd_max: f32, ks_max: f32) -> (f32, bool) {
     if 2.0 * kd_max <= 1.0 && 2.0 * ks_max <= 1.0 {
         return (0.5, true);
