@@ -17,7 +17,7 @@
 //! disparity (inverse depth) map with the streak pixels marked, and the side view of the point
 //! cloud (Z forward against Y up) that shows the streaks' columns below the road.
 
-use crate::detect::{detect_streaks, DetectError, DetectParams, Streak};
+use crate::detect::{detect_streaks, score_mask, DetectError, DetectParams, MaskScore, Streak};
 use crate::lk::{lk_region, lk_rows, LkError, LkParams, Region, RowDisparity};
 use crate::model::{streak_rows, ModelError, RoadCamera, StereoRig};
 use crate::plot::{Marker, Plot, PlotError, Series, BLACK_RGB, BLUE, GREY, RED};
@@ -106,11 +106,14 @@ pub struct StereoInput {
     pub truth_disparity: Option<GrayImage>,
     /// Ground-truth depth of the left image, if known.
     pub truth_depth: Option<GrayImage>,
+    /// The renderer's streak mask of the left image (`streak_mask_left.png`), if present.
+    pub truth_streak_mask: Option<GrayImage>,
 }
 
 impl StereoInput {
     /// Loads `dir/{left,right}.exr` (or `.png` when there is no EXR), `dir/rig.json` and the
-    /// ground truth `dir/disparity_left.pfm` and `dir/depth_left.pfm` if present.
+    /// ground truth `dir/disparity_left.pfm`, `dir/depth_left.pfm` and the renderer's streak
+    /// mask `dir/streak_mask_left.png` if present.
     pub fn load(dir: &Path) -> Result<Self, ReportError> {
         let image = |name: &str| -> Result<GrayImage, ReportError> {
             let exr = dir.join(format!("{name}.exr"));
@@ -139,6 +142,14 @@ impl StereoInput {
             lights: file.lights,
             truth_disparity: optional("disparity_left.pfm")?,
             truth_depth: optional("depth_left.pfm")?,
+            truth_streak_mask: {
+                let p = dir.join("streak_mask_left.png");
+                if p.exists() {
+                    Some(GrayImage::load(&p)?)
+                } else {
+                    None
+                }
+            },
         };
         let i = input.rig.intrinsics();
         let size = (i.width() as usize, i.height() as usize);
@@ -147,6 +158,7 @@ impl StereoInput {
             ("right image", Some(&input.right)),
             ("disparity_left.pfm", input.truth_disparity.as_ref()),
             ("depth_left.pfm", input.truth_depth.as_ref()),
+            ("streak_mask_left.png", input.truth_streak_mask.as_ref()),
         ];
         for (what, img) in named {
             if let Some(img) = img {
@@ -478,6 +490,9 @@ pub struct Report {
     pub regions: Vec<RegionReport>,
     /// The dense disparity.
     pub dense: DenseSummary,
+    /// The detector's streak pixels scored against the renderer's streak mask, when the input
+    /// has one (`streak_mask_left.png`).
+    pub detection: Option<MaskScore>,
 }
 
 /// The report and the images it was made from.
@@ -941,6 +956,10 @@ pub fn analyze(input: &StereoInput, params: &AnalyzeParams) -> Result<Analysis, 
     };
     let dense = sgm(&input.left, &input.right, &sgm_params)?;
     let dense_summary = summarize_dense(&dense, &found.mask, &geo, sgm_params.max_disp);
+    let detection = match &input.truth_streak_mask {
+        Some(truth) => Some(score_mask(&found.mask, truth)?),
+        None => None,
+    };
     let i = input.rig.intrinsics();
     let report = Report {
         rig: RigSummary {
@@ -957,6 +976,7 @@ pub fn analyze(input: &StereoInput, params: &AnalyzeParams) -> Result<Analysis, 
         streaks,
         regions,
         dense: dense_summary,
+        detection,
     };
     Ok(Analysis {
         report,
@@ -1201,6 +1221,12 @@ pub fn summary_table(report: &Report) -> String {
         report.dense.streak_pixels,
         report.dense.other_pixels_below_road
     ));
+    if let Some(d) = &report.detection {
+        s.push_str(&format!(
+            "streak detection against the renderer's streak mask: precision {:.2}, recall {:.2} ({} detected, {} true pixels)\n",
+            d.precision, d.recall, d.detected, d.truth
+        ));
+    }
     s
 }
 
