@@ -1308,6 +1308,7 @@ mod tests {
             lights: Vec::new(),
             truth_disparity: Some(pair.disparity),
             truth_depth: None,
+            truth_streak_mask: None,
         };
         let geo = Geometry::new(&input.rig).unwrap();
         let region = Region {
