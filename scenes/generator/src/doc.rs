@@ -83,6 +83,9 @@ pub enum Reflect {
         ks: [f64; 3],
         /// Optional wet/dry map.
         dryness: Option<Dryness>,
+        /// Optional albedo texture (image index from [`Doc::add_png`]), written as the
+        /// baseColorTexture: its linear RGB multiplies `kd`.
+        albedo: Option<usize>,
     },
     /// A black, non-reflecting surface (glTF metallic-roughness with base colour 0): used
     /// for emitters, whose look is their emission.
@@ -113,6 +116,7 @@ impl Material {
                 kd,
                 ks,
                 dryness: None,
+                albedo: None,
             },
             emission: None,
             double_sided: false,
@@ -123,6 +127,15 @@ impl Material {
     pub fn with_dryness(mut self, d: Dryness) -> Self {
         if let Reflect::Paper { dryness, .. } = &mut self.reflect {
             *dryness = Some(d);
+        }
+        self
+    }
+
+    /// The same paper material with an albedo texture multiplying `kd` (no effect on other
+    /// reflectances).
+    pub fn with_albedo(mut self, image: usize) -> Self {
+        if let Reflect::Paper { albedo, .. } = &mut self.reflect {
+            *albedo = Some(image);
         }
         self
     }
@@ -295,10 +308,7 @@ impl Doc {
         let mut attributes = json!({ "POSITION": pos, "NORMAL": nor });
         let textured = matches!(
             &material.reflect,
-            Reflect::Paper {
-                dryness: Some(_),
-                ..
-            }
+            Reflect::Paper { dryness, albedo, .. } if dryness.is_some() || albedo.is_some()
         );
         if textured {
             let bytes: Vec<u8> = mesh
@@ -347,6 +357,17 @@ impl Doc {
         Ok(())
     }
 
+    /// The glTF texture index of image `image`, adding the texture on first use.
+    fn texture_index(&mut self, image: usize) -> usize {
+        match self.textures_used.iter().position(|&i| i == image) {
+            Some(t) => t,
+            None => {
+                self.textures_used.push(image);
+                self.textures_used.len() - 1
+            }
+        }
+    }
+
     fn material_index(&mut self, m: &Material) -> usize {
         let mut v = json!({ "name": m.name });
         match &m.reflect {
@@ -362,6 +383,7 @@ impl Doc {
                 kd,
                 ks,
                 dryness,
+                albedo,
             } => {
                 let mut s = json!({ "kd": kd, "ks": ks });
                 // glTF fallback for other viewers: roughness = sqrt(alpha).
@@ -392,14 +414,12 @@ impl Doc {
                     s["alpha_dry"] = json!(d.alpha_dry);
                     s["ks_dry"] = json!(d.ks_dry);
                     pbr["roughnessFactor"] = json!(round7(d.alpha_dry.sqrt()));
-                    let tex = match self.textures_used.iter().position(|&i| i == d.image) {
-                        Some(t) => t,
-                        None => {
-                            self.textures_used.push(d.image);
-                            self.textures_used.len() - 1
-                        }
-                    };
+                    let tex = self.texture_index(d.image);
                     pbr["metallicRoughnessTexture"] = json!({ "index": tex });
+                }
+                if let Some(image) = albedo {
+                    let tex = self.texture_index(*image);
+                    pbr["baseColorTexture"] = json!({ "index": tex });
                 }
                 v["pbrMetallicRoughness"] = pbr;
                 v["extras"] = json!({ "streaks": s });

@@ -11,7 +11,8 @@ pub struct Mesh {
     pub positions: Vec<Vec3>,
     /// Unit vertex normals.
     pub normals: Vec<Vec3>,
-    /// Texture coordinates (glTF convention: v down the image).
+    /// Texture coordinates (glTF convention: v down the image); [`Mesh::rect`],
+    /// [`Mesh::cuboid`] and [`Mesh::cylinder`] give them in metres along the surface.
     pub uvs: Vec<Vec2>,
     /// Triangle vertex indices.
     pub indices: Vec<u32>,
@@ -26,6 +27,14 @@ impl Mesh {
     /// Number of triangles.
     pub fn triangle_count(&self) -> usize {
         self.indices.len() / 3
+    }
+
+    /// Divides every texture coordinate by `metres` (texture coordinates in metres become
+    /// tiles of a texture covering `metres` x `metres`).
+    pub fn scale_uvs(&mut self, metres: f32) {
+        for t in &mut self.uvs {
+            *t /= metres;
+        }
     }
 
     fn vertex(&mut self, p: Vec3, n: Vec3, uv: Vec2) -> u32 {
@@ -54,13 +63,15 @@ impl Mesh {
         self.triangle(i[0], i[2], i[3], normal);
     }
 
-    /// A rectangle centred at `c` spanned by half-axes `u` and `v`, facing `u x v`.
+    /// A rectangle centred at `c` spanned by half-axes `u` and `v`, facing `u x v`; texture
+    /// coordinates in metres (u along `u`, v against `v`).
     pub fn rect(&mut self, c: Vec3, u: Vec3, v: Vec3) {
         let p = [c - u - v, c + u - v, c + u + v, c - u + v];
+        let (lu, lv) = (2.0 * u.length(), 2.0 * v.length());
         let uv = [
-            Vec2::new(0.0, 1.0),
-            Vec2::ONE,
-            Vec2::new(1.0, 0.0),
+            Vec2::new(0.0, lv),
+            Vec2::new(lu, lv),
+            Vec2::new(lu, 0.0),
             Vec2::ZERO,
         ];
         self.quad_uv(p, uv, u.cross(v).normalize());
@@ -79,7 +90,8 @@ impl Mesh {
         self.rect(c - z, y, x);
     }
 
-    /// A vertical cylinder (smooth sides, flat top cap, open bottom) standing on `base`.
+    /// A vertical cylinder (smooth sides, flat top cap, open bottom) standing on `base`; side
+    /// texture coordinates in metres (u around, v down from the top).
     pub fn cylinder(&mut self, base: Vec3, radius: f32, height: f32, segments: u32) {
         let top = base + Vec3::Y * height;
         let ring = |k: u32| {
@@ -88,10 +100,10 @@ impl Mesh {
         };
         for k in 0..segments {
             let (d0, d1) = (ring(k), ring(k + 1));
-            let u0 = k as f32 / segments as f32;
-            let u1 = (k + 1) as f32 / segments as f32;
-            let b0 = self.vertex(base + d0 * radius, d0, Vec2::new(u0, 1.0));
-            let b1 = self.vertex(base + d1 * radius, d1, Vec2::new(u1, 1.0));
+            let arc = std::f32::consts::TAU * radius / segments as f32;
+            let (u0, u1) = (k as f32 * arc, (k + 1) as f32 * arc);
+            let b0 = self.vertex(base + d0 * radius, d0, Vec2::new(u0, height));
+            let b1 = self.vertex(base + d1 * radius, d1, Vec2::new(u1, height));
             let t1 = self.vertex(top + d1 * radius, d1, Vec2::new(u1, 0.0));
             let t0 = self.vertex(top + d0 * radius, d0, Vec2::new(u0, 0.0));
             let out = (d0 + d1).normalize();
@@ -217,5 +229,9 @@ mod tests {
         m.rect(Vec3::ZERO, Vec3::Z, Vec3::X);
         check_winding(&m);
         assert!(m.normals.iter().all(|n| *n == Vec3::Y));
+        // Texture coordinates in metres: 2 m along u, 2 m along v.
+        assert_eq!(m.uvs[2], Vec2::new(2.0, 0.0));
+        m.scale_uvs(4.0);
+        assert_eq!(m.uvs[0], Vec2::new(0.0, 0.5));
     }
 }

@@ -3,7 +3,8 @@
 //! telephone poles, cars, a traffic light and building facades with lit windows.
 //! [`Street::full`] is `rainy_street`; [`Street::small`] is `rainy_street_small` for tests.
 
-use crate::doc::{Doc, Dryness, Light, LightKind, Material, PaperBsdf};
+use crate::albedo::{albedo_png, Pattern};
+use crate::doc::{round7, Doc, Dryness, Light, LightKind, Material, PaperBsdf};
 use crate::estimate::Brdf;
 use crate::mesh::Mesh;
 use crate::wetness::dryness_png;
@@ -26,6 +27,15 @@ pub const LAMP_INTENSITY: f64 = 250.0;
 pub const HEADLIGHT_INTENSITY: f64 = 20.0;
 /// Red signal light radiant intensity on axis (W/sr).
 pub const SIGNAL_INTENSITY: f64 = 60.0;
+/// Size in texels of the tiling albedo textures (stone, brick, wood).
+pub const TILE_TEXELS: u32 = 256;
+/// Metres covered by one tile on small objects (poles, kerbs): 1 cm per texel.
+pub const TILE_FINE: f32 = 2.56;
+/// Metres covered by one tile on large surfaces (sidewalks, facades): 2 cm per texel.
+pub const TILE_COARSE: f32 = 5.12;
+/// Texels of the road's albedo texture across the carriageway (2.7 cm each).
+pub const ROAD_ALBEDO_ACROSS: u32 = 256;
+
 /// Asphalt: wet (w = 0, puddle) and dry (w = 1) parameters.
 pub const ASPHALT_KD: f64 = 0.04;
 /// Specular reflectance of standing water (w = 0).
@@ -88,8 +98,45 @@ pub struct Street {
     pub windows: bool,
     /// Noise seed of the dryness map.
     pub seed: u32,
-    /// Dryness map size in pixels (across, along the road); powers of two.
+    /// Dryness map size in pixels (across, along the road); powers of two. The road's
+    /// albedo texture has [`ROAD_ALBEDO_ACROSS`] x twice as many.
     pub texture: (u32, u32),
+}
+
+/// A tiling albedo image in a [`Doc`] and its mean linear value.
+#[derive(Clone, Copy, Debug)]
+struct Albedo {
+    image: usize,
+    mean: f64,
+}
+
+impl Albedo {
+    fn new(
+        doc: &mut Doc,
+        suffix: &str,
+        pattern: Pattern,
+        size: (u32, u32),
+        seed: u32,
+    ) -> Result<Self, Error> {
+        let (png, mean) = albedo_png(pattern, size, seed)?;
+        Ok(Self {
+            image: doc.add_png(suffix, png),
+            mean,
+        })
+    }
+
+    /// A paper material whose albedo is this texture times `kd / mean` (mean colour `kd`).
+    fn paper(&self, name: &str, bsdf: PaperBsdf, kd: [f64; 3], ks: [f64; 3]) -> Material {
+        Material::paper(name, bsdf, kd.map(|k| round7(k / self.mean)), ks).with_albedo(self.image)
+    }
+}
+
+/// The street's tiling albedo textures.
+#[derive(Clone, Copy, Debug)]
+struct Albedos {
+    stone: Albedo,
+    brick: Albedo,
+    wood: Albedo,
 }
 
 impl Street {
@@ -168,16 +215,22 @@ impl Street {
     /// Builds the scene.
     pub fn build(&self) -> Result<Doc, Error> {
         let mut doc = Doc::new(self.name, self.description);
-        self.road(&mut doc)?;
-        self.lamps(&mut doc)?;
-        self.poles(&mut doc)?;
+        let tile = (TILE_TEXELS, TILE_TEXELS);
+        let tex = Albedos {
+            stone: Albedo::new(&mut doc, "stone", Pattern::Stone, tile, self.seed + 11)?,
+            brick: Albedo::new(&mut doc, "brick", Pattern::Brick, tile, self.seed + 12)?,
+            wood: Albedo::new(&mut doc, "wood", Pattern::Wood, tile, self.seed + 13)?,
+        };
+        self.road(&mut doc, &tex)?;
+        self.lamps(&mut doc, &tex)?;
+        self.poles(&mut doc, &tex)?;
         for (k, car) in self.cars.iter().enumerate() {
             add_car(&mut doc, k, car)?;
         }
         if let Some(z) = self.traffic_light {
             add_traffic_light(&mut doc, z)?;
         }
-        self.buildings(&mut doc)?;
+        self.buildings(&mut doc, &tex)?;
         doc.add_camera(
             "driver",
             EYE,
@@ -188,22 +241,31 @@ impl Street {
         Ok(doc)
     }
 
-    fn road(&self, doc: &mut Doc) -> Result<(), Error> {
+    fn road(&self, doc: &mut Doc, tex: &Albedos) -> Result<(), Error> {
         let (png, _, _) = dryness_png(ROAD_HALF, self.near, self.far, self.texture, self.seed)?;
         let image = doc.add_png("dryness", png);
-        let asphalt = Material::paper(
-            "wet_asphalt",
-            PaperBsdf::Ggx {
-                alpha: ASPHALT_ALPHA_WET,
-            },
-            [ASPHALT_KD; 3],
-            [ASPHALT_KS_WET; 3],
-        )
-        .with_dryness(Dryness {
-            image,
-            alpha_dry: ASPHALT_ALPHA_DRY,
-            ks_dry: [ASPHALT_KS_DRY; 3],
-        });
+        // The albedo shares the dryness map's texture coordinates (the whole carriageway).
+        let grain = Albedo::new(
+            doc,
+            "asphalt",
+            Pattern::Asphalt,
+            (ROAD_ALBEDO_ACROSS, 2 * self.texture.1),
+            self.seed + 10,
+        )?;
+        let asphalt = grain
+            .paper(
+                "wet_asphalt",
+                PaperBsdf::Ggx {
+                    alpha: ASPHALT_ALPHA_WET,
+                },
+                [ASPHALT_KD; 3],
+                [ASPHALT_KS_WET; 3],
+            )
+            .with_dryness(Dryness {
+                image,
+                alpha_dry: ASPHALT_ALPHA_DRY,
+                ks_dry: [ASPHALT_KS_DRY; 3],
+            });
         let (h, n, f) = (ROAD_HALF, self.near, self.far);
         let mut road = Mesh::new();
         road.quad_uv(
@@ -248,13 +310,13 @@ impl Street {
         doc.add_mesh("lane_markings", &marks, &paint)?;
 
         // Kerbs and sidewalks (top at 0.15 m) up to the facades.
-        let stone = Material::paper(
+        let stone = tex.stone.paper(
             "kerb_granite",
             PaperBsdf::Ggx { alpha: 0.25 },
             [0.22; 3],
             [0.04; 3],
         );
-        let pavement = Material::paper(
+        let pavement = tex.stone.paper(
             "wet_pavement",
             PaperBsdf::Ggx { alpha: 0.12 },
             [0.1; 3],
@@ -272,13 +334,15 @@ impl Street {
                 Vec3::X * (d - c).abs() * 0.5,
             );
         }
+        kerbs.scale_uvs(TILE_FINE);
+        walks.scale_uvs(TILE_COARSE);
         doc.add_mesh("kerbs", &kerbs, &stone)?;
         doc.add_mesh("sidewalks", &walks, &pavement)?;
         Ok(())
     }
 
-    fn lamps(&self, doc: &mut Doc) -> Result<(), Error> {
-        let metal = Material::paper(
+    fn lamps(&self, doc: &mut Doc, tex: &Albedos) -> Result<(), Error> {
+        let metal = tex.stone.paper(
             "painted_metal",
             PaperBsdf::Ggx { alpha: 0.3 },
             [0.06; 3],
@@ -315,6 +379,7 @@ impl Street {
                 direction: Vec3::NEG_Y,
             });
         }
+        poles.scale_uvs(TILE_FINE);
         doc.add_mesh("lamp_posts", &poles, &metal)?;
         // rect(c, Z, X) faces Z x X = +Y; the lens must face down.
         flip(&mut lenses);
@@ -322,8 +387,8 @@ impl Street {
         Ok(())
     }
 
-    fn poles(&self, doc: &mut Doc) -> Result<(), Error> {
-        let wood = Material::paper(
+    fn poles(&self, doc: &mut Doc, tex: &Albedos) -> Result<(), Error> {
+        let wood = tex.wood.paper(
             "wet_wood",
             PaperBsdf::Ggx { alpha: 0.35 },
             [0.1, 0.07, 0.045],
@@ -338,27 +403,28 @@ impl Street {
                 Vec3::new(x + 0.9, 8.42, z + 0.06),
             );
         }
+        m.scale_uvs(TILE_FINE);
         if !self.poles.is_empty() {
             doc.add_mesh("telephone_poles", &m, &wood)?;
         }
         Ok(())
     }
 
-    fn buildings(&self, doc: &mut Doc) -> Result<(), Error> {
+    fn buildings(&self, doc: &mut Doc, tex: &Albedos) -> Result<(), Error> {
         let facades = [
-            Material::paper(
+            tex.brick.paper(
                 "facade_brick",
                 PaperBsdf::Ggx { alpha: 0.4 },
                 [0.16, 0.09, 0.07],
                 [0.02; 3],
             ),
-            Material::paper(
+            tex.stone.paper(
                 "facade_render",
                 PaperBsdf::Ggx { alpha: 0.4 },
                 [0.3, 0.28, 0.24],
                 [0.02; 3],
             ),
-            Material::paper(
+            tex.stone.paper(
                 "facade_concrete",
                 PaperBsdf::Ggx { alpha: 0.4 },
                 [0.18, 0.18, 0.19],
@@ -455,7 +521,8 @@ impl Street {
                 }
             }
         }
-        for (k, m) in by_material.iter().enumerate() {
+        for (k, m) in by_material.iter_mut().enumerate() {
+            m.scale_uvs(TILE_COARSE);
             if !m.indices.is_empty() {
                 doc.add_mesh(&format!("buildings_{k}"), m, &facades[k])?;
             }

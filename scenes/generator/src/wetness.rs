@@ -10,7 +10,7 @@ use image::{ImageEncoder, RgbImage};
 pub const WET_ROAD_W: f32 = 0.2;
 
 /// A 32-bit integer hash (Chris Wellons' "lowbias32").
-fn hash(mut x: u32) -> u32 {
+pub fn hash(mut x: u32) -> u32 {
     x ^= x >> 16;
     x = x.wrapping_mul(0x7feb_352d);
     x ^= x >> 15;
@@ -27,15 +27,37 @@ fn lattice(i: i32, j: i32, seed: u32) -> f32 {
 
 /// Smooth value noise in [0, 1) with a quintic fade between lattice points.
 pub fn value_noise(x: f32, y: f32, seed: u32) -> f32 {
+    noise(x, y, seed, |i| i, |j| j)
+}
+
+/// [`value_noise`] that repeats with periods `(px, py)` (lattice cells) in x and y, for
+/// tiling textures.
+pub fn tiling_noise(x: f32, y: f32, (px, py): (i32, i32), seed: u32) -> f32 {
+    noise(
+        x,
+        y,
+        seed,
+        |i| i.rem_euclid(px.max(1)),
+        |j| j.rem_euclid(py.max(1)),
+    )
+}
+
+fn noise(
+    x: f32,
+    y: f32,
+    seed: u32,
+    wrap_x: impl Fn(i32) -> i32,
+    wrap_y: impl Fn(i32) -> i32,
+) -> f32 {
     let (xi, yi) = (x.floor(), y.floor());
     let (fx, fy) = (x - xi, y - yi);
     let fade = |t: f32| t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
     let (u, v) = (fade(fx), fade(fy));
     let (i, j) = (xi as i32, yi as i32);
-    let a = lattice(i, j, seed);
-    let b = lattice(i + 1, j, seed);
-    let c = lattice(i, j + 1, seed);
-    let d = lattice(i + 1, j + 1, seed);
+    let a = lattice(wrap_x(i), wrap_y(j), seed);
+    let b = lattice(wrap_x(i + 1), wrap_y(j), seed);
+    let c = lattice(wrap_x(i), wrap_y(j + 1), seed);
+    let d = lattice(wrap_x(i + 1), wrap_y(j + 1), seed);
     let top = a + (b - a) * u;
     let bottom = c + (d - c) * u;
     top + (bottom - top) * v
