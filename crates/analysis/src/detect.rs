@@ -3,7 +3,7 @@
 //! 1. **Thresholds relative to the local background** (robust to exposure and to a road that
 //!    is brighter in some rows than others): the image is smoothed with a small box filter;
 //!    per row, the background `b` is the row's median and the noise `s` its MAD-based standard
-//!    deviation. Pixels above `b + low s` are candidates, and a region is kept only if it
+//!    deviation (at least `noise_floor` of the image's range). Pixels above `b + low s` are candidates, and a region is kept only if it
 //!    reaches `b + high s` (hysteresis). Within a streak, each row keeps the pixels whose
 //!    contrast `v - b` is at least `row_fraction` of the row's peak contrast (the streak's
 //!    cross-section, not the glow around it).
@@ -60,6 +60,9 @@ pub struct DetectParams {
     pub high: f32,
     /// Low (growth) threshold, likewise.
     pub low: f32,
+    /// Least noise deviation, as a share of the image's range (99.9th percentile minus median):
+    /// keeps the thresholds finite on noise-free (synthetic, black-background) images.
+    pub noise_floor: f32,
     /// Share of a row's peak contrast a streak pixel must reach (0 keeps all grown pixels).
     pub row_fraction: f32,
     /// Brightness-gap ratio for cutting a region (0 disables).
@@ -71,6 +74,10 @@ pub struct DetectParams {
     pub min_rows: usize,
     /// Smallest ratio of height to mean width of a streak.
     pub min_elongation: f32,
+    /// Largest |slope| (pixels of x per pixel of y) of a streak's axis: streaks of a level rig
+    /// hang nearly vertically; a steeper elongated region is a lane marking or a kerb, and
+    /// is dropped.
+    pub max_slope: f32,
 }
 
 impl Default for DetectParams {
@@ -81,10 +88,12 @@ impl Default for DetectParams {
             high: 12.0,
             low: 4.0,
             row_fraction: 0.25,
+            noise_floor: 0.01,
             gap: 0.5,
             head_ratio: 2.0,
             min_rows: 8,
             min_elongation: 2.0,
+            max_slope: 0.5,
         }
     }
 }
@@ -99,6 +108,9 @@ impl DetectParams {
         if !(0.0..1.0).contains(&self.row_fraction) {
             return bad("row_fraction", "must be in [0, 1)");
         }
+        if !(0.0..1.0).contains(&self.noise_floor) {
+            return bad("noise_floor", "must be in [0, 1)");
+        }
         if self.smooth_radius > 16 {
             return bad("smooth_radius", "must be at most 16");
         }
@@ -110,6 +122,9 @@ impl DetectParams {
         }
         if self.horizon.is_some_and(|h| !h.is_finite()) {
             return bad("horizon", "must be a finite number");
+        }
+        if self.max_slope.is_nan() || self.max_slope < 0.0 {
+            return bad("max_slope", "must be non-negative");
         }
         if self.min_elongation.is_nan() || self.min_elongation < 0.0 {
             return bad("min_elongation", "must be non-negative");
@@ -241,13 +256,15 @@ pub fn detect_streaks(img: &GrayImage, params: &DetectParams) -> Result<Detectio
         lo: vec![f32::INFINITY; h],
         hi: vec![f32::INFINITY; h],
     };
+    let range = quantile(&img.data, 0.999, &mut buf) - quantile(&img.data, 0.5, &mut buf);
+    let floor = params.noise_floor * range.max(0.0);
     for y in 0..h {
         let row = &img.data[y * w..(y + 1) * w];
         let b = quantile(row, 0.5, &mut buf);
         for (d, &v) in dev.iter_mut().zip(row) {
             *d = (v - b).abs();
         }
-        let s = 1.4826 * quantile(&dev, 0.5, &mut buf);
+        let s = (1.4826 * quantile(&dev, 0.5, &mut buf)).max(floor);
         th.bg[y] = b;
         if s > 0.0 {
             th.lo[y] = params.low * s;
@@ -446,7 +463,7 @@ fn classify(
     }
     // Per-row weighted centres, then the weighted line fit x = a + b y.
     let mut centres = Vec::with_capacity(nrows);
-    let mut pixels = 0;
+    let mut kept = Vec::with_capacity(region.len());
     let r = params.smooth_radius;
     let (mut s, mut sy, mut sx, mut syy, mut sxy) = (0.0f64, 0.0, 0.0, 0.0, 0.0);
     let mut k = 0;
@@ -472,8 +489,7 @@ fn classify(
             let wgt = (c - keep) as f64 + 1e-12;
             rw += wgt;
             rx += wgt * ((i % w) as f64 + 0.5);
-            mask.data[i] = 1.0;
-            pixels += 1;
+            kept.push(i);
         }
         k = end;
         let xc = rx / rw;
@@ -492,6 +508,12 @@ fn classify(
         0.0
     };
     let a = (sx - b * sy) / s;
+    if b.abs() > params.max_slope as f64 {
+        return;
+    }
+    for &i in &kept {
+        mask.data[i] = 1.0;
+    }
     det.streaks.push(Streak {
         first_row: first_row + r,
         last_row: last_row - r,
@@ -500,7 +522,7 @@ fn classify(
         axis_b: b as f32,
         peak,
         elongation,
-        pixels,
+        pixels: kept.len(),
     });
 }
 

@@ -1065,7 +1065,8 @@ pub fn write_report_json(path: &Path, report: &Report) -> Result<(), ReportError
 
 /// Writes everything into `dir` (created if missing): `report.json`, `streak<i>.png` and
 /// `<region>.png` (disparity against row), `depth.png` (the SGM disparity, i.e. inverse
-/// depth, turbo colours, with the streak pixels outlined red) and `side_view.png` (the SGM
+/// depth, turbo colours, with the streak pixels outlined red), `streak_mask.png` (the
+/// detector's streak pixels, white) and `side_view.png` (the SGM
 /// point cloud, Z forward against Y up, streak points red). Returns the files written.
 pub fn write_outputs(
     dir: &Path,
@@ -1122,6 +1123,12 @@ pub fn write_outputs(
     }
     let path = dir.join("depth.png");
     save_rgb8_png(&path, &img)?;
+    written.push(path);
+    let path = dir.join("streak_mask.png");
+    analysis
+        .streak_mask
+        .save_png(&path)
+        .map_err(|e| write_err(&path)(e.to_string()))?;
     written.push(path);
     // Side view of the point cloud.
     let (mut other, mut streak) = (Vec::new(), Vec::new());
