@@ -1,8 +1,12 @@
 //! Specular streak detection: bright, vertically elongated regions below the horizon.
 //!
-//! 1. **Thresholds relative to the image** (robust to exposure): with `m` the median and `t`
-//!    a high percentile of the intensities, pixels above `m + low (t - m)` are candidates and a
-//!    region is kept only if it reaches `m + high (t - m)` (hysteresis).
+//! 1. **Thresholds relative to the local background** (robust to exposure and to a road that
+//!    is brighter in some rows than others): the image is smoothed with a small box filter;
+//!    per row, the background `b` is the row's median and the noise `s` its MAD-based standard
+//!    deviation (at least `noise_floor` of the brightest contrasts below the horizon). Pixels above `b + low s` are candidates, and a region is kept only if it
+//!    reaches `b + high s` (hysteresis). Within a streak, each row keeps the pixels whose
+//!    contrast `v - b` is at least `row_fraction` of the row's peak contrast (the streak's
+//!    cross-section, not the glow around it).
 //! 2. **Regions** are 8-connected, but never across the horizon (given, or the principal
 //!    point's row, the image centre, for a pitch-0 rig): a street lamp above the horizon and its
 //!    streak below it come apart. A region below the horizon is further **cut at brightness
@@ -50,12 +54,17 @@ pub enum DetectError {
 pub struct DetectParams {
     /// Image y coordinate of the horizon; `None`: the image centre (pitch-0 rig).
     pub horizon: Option<f32>,
-    /// The reference percentile (0..1) of the intensities.
-    pub percentile: f32,
-    /// High (seed) threshold as a fraction of the way from the median to the percentile.
+    /// Radius of the box filter applied before thresholding, pixels (0: none).
+    pub smooth_radius: usize,
+    /// High (seed) threshold in noise deviations above the row's background.
     pub high: f32,
     /// Low (growth) threshold, likewise.
     pub low: f32,
+    /// Least noise deviation, as a share of the 99.9th percentile of the contrasts below the
+    /// horizon: keeps the thresholds finite on noise-free (black-background) images.
+    pub noise_floor: f32,
+    /// Share of a row's peak contrast a streak pixel must reach (0 keeps all grown pixels).
+    pub row_fraction: f32,
     /// Brightness-gap ratio for cutting a region (0 disables).
     pub gap: f32,
     /// A region's leading rows brighter than this many times its median row peak, if compact,
@@ -65,19 +74,26 @@ pub struct DetectParams {
     pub min_rows: usize,
     /// Smallest ratio of height to mean width of a streak.
     pub min_elongation: f32,
+    /// Largest |slope| (pixels of x per pixel of y) of a streak's axis: streaks of a level rig
+    /// hang nearly vertically; a steeper elongated region is a lane marking or a kerb, and
+    /// is dropped.
+    pub max_slope: f32,
 }
 
 impl Default for DetectParams {
     fn default() -> Self {
         Self {
             horizon: None,
-            percentile: 0.999,
-            high: 0.3,
-            low: 0.12,
+            smooth_radius: 1,
+            high: 12.0,
+            low: 4.0,
+            row_fraction: 0.25,
+            noise_floor: 0.01,
             gap: 0.5,
             head_ratio: 2.0,
             min_rows: 8,
             min_elongation: 2.0,
+            max_slope: 0.5,
         }
     }
 }
@@ -86,11 +102,17 @@ impl DetectParams {
     /// Checks the parameters.
     pub fn validate(&self) -> Result<(), DetectError> {
         let bad = |name, reason| Err(DetectError::Param { name, reason });
-        if !(0.5..=1.0).contains(&self.percentile) {
-            return bad("percentile", "must be in [0.5, 1]");
+        if !(self.low > 0.0 && self.low <= self.high && self.high.is_finite()) {
+            return bad("low", "need 0 < low <= high, finite");
         }
-        if !(self.low > 0.0 && self.low <= self.high && self.high <= 1.0) {
-            return bad("low", "need 0 < low <= high <= 1");
+        if !(0.0..1.0).contains(&self.row_fraction) {
+            return bad("row_fraction", "must be in [0, 1)");
+        }
+        if !(0.0..1.0).contains(&self.noise_floor) {
+            return bad("noise_floor", "must be in [0, 1)");
+        }
+        if self.smooth_radius > 16 {
+            return bad("smooth_radius", "must be at most 16");
         }
         if self.head_ratio.is_nan() || self.head_ratio < 0.0 {
             return bad("head_ratio", "must be non-negative");
@@ -100,6 +122,9 @@ impl DetectParams {
         }
         if self.horizon.is_some_and(|h| !h.is_finite()) {
             return bad("horizon", "must be a finite number");
+        }
+        if self.max_slope.is_nan() || self.max_slope < 0.0 {
+            return bad("max_slope", "must be non-negative");
         }
         if self.min_elongation.is_nan() || self.min_elongation < 0.0 {
             return bad("min_elongation", "must be non-negative");
@@ -153,18 +178,63 @@ pub struct Detection {
     pub mask: GrayImage,
     /// The horizon used (image y).
     pub horizon: f32,
-    /// The low and high thresholds used.
+    /// The low and high thresholds used, as contrasts above the background, medians over the
+    /// rows below the horizon.
     pub thresholds: (f32, f32),
 }
 
-/// The `p`-quantile (0..1) of the finite values.
-fn quantile(values: &[f32], p: f32) -> f32 {
-    let mut v: Vec<f32> = values.iter().copied().filter(|v| v.is_finite()).collect();
-    if v.is_empty() {
+/// The `p`-quantile (0..1) of the finite values; `buf` is scratch space.
+fn quantile(values: &[f32], p: f32, buf: &mut Vec<f32>) -> f32 {
+    buf.clear();
+    buf.extend(values.iter().copied().filter(|v| v.is_finite()));
+    if buf.is_empty() {
         return 0.0;
     }
-    let i = ((v.len() - 1) as f32 * p).round() as usize;
-    *v.select_nth_unstable_by(i, f32::total_cmp).1
+    let i = ((buf.len() - 1) as f32 * p).round() as usize;
+    *buf.select_nth_unstable_by(i, f32::total_cmp).1
+}
+
+/// `img` smoothed with a `(2 r + 1)`-square box filter (clamped at the borders); non-finite
+/// values count as 0.
+fn box_blur(img: &GrayImage, r: usize) -> GrayImage {
+    let (w, h) = (img.width, img.height);
+    let mut out = img.clone();
+    for v in &mut out.data {
+        if !v.is_finite() {
+            *v = 0.0;
+        }
+    }
+    if r == 0 {
+        return out;
+    }
+    let mut tmp = vec![0.0f32; w * h];
+    let mut prefix = vec![0.0f64; w.max(h) + 1];
+    for y in 0..h {
+        for x in 0..w {
+            prefix[x + 1] = prefix[x] + out.data[y * w + x] as f64;
+        }
+        for x in 0..w {
+            let (x0, x1) = (x.saturating_sub(r), (x + r + 1).min(w));
+            tmp[y * w + x] = ((prefix[x1] - prefix[x0]) / (x1 - x0) as f64) as f32;
+        }
+    }
+    for x in 0..w {
+        for y in 0..h {
+            prefix[y + 1] = prefix[y] + tmp[y * w + x] as f64;
+        }
+        for y in 0..h {
+            let (y0, y1) = (y.saturating_sub(r), (y + r + 1).min(h));
+            out.data[y * w + x] = ((prefix[y1] - prefix[y0]) / (y1 - y0) as f64) as f32;
+        }
+    }
+    out
+}
+
+/// Per-row thresholds: background (median), and the low and high contrasts above it.
+struct RowThresholds {
+    bg: Vec<f32>,
+    lo: Vec<f32>,
+    hi: Vec<f32>,
 }
 
 /// Finds streaks and lamps in `img`.
@@ -174,25 +244,54 @@ pub fn detect_streaks(img: &GrayImage, params: &DetectParams) -> Result<Detectio
     let horizon = params.horizon.unwrap_or(0.5 * h as f32);
     // Rows with centre below the horizon (y + 0.5 > horizon) are "below".
     let below = |y: usize| y as f32 + 0.5 > horizon;
-    let med = quantile(&img.data, 0.5);
-    let top = quantile(&img.data, params.percentile);
-    let t_lo = med + params.low * (top - med);
-    let t_hi = med + params.high * (top - med);
     let mut mask = GrayImage::new(w, h, 0.0).map_err(|_| DetectError::Param {
         name: "image",
         reason: "empty image",
     })?;
+    let img = &box_blur(img, params.smooth_radius);
+    let mut buf = Vec::with_capacity(w);
+    let mut dev = vec![0.0f32; w];
+    let mut th = RowThresholds {
+        bg: vec![0.0; h],
+        lo: vec![f32::INFINITY; h],
+        hi: vec![f32::INFINITY; h],
+    };
+    let mut noise = vec![0.0f32; h];
+    for ((row, b), n) in img.data.chunks_exact(w).zip(&mut th.bg).zip(&mut noise) {
+        *b = quantile(row, 0.5, &mut buf);
+        for (d, &v) in dev.iter_mut().zip(row) {
+            *d = (v - *b).abs();
+        }
+        *n = 1.4826 * quantile(&dev, 0.5, &mut buf);
+    }
+    // The floor: a share of the brightest contrasts below the horizon (lamps above it, however
+    // bright, do not raise it).
+    let contrasts: Vec<f32> = (0..w * h)
+        .filter(|&i| below(i / w))
+        .map(|i| img.data[i] - th.bg[i / w])
+        .collect();
+    let floor = params.noise_floor * quantile(&contrasts, 0.999, &mut buf).max(0.0);
+    for ((n, lo), hi) in noise.iter().zip(&mut th.lo).zip(&mut th.hi) {
+        let s = n.max(floor);
+        if s > 0.0 {
+            *lo = params.low * s;
+            *hi = params.high * s;
+        }
+    }
+    let rows_below: Vec<usize> = (0..h).filter(|&y| below(y)).collect();
+    let med_of = |v: &[f32], buf: &mut Vec<f32>| {
+        let sel: Vec<f32> = rows_below.iter().map(|&y| v[y]).collect();
+        quantile(&sel, 0.5, buf)
+    };
+    let thresholds = (med_of(&th.lo, &mut buf), med_of(&th.hi, &mut buf));
     let mut det = Detection {
         streaks: Vec::new(),
         lamps: Vec::new(),
         mask: mask.clone(),
         horizon,
-        thresholds: (t_lo, t_hi),
+        thresholds,
     };
-    if top <= med {
-        return Ok(det);
-    }
-    let on = |i: usize| img.data[i].is_finite() && img.data[i] >= t_lo;
+    let on = |i: usize| img.data[i] - th.bg[i / w] >= th.lo[i / w];
     let mut label = vec![false; w * h];
     let mut stack = Vec::new();
     let mut region: Vec<usize> = Vec::new();
@@ -225,11 +324,11 @@ pub fn detect_streaks(img: &GrayImage, params: &DetectParams) -> Result<Detectio
             for part in split_at_gaps(img, &region, params.gap) {
                 let (head, rest) = split_head(img, part, params.head_ratio);
                 for p in [head, rest] {
-                    classify(img, p, t_lo, t_hi, params, &mut det, &mut mask);
+                    classify(img, p, &th, params, &mut det, &mut mask);
                 }
             }
         } else {
-            classify(img, &region, t_lo, t_hi, params, &mut det, &mut mask);
+            classify(img, &region, &th, params, &mut det, &mut mask);
         }
     }
     det.streaks.sort_by_key(|s| (s.first_row, s.pixels));
@@ -336,15 +435,15 @@ fn split_head<'a>(img: &GrayImage, region: &'a [usize], ratio: f32) -> (&'a [usi
 fn classify(
     img: &GrayImage,
     region: &[usize],
-    t_lo: f32,
-    t_hi: f32,
+    th: &RowThresholds,
     params: &DetectParams,
     det: &mut Detection,
     mask: &mut GrayImage,
 ) {
     let w = img.width;
+    let contrast = |i: usize| img.data[i] - th.bg[i / w];
     let peak = region.iter().map(|&i| img.data[i]).fold(f32::MIN, f32::max);
-    if peak < t_hi || region.is_empty() {
+    if region.is_empty() || !region.iter().any(|&i| contrast(i) >= th.hi[i / w]) {
         return;
     }
     let first_row = region[0] / w;
@@ -356,7 +455,7 @@ fn classify(
     if !below || nrows < params.min_rows || elongation < params.min_elongation {
         let (mut sw, mut sx, mut sy) = (0.0f64, 0.0f64, 0.0f64);
         for &i in region {
-            let wgt = (img.data[i] - t_lo).max(0.0) as f64 + 1e-12;
+            let wgt = (contrast(i) - th.lo[i / w]).max(0.0) as f64 + 1e-12;
             sw += wgt;
             sx += wgt * ((i % w) as f64 + 0.5);
             sy += wgt * ((i / w) as f64 + 0.5);
@@ -371,19 +470,35 @@ fn classify(
     }
     // Per-row weighted centres, then the weighted line fit x = a + b y.
     let mut centres = Vec::with_capacity(nrows);
+    let mut kept = Vec::with_capacity(region.len());
+    let r = params.smooth_radius;
     let (mut s, mut sy, mut sx, mut syy, mut sxy) = (0.0f64, 0.0, 0.0, 0.0, 0.0);
     let mut k = 0;
     while k < region.len() {
         let y = region[k] / w;
+        let end = k + region[k..].iter().take_while(|&&i| i / w == y).count();
+        // The smoothing spreads a streak's ends by its radius.
+        if y < first_row + r || y + r > last_row {
+            k = end;
+            continue;
+        }
+        let row_peak = region[k..end]
+            .iter()
+            .map(|&i| contrast(i))
+            .fold(0.0f32, f32::max);
+        let keep = params.row_fraction * row_peak;
         let (mut rw, mut rx) = (0.0f64, 0.0f64);
-        while k < region.len() && region[k] / w == y {
-            let i = region[k];
-            let wgt = (img.data[i] - t_lo).max(0.0) as f64 + 1e-12;
+        for &i in &region[k..end] {
+            let c = contrast(i);
+            if c < keep {
+                continue;
+            }
+            let wgt = (c - keep) as f64 + 1e-12;
             rw += wgt;
             rx += wgt * ((i % w) as f64 + 0.5);
-            mask.data[i] = 1.0;
-            k += 1;
+            kept.push(i);
         }
+        k = end;
         let xc = rx / rw;
         let yc = y as f64 + 0.5;
         centres.push((y, xc as f32));
@@ -400,15 +515,21 @@ fn classify(
         0.0
     };
     let a = (sx - b * sy) / s;
+    if b.abs() > params.max_slope as f64 {
+        return;
+    }
+    for &i in &kept {
+        mask.data[i] = 1.0;
+    }
     det.streaks.push(Streak {
-        first_row,
-        last_row,
+        first_row: first_row + r,
+        last_row: last_row - r,
         centres,
         axis_a: a as f32,
         axis_b: b as f32,
         peak,
         elongation,
-        pixels: region.len(),
+        pixels: kept.len(),
     });
 }
 
@@ -458,6 +579,50 @@ pub fn score_mask(detected: &GrayImage, truth: &GrayImage) -> Result<MaskScore, 
         detected: nd,
         truth: nt,
     })
+}
+
+/// The part of a ground-truth streak mask the detector is meant to find: "on" pixels (above
+/// 0.5) below `horizon` (pixel centre below it) in 8-connected components taller than wide.
+/// Glints on windows above the horizon and wide glossy patches are left out.
+pub fn vertical_truth(truth: &GrayImage, horizon: f32) -> GrayImage {
+    let (w, h) = (truth.width, truth.height);
+    let mut out = GrayImage {
+        width: w,
+        height: h,
+        data: vec![0.0; w * h],
+    };
+    let on = |i: usize| truth.data[i] > 0.5 && (i / w) as f32 + 0.5 > horizon;
+    let mut seen = vec![false; w * h];
+    let (mut stack, mut comp) = (Vec::new(), Vec::new());
+    for start in 0..w * h {
+        if seen[start] || !on(start) {
+            continue;
+        }
+        comp.clear();
+        seen[start] = true;
+        stack.push(start);
+        let (mut x0, mut x1, mut y0, mut y1) = (w, 0, h, 0);
+        while let Some(i) = stack.pop() {
+            comp.push(i);
+            let (x, y) = (i % w, i / w);
+            (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
+            for ny in y.saturating_sub(1)..(y + 2).min(h) {
+                for nx in x.saturating_sub(1)..(x + 2).min(w) {
+                    let j = ny * w + nx;
+                    if !seen[j] && on(j) {
+                        seen[j] = true;
+                        stack.push(j);
+                    }
+                }
+            }
+        }
+        if y1 - y0 > x1 - x0 {
+            for &i in &comp {
+                out.data[i] = 1.0;
+            }
+        }
+    }
+    out
 }
 
 #[cfg(test)]
@@ -572,6 +737,59 @@ mod tests {
         let bias = sum / n as f32;
         eprintln!("LK along detected streaks: {n} rows, bias {bias} px, worst {worst} px");
         assert!(bias.abs() < 0.02 && worst < 0.3, "{bias} {worst}");
+    }
+
+    /// A faint streak on a road whose brightness ramps down the image, under a lamp 300 times
+    /// brighter: thresholds from the image's percentiles would miss it; the row background
+    /// finds it. A lane marking (slope 1.5) is not a streak.
+    #[test]
+    fn faint_streak_on_a_ramped_road_under_a_bright_lamp() {
+        let (w, h) = (200, 160);
+        let mut img = GrayImage::new(w, h, 0.0).unwrap();
+        let mut truth = GrayImage::new(w, h, 0.0).unwrap();
+        let mut rng = SplitMix(11);
+        for y in 0..h {
+            for x in 0..w {
+                let (xc, yc) = (x as f32 + 0.5, y as f32 + 0.5);
+                let road = 0.05 + 0.3 * yc / h as f32;
+                let dx = xc - (100.0 + 0.05 * yc);
+                let s = if (70.0..150.0).contains(&yc) {
+                    0.15 * (-dx * dx / (2.0 * 3.0 * 3.0)).exp()
+                } else {
+                    0.0
+                };
+                let r2 = (xc - 100.0).powi(2) + (yc - 30.0).powi(2);
+                let lamp = 50.0 * (-r2 / 8.0).exp();
+                let lane = if yc > 70.0 && (xc - (80.0 - 1.5 * (yc - 70.0))).abs() < 1.5 {
+                    0.3
+                } else {
+                    0.0
+                };
+                img.set(x, y, road + s + lamp + lane + 0.005 * rng.gaussian());
+                truth.set(x, y, if s > 0.25 * 0.15 { 1.0 } else { 0.0 });
+            }
+        }
+        let p = DetectParams {
+            horizon: Some(60.0),
+            ..DetectParams::default()
+        };
+        let det = detect_streaks(&img, &p).unwrap();
+        assert_eq!(det.streaks.len(), 1, "{:?}", det.streaks);
+        let s = &det.streaks[0];
+        assert!((s.axis_a + s.axis_b * 110.0 - 105.5).abs() < 0.5, "{s:?}");
+        let score = score_mask(&det.mask, &truth).unwrap();
+        assert!(score.precision > 0.9 && score.recall > 0.8, "{score:?}");
+        // The same truth is all vertical and below the horizon; a wide blob and anything above
+        // the horizon are not.
+        let mut t2 = truth.clone();
+        for y in 20..30 {
+            for x in 10..60 {
+                t2.set(x, y + 100, 1.0);
+                t2.set(x + 100, y, 1.0);
+            }
+        }
+        let v = vertical_truth(&t2, 60.0);
+        assert_eq!(v.data, truth.data);
     }
 
     #[test]

@@ -17,7 +17,9 @@
 //! disparity (inverse depth) map with the streak pixels marked, and the side view of the point
 //! cloud (Z forward against Y up) that shows the streaks' columns below the road.
 
-use crate::detect::{detect_streaks, score_mask, DetectError, DetectParams, MaskScore, Streak};
+use crate::detect::{
+    detect_streaks, score_mask, vertical_truth, DetectError, DetectParams, MaskScore, Streak,
+};
 use crate::lk::{lk_region, lk_rows, LkError, LkParams, Region, RowDisparity};
 use crate::model::{streak_rows, ModelError, RoadCamera, StereoRig};
 use crate::plot::{Marker, Plot, PlotError, Series, BLACK_RGB, BLUE, GREY, RED};
@@ -204,6 +206,10 @@ pub struct AnalyzeParams {
     pub auto_road: bool,
     /// Farthest a light's mirror image may be from a streak's axis, in pixels.
     pub match_tolerance_px: f32,
+    /// A light match is dropped when the streak's median measured disparity is within this
+    /// many pixels of the road's (a specular streak lies below the road; one at road disparity
+    /// is road texture or a diffuse glow, not the light's reflection). 0 disables.
+    pub road_reject_px: f32,
 }
 
 impl Default for AnalyzeParams {
@@ -221,6 +227,7 @@ impl Default for AnalyzeParams {
             auto_objects: 2,
             auto_road: true,
             match_tolerance_px: 12.0,
+            road_reject_px: 0.5,
         }
     }
 }
@@ -493,6 +500,12 @@ pub struct Report {
     /// The detector's streak pixels scored against the renderer's streak mask, when the input
     /// has one (`streak_mask_left.png`).
     pub detection: Option<MaskScore>,
+    /// The same against only the mask's road streaks: pixels below the horizon in connected
+    /// components taller than wide ([`vertical_truth`]). The renderer's mask also marks glints
+    /// on windows and broad glossy road, which the detector does not look for; this recall is
+    /// the honest measure of the detector (its precision counts detections outside those
+    /// components as false).
+    pub detection_vertical: Option<MaskScore>,
 }
 
 /// The report and the images it was made from.
@@ -602,18 +615,39 @@ impl Geometry {
     }
 }
 
-fn light_position(light: &LightRecord) -> Option<(&'static str, [f32; 3])> {
+/// A light's kind, road-frame position and strength (radiant intensity, luminance; an emissive
+/// group's radiance times its area).
+fn light_position(light: &LightRecord) -> Option<(&'static str, [f32; 3], f64)> {
+    let lum = |c: [f32; 3]| (0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]) as f64;
     match light {
-        LightRecord::Point { position, .. } => position.road.map(|p| ("point", p)),
-        LightRecord::Spot { position, .. } => position.road.map(|p| ("spot", p)),
-        LightRecord::Emissive { centroid, .. } => centroid.road.map(|p| ("emissive", p)),
+        LightRecord::Point {
+            position,
+            intensity,
+            ..
+        } => position.road.map(|p| ("point", p, lum(*intensity))),
+        LightRecord::Spot {
+            position,
+            intensity,
+            ..
+        } => position.road.map(|p| ("spot", p, lum(*intensity))),
+        LightRecord::Emissive {
+            centroid,
+            radiance,
+            area,
+            ..
+        } => centroid
+            .road
+            .map(|p| ("emissive", p, lum(*radiance) * *area as f64)),
         LightRecord::Directional { .. } => None,
     }
 }
 
-/// The light whose mirror image projects nearest the streak's axis, above its top row... in
-/// image terms: the mirror image must lie within the streak's rows or above them (farther),
-/// and the light itself above the streak.
+/// The light that makes a streak: among the lights whose mirror image `(X, -Y, Z)` projects
+/// within `tolerance` pixels of the streak's axis (at the mirror image's row, or the streak's
+/// first row if the mirror image is above it), whose own image is above the streak's first
+/// row and whose mirror image is not below its last row, the one with the strongest predicted
+/// streak: strength over the squared distance from the camera to the mirror image (a faint
+/// light that happens to line up does not win over the lamp that makes the streak).
 fn match_light(
     streak: &Streak,
     lights: &[LightRecord],
@@ -621,16 +655,17 @@ fn match_light(
     tolerance: f32,
 ) -> Option<MatchedLight> {
     let cam = &geo.model_rig.camera;
-    let mut best: Option<MatchedLight> = None;
+    let mut best: Option<(f64, MatchedLight)> = None;
     for (index, light) in lights.iter().enumerate() {
-        let Some((kind, p)) = light_position(light) else {
+        let Some((kind, p, strength)) = light_position(light) else {
             continue;
         };
         let p = DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
         if p.y <= 0.0 || p.z <= 0.0 {
             continue;
         }
-        let Some(mirror) = cam.project(DVec3::new(p.x, -p.y, p.z)) else {
+        let virt = DVec3::new(p.x, -p.y, p.z);
+        let Some(mirror) = cam.project(virt) else {
             continue;
         };
         let Some(lamp) = cam.project(p) else { continue };
@@ -640,21 +675,26 @@ fn match_light(
             continue;
         }
         // Left-image x: the cyclopean x plus half the disparity of the virtual light.
-        let half = 0.5 * geo.model_rig.pixel_disparity(DVec3::new(p.x, -p.y, p.z));
+        let half = 0.5 * geo.model_rig.pixel_disparity(virt);
         let row = mirror.y.max(streak.first_row as f64);
         let axis = streak.axis_a as f64 + streak.axis_b as f64 * row;
         let distance = (axis - (mirror.x + half)).abs();
-        if distance <= tolerance as f64 && best.as_ref().is_none_or(|b| distance < b.distance_px) {
-            best = Some(MatchedLight {
-                index,
-                kind: kind.into(),
-                road: p.to_array(),
-                mirror_px: [mirror.x + half, mirror.y],
-                distance_px: distance,
-            });
+        let predicted =
+            strength / (virt - DVec3::new(0.0, geo.rig.height() as f64, 0.0)).length_squared();
+        if distance <= tolerance as f64 && best.as_ref().is_none_or(|b| predicted > b.0) {
+            best = Some((
+                predicted,
+                MatchedLight {
+                    index,
+                    kind: kind.into(),
+                    road: p.to_array(),
+                    mirror_px: [mirror.x + half, mirror.y],
+                    distance_px: distance,
+                },
+            ));
         }
     }
-    best
+    best.map(|b| b.1)
 }
 
 fn lk_err(what: impl Into<String>) -> impl FnOnce(LkError) -> ReportError {
@@ -679,7 +719,7 @@ fn analyze_streak(
         .collect();
     let measured = lk_rows(&input.left, &input.right, &centres, lk)
         .map_err(lk_err(format!("LK along streak {index}")))?;
-    let light = match_light(streak, &input.lights, geo, params.match_tolerance_px);
+    let mut light = match_light(streak, &input.lights, geo, params.match_tolerance_px);
     let mut predicted = std::collections::HashMap::new();
     if let Some(l) = &light {
         let rows = streak.first_row as u32..streak.last_row as u32 + 1;
@@ -704,13 +744,24 @@ fn analyze_streak(
             predicted.insert(p.row as usize, (p.point.disparity_px, road_px));
         }
     }
-    let rows: Vec<RowRecord> = measured
+    let mut rows: Vec<RowRecord> = measured
         .iter()
         .map(|r| {
             let p = predicted.get(&r.row);
             geo.record(r, p.map(|p| p.0), p.map(|p| p.1))
         })
         .collect();
+    let off_road = median(
+        rows.iter()
+            .filter_map(|r| r.road_px.map(|road| (r.measured_px - road).abs()))
+            .collect(),
+    );
+    if off_road.is_finite() && off_road < params.road_reject_px as f64 {
+        light = None;
+        for r in &mut rows {
+            (r.predicted_px, r.predicted_deg, r.road_px) = (None, None, None);
+        }
+    }
     let road: Vec<f64> = rows.iter().filter_map(|r| r.road_px).collect();
     Ok(StreakReport {
         index,
@@ -897,6 +948,12 @@ pub fn analyze(input: &StereoInput, params: &AnalyzeParams) -> Result<Analysis, 
             reason: format!("must be positive, got {}", params.match_tolerance_px),
         });
     }
+    if !(params.road_reject_px.is_finite() && params.road_reject_px >= 0.0) {
+        return Err(ReportError::Param {
+            name: "road_reject_px",
+            reason: format!("must be non-negative, got {}", params.road_reject_px),
+        });
+    }
     let geo = Geometry::new(&input.rig)?;
     let range = disparity_range(input, &geo);
     // The search range of the scene: a wider one lets windows near the left edge run out of
@@ -956,9 +1013,15 @@ pub fn analyze(input: &StereoInput, params: &AnalyzeParams) -> Result<Analysis, 
     };
     let dense = sgm(&input.left, &input.right, &sgm_params)?;
     let dense_summary = summarize_dense(&dense, &found.mask, &geo, sgm_params.max_disp);
-    let detection = match &input.truth_streak_mask {
-        Some(truth) => Some(score_mask(&found.mask, truth)?),
-        None => None,
+    let (detection, detection_vertical) = match &input.truth_streak_mask {
+        Some(truth) => (
+            Some(score_mask(&found.mask, truth)?),
+            Some(score_mask(
+                &found.mask,
+                &vertical_truth(truth, found.horizon),
+            )?),
+        ),
+        None => (None, None),
     };
     let i = input.rig.intrinsics();
     let report = Report {
@@ -977,6 +1040,7 @@ pub fn analyze(input: &StereoInput, params: &AnalyzeParams) -> Result<Analysis, 
         regions,
         dense: dense_summary,
         detection,
+        detection_vertical,
     };
     Ok(Analysis {
         report,
@@ -1065,7 +1129,8 @@ pub fn write_report_json(path: &Path, report: &Report) -> Result<(), ReportError
 
 /// Writes everything into `dir` (created if missing): `report.json`, `streak<i>.png` and
 /// `<region>.png` (disparity against row), `depth.png` (the SGM disparity, i.e. inverse
-/// depth, turbo colours, with the streak pixels outlined red) and `side_view.png` (the SGM
+/// depth, turbo colours, with the streak pixels outlined red), `streak_mask.png` (the
+/// detector's streak pixels, white) and `side_view.png` (the SGM
 /// point cloud, Z forward against Y up, streak points red). Returns the files written.
 pub fn write_outputs(
     dir: &Path,
@@ -1122,6 +1187,12 @@ pub fn write_outputs(
     }
     let path = dir.join("depth.png");
     save_rgb8_png(&path, &img)?;
+    written.push(path);
+    let path = dir.join("streak_mask.png");
+    analysis
+        .streak_mask
+        .save_png(&path)
+        .map_err(|e| write_err(&path)(e.to_string()))?;
     written.push(path);
     // Side view of the point cloud.
     let (mut other, mut streak) = (Vec::new(), Vec::new());
@@ -1227,6 +1298,12 @@ pub fn summary_table(report: &Report) -> String {
             d.precision, d.recall, d.detected, d.truth
         ));
     }
+    if let Some(d) = &report.detection_vertical {
+        s.push_str(&format!(
+            "  against its road streaks only (below the horizon, components taller than wide): precision {:.2}, recall {:.2} ({} true pixels)\n",
+            d.precision, d.recall, d.truth
+        ));
+    }
     s
 }
 
@@ -1246,12 +1323,13 @@ mod tests {
         )
         .unwrap();
         let geo = Geometry::new(&rig).unwrap();
-        let light = |x: f32, y: f32, z: f32| LightRecord::Point {
+        let light_i = |x: f32, y: f32, z: f32, i: f32| LightRecord::Point {
             // World -Z is road +Z for a rig looking along -Z.
             position: streaks_stereo::rigfile::Placed::point(Vec3::new(x, y, -z), Some(&geo.road)),
-            intensity: [1.0; 3],
+            intensity: [i; 3],
             range: None,
         };
+        let light = |x: f32, y: f32, z: f32| light_i(x, y, z, 1.0);
         let lights = vec![light(-3.0, 5.0, 30.0), light(1.0, 4.0, 20.0)];
         // The second light's mirror image (1, -4, 20) seen from (0, 1.5, 0): x = 160 + 15,
         // y = 120 + 300 * 5.5 / 20 = 202.5. A vertical streak through it.
@@ -1269,6 +1347,14 @@ mod tests {
         assert_eq!(m.index, 1);
         assert!(m.distance_px < 1.5, "{m:?}");
         assert!((m.mirror_px[1] - 202.5).abs() < 1e-3);
+        // A second light in the same column farther away (mirror image at x 175, y 175): the
+        // one with the stronger predicted streak wins, whichever lines up more closely.
+        for (i, want) in [(0.01f32, 1usize), (100.0, 2)] {
+            let mut lights = lights.clone();
+            lights.push(light_i(1.5, 4.0, 30.0, i));
+            let m = match_light(&streak, &lights, &geo, 4.0).expect("matched");
+            assert_eq!(m.index, want, "intensity {i}: {m:?}");
+        }
         // Too far from every axis: no match.
         let off = Streak {
             axis_a: 260.0,
