@@ -47,7 +47,7 @@ use crate::bsdf::Bsdf;
 use crate::camera::Camera;
 use crate::film::{Film, Pixel};
 use crate::geometry::{offset_ray_origin, Frame, Ray};
-use crate::light::{emitted_radiance, LightSampler};
+use crate::light::{emitted_radiance, LightSampler, Receiver, Visibility};
 use crate::output::RgbImage;
 use crate::sampling::{power_heuristic, Sampler};
 use crate::scene::Scene;
@@ -228,7 +228,7 @@ fn trace_path(
     // Number of segments before the current one (Mitsuba's `depth`).
     let mut depth = 0u32;
     // The previous vertex and the BSDF-sampling density of the current direction, for MIS.
-    let mut prev_p = ray.origin;
+    let mut prev: Option<Receiver> = None;
     let mut prev_bsdf_pdf = 0.0f32;
     // At the first hit: the BSDF and frame, for the specular layer of a hit emitter.
     let mut first_bsdf: Option<(Bsdf, Frame, Vec3)> = None;
@@ -246,9 +246,7 @@ fn trace_path(
             if depth == 0 {
                 out.radiance += throughput * le;
             } else {
-                let light_pdf = lights.light_of_triangle(hit.triangle).map_or(0.0, |i| {
-                    lights.pmf(prev_p, i) * scene.lights[i].pdf_li(scene, prev_p, &hit)
-                });
+                let light_pdf = prev.map_or(0.0, |rx| lights.pdf_li(scene, &rx, &hit));
                 let weight = power_heuristic(1.0, prev_bsdf_pdf, 1.0, light_pdf);
                 out.radiance += throughput * le * weight;
                 if let (1, Some((bsdf, frame, wo_local))) = (depth, first_bsdf) {
@@ -285,38 +283,62 @@ fn trace_path(
         // 2. Next-event estimation (always draws 3 numbers, so the dimensions stay aligned).
         let u_light = sampler.next_1d();
         let u_point = sampler.next_2d();
-        if let Some((index, pmf)) = lights.sample(hit.p, u_light) {
-            let light = &scene.lights[index];
-            if let Some(ls) = light.sample_li(scene, hit.p, u_point) {
-                let wi_local = frame.to_local(ls.wi);
-                if wi_local.z > 0.0 && ng.dot(ls.wi) > 0.0 {
-                    let f = bsdf.eval_lobes(wo_local, wi_local);
-                    let total = f.total();
-                    if total.max_element() > 0.0 {
-                        let origin = offset_ray_origin(hit.p, ng, ls.wi);
-                        let t_max = if ls.dist.is_finite() {
-                            (ls.dist - (origin - hit.p).length()) * (1.0 - SHADOW_EPSILON)
-                        } else {
-                            f32::INFINITY
-                        };
-                        out.rays += 1;
-                        let shadow = Ray {
-                            origin,
-                            direction: ls.wi,
-                            t_max,
-                        };
-                        if !scene.occluded(&shadow) {
-                            let light_pdf = pmf * ls.pdf;
-                            let weight = if ls.delta {
-                                1.0
+        let rx = Receiver {
+            p: hit.p,
+            ng,
+            frame,
+            wo_local,
+            bsdf,
+        };
+        if let Some(ls) = lights.sample_li(scene, &rx, u_light, u_point) {
+            let wi_local = frame.to_local(ls.wi);
+            if wi_local.z > 0.0 && ng.dot(ls.wi) > 0.0 {
+                let f = bsdf.eval_lobes(wo_local, wi_local);
+                let total = f.total();
+                if total.max_element() > 0.0 {
+                    let origin = offset_ray_origin(hit.p, ng, ls.wi);
+                    out.rays += 1;
+                    let li = match ls.visibility {
+                        Visibility::ShadowRay => {
+                            let t_max = if ls.dist.is_finite() {
+                                (ls.dist - (origin - hit.p).length()) * (1.0 - SHADOW_EPSILON)
                             } else {
-                                power_heuristic(1.0, light_pdf, 1.0, bsdf.pdf(wo_local, wi_local))
+                                f32::INFINITY
                             };
-                            let scale = ls.li * (wi_local.z * weight / light_pdf);
-                            out.radiance += throughput * total * scale;
-                            if depth == 0 && want_specular {
-                                out.specular += f.glossy * scale;
+                            let shadow = Ray {
+                                origin,
+                                direction: ls.wi,
+                                t_max,
+                            };
+                            if scene.occluded(&shadow) {
+                                Vec3::ZERO
+                            } else {
+                                ls.li
                             }
+                        }
+                        Visibility::FirstHit { emitter } => {
+                            match scene.intersect(&Ray::new(origin, ls.wi)) {
+                                Some(h)
+                                    if lights
+                                        .emitter_of(h.triangle)
+                                        .is_some_and(|(e, _)| e == emitter as usize) =>
+                                {
+                                    emitted_radiance(scene, &h, -ls.wi)
+                                }
+                                _ => Vec3::ZERO,
+                            }
+                        }
+                    };
+                    if li.max_element() > 0.0 {
+                        let weight = if ls.delta {
+                            1.0
+                        } else {
+                            power_heuristic(1.0, ls.pdf, 1.0, bsdf.pdf(wo_local, wi_local))
+                        };
+                        let scale = li * (wi_local.z * weight / ls.pdf);
+                        out.radiance += throughput * total * scale;
+                        if depth == 0 && want_specular {
+                            out.specular += f.glossy * scale;
                         }
                     }
                 }
@@ -337,7 +359,7 @@ fn trace_path(
         if depth == 0 && want_specular {
             first_bsdf = Some((bsdf, frame, wo_local));
         }
-        prev_p = hit.p;
+        prev = Some(rx);
         prev_bsdf_pdf = bs.pdf;
         ray = Ray::new(offset_ray_origin(hit.p, ng, wi), wi);
         depth += 1;

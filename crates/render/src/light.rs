@@ -24,9 +24,15 @@
 //! Triangles are sampled uniformly by area and the density converted to solid angle,
 //! `pdf = d^2 / (|cos theta_light| A)`.
 
-use crate::sampling::{luminance, square_to_uniform_triangle, DiscreteDistribution};
+use crate::bsdf::Bsdf;
+use crate::geometry::Frame;
+use crate::sampling::{
+    luminance, square_to_uniform_cone, square_to_uniform_cone_pdf, square_to_uniform_triangle,
+    DiscreteDistribution, ONE_MINUS_EPSILON,
+};
 use crate::scene::{Scene, SurfaceHit};
 use glam::{Vec2, Vec3};
+use std::collections::HashMap;
 use std::f32::consts::PI;
 
 /// A light source.
@@ -83,6 +89,8 @@ pub struct LightSample {
     pub pdf: f32,
     /// Whether the light is a delta light (not reachable by BSDF sampling: no MIS).
     pub delta: bool,
+    /// How to test that the light arrives.
+    pub visibility: Visibility,
 }
 
 /// The KHR_lights_punctual range window `clamp(1 - (d/range)^4, 0, 1)`; 1 without a range.
@@ -172,6 +180,7 @@ impl Light {
                 li: irradiance,
                 pdf: 1.0,
                 delta: true,
+                visibility: Visibility::ShadowRay,
             }),
             Light::Triangle { triangle } => {
                 let v = triangle_vertices(scene, triangle);
@@ -204,6 +213,7 @@ impl Light {
                     li,
                     pdf,
                     delta: false,
+                    visibility: Visibility::ShadowRay,
                 })
             }
         }
@@ -278,73 +288,510 @@ fn punctual(
         li: intensity * (scale / dist2),
         pdf: 1.0,
         delta: true,
+        visibility: Visibility::ShadowRay,
     })
 }
 
-/// Chooses the light for next-event estimation.
+/// How the integrator decides whether a [`LightSample`] is visible.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Visibility {
+    /// The sample is a point at `dist`: trace a shadow ray (any hit) up to it; `li` is the
+    /// light's radiance there.
+    ShadowRay,
+    /// The sample is only a direction toward emitter `emitter` of the [`LightSampler`]
+    /// (sampled uniformly in the cone that bounds it): trace a closest-hit ray; the light
+    /// arrives if the ray first hits one of that emitter's triangles, with the radiance that
+    /// triangle emits toward the shading point (`li` is zero and `dist` infinite until then).
+    FirstHit {
+        /// Index of the emitter among the sampler's emitters.
+        emitter: u32,
+    },
+}
+
+/// What the light sampler may know about the shading point: position, geometric normal,
+/// shading frame, outgoing direction and BSDF. With few emitters the choice of light weighs
+/// each by the BSDF toward it (see [`LightSampler`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Receiver {
+    /// Shading point.
+    pub p: Vec3,
+    /// Geometric normal, on the side of `wo`.
+    pub ng: Vec3,
+    /// Shading frame (normal on the side of `wo`).
+    pub frame: Frame,
+    /// Outgoing direction in the shading frame.
+    pub wo_local: Vec3,
+    /// BSDF at the point.
+    pub bsdf: Bsdf,
+}
+
+/// Up to this many emitters the light choice weighs each by the BSDF toward it; beyond, it is
+/// by power alone (the per-point weights cost one BSDF evaluation per emitter).
+pub const MAX_BSDF_AWARE_EMITTERS: usize = 16;
+
+/// Share of the light choice made by irradiance alone when it is BSDF-aware (defensive
+/// sampling: every emitter that can light the point keeps a positive probability even where
+/// the BSDF toward its centre is zero).
+const DEFENSIVE_SHARE: f32 = 0.1;
+
+/// An emitter mesh is sampled by its bounding cone when its area is at least this many times
+/// `pi r^2` (r: its bounding radius): a closed, roughly round shape (a tessellated sphere has
+/// about 4) fills its cone; a flat lens (at most 1) would waste most cone samples.
+const COMPACT_AREA_RATIO: f32 = 2.0;
+
+/// What the sampler chooses between: one punctual light, or one emitter mesh.
+#[derive(Clone, Debug)]
+enum Emitter {
+    /// A point, spot or directional light: index into `scene.lights`.
+    Punctual(u32),
+    /// Connected emissive triangles of one material.
+    Mesh(MeshEmitter),
+}
+
+/// Emissive triangles that share vertices and a material: a lamp's bulb, a lens, a window.
+#[derive(Clone, Debug)]
+struct MeshEmitter {
+    /// Indices into `scene.lights` of its [`Light::Triangle`]s.
+    lights: Vec<u32>,
+    /// Choice of triangle for area sampling, by power.
+    distribution: DiscreteDistribution,
+    /// Total power (luminance, W).
+    power: f32,
+    /// Centre of its bounding sphere.
+    centre: Vec3,
+    /// Radius of its bounding sphere (slightly inflated, so the cone bounds every triangle).
+    radius: f32,
+    /// Whether it is sampled by its bounding cone from outside the bounding sphere.
+    cone: bool,
+    /// For a flat one-sided emitter: its plane `(n, n . v)`; points behind it get no light.
+    front: Option<(Vec3, f32)>,
+}
+
+/// Chooses a light and a sample on it for next-event estimation, and gives the density of that
+/// choice for multiple importance sampling.
 ///
-/// Strategy: proportional to each light's [`Light::power`] (pbrt's `PowerLightSampler`). A
-/// street has a few bright lamps and many dim emissive triangles (windows, signs); choosing
-/// by power spends the shadow rays where the light is, while uniform choice would waste most
-/// of them on dim emitters. The choice ignores the shading point today; [`LightSampler::sample`]
-/// and [`LightSampler::pmf`] take it anyway so that a spatial strategy (a light BVH or
-/// per-region distributions) can replace this one without touching the integrator.
+/// Emissive triangles are grouped into emitters: the connected pieces (shared vertex
+/// positions) of each emissive material. Point, spot and directional lights are emitters of
+/// their own.
+///
+/// Which emitter: with at most [`MAX_BSDF_AWARE_EMITTERS`] emitters, in proportion to
+/// `E_i (0.9 F_i / sum E F + 0.1 / sum E)`-style weights: `E_i` is the irradiance the emitter
+/// would give at the point (intensity, spot falloff and range window over `d^2` for punctual
+/// lights, the directional irradiance, `power / (4 pi max(d, r)^2)` for a mesh of bounding
+/// radius `r`, zero behind a flat one-sided mesh) and `F_i` the luminance of the BSDF times the
+/// cosine toward the emitter's centre. On a glossy wet road this sends the shadow rays of a
+/// streak's pixels to the lamp that makes the streak. With more emitters, by power alone
+/// (pbrt's `PowerLightSampler`), independent of the point.
+///
+/// Where on it: punctual lights by [`Light::sample_li`]; a compact emitter mesh (area at
+/// least `2 pi r^2`, e.g. a tessellated sphere lamp) seen from outside its bounding sphere
+/// uniformly in the cone of directions that bounds it ([`Visibility::FirstHit`]: no sample
+/// is wasted on the back of the sphere); other meshes, or points inside the bounding sphere, by
+/// choosing a triangle by power and a point on it uniformly by area.
+///
+/// Every choice is a deterministic function of the point, so [`LightSampler::sample_li`] and
+/// [`LightSampler::pdf_li`] agree exactly, which MIS needs.
 #[derive(Clone, Debug)]
 pub struct LightSampler {
-    /// Power distribution over `scene.lights` (`None`: no light emits).
-    distribution: Option<DiscreteDistribution>,
-    /// For each scene triangle, the index of its `Light::Triangle` (`u32::MAX`: none).
-    light_of_triangle: Vec<u32>,
+    /// The emitters.
+    emitters: Vec<Emitter>,
+    /// Power distribution over `emitters` (`None`: nothing emits).
+    power: Option<DiscreteDistribution>,
+    /// Whether the choice weighs the BSDF (few emitters).
+    bsdf_aware: bool,
+    /// For each scene triangle: `(emitter, index within the emitter)`, `u32::MAX` if none.
+    emitter_of_triangle: Vec<(u32, u32)>,
+}
+
+/// Positive finite power, else 0.
+fn clean_power(p: f32) -> f32 {
+    if p.is_finite() {
+        p.max(0.0)
+    } else {
+        0.0
+    }
+}
+
+/// Groups the scene's [`Light::Triangle`]s by material and shared vertex positions (union-find).
+fn group_triangle_lights(scene: &Scene) -> Vec<Vec<u32>> {
+    let tri_lights: Vec<(u32, u32)> = scene
+        .lights
+        .iter()
+        .enumerate()
+        .filter_map(|(i, l)| match *l {
+            Light::Triangle { triangle } => Some((i as u32, triangle)),
+            _ => None,
+        })
+        .collect();
+    let mut parent: Vec<usize> = (0..tri_lights.len()).collect();
+    fn find(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    let mut first_at: HashMap<(u32, [u32; 3]), usize> = HashMap::new();
+    for (k, &(_, triangle)) in tri_lights.iter().enumerate() {
+        let material = scene.triangle_materials[triangle as usize];
+        for v in scene.triangles[triangle as usize] {
+            let key = (
+                material,
+                scene.positions[v as usize].to_array().map(f32::to_bits),
+            );
+            let other = *first_at.entry(key).or_insert(k);
+            let (a, b) = (find(&mut parent, k), find(&mut parent, other));
+            if a != b {
+                parent[a.max(b)] = a.min(b);
+            }
+        }
+    }
+    let mut groups: Vec<Vec<u32>> = Vec::new();
+    let mut group_of_root: HashMap<usize, usize> = HashMap::new();
+    for (k, &(light, _)) in tri_lights.iter().enumerate() {
+        let root = find(&mut parent, k);
+        let g = *group_of_root.entry(root).or_insert_with(|| {
+            groups.push(Vec::new());
+            groups.len() - 1
+        });
+        groups[g].push(light);
+    }
+    groups
+}
+
+impl MeshEmitter {
+    /// Builds the emitter of the given triangle lights; `None` if none of them emits.
+    fn new(scene: &Scene, lights: Vec<u32>) -> Option<Self> {
+        let powers: Vec<f32> = lights
+            .iter()
+            .map(|&i| clean_power(scene.lights[i as usize].power(scene)))
+            .collect();
+        let distribution = DiscreteDistribution::new(&powers)?;
+        let triangles: Vec<u32> = lights
+            .iter()
+            .map(|&i| match scene.lights[i as usize] {
+                Light::Triangle { triangle } => triangle,
+                _ => unreachable!("mesh emitters hold triangle lights only"),
+            })
+            .collect();
+        let (lo, hi) = triangles
+            .iter()
+            .flat_map(|&t| triangle_vertices(scene, t))
+            .fold(
+                (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+                |(lo, hi), v| (lo.min(v), hi.max(v)),
+            );
+        let centre = 0.5 * (lo + hi);
+        let radius = triangles
+            .iter()
+            .flat_map(|&t| triangle_vertices(scene, t))
+            .map(|v| v.distance(centre))
+            .fold(0.0f32, f32::max);
+        // Inflate a little so that rounding never leaves a triangle outside the cone.
+        let radius = radius * (1.0 + 1e-4) + 1e-6 * centre.abs().max_element();
+        let area: f32 = triangles
+            .iter()
+            .map(|&t| scene.triangle_normal_area(t).1)
+            .sum();
+        let (n0, _) = scene.triangle_normal_area(triangles[0]);
+        let one_sided =
+            !scene.materials[scene.triangle_materials[triangles[0] as usize] as usize].double_sided;
+        let flat = triangles.iter().all(|&t| {
+            let (n, _) = scene.triangle_normal_area(t);
+            n.dot(n0) > 1.0 - 1e-5
+                && (triangle_vertices(scene, t)[0] - centre).dot(n0).abs()
+                    <= 1e-4 * radius.max(1e-6)
+        });
+        let front = (one_sided && flat).then(|| (n0, n0.dot(centre)));
+        Some(Self {
+            lights,
+            distribution,
+            power: powers.iter().sum(),
+            centre,
+            radius,
+            cone: area >= COMPACT_AREA_RATIO * PI * radius * radius,
+            front,
+        })
+    }
+
+    /// The irradiance-like weight `power / (4 pi max(d, r)^2)`, zero behind a flat one-sided
+    /// emitter.
+    #[inline]
+    fn irradiance(&self, p: Vec3) -> f32 {
+        if let Some((n, offset)) = self.front {
+            if n.dot(p) <= offset {
+                return 0.0;
+            }
+        }
+        let d2 = (self.centre - p)
+            .length_squared()
+            .max(self.radius * self.radius);
+        self.power / (4.0 * PI * d2)
+    }
+
+    /// `1 - cos` of the half-angle of the bounding cone seen from `p`, when `p` is outside the
+    /// bounding sphere and the emitter is sampled by its cone.
+    #[inline]
+    fn cone_from(&self, p: Vec3) -> Option<(Vec3, f32)> {
+        if !self.cone {
+            return None;
+        }
+        let d = self.centre - p;
+        let dist2 = d.length_squared();
+        let r2 = self.radius * self.radius;
+        if dist2 <= r2 * (1.0 + 1e-3) {
+            return None;
+        }
+        let sin2 = r2 / dist2;
+        // 1 - cos without cancellation for narrow cones.
+        let one_minus_cos = sin2 / (1.0 + (1.0 - sin2).sqrt());
+        Some((d / dist2.sqrt(), one_minus_cos))
+    }
+
+    /// A sample from `p` (see [`LightSampler`]); `u_tri` chooses the triangle for area sampling.
+    fn sample_li(
+        &self,
+        scene: &Scene,
+        emitter: u32,
+        p: Vec3,
+        u_tri: f32,
+        u: Vec2,
+    ) -> Option<LightSample> {
+        if let Some((axis, one_minus_cos)) = self.cone_from(p) {
+            let wi = Frame::from_normal(axis).to_world(square_to_uniform_cone(u, one_minus_cos));
+            return Some(LightSample {
+                wi,
+                dist: f32::INFINITY,
+                li: Vec3::ZERO,
+                pdf: square_to_uniform_cone_pdf(Vec3::Z, one_minus_cos),
+                delta: false,
+                visibility: Visibility::FirstHit { emitter },
+            });
+        }
+        let (k, pmf) = self.distribution.sample(u_tri);
+        let mut ls = scene.lights[self.lights[k] as usize].sample_li(scene, p, u)?;
+        ls.pdf *= pmf;
+        Some(ls)
+    }
+
+    /// The density with which [`MeshEmitter::sample_li`] from `p` returns the direction to
+    /// `hit`, a point on its triangle number `k`.
+    fn pdf_li(&self, scene: &Scene, p: Vec3, k: usize, hit: &SurfaceHit) -> f32 {
+        if let Some((_, one_minus_cos)) = self.cone_from(p) {
+            return square_to_uniform_cone_pdf(Vec3::Z, one_minus_cos);
+        }
+        self.distribution.pmf(k) * scene.lights[self.lights[k] as usize].pdf_li(scene, p, hit)
+    }
 }
 
 impl LightSampler {
-    /// Builds the power distribution of `scene.lights`.
+    /// Groups the emissive triangles into emitters and builds the power distribution.
     pub fn new(scene: &Scene) -> Self {
-        let powers: Vec<f32> = scene
+        let mut emitters: Vec<Emitter> = scene
             .lights
             .iter()
-            .map(|l| {
-                let p = l.power(scene);
-                if p.is_finite() {
-                    p.max(0.0)
-                } else {
-                    0.0
-                }
-            })
+            .enumerate()
+            .filter(|(_, l)| l.is_delta())
+            .map(|(i, _)| Emitter::Punctual(i as u32))
             .collect();
-        let mut light_of_triangle = vec![u32::MAX; scene.triangles.len()];
-        for (i, light) in scene.lights.iter().enumerate() {
-            if let Light::Triangle { triangle } = *light {
-                light_of_triangle[triangle as usize] = i as u32;
+        emitters.extend(
+            group_triangle_lights(scene)
+                .into_iter()
+                .filter_map(|lights| MeshEmitter::new(scene, lights))
+                .map(Emitter::Mesh),
+        );
+        let mut emitter_of_triangle = vec![(u32::MAX, u32::MAX); scene.triangles.len()];
+        for (e, emitter) in emitters.iter().enumerate() {
+            if let Emitter::Mesh(m) = emitter {
+                for (k, &light) in m.lights.iter().enumerate() {
+                    if let Light::Triangle { triangle } = scene.lights[light as usize] {
+                        emitter_of_triangle[triangle as usize] = (e as u32, k as u32);
+                    }
+                }
             }
         }
+        let powers: Vec<f32> = emitters
+            .iter()
+            .map(|e| match e {
+                Emitter::Punctual(i) => clean_power(scene.lights[*i as usize].power(scene)),
+                Emitter::Mesh(m) => m.power,
+            })
+            .collect();
         Self {
-            distribution: DiscreteDistribution::new(&powers),
-            light_of_triangle,
+            bsdf_aware: emitters.len() <= MAX_BSDF_AWARE_EMITTERS,
+            power: DiscreteDistribution::new(&powers),
+            emitters,
+            emitter_of_triangle,
         }
     }
 
-    /// Picks a light for shading point `p` with `u` in [0, 1): `(light index, probability)`;
-    /// `None` when the scene has no light with positive power.
-    #[inline]
-    pub fn sample(&self, p: Vec3, u: f32) -> Option<(usize, f32)> {
-        let _ = p;
-        let (i, pmf) = self.distribution.as_ref()?.sample(u);
-        (pmf > 0.0).then_some((i, pmf))
+    /// Number of emitters (punctual lights plus emitter meshes).
+    pub fn emitter_count(&self) -> usize {
+        self.emitters.len()
     }
 
-    /// The probability that [`LightSampler::sample`] at `p` picks light `light`.
+    /// The irradiance-like weight `E_i` of emitter `e` at `p` (see [`LightSampler`]).
     #[inline]
-    pub fn pmf(&self, p: Vec3, light: usize) -> f32 {
-        let _ = p;
-        self.distribution.as_ref().map_or(0.0, |d| d.pmf(light))
+    fn irradiance(&self, scene: &Scene, e: usize, p: Vec3) -> f32 {
+        match &self.emitters[e] {
+            Emitter::Mesh(m) => m.irradiance(p),
+            Emitter::Punctual(i) => {
+                // A point sample of a punctual light is its irradiance at p.
+                match scene.lights[*i as usize].sample_li(scene, p, Vec2::ZERO) {
+                    Some(ls) => clean_power(luminance(ls.li)),
+                    None => 0.0,
+                }
+            }
+        }
     }
 
-    /// The light index of emissive triangle `triangle`, if it is one.
+    /// The luminance of `f * cos` toward emitter `e` from the receiver (0 below its surface).
     #[inline]
-    pub fn light_of_triangle(&self, triangle: u32) -> Option<usize> {
-        match self.light_of_triangle.get(triangle as usize) {
-            Some(&i) if i != u32::MAX => Some(i as usize),
+    fn bsdf_weight(&self, scene: &Scene, e: usize, rx: &Receiver) -> f32 {
+        let wi = match &self.emitters[e] {
+            Emitter::Mesh(m) => (m.centre - rx.p).normalize_or_zero(),
+            Emitter::Punctual(i) => match scene.lights[*i as usize] {
+                Light::Directional { direction, .. } => -direction,
+                Light::Point { position, .. } | Light::Spot { position, .. } => {
+                    (position - rx.p).normalize_or_zero()
+                }
+                Light::Triangle { .. } => Vec3::ZERO,
+            },
+        };
+        let wi_local = rx.frame.to_local(wi);
+        if wi_local.z <= 0.0 || rx.ng.dot(wi) <= 0.0 {
+            return 0.0;
+        }
+        clean_power(luminance(rx.bsdf.eval_lobes(rx.wo_local, wi_local).total()) * wi_local.z)
+    }
+
+    /// The per-point weights `E_i` and `E_i F_i` of every emitter, with their sums.
+    #[inline]
+    fn weights(
+        &self,
+        scene: &Scene,
+        rx: &Receiver,
+    ) -> (
+        [f32; MAX_BSDF_AWARE_EMITTERS],
+        [f32; MAX_BSDF_AWARE_EMITTERS],
+        f32,
+        f32,
+    ) {
+        let mut e_w = [0.0f32; MAX_BSDF_AWARE_EMITTERS];
+        let mut ef_w = [0.0f32; MAX_BSDF_AWARE_EMITTERS];
+        let (mut e_sum, mut ef_sum) = (0.0f32, 0.0f32);
+        for i in 0..self.emitters.len() {
+            let e = self.irradiance(scene, i, rx.p);
+            if e > 0.0 {
+                e_w[i] = e;
+                ef_w[i] = e * self.bsdf_weight(scene, i, rx);
+                e_sum += e_w[i];
+                ef_sum += ef_w[i];
+            }
+        }
+        (e_w, ef_w, e_sum, ef_sum)
+    }
+
+    /// Chooses an emitter for the receiver: `(emitter, probability, u rescaled within it)`.
+    #[inline]
+    fn choose(&self, scene: &Scene, rx: &Receiver, u: f32) -> Option<(usize, f32, f32)> {
+        if !self.bsdf_aware {
+            let (i, pmf, reused) = self.power.as_ref()?.sample_reuse(u);
+            return (pmf > 0.0).then_some((i, pmf, reused));
+        }
+        let (e_w, ef_w, e_sum, ef_sum) = self.weights(scene, rx);
+        if !(e_sum > 0.0 && e_sum.is_finite() && ef_sum.is_finite()) {
+            return None;
+        }
+        // The mixture: with probability `share` by E alone, else by E F.
+        let share = if ef_sum > 0.0 { DEFENSIVE_SHARE } else { 1.0 };
+        let (weights, sum, u_in) = if u < share {
+            (&e_w, e_sum, u / share)
+        } else {
+            (&ef_w, ef_sum, (u - share) / (1.0 - share))
+        };
+        let target = u_in * sum;
+        let n = self.emitters.len();
+        let mut acc = 0.0f32;
+        let mut chosen = None;
+        for (i, &w) in weights[..n].iter().enumerate() {
+            if w > 0.0 {
+                chosen = Some(i);
+                if target < acc + w {
+                    break;
+                }
+            }
+            acc += w;
+        }
+        let i = chosen?;
+        let before: f32 = weights[..i].iter().sum();
+        let reused = ((target - before) / weights[i]).clamp(0.0, ONE_MINUS_EPSILON);
+        let pmf = self.mixture_pmf(i, &e_w, &ef_w, e_sum, ef_sum);
+        (pmf > 0.0).then_some((i, pmf, reused))
+    }
+
+    /// The mixture probability of emitter `i` from the per-point weights.
+    #[inline]
+    fn mixture_pmf(&self, i: usize, e_w: &[f32], ef_w: &[f32], e_sum: f32, ef_sum: f32) -> f32 {
+        if ef_sum > 0.0 {
+            DEFENSIVE_SHARE * e_w[i] / e_sum + (1.0 - DEFENSIVE_SHARE) * ef_w[i] / ef_sum
+        } else {
+            e_w[i] / e_sum
+        }
+    }
+
+    /// The probability that [`LightSampler::sample_li`] at the receiver chooses emitter `e`.
+    pub fn emitter_pmf(&self, scene: &Scene, rx: &Receiver, e: usize) -> f32 {
+        if e >= self.emitters.len() {
+            return 0.0;
+        }
+        if !self.bsdf_aware {
+            return self.power.as_ref().map_or(0.0, |d| d.pmf(e));
+        }
+        let (e_w, ef_w, e_sum, ef_sum) = self.weights(scene, rx);
+        if !(e_sum > 0.0 && e_sum.is_finite() && ef_sum.is_finite()) {
+            return 0.0;
+        }
+        self.mixture_pmf(e, &e_w, &ef_w, e_sum, ef_sum)
+    }
+
+    /// Chooses an emitter with `u_light` and samples it with `u` (see [`LightSampler`]). The
+    /// returned `pdf` includes the probability of the choice; `None` when nothing was sampled.
+    pub fn sample_li(
+        &self,
+        scene: &Scene,
+        rx: &Receiver,
+        u_light: f32,
+        u: Vec2,
+    ) -> Option<LightSample> {
+        let (e, pmf, reused) = self.choose(scene, rx, u_light)?;
+        let mut ls = match &self.emitters[e] {
+            Emitter::Punctual(i) => scene.lights[*i as usize].sample_li(scene, rx.p, u)?,
+            Emitter::Mesh(m) => m.sample_li(scene, e as u32, rx.p, reused, u)?,
+        };
+        ls.pdf *= pmf;
+        Some(ls)
+    }
+
+    /// The density (choice included) with which [`LightSampler::sample_li`] at the receiver
+    /// returns the direction toward `hit`, a point on an emissive triangle; 0 if `hit` is not on
+    /// an emitter.
+    pub fn pdf_li(&self, scene: &Scene, rx: &Receiver, hit: &SurfaceHit) -> f32 {
+        let Some((e, k)) = self.emitter_of(hit.triangle) else {
+            return 0.0;
+        };
+        let Emitter::Mesh(m) = &self.emitters[e] else {
+            return 0.0;
+        };
+        self.emitter_pmf(scene, rx, e) * m.pdf_li(scene, rx.p, k, hit)
+    }
+
+    /// The emitter of scene triangle `triangle` and the triangle's index within it, if it is
+    /// emissive.
+    #[inline]
+    pub fn emitter_of(&self, triangle: u32) -> Option<(usize, usize)> {
+        match self.emitter_of_triangle.get(triangle as usize) {
+            Some(&(e, k)) if e != u32::MAX => Some((e as usize, k as usize)),
             _ => None,
         }
     }
@@ -529,73 +976,399 @@ mod tests {
         }
     }
 
+    /// A receiver at `p` on a surface facing +Y with the given BSDF, viewed from `wo`.
+    fn receiver(p: Vec3, bsdf: Bsdf, wo: Vec3) -> Receiver {
+        let frame = Frame::from_normal(Vec3::Y);
+        Receiver {
+            p,
+            ng: Vec3::Y,
+            frame,
+            wo_local: frame.to_local(wo.normalize()),
+            bsdf,
+        }
+    }
+
+    /// Appends a UV sphere (outward winding) of `material` to `parts`.
+    fn sphere(parts: &mut SceneParts, centre: Vec3, r: f32, material: u32) {
+        let (rings, segments) = (12u32, 16u32);
+        let base = parts.positions.len() as u32;
+        for i in 0..=rings {
+            let theta = PI * i as f32 / rings as f32;
+            for j in 0..segments {
+                let phi = 2.0 * PI * j as f32 / segments as f32;
+                parts.positions.push(
+                    centre
+                        + r * Vec3::new(
+                            theta.sin() * phi.cos(),
+                            theta.cos(),
+                            theta.sin() * phi.sin(),
+                        ),
+                );
+            }
+        }
+        let idx = |i: u32, j: u32| base + i * segments + j % segments;
+        for i in 0..rings {
+            for j in 0..segments {
+                let (a, b, c, d) = (idx(i, j), idx(i, j + 1), idx(i + 1, j), idx(i + 1, j + 1));
+                for t in [[a, b, d], [a, d, c]] {
+                    let [p0, p1, p2] = t.map(|v| parts.positions[v as usize]);
+                    let n = (p1 - p0).cross(p2 - p0);
+                    if n.length() > 1e-9 {
+                        // Outward: flip if the winding faces the centre.
+                        let t = if n.dot(p0 - centre) < 0.0 {
+                            [t[0], t[2], t[1]]
+                        } else {
+                            t
+                        };
+                        parts.triangles.push(t);
+                        parts.triangle_materials.push(material);
+                    }
+                }
+            }
+        }
+    }
+
+    /// A sphere lamp of radiance `le` at `centre` over a floor, plus two separate lens quads
+    /// (one-sided, facing down), and the given punctual lights.
+    fn lamp_scene(centre: Vec3, le: f32, punctual: Vec<Light>) -> Scene {
+        let mut lamp = Material::diffuse("lamp", Vec3::ZERO);
+        lamp.emission = Vec3::splat(le);
+        let mut lens = Material::diffuse("lens", Vec3::ZERO);
+        lens.emission = Vec3::splat(3.0);
+        let mut parts = SceneParts {
+            source: "test".into(),
+            materials: vec![Material::diffuse("floor", Vec3::splat(0.5)), lamp, lens],
+            lights: punctual,
+            ..Default::default()
+        };
+        let quad = |parts: &mut SceneParts, c: Vec3, h: f32, up: bool, m: u32| {
+            let b = parts.positions.len() as u32;
+            parts.positions.extend([
+                c + Vec3::new(-h, 0.0, -h),
+                c + Vec3::new(h, 0.0, -h),
+                c + Vec3::new(h, 0.0, h),
+                c + Vec3::new(-h, 0.0, h),
+            ]);
+            // Counter-clockwise seen from above faces +Y.
+            let (t0, t1) = if up {
+                ([b, b + 3, b + 2], [b, b + 2, b + 1])
+            } else {
+                ([b, b + 1, b + 2], [b, b + 2, b + 3])
+            };
+            parts.triangles.extend([t0, t1]);
+            parts.triangle_materials.extend([m, m]);
+        };
+        quad(&mut parts, Vec3::ZERO, 50.0, true, 0);
+        sphere(&mut parts, centre, 0.3, 1);
+        quad(&mut parts, Vec3::new(4.0, 3.0, 0.0), 0.2, false, 2);
+        quad(&mut parts, Vec3::new(-4.0, 3.0, 0.0), 0.2, false, 2);
+        Scene::from_parts(parts).unwrap()
+    }
+
+    /// Irradiance at `p` (normal `n`) from a uniformly emitting polygon of radiance 1
+    /// (Lambert's formula: `E = 1/2 sum_i angle_i (n . unit(v_i x v_{i+1}))`).
+    /// In f64: the terms cancel to a small sum for small, distant polygons.
+    fn polygon_irradiance(p: Vec3, n: Vec3, verts: &[Vec3]) -> f64 {
+        let (p, n) = (p.as_dvec3(), n.as_dvec3());
+        let mut e = 0.0;
+        for i in 0..verts.len() {
+            let a = (verts[i].as_dvec3() - p).normalize();
+            let b = (verts[(i + 1) % verts.len()].as_dvec3() - p).normalize();
+            let angle = a.dot(b).clamp(-1.0, 1.0).acos();
+            e += angle * n.dot(a.cross(b).normalize());
+        }
+        0.5 * e.abs()
+    }
+
+    /// Next-event estimate of the irradiance (`sum L cos / pdf`, emitter meshes only) at the
+    /// receiver, resolving first-hit samples by tracing, with `n * n` stratified samples.
+    fn estimate_irradiance(s: &Scene, ls: &LightSampler, rx: &Receiver, n: usize) -> f64 {
+        let mut sum = 0.0f64;
+        let mut rng = crate::sampling::Pcg32::new(7, 1);
+        for _ in 0..n {
+            for _ in 0..n {
+                let u_light = rng.next_f32();
+                let u = rng.next_2d();
+                let Some(sample) = ls.sample_li(s, rx, u_light, u) else {
+                    continue;
+                };
+                if sample.delta {
+                    continue;
+                }
+                let li = match sample.visibility {
+                    Visibility::ShadowRay => sample.li,
+                    Visibility::FirstHit { emitter } => {
+                        let ray = crate::geometry::Ray::new(rx.p + Vec3::Y * 1e-4, sample.wi);
+                        match s.intersect(&ray) {
+                            Some(h)
+                                if ls.emitter_of(h.triangle).map(|x| x.0)
+                                    == Some(emitter as usize) =>
+                            {
+                                // The density of the first-hit direction is what pdf_li says.
+                                let pdf = ls.pdf_li(s, rx, &h);
+                                assert!(
+                                    (pdf - sample.pdf).abs() <= 1e-3 * sample.pdf,
+                                    "{pdf} {}",
+                                    sample.pdf
+                                );
+                                emitted_radiance(s, &h, -sample.wi)
+                            }
+                            _ => Vec3::ZERO,
+                        }
+                    }
+                };
+                sum += (li.x * sample.wi.dot(rx.ng).max(0.0) / sample.pdf) as f64;
+            }
+        }
+        sum / (n * n) as f64
+    }
+
     #[test]
-    fn selection_pmf_is_proportional_to_power() {
+    fn emissive_triangles_are_grouped_into_emitters() {
         let point = Light::Point {
-            position: Vec3::ZERO,
-            intensity: Vec3::splat(2.0),
+            position: Vec3::new(0.0, 5.0, 0.0),
+            intensity: Vec3::splat(10.0),
             range: None,
         };
-        let spot = Light::Spot {
-            position: Vec3::ZERO,
-            direction: -Vec3::Y,
-            intensity: Vec3::splat(30.0),
-            cos_inner: 0.9,
-            cos_outer: 0.8,
-            range: Some(3.0),
+        let s = lamp_scene(Vec3::new(0.0, 2.0, -3.0), 5.0, vec![point]);
+        let ls = LightSampler::new(&s);
+        // The point light, the sphere, two separate lenses.
+        assert_eq!(ls.emitter_count(), 4);
+        let mut kinds = Vec::new();
+        for e in &ls.emitters {
+            if let Emitter::Mesh(m) = e {
+                kinds.push((m.lights.len(), m.cone, m.front.is_some()));
+            }
+        }
+        kinds.sort();
+        assert_eq!(kinds[0], (2, false, true));
+        assert_eq!(kinds[1], (2, false, true));
+        assert!(kinds[2].0 > 300 && kinds[2].1 && !kinds[2].2, "{kinds:?}");
+        // Every emissive triangle maps back to its emitter.
+        for (i, l) in s.lights.iter().enumerate() {
+            if let Light::Triangle { triangle } = *l {
+                let (e, k) = ls.emitter_of(triangle).unwrap();
+                let Emitter::Mesh(m) = &ls.emitters[e] else {
+                    panic!()
+                };
+                assert_eq!(m.lights[k] as usize, i);
+            }
+        }
+        assert_eq!(ls.emitter_of(0), None);
+    }
+
+    #[test]
+    fn cone_sampling_of_a_sphere_lamp_gives_its_exact_irradiance() {
+        let centre = Vec3::new(0.5, 2.0, -3.0);
+        let s = lamp_scene(centre, 1.0, vec![]);
+        let ls = LightSampler::new(&s);
+        let p = Vec3::new(0.0, 0.0, 0.0);
+        // Exact: the sum over the sphere triangles that face p (a convex polyhedron: they tile
+        // its silhouette once).
+        let mut exact = 0.0f64;
+        for (t, &m) in s.triangle_materials.iter().enumerate() {
+            if m == 1 {
+                let v = triangle_vertices(&s, t as u32);
+                let (n, _) = s.triangle_normal_area(t as u32);
+                if n.dot(p - v[0]) > 0.0 {
+                    exact += polygon_irradiance(p, Vec3::Y, &v);
+                }
+            }
+        }
+        // Lenses add a little; count them with their own exact irradiance.
+        for c in [Vec3::new(4.0, 3.0, 0.0), Vec3::new(-4.0, 3.0, 0.0)] {
+            let h = 0.2;
+            let quad = [
+                c + Vec3::new(-h, 0.0, -h),
+                c + Vec3::new(h, 0.0, -h),
+                c + Vec3::new(h, 0.0, h),
+                c + Vec3::new(-h, 0.0, h),
+            ];
+            exact += 3.0 * polygon_irradiance(p, Vec3::Y, &quad);
+        }
+        for bsdf in [
+            Bsdf::Diffuse(crate::bsdf::Diffuse {
+                kd: Vec3::splat(0.5),
+            }),
+            Bsdf::Ggx(crate::bsdf::Ggx {
+                kd: Vec3::splat(0.05),
+                ks: Vec3::splat(0.5),
+                alpha: 0.1,
+            }),
+        ] {
+            let rx = receiver(p, bsdf, Vec3::new(0.0, 1.0, 6.0));
+            let est = estimate_irradiance(&s, &ls, &rx, 256);
+            assert!(
+                (est - exact).abs() < 5e-3 * exact,
+                "{bsdf:?}: {est} vs {exact}"
+            );
+        }
+    }
+
+    /// The cone samples that reach the sphere lamp cover exactly the solid angle of its
+    /// silhouette: `E[1{hit} / pdf]` against the sum of the solid angles of the triangles that
+    /// face the point (from afar, from close by, from just outside the bounding sphere).
+    #[test]
+    fn cone_samples_cover_the_lamp_silhouette_exactly() {
+        let centre = Vec3::new(0.5, 2.0, -3.0);
+        let s = lamp_scene(centre, 1.0, vec![]);
+        let ls = LightSampler::new(&s);
+        let e = (0..ls.emitter_count())
+            .find(|&e| matches!(&ls.emitters[e], Emitter::Mesh(m) if m.cone))
+            .unwrap();
+        let Emitter::Mesh(m) = &ls.emitters[e] else {
+            unreachable!()
         };
-        let sun = Light::Directional {
-            direction: -Vec3::Y,
-            irradiance: Vec3::splat(0.01),
-        };
-        let dark = Light::Point {
-            position: Vec3::ZERO,
-            intensity: Vec3::ZERO,
-            range: None,
-        };
-        let s = scene(false, vec![point, spot, sun, dark]);
-        let (_, r) = s.bounding_sphere();
-        let (_, area) = s.triangle_normal_area(0);
-        let expected = [
-            4.0 * PI * 2.0,
-            2.0 * PI * (1.0 - 0.85) * 30.0,
-            PI * r * r * 0.01,
-            0.0,
-            PI * area * luminance(Vec3::new(2.0, 1.0, 0.5)),
+        for p in [Vec3::ZERO, centre + Vec3::Z * 4.0, centre - Vec3::Z * 0.35] {
+            let mut rng = crate::sampling::Pcg32::new(3, 4);
+            let n = 200_000;
+            let mut omega = 0.0f64;
+            for _ in 0..n {
+                let sample = m.sample_li(&s, e as u32, p, 0.5, rng.next_2d()).unwrap();
+                assert_eq!(
+                    sample.visibility,
+                    Visibility::FirstHit { emitter: e as u32 }
+                );
+                let hit = s.intersect(&crate::geometry::Ray::new(p, sample.wi));
+                if let Some(h) = hit.filter(|h| ls.emitter_of(h.triangle).map(|x| x.0) == Some(e)) {
+                    assert!(emitted_radiance(&s, &h, -sample.wi).x > 0.0);
+                    omega += 1.0 / sample.pdf as f64;
+                }
+            }
+            let omega = omega / n as f64;
+            let mut exact = 0.0f64;
+            for (t, &material) in s.triangle_materials.iter().enumerate() {
+                let (normal, _) = s.triangle_normal_area(t as u32);
+                let v = triangle_vertices(&s, t as u32).map(|x| x - p);
+                if material == 1 && normal.dot(-v[0]) > 0.0 {
+                    exact += solid_angle(v[0], v[1], v[2]) as f64;
+                }
+            }
+            assert!(
+                (omega / exact - 1.0).abs() < 1.5e-3,
+                "{p}: {omega} vs {exact}"
+            );
+        }
+    }
+
+    #[test]
+    fn emitter_choice_is_a_distribution_and_follows_the_bsdf() {
+        let lights = vec![
+            Light::Point {
+                position: Vec3::new(3.0, 4.0, -10.0),
+                intensity: Vec3::splat(40.0),
+                range: None,
+            },
+            Light::Spot {
+                position: Vec3::new(0.0, 4.0, 0.0),
+                direction: -Vec3::Y,
+                intensity: Vec3::splat(30.0),
+                cos_inner: 0.9,
+                cos_outer: 0.8,
+                range: None,
+            },
+            Light::Directional {
+                direction: -Vec3::Y,
+                irradiance: Vec3::splat(0.01),
+            },
         ];
-        assert_eq!(s.lights.len(), expected.len());
-        let total: f32 = expected.iter().sum();
-        let sampler = LightSampler::new(&s);
-        for (i, e) in expected.iter().enumerate() {
-            assert!(
-                (sampler.pmf(Vec3::ZERO, i) - e / total).abs() < 1e-5,
-                "light {i}"
-            );
+        let s = lamp_scene(Vec3::new(-3.0, 2.0, -10.0), 50.0, lights);
+        let ls = LightSampler::new(&s);
+        let n_e = ls.emitter_count();
+        assert_eq!(n_e, 6);
+        let glossy = Bsdf::Ggx(crate::bsdf::Ggx {
+            kd: Vec3::splat(0.02),
+            ks: Vec3::splat(0.6),
+            alpha: 0.05,
+        });
+        // Receivers on the mirror paths of the sphere and of the point light, seen from the eye.
+        let eye = Vec3::new(0.0, 1.5, 0.0);
+        let mirror = |l: Vec3| {
+            let t = eye.y / (eye.y + l.y);
+            eye + (Vec3::new(l.x, 0.0, l.z) - Vec3::new(eye.x, 0.0, eye.z)) * t - Vec3::Y * eye.y
+        };
+        let on_sphere = mirror(Vec3::new(-3.0, 2.0, -10.0));
+        let on_point = mirror(Vec3::new(3.0, 4.0, -10.0));
+        for (p, favoured) in [(on_sphere, 3usize), (on_point, 0usize)] {
+            let rx = receiver(p, glossy, eye - p);
+            let pmfs: Vec<f32> = (0..n_e).map(|e| ls.emitter_pmf(&s, &rx, e)).collect();
+            let total: f32 = pmfs.iter().sum();
+            assert!((total - 1.0).abs() < 1e-5, "{pmfs:?}");
+            // The spot (emitter 1) lights its cone only, which holds the second point only.
+            assert_eq!(pmfs[1] == 0.0, favoured == 3, "{pmfs:?}");
+            // The lamp whose streak this is gets most of the samples.
+            let favoured = if favoured == 3 {
+                (0..n_e)
+                    .find(|&e| matches!(&ls.emitters[e], Emitter::Mesh(m) if m.cone))
+                    .unwrap()
+            } else {
+                favoured
+            };
+            assert!(pmfs[favoured] > 0.8, "{favoured} {pmfs:?}");
+            // Sampling frequencies follow the pmf.
+            let n = 20_000;
+            let mut counts = vec![0usize; n_e];
+            for k in 0..n {
+                let u = (k as f32 + 0.5) / n as f32;
+                let (e, pmf, reused) = ls.choose(&s, &rx, u).unwrap();
+                assert!((pmf - pmfs[e]).abs() < 1e-6 && (0.0..1.0).contains(&reused));
+                counts[e] += 1;
+            }
+            for e in 0..n_e {
+                assert!((counts[e] as f32 / n as f32 - pmfs[e]).abs() < 1e-3, "{e}");
+            }
         }
-        // Sampling frequencies follow the pmf; the dark light is never chosen.
-        let n = 10_000;
-        let mut counts = [0usize; 5];
-        for k in 0..n {
-            let (i, pmf) = sampler
-                .sample(Vec3::ZERO, (k as f32 + 0.5) / n as f32)
-                .unwrap();
-            assert_eq!(pmf, sampler.pmf(Vec3::ZERO, i));
-            counts[i] += 1;
+        // Below a one-sided lens nothing; above it (behind its front face), the lens gets 0.
+        let above = receiver(Vec3::new(4.0, 3.5, 0.0), glossy, Vec3::Y);
+        for e in 0..n_e {
+            if let Emitter::Mesh(m) = &ls.emitters[e] {
+                if m.front.is_some() && m.centre.x > 0.0 {
+                    assert_eq!(ls.emitter_pmf(&s, &above, e), 0.0);
+                }
+            }
         }
-        for (i, e) in expected.iter().enumerate() {
-            assert!(
-                (counts[i] as f32 / n as f32 - e / total).abs() < 2e-3,
-                "light {i}"
-            );
+    }
+
+    #[test]
+    fn many_emitters_are_chosen_by_power() {
+        let lights: Vec<Light> = (0..MAX_BSDF_AWARE_EMITTERS + 1)
+            .map(|i| Light::Point {
+                position: Vec3::new(i as f32, 3.0, 0.0),
+                intensity: Vec3::splat(1.0 + i as f32),
+                range: None,
+            })
+            .collect();
+        let s = lamp_scene(Vec3::new(0.0, 2.0, -3.0), 5.0, lights);
+        let ls = LightSampler::new(&s);
+        assert!(!ls.bsdf_aware);
+        let rx = receiver(
+            Vec3::ZERO,
+            Bsdf::Diffuse(crate::bsdf::Diffuse { kd: Vec3::ONE }),
+            Vec3::Y,
+        );
+        let powers: Vec<f32> = (0..ls.emitter_count())
+            .map(|e| match &ls.emitters[e] {
+                Emitter::Punctual(i) => s.lights[*i as usize].power(&s),
+                Emitter::Mesh(m) => m.power,
+            })
+            .collect();
+        let total: f32 = powers.iter().sum();
+        for (e, p) in powers.iter().enumerate() {
+            assert!((ls.emitter_pmf(&s, &rx, e) - p / total).abs() < 1e-6);
         }
-        assert_eq!(sampler.light_of_triangle(0), Some(4));
-        assert_eq!(sampler.light_of_triangle(1), None);
     }
 
     #[test]
     fn no_lights_no_samples() {
         let mut s = scene(false, vec![]);
         s.lights.clear();
-        assert!(LightSampler::new(&s).sample(Vec3::ZERO, 0.5).is_none());
+        let rx = receiver(
+            Vec3::ZERO,
+            Bsdf::Diffuse(crate::bsdf::Diffuse { kd: Vec3::ONE }),
+            Vec3::Y,
+        );
+        assert!(LightSampler::new(&s)
+            .sample_li(&s, &rx, 0.5, Vec2::splat(0.5))
+            .is_none());
     }
 }
