@@ -7,17 +7,21 @@ ours, ...) so that load from other processes falls on both alike, each run with 
 Every run is a whole process: Mitsuba's time includes Python start-up, `import mitsuba`, scene
 loading and its LLVM JIT compilation; ours includes scene loading and the BVH build.
 
-A converged reference is rendered once by `--ref-renderer` (default: streaks) at `--ref-spp`.
-Against it the script reports, on the road region (`--region`, fractions of the image, y down):
+A converged reference is rendered by `--ref-renderer` (default: streaks) at `--ref-spp`, as two
+renders of half the spp with seeds 1000 and 1001 (kept in the work folder and reused). Their
+average is the reference; their difference measures the reference's own noise. Against it the
+script reports, on the road region (`--region`, fractions of the image, y down):
 
 - time ratio at equal spp: median t_ours / median t_mitsuba;
 - MSE of each renderer (mean over runs, pixels and channels; divided by mean(ref)^2, so it is a
-  squared relative RMSE);
+  squared relative RMSE), minus the reference's own noise (Var(ref pixel) = E[(a - b)^2] / 4):
+  with a fast-converging renderer the reference's noise would otherwise dominate its MSE. The
+  raw MSE is reported too;
 - the equal-error time ratio (t_ours * MSE_ours) / (t_mitsuba * MSE_mitsuba): below 1 means we
   reach Mitsuba's error in less time (MSE falls as 1/time for an unbiased renderer);
 - each renderer's relative bias mean(run) / mean(ref) - 1 with its standard error from the
-  spread of the runs, and z = bias / standard error (|z| < 3: bias within noise). The reference's
-  own noise makes both MSEs slightly larger by the same amount (it is independent of the runs).
+  spread of the runs and the reference's own standard error (sqrt(sum (a - b)^2) / (2 N)),
+  and z = bias / standard error (|z| < 3: bias within noise).
 
 Usage:
     python3 tools/mitsuba/race.py scenes/crosscheck.gltf --camera cam --region road=0,0.7,1,1 \
@@ -157,22 +161,33 @@ def main() -> int:
     def load(path: Path):
         return np.array(mi.Bitmap(str(path)), dtype=np.float64)[..., :3]
 
-    ref_path = out / f"ref_{args.ref_renderer}_{args.ref_spp}spp.exr"
-    if not ref_path.exists():
-        make = ours if args.ref_renderer == "streaks" else theirs
-        log(f"reference: {args.ref_renderer}, {args.ref_spp} spp ...")
-        t = timed(make(args.ref_spp, 1000, ref_path))
-        log(f"reference took {t:.1f} s")
-    ref = load(ref_path)
+    # The reference is two renders of half the spp each (seeds 1000 and 1001): their average is
+    # the reference, and their difference measures the reference's own noise, which would
+    # otherwise inflate both renderers' MSE and hide a bias behind an unknown reference error.
+    half = max(args.ref_spp // 2, 1)
+    ref_paths = [out / f"ref_{args.ref_renderer}_{half}spp_seed{seed}.exr" for seed in (1000, 1001)]
+    make = ours if args.ref_renderer == "streaks" else theirs
+    for seed, path in zip((1000, 1001), ref_paths):
+        if not path.exists():
+            log(f"reference: {args.ref_renderer}, {half} spp, seed {seed} ...")
+            t = timed(make(half, seed, path))
+            log(f"reference half took {t:.1f} s")
+    ref_a, ref_b = (load(path) for path in ref_paths)
 
     _, (x0, y0, x1, y1) = args.region
-    h, w = ref.shape[:2]
+    h, w = ref_a.shape[:2]
     ys = slice(round(y0 * h), max(round(y1 * h), round(y0 * h) + 1))
     xs = slice(round(x0 * w), max(round(x1 * w), round(x0 * w) + 1))
-    ref_r = ref[ys, xs]
+    ref_a, ref_b = ref_a[ys, xs], ref_b[ys, xs]
+    ref_r = 0.5 * (ref_a + ref_b)
     ref_mean = float(ref_r.mean())
     if not ref_mean > 0:
         raise SystemExit(f"the reference is black in region {args.region[0]}")
+    # Var(ref pixel) = E[(a - b)^2] / 4 for the average of two independent halves; the
+    # standard error of the region mean is sqrt(sum (a - b)^2) / (2 N).
+    diff2 = (ref_a - ref_b) ** 2
+    ref_noise_mse = float(diff2.mean()) / 4.0 / ref_mean**2
+    ref_se = float(np.sqrt(diff2.sum())) / (2.0 * diff2.size) / ref_mean
 
     results = {"ours": {"times": [], "mse": [], "means": []}, "mitsuba": {"times": [], "mse": [], "means": []}}
     for run in range(args.runs):
@@ -191,11 +206,16 @@ def main() -> int:
     summary = {}
     for who, r in results.items():
         bias = statistics.mean(r["means"]) / ref_mean - 1.0
-        se = statistics.stdev(r["means"]) / (len(r["means"]) ** 0.5) / ref_mean
+        se_runs = statistics.stdev(r["means"]) / (len(r["means"]) ** 0.5) / ref_mean
+        se = (se_runs**2 + ref_se**2) ** 0.5
+        raw = statistics.mean(r["mse"])
+        # The renderer's own MSE: the raw MSE against the reference minus the reference's noise.
+        own = max(raw - ref_noise_mse, 0.0)
         summary[who] = {
             "median_seconds": statistics.median(r["times"]),
-            "mse_relative": statistics.mean(r["mse"]),
-            "rmse_relative": statistics.mean(r["mse"]) ** 0.5,
+            "mse_relative_raw": raw,
+            "mse_relative": own,
+            "rmse_relative": own**0.5,
             "bias_relative": bias,
             "bias_standard_error": se,
             "bias_z": bias / se if se > 0 else float("inf"),
@@ -206,23 +226,30 @@ def main() -> int:
         "scene": str(args.scene),
         "width": args.width, "height": args.height, "spp": args.spp, "max_depth": args.max_depth,
         "mitsuba_variant": args.variant, "mitsuba_version": mi.__version__,
-        "reference": {"renderer": args.ref_renderer, "spp": args.ref_spp, "path": str(ref_path)},
+        "reference": {"renderer": args.ref_renderer, "spp": args.ref_spp,
+                      "paths": [str(p) for p in ref_paths], "noise_mse_relative": ref_noise_mse,
+                      "mean_standard_error": ref_se},
         "region": {"name": args.region[0], "fractions": args.region[1]},
         "time_ratio_equal_spp": so["median_seconds"] / sm["median_seconds"],
         "equal_error_time_ratio": (so["median_seconds"] * so["mse_relative"])
         / (sm["median_seconds"] * sm["mse_relative"]),
+        "equal_error_time_ratio_raw": (so["median_seconds"] * so["mse_relative_raw"])
+        / (sm["median_seconds"] * sm["mse_relative_raw"]),
         "ours": so, "mitsuba": sm,
     }
     print(f"{args.scene.name} {args.width}x{args.height}, {args.spp} spp, max depth {args.max_depth}, "
           f"{args.runs} runs each; mitsuba {mi.__version__} {args.variant}; reference "
           f"{args.ref_renderer} {args.ref_spp} spp; region {args.region[0]}")
-    print(f"{'':8} {'median s':>9} {'rel RMSE':>9} {'rel bias':>9} {'z':>6}")
+    print(f"reference noise: relative RMSE {ref_noise_mse ** 0.5:.4f}, mean standard error {ref_se:.5f}"
+          " (subtracted from the MSEs below; included in z)")
+    print(f"{'':8} {'median s':>9} {'rel RMSE':>9} {'raw RMSE':>9} {'rel bias':>9} {'z':>6}")
     for who in ("ours", "mitsuba"):
         s = summary[who]
         print(f"{who:8} {s['median_seconds']:9.3f} {s['rmse_relative']:9.4f} "
-              f"{s['bias_relative']:+9.4f} {s['bias_z']:6.2f}")
+              f"{s['mse_relative_raw'] ** 0.5:9.4f} {s['bias_relative']:+9.4f} {s['bias_z']:6.2f}")
     print(f"time ratio at equal spp (ours/mitsuba): {report['time_ratio_equal_spp']:.3f}")
-    print(f"equal-error time ratio (t*MSE ours / t*MSE mitsuba): {report['equal_error_time_ratio']:.3f}")
+    print(f"equal-error time ratio (t*MSE ours / t*MSE mitsuba): {report['equal_error_time_ratio']:.3f}"
+          f" (raw, reference noise not subtracted: {report['equal_error_time_ratio_raw']:.3f})")
     if args.json:
         args.json.write_text(json.dumps(report, indent=2))
     return 0

@@ -4,9 +4,11 @@
 //!
 //! 1. adds the emission of the surface it hit (seen directly: in full; reached by a BSDF
 //!    sample: weighted by the power heuristic against light sampling),
-//! 2. samples one light with the [`LightSampler`] and one point on it (next-event estimation):
-//!    area lights are weighted by the power heuristic against BSDF sampling, delta lights
-//!    (point, spot, directional) cannot be hit by BSDF samples and are added unweighted,
+//! 2. samples one light with the [`LightSampler`] and one point or direction on it (next-event
+//!    estimation): a point is tested with a shadow ray, a direction toward a compact emitter
+//!    ([`crate::light::Visibility::FirstHit`]) with a closest-hit ray that must land on that
+//!    emitter; area lights are weighted by the power heuristic against BSDF sampling, delta
+//!    lights (point, spot, directional) cannot be hit by BSDF samples and are added unweighted,
 //! 3. samples the BSDF for the next direction.
 //!
 //! `max_depth` has Mitsuba 3's meaning (`path.cpp`): the longest path, counted in segments
@@ -317,7 +319,12 @@ fn trace_path(
                             }
                         }
                         Visibility::FirstHit { emitter } => {
-                            match scene.intersect(&Ray::new(origin, ls.wi)) {
+                            let ray = Ray {
+                                origin,
+                                direction: ls.wi,
+                                t_max: ls.dist * (1.0 + 1e-4),
+                            };
+                            match scene.intersect(&ray) {
                                 Some(h)
                                     if lights
                                         .emitter_of(h.triangle)

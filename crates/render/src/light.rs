@@ -21,8 +21,10 @@
 //! `t = clamp((c - cos_outer) / (cos_inner - cos_outer), 0, 1)` and the intensity is scaled by
 //! `t * t`.
 //!
-//! Triangles are sampled uniformly by area and the density converted to solid angle,
-//! `pdf = d^2 / (|cos theta_light| A)`.
+//! A [`Light::Triangle`] is sampled uniformly by area and the density converted to solid angle,
+//! `pdf = d^2 / (|cos theta_light| A)`. The [`LightSampler`] groups emissive triangles into
+//! emitters and samples a compact emitter (a sphere lamp) by the cone of directions that bounds
+//! it instead; see its documentation.
 
 use crate::bsdf::Bsdf;
 use crate::geometry::Frame;
@@ -301,7 +303,8 @@ pub enum Visibility {
     /// The sample is only a direction toward emitter `emitter` of the [`LightSampler`]
     /// (sampled uniformly in the cone that bounds it): trace a closest-hit ray; the light
     /// arrives if the ray first hits one of that emitter's triangles, with the radiance that
-    /// triangle emits toward the shading point (`li` is zero and `dist` infinite until then).
+    /// triangle emits toward the shading point (`li` is zero until then; `dist` is the distance
+    /// to the far side of the emitter's bounding sphere, beyond which the ray need not look).
     FirstHit {
         /// Index of the emitter among the sampler's emitters.
         emitter: u32,
@@ -561,7 +564,7 @@ impl MeshEmitter {
             let wi = Frame::from_normal(axis).to_world(square_to_uniform_cone(u, one_minus_cos));
             return Some(LightSample {
                 wi,
-                dist: f32::INFINITY,
+                dist: (self.centre - p).length() + self.radius,
                 li: Vec3::ZERO,
                 pdf: square_to_uniform_cone_pdf(Vec3::Z, one_minus_cos),
                 delta: false,
