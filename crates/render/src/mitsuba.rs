@@ -636,10 +636,14 @@ pub(crate) fn export_parts(
             let radiance = mw.colour(m, &stem, "radiance", m.emission, m.emission_texture)?;
             emitter = format!("<emitter type=\"area\">{radiance}</emitter>");
         }
+        // Our emission is one-sided by the geometric normal (the winding); Mitsuba's area
+        // emitter tests the shading normal, which on a smooth lamp mesh darkens the rim (0.2% of
+        // a sphere lamp's streak on scenes/crosscheck.gltf). Face normals make the two agree.
+        let face_normals = m.is_emissive();
         let _ = writeln!(
             xml,
             "<shape type=\"ply\"><string name=\"filename\" value=\"{}\"/>\
-             <boolean name=\"face_normals\" value=\"false\"/>{bsdf}{emitter}</shape>",
+             <boolean name=\"face_normals\" value=\"{face_normals}\"/>{bsdf}{emitter}</shape>",
             esc(&mesh.file_name)
         );
     }
@@ -846,6 +850,12 @@ mod tests {
 
         let shapes = find("shape", "ply");
         assert_eq!(shapes.len(), 3);
+        // Emitters use face normals (one-sided by the winding, as ours); the rest are smooth.
+        for shape in &shapes {
+            let emits = shape.children().any(|c| c.has_tag_name("emitter"));
+            let face = param(*shape, "face_normals");
+            assert_eq!(face.as_deref(), Some(if emits { "true" } else { "false" }));
+        }
         // Road: blend of diffuse (bitmap of 2 kd) and a ggx roughconductor with 2 ks.
         let blend = shapes[0]
             .children()
