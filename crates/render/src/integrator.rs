@@ -282,9 +282,11 @@ fn trace_path(
             break;
         }
 
-        // 2. Next-event estimation (always draws 3 numbers, so the dimensions stay aligned).
-        let u_light = sampler.next_1d();
-        let u_point = sampler.next_2d();
+        // 2. Next-event estimation. A vertex draws two 4D samples, one for the light (point,
+        // choice) and one for the BSDF (direction, lobe, roulette), always, so the dimensions
+        // stay aligned.
+        let [px, py, u_light, _] = sampler.next_4d();
+        let u_point = Vec2::new(px, py);
         let rx = Receiver {
             p: hit.p,
             ng,
@@ -353,8 +355,8 @@ fn trace_path(
         }
 
         // 3. BSDF sampling.
-        let u_lobe = sampler.next_1d();
-        let u_dir = sampler.next_2d();
+        let [dx, dy, u_lobe, u_rr] = sampler.next_4d();
+        let u_dir = Vec2::new(dx, dy);
         let Some(bs) = bsdf.sample(wo_local, u_lobe, u_dir) else {
             break;
         };
@@ -374,7 +376,7 @@ fn trace_path(
         // Russian roulette (Mitsuba's rule).
         if depth >= RR_DEPTH {
             let q = throughput.max_element().min(0.95);
-            if sampler.next_1d() >= q {
+            if u_rr >= q {
                 break;
             }
             throughput /= q;

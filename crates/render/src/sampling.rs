@@ -392,9 +392,9 @@ pub const SOBOL_MAX_SAMPLES: u32 = 1 << 16;
 /// Owen-scrambled Sobol sampler (Burley 2020, via the `sobol_burley` crate), padded the way
 /// Burley and pbrt-v4's `PaddedSobolSampler` do.
 ///
-/// Each call to [`Sampler::next_1d`] or [`Sampler::next_2d`] consumes one *dimension slot*.
-/// Slot `d` of pixel `(x, y)` reads Sobol dimension 0 (1D) or dimensions 0 and 1 (2D) with the
-/// scramble seed `hash(seed, x, y, d)`. Dimensions 0 and 1 of Sobol form a (0,2)-sequence, so
+/// Each call to [`Sampler::next_1d`], [`Sampler::next_2d`] or [`Sampler::next_4d`] consumes one
+/// *dimension slot*. Slot `d` of pixel `(x, y)` reads Sobol dimension 0 (1D), dimensions 0 and 1
+/// (2D) or dimensions 0 to 3 (4D) with the scramble seed `hash(seed, x, y, d)`. Dimensions 0 and 1 of Sobol form a (0,2)-sequence, so
 /// every 2D request is as well stratified as Sobol can be, independent slots are decorrelated by
 /// their seeds, pixels are decorrelated by hashing the pixel into the seed, and there is no
 /// dimension limit. Values depend only on `(seed, pixel, sample_index, slot)`, so renders are
@@ -471,6 +471,26 @@ impl Sampler {
             Vec2::new(x, y)
         } else {
             self.hashed(s).next_2d()
+        }
+    }
+
+    /// The next 4D value in `[0, 1)^4`: Sobol dimensions 0 to 3 of one slot (one hash and one
+    /// `sample_4d` call for four numbers). Dimensions 0 and 1 form a (0,2)-sequence, so put the
+    /// 2D sample that needs the best stratification there (a direction or a point on a light)
+    /// and the 1D choices (light, lobe, roulette) in 2 and 3.
+    #[inline]
+    pub fn next_4d(&mut self) -> [f32; 4] {
+        let s = self.next_slot_seed();
+        if self.sample_index < SOBOL_MAX_SAMPLES {
+            sobol_burley::sample_4d(self.sample_index, 0, s)
+        } else {
+            let mut rng = self.hashed(s);
+            [
+                rng.next_f32(),
+                rng.next_f32(),
+                rng.next_f32(),
+                rng.next_f32(),
+            ]
         }
     }
 }
@@ -742,5 +762,40 @@ mod tests {
             assert_eq!(v.x, sobol_burley::sample(i, 0, seed));
             assert_eq!(v.y, sobol_burley::sample(i, 1, seed));
         }
+    }
+
+    #[test]
+    fn sampler_4d_is_four_sobol_dimensions_of_one_slot() {
+        // next_4d reads dimensions 0..4 of one slot: the first two are the same (0,2)-sequence
+        // as next_2d, each of the last two is stratified in 1D, and a slot is consumed.
+        let mut s = Sampler::new(11);
+        let (mut hit_xy, mut hit_z, mut hit_w) = ([0u32; 16], [0u32; 16], [0u32; 16]);
+        for i in 0..16 {
+            s.start_pixel_sample((7, 1), i);
+            s.next_2d();
+            let seed = {
+                let mut probe = s.clone();
+                probe.next_slot_seed()
+            };
+            let v = s.next_4d();
+            for (d, x) in v.iter().enumerate() {
+                assert_eq!(*x, sobol_burley::sample(i, d as u32, seed));
+                assert!((0.0..1.0).contains(x));
+            }
+            hit_xy[(v[0] * 4.0) as usize * 4 + (v[1] * 4.0) as usize] += 1;
+            hit_z[(v[2] * 16.0) as usize] += 1;
+            hit_w[(v[3] * 16.0) as usize] += 1;
+            // The next slot is a different one.
+            assert_ne!(s.clone().next_4d(), v);
+        }
+        for hit in [hit_xy, hit_z, hit_w] {
+            assert!(hit.iter().all(|&h| h == 1), "{hit:?}");
+        }
+        // Past sobol_burley's limit: hashed values, still in range and deterministic.
+        s.start_pixel_sample((7, 1), SOBOL_MAX_SAMPLES + 3);
+        let a = s.next_4d();
+        s.start_pixel_sample((7, 1), SOBOL_MAX_SAMPLES + 3);
+        assert_eq!(a, s.next_4d());
+        assert!(a.iter().all(|x| (0.0..1.0).contains(x)));
     }
 }
