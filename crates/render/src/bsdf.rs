@@ -226,12 +226,13 @@ fn sample_ggx_visible_normal(wo: Vec3, alpha: f32, u: Vec2) -> Option<Vec3> {
     (h.z > 0.0).then_some(h)
 }
 
-/// Solid-angle density of `wi` when the GGX glossy lobe samples visible normals:
-/// `D(h) G1(wo, h) / (4 wo.z)` (the Jacobian `1 / (4 wo.h)` cancels `wo.h`).
+/// The GGX glossy lobe's microfacet BRDF without `ks` (`D G1(wo) G1(wi) / (4 wo.z wi.z)`) and
+/// the solid-angle density of `wi` when it samples visible normals, `D(h) G1(wo, h) / (4 wo.z)`
+/// (the Jacobian `1 / (4 wo.h)` cancels `wo.h`); they share `D G1(wo) / (4 wo.z)`.
 #[inline]
-fn ggx_visible_pdf(wo: Vec3, wi: Vec3, alpha: f32) -> f32 {
-    let h = half_vector(wo, wi);
-    ggx_d(h, alpha) * ggx_smith_g1(wo, h, alpha) / (4.0 * wo.z)
+fn ggx_spec_pdf(wo: Vec3, wi: Vec3, h: Vec3, alpha: f32) -> (f32, f32) {
+    let pdf = ggx_d(h, alpha) * ggx_smith_g1(wo, h, alpha) / (4.0 * wo.z);
+    (pdf * ggx_smith_g1(wi, h, alpha) / wi.z, pdf)
 }
 
 /// Cheap estimate of the GGX glossy lobe's directional albedo (with `ks = 1`): `G1` at
@@ -245,6 +246,21 @@ fn ggx_albedo_factor(cos_o: f32, alpha: f32) -> f32 {
     2.0 / (1.0 + (1.0 + alpha * alpha * tan2).sqrt())
 }
 
+/// The density of the lobe mixture: the diffuse lobe (cosine-weighted) with probability
+/// `1 - p_glossy`, the glossy lobe (its own density `glossy_pdf`) with `p_glossy`. A lobe that is
+/// never chosen adds nothing (not even an infinite density times zero).
+#[inline]
+fn mixture_pdf(wi: Vec3, glossy_pdf: f32, p_glossy: f32) -> f32 {
+    let mut pdf = 0.0;
+    if p_glossy < 1.0 {
+        pdf += (1.0 - p_glossy) * square_to_cosine_hemisphere_pdf(wi);
+    }
+    if p_glossy > 0.0 {
+        pdf += p_glossy * glossy_pdf;
+    }
+    pdf
+}
+
 /// Hemisphere check shared by every model.
 #[inline]
 fn above(wo: Vec3, wi: Vec3) -> bool {
@@ -254,16 +270,18 @@ fn above(wo: Vec3, wi: Vec3) -> bool {
 // ---------------------------------------------------------------------------------------------
 // The models: each gives its lobes, the glossy lobe's pdf and sampling, and the lobe choice.
 
+// Each model's `eval_pdf` takes `wo` and `wi` above the surface and returns `f(wo, wi)` split
+// by lobe with the glossy lobe's own sampling density of `wi` (see `Bsdf::eval_pdf`): both
+// come from the same half vector and microfacet terms.
+
 impl Diffuse {
     #[inline]
-    fn eval_lobes(&self, wo: Vec3, wi: Vec3) -> LobeValues {
-        if !above(wo, wi) {
-            return LobeValues::default();
-        }
-        LobeValues {
+    fn eval_pdf(&self, _wo: Vec3, _wi: Vec3) -> (LobeValues, f32) {
+        let f = LobeValues {
             diffuse: self.kd * FRAC_1_PI,
             glossy: Vec3::ZERO,
-        }
+        };
+        (f, 0.0)
     }
 }
 
@@ -275,19 +293,13 @@ impl Ggx {
     }
 
     #[inline]
-    fn eval_lobes(&self, wo: Vec3, wi: Vec3) -> LobeValues {
-        if !above(wo, wi) {
-            return LobeValues::default();
-        }
-        let h = half_vector(wo, wi);
-        let spec = ggx_d(h, self.alpha())
-            * ggx_smith_g1(wo, h, self.alpha())
-            * ggx_smith_g1(wi, h, self.alpha())
-            / (4.0 * wo.z * wi.z);
-        LobeValues {
+    fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (LobeValues, f32) {
+        let (spec, pdf) = ggx_spec_pdf(wo, wi, half_vector(wo, wi), self.alpha());
+        let f = LobeValues {
             diffuse: self.kd * FRAC_1_PI,
             glossy: self.ks * spec,
-        }
+        };
+        (f, pdf)
     }
 
     #[inline]
@@ -304,37 +316,21 @@ impl Ward {
         self.alpha.max(MIN_ALPHA)
     }
 
-    /// The normalised slope density's solid-angle form `exp(-tan^2/alpha^2) / (pi alpha^2 cos^3)`
-    /// (density of the sampled half vector).
+    /// The glossy lobe `exp(-tan^2(delta)/alpha^2) / (4 pi alpha^2 sqrt(cos_i cos_o))` and its
+    /// sampling density: the half vector is drawn with the normalised slope density's
+    /// solid-angle form `exp(-tan^2/alpha^2) / (pi alpha^2 cos^3(delta))`, and `1 / (4 wo.h)`
+    /// turns it into a density of `wi`.
     #[inline]
-    fn half_vector_pdf(&self, h: Vec3) -> f32 {
-        if h.z <= 0.0 {
-            return 0.0;
-        }
-        let a2 = self.alpha() * self.alpha();
-        let tan2 = (h.x * h.x + h.y * h.y) / (h.z * h.z);
-        (-tan2 / a2).exp() / (PI * a2 * h.z * h.z * h.z)
-    }
-
-    #[inline]
-    fn eval_lobes(&self, wo: Vec3, wi: Vec3) -> LobeValues {
-        if !above(wo, wi) {
-            return LobeValues::default();
-        }
+    fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (LobeValues, f32) {
         let h = half_vector(wo, wi);
         let a2 = self.alpha() * self.alpha();
         let tan2 = (h.x * h.x + h.y * h.y) / (h.z * h.z);
-        let spec = (-tan2 / a2).exp() / (4.0 * PI * a2 * (wo.z * wi.z).sqrt());
-        LobeValues {
+        let gauss = (-tan2 / a2).exp() / (PI * a2);
+        let f = LobeValues {
             diffuse: self.kd * FRAC_1_PI,
-            glossy: self.ks * spec,
-        }
-    }
-
-    #[inline]
-    fn glossy_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        let h = half_vector(wo, wi);
-        self.half_vector_pdf(h) / (4.0 * wo.dot(h))
+            glossy: self.ks * (gauss / (4.0 * (wo.z * wi.z).sqrt())),
+        };
+        (f, gauss / (h.z * h.z * h.z * 4.0 * wo.dot(h)))
     }
 
     #[inline]
@@ -367,25 +363,19 @@ impl BlinnPhong {
         self.shininess.max(0.0)
     }
 
+    /// The glossy lobe `(s + 8) / (8 pi) cos^s(theta_h)` and its sampling density: the half
+    /// vector is drawn with density `(s + 1) / (2 pi) cos^s(theta_h)`, and `1 / (4 wo.h)` turns
+    /// it into a density of `wi`.
     #[inline]
-    fn eval_lobes(&self, wo: Vec3, wi: Vec3) -> LobeValues {
-        if !above(wo, wi) {
-            return LobeValues::default();
-        }
+    fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (LobeValues, f32) {
         let h = half_vector(wo, wi);
         let s = self.shininess();
-        let spec = (s + 8.0) / (8.0 * PI) * h.z.powf(s);
-        LobeValues {
+        let cos_s = h.z.powf(s);
+        let f = LobeValues {
             diffuse: self.kd * FRAC_1_PI,
-            glossy: self.ks * spec,
-        }
-    }
-
-    #[inline]
-    fn glossy_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        let h = half_vector(wo, wi);
-        let s = self.shininess();
-        (s + 1.0) / TAU * h.z.max(0.0).powf(s) / (4.0 * wo.dot(h))
+            glossy: self.ks * ((s + 8.0) / (8.0 * PI) * cos_s),
+        };
+        (f, (s + 1.0) / TAU * cos_s / (4.0 * wo.dot(h)))
     }
 
     #[inline]
@@ -432,19 +422,15 @@ impl GltfPbr {
     }
 
     #[inline]
-    fn eval_lobes(&self, wo: Vec3, wi: Vec3) -> LobeValues {
-        if !above(wo, wi) {
-            return LobeValues::default();
-        }
-        let alpha = self.alpha();
+    fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (LobeValues, f32) {
         let h = half_vector(wo, wi);
-        let f = self.schlick(wo.dot(h));
-        let spec = ggx_d(h, alpha) * ggx_smith_g1(wo, h, alpha) * ggx_smith_g1(wi, h, alpha)
-            / (4.0 * wo.z * wi.z);
-        LobeValues {
-            diffuse: (Vec3::ONE - f) * self.diffuse_color() * FRAC_1_PI,
-            glossy: f * spec,
-        }
+        let fresnel = self.schlick(wo.dot(h));
+        let (spec, pdf) = ggx_spec_pdf(wo, wi, h, self.alpha());
+        let f = LobeValues {
+            diffuse: (Vec3::ONE - fresnel) * self.diffuse_color() * FRAC_1_PI,
+            glossy: fresnel * spec,
+        };
+        (f, pdf)
     }
 
     #[inline]
@@ -459,16 +445,39 @@ impl GltfPbr {
 // Dispatch
 
 impl Bsdf {
+    /// `f(wo, wi)` split by lobe and the glossy lobe's own sampling density of `wi`; zero when
+    /// either direction is below the surface.
+    #[inline]
+    fn eval_glossy_pdf(&self, wo: Vec3, wi: Vec3) -> (LobeValues, f32) {
+        if !above(wo, wi) {
+            return (LobeValues::default(), 0.0);
+        }
+        match self {
+            Bsdf::Diffuse(m) => m.eval_pdf(wo, wi),
+            Bsdf::Ggx(m) => m.eval_pdf(wo, wi),
+            Bsdf::Ward(m) => m.eval_pdf(wo, wi),
+            Bsdf::BlinnPhong(m) => m.eval_pdf(wo, wi),
+            Bsdf::GltfPbr(m) => m.eval_pdf(wo, wi),
+        }
+    }
+
     /// `f(wo, wi)` split by lobe; zero when either direction is below the surface.
     #[inline]
     pub fn eval_lobes(&self, wo: Vec3, wi: Vec3) -> LobeValues {
-        match self {
-            Bsdf::Diffuse(m) => m.eval_lobes(wo, wi),
-            Bsdf::Ggx(m) => m.eval_lobes(wo, wi),
-            Bsdf::Ward(m) => m.eval_lobes(wo, wi),
-            Bsdf::BlinnPhong(m) => m.eval_lobes(wo, wi),
-            Bsdf::GltfPbr(m) => m.eval_lobes(wo, wi),
+        self.eval_glossy_pdf(wo, wi).0
+    }
+
+    /// `f(wo, wi)` split by lobe and [`Bsdf::pdf`] together, for the price of one: both share
+    /// the half vector and the microfacet terms (next-event estimation with MIS needs both).
+    #[inline]
+    pub fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (LobeValues, f32) {
+        let (f, glossy_pdf) = self.eval_glossy_pdf(wo, wi);
+        if !above(wo, wi) {
+            return (f, 0.0);
         }
+        let pdf = mixture_pdf(wi, glossy_pdf, self.glossy_probability(wo));
+        debug_assert!(pdf >= 0.0 && !pdf.is_nan(), "pdf {pdf} for {wo} {wi}");
+        (f, pdf)
     }
 
     /// `f(wo, wi)`, all lobes.
@@ -494,18 +503,6 @@ impl Bsdf {
         p
     }
 
-    /// Solid-angle density of `wi` under the glossy lobe's own sampling strategy alone.
-    #[inline]
-    fn glossy_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        match self {
-            Bsdf::Diffuse(_) => 0.0,
-            Bsdf::Ggx(m) => ggx_visible_pdf(wo, wi, m.alpha()),
-            Bsdf::Ward(m) => m.glossy_pdf(wo, wi),
-            Bsdf::BlinnPhong(m) => m.glossy_pdf(wo, wi),
-            Bsdf::GltfPbr(m) => ggx_visible_pdf(wo, wi, m.alpha()),
-        }
-    }
-
     /// Samples `wi` from the glossy lobe alone (may be below the surface).
     #[inline]
     fn sample_glossy(&self, wo: Vec3, u: Vec2) -> Option<Vec3> {
@@ -518,28 +515,10 @@ impl Bsdf {
         }
     }
 
-    /// The mixture density for a known glossy probability.
-    #[inline]
-    fn mixture_pdf(&self, wo: Vec3, wi: Vec3, p_glossy: f32) -> f32 {
-        let mut pdf = 0.0;
-        if p_glossy < 1.0 {
-            pdf += (1.0 - p_glossy) * square_to_cosine_hemisphere_pdf(wi);
-        }
-        if p_glossy > 0.0 {
-            pdf += p_glossy * self.glossy_pdf(wo, wi);
-        }
-        pdf
-    }
-
     /// Solid-angle density with which [`Bsdf::sample`] returns `wi` given `wo`.
     #[inline]
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if !above(wo, wi) {
-            return 0.0;
-        }
-        let pdf = self.mixture_pdf(wo, wi, self.glossy_probability(wo));
-        debug_assert!(pdf >= 0.0 && !pdf.is_nan(), "pdf {pdf} for {wo} {wi}");
-        pdf
+        self.eval_pdf(wo, wi).1
     }
 
     /// Samples `wi` given `wo`: `u_lobe` chooses the lobe, `u` samples within it.
@@ -562,13 +541,14 @@ impl Bsdf {
         if wi.z <= 0.0 {
             return None;
         }
-        let pdf = self.mixture_pdf(wo, wi, p_glossy);
+        let (f, glossy_pdf) = self.eval_glossy_pdf(wo, wi);
+        let pdf = mixture_pdf(wi, glossy_pdf, p_glossy);
         if !(pdf > 0.0 && pdf.is_finite()) {
             return None;
         }
         Some(BsdfSample {
             wi,
-            f: self.eval(wo, wi),
+            f: f.total(),
             pdf,
             lobe,
         })

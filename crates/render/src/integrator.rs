@@ -297,7 +297,12 @@ fn trace_path(
         if let Some(ls) = lights.sample_li(scene, &rx, u_light, u_point) {
             let wi_local = frame.to_local(ls.wi);
             if wi_local.z > 0.0 && ng.dot(ls.wi) > 0.0 {
-                let f = bsdf.eval_lobes(wo_local, wi_local);
+                // The BSDF's density of wi matters only for MIS against an area light.
+                let (f, bsdf_pdf) = if ls.delta {
+                    (bsdf.eval_lobes(wo_local, wi_local), 0.0)
+                } else {
+                    bsdf.eval_pdf(wo_local, wi_local)
+                };
                 let total = f.total();
                 if total.max_element() > 0.0 {
                     let origin = offset_ray_origin(hit.p, ng, ls.wi);
@@ -342,7 +347,7 @@ fn trace_path(
                         let weight = if ls.delta {
                             1.0
                         } else {
-                            power_heuristic(1.0, ls.pdf, 1.0, bsdf.pdf(wo_local, wi_local))
+                            power_heuristic(1.0, ls.pdf, 1.0, bsdf_pdf)
                         };
                         let scale = li * (wi_local.z * weight / ls.pdf);
                         out.radiance += throughput * total * scale;
