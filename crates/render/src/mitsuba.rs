@@ -20,7 +20,7 @@
 //! | glTF metallic-roughness | `principled` (base_color, metallic, roughness) | no: different Fresnel and diffuse models (warning); metallicRoughnessTexture ignored (warning) |
 //! | diffuse | `diffuse` | yes |
 //! | kd / base colour / emission texture | `bitmap` (an EXR of texture x factor, so the factor is baked in) | yes (bilinear, repeat) |
-//! | wet/dry map ([`Wetness`](crate::material::Wetness)) | the wet `alpha` and `ks` everywhere | no (warning) |
+//! | wet/dry map ([`Wetness`](crate::material::Wetness)) | `alpha` and `specular_reflectance` as `bitmap`s baked per texel of the dryness map (`mix(wet, dry, w)`) | yes for `ggx` and `ward`'s alpha (linear in `w`, so bilinear filtering commutes); blinn_phong's alpha is not linear in the shininess (approximation already) |
 //! | double-sided material | BSDF wrapped in `twosided` | yes |
 //! | camera | `perspective`, `fov_axis` y, `fov` in degrees, `to_world` as a `lookat` | yes |
 //! | film, filter | `hdrfilm` (rgb, float32) with a `box` filter | yes |
@@ -292,7 +292,58 @@ struct MaterialWriter<'a> {
     textures: &'a mut Vec<BakedTexture>,
 }
 
-impl MaterialWriter<'_> {
+impl<'a> MaterialWriter<'a> {
+    /// A `bitmap` texture parameter `name` of the given linear texels (written as
+    /// `textures/{stem}_{name}.exr`).
+    fn bitmap(&mut self, stem: &str, name: &str, tex: &Texture, texels: Vec<Vec3>) -> String {
+        let file_name = format!("textures/{stem}_{name}.exr");
+        self.textures.push(BakedTexture {
+            file_name: file_name.clone(),
+            width: tex.width,
+            height: tex.height,
+            texels,
+        });
+        format!(
+            "<texture type=\"bitmap\" name=\"{name}\">\
+             <string name=\"filename\" value=\"{}\"/>\
+             <string name=\"filter_type\" value=\"bilinear\"/>\
+             <string name=\"wrap_mode\" value=\"repeat\"/>\
+             <boolean name=\"raw\" value=\"true\"/></texture>",
+            esc(&file_name)
+        )
+    }
+
+    /// The scene texture `id` of `material`, or a [`MitsubaError::MissingTexture`].
+    fn texture(&self, material: &Material, id: TextureId) -> Result<&'a Texture, MitsubaError> {
+        self.parts
+            .textures
+            .get(id as usize)
+            .ok_or_else(|| MitsubaError::MissingTexture {
+                file: self.parts.source.to_path_buf(),
+                material: material.name.clone(),
+                texture: id,
+            })
+    }
+
+    /// A parameter that follows the dryness `w` (green channel of the wet/dry map, clamped to
+    /// [0, 1] as the renderer does): a `bitmap` of `value(w)` per texel of the map.
+    fn by_dryness(
+        &mut self,
+        material: &Material,
+        stem: &str,
+        name: &str,
+        map: TextureId,
+        value: impl Fn(f32) -> Vec3,
+    ) -> Result<String, MitsubaError> {
+        let tex = self.texture(material, map)?;
+        let texels = tex
+            .texels
+            .iter()
+            .map(|t| value(t.y.clamp(0.0, 1.0)))
+            .collect();
+        Ok(self.bitmap(stem, name, tex, texels))
+    }
+
     /// A colour parameter: an `rgb`, or a `bitmap` of `texture x factor`.
     fn colour(
         &mut self,
@@ -305,30 +356,9 @@ impl MaterialWriter<'_> {
         let Some(id) = texture else {
             return Ok(rgb(name, factor));
         };
-        let tex =
-            self.parts
-                .textures
-                .get(id as usize)
-                .ok_or_else(|| MitsubaError::MissingTexture {
-                    file: self.parts.source.to_path_buf(),
-                    material: material.name.clone(),
-                    texture: id,
-                })?;
-        let file_name = format!("textures/{stem}_{name}.exr");
-        self.textures.push(BakedTexture {
-            file_name: file_name.clone(),
-            width: tex.width,
-            height: tex.height,
-            texels: tex.texels.iter().map(|t| t.truncate() * factor).collect(),
-        });
-        Ok(format!(
-            "<texture type=\"bitmap\" name=\"{name}\">\
-             <string name=\"filename\" value=\"{}\"/>\
-             <string name=\"filter_type\" value=\"bilinear\"/>\
-             <string name=\"wrap_mode\" value=\"repeat\"/>\
-             <boolean name=\"raw\" value=\"true\"/></texture>",
-            esc(&file_name)
-        ))
+        let tex = self.texture(material, id)?;
+        let texels = tex.texels.iter().map(|t| t.truncate() * factor).collect();
+        Ok(self.bitmap(stem, name, tex, texels))
     }
 
     /// The `<bsdf>` element of a material.
@@ -349,6 +379,11 @@ impl MaterialWriter<'_> {
                 kd_texture,
                 wetness,
             } => {
+                // Mitsuba's alpha for our alpha (or, for blinn_phong, shininess).
+                let to_alpha = |a: f32| match model {
+                    PaperModel::Ggx | PaperModel::Ward => a,
+                    PaperModel::BlinnPhong => (2.0 / (a + 2.0)).sqrt(),
+                };
                 let (distribution, a) = match model {
                     PaperModel::Ggx => ("ggx", *alpha),
                     PaperModel::Ward => {
@@ -360,7 +395,7 @@ impl MaterialWriter<'_> {
                         ("beckmann", *alpha)
                     }
                     PaperModel::BlinnPhong => {
-                        let a = (2.0 / (shininess + 2.0)).sqrt();
+                        let a = to_alpha(*shininess);
                         self.warnings.push(format!(
                             "material {:?}: Mitsuba has no Blinn-Phong model; exported as a \
                              beckmann roughconductor with alpha = sqrt(2/(s+2)) = {a} \
@@ -370,14 +405,12 @@ impl MaterialWriter<'_> {
                         ("beckmann", a)
                     }
                 };
-                if wetness.is_some() {
-                    self.warnings.push(format!(
-                        "material {:?}: the wet/dry map is not exported; the wet alpha and ks \
-                         are used everywhere (dry patches will differ)",
-                        m.name
-                    ));
-                }
-                let (w, exact) = blend_weight(kd.max_element(), ks.max_element());
+                // The largest ks anywhere on the surface sets the blend weight.
+                let ks_max = wetness
+                    .as_ref()
+                    .map_or(*ks, |wet| ks.max(wet.ks_dry))
+                    .max_element();
+                let (w, exact) = blend_weight(kd.max_element(), ks_max);
                 if !exact {
                     self.warnings.push(format!(
                         "material {:?}: kd + ks exceeds 1, which Mitsuba's blendbsdf cannot \
@@ -394,6 +427,31 @@ impl MaterialWriter<'_> {
                 };
                 let diffuse =
                     self.colour(m, &stem, "reflectance", scale(*kd, 1.0 - w), *kd_texture)?;
+                let (alpha_xml, specular) = match wetness {
+                    None => (
+                        format!("<float name=\"alpha\" value=\"{a:?}\"/>"),
+                        rgb("specular_reflectance", scale(*ks, w)),
+                    ),
+                    Some(wet) => {
+                        let own = match model {
+                            PaperModel::BlinnPhong => *shininess,
+                            PaperModel::Ggx | PaperModel::Ward => *alpha,
+                        };
+                        let alpha_at = |dry: f32| own + (wet.alpha_dry - own) * dry;
+                        (
+                            self.by_dryness(m, &stem, "alpha", wet.texture, |dry| {
+                                Vec3::splat(to_alpha(alpha_at(dry)))
+                            })?,
+                            self.by_dryness(
+                                m,
+                                &stem,
+                                "specular_reflectance",
+                                wet.texture,
+                                |dry| scale(ks.lerp(wet.ks_dry, dry), w),
+                            )?,
+                        )
+                    }
+                };
                 let _ = write!(
                     out,
                     "<bsdf type=\"blendbsdf\"><float name=\"weight\" value=\"{w:?}\"/>\
@@ -401,8 +459,7 @@ impl MaterialWriter<'_> {
                      <bsdf type=\"roughconductor\">\
                      <string name=\"distribution\" value=\"{distribution}\"/>\
                      <string name=\"material\" value=\"none\"/>\
-                     <float name=\"alpha\" value=\"{a:?}\"/>{}</bsdf></bsdf>",
-                    rgb("specular_reflectance", scale(*ks, w))
+                     {alpha_xml}{specular}</bsdf></bsdf>"
                 );
             }
             Reflectance::GltfPbr {
@@ -866,15 +923,33 @@ mod tests {
         let cond = find("bsdf", "roughconductor");
         assert_eq!(param(cond[0], "distribution").as_deref(), Some("ggx"));
         assert_eq!(param(cond[0], "material").as_deref(), Some("none"));
-        assert_eq!(param(cond[0], "alpha").as_deref(), Some("0.1"));
-        assert_eq!(
-            floats(&param(cond[0], "specular_reflectance").unwrap()),
-            [0.08; 3]
-        );
         assert_eq!(param(cond[1], "distribution").as_deref(), Some("beckmann"));
-        assert_eq!(find("texture", "bitmap").len(), 1);
-        assert_eq!(ex.textures.len(), 1);
+        // The wall has no wet/dry map: plain alpha and 2 ks.
+        assert_eq!(param(cond[1], "alpha").as_deref(), Some("0.2"));
+        assert_eq!(
+            floats(&param(cond[1], "specular_reflectance").unwrap()),
+            [0.2; 3]
+        );
+        // The road's kd texture, and its alpha and ks baked from the dryness map (green
+        // channel 0.5 and 1): alpha mix(0.1, 0.5, w), specular 2 mix(0.04, 0.02, w).
+        let bitmaps = find("texture", "bitmap");
+        let names: Vec<_> = bitmaps.iter().map(|b| b.attribute("name")).collect();
+        assert_eq!(
+            names,
+            [
+                Some("reflectance"),
+                Some("alpha"),
+                Some("specular_reflectance")
+            ]
+        );
+        assert_eq!(bitmaps[1].parent(), Some(cond[0]));
+        assert_eq!(bitmaps[2].parent(), Some(cond[0]));
+        assert_eq!(ex.textures.len(), 3);
         assert_eq!(ex.textures[0].texels[0], Vec3::new(0.1, 0.05, 0.025));
+        let close = |a: Vec3, b: f32| (a - Vec3::splat(b)).abs().max_element() < 1e-6;
+        let (alpha, spec) = (&ex.textures[1].texels, &ex.textures[2].texels);
+        assert!(close(alpha[0], 0.3) && close(alpha[1], 0.5), "{alpha:?}");
+        assert!(close(spec[0], 0.06) && close(spec[1], 0.04), "{spec:?}");
         // Lamp: an area emitter of the same radiance.
         let area = find("emitter", "area");
         assert_eq!(area.len(), 1);
@@ -882,8 +957,13 @@ mod tests {
             floats(&param(area[0], "radiance").unwrap()),
             [10.0, 9.0, 8.0]
         );
-        // Warnings: wetness, Ward, spot falloff, spot range.
-        for needle in ["wet/dry", "Ward", "falloff", "range"] {
+        // Warnings: Ward, spot falloff, spot range; the wet/dry map is exact.
+        assert!(
+            !ex.warnings.iter().any(|w| w.contains("wet")),
+            "{:?}",
+            ex.warnings
+        );
+        for needle in ["Ward", "falloff", "range"] {
             assert!(
                 ex.warnings.iter().any(|w| w.contains(needle)),
                 "no warning about {needle}: {:?}",
