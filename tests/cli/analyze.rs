@@ -67,6 +67,18 @@ fn analyze_reports_streaks_matched_to_lights_with_depths_below_the_road() {
         .count();
     assert_eq!(n_named, 1);
     assert!(r["dense"]["density"].as_f64().unwrap() > 0.2);
+    // The SGM disparity scored against the ground truth, split by the renderer's streak mask.
+    let acc = &r["dense"]["accuracy"];
+    assert_eq!(acc["streak_mask"], "renderer", "{acc}");
+    let pixels = |k: &str| acc[k]["truth_pixels"].as_u64().unwrap();
+    assert!(pixels("streak") > 0, "{acc}");
+    assert_eq!(pixels("all"), pixels("streak") + pixels("non_streak"), "{acc}");
+    for k in ["all", "streak", "non_streak"] {
+        for f in ["bad", "mean_abs", "density"] {
+            assert!(finite(&acc[k][f]), "{k}.{f}: {acc}");
+        }
+    }
+    assert!(run.stderr().contains("bad-2.0"), "{}", run.stderr());
     // Bad inputs are errors, not panics.
     let bad = t.streaks(&["analyze", "out", "--region", "x=1,2,3"]);
     assert!(!bad.output.status.success());

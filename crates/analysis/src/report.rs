@@ -23,7 +23,9 @@ use crate::detect::{
 use crate::lk::{lk_region, lk_rows, LkError, LkParams, Region, RowDisparity};
 use crate::model::{streak_rows, ModelError, RoadCamera, StereoRig};
 use crate::plot::{Marker, Plot, PlotError, Series, BLACK_RGB, BLUE, GREY, RED};
-use crate::sgm::{disparity_preview, sgm, SgmError, SgmParams};
+use crate::sgm::{
+    compare_disparity_where, disparity_preview, sgm, DisparityErrors, SgmError, SgmParams,
+};
 use glam::{DVec2, DVec3, Vec2, Vec3};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -480,6 +482,52 @@ pub struct DenseSummary {
     pub streak_pixels: usize,
     /// Valid non-streak pixels more than 0.1 m below the road.
     pub other_pixels_below_road: usize,
+    /// The dense disparity scored against the ground truth, when the input has it.
+    pub accuracy: Option<DenseAccuracy>,
+}
+
+/// The dense disparity scored against the ground-truth disparity: bad-2.0 (the share of the
+/// estimated pixels off by more than 2 px), mean absolute error and the share of pixels with
+/// an estimate ([`DisparityErrors`]), over every pixel that sees a surface and separately over
+/// the streak pixels and the others. Streak pixels are expected to be wrong: stereo sees the
+/// virtual light there, not the road.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct DenseAccuracy {
+    /// The mask that tells streak pixels from the others: `renderer` (the input's
+    /// `streak_mask_left.png`) or `detector` (the analysis' own, when the input has none).
+    pub streak_mask: &'static str,
+    /// Every pixel with a ground truth.
+    pub all: DisparityErrors,
+    /// The streak pixels.
+    pub streak: DisparityErrors,
+    /// The other pixels.
+    pub non_streak: DisparityErrors,
+}
+
+/// Bad-2.0, mean absolute error and density of `dense` against `truth`, overall and split by
+/// `streak_mask` (a pixel is a streak pixel when its mask value exceeds 0.5).
+pub fn dense_accuracy(
+    dense: &GrayImage,
+    truth: &GrayImage,
+    streak_mask: &GrayImage,
+    mask_name: &'static str,
+) -> Result<DenseAccuracy, ReportError> {
+    if (streak_mask.width, streak_mask.height) != (truth.width, truth.height) {
+        return Err(SgmError::SizeMismatch {
+            lw: streak_mask.width,
+            lh: streak_mask.height,
+            rw: truth.width,
+            rh: truth.height,
+        }
+        .into());
+    }
+    let on = |i: usize| streak_mask.data[i] > 0.5;
+    Ok(DenseAccuracy {
+        streak_mask: mask_name,
+        all: compare_disparity_where(dense, truth, 2.0, |_| true)?,
+        streak: compare_disparity_where(dense, truth, 2.0, on)?,
+        non_streak: compare_disparity_where(dense, truth, 2.0, |i| !on(i))?,
+    })
 }
 
 /// `report.json`.
@@ -1012,7 +1060,12 @@ pub fn analyze(input: &StereoInput, params: &AnalyzeParams) -> Result<Analysis, 
         ..params.sgm
     };
     let dense = sgm(&input.left, &input.right, &sgm_params)?;
-    let dense_summary = summarize_dense(&dense, &found.mask, &geo, sgm_params.max_disp);
+    let accuracy = match (&input.truth_disparity, &input.truth_streak_mask) {
+        (Some(truth), Some(mask)) => Some(dense_accuracy(&dense, truth, mask, "renderer")?),
+        (Some(truth), None) => Some(dense_accuracy(&dense, truth, &found.mask, "detector")?),
+        (None, _) => None,
+    };
+    let dense_summary = summarize_dense(&dense, &found.mask, &geo, sgm_params.max_disp, accuracy);
     let (detection, detection_vertical) = match &input.truth_streak_mask {
         Some(truth) => (
             Some(score_mask(&found.mask, truth)?),
@@ -1068,7 +1121,13 @@ fn for_each_point(
     }
 }
 
-fn summarize_dense(dense: &GrayImage, mask: &GrayImage, geo: &Geometry, max: i32) -> DenseSummary {
+fn summarize_dense(
+    dense: &GrayImage,
+    mask: &GrayImage,
+    geo: &Geometry,
+    max: i32,
+    accuracy: Option<DenseAccuracy>,
+) -> DenseSummary {
     let (mut valid, mut streak, mut streak_below, mut other_below) = (0usize, 0, 0, 0);
     for_each_point(dense, mask, geo, |_, _, is_streak, p| {
         valid += 1;
@@ -1086,6 +1145,7 @@ fn summarize_dense(dense: &GrayImage, mask: &GrayImage, geo: &Geometry, max: i32
         streak_pixels_below_road: streak_below,
         streak_pixels: streak,
         other_pixels_below_road: other_below,
+        accuracy,
     }
 }
 
@@ -1292,6 +1352,25 @@ pub fn summary_table(report: &Report) -> String {
         report.dense.streak_pixels,
         report.dense.other_pixels_below_road
     ));
+    if let Some(a) = &report.dense.accuracy {
+        s.push_str(&format!(
+            "dense SGM against the ground truth ({} streak mask): bad-2.0 / mean abs error / valid\n",
+            a.streak_mask
+        ));
+        for (what, e) in [
+            ("all", &a.all),
+            ("streak", &a.streak),
+            ("non-streak", &a.non_streak),
+        ] {
+            s.push_str(&format!(
+                "  {what:<10} {:>5.1}% / {:>6.2} px / {:>5.1}% of {} pixels\n",
+                100.0 * e.bad,
+                e.mean_abs,
+                100.0 * e.density,
+                e.truth_pixels
+            ));
+        }
+    }
     if let Some(d) = &report.detection {
         s.push_str(&format!(
             "streak detection against the renderer's streak mask: precision {:.2}, recall {:.2} ({} detected, {} true pixels)\n",
@@ -1370,6 +1449,68 @@ mod tests {
         assert!((f.slope + 0.5).abs() < 1e-12 && (f.intercept - 2.0).abs() < 1e-12);
         assert!(f.slope_se < 1e-9);
         assert!(fit_line(&[(1.0, 1.0), (1.0, 2.0)]).is_none());
+    }
+
+    /// The paper's point in miniature: a box drawn at a larger disparity than the surface it
+    /// lies on (as a streak shows the virtual light, not the road). SGM follows the image, so
+    /// against the surface's ground truth the "streak" pixels are bad and the others good.
+    #[test]
+    fn dense_disparity_is_scored_against_the_truth_split_by_the_streak_mask() {
+        let mut scene = SynthScene::textured(160, 120, 5);
+        scene.boxes.truncate(1);
+        scene.noise = 0.0;
+        let b = scene.boxes[0];
+        let pair = scene.render().unwrap();
+        let mut truth = pair.disparity.clone();
+        let mut mask = GrayImage::new(160, 120, 0.0).unwrap();
+        for y in b.y0..b.y1 {
+            for x in b.x0..b.x1 {
+                truth.set(x, y, scene.background_disparity(y));
+                mask.set(x, y, 1.0);
+            }
+        }
+        let rig = Rig::new(
+            Intrinsics::new(160, 120, 150.0).unwrap(),
+            0.065,
+            Affine3A::from_translation(Vec3::new(0.0, 1.5, 0.0)),
+        )
+        .unwrap();
+        let mut input = StereoInput {
+            left: pair.left,
+            right: pair.right,
+            rig,
+            lights: Vec::new(),
+            truth_disparity: Some(truth),
+            truth_depth: None,
+            truth_streak_mask: Some(mask),
+        };
+        let a = analyze(&input, &AnalyzeParams::default()).unwrap();
+        let acc = a.report.dense.accuracy.expect("scored against the truth");
+        eprintln!("{acc:?}");
+        assert_eq!(acc.streak_mask, "renderer");
+        let box_pixels = (b.x1 - b.x0) * (b.y1 - b.y0);
+        assert_eq!(acc.streak.truth_pixels, box_pixels);
+        assert_eq!(acc.all.truth_pixels, 160 * 120);
+        assert_eq!(acc.non_streak.truth_pixels, 160 * 120 - box_pixels);
+        assert!(acc.non_streak.bad < 0.05, "{:?}", acc.non_streak);
+        assert!(acc.non_streak.mean_abs < 0.5, "{:?}", acc.non_streak);
+        assert!(acc.non_streak.density > 0.8, "{:?}", acc.non_streak);
+        assert!(acc.streak.bad > 0.8, "{:?}", acc.streak);
+        assert!(acc.streak.mean_abs > 4.0, "{:?}", acc.streak);
+        assert!(acc.all.bad > acc.non_streak.bad && acc.all.bad < acc.streak.bad);
+        let table = summary_table(&a.report);
+        assert!(
+            table.contains("bad-2.0") && table.contains("non-streak"),
+            "{table}"
+        );
+        // Without its own mask the analysis splits by the detector's; without a truth there is
+        // no score.
+        input.truth_streak_mask = None;
+        let a = analyze(&input, &AnalyzeParams::default()).unwrap();
+        assert_eq!(a.report.dense.accuracy.unwrap().streak_mask, "detector");
+        input.truth_disparity = None;
+        let a = analyze(&input, &AnalyzeParams::default()).unwrap();
+        assert!(a.report.dense.accuracy.is_none());
     }
 
     /// A synthetic pair with a known answer: a textured road whose disparity falls linearly
