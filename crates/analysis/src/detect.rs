@@ -626,7 +626,7 @@ pub fn vertical_truth(truth: &GrayImage, horizon: f32) -> GrayImage {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::synth::SplitMix;
 
@@ -638,7 +638,10 @@ mod tests {
     }
 
     /// The scene seen with everything shifted left by `disparity` pixels (a right image).
-    fn scene_shifted(exposure: f32, disparity: f32) -> (GrayImage, GrayImage, Vec<(f32, f32)>) {
+    pub(crate) fn scene_shifted(
+        exposure: f32,
+        disparity: f32,
+    ) -> (GrayImage, GrayImage, Vec<(f32, f32)>) {
         let (w, h) = (320, 240);
         let streaks = [
             (60.0f32, 0.05f32, 124.0f32, 236.0f32, 0.5f32),

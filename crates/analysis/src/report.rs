@@ -10,10 +10,11 @@
 //! assign (`Z = f b / d`) and how far below the road the implied 3D point lies (the pixel
 //! back-projected at that depth, its Y in the road frame). Thin vertical objects (poles, found in
 //! the ground-truth depth), plain road (the most textured road pixel of every row) and named
-//! regions are measured the same way against their ground truth, as in Fig. 8, on the pair
-//! with its fireflies removed and its range log-compressed ([`crate::lk::despeckle`],
-//! [`crate::lk::log_compress`]); rows whose match has a low NCC are left out of their RMS and
-//! counted. A dense SGM disparity ([`crate::sgm`]) gives the point cloud of the side view, and
+//! regions are measured the same way against their ground truth, as in Fig. 8; rows whose
+//! match has a low NCC are left out of their RMS and counted. Every LK measurement, streaks
+//! and regions, is made on the pair with its Monte Carlo fireflies removed and its range
+//! log-compressed ([`crate::lk::despeckle`], [`crate::lk::log_compress`]): a single firefly
+//! in a window outweighs a dark road's texture and a faint streak alike. A dense SGM disparity ([`crate::sgm`]) gives the point cloud of the side view, and
 //! is scored against the ground truth (bad-2.0, mean error) on streak and other pixels.
 //!
 //! [`write_outputs`] writes `report.json`, one disparity-against-row plot per region, a
@@ -770,6 +771,7 @@ fn analyze_streak(
     index: usize,
     streak: &Streak,
     input: &StereoInput,
+    prepared: (&GrayImage, &GrayImage),
     geo: &Geometry,
     params: &AnalyzeParams,
     lk: &LkParams,
@@ -781,7 +783,7 @@ fn analyze_streak(
         .copied()
         .filter(|&(y, x)| y < h && (0.0..=w).contains(&x))
         .collect();
-    let measured = lk_rows(&input.left, &input.right, &centres, lk)
+    let measured = lk_rows(prepared.0, prepared.1, &centres, lk)
         .map_err(lk_err(format!("LK along streak {index}")))?;
     let mut light = match_light(streak, &input.lights, geo, params.match_tolerance_px);
     let mut predicted = std::collections::HashMap::new();
@@ -901,7 +903,7 @@ fn measure_region(
     })
 }
 
-/// The pair as the regions are measured: fireflies removed ([`despeckle`], ratio 2) and the
+/// The pair as LK measures it (streaks and regions): fireflies removed ([`despeckle`], ratio 2) and the
 /// range compressed ([`log_compress`], floor a tenth of the left image's median).
 fn prepare_matte(input: &StereoInput) -> (GrayImage, GrayImage) {
     let mut v: Vec<f32> = input
@@ -1177,13 +1179,14 @@ pub fn analyze(input: &StereoInput, params: &AnalyzeParams) -> Result<Analysis, 
         ..params.detect
     };
     let found = detect_streaks(&input.left, &detect)?;
+    // Every LK measurement is made on the prepared pair.
+    let (left, right) = prepare_matte(input);
     let streaks = found
         .streaks
         .iter()
         .enumerate()
-        .map(|(i, s)| analyze_streak(i, s, input, &geo, params, &lk))
+        .map(|(i, s)| analyze_streak(i, s, input, (&left, &right), &geo, params, &lk))
         .collect::<Result<Vec<_>, _>>()?;
-    let (left, right) = prepare_matte(input);
     let ri = RegionInput {
         input,
         geo: &geo,
@@ -1850,6 +1853,65 @@ mod tests {
         let raw_rms = r.comparison.unwrap().rms_px;
         eprintln!("raw pair: RMS {raw_rms} px");
         assert!(raw_rms > 0.5, "{raw_rms}");
+    }
+
+    /// Streaks at 6.35 px in a pair sprinkled with fireflies: on the prepared pair the analysis
+    /// measures them as on a clean one; on the raw pair the fireflies throw rows off.
+    #[test]
+    fn streaks_are_measured_through_fireflies() {
+        let (mut left, _, _) = crate::detect::tests::scene_shifted(1.0, 0.0);
+        let (mut right, _, _) = crate::detect::tests::scene_shifted(1.0, 6.35);
+        let mut rng = crate::synth::SplitMix(8);
+        for img in [&mut left, &mut right] {
+            for v in &mut img.data {
+                if rng.uniform() < 1.0 / 150.0 {
+                    *v += 5.0;
+                }
+            }
+        }
+        let rig = Rig::new(
+            Intrinsics::new(320, 240, 300.0).unwrap(),
+            0.065,
+            Affine3A::from_translation(Vec3::new(0.0, 1.5, 0.0)),
+        )
+        .unwrap();
+        let input = StereoInput {
+            left,
+            right,
+            rig,
+            lights: Vec::new(),
+            truth_disparity: None,
+            truth_depth: None,
+            truth_streak_mask: None,
+        };
+        let params = AnalyzeParams {
+            lk: LkParams {
+                min_disp: 0,
+                max_disp: 16,
+                ..AnalyzeParams::default().lk
+            },
+            ..AnalyzeParams::default()
+        };
+        let a = analyze(&input, &params).unwrap();
+        let rows: Vec<&RowRecord> = a.report.streaks.iter().flat_map(|s| &s.rows).collect();
+        assert!(rows.len() > 150, "{} rows", rows.len());
+        let rms = |d: &[f64]| (d.iter().map(|e| e * e).sum::<f64>() / d.len() as f64).sqrt();
+        let err: Vec<f64> = rows.iter().map(|r| r.measured_px - 6.35).collect();
+        eprintln!(
+            "{} streak rows through fireflies: RMS {} px",
+            err.len(),
+            rms(&err)
+        );
+        assert!(rms(&err) < 0.25, "{}", rms(&err));
+        let lk = LkParams {
+            max_disp: 16,
+            ..params.lk
+        };
+        let centres: Vec<(usize, f32)> = rows.iter().map(|r| (r.row, r.x)).collect();
+        let raw = lk_rows(&input.left, &input.right, &centres, &lk).unwrap();
+        let err: Vec<f64> = raw.iter().map(|r| r.disparity as f64 - 6.35).collect();
+        eprintln!("the same rows on the raw pair: RMS {} px", rms(&err));
+        assert!(rms(&err) > 0.5, "{}", rms(&err));
     }
 
     /// A synthetic pair with a known answer: a textured road whose disparity falls linearly
