@@ -1352,8 +1352,15 @@ fn summarize_dense(
 }
 
 /// The disparity-against-row plot of one region: measured black, predicted blue, and for a
-/// streak the road's disparity grey.
-pub fn rows_plot(title: &str, rows: &[RowRecord], predicted_label: &str) -> Plot {
+/// streak the road's disparity grey. Given `min_ncc`, the rows whose match has a lower NCC
+/// (left out of a region's comparison) are drawn grey.
+pub fn rows_plot(
+    title: &str,
+    rows: &[RowRecord],
+    predicted_label: &str,
+    min_ncc: Option<f32>,
+) -> Plot {
+    let low = |r: &RowRecord| min_ncc.is_some_and(|m| r.ncc < m || r.ncc.is_nan());
     let pts = |f: &dyn Fn(&RowRecord) -> Option<f64>| -> Vec<(f64, f64)> {
         rows.iter()
             .filter_map(|r| f(r).filter(|v| v.is_finite()).map(|v| (r.row as f64, v)))
@@ -1363,8 +1370,17 @@ pub fn rows_plot(title: &str, rows: &[RowRecord], predicted_label: &str) -> Plot
         "measured (1D LK)",
         BLACK_RGB,
         Marker::Circle,
-        pts(&|r| Some(r.measured_px)),
+        pts(&|r| (!low(r)).then_some(r.measured_px)),
     ));
+    let left_out = pts(&|r| low(r).then_some(r.measured_px));
+    if let (Some(m), false) = (min_ncc, left_out.is_empty()) {
+        plot = plot.with(Series::scatter(
+            format!("measured, NCC < {m} (left out)"),
+            GREY,
+            Marker::Circle,
+            left_out,
+        ));
+    }
     let predicted = pts(&|r| r.predicted_px);
     if !predicted.is_empty() {
         plot = plot.with(Series::line(predicted_label, BLUE, predicted));
@@ -1414,13 +1430,13 @@ pub fn write_outputs(
             None => format!("streak {} (no light matched)", s.index),
         };
         let path = dir.join(format!("streak{}.png", s.index));
-        rows_plot(&title, &s.rows, "predicted (Eq. 4 + Eq. 5)").write_png(&path)?;
+        rows_plot(&title, &s.rows, "predicted (Eq. 4 + Eq. 5)", None).write_png(&path)?;
         written.push(path);
     }
     for r in &report.regions {
         let path = dir.join(format!("{}.png", r.name));
         let title = format!("{} {} (x {}..{})", r.kind, r.name, r.region.x0, r.region.x1);
-        rows_plot(&title, &r.rows, "ground truth").write_png(&path)?;
+        rows_plot(&title, &r.rows, "ground truth", Some(r.min_ncc)).write_png(&path)?;
         written.push(path);
     }
     let geo = Geometry::new(&input.rig)?;
@@ -1826,6 +1842,11 @@ mod tests {
         assert!(c.rows + road.low_confidence_rows >= road.rows.len() - 2);
         assert!(c.rows >= 45, "{c:?}");
         assert!(c.rms_px < 0.1, "{c:?}");
+        // The plot draws the left-out rows apart.
+        let plot = rows_plot("road", &road.rows, "ground truth", Some(road.min_ncc));
+        let count = |i: usize| plot.series[i].paths.iter().map(Vec::len).sum::<usize>();
+        assert_eq!(count(0), road.rows.len() - road.low_confidence_rows);
+        assert_eq!(count(1), road.low_confidence_rows);
         // Left out: the last rows, whose windows are cut by the bottom border.
         assert!(
             road.low_confidence_rows <= 5,
