@@ -556,6 +556,9 @@ pub struct Report {
     pub horizon_row: f32,
     /// Lamps found by the detector.
     pub lamps: usize,
+    /// Glows found by the detector (bright regions below the horizon reaching the bottom row:
+    /// the near end of a reflection; in the streak mask, not measured by LK).
+    pub glows: usize,
     /// The streaks.
     pub streaks: Vec<StreakReport>,
     /// Vertical objects, road and named regions.
@@ -1291,6 +1294,7 @@ pub fn analyze(input: &StereoInput, params: &AnalyzeParams) -> Result<Analysis, 
         },
         horizon_row: found.horizon,
         lamps: found.lamps.len(),
+        glows: found.glows.len(),
         streaks,
         regions,
         dense: dense_summary,
@@ -1600,6 +1604,12 @@ pub fn summary_table(report: &Report) -> String {
             ));
         }
     }
+    s.push_str(&format!(
+        "detector: {} streaks, {} glows (wide reflections at the bottom, masked, not measured), {} lamps\n",
+        report.streaks.len(),
+        report.glows,
+        report.lamps
+    ));
     if let Some(d) = &report.detection {
         s.push_str(&format!(
             "streak detection against the renderer's streak mask: precision {:.2}, recall {:.2} ({} detected, {} true pixels)\n",
