@@ -102,6 +102,10 @@ fn analyze_reports_streaks_matched_to_lights_with_depths_below_the_road() {
         }
     }
     assert!(run.stderr().contains("bad-2.0"), "{}", run.stderr());
+    // The paper's point: SGM goes wrong on the streaks, not elsewhere.
+    let bad = |k: &str| acc[k]["bad"].as_f64().unwrap();
+    assert!(bad("streak") > 2.0 * bad("non_streak"), "{acc}");
+    assert!(bad("non_streak") < 0.1, "{acc}");
     // Bad inputs are errors, not panics.
     let bad = t.streaks(&["analyze", "out", "--region", "x=1,2,3"]);
     assert!(!bad.output.status.success());
