@@ -19,9 +19,13 @@ pub struct Args {
     /// A region to measure as well, `name=x0,y0,x1,y1` (pixels, half-open); repeatable.
     #[arg(long = "region", value_parser = parse_named_region)]
     pub regions: Vec<NamedRegion>,
-    /// How many vertical objects to pick from the ground-truth depth.
-    #[arg(long, default_value_t = 2)]
+    /// How many thin vertical objects (poles) to pick from the ground-truth depth.
+    #[arg(long, default_value_t = 3)]
     pub objects: usize,
+    /// Rows of a region whose LK match has a lower NCC are left out of its RMS against the
+    /// ground truth (and counted in the report).
+    #[arg(long, default_value_t = 0.8, allow_negative_numbers = true)]
+    pub min_ncc: f32,
     /// LK window width in pixels (odd).
     #[arg(long, default_value_t = 21)]
     pub window: usize,
@@ -77,6 +81,7 @@ impl Args {
             },
             regions: self.regions.clone(),
             auto_objects: self.objects,
+            min_ncc: self.min_ncc,
             match_tolerance_px: self.match_tolerance,
             ..AnalyzeParams::default()
         };
@@ -89,7 +94,8 @@ impl Args {
         Self {
             dir: dir.to_path_buf(),
             regions: Vec::new(),
-            objects: 2,
+            objects: 3,
+            min_ncc: 0.8,
             window: 21,
             rows: 5,
             horizon: None,

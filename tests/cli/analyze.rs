@@ -66,7 +66,46 @@ fn analyze_reports_streaks_matched_to_lights_with_depths_below_the_road() {
         .filter(|g| g["name"] == "left_half")
         .count();
     assert_eq!(n_named, 1);
+    // Road and a pole picked from the ground truth, sub-pixel against it on their confident
+    // rows (NCC >= 0.8; the others are counted).
+    for kind in ["road", "object"] {
+        let g = r["regions"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|g| g["kind"] == kind)
+            .unwrap_or_else(|| panic!("no {kind} region"));
+        let rows = g["rows"].as_array().unwrap().len() as u64;
+        let left_out = g["low_confidence_rows"].as_u64().unwrap();
+        let c = &g["comparison"];
+        assert!(
+            2 * left_out < rows,
+            "{kind}: {left_out} of {rows} rows left out"
+        );
+        assert!(c["rms_px"].as_f64().unwrap() < 0.5, "{kind}: {c}");
+        assert!(g["window"].as_u64().unwrap() % 2 == 1, "{g}");
+    }
     assert!(r["dense"]["density"].as_f64().unwrap() > 0.2);
+    // The SGM disparity scored against the ground truth, split by the renderer's streak mask.
+    let acc = &r["dense"]["accuracy"];
+    assert_eq!(acc["streak_mask"], "renderer", "{acc}");
+    let pixels = |k: &str| acc[k]["truth_pixels"].as_u64().unwrap();
+    assert!(pixels("streak") > 0, "{acc}");
+    assert_eq!(
+        pixels("all"),
+        pixels("streak") + pixels("non_streak"),
+        "{acc}"
+    );
+    for k in ["all", "streak", "non_streak"] {
+        for f in ["bad", "mean_abs", "density"] {
+            assert!(finite(&acc[k][f]), "{k}.{f}: {acc}");
+        }
+    }
+    assert!(run.stderr().contains("bad-2.0"), "{}", run.stderr());
+    // The paper's point: SGM goes wrong on the streaks, not elsewhere.
+    let bad = |k: &str| acc[k]["bad"].as_f64().unwrap();
+    assert!(bad("streak") > 2.0 * bad("non_streak"), "{acc}");
+    assert!(bad("non_streak") < 0.1, "{acc}");
     // Bad inputs are errors, not panics.
     let bad = t.streaks(&["analyze", "out", "--region", "x=1,2,3"]);
     assert!(!bad.output.status.success());

@@ -14,7 +14,10 @@
 //!    (a low headlight and its streak), and a bright compact **head** is split off its top
 //!    (leading rows brighter than `head_ratio` times the region's median row peak).
 //! 3. **Classification**: a region spanning at least `min_rows` rows and `min_elongation` times
-//!    taller than its mean width is a streak; the others are lamps.
+//!    taller than its mean width is a streak; a region below the horizon, at least `min_rows`
+//!    tall, that reaches the bottom row of the image is a **glow**, the near end of a reflection that widens as the road comes
+//!    closer (a lamp cannot appear there: it would have to be a light a metre or two in front
+//!    of the camera), and its pixels join the streak mask; the others are lamps.
 //! 4. **Per streak**: its centre per row (intensity-weighted, weights above the low threshold),
 //!    the axis `x = a + b y` fitted to the centres (weighted least squares), row extent, peak,
 //!    elongation.
@@ -174,6 +177,9 @@ pub struct Detection {
     pub streaks: Vec<Streak>,
     /// Lamps.
     pub lamps: Vec<Lamp>,
+    /// Glows: bright regions below the horizon, at least `min_rows` tall but not elongated,
+    /// reaching the bottom row (their pixels are in `mask`; LK does not follow them).
+    pub glows: Vec<Lamp>,
     /// 1 on streak pixels, 0 elsewhere.
     pub mask: GrayImage,
     /// The horizon used (image y).
@@ -287,6 +293,7 @@ pub fn detect_streaks(img: &GrayImage, params: &DetectParams) -> Result<Detectio
     let mut det = Detection {
         streaks: Vec::new(),
         lamps: Vec::new(),
+        glows: Vec::new(),
         mask: mask.clone(),
         horizon,
         thresholds,
@@ -452,6 +459,7 @@ fn classify(
     let mean_width = region.len() as f32 / nrows as f32;
     let elongation = nrows as f32 / mean_width;
     let below = first_row as f32 + 0.5 > det.horizon;
+    let glow = below && last_row + 1 == img.height && nrows >= params.min_rows;
     if !below || nrows < params.min_rows || elongation < params.min_elongation {
         let (mut sw, mut sx, mut sy) = (0.0f64, 0.0f64, 0.0f64);
         for &i in region {
@@ -460,12 +468,32 @@ fn classify(
             sx += wgt * ((i % w) as f64 + 0.5);
             sy += wgt * ((i / w) as f64 + 0.5);
         }
-        det.lamps.push(Lamp {
+        let lamp = Lamp {
             x: (sx / sw) as f32,
             y: (sy / sw) as f32,
             peak,
             pixels: region.len(),
-        });
+        };
+        if glow {
+            // The pixels of each row within `row_fraction` of its peak contrast, as a streak's.
+            let mut k = 0;
+            while k < region.len() {
+                let y = region[k] / w;
+                let end = k + region[k..].iter().take_while(|&&i| i / w == y).count();
+                let row = &region[k..end];
+                let keep =
+                    params.row_fraction * row.iter().map(|&i| contrast(i)).fold(0.0, f32::max);
+                for &i in row {
+                    if contrast(i) >= keep {
+                        mask.data[i] = 1.0;
+                    }
+                }
+                k = end;
+            }
+            det.glows.push(lamp);
+        } else {
+            det.lamps.push(lamp);
+        }
         return;
     }
     // Per-row weighted centres, then the weighted line fit x = a + b y.
@@ -626,7 +654,7 @@ pub fn vertical_truth(truth: &GrayImage, horizon: f32) -> GrayImage {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::synth::SplitMix;
 
@@ -638,7 +666,10 @@ mod tests {
     }
 
     /// The scene seen with everything shifted left by `disparity` pixels (a right image).
-    fn scene_shifted(exposure: f32, disparity: f32) -> (GrayImage, GrayImage, Vec<(f32, f32)>) {
+    pub(crate) fn scene_shifted(
+        exposure: f32,
+        disparity: f32,
+    ) -> (GrayImage, GrayImage, Vec<(f32, f32)>) {
         let (w, h) = (320, 240);
         let streaks = [
             (60.0f32, 0.05f32, 124.0f32, 236.0f32, 0.5f32),
@@ -790,6 +821,36 @@ mod tests {
         }
         let v = vertical_truth(&t2, 60.0);
         assert_eq!(v.data, truth.data);
+    }
+
+    /// A wide glow reaching the bottom of the image (the near end of a reflection) joins the
+    /// streak mask; a compact headlight below the horizon stays a lamp, out of the mask.
+    #[test]
+    fn a_glow_at_the_bottom_is_a_reflection_and_a_headlight_a_lamp() {
+        let (w, h) = (200, 120);
+        let mut img = GrayImage::new(w, h, 0.0).unwrap();
+        let mut rng = SplitMix(3);
+        for y in 0..h {
+            for x in 0..w {
+                let (xc, yc) = (x as f32 + 0.5, y as f32 + 0.5);
+                let glow =
+                    0.5 * (-((xc - 120.0) / 18.0).powi(2) - ((yc - 120.0) / 15.0).powi(2)).exp();
+                let head = 1.0 * (-((xc - 50.0).powi(2) + (yc - 80.0).powi(2)) / 8.0).exp();
+                img.set(x, y, 0.03 + glow + head + 0.005 * rng.gaussian());
+            }
+        }
+        let p = DetectParams {
+            horizon: Some(60.0),
+            ..DetectParams::default()
+        };
+        let det = detect_streaks(&img, &p).unwrap();
+        assert!(det.streaks.is_empty(), "{:?}", det.streaks);
+        assert_eq!(det.glows.len(), 1, "{:?}", det.glows);
+        assert!((det.glows[0].x - 120.0).abs() < 2.0, "{:?}", det.glows);
+        assert_eq!(det.lamps.len(), 1, "{:?}", det.lamps);
+        assert!((det.lamps[0].x - 50.0).abs() < 1.0 && (det.lamps[0].y - 80.0).abs() < 1.0);
+        assert!(det.mask.get(120, 115) > 0.5 && det.mask.get(120, h - 1) > 0.5);
+        assert_eq!(det.mask.get(50, 80), 0.0);
     }
 
     #[test]

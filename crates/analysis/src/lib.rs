@@ -11,8 +11,14 @@
 //! - [`plot`]: line, scatter and arrow plots with labelled axes and legends, written
 //!   atomically to PNG (plotters, with a font bundled in the crate).
 //! - [`figures`]: the paper's figures made from the model (Fig. 4, Fig. 5).
+//! - [`lk`]: the paper's per-row 1D Lucas-Kanade estimator, and the preparation of a rendered
+//!   pair for it (fireflies removed, range log-compressed).
+//! - [`detect`]: streaks, glows and lamps in the left image; masks scored against the truth.
+//! - [`sgm`]: dense semi-global matching, and its errors against a ground truth (bad-2.0).
 //! - [`report`]: the per-streak analysis of a rendered or photographed pair (Fig. 6, Fig. 8):
-//!   measured against predicted disparity per row, implied depths, plots and `report.json`.
+//!   measured against predicted disparity per row, poles and road against their ground truth,
+//!   the dense disparity scored on streak and other pixels, implied depths, plots and
+//!   `report.json`.
 //!
 //! ```
 //! use glam::DVec3;

@@ -451,6 +451,54 @@ pub fn lk_region(
     lk_rows(left, right, &centres, params)
 }
 
+/// Removes Monte Carlo fireflies: a pixel brighter than `ratio` times the second brightest of
+/// its 8 neighbours is replaced by that neighbour (border pixels are kept; the second, so that
+/// two fireflies side by side both go). A firefly lands in one eye only, and one in a window
+/// outweighs the whole texture of a dark road; a real feature (an edge, a streak, a lamp) spans
+/// more than two pixels and is left alone, but for the last pixel of a one-pixel-wide line.
+pub fn despeckle(img: &GrayImage, ratio: f32) -> GrayImage {
+    let mut out = img.clone();
+    let (w, h) = (img.width, img.height);
+    for y in 1..h.saturating_sub(1) {
+        for x in 1..w.saturating_sub(1) {
+            let (mut m1, mut m2) = (f32::NEG_INFINITY, f32::NEG_INFINITY);
+            for (dx, dy) in [
+                (0, 0),
+                (1, 0),
+                (2, 0),
+                (0, 1),
+                (2, 1),
+                (0, 2),
+                (1, 2),
+                (2, 2),
+            ] {
+                let v = img.get(x + dx - 1, y + dy - 1);
+                if v > m1 {
+                    (m1, m2) = (v, m1);
+                } else if v > m2 {
+                    m2 = v;
+                }
+            }
+            if img.get(x, y) > ratio * m2.max(0.0) {
+                out.set(x, y, m2);
+            }
+        }
+    }
+    out
+}
+
+/// Compresses the dynamic range: `ln(max(v, 0) + floor)`. On a night image lit by a few lamps
+/// the texture of a dark road is multiplied by the illumination; in the log it has the same
+/// contrast everywhere, and bright neighbours no longer dominate a window. `floor` (positive)
+/// keeps the noise of the darkest pixels from being amplified without bound.
+pub fn log_compress(img: &GrayImage, floor: f32) -> GrayImage {
+    let mut out = img.clone();
+    for v in &mut out.data {
+        *v = (v.max(0.0) + floor).ln();
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -469,6 +517,27 @@ mod tests {
             }
         }
         (l, r)
+    }
+
+    #[test]
+    fn despeckle_removes_single_pixels_only_and_log_compress_is_monotone() {
+        let mut img = GrayImage::new(7, 7, 0.1).unwrap();
+        img.set(2, 2, 5.0); // a firefly
+        img.set(2, 4, 6.0); // two side by side
+        img.set(3, 4, 4.0);
+        for y in 0..7 {
+            img.set(5, y, 3.0); // a one-pixel-wide vertical line: a feature, not a firefly
+        }
+        let d = despeckle(&img, 2.0);
+        assert_eq!(d.get(2, 2), 0.1);
+        assert_eq!((d.get(2, 4), d.get(3, 4)), (0.1, 0.1));
+        for y in 0..7 {
+            assert_eq!(d.get(5, y), 3.0);
+        }
+        assert_eq!(d.get(0, 0), 0.1);
+        let l = log_compress(&img, 0.01);
+        assert!((l.get(0, 0) - 0.11f32.ln()).abs() < 1e-6);
+        assert!(l.get(2, 2) > l.get(5, 0) && l.get(5, 0) > l.get(0, 0));
     }
 
     #[test]

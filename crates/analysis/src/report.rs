@@ -8,10 +8,14 @@
 //! streak's centres ([`crate::lk::lk_rows`]) and predicts it with Eq. 4 and Eq. 5
 //! ([`crate::model::streak_rows`]). For every row it records the depth a stereo system would
 //! assign (`Z = f b / d`) and how far below the road the implied 3D point lies (the pixel
-//! back-projected at that depth, its Y in the road frame). Vertical objects (regions where the
-//! ground-truth depth is constant over many rows, or named regions) and plain road are
-//! measured the same way against their ground truth, as in Fig. 8. A dense SGM disparity
-//! ([`crate::sgm`]) gives the point cloud of the side view.
+//! back-projected at that depth, its Y in the road frame). Thin vertical objects (poles, found in
+//! the ground-truth depth), plain road (the most textured road pixel of every row) and named
+//! regions are measured the same way against their ground truth, as in Fig. 8; rows whose
+//! match has a low NCC are left out of their RMS and counted. Every LK measurement, streaks
+//! and regions, is made on the pair with its Monte Carlo fireflies removed and its range
+//! log-compressed ([`crate::lk::despeckle`], [`crate::lk::log_compress`]): a single firefly
+//! in a window outweighs a dark road's texture and a faint streak alike. A dense SGM disparity ([`crate::sgm`]) gives the point cloud of the side view, and
+//! is scored against the ground truth (bad-2.0, mean error) on streak and other pixels.
 //!
 //! [`write_outputs`] writes `report.json`, one disparity-against-row plot per region, a
 //! disparity (inverse depth) map with the streak pixels marked, and the side view of the point
@@ -20,10 +24,12 @@
 use crate::detect::{
     detect_streaks, score_mask, vertical_truth, DetectError, DetectParams, MaskScore, Streak,
 };
-use crate::lk::{lk_region, lk_rows, LkError, LkParams, Region, RowDisparity};
+use crate::lk::{despeckle, lk_rows, log_compress, LkError, LkParams, Region, RowDisparity};
 use crate::model::{streak_rows, ModelError, RoadCamera, StereoRig};
 use crate::plot::{Marker, Plot, PlotError, Series, BLACK_RGB, BLUE, GREY, RED};
-use crate::sgm::{disparity_preview, sgm, SgmError, SgmParams};
+use crate::sgm::{
+    compare_disparity_where, disparity_preview, sgm, DisparityErrors, SgmError, SgmParams,
+};
 use glam::{DVec2, DVec3, Vec2, Vec3};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -204,6 +210,9 @@ pub struct AnalyzeParams {
     pub auto_objects: usize,
     /// Whether to pick a plain road region automatically.
     pub auto_road: bool,
+    /// Rows of a region whose LK match has a lower NCC are left out of its comparison with the
+    /// ground truth (and counted).
+    pub min_ncc: f32,
     /// Farthest a light's mirror image may be from a streak's axis, in pixels.
     pub match_tolerance_px: f32,
     /// A light match is dropped when the streak's median measured disparity is within this
@@ -224,8 +233,9 @@ impl Default for AnalyzeParams {
             detect: DetectParams::default(),
             sgm: SgmParams::default(),
             regions: Vec::new(),
-            auto_objects: 2,
+            auto_objects: 3,
             auto_road: true,
+            min_ncc: 0.8,
             match_tolerance_px: 12.0,
             road_reject_px: 0.5,
         }
@@ -440,12 +450,21 @@ pub struct RegionReport {
     pub name: String,
     /// `object`, `road` or `named`.
     pub kind: String,
-    /// The pixels (LK at the centre column of every row).
+    /// The pixels: a named region is measured at its centre column, an object at its centre
+    /// in every row, the road at the most textured road pixel of every row (each row's `x`).
     pub region: Region,
+    /// LK window width, pixels (an object's is fitted to its width).
+    pub window: usize,
+    /// Rows whose NCC is below this are left out of `comparison`.
+    pub min_ncc: f32,
+    /// How many rows were left out.
+    pub low_confidence_rows: usize,
     /// Per row; `predicted` is the ground-truth disparity.
     pub rows: Vec<RowRecord>,
-    /// Measured against the ground truth.
+    /// Measured against the ground truth over the confident rows.
     pub comparison: Option<Comparison>,
+    /// Measured against the ground truth over every row.
+    pub comparison_all_rows: Option<Comparison>,
 }
 
 /// The rig as the report states it.
@@ -480,6 +499,52 @@ pub struct DenseSummary {
     pub streak_pixels: usize,
     /// Valid non-streak pixels more than 0.1 m below the road.
     pub other_pixels_below_road: usize,
+    /// The dense disparity scored against the ground truth, when the input has it.
+    pub accuracy: Option<DenseAccuracy>,
+}
+
+/// The dense disparity scored against the ground-truth disparity: bad-2.0 (the share of the
+/// estimated pixels off by more than 2 px), mean absolute error and the share of pixels with
+/// an estimate ([`DisparityErrors`]), over every pixel that sees a surface and separately over
+/// the streak pixels and the others. Streak pixels are expected to be wrong: stereo sees the
+/// virtual light there, not the road.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct DenseAccuracy {
+    /// The mask that tells streak pixels from the others: `renderer` (the input's
+    /// `streak_mask_left.png`) or `detector` (the analysis' own, when the input has none).
+    pub streak_mask: &'static str,
+    /// Every pixel with a ground truth.
+    pub all: DisparityErrors,
+    /// The streak pixels.
+    pub streak: DisparityErrors,
+    /// The other pixels.
+    pub non_streak: DisparityErrors,
+}
+
+/// Bad-2.0, mean absolute error and density of `dense` against `truth`, overall and split by
+/// `streak_mask` (a pixel is a streak pixel when its mask value exceeds 0.5).
+pub fn dense_accuracy(
+    dense: &GrayImage,
+    truth: &GrayImage,
+    streak_mask: &GrayImage,
+    mask_name: &'static str,
+) -> Result<DenseAccuracy, ReportError> {
+    if (streak_mask.width, streak_mask.height) != (truth.width, truth.height) {
+        return Err(SgmError::SizeMismatch {
+            lw: streak_mask.width,
+            lh: streak_mask.height,
+            rw: truth.width,
+            rh: truth.height,
+        }
+        .into());
+    }
+    let on = |i: usize| streak_mask.data[i] > 0.5;
+    Ok(DenseAccuracy {
+        streak_mask: mask_name,
+        all: compare_disparity_where(dense, truth, 2.0, |_| true)?,
+        streak: compare_disparity_where(dense, truth, 2.0, on)?,
+        non_streak: compare_disparity_where(dense, truth, 2.0, |i| !on(i))?,
+    })
 }
 
 /// `report.json`.
@@ -491,6 +556,9 @@ pub struct Report {
     pub horizon_row: f32,
     /// Lamps found by the detector.
     pub lamps: usize,
+    /// Glows found by the detector (bright regions below the horizon reaching the bottom row:
+    /// the near end of a reflection; in the streak mask, not measured by LK).
+    pub glows: usize,
     /// The streaks.
     pub streaks: Vec<StreakReport>,
     /// Vertical objects, road and named regions.
@@ -706,6 +774,7 @@ fn analyze_streak(
     index: usize,
     streak: &Streak,
     input: &StereoInput,
+    prepared: (&GrayImage, &GrayImage),
     geo: &Geometry,
     params: &AnalyzeParams,
     lk: &LkParams,
@@ -717,7 +786,7 @@ fn analyze_streak(
         .copied()
         .filter(|&(y, x)| y < h && (0.0..=w).contains(&x))
         .collect();
-    let measured = lk_rows(&input.left, &input.right, &centres, lk)
+    let measured = lk_rows(prepared.0, prepared.1, &centres, lk)
         .map_err(lk_err(format!("LK along streak {index}")))?;
     let mut light = match_light(streak, &input.lights, geo, params.match_tolerance_px);
     let mut predicted = std::collections::HashMap::new();
@@ -782,35 +851,80 @@ fn analyze_streak(
     })
 }
 
+/// What [`measure_region`] needs besides the region.
+struct RegionInput<'a> {
+    input: &'a StereoInput,
+    geo: &'a Geometry,
+    /// The prepared pair ([`prepare_matte`]).
+    left: &'a GrayImage,
+    right: &'a GrayImage,
+    min_ncc: f32,
+}
+
+/// Measures a region row by row at `centres` (row, left-image x) with `lk`, against the
+/// ground truth at the pixel of each centre; the comparison keeps the rows whose NCC reaches
+/// `min_ncc`.
 fn measure_region(
     name: String,
     kind: &str,
     region: Region,
-    input: &StereoInput,
-    geo: &Geometry,
+    centres: &[(usize, f32)],
     lk: &LkParams,
+    ri: &RegionInput,
 ) -> Result<RegionReport, ReportError> {
-    let measured = lk_region(&input.left, &input.right, region, lk)
+    let measured = lk_rows(ri.left, ri.right, centres, lk)
         .map_err(lk_err(format!("LK over region {name}")))?;
-    let xc = (region.centre_x() as usize).min(input.left.width - 1);
+    let w = ri.input.left.width;
     let rows: Vec<RowRecord> = measured
         .iter()
         .map(|r| {
-            let truth = input
+            let xc = (r.x.max(0.0) as usize).min(w - 1);
+            let truth = ri
+                .input
                 .truth_disparity
                 .as_ref()
                 .map(|t| t.get(xc, r.row) as f64)
                 .filter(|d| d.is_finite());
-            geo.record(r, truth, None)
+            ri.geo.record(r, truth, None)
         })
+        .collect();
+    let confident: Vec<RowRecord> = rows
+        .iter()
+        .filter(|r| r.ncc >= ri.min_ncc)
+        .copied()
         .collect();
     Ok(RegionReport {
         name,
         kind: kind.into(),
         region,
-        comparison: compare(&rows),
+        window: lk.window,
+        min_ncc: ri.min_ncc,
+        low_confidence_rows: rows.len() - confident.len(),
+        comparison: compare(&confident),
+        comparison_all_rows: compare(&rows),
         rows,
     })
+}
+
+/// The pair as LK measures it (streaks and regions): fireflies removed ([`despeckle`], ratio 2) and the
+/// range compressed ([`log_compress`], floor a tenth of the left image's median).
+fn prepare_matte(input: &StereoInput) -> (GrayImage, GrayImage) {
+    let mut v: Vec<f32> = input
+        .left
+        .data
+        .iter()
+        .copied()
+        .filter(|v| v.is_finite())
+        .collect();
+    let median = if v.is_empty() {
+        0.0
+    } else {
+        let i = v.len() / 2;
+        *v.select_nth_unstable_by(i, f32::total_cmp).1
+    };
+    let floor = (0.1 * median).max(1e-6);
+    let prep = |img: &GrayImage| log_compress(&despeckle(img, 2.0), floor);
+    (prep(&input.left), prep(&input.right))
 }
 
 /// Height above the road of the ground-truth point at pixel `(x, y)`.
@@ -822,101 +936,194 @@ fn truth_road_y(depth: &GrayImage, geo: &Geometry, x: usize, y: usize) -> f32 {
     geo.implied(x as f32 + 0.5, y as f32 + 0.5, z).y
 }
 
-/// Vertical objects: columns whose ground-truth depth stays within 2 % over many rows (across
-/// the whole LK window) off the road, longest runs first, at least a tenth of the image width
-/// apart.
-fn find_objects(depth: &GrayImage, geo: &Geometry, half: usize, count: usize) -> Vec<Region> {
+/// A region picked from the ground truth: its bounding box, the per-row centres LK measures
+/// at, and the window width that fits it.
+#[derive(Clone, Debug, PartialEq)]
+struct Picked {
+    region: Region,
+    centres: Vec<(usize, f32)>,
+    window: usize,
+}
+
+/// Narrowest and widest vertical object [`find_objects`] picks, pixels.
+const OBJECT_WIDTH: (usize, usize) = (4, 32);
+
+/// Thin vertical objects (poles, posts): in every row, the maximal runs of pixels more than
+/// 0.1 m above the road whose ground-truth depth changes by less than 2 % from one pixel to the
+/// next, [`OBJECT_WIDTH`] wide, 2 pixels or more from the border of both images. A column is followed down while such a run holds it and its
+/// depth changes by less than 2 % from row to row; the longest runs (at least `h / 12` and
+/// 12 rows) are picked, at least a tenth of the image width apart. LK is centred on the
+/// object in every row, with a window 4 pixels wider than its median width (odd, at most
+/// `max_window`): the object and its two edges, little of the background behind it.
+fn find_objects(depth: &GrayImage, geo: &Geometry, count: usize, max_window: usize) -> Vec<Picked> {
     let (w, h) = (depth.width, depth.height);
-    let min_rows = (h / 12).max(12);
-    let mut runs: Vec<(usize, usize, usize)> = Vec::new(); // (length, x, y0)
     let near = |a: f32, b: f32| (a / b - 1.0).abs() < 0.02;
-    for x in (half..w.saturating_sub(half)).step_by(2) {
-        let ok = |y: usize| {
+    // Per pixel: its row run's first and last column (usize::MAX when not an object pixel).
+    let mut runs = vec![(usize::MAX, usize::MAX); w * h];
+    for y in 0..h {
+        let valid = |x: usize| {
             let z = depth.get(x, y);
-            z.is_finite()
-                && z > 0.0
-                && near(depth.get(x - half, y), z)
-                && near(depth.get(x + half, y), z)
-                && truth_road_y(depth, geo, x, y) > 0.1
+            z.is_finite() && z > 0.0 && truth_road_y(depth, geo, x, y) > 0.1
         };
-        let mut y = 0;
-        while y < h {
-            if !ok(y) {
-                y += 1;
+        let mut x = 0;
+        while x < w {
+            if !valid(x) {
+                x += 1;
                 continue;
             }
-            let (y0, z0) = (y, depth.get(x, y));
-            while y < h && ok(y) && near(depth.get(x, y), z0) {
-                y += 1;
+            let x0 = x;
+            x += 1;
+            while x < w && valid(x) && near(depth.get(x, y), depth.get(x - 1, y)) {
+                x += 1;
             }
-            if y - y0 >= min_rows {
-                runs.push((y - y0, x, y0));
+            for r in &mut runs[y * w + x0..y * w + x] {
+                *r = (x0, x - 1);
             }
         }
     }
-    runs.sort_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)));
-    let mut picked: Vec<Region> = Vec::new();
-    for (len, x, y0) in runs {
+    // Thin, and with its edges and 2 pixels beyond them inside both images (the right image
+    // sees the object `f b / Z` pixels further left).
+    let fb = geo.f as f32 * geo.rig.baseline();
+    let thin = |x: usize, y: usize| {
+        let (a, b) = runs[y * w + x];
+        a != usize::MAX
+            && (OBJECT_WIDTH.0..=OBJECT_WIDTH.1).contains(&(b - a + 1))
+            && a as f32 - 2.0 - fb / depth.get(x, y) >= 0.0
+            && b + 3 <= w
+    };
+    let min_rows = (h / 12).max(12);
+    let mut found: Vec<(usize, usize, usize)> = Vec::new(); // (length, x, y0)
+    for x in 0..w {
+        let mut y = 0;
+        while y < h {
+            if !thin(x, y) {
+                y += 1;
+                continue;
+            }
+            let y0 = y;
+            y += 1;
+            while y < h && thin(x, y) && near(depth.get(x, y), depth.get(x, y - 1)) {
+                y += 1;
+            }
+            if y - y0 >= min_rows {
+                found.push((y - y0, x, y0));
+            }
+        }
+    }
+    found.sort_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)));
+    let mut picked: Vec<Picked> = Vec::new();
+    for (len, x, y0) in found {
         if picked.len() == count {
             break;
         }
         if picked
             .iter()
-            .all(|r| (r.centre_x() - x as f32).abs() > 0.1 * w as f32)
+            .any(|p| (p.region.centre_x() - x as f32).abs() <= 0.1 * w as f32)
         {
-            picked.push(Region {
-                x0: x - half,
-                x1: x + half + 1,
+            continue;
+        }
+        let rows = y0..y0 + len;
+        let centres: Vec<(usize, f32)> = rows
+            .clone()
+            .map(|y| {
+                let (a, b) = runs[y * w + x];
+                (y, 0.5 * (a + b + 1) as f32)
+            })
+            .collect();
+        let mut widths: Vec<usize> = rows
+            .clone()
+            .map(|y| {
+                let (a, b) = runs[y * w + x];
+                b - a + 1
+            })
+            .collect();
+        widths.sort_unstable();
+        let window = ((widths[widths.len() / 2] + 4) | 1)
+            .min(max_window | 1)
+            .max(3);
+        let x0 = rows.clone().map(|y| runs[y * w + x].0).min().unwrap_or(x);
+        let x1 = rows.map(|y| runs[y * w + x].1 + 1).max().unwrap_or(x + 1);
+        picked.push(Picked {
+            region: Region {
+                x0,
+                x1,
                 y0,
                 y1: y0 + len,
-            });
-        }
+            },
+            centres,
+            window,
+        });
     }
     picked
 }
 
-/// Plain road: the column whose longest run of road pixels (ground truth within 2 cm of the
-/// road plane across the window) avoids the streak mask, nearest the image centre among the
-/// longest.
-fn find_road(depth: &GrayImage, mask: &GrayImage, geo: &Geometry, half: usize) -> Option<Region> {
+/// Plain road, one measurement per row: among the pixels whose LK window (`half` either side)
+/// lies on the road in the ground truth (within 2 cm of the plane at its centre and both ends),
+/// inside the right image as well, and off the streak mask, the one whose window has the most texture, the largest sum of the
+/// squared horizontal gradient of the prepared left image averaged over 3 rows (against the
+/// noise). Lane markings and the asphalt's grain win over the smooth glow of the reflections.
+/// Rows without such a pixel are skipped; `None` with fewer than 12 rows.
+fn find_road(
+    depth: &GrayImage,
+    mask: &GrayImage,
+    img: &GrayImage,
+    geo: &Geometry,
+    half: usize,
+) -> Option<Picked> {
     let (w, h) = (depth.width, depth.height);
-    let mut best: Option<(usize, usize, usize, usize)> = None; // (len, -dist key, x, y0)
-    for x in (half..w.saturating_sub(half)).step_by(2) {
-        let ok = |y: usize| {
-            [x - half, x, x + half]
-                .iter()
-                .all(|&xx| truth_road_y(depth, geo, xx, y).abs() < 0.02 && mask.get(xx, y) <= 0.0)
-        };
-        let mut y = 0;
-        while y < h {
-            if !ok(y) {
-                y += 1;
+    if w < 2 * half + 3 || h < 3 {
+        return None;
+    }
+    let fb = geo.f as f32 * geo.rig.baseline();
+    let mut centres = Vec::new();
+    let (mut gsum, mut msum) = (vec![0.0f64; w + 1], vec![0usize; w + 1]);
+    for y in 0..h {
+        let (ya, yb) = (y.saturating_sub(1), (y + 1).min(h - 1));
+        let avg = |x: usize| (img.get(x, ya) + img.get(x, y) + img.get(x, yb)) as f64 / 3.0;
+        for x in 0..w {
+            let g = if x > 0 && x + 1 < w {
+                (avg(x + 1) - avg(x - 1)).powi(2)
+            } else {
+                0.0
+            };
+            gsum[x + 1] = gsum[x] + if g.is_finite() { g } else { 0.0 };
+            msum[x + 1] = msum[x] + (mask.get(x, y) > 0.5) as usize;
+        }
+        let mut best: Option<(f64, usize)> = None;
+        for x in half + 1..w - half - 1 {
+            let (a, b) = (x - half, x + half + 1);
+            if msum[b] != msum[a] {
                 continue;
             }
-            let y0 = y;
-            while y < h && ok(y) {
-                y += 1;
-            }
-            let len = y - y0;
-            let dist = x.abs_diff(w / 2);
-            let better = best.is_none_or(|(bl, bd, _, _)| len > bl || (len == bl && dist < bd));
-            if better {
-                best = Some((len, dist, x, y0));
+            // On the road, and the window inside the right image too.
+            let on_road = [a, x, b - 1]
+                .iter()
+                .all(|&xx| truth_road_y(depth, geo, xx, y).abs() < 0.02)
+                && a as f32 - fb / depth.get(a, y) >= 0.0;
+            let energy = gsum[b] - gsum[a];
+            if on_road && best.is_none_or(|(e, _)| energy > e) {
+                best = Some((energy, x));
             }
         }
+        if let Some((_, x)) = best {
+            centres.push((y, x as f32 + 0.5));
+        }
     }
-    best.filter(|b| b.0 >= 12).map(|(len, _, x, y0)| Region {
-        x0: x - half,
-        x1: x + half + 1,
-        y0,
-        y1: y0 + len,
+    if centres.len() < 12 {
+        return None;
+    }
+    let xs = || centres.iter().map(|c| c.1 as usize);
+    let region = Region {
+        x0: xs().min()? - half,
+        x1: xs().max()? + half + 1,
+        y0: centres.first()?.0,
+        y1: centres.last()?.0 + 1,
+    };
+    Some(Picked {
+        region,
+        centres,
+        window: 2 * half + 1,
     })
-}
-
-/// Whether a region picked automatically has texture enough to measure: at least half its
-/// rows matched with an NCC above 0.5 (flat windows have NaN NCC).
-fn textured(region: &RegionReport) -> bool {
-    2 * region.rows.iter().filter(|r| r.ncc > 0.5).count() >= region.rows.len()
 }
 
 /// The SGM range that covers the scene: up to the largest ground-truth disparity (or that of
@@ -948,6 +1155,12 @@ pub fn analyze(input: &StereoInput, params: &AnalyzeParams) -> Result<Analysis, 
             reason: format!("must be positive, got {}", params.match_tolerance_px),
         });
     }
+    if !(-1.0..=1.0).contains(&params.min_ncc) {
+        return Err(ReportError::Param {
+            name: "min_ncc",
+            reason: format!("must be from -1 to 1, got {}", params.min_ncc),
+        });
+    }
     if !(params.road_reject_px.is_finite() && params.road_reject_px >= 0.0) {
         return Err(ReportError::Param {
             name: "road_reject_px",
@@ -969,40 +1182,80 @@ pub fn analyze(input: &StereoInput, params: &AnalyzeParams) -> Result<Analysis, 
         ..params.detect
     };
     let found = detect_streaks(&input.left, &detect)?;
+    // Every LK measurement is made on the prepared pair.
+    let (left, right) = prepare_matte(input);
     let streaks = found
         .streaks
         .iter()
         .enumerate()
-        .map(|(i, s)| analyze_streak(i, s, input, &geo, params, &lk))
+        .map(|(i, s)| analyze_streak(i, s, input, (&left, &right), &geo, params, &lk))
         .collect::<Result<Vec<_>, _>>()?;
-    let half = lk.window / 2;
+    let ri = RegionInput {
+        input,
+        geo: &geo,
+        left: &left,
+        right: &right,
+        min_ncc: params.min_ncc,
+    };
     let mut regions = Vec::new();
     for r in &params.regions {
+        let g = r.region;
+        if g.x0 >= g.x1 || g.y0 >= g.y1 || g.x1 > input.left.width || g.y1 > input.left.height {
+            return Err(ReportError::Lk {
+                what: format!("region {}", r.name),
+                source: LkError::Region {
+                    x0: g.x0,
+                    y0: g.y0,
+                    x1: g.x1,
+                    y1: g.y1,
+                    width: input.left.width,
+                    height: input.left.height,
+                },
+            });
+        }
+        let centres: Vec<(usize, f32)> = (g.y0..g.y1).map(|y| (y, g.centre_x())).collect();
         regions.push(measure_region(
             r.name.clone(),
             "named",
-            r.region,
-            input,
-            &geo,
+            g,
+            &centres,
             &lk,
+            &ri,
         )?);
     }
     if let Some(depth) = &input.truth_depth {
-        for (i, r) in find_objects(depth, &geo, half, params.auto_objects)
+        for (i, p) in find_objects(depth, &geo, params.auto_objects, lk.window)
             .into_iter()
             .enumerate()
         {
-            let m = measure_region(format!("object{i}"), "object", r, input, &geo, &lk)?;
-            if textured(&m) {
-                regions.push(m);
-            }
+            let lk = LkParams {
+                window: p.window,
+                ..lk
+            };
+            let name = format!("object{i}");
+            regions.push(measure_region(
+                name, "object", p.region, &p.centres, &lk, &ri,
+            )?);
         }
         if params.auto_road {
-            if let Some(r) = find_road(depth, &found.mask, &geo, half) {
-                let m = measure_region("road".into(), "road", r, input, &geo, &lk)?;
-                if textured(&m) {
-                    regions.push(m);
+            // Off the renderer's streaks and the detector's.
+            let mut mask = found.mask.clone();
+            if let Some(t) = &input.truth_streak_mask {
+                for (m, &t) in mask.data.iter_mut().zip(&t.data) {
+                    if t > 0.5 {
+                        *m = 1.0;
+                    }
                 }
+            }
+            if let Some(p) = find_road(depth, &mask, &left, &geo, lk.window / 2) {
+                regions.push(measure_region(
+                    "road".into(),
+                    "road",
+                    p.region,
+                    &p.centres,
+                    &lk,
+                    &ri,
+                )?);
             }
         }
     }
@@ -1012,7 +1265,12 @@ pub fn analyze(input: &StereoInput, params: &AnalyzeParams) -> Result<Analysis, 
         ..params.sgm
     };
     let dense = sgm(&input.left, &input.right, &sgm_params)?;
-    let dense_summary = summarize_dense(&dense, &found.mask, &geo, sgm_params.max_disp);
+    let accuracy = match (&input.truth_disparity, &input.truth_streak_mask) {
+        (Some(truth), Some(mask)) => Some(dense_accuracy(&dense, truth, mask, "renderer")?),
+        (Some(truth), None) => Some(dense_accuracy(&dense, truth, &found.mask, "detector")?),
+        (None, _) => None,
+    };
+    let dense_summary = summarize_dense(&dense, &found.mask, &geo, sgm_params.max_disp, accuracy);
     let (detection, detection_vertical) = match &input.truth_streak_mask {
         Some(truth) => (
             Some(score_mask(&found.mask, truth)?),
@@ -1036,6 +1294,7 @@ pub fn analyze(input: &StereoInput, params: &AnalyzeParams) -> Result<Analysis, 
         },
         horizon_row: found.horizon,
         lamps: found.lamps.len(),
+        glows: found.glows.len(),
         streaks,
         regions,
         dense: dense_summary,
@@ -1068,7 +1327,13 @@ fn for_each_point(
     }
 }
 
-fn summarize_dense(dense: &GrayImage, mask: &GrayImage, geo: &Geometry, max: i32) -> DenseSummary {
+fn summarize_dense(
+    dense: &GrayImage,
+    mask: &GrayImage,
+    geo: &Geometry,
+    max: i32,
+    accuracy: Option<DenseAccuracy>,
+) -> DenseSummary {
     let (mut valid, mut streak, mut streak_below, mut other_below) = (0usize, 0, 0, 0);
     for_each_point(dense, mask, geo, |_, _, is_streak, p| {
         valid += 1;
@@ -1086,12 +1351,20 @@ fn summarize_dense(dense: &GrayImage, mask: &GrayImage, geo: &Geometry, max: i32
         streak_pixels_below_road: streak_below,
         streak_pixels: streak,
         other_pixels_below_road: other_below,
+        accuracy,
     }
 }
 
 /// The disparity-against-row plot of one region: measured black, predicted blue, and for a
-/// streak the road's disparity grey.
-pub fn rows_plot(title: &str, rows: &[RowRecord], predicted_label: &str) -> Plot {
+/// streak the road's disparity grey. Given `min_ncc`, the rows whose match has a lower NCC
+/// (left out of a region's comparison) are drawn grey.
+pub fn rows_plot(
+    title: &str,
+    rows: &[RowRecord],
+    predicted_label: &str,
+    min_ncc: Option<f32>,
+) -> Plot {
+    let low = |r: &RowRecord| min_ncc.is_some_and(|m| r.ncc < m || r.ncc.is_nan());
     let pts = |f: &dyn Fn(&RowRecord) -> Option<f64>| -> Vec<(f64, f64)> {
         rows.iter()
             .filter_map(|r| f(r).filter(|v| v.is_finite()).map(|v| (r.row as f64, v)))
@@ -1101,8 +1374,17 @@ pub fn rows_plot(title: &str, rows: &[RowRecord], predicted_label: &str) -> Plot
         "measured (1D LK)",
         BLACK_RGB,
         Marker::Circle,
-        pts(&|r| Some(r.measured_px)),
+        pts(&|r| (!low(r)).then_some(r.measured_px)),
     ));
+    let left_out = pts(&|r| low(r).then_some(r.measured_px));
+    if let (Some(m), false) = (min_ncc, left_out.is_empty()) {
+        plot = plot.with(Series::scatter(
+            format!("measured, NCC < {m} (left out)"),
+            GREY,
+            Marker::Circle,
+            left_out,
+        ));
+    }
     let predicted = pts(&|r| r.predicted_px);
     if !predicted.is_empty() {
         plot = plot.with(Series::line(predicted_label, BLUE, predicted));
@@ -1152,13 +1434,13 @@ pub fn write_outputs(
             None => format!("streak {} (no light matched)", s.index),
         };
         let path = dir.join(format!("streak{}.png", s.index));
-        rows_plot(&title, &s.rows, "predicted (Eq. 4 + Eq. 5)").write_png(&path)?;
+        rows_plot(&title, &s.rows, "predicted (Eq. 4 + Eq. 5)", None).write_png(&path)?;
         written.push(path);
     }
     for r in &report.regions {
         let path = dir.join(format!("{}.png", r.name));
         let title = format!("{} {} (x {}..{})", r.kind, r.name, r.region.x0, r.region.x1);
-        rows_plot(&title, &r.rows, "ground truth").write_png(&path)?;
+        rows_plot(&title, &r.rows, "ground truth", Some(r.min_ncc)).write_png(&path)?;
         written.push(path);
     }
     let geo = Geometry::new(&input.rig)?;
@@ -1272,7 +1554,7 @@ pub fn summary_table(report: &Report) -> String {
         s.push_str(&format!(
             "{:<11} {:>4}  {:>5}  {:>9}  {:>9}  {:>9}  {:>7}  {:>8}  {:>8}  {:>7.2}m  {:>7.2}m\n",
             r.name,
-            r.rows.len(),
+            r.rows.len() - r.low_confidence_rows,
             "-",
             format!("{:.3}", span(r.rows.iter().map(|x| x.measured_px))),
             opt(c.map(|c| c.predicted_span_px)),
@@ -1284,6 +1566,17 @@ pub fn summary_table(report: &Report) -> String {
             median(r.rows.iter().map(|x| x.road_y_m).collect()),
         ));
     }
+    if !report.regions.is_empty() {
+        s.push_str(&format!(
+            "regions: rows = rows with NCC >= {} (their RMS against the ground truth); left out:{}\n",
+            report.regions[0].min_ncc,
+            report
+                .regions
+                .iter()
+                .map(|r| format!(" {} {} of {}", r.name, r.low_confidence_rows, r.rows.len()))
+                .collect::<String>()
+        ));
+    }
     s.push_str(&format!(
         "dense SGM (0..{} px): {:.0}% valid; {} of {} streak pixels imply points > 0.1 m below the road ({} other pixels do)\n",
         report.dense.range.1,
@@ -1291,6 +1584,31 @@ pub fn summary_table(report: &Report) -> String {
         report.dense.streak_pixels_below_road,
         report.dense.streak_pixels,
         report.dense.other_pixels_below_road
+    ));
+    if let Some(a) = &report.dense.accuracy {
+        s.push_str(&format!(
+            "dense SGM against the ground truth ({} streak mask): bad-2.0 / mean abs error / valid\n",
+            a.streak_mask
+        ));
+        for (what, e) in [
+            ("all", &a.all),
+            ("streak", &a.streak),
+            ("non-streak", &a.non_streak),
+        ] {
+            s.push_str(&format!(
+                "  {what:<10} {:>5.1}% / {:>6.2} px / {:>5.1}% of {} pixels\n",
+                100.0 * e.bad,
+                e.mean_abs,
+                100.0 * e.density,
+                e.truth_pixels
+            ));
+        }
+    }
+    s.push_str(&format!(
+        "detector: {} streaks, {} glows (wide reflections at the bottom, masked, not measured), {} lamps\n",
+        report.streaks.len(),
+        report.glows,
+        report.lamps
     ));
     if let Some(d) = &report.detection {
         s.push_str(&format!(
@@ -1372,6 +1690,261 @@ mod tests {
         assert!(fit_line(&[(1.0, 1.0), (1.0, 2.0)]).is_none());
     }
 
+    /// The paper's point in miniature: a box drawn at a larger disparity than the surface it
+    /// lies on (as a streak shows the virtual light, not the road). SGM follows the image, so
+    /// against the surface's ground truth the "streak" pixels are bad and the others good.
+    #[test]
+    fn dense_disparity_is_scored_against_the_truth_split_by_the_streak_mask() {
+        let mut scene = SynthScene::textured(160, 120, 5);
+        scene.boxes.truncate(1);
+        scene.noise = 0.0;
+        let b = scene.boxes[0];
+        let pair = scene.render().unwrap();
+        let mut truth = pair.disparity.clone();
+        let mut mask = GrayImage::new(160, 120, 0.0).unwrap();
+        for y in b.y0..b.y1 {
+            for x in b.x0..b.x1 {
+                truth.set(x, y, scene.background_disparity(y));
+                mask.set(x, y, 1.0);
+            }
+        }
+        let rig = Rig::new(
+            Intrinsics::new(160, 120, 150.0).unwrap(),
+            0.065,
+            Affine3A::from_translation(Vec3::new(0.0, 1.5, 0.0)),
+        )
+        .unwrap();
+        let mut input = StereoInput {
+            left: pair.left,
+            right: pair.right,
+            rig,
+            lights: Vec::new(),
+            truth_disparity: Some(truth),
+            truth_depth: None,
+            truth_streak_mask: Some(mask),
+        };
+        let a = analyze(&input, &AnalyzeParams::default()).unwrap();
+        let acc = a.report.dense.accuracy.expect("scored against the truth");
+        eprintln!("{acc:?}");
+        assert_eq!(acc.streak_mask, "renderer");
+        let box_pixels = (b.x1 - b.x0) * (b.y1 - b.y0);
+        assert_eq!(acc.streak.truth_pixels, box_pixels);
+        assert_eq!(acc.all.truth_pixels, 160 * 120);
+        assert_eq!(acc.non_streak.truth_pixels, 160 * 120 - box_pixels);
+        assert!(acc.non_streak.bad < 0.05, "{:?}", acc.non_streak);
+        assert!(acc.non_streak.mean_abs < 0.5, "{:?}", acc.non_streak);
+        assert!(acc.non_streak.density > 0.8, "{:?}", acc.non_streak);
+        assert!(acc.streak.bad > 0.8, "{:?}", acc.streak);
+        assert!(acc.streak.mean_abs > 4.0, "{:?}", acc.streak);
+        assert!(acc.all.bad > acc.non_streak.bad && acc.all.bad < acc.streak.bad);
+        let table = summary_table(&a.report);
+        assert!(
+            table.contains("bad-2.0") && table.contains("non-streak"),
+            "{table}"
+        );
+        // Without its own mask the analysis splits by the detector's; without a truth there is
+        // no score.
+        input.truth_streak_mask = None;
+        let a = analyze(&input, &AnalyzeParams::default()).unwrap();
+        assert_eq!(a.report.dense.accuracy.unwrap().streak_mask, "detector");
+        input.truth_disparity = None;
+        let a = analyze(&input, &AnalyzeParams::default()).unwrap();
+        assert!(a.report.dense.accuracy.is_none());
+    }
+
+    /// A level rig 1.5 m above a road, and the ground-truth depth of a road that ends at the
+    /// horizon (row 60 of 120) with the sky above.
+    fn level_rig(baseline: f32) -> (Rig, GrayImage) {
+        let rig = Rig::new(
+            Intrinsics::new(160, 120, 150.0).unwrap(),
+            baseline,
+            Affine3A::from_translation(Vec3::new(0.0, 1.5, 0.0)),
+        )
+        .unwrap();
+        let mut depth = GrayImage::new(160, 120, f32::INFINITY).unwrap();
+        for y in 60..120 {
+            for x in 0..160 {
+                depth.set(x, y, 150.0 * 1.5 / (y as f32 + 0.5 - 60.0));
+            }
+        }
+        (rig, depth)
+    }
+
+    #[test]
+    fn thin_vertical_objects_are_found_in_the_ground_truth_with_a_window_to_fit() {
+        let (rig, mut depth) = level_rig(0.065);
+        let geo = Geometry::new(&rig).unwrap();
+        // A wall 20 m away above the road, a 6 px pole 8 m away standing on the road, and a
+        // pole at the left border (its match would leave the right image).
+        for y in 0..120 {
+            for x in 0..160 {
+                let wall_ground = y as f32 + 0.5 - 60.0 > 150.0 * 1.5 / 20.0;
+                if !wall_ground {
+                    depth.set(x, y, 20.0);
+                }
+            }
+        }
+        let pole_bottom = (60.0 + 150.0 * 1.5 / 8.0) as usize; // row 88
+        for y in 0..pole_bottom {
+            for x in (100..106).chain(0..3) {
+                depth.set(x, y, 8.0);
+            }
+        }
+        let found = find_objects(&depth, &geo, 3, 21);
+        assert_eq!(found.len(), 1, "{found:?}");
+        let p = &found[0];
+        assert_eq!((p.region.x0, p.region.x1, p.region.y0), (100, 106, 0));
+        // The rows more than 0.1 m above the road.
+        assert!((p.region.y1 as i64 - 86).abs() <= 1, "{:?}", p.region);
+        assert_eq!(p.window, 11);
+        assert!(p.centres.iter().all(|c| c.1 == 103.0));
+        // The widest pole is 32 pixels.
+        for y in 0..pole_bottom {
+            for x in 100..140 {
+                depth.set(x, y, 8.0);
+            }
+        }
+        assert!(find_objects(&depth, &geo, 3, 21).is_empty());
+    }
+
+    /// Fireflies (single pixels tens of times brighter than the texture, in one eye at a time)
+    /// on a textured road: measured on the raw pair they throw whole rows off; after
+    /// [`prepare_matte`] the road is sub-pixel accurate, and the analysis finds it by itself.
+    #[test]
+    fn road_is_measured_sub_pixel_through_fireflies() {
+        let (rig, depth) = level_rig(0.3);
+        // The road's disparity b (y + 0.5 - 60) / 1.5 on every row (negative above the
+        // horizon, where the truth has no surface).
+        let mut scene = SynthScene::textured(160, 120, 9);
+        scene.boxes.clear();
+        scene.disparity_top = -11.9;
+        scene.disparity_bottom = 11.9;
+        let mut pair = scene.render().unwrap();
+        let mut rng = crate::synth::SplitMix(4);
+        for img in [&mut pair.left, &mut pair.right] {
+            for v in &mut img.data {
+                if rng.uniform() < 1.0 / 150.0 {
+                    *v += 20.0;
+                }
+            }
+        }
+        let mut truth = pair.disparity.clone();
+        for (t, z) in truth.data.iter_mut().zip(&depth.data) {
+            if !z.is_finite() {
+                *t = f32::INFINITY;
+            }
+        }
+        let input = StereoInput {
+            left: pair.left,
+            right: pair.right,
+            rig,
+            lights: Vec::new(),
+            truth_disparity: Some(truth),
+            truth_depth: Some(depth),
+            truth_streak_mask: None,
+        };
+        let a = analyze(&input, &AnalyzeParams::default()).unwrap();
+        let road = a.report.regions.iter().find(|r| r.kind == "road");
+        let road = road.expect("the road is found");
+        let c = road.comparison.expect("confident rows");
+        eprintln!("road: {} rows left out; {c:?}", road.low_confidence_rows);
+        assert!(road.rows.len() >= 50, "{}", road.rows.len());
+        assert!(c.rows + road.low_confidence_rows >= road.rows.len() - 2);
+        assert!(c.rows >= 45, "{c:?}");
+        assert!(c.rms_px < 0.1, "{c:?}");
+        // The plot draws the left-out rows apart.
+        let plot = rows_plot("road", &road.rows, "ground truth", Some(road.min_ncc));
+        let count = |i: usize| plot.series[i].paths.iter().map(Vec::len).sum::<usize>();
+        assert_eq!(count(0), road.rows.len() - road.low_confidence_rows);
+        assert_eq!(count(1), road.low_confidence_rows);
+        // Left out: the last rows, whose windows are cut by the bottom border.
+        assert!(
+            road.low_confidence_rows <= 5,
+            "{}",
+            road.low_confidence_rows
+        );
+        assert_eq!(road.comparison_all_rows.unwrap().rows, road.rows.len());
+        // The same rows on the raw pair.
+        let geo = Geometry::new(&input.rig).unwrap();
+        let raw = RegionInput {
+            input: &input,
+            geo: &geo,
+            left: &input.left,
+            right: &input.right,
+            min_ncc: -1.0,
+        };
+        let centres: Vec<(usize, f32)> = road.rows.iter().map(|r| (r.row, r.x)).collect();
+        let lk = LkParams {
+            window: road.window,
+            rows: 5,
+            max_disp: 16,
+            ..LkParams::default()
+        };
+        let r = measure_region("raw".into(), "road", road.region, &centres, &lk, &raw).unwrap();
+        let raw_rms = r.comparison.unwrap().rms_px;
+        eprintln!("raw pair: RMS {raw_rms} px");
+        assert!(raw_rms > 0.5, "{raw_rms}");
+    }
+
+    /// Streaks at 6.35 px in a pair sprinkled with fireflies: on the prepared pair the analysis
+    /// measures them as on a clean one; on the raw pair the fireflies throw rows off.
+    #[test]
+    fn streaks_are_measured_through_fireflies() {
+        let (mut left, _, _) = crate::detect::tests::scene_shifted(1.0, 0.0);
+        let (mut right, _, _) = crate::detect::tests::scene_shifted(1.0, 6.35);
+        let mut rng = crate::synth::SplitMix(8);
+        for img in [&mut left, &mut right] {
+            for v in &mut img.data {
+                if rng.uniform() < 1.0 / 150.0 {
+                    *v += 5.0;
+                }
+            }
+        }
+        let rig = Rig::new(
+            Intrinsics::new(320, 240, 300.0).unwrap(),
+            0.065,
+            Affine3A::from_translation(Vec3::new(0.0, 1.5, 0.0)),
+        )
+        .unwrap();
+        let input = StereoInput {
+            left,
+            right,
+            rig,
+            lights: Vec::new(),
+            truth_disparity: None,
+            truth_depth: None,
+            truth_streak_mask: None,
+        };
+        let params = AnalyzeParams {
+            lk: LkParams {
+                min_disp: 0,
+                max_disp: 16,
+                ..AnalyzeParams::default().lk
+            },
+            ..AnalyzeParams::default()
+        };
+        let a = analyze(&input, &params).unwrap();
+        let rows: Vec<&RowRecord> = a.report.streaks.iter().flat_map(|s| &s.rows).collect();
+        assert!(rows.len() > 150, "{} rows", rows.len());
+        let rms = |d: &[f64]| (d.iter().map(|e| e * e).sum::<f64>() / d.len() as f64).sqrt();
+        let err: Vec<f64> = rows.iter().map(|r| r.measured_px - 6.35).collect();
+        eprintln!(
+            "{} streak rows through fireflies: RMS {} px",
+            err.len(),
+            rms(&err)
+        );
+        assert!(rms(&err) < 0.25, "{}", rms(&err));
+        let lk = LkParams {
+            max_disp: 16,
+            ..params.lk
+        };
+        let centres: Vec<(usize, f32)> = rows.iter().map(|r| (r.row, r.x)).collect();
+        let raw = lk_rows(&input.left, &input.right, &centres, &lk).unwrap();
+        let err: Vec<f64> = raw.iter().map(|r| r.disparity as f64 - 6.35).collect();
+        eprintln!("the same rows on the raw pair: RMS {} px", rms(&err));
+        assert!(rms(&err) > 0.5, "{}", rms(&err));
+    }
+
     /// A synthetic pair with a known answer: a textured road whose disparity falls linearly
     /// from the bottom row to the top; LK over a region measured against the known value
     /// must agree, with the same slope.
@@ -1408,7 +1981,17 @@ mod tests {
             max_disp: 16,
             ..LkParams::default()
         };
-        let r = measure_region("r".into(), "named", region, &input, &geo, &lk).unwrap();
+        let (left, right) = prepare_matte(&input);
+        let ri = RegionInput {
+            input: &input,
+            geo: &geo,
+            left: &left,
+            right: &right,
+            min_ncc: 0.8,
+        };
+        let centres: Vec<(usize, f32)> = (20..100).map(|y| (y, region.centre_x())).collect();
+        let r = measure_region("r".into(), "named", region, &centres, &lk, &ri).unwrap();
+        assert_eq!(r.low_confidence_rows, 0);
         let c = r.comparison.unwrap();
         assert_eq!(c.rows, 80);
         eprintln!("synthetic road region: {c:?}");

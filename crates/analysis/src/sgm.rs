@@ -556,6 +556,17 @@ pub fn compare_disparity(
     truth: &GrayImage,
     threshold: f32,
 ) -> Result<DisparityErrors, SgmError> {
+    compare_disparity_where(estimate, truth, threshold, |_| true)
+}
+
+/// [`compare_disparity`] over the pixels whose index `y * width + x` `select` accepts (for
+/// example the pixels of a streak mask, or all the others).
+pub fn compare_disparity_where(
+    estimate: &GrayImage,
+    truth: &GrayImage,
+    threshold: f32,
+    select: impl Fn(usize) -> bool,
+) -> Result<DisparityErrors, SgmError> {
     if (estimate.width, estimate.height) != (truth.width, truth.height) {
         return Err(SgmError::SizeMismatch {
             lw: estimate.width,
@@ -565,8 +576,8 @@ pub fn compare_disparity(
         });
     }
     let (mut n, mut m, mut bad, mut sa, mut ss) = (0usize, 0usize, 0usize, 0.0f64, 0.0f64);
-    for (&e, &t) in estimate.data.iter().zip(&truth.data) {
-        if !t.is_finite() {
+    for (i, (&e, &t)) in estimate.data.iter().zip(&truth.data).enumerate() {
+        if !t.is_finite() || !select(i) {
             continue;
         }
         n += 1;
@@ -722,6 +733,39 @@ mod tests {
         write_disparity_png(&png, &img, Some((0.0, 10.0))).unwrap();
         assert_eq!(::image::open(&png).unwrap().width(), 3);
         assert!(write_disparity_png(&dir.path().join("no/d.png"), &img, None).is_err());
+    }
+
+    #[test]
+    fn errors_against_truth_count_only_the_selected_pixels() {
+        // Truth 5 everywhere but one pixel without a surface; the estimate is right on the left
+        // half, 3 px off on the right half, and missing at one pixel.
+        let mut truth = GrayImage::new(4, 2, 5.0).unwrap();
+        truth.set(0, 1, f32::INFINITY);
+        let mut est = GrayImage::new(4, 2, 5.0).unwrap();
+        for y in 0..2 {
+            est.set(2, y, 8.0);
+            est.set(3, y, 8.0);
+        }
+        est.set(1, 0, f32::INFINITY);
+        let all = compare_disparity(&est, &truth, 2.0).unwrap();
+        assert_eq!(all.truth_pixels, 7);
+        assert!((all.density - 6.0 / 7.0).abs() < 1e-12);
+        assert!((all.bad - 4.0 / 6.0).abs() < 1e-12);
+        assert!((all.bad_all - 5.0 / 7.0).abs() < 1e-12);
+        assert!((all.mean_abs - 2.0).abs() < 1e-6);
+        let right = compare_disparity_where(&est, &truth, 2.0, |i| i % 4 >= 2).unwrap();
+        assert_eq!(
+            (right.truth_pixels, right.bad, right.mean_abs),
+            (4, 1.0, 3.0)
+        );
+        let left = compare_disparity_where(&est, &truth, 2.0, |i| i % 4 < 2).unwrap();
+        assert_eq!(left.truth_pixels, 3);
+        assert_eq!(
+            (left.density, left.bad, left.mean_abs),
+            (2.0 / 3.0, 0.0, 0.0)
+        );
+        let none = compare_disparity_where(&est, &truth, 2.0, |_| false).unwrap();
+        assert_eq!((none.truth_pixels, none.density), (0, 0.0));
     }
 
     /// Timing of a megapixel pair: `cargo test --release -p streaks-analysis -- --ignored
