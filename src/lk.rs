@@ -5,7 +5,7 @@ use anyhow::{bail, Context};
 use std::path::PathBuf;
 use streaks_analysis::detect::{detect_streaks, DetectParams};
 use streaks_analysis::lk::{
-    lk_region, lk_rows, Interp, LkParams, Photometric, Region, RowDisparity,
+    lk_region, lk_rows, prepare_pair, Interp, LkParams, Photometric, Region, RowDisparity,
 };
 use streaks_stereo::image::GrayImage;
 
@@ -54,6 +54,10 @@ pub struct Args {
     /// Compensate a gain (contrast) difference as well as an offset between the cameras.
     #[arg(long)]
     pub gain: bool,
+    /// Measure the images as they are. By default they are prepared as `streaks analyze`
+    /// does: single-pixel fireflies removed and the range log-compressed.
+    #[arg(long)]
+    pub raw: bool,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Csv)]
     pub format: Format,
@@ -75,6 +79,10 @@ fn parse_region(s: &str) -> Result<Region, String> {
 pub fn run(args: Args) -> anyhow::Result<()> {
     let left = GrayImage::load(&args.left).context("reading the left image")?;
     let right = GrayImage::load(&args.right).context("reading the right image")?;
+    // LK measures the prepared pair; streaks are detected on the left image as it is (as
+    // `streaks analyze` does).
+    let prepared = (!args.raw).then(|| prepare_pair(&left, &right));
+    let (lk_left, lk_right) = prepared.as_ref().map_or((&left, &right), |(l, r)| (l, r));
     if args.min_disp > args.max_disp {
         bail!(
             "--min-disp {} exceeds --max-disp {}",
@@ -101,7 +109,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     };
     // (streak index, estimate) pairs.
     let rows: Vec<(Option<usize>, RowDisparity)> = match args.region {
-        Some(region) => lk_region(&left, &right, region, &params)
+        Some(region) => lk_region(lk_left, lk_right, region, &params)
             .context("estimating disparities")?
             .into_iter()
             .map(|r| (None, r))
@@ -120,7 +128,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             );
             let mut rows = Vec::new();
             for (i, streak) in found.streaks.iter().enumerate() {
-                let est = lk_rows(&left, &right, &streak.centres, &params)
+                let est = lk_rows(lk_left, lk_right, &streak.centres, &params)
                     .with_context(|| format!("estimating disparities along streak {i}"))?;
                 rows.extend(est.into_iter().map(|r| (Some(i), r)));
             }

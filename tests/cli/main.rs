@@ -4,5 +4,6 @@
 
 mod analyze;
 mod common;
+mod measure;
 mod render;
 mod stereo;

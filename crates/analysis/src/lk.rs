@@ -499,6 +499,28 @@ pub fn log_compress(img: &GrayImage, floor: f32) -> GrayImage {
     out
 }
 
+/// A rendered or photographed pair as LK measures it best at night: fireflies removed
+/// ([`despeckle`], ratio 2) and the range compressed ([`log_compress`], floor a tenth of the
+/// left image's median, so both eyes get the same curve). `streaks analyze` measures streaks,
+/// poles and road on this, and `streaks lk` does unless told `--raw`.
+pub fn prepare_pair(left: &GrayImage, right: &GrayImage) -> (GrayImage, GrayImage) {
+    let mut v: Vec<f32> = left
+        .data
+        .iter()
+        .copied()
+        .filter(|v| v.is_finite())
+        .collect();
+    let median = if v.is_empty() {
+        0.0
+    } else {
+        let i = v.len() / 2;
+        *v.select_nth_unstable_by(i, f32::total_cmp).1
+    };
+    let floor = (0.1 * median).max(1e-6);
+    let prep = |img: &GrayImage| log_compress(&despeckle(img, 2.0), floor);
+    (prep(left), prep(right))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

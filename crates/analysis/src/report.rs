@@ -24,7 +24,7 @@
 use crate::detect::{
     detect_streaks, score_mask, vertical_truth, DetectError, DetectParams, MaskScore, Streak,
 };
-use crate::lk::{despeckle, lk_rows, log_compress, LkError, LkParams, Region, RowDisparity};
+use crate::lk::{lk_rows, prepare_pair, LkError, LkParams, Region, RowDisparity};
 use crate::model::{streak_rows, ModelError, RoadCamera, StereoRig};
 use crate::plot::{Marker, Plot, PlotError, Series, BLACK_RGB, BLUE, GREY, RED};
 use crate::sgm::{
@@ -855,7 +855,7 @@ fn analyze_streak(
 struct RegionInput<'a> {
     input: &'a StereoInput,
     geo: &'a Geometry,
-    /// The prepared pair ([`prepare_matte`]).
+    /// The prepared pair ([`prepare_pair`]).
     left: &'a GrayImage,
     right: &'a GrayImage,
     min_ncc: f32,
@@ -904,27 +904,6 @@ fn measure_region(
         comparison_all_rows: compare(&rows),
         rows,
     })
-}
-
-/// The pair as LK measures it (streaks and regions): fireflies removed ([`despeckle`], ratio 2) and the
-/// range compressed ([`log_compress`], floor a tenth of the left image's median).
-fn prepare_matte(input: &StereoInput) -> (GrayImage, GrayImage) {
-    let mut v: Vec<f32> = input
-        .left
-        .data
-        .iter()
-        .copied()
-        .filter(|v| v.is_finite())
-        .collect();
-    let median = if v.is_empty() {
-        0.0
-    } else {
-        let i = v.len() / 2;
-        *v.select_nth_unstable_by(i, f32::total_cmp).1
-    };
-    let floor = (0.1 * median).max(1e-6);
-    let prep = |img: &GrayImage| log_compress(&despeckle(img, 2.0), floor);
-    (prep(&input.left), prep(&input.right))
 }
 
 /// Height above the road of the ground-truth point at pixel `(x, y)`.
@@ -1183,7 +1162,7 @@ pub fn analyze(input: &StereoInput, params: &AnalyzeParams) -> Result<Analysis, 
     };
     let found = detect_streaks(&input.left, &detect)?;
     // Every LK measurement is made on the prepared pair.
-    let (left, right) = prepare_matte(input);
+    let (left, right) = prepare_pair(&input.left, &input.right);
     let streaks = found
         .streaks
         .iter()
@@ -1809,7 +1788,7 @@ mod tests {
 
     /// Fireflies (single pixels tens of times brighter than the texture, in one eye at a time)
     /// on a textured road: measured on the raw pair they throw whole rows off; after
-    /// [`prepare_matte`] the road is sub-pixel accurate, and the analysis finds it by itself.
+    /// [`prepare_pair`] the road is sub-pixel accurate, and the analysis finds it by itself.
     #[test]
     fn road_is_measured_sub_pixel_through_fireflies() {
         let (rig, depth) = level_rig(0.3);
@@ -1981,7 +1960,7 @@ mod tests {
             max_disp: 16,
             ..LkParams::default()
         };
-        let (left, right) = prepare_matte(&input);
+        let (left, right) = prepare_pair(&input.left, &input.right);
         let ri = RegionInput {
             input: &input,
             geo: &geo,
