@@ -54,6 +54,11 @@ pub struct Args {
     /// Compensate a gain (contrast) difference as well as an offset between the cameras.
     #[arg(long)]
     pub gain: bool,
+    /// Pyramid levels for coarse-to-fine estimation (1: search the whole disparity range at
+    /// full resolution; 2 to 8: search it on the image reduced 2^(levels-1) times, then refine
+    /// level by level).
+    #[arg(long, default_value_t = 1)]
+    pub levels: usize,
     /// Measure the images as they are. By default they are prepared as `streaks analyze`
     /// does: single-pixel fireflies removed and the range log-compressed.
     #[arg(long)]
@@ -105,6 +110,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         } else {
             Photometric::Offset
         },
+        levels: args.levels,
         ..LkParams::default()
     };
     // (streak index, estimate) pairs.

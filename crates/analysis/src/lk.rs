@@ -15,6 +15,13 @@
 //! Each row reports a confidence: the best NCC, the mean squared gradient in the window
 //! (texture), the final RMS residual and whether the iterations converged.
 //!
+//! Coarse to fine (optional, [`LkParams::levels`] > 1): both images are reduced by 2x2 box
+//! averaging `levels - 1` times; the whole range `[min_disp, max_disp]` (scaled down) is searched
+//! and refined only on the coarsest level, and each finer level searches the 5 integer
+//! disparities around twice the coarser estimate before refining. For a wide disparity range
+//! this cuts the integer search by about `2^(levels-1)`, and the coarse levels see a larger
+//! part of the image, which steers a window with repetitive texture to the right match.
+//!
 //! Coordinates follow DESIGN.md: `x` is an image coordinate in pixels (pixel `i` covers
 //! `[i, i+1)`, its centre is `i + 0.5`); rows are pixel indices; `d = x_left - x_right`.
 
@@ -104,6 +111,9 @@ pub struct LkParams {
     pub interp: Interp,
     /// How exposure differences between the cameras are compensated.
     pub photometric: Photometric,
+    /// Pyramid levels for coarse-to-fine estimation (1: none; at most 8; see the module
+    /// documentation).
+    pub levels: usize,
 }
 
 impl Default for LkParams {
@@ -117,6 +127,7 @@ impl Default for LkParams {
             tolerance: 1e-3,
             interp: Interp::Cubic,
             photometric: Photometric::Offset,
+            levels: 1,
         }
     }
 }
@@ -144,6 +155,9 @@ impl LkParams {
         }
         if self.tolerance.is_nan() || self.tolerance <= 0.0 {
             return bad("tolerance", "must be positive");
+        }
+        if !(1..=8).contains(&self.levels) {
+            return bad("levels", "must be from 1 to 8");
         }
         Ok(())
     }
@@ -401,8 +415,27 @@ fn check(left: &GrayImage, right: &GrayImage, params: &LkParams) -> Result<(), L
     params.validate()
 }
 
-/// Estimates the disparity of each `(row, x)` (row index, left-image x coordinate).
-/// Rows outside the image or non-finite `x` are errors.
+/// The image reduced by 2: each pixel the mean of a 2x2 block (a last odd row or column is
+/// dropped; at least one pixel remains). Pixel `i` of the result covers `[2i, 2i+2)` of the
+/// input, so a coordinate `x` becomes `x / 2`.
+fn half_size(img: &GrayImage) -> GrayImage {
+    let (w, h) = ((img.width / 2).max(1), (img.height / 2).max(1));
+    let at = |x: usize, y: usize| img.get(x.min(img.width - 1), y.min(img.height - 1));
+    let data = (0..h)
+        .flat_map(|y| {
+            (0..w).map(move |x| {
+                0.25 * (at(2 * x, 2 * y)
+                    + at(2 * x + 1, 2 * y)
+                    + at(2 * x, 2 * y + 1)
+                    + at(2 * x + 1, 2 * y + 1))
+            })
+        })
+        .collect();
+    GrayImage::from_vec(w, h, data).expect("a reduced image keeps at least one pixel")
+}
+
+/// Estimates the disparity of each `(row, x)` (row index, left-image x coordinate), coarse to
+/// fine when `params.levels > 1`. Rows outside the image or non-finite `x` are errors.
 pub fn lk_rows(
     left: &GrayImage,
     right: &GrayImage,
@@ -410,6 +443,12 @@ pub fn lk_rows(
     params: &LkParams,
 ) -> Result<Vec<RowDisparity>, LkError> {
     check(left, right, params)?;
+    // pyramid[l] is level l + 1 (level 0 is the input).
+    let mut pyramid: Vec<(GrayImage, GrayImage)> = Vec::with_capacity(params.levels - 1);
+    for _ in 1..params.levels {
+        let (l, r) = pyramid.last().map_or((left, right), |(l, r)| (l, r));
+        pyramid.push((half_size(l), half_size(r)));
+    }
     let mut scratch = LkScratch::default();
     centres
         .iter()
@@ -423,7 +462,37 @@ pub fn lk_rows(
                     ),
                 });
             }
-            Ok(lk_row(left, right, row, x, params, &mut scratch))
+            // The search range of the current level, from the coarsest level down.
+            let coarsest = pyramid.len() as u32;
+            let scale = 1i32 << coarsest;
+            let mut range = (
+                params.min_disp.div_euclid(scale),
+                -(-params.max_disp).div_euclid(scale),
+            );
+            for level in (1..=coarsest).rev() {
+                let (l, r) = &pyramid[level as usize - 1];
+                let p = LkParams {
+                    min_disp: range.0,
+                    max_disp: range.1,
+                    ..*params
+                };
+                let f = (1u32 << level) as f32;
+                let y = (row >> level).min(l.height - 1);
+                let d = lk_row(l, r, y, x / f, &p, &mut scratch).disparity;
+                // The next finer level: 5 integers around twice this estimate, in range.
+                let (lo, hi) = (
+                    params.min_disp.div_euclid(1 << (level - 1)),
+                    -(-params.max_disp).div_euclid(1 << (level - 1)),
+                );
+                let centre = (2.0 * d).round() as i32;
+                range = ((centre - 2).clamp(lo, hi), (centre + 2).clamp(lo, hi));
+            }
+            let p = LkParams {
+                min_disp: range.0,
+                max_disp: range.1,
+                ..*params
+            };
+            Ok(lk_row(left, right, row, x, &p, &mut scratch))
         })
         .collect()
 }
@@ -593,6 +662,59 @@ mod tests {
                 worst[0], worst[1]
             );
             assert!(worst[0] < 0.05 && worst[1] < 0.1, "{worst:?}");
+        }
+    }
+
+    #[test]
+    fn coarse_to_fine_finds_large_disparities_with_a_narrow_search() {
+        // 160 x 24 pair shifted by up to 45.6 px, searched over [0, 64]: the pyramid finds the
+        // same sub-pixel answer as the full search; a wrong start range cannot hide it, since
+        // the coarsest level still searches the whole (scaled) range.
+        let region = Region {
+            x0: 100,
+            y0: 4,
+            x1: 131,
+            y1: 20,
+        };
+        for &d in &[3.4f32, 21.37, 45.6] {
+            let t = Texture::new(11);
+            let (w, h) = (160, 24);
+            let mut l = GrayImage::new(w, h, 0.0).unwrap();
+            let mut r = GrayImage::new(w, h, 0.0).unwrap();
+            for y in 0..h {
+                for x in 0..w {
+                    let (xc, yc) = (x as f32 + 0.5, y as f32 + 0.5);
+                    l.set(x, y, t.at(xc, yc));
+                    r.set(x, y, t.at(xc + d, yc));
+                }
+            }
+            for levels in [1, 2, 3, 4] {
+                let p = LkParams {
+                    max_disp: 64,
+                    levels,
+                    ..LkParams::default()
+                };
+                for e in lk_region(&l, &r, region, &p).unwrap() {
+                    assert!(
+                        (e.disparity - d).abs() < 0.05,
+                        "levels {levels}, d {d}: {e:?}"
+                    );
+                }
+            }
+        }
+        // The reduced image is the 2x2 mean, and levels out of range are errors.
+        let img = GrayImage::from_vec(3, 2, vec![1.0, 3.0, 9.0, 5.0, 7.0, 9.0]).unwrap();
+        let half = half_size(&img);
+        assert_eq!((half.width, half.height, half.get(0, 0)), (1, 1, 4.0));
+        for levels in [0, 9] {
+            let p = LkParams {
+                levels,
+                ..LkParams::default()
+            };
+            assert!(matches!(
+                p.validate(),
+                Err(LkError::Param { name: "levels", .. })
+            ));
         }
     }
 
