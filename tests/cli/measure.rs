@@ -1,8 +1,7 @@
 //! End-to-end tests of the measuring commands on synthetic pairs with known disparity.
 
 use crate::common::TestDir;
-use streaks_analysis::synth::{SynthPair, Texture};
-use streaks_stereo::image::GrayImage;
+use streaks_analysis::synth::SynthPair;
 
 /// The constant disparity of the synthetic pair.
 const D: f32 = 3.4;
@@ -37,28 +36,16 @@ fn lk_measures_through_fireflies_unless_raw() {
     // A dark textured pair at a constant disparity, with one-pixel fireflies in the left
     // image along the measured column, as a 16-spp render has them.
     let t = TestDir::new();
-    let (w, h) = (96, 32);
-    let texture = Texture::new(5);
-    let mut left = GrayImage::new(w, h, 0.0).unwrap();
-    let mut right = GrayImage::new(w, h, 0.0).unwrap();
-    for y in 0..h {
-        for x in 0..w {
-            let (xc, yc) = (x as f32 + 0.5, y as f32 + 0.5);
-            left.set(x, y, 0.3 * texture.at(xc, yc));
-            right.set(x, y, 0.3 * texture.at(xc + D, yc));
+    let mut pair = SynthPair::shifted(96, 32, 5, D, 1.0, 0.0).unwrap();
+    for img in [&mut pair.left, &mut pair.right] {
+        for v in &mut img.data {
+            *v *= 0.3;
         }
     }
     for y in (3..30).step_by(2) {
-        left.set(44 + (y % 5) - 2, y, 1.0);
+        pair.left.set(44 + (y % 5) - 2, y, 1.0);
     }
-    let disparity = GrayImage::new(w, h, D).unwrap();
-    SynthPair {
-        left,
-        right,
-        disparity,
-    }
-    .save(t.path())
-    .unwrap();
+    pair.save(t.path()).unwrap();
     let raw = lk_rms(&t, &["--raw"]);
     let prepared = lk_rms(&t, &[]);
     // Measured: 0.14 px prepared, 3.6 px raw.

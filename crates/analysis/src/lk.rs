@@ -593,21 +593,11 @@ pub fn prepare_pair(left: &GrayImage, right: &GrayImage) -> (GrayImage, GrayImag
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::synth::{SynthScene, Texture};
+    use crate::synth::{SynthPair, SynthScene};
 
     fn shifted_pair(d: f32, gain: f32, offset: f32) -> (GrayImage, GrayImage) {
-        let t = Texture::new(7);
-        let (w, h) = (96, 24);
-        let mut l = GrayImage::new(w, h, 0.0).unwrap();
-        let mut r = GrayImage::new(w, h, 0.0).unwrap();
-        for y in 0..h {
-            for x in 0..w {
-                let (xc, yc) = (x as f32 + 0.5, y as f32 + 0.5);
-                l.set(x, y, t.at(xc, yc));
-                r.set(x, y, gain * t.at(xc + d, yc) + offset);
-            }
-        }
-        (l, r)
+        let p = SynthPair::shifted(96, 24, 7, d, gain, offset).unwrap();
+        (p.left, p.right)
     }
 
     #[test]
@@ -677,17 +667,9 @@ mod tests {
             y1: 20,
         };
         for &d in &[3.4f32, 21.37, 45.6] {
-            let t = Texture::new(11);
-            let (w, h) = (160, 24);
-            let mut l = GrayImage::new(w, h, 0.0).unwrap();
-            let mut r = GrayImage::new(w, h, 0.0).unwrap();
-            for y in 0..h {
-                for x in 0..w {
-                    let (xc, yc) = (x as f32 + 0.5, y as f32 + 0.5);
-                    l.set(x, y, t.at(xc, yc));
-                    r.set(x, y, t.at(xc + d, yc));
-                }
-            }
+            let SynthPair {
+                left: l, right: r, ..
+            } = SynthPair::shifted(160, 24, 11, d, 1.0, 0.0).unwrap();
             for levels in [1, 2, 3, 4] {
                 let p = LkParams {
                     max_disp: 64,

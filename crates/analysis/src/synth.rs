@@ -64,6 +64,34 @@ pub struct SynthPair {
 }
 
 impl SynthPair {
+    /// A fronto-parallel textured plane at the constant disparity `d`: left `T(x, y)`, right
+    /// `gain T(x + d, y) + offset` (an exposure difference), with the texture of `seed`.
+    /// An error for a zero size.
+    pub fn shifted(
+        width: usize,
+        height: usize,
+        seed: u64,
+        d: f32,
+        gain: f32,
+        offset: f32,
+    ) -> Result<Self, ImageError> {
+        let t = Texture::new(seed);
+        let mut left = GrayImage::new(width, height, 0.0)?;
+        let mut right = GrayImage::new(width, height, 0.0)?;
+        for y in 0..height {
+            for x in 0..width {
+                let (xc, yc) = (x as f32 + 0.5, y as f32 + 0.5);
+                left.set(x, y, t.at(xc, yc));
+                right.set(x, y, gain * t.at(xc + d, yc) + offset);
+            }
+        }
+        Ok(Self {
+            left,
+            right,
+            disparity: GrayImage::new(width, height, d)?,
+        })
+    }
+
     /// Writes `left.png` and `right.png` (16-bit grey, values clipped to [0, 1]) and
     /// `disparity_left.pfm` into `dir`, the layout `streaks stereo` writes.
     pub fn save(&self, dir: &Path) -> Result<(), ImageError> {
