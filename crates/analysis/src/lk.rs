@@ -449,6 +449,15 @@ pub fn lk_rows(
         let (l, r) = pyramid.last().map_or((left, right), |(l, r)| (l, r));
         pyramid.push((half_size(l), half_size(r)));
     }
+    let coarsest = pyramid.len() as u32;
+    // [min_disp, max_disp] on level `level` (floor and ceiling of the scaled bounds).
+    let full_range = |level: u32| {
+        let scale = 1i32 << level;
+        (
+            params.min_disp.div_euclid(scale),
+            -(-params.max_disp).div_euclid(scale),
+        )
+    };
     let mut scratch = LkScratch::default();
     centres
         .iter()
@@ -463,12 +472,7 @@ pub fn lk_rows(
                 });
             }
             // The search range of the current level, from the coarsest level down.
-            let coarsest = pyramid.len() as u32;
-            let scale = 1i32 << coarsest;
-            let mut range = (
-                params.min_disp.div_euclid(scale),
-                -(-params.max_disp).div_euclid(scale),
-            );
+            let mut range = full_range(coarsest);
             for level in (1..=coarsest).rev() {
                 let (l, r) = &pyramid[level as usize - 1];
                 let p = LkParams {
@@ -480,10 +484,7 @@ pub fn lk_rows(
                 let y = (row >> level).min(l.height - 1);
                 let d = lk_row(l, r, y, x / f, &p, &mut scratch).disparity;
                 // The next finer level: 5 integers around twice this estimate, in range.
-                let (lo, hi) = (
-                    params.min_disp.div_euclid(1 << (level - 1)),
-                    -(-params.max_disp).div_euclid(1 << (level - 1)),
-                );
+                let (lo, hi) = full_range(level - 1);
                 let centre = (2.0 * d).round() as i32;
                 range = ((centre - 2).clamp(lo, hi), (centre + 2).clamp(lo, hi));
             }
