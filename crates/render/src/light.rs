@@ -26,7 +26,7 @@
 //! emitters and samples a compact emitter (a sphere lamp) by the cone of directions that bounds
 //! it instead; see its documentation.
 
-use crate::bsdf::Bsdf;
+use crate::bsdf::{Bsdf, LuminanceEval};
 use crate::geometry::Frame;
 use crate::sampling::{
     luminance, square_to_uniform_cone, square_to_uniform_cone_pdf, square_to_uniform_triangle,
@@ -650,7 +650,7 @@ impl LightSampler {
 
     /// The luminance of `f * cos` toward emitter `e` from the receiver (0 below its surface).
     #[inline]
-    fn bsdf_weight(&self, scene: &Scene, e: usize, rx: &Receiver) -> f32 {
+    fn bsdf_weight(&self, scene: &Scene, e: usize, rx: &Receiver, f: &LuminanceEval) -> f32 {
         let wi = match &self.emitters[e] {
             Emitter::Mesh(m) => (m.centre - rx.p).normalize_or_zero(),
             Emitter::Punctual(i) => match scene.lights[*i as usize] {
@@ -665,7 +665,7 @@ impl LightSampler {
         if wi_local.z <= 0.0 || rx.ng.dot(wi) <= 0.0 {
             return 0.0;
         }
-        clean_power(luminance(rx.bsdf.eval_lobes(rx.wo_local, wi_local).total()) * wi_local.z)
+        clean_power(f.eval(wi_local) * wi_local.z)
     }
 
     /// The per-point weights `E_i` and `E_i F_i` of every emitter, with their sums.
@@ -683,11 +683,12 @@ impl LightSampler {
         let mut e_w = [0.0f32; MAX_BSDF_AWARE_EMITTERS];
         let mut ef_w = [0.0f32; MAX_BSDF_AWARE_EMITTERS];
         let (mut e_sum, mut ef_sum) = (0.0f32, 0.0f32);
+        let f = rx.bsdf.luminance_at(rx.wo_local);
         for i in 0..self.emitters.len() {
             let e = self.irradiance(scene, i, rx.p);
             if e > 0.0 {
                 e_w[i] = e;
-                ef_w[i] = e * self.bsdf_weight(scene, i, rx);
+                ef_w[i] = e * self.bsdf_weight(scene, i, rx, &f);
                 e_sum += e_w[i];
                 ef_sum += ef_w[i];
             }
