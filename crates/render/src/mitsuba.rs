@@ -336,11 +336,7 @@ impl<'a> MaterialWriter<'a> {
         value: impl Fn(f32) -> Vec3,
     ) -> Result<String, MitsubaError> {
         let tex = self.texture(material, map)?;
-        let texels = tex
-            .texels
-            .iter()
-            .map(|t| value(t.y.clamp(0.0, 1.0)))
-            .collect();
+        let texels = tex.texels().map(|t| value(t.y.clamp(0.0, 1.0))).collect();
         Ok(self.bitmap(stem, name, tex, texels))
     }
 
@@ -357,7 +353,7 @@ impl<'a> MaterialWriter<'a> {
             return Ok(rgb(name, factor));
         };
         let tex = self.texture(material, id)?;
-        let texels = tex.texels.iter().map(|t| t.truncate() * factor).collect();
+        let texels = tex.texels().map(|t| t.truncate() * factor).collect();
         Ok(self.bitmap(stem, name, tex, texels))
     }
 
@@ -717,6 +713,7 @@ pub(crate) fn export_parts(
 mod tests {
     use super::*;
     use crate::material::Wetness;
+    use crate::texture::ColorSpace;
     use glam::{Affine3A, Vec4};
 
     fn mat(name: &str, reflectance: Reflectance, emission: Vec3) -> Material {
@@ -794,11 +791,13 @@ mod tests {
                     mat("lamp", lamp, Vec3::new(10.0, 9.0, 8.0)),
                     mat("wall", wall, Vec3::ZERO),
                 ],
-                textures: vec![Texture {
-                    width: 2,
-                    height: 1,
-                    texels: vec![Vec4::new(1.0, 0.5, 0.25, 1.0), Vec4::ONE],
-                }],
+                textures: vec![Texture::from_rgba(
+                    2,
+                    1,
+                    vec![Vec4::new(1.0, 0.5, 0.25, 1.0), Vec4::ONE],
+                    ColorSpace::Linear,
+                )
+                .unwrap()],
                 lights: vec![
                     Light::Point {
                         position: Vec3::new(0.0, 5.0, -3.0),

@@ -3,6 +3,7 @@
 //! once, when they are loaded; data textures (metallic-roughness, dryness) are kept linear.
 
 use glam::{Vec2, Vec4};
+use std::sync::LazyLock;
 
 /// Index of a texture in [`crate::scene::Scene::textures`].
 pub type TextureId = u32;
@@ -27,8 +28,28 @@ pub fn srgb_to_linear(c: f32) -> f32 {
     }
 }
 
+/// Linear values of the 256 byte values: `i / 255`.
+static LINEAR_BYTES: LazyLock<[f32; 256]> = LazyLock::new(|| byte_table(|v| v));
+/// sRGB-decoded values of the 256 byte values: `srgb_to_linear(i / 255)`.
+static SRGB_BYTES: LazyLock<[f32; 256]> = LazyLock::new(|| byte_table(srgb_to_linear));
+
+fn byte_table(decode: fn(f32) -> f32) -> [f32; 256] {
+    std::array::from_fn(|i| decode(f32::from(i as u8) / 255.0))
+}
+
+/// How the texels are stored.
+#[derive(Clone, Debug)]
+enum Texels {
+    /// 8-bit RGBA as in the image file (a quarter of the memory traffic of floats), decoded per
+    /// fetch by table: `srgb` says whether RGB is sRGB-encoded (alpha never is). The decoded
+    /// values are exactly those of decoding at load time.
+    Rgba8 { texels: Vec<[u8; 4]>, srgb: bool },
+    /// Linear float RGBA (16-bit and float images, procedural textures).
+    Rgba32F(Vec<Vec4>),
+}
+
 /// A decoded RGBA image in linear values, sampled with bilinear filtering and repeat wrapping
-/// (glTF's default sampler).
+/// (glTF's default sampler). 8-bit images keep their bytes (see [`Texture::from_rgba8`]).
 #[derive(Clone, Debug)]
 pub struct Texture {
     /// Width in texels.
@@ -36,7 +57,7 @@ pub struct Texture {
     /// Height in texels.
     pub height: u32,
     /// Row-major texels, top row first (glTF uv (0,0) is the top-left corner).
-    pub texels: Vec<Vec4>,
+    texels: Texels,
 }
 
 impl Texture {
@@ -44,7 +65,7 @@ impl Texture {
     /// when `space` is [`ColorSpace::Srgb`] (alpha is always linear). `None` when the size does
     /// not match the texel count or is zero.
     pub fn from_rgba(width: u32, height: u32, rgba: Vec<Vec4>, space: ColorSpace) -> Option<Self> {
-        if width == 0 || height == 0 || rgba.len() as u64 != u64::from(width) * u64::from(height) {
+        if !Self::size_matches(width, height, rgba.len()) {
             return None;
         }
         let texels = match space {
@@ -64,24 +85,59 @@ impl Texture {
         Some(Self {
             width,
             height,
-            texels,
+            texels: Texels::Rgba32F(texels),
         })
     }
 
-    /// A texture from 8-bit RGBA bytes (top row first).
+    /// A texture from 8-bit RGBA bytes (top row first), kept as bytes: each fetch decodes
+    /// them by table to the same values [`Texture::from_rgba`] would store (`byte / 255`,
+    /// sRGB-decoded in RGB for [`ColorSpace::Srgb`]). `None` when the size does not match the
+    /// byte count or is zero.
     pub fn from_rgba8(width: u32, height: u32, bytes: &[u8], space: ColorSpace) -> Option<Self> {
-        let rgba = bytes
+        if bytes.len() % 4 != 0 || !Self::size_matches(width, height, bytes.len() / 4) {
+            return None;
+        }
+        let texels = bytes
             .chunks_exact(4)
-            .map(|c| Vec4::new(c[0] as f32, c[1] as f32, c[2] as f32, c[3] as f32) / 255.0)
+            .map(|c| [c[0], c[1], c[2], c[3]])
             .collect();
-        Self::from_rgba(width, height, rgba, space)
+        Some(Self {
+            width,
+            height,
+            texels: Texels::Rgba8 {
+                texels,
+                srgb: space == ColorSpace::Srgb,
+            },
+        })
     }
 
+    fn size_matches(width: u32, height: u32, count: usize) -> bool {
+        width > 0 && height > 0 && count as u64 == u64::from(width) * u64::from(height)
+    }
+
+    /// Number of texels (`width * height`).
+    pub fn texel_count(&self) -> usize {
+        match &self.texels {
+            Texels::Rgba8 { texels, .. } => texels.len(),
+            Texels::Rgba32F(texels) => texels.len(),
+        }
+    }
+
+    /// The linear value of texel `index` (row-major, top row first).
     #[inline]
-    fn texel(&self, x: i64, y: i64) -> Vec4 {
-        let x = x.rem_euclid(i64::from(self.width)) as usize;
-        let y = y.rem_euclid(i64::from(self.height)) as usize;
-        self.texels[y * self.width as usize + x]
+    pub fn texel(&self, index: usize) -> Vec4 {
+        match &self.texels {
+            Texels::Rgba8 { texels, srgb } => {
+                let rgb = if *srgb { &SRGB_BYTES } else { &LINEAR_BYTES };
+                decode_rgba8(texels[index], rgb, &LINEAR_BYTES)
+            }
+            Texels::Rgba32F(texels) => texels[index],
+        }
+    }
+
+    /// The linear values of all texels, row-major, top row first.
+    pub fn texels(&self) -> impl ExactSizeIterator<Item = Vec4> + '_ {
+        (0..self.texel_count()).map(|i| self.texel(i))
     }
 
     /// The filtered value at `uv`: bilinear between texel centres (texel `(i, j)` has its
@@ -89,7 +145,7 @@ impl Texture {
     #[inline]
     pub fn sample(&self, uv: Vec2) -> Vec4 {
         if !uv.is_finite() {
-            return self.texels[0];
+            return self.texel(0);
         }
         // Reduce to one period first so that huge uvs keep their precision.
         let u = uv.x - uv.x.floor();
@@ -99,10 +155,34 @@ impl Texture {
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
         let (x0, y0) = (x0 as i64, y0 as i64);
-        let top = self.texel(x0, y0).lerp(self.texel(x0 + 1, y0), fx);
-        let bottom = self.texel(x0, y0 + 1).lerp(self.texel(x0 + 1, y0 + 1), fx);
-        top.lerp(bottom, fy)
+        let (w, h) = (i64::from(self.width), i64::from(self.height));
+        let (xa, xb) = (x0.rem_euclid(w) as usize, (x0 + 1).rem_euclid(w) as usize);
+        let (ya, yb) = (y0.rem_euclid(h) as usize, (y0 + 1).rem_euclid(h) as usize);
+        let row = self.width as usize;
+        let [i00, i10, i01, i11] = [ya * row + xa, ya * row + xb, yb * row + xa, yb * row + xb];
+        let [c00, c10, c01, c11] = match &self.texels {
+            Texels::Rgba8 { texels, srgb } => {
+                let (rgb, alpha) = (
+                    if *srgb { &*SRGB_BYTES } else { &*LINEAR_BYTES },
+                    &*LINEAR_BYTES,
+                );
+                [i00, i10, i01, i11].map(|i| decode_rgba8(texels[i], rgb, alpha))
+            }
+            Texels::Rgba32F(texels) => [i00, i10, i01, i11].map(|i| texels[i]),
+        };
+        c00.lerp(c10, fx).lerp(c01.lerp(c11, fx), fy)
     }
+}
+
+/// One 8-bit texel's linear value: RGB through `rgb`, alpha through `alpha`.
+#[inline]
+fn decode_rgba8(c: [u8; 4], rgb: &[f32; 256], alpha: &[f32; 256]) -> Vec4 {
+    Vec4::new(
+        rgb[usize::from(c[0])],
+        rgb[usize::from(c[1])],
+        rgb[usize::from(c[2])],
+        alpha[usize::from(c[3])],
+    )
 }
 
 #[cfg(test)]
@@ -125,6 +205,29 @@ mod tests {
         // Repeat wrapping: u = 0 blends the last and first columns.
         assert!((t.sample(Vec2::new(0.0, 0.25)).x - 0.5).abs() < 1e-6);
         assert_eq!(t.sample(Vec2::new(-1.25, 3.25)).x, 1.0);
+    }
+
+    /// Bytes kept as bytes sample to exactly the values of decoding them at load time.
+    #[test]
+    fn rgba8_samples_as_decoded_floats() {
+        let mut rng = crate::sampling::Pcg32::new(5, 9);
+        let bytes: Vec<u8> = (0..5 * 3 * 4)
+            .map(|_| (rng.next_f32() * 256.0) as u8)
+            .collect();
+        for space in [ColorSpace::Srgb, ColorSpace::Linear] {
+            let floats = bytes
+                .chunks_exact(4)
+                .map(|c| Vec4::new(c[0] as f32, c[1] as f32, c[2] as f32, c[3] as f32) / 255.0)
+                .collect();
+            let a = Texture::from_rgba8(5, 3, &bytes, space).unwrap();
+            let b = Texture::from_rgba(5, 3, floats, space).unwrap();
+            assert!(a.texels().eq(b.texels()));
+            for _ in 0..200 {
+                let uv = Vec2::new(rng.next_f32() * 4.0 - 2.0, rng.next_f32() * 4.0 - 2.0);
+                assert_eq!(a.sample(uv), b.sample(uv), "{space:?} at {uv}");
+            }
+        }
+        assert!(Texture::from_rgba8(5, 3, &bytes[..56], ColorSpace::Linear).is_none());
     }
 
     #[test]

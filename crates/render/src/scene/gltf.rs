@@ -760,6 +760,18 @@ fn triangulate(mode: Mode, idx: &[u32]) -> Vec<[u32; 3]> {
 fn decode_image(data: &gltf::image::Data, space: ColorSpace) -> Option<Texture> {
     use gltf::image::Format;
     let p = &data.pixels;
+    // 8-bit images stay bytes (RGBA8); grey (and grey-alpha) images replicate their value, as
+    // image viewers do.
+    let rgba8 = |channels: usize| -> Vec<u8> {
+        p.chunks_exact(channels)
+            .flat_map(|c| match channels {
+                1 => [c[0], c[0], c[0], 255],
+                2 => [c[0], c[0], c[0], c[1]],
+                3 => [c[0], c[1], c[2], 255],
+                _ => [c[0], c[1], c[2], c[3]],
+            })
+            .collect()
+    };
     let u16s = |c: &[u8]| -> Vec<f32> {
         c.chunks_exact(2)
             .map(|b| f32::from(u16::from_ne_bytes([b[0], b[1]])) / 65535.0)
@@ -771,10 +783,10 @@ fn decode_image(data: &gltf::image::Data, space: ColorSpace) -> Option<Texture> 
             .collect()
     };
     let (values, channels): (Vec<f32>, usize) = match data.format {
-        Format::R8 => (p.iter().map(|&b| f32::from(b) / 255.0).collect(), 1),
-        Format::R8G8 => (p.iter().map(|&b| f32::from(b) / 255.0).collect(), 2),
-        Format::R8G8B8 => (p.iter().map(|&b| f32::from(b) / 255.0).collect(), 3),
-        Format::R8G8B8A8 => (p.iter().map(|&b| f32::from(b) / 255.0).collect(), 4),
+        Format::R8 => return Texture::from_rgba8(data.width, data.height, &rgba8(1), space),
+        Format::R8G8 => return Texture::from_rgba8(data.width, data.height, &rgba8(2), space),
+        Format::R8G8B8 => return Texture::from_rgba8(data.width, data.height, &rgba8(3), space),
+        Format::R8G8B8A8 => return Texture::from_rgba8(data.width, data.height, p, space),
         Format::R16 => (u16s(p), 1),
         Format::R16G16 => (u16s(p), 2),
         Format::R16G16B16 => (u16s(p), 3),
@@ -785,7 +797,6 @@ fn decode_image(data: &gltf::image::Data, space: ColorSpace) -> Option<Texture> 
     let rgba = values
         .chunks_exact(channels)
         .map(|c| match channels {
-            // Grey (and grey-alpha) images replicate their value, as image viewers do.
             1 => Vec4::new(c[0], c[0], c[0], 1.0),
             2 => Vec4::new(c[0], c[0], c[0], c[1]),
             3 => Vec4::new(c[0], c[1], c[2], 1.0),
