@@ -9,6 +9,7 @@
 
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, PI, TAU};
+use std::sync::LazyLock;
 
 /// Rec. 709 / sRGB-primaries luminance of a linear RGB colour.
 #[inline]
@@ -386,6 +387,40 @@ impl Pcg32 {
     }
 }
 
+/// Sobol dimensions 0 to 3 (`sobol_burley`'s dimension set 0) by byte of the bit-reversed
+/// sample index: entry `[b][v]` is the XOR of the direction vectors of the set bits of `v` in
+/// byte `b` of the index's top 16 bits (the only bits `sobol_burley` uses). Two lookups
+/// replace its loop over the set bits (about eight, data-dependent); 8 KB.
+static SOBOL_SET0_BY_BYTE: LazyLock<[[[u32; 4]; 256]; 2]> = LazyLock::new(|| {
+    std::array::from_fn(|b| {
+        std::array::from_fn(|v| {
+            let bits = (v as u32) << (24 - 8 * b as u32);
+            sobol_burley::parts::sobol_int4_rev(bits, 0).into()
+        })
+    })
+});
+
+/// `sobol_burley::sample_4d(sample_index, 0, seed)`, bit for bit (tested), with the Sobol
+/// part from [`SOBOL_SET0_BY_BYTE`]: the same index shuffle, Owen scramble and constants.
+#[inline]
+fn sobol_4d(sample_index: u32, seed: u32) -> [f32; 4] {
+    use sobol_burley::parts::{hash, hash_int4, owen_scramble_int4_rev, owen_scramble_rev, Int4};
+    let index_rev = owen_scramble_rev(sample_index.reverse_bits(), hash(seed ^ 0x79c68e4a));
+    let table = &*SOBOL_SET0_BY_BYTE;
+    let sobol = Int4::from(table[0][(index_rev >> 24) as usize])
+        ^ Int4::from(table[1][((index_rev >> 16) & 0xff) as usize]);
+    let s = seed.wrapping_mul(0x9c8f2d3b);
+    let scramble = Int4::from([
+        s ^ 0x912f69ba,
+        s ^ 0x174f18ab,
+        s ^ 0x691e72ca,
+        s ^ 0xb40cc1b8,
+    ]);
+    owen_scramble_int4_rev(sobol, hash_int4(scramble))
+        .reverse_bits()
+        .to_f32_norm()
+}
+
 /// The sample indices `sobol_burley` supports (`2^16`).
 pub const SOBOL_MAX_SAMPLES: u32 = 1 << 16;
 
@@ -467,7 +502,7 @@ impl Sampler {
         if self.sample_index < SOBOL_MAX_SAMPLES {
             // `sample_4d` returns exactly `sample(i, 0..4, s)` (sobol_burley tests this), and
             // shares the index scramble and uses SIMD: one call is cheaper than two `sample`s.
-            let [x, y, _, _] = sobol_burley::sample_4d(self.sample_index, 0, s);
+            let [x, y, _, _] = sobol_4d(self.sample_index, s);
             Vec2::new(x, y)
         } else {
             self.hashed(s).next_2d()
@@ -482,7 +517,7 @@ impl Sampler {
     pub fn next_4d(&mut self) -> [f32; 4] {
         let s = self.next_slot_seed();
         if self.sample_index < SOBOL_MAX_SAMPLES {
-            sobol_burley::sample_4d(self.sample_index, 0, s)
+            sobol_4d(self.sample_index, s)
         } else {
             let mut rng = self.hashed(s);
             [
@@ -498,6 +533,21 @@ impl Sampler {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn sobol_4d_is_sobol_burley_sample_4d() {
+        let mut rng = Pcg32::new(3, 4);
+        for i in (0..300).chain([1023, 4096, 65535]) {
+            for _ in 0..50 {
+                let seed = rng.next_u32();
+                assert_eq!(
+                    sobol_4d(i, seed),
+                    sobol_burley::sample_4d(i, 0, seed),
+                    "index {i}, seed {seed}"
+                );
+            }
+        }
+    }
     use crate::testing::{chi_square_plane, chi_square_sphere, ChiSquareConfig};
 
     const WARP_TESTS: usize = 5;
