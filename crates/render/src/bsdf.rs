@@ -179,33 +179,13 @@ fn glossy_probability(ks_luminance: f32, glossy_factor: f32, diffuse_weight: f32
     }
 }
 
-/// GGX (Trowbridge-Reitz) normal distribution `D(h)`, as Mitsuba 3's `MicrofacetDistribution::eval`
-/// (including its cut-off of values below 1e-20).
+/// `v.z + sqrt(v.z^2 + alpha^2 (v.x^2 + v.y^2))` for `v` above the surface: GGX's separable
+/// Smith masking over the cosine, `G1(v) / v.z`, is `2 /` this. (Mitsuba 3's `smith_g1` is
+/// `2 / (1 + sqrt(1 + alpha^2 tan^2(theta_v)))`, 0 when `v` sees the back of the microfacet,
+/// which never happens for the half vector of two directions above the surface.)
 #[inline]
-pub fn ggx_d(h: Vec3, alpha: f32) -> f32 {
-    let a2 = alpha * alpha;
-    let t = (h.x * h.x + h.y * h.y) / a2 + h.z * h.z;
-    let d = 1.0 / (PI * a2 * t * t);
-    if d * h.z > 1e-20 {
-        d
-    } else {
-        0.0
-    }
-}
-
-/// Separable Smith masking `G1(v, h)` for GGX, as Mitsuba 3's `smith_g1`:
-/// `2 / (1 + sqrt(1 + alpha^2 tan^2(theta_v)))`, 0 when `v` sees the back of the microfacet.
-#[inline]
-pub fn ggx_smith_g1(v: Vec3, h: Vec3, alpha: f32) -> f32 {
-    if v.dot(h) * v.z <= 0.0 {
-        return 0.0;
-    }
-    let xy_alpha_2 = alpha * alpha * (v.x * v.x + v.y * v.y);
-    if xy_alpha_2 == 0.0 {
-        return 1.0;
-    }
-    let tan_theta_alpha_2 = xy_alpha_2 / (v.z * v.z);
-    2.0 / (1.0 + (1.0 + tan_theta_alpha_2).sqrt())
+fn ggx_g1_denominator(v: Vec3, a2: f32) -> f32 {
+    v.z + (v.z * v.z + a2 * (v.x * v.x + v.y * v.y)).sqrt()
 }
 
 /// Samples a GGX visible normal for `wo` (density `D(h) G1(wo, h) max(0, wo.h) / wo.z`) by
@@ -226,13 +206,31 @@ fn sample_ggx_visible_normal(wo: Vec3, alpha: f32, u: Vec2) -> Option<Vec3> {
     (h.z > 0.0).then_some(h)
 }
 
-/// The GGX glossy lobe's microfacet BRDF without `ks` (`D G1(wo) G1(wi) / (4 wo.z wi.z)`) and
-/// the solid-angle density of `wi` when it samples visible normals, `D(h) G1(wo, h) / (4 wo.z)`
-/// (the Jacobian `1 / (4 wo.h)` cancels `wo.h`); they share `D G1(wo) / (4 wo.z)`.
+/// The GGX glossy lobe's microfacet BRDF without `ks`, `D(h) G1(wo) G1(wi) / (4 wo.z wi.z)`,
+/// for `wo` and `wi` above the surface, given `go = ggx_g1_denominator(wo, alpha^2)`; also
+/// returns `ggx_g1_denominator(wi, alpha^2)`. With the half vector left unnormalised,
+/// `h = wo + wi`, and `q = h.x^2 + h.y^2 + alpha^2 h.z^2`, Mitsuba 3's GGX
+/// `D = 1 / (pi alpha^2 ((h.x^2 + h.y^2) / alpha^2 + h.z^2)^2)` of the normalised half vector
+/// is `alpha^2 |h|^4 / (pi q^2)`, so the lobe is `alpha^2 |h|^4 / (pi q^2 go gi)`: one division
+/// and one square root besides `go`. (Mitsuba also cuts `D` to 0 below 1e-20; that is not
+/// done here.)
 #[inline]
-fn ggx_spec_pdf(wo: Vec3, wi: Vec3, h: Vec3, alpha: f32) -> (f32, f32) {
-    let pdf = ggx_d(h, alpha) * ggx_smith_g1(wo, h, alpha) / (4.0 * wo.z);
-    (pdf * ggx_smith_g1(wi, h, alpha) / wi.z, pdf)
+fn ggx_spec(wo: Vec3, wi: Vec3, a2: f32, go: f32) -> (f32, f32) {
+    let h = wo + wi;
+    let h2 = h.length_squared();
+    let q = h.x * h.x + h.y * h.y + a2 * h.z * h.z;
+    let gi = ggx_g1_denominator(wi, a2);
+    (a2 * h2 * h2 / (PI * q * q * go * gi), gi)
+}
+
+/// [`ggx_spec`] and the solid-angle density of `wi` when the lobe samples visible normals,
+/// `D(h) G1(wo, h) / (4 wo.z)` (the Jacobian `1 / (4 wo.h)` cancels `wo.h`), which is the lobe
+/// times `wi.z / G1(wi)`, i.e. times `gi / 2`.
+#[inline]
+fn ggx_spec_pdf(wo: Vec3, wi: Vec3, alpha: f32) -> (f32, f32) {
+    let a2 = alpha * alpha;
+    let (spec, gi) = ggx_spec(wo, wi, a2, ggx_g1_denominator(wo, a2));
+    (spec, 0.5 * spec * gi)
 }
 
 /// Cheap estimate of the GGX glossy lobe's directional albedo (with `ks = 1`): `G1` at
@@ -294,7 +292,7 @@ impl Ggx {
 
     #[inline]
     fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (LobeValues, f32) {
-        let (spec, pdf) = ggx_spec_pdf(wo, wi, half_vector(wo, wi), self.alpha());
+        let (spec, pdf) = ggx_spec_pdf(wo, wi, self.alpha());
         let f = LobeValues {
             diffuse: self.kd * FRAC_1_PI,
             glossy: self.ks * spec,
@@ -423,9 +421,8 @@ impl GltfPbr {
 
     #[inline]
     fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (LobeValues, f32) {
-        let h = half_vector(wo, wi);
-        let fresnel = self.schlick(wo.dot(h));
-        let (spec, pdf) = ggx_spec_pdf(wo, wi, h, self.alpha());
+        let fresnel = self.schlick(wo.dot(half_vector(wo, wi)));
+        let (spec, pdf) = ggx_spec_pdf(wo, wi, self.alpha());
         let f = LobeValues {
             diffuse: (Vec3::ONE - fresnel) * self.diffuse_color() * FRAC_1_PI,
             glossy: fresnel * spec,
@@ -568,24 +565,9 @@ impl Bsdf {
     }
 }
 
-/// `D(h) G1(wi, h) / wi.z` of GGX from the unnormalised half vector `h_sum = wo + wi`, with
-/// one square root and one division (the light choice's hot path; [`ggx_d`] and
-/// [`ggx_smith_g1`] are the reference forms, without the former's 1e-20 cut-off). With
-/// `q = h.x^2 + h.y^2 + alpha^2 h.z^2` for the unnormalised `h`, `D = alpha^2 |h|^4 / (pi q^2)`,
-/// and `G1(wi) / wi.z = 2 / (wi.z + sqrt(wi.z^2 + alpha^2 (wi.x^2 + wi.y^2)))`, both
-/// directions above the surface.
-#[inline]
-fn ggx_d_g1_over_cos(h_sum: Vec3, wi: Vec3, alpha: f32) -> f32 {
-    let a2 = alpha * alpha;
-    let h2 = h_sum.length_squared();
-    let q = h_sum.x * h_sum.x + h_sum.y * h_sum.y + a2 * h_sum.z * h_sum.z;
-    let g = wi.z + (wi.z * wi.z + a2 * (wi.x * wi.x + wi.y * wi.y)).sqrt();
-    2.0 * a2 * h2 * h2 / (PI * q * q * g)
-}
-
 /// `luminance(f(wo, wi))` for one `wo` and many `wi`: the light choice's per-emitter BSDF
 /// weight, a dozen evaluations per path vertex. What depends on `wo` alone (the lobes'
-/// luminances, GGX's `G1(wo)`, `1 / (4 wo.z)`) is computed once by [`Bsdf::luminance_at`];
+/// luminances, GGX's masking term of `wo`) is computed once by [`Bsdf::luminance_at`];
 /// each [`LuminanceEval::eval`] then costs a half vector and the lobe's own terms, in scalars.
 /// Equal to `luminance(bsdf.eval(wo, wi))` up to rounding (tested).
 #[derive(Clone, Copy, Debug)]
@@ -602,15 +584,15 @@ pub struct LuminanceEval {
 #[derive(Clone, Copy, Debug)]
 enum LuminanceLobe {
     None,
-    /// GGX: `alpha` and `G1(wo) / (4 wo.z)`.
+    /// GGX: `alpha^2` and `ggx_g1_denominator(wo)`.
     Ggx {
-        alpha: f32,
-        g1o_4coso: f32,
+        a2: f32,
+        go: f32,
     },
     /// glTF: GGX as above, with Schlick's Fresnel applied to both lobes.
     GltfGgx {
-        alpha: f32,
-        g1o_4coso: f32,
+        a2: f32,
+        go: f32,
     },
     /// Ward: `alpha^2`.
     Ward {
@@ -633,12 +615,12 @@ impl LuminanceEval {
         }
         match self.lobe {
             LuminanceLobe::None => self.diffuse,
-            LuminanceLobe::Ggx { alpha, g1o_4coso } => {
-                self.diffuse + self.glossy * g1o_4coso * ggx_d_g1_over_cos(wo + wi, wi, alpha)
+            LuminanceLobe::Ggx { a2, go } => {
+                self.diffuse + self.glossy * ggx_spec(wo, wi, a2, go).0
             }
-            LuminanceLobe::GltfGgx { alpha, g1o_4coso } => {
+            LuminanceLobe::GltfGgx { a2, go } => {
+                let spec = ggx_spec(wo, wi, a2, go).0;
                 let h = half_vector(wo, wi);
-                let spec = ggx_d(h, alpha) * g1o_4coso * ggx_smith_g1(wi, h, alpha) / wi.z;
                 // F = F0 + (1 - F0) s, so luminance(F) = L(F0) + (1 - L(F0)) s, and
                 // 1 - F = (1 - F0)(1 - s) scales the diffuse lobe by (1 - s).
                 let s = (1.0 - wo.dot(h).abs()).clamp(0.0, 1.0).powi(5);
@@ -664,19 +646,16 @@ impl Bsdf {
     /// [`LuminanceEval`]).
     #[inline]
     pub fn luminance_at(&self, wo: Vec3) -> LuminanceEval {
-        // G1(wo, h) for any h with wo.h > 0 (always so for a half vector of two directions
-        // above the surface), divided by 4 wo.z.
-        let g1o = |alpha: f32| ggx_smith_g1(wo, Vec3::Z, alpha) / (4.0 * wo.z);
+        let ggx = |alpha: f32| {
+            let a2 = alpha * alpha;
+            (a2, ggx_g1_denominator(wo, a2))
+        };
         let (diffuse, glossy, lobe) = match self {
             Bsdf::Diffuse(m) => (luminance(m.kd), 0.0, LuminanceLobe::None),
-            Bsdf::Ggx(m) => (
-                luminance(m.kd),
-                luminance(m.ks),
-                LuminanceLobe::Ggx {
-                    alpha: m.alpha(),
-                    g1o_4coso: g1o(m.alpha()),
-                },
-            ),
+            Bsdf::Ggx(m) => (luminance(m.kd), luminance(m.ks), {
+                let (a2, go) = ggx(m.alpha());
+                LuminanceLobe::Ggx { a2, go }
+            }),
             Bsdf::Ward(m) => (
                 luminance(m.kd),
                 luminance(m.ks),
@@ -695,9 +674,9 @@ impl Bsdf {
             Bsdf::GltfPbr(m) => (
                 luminance((Vec3::ONE - m.f0()) * m.diffuse_color()),
                 luminance(m.f0()),
-                LuminanceLobe::GltfGgx {
-                    alpha: m.alpha(),
-                    g1o_4coso: g1o(m.alpha()),
+                {
+                    let (a2, go) = ggx(m.alpha());
+                    LuminanceLobe::GltfGgx { a2, go }
                 },
             ),
         };
