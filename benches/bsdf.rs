@@ -234,6 +234,21 @@ fn bench_sampler(c: &mut Criterion) {
             acc
         })
     });
+    group.bench_function("next_4d", |b| {
+        let mut index = 0u32;
+        b.iter(|| {
+            index = (index + 1) % 1024;
+            sampler.start_pixel_sample((index, 7), index);
+            let mut acc = [0.0f32; 4];
+            for _ in 0..BATCH {
+                let v = sampler.next_4d();
+                for (a, x) in acc.iter_mut().zip(v) {
+                    *a += x;
+                }
+            }
+            acc
+        })
+    });
     group.bench_function("next_1d", |b| {
         let mut index = 0u32;
         b.iter(|| {

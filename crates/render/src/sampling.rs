@@ -487,7 +487,8 @@ impl Sampler {
     pub fn next_1d(&mut self) -> f32 {
         let s = self.next_slot_seed();
         let v = if self.sample_index < SOBOL_MAX_SAMPLES {
-            sobol_burley::sample(self.sample_index, 0, s)
+            // Dimension 0 of `sobol_4d`: exactly `sobol_burley::sample(i, 0, s)` (tested).
+            sobol_4d(self.sample_index, s)[0]
         } else {
             self.hashed(s).next_f32()
         };
@@ -540,11 +541,15 @@ mod tests {
         for i in (0..300).chain([1023, 4096, 65535]) {
             for _ in 0..50 {
                 let seed = rng.next_u32();
+                let v = sobol_4d(i, seed);
                 assert_eq!(
-                    sobol_4d(i, seed),
+                    v,
                     sobol_burley::sample_4d(i, 0, seed),
                     "index {i}, seed {seed}"
                 );
+                for (d, x) in v.into_iter().enumerate() {
+                    assert_eq!(x, sobol_burley::sample(i, d as u32, seed));
+                }
             }
         }
     }
