@@ -328,9 +328,13 @@ pub struct Receiver {
     pub bsdf: Bsdf,
 }
 
-/// Up to this many emitters the light choice weighs each by the BSDF toward it; beyond, it is
-/// by power alone (the per-point weights cost one BSDF evaluation per emitter).
-pub const MAX_BSDF_AWARE_EMITTERS: usize = 16;
+/// The light choice weighs at most this many clusters of emitters by the BSDF toward them
+/// (the per-point weights cost one BSDF evaluation per cluster): up to this many emitters,
+/// each is a cluster of its own; beyond, they are grouped by position.
+pub const MAX_CLUSTERS: usize = 16;
+
+/// Lloyd iterations of the clustering of many emitters.
+const CLUSTER_ITERATIONS: usize = 16;
 
 /// Share of the light choice made by irradiance alone when it is BSDF-aware (defensive
 /// sampling: every emitter that can light the point keeps a positive probability even where
@@ -370,6 +374,22 @@ struct MeshEmitter {
     front: Option<(Vec3, f32)>,
 }
 
+/// Emitters that the light choice weighs as one: by the irradiance their total power would
+/// give from their bounding sphere, and by the BSDF toward its centre.
+#[derive(Clone, Debug)]
+struct Cluster {
+    /// Indices into `LightSampler::emitters`.
+    members: Vec<u32>,
+    /// The member when there is only one (read without going through `members`).
+    single: Option<u32>,
+    /// Centre of a sphere that bounds the members (their bounding spheres for meshes).
+    centre: Vec3,
+    /// Its radius.
+    radius: f32,
+    /// Total power of the members (luminance, W).
+    power: f32,
+}
+
 /// Chooses a light and a sample on it for next-event estimation, and gives the density of that
 /// choice for multiple importance sampling.
 ///
@@ -377,14 +397,18 @@ struct MeshEmitter {
 /// positions) of each emissive material. Point, spot and directional lights are emitters of
 /// their own.
 ///
-/// Which emitter: with at most [`MAX_BSDF_AWARE_EMITTERS`] emitters, in proportion to
+/// Which emitter: with at most [`MAX_CLUSTERS`] emitters, in proportion to
 /// `E_i (0.9 F_i / sum E F + 0.1 / sum E)`-style weights: `E_i` is the irradiance the emitter
 /// would give at the point (intensity, spot falloff and range window over `d^2` for punctual
 /// lights, the directional irradiance, `power / (4 pi max(d, r)^2)` for a mesh of bounding
 /// radius `r`, zero behind a flat one-sided mesh) and `F_i` the luminance of the BSDF times the
 /// cosine toward the emitter's centre. On a glossy wet road this sends the shadow rays of a
-/// streak's pixels to the lamp that makes the streak. With more emitters, by power alone
-/// (pbrt's `PowerLightSampler`), independent of the point.
+/// streak's pixels to the lamp that makes the streak. With more emitters (a street of lamps,
+/// cars and windows), they are first grouped by position into at most [`MAX_CLUSTERS`]
+/// clusters (k-means, power-weighted); the same weights choose a cluster, with `E` from the
+/// cluster's total power over its bounding sphere and `F` toward its centre, and the member is
+/// then chosen in proportion to its own `E_i`. A one-level light tree: the per-point cost
+/// stays at [`MAX_CLUSTERS`] BSDF evaluations plus the chosen cluster's members.
 ///
 /// Where on it: punctual lights by [`Light::sample_li`]; a compact emitter mesh (area at
 /// least `2 pi r^2`, e.g. a tessellated sphere lamp) seen from outside its bounding sphere
@@ -398,10 +422,10 @@ struct MeshEmitter {
 pub struct LightSampler {
     /// The emitters.
     emitters: Vec<Emitter>,
-    /// Power distribution over `emitters` (`None`: nothing emits).
-    power: Option<DiscreteDistribution>,
-    /// Whether the choice weighs the BSDF (few emitters).
-    bsdf_aware: bool,
+    /// At most [`MAX_CLUSTERS`] groups of emitters (singletons when there are few).
+    clusters: Vec<Cluster>,
+    /// The cluster of each emitter.
+    cluster_of: Vec<u32>,
     /// For each scene triangle: `(emitter, index within the emitter)`, `u32::MAX` if none.
     emitter_of_triangle: Vec<(u32, u32)>,
 }
@@ -413,6 +437,146 @@ fn clean_power(p: f32) -> f32 {
     } else {
         0.0
     }
+}
+
+/// Chooses index `i` with probability `w_i / sum` by inverting the cumulative sum at `u sum`
+/// (`u` in [0, 1)): the first positive weight whose cumulative sum exceeds it (else the last
+/// positive one), with `u` rescaled to [0, 1) within that weight.
+fn choose_in(weights: impl IntoIterator<Item = f32>, sum: f32, u: f32) -> Option<(usize, f32)> {
+    let target = u * sum;
+    let mut acc = 0.0f32;
+    let mut chosen = None;
+    for (i, w) in weights.into_iter().enumerate() {
+        if w > 0.0 {
+            chosen = Some((i, acc, w));
+            if target < acc + w {
+                break;
+            }
+        }
+        acc += w;
+    }
+    let (i, before, w) = chosen?;
+    Some((i, ((target - before) / w).clamp(0.0, ONE_MINUS_EPSILON)))
+}
+
+/// Groups the emitters for the light choice: each its own cluster when there are at most
+/// [`MAX_CLUSTERS`]; else directional lights alone and the others by position (the centres of
+/// meshes, the positions of point and spot lights) into the remaining clusters, by k-means
+/// weighted by power, started from the most powerful emitter and then the farthest ones.
+fn cluster_emitters(scene: &Scene, emitters: &[Emitter]) -> Vec<Cluster> {
+    // Position, bounding radius and power of each emitter (`None`: directional).
+    let info: Vec<(Option<Vec3>, f32, f32)> = emitters
+        .iter()
+        .map(|e| match e {
+            Emitter::Mesh(m) => (Some(m.centre), m.radius, m.power),
+            Emitter::Punctual(i) => {
+                let light = &scene.lights[*i as usize];
+                let power = clean_power(light.power(scene));
+                match *light {
+                    Light::Point { position, .. } | Light::Spot { position, .. } => {
+                        (Some(position), 0.0, power)
+                    }
+                    _ => (None, 0.0, power),
+                }
+            }
+        })
+        .collect();
+    let cluster = |members: Vec<u32>| {
+        let spheres: Vec<(Vec3, f32)> = members
+            .iter()
+            .filter_map(|&e| info[e as usize].0.map(|p| (p, info[e as usize].1)))
+            .collect();
+        let (lo, hi) = spheres.iter().fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), &(p, r)| (lo.min(p - r), hi.max(p + r)),
+        );
+        let centre = if spheres.is_empty() {
+            Vec3::ZERO
+        } else {
+            0.5 * (lo + hi)
+        };
+        let radius = spheres
+            .iter()
+            .map(|&(p, r)| p.distance(centre) + r)
+            .fold(0.0f32, f32::max);
+        let power = members.iter().map(|&e| info[e as usize].2).sum();
+        Cluster {
+            single: (members.len() == 1).then(|| members[0]),
+            members,
+            centre,
+            radius,
+            power,
+        }
+    };
+    if emitters.len() <= MAX_CLUSTERS {
+        return (0..emitters.len() as u32)
+            .map(|e| cluster(vec![e]))
+            .collect();
+    }
+    let directional: Vec<u32> = (0..emitters.len() as u32)
+        .filter(|&e| info[e as usize].0.is_none())
+        .collect();
+    let placed: Vec<(u32, Vec3, f32)> = (0..emitters.len() as u32)
+        .filter_map(|e| info[e as usize].0.map(|p| (e, p, info[e as usize].2)))
+        .collect();
+    let k = MAX_CLUSTERS.saturating_sub(directional.len()).max(1);
+    // Start: the most powerful emitter, then each time the one farthest from the centres.
+    let mut centres: Vec<Vec3> = Vec::with_capacity(k);
+    if let Some(&(_, p, _)) = placed.iter().max_by(|a, b| a.2.total_cmp(&b.2)) {
+        centres.push(p);
+    }
+    while centres.len() < k.min(placed.len()) {
+        let far = placed
+            .iter()
+            .map(|&(_, p, _)| {
+                let d = centres
+                    .iter()
+                    .map(|c| c.distance_squared(p))
+                    .fold(f32::INFINITY, f32::min);
+                (p, d)
+            })
+            .max_by(|a, b| a.1.total_cmp(&b.1));
+        match far {
+            Some((p, d)) if d > 0.0 => centres.push(p),
+            _ => break,
+        }
+    }
+    let nearest = |centres: &[Vec3], p: Vec3| {
+        (0..centres.len())
+            .min_by(|&a, &b| {
+                centres[a]
+                    .distance_squared(p)
+                    .total_cmp(&centres[b].distance_squared(p))
+            })
+            .unwrap_or(0)
+    };
+    for _ in 0..CLUSTER_ITERATIONS {
+        let mut sums = vec![(Vec3::ZERO, 0.0f32, Vec3::ZERO, 0usize); centres.len()];
+        for &(_, p, power) in &placed {
+            let s = &mut sums[nearest(&centres, p)];
+            s.0 += p * power;
+            s.1 += power;
+            s.2 += p;
+            s.3 += 1;
+        }
+        for (c, &(weighted, power, plain, n)) in centres.iter_mut().zip(&sums) {
+            if power > 0.0 {
+                *c = weighted / power;
+            } else if n > 0 {
+                *c = plain / n as f32;
+            }
+        }
+    }
+    let mut groups = vec![Vec::new(); centres.len()];
+    for &(e, p, _) in &placed {
+        groups[nearest(&centres, p)].push(e);
+    }
+    groups
+        .into_iter()
+        .filter(|g| !g.is_empty())
+        .chain(directional.into_iter().map(|e| vec![e]))
+        .map(cluster)
+        .collect()
 }
 
 /// Groups the scene's [`Light::Triangle`]s by material and shared vertex positions (union-find).
@@ -613,17 +777,17 @@ impl LightSampler {
                 }
             }
         }
-        let powers: Vec<f32> = emitters
-            .iter()
-            .map(|e| match e {
-                Emitter::Punctual(i) => clean_power(scene.lights[*i as usize].power(scene)),
-                Emitter::Mesh(m) => m.power,
-            })
-            .collect();
+        let clusters = cluster_emitters(scene, &emitters);
+        let mut cluster_of = vec![0u32; emitters.len()];
+        for (c, cluster) in clusters.iter().enumerate() {
+            for &e in &cluster.members {
+                cluster_of[e as usize] = c as u32;
+            }
+        }
         Self {
-            bsdf_aware: emitters.len() <= MAX_BSDF_AWARE_EMITTERS,
-            power: DiscreteDistribution::new(&powers),
             emitters,
+            clusters,
+            cluster_of,
             emitter_of_triangle,
         }
     }
@@ -633,8 +797,9 @@ impl LightSampler {
         self.emitters.len()
     }
 
-    /// The irradiance-like weight `E_i` of emitter `e` at `p` (see [`LightSampler`]).
-    #[inline]
+    /// The irradiance-like weight `E_i` of emitter `e` at `p` (see [`LightSampler`]). Always
+    /// inlined: the per-point weights call it for every emitter.
+    #[inline(always)]
     fn irradiance(&self, scene: &Scene, e: usize, p: Vec3) -> f32 {
         match &self.emitters[e] {
             Emitter::Mesh(m) => m.irradiance(p),
@@ -648,19 +813,24 @@ impl LightSampler {
         }
     }
 
-    /// The luminance of `f * cos` toward emitter `e` from the receiver (0 below its surface).
+    /// The direction from `p` toward emitter `e` that the BSDF weight uses (toward its centre).
     #[inline]
-    fn bsdf_weight(&self, scene: &Scene, e: usize, rx: &Receiver, f: &LuminanceEval) -> f32 {
-        let wi = match &self.emitters[e] {
-            Emitter::Mesh(m) => (m.centre - rx.p).normalize_or_zero(),
+    fn direction_to(&self, scene: &Scene, e: usize, p: Vec3) -> Vec3 {
+        match &self.emitters[e] {
+            Emitter::Mesh(m) => (m.centre - p).normalize_or_zero(),
             Emitter::Punctual(i) => match scene.lights[*i as usize] {
                 Light::Directional { direction, .. } => -direction,
                 Light::Point { position, .. } | Light::Spot { position, .. } => {
-                    (position - rx.p).normalize_or_zero()
+                    (position - p).normalize_or_zero()
                 }
                 Light::Triangle { .. } => Vec3::ZERO,
             },
-        };
+        }
+    }
+
+    /// The luminance of `f * cos` toward `wi` from the receiver (0 below its surface).
+    #[inline]
+    fn bsdf_weight(rx: &Receiver, f: &LuminanceEval, wi: Vec3) -> f32 {
         let wi_local = rx.frame.to_local(wi);
         if wi_local.z <= 0.0 || rx.ng.dot(wi) <= 0.0 {
             return 0.0;
@@ -668,41 +838,60 @@ impl LightSampler {
         clean_power(f.eval(wi_local) * wi_local.z)
     }
 
-    /// The per-point weights `E_i` and `E_i F_i` of every emitter, with their sums.
+    /// The per-point weights `E_c` and `E_c F_c` of every cluster, with their sums (see
+    /// [`LightSampler`]). A single emitter's cluster has the emitter's own `E` and `F`.
     #[inline]
     fn weights(
         &self,
         scene: &Scene,
         rx: &Receiver,
-    ) -> (
-        [f32; MAX_BSDF_AWARE_EMITTERS],
-        [f32; MAX_BSDF_AWARE_EMITTERS],
-        f32,
-        f32,
-    ) {
-        let mut e_w = [0.0f32; MAX_BSDF_AWARE_EMITTERS];
-        let mut ef_w = [0.0f32; MAX_BSDF_AWARE_EMITTERS];
+    ) -> ([f32; MAX_CLUSTERS], [f32; MAX_CLUSTERS], f32, f32) {
+        let mut e_w = [0.0f32; MAX_CLUSTERS];
+        let mut ef_w = [0.0f32; MAX_CLUSTERS];
         let (mut e_sum, mut ef_sum) = (0.0f32, 0.0f32);
         let f = rx.bsdf.luminance_at(rx.wo_local);
-        for i in 0..self.emitters.len() {
-            let e = self.irradiance(scene, i, rx.p);
+        for (c, cluster) in self.clusters.iter().enumerate() {
+            let (e, wi) = if let Some(i) = cluster.single {
+                let i = i as usize;
+                let e = self.irradiance(scene, i, rx.p);
+                (
+                    e,
+                    if e > 0.0 {
+                        self.direction_to(scene, i, rx.p)
+                    } else {
+                        Vec3::ZERO
+                    },
+                )
+            } else {
+                let d2 = (cluster.centre - rx.p)
+                    .length_squared()
+                    .max(cluster.radius * cluster.radius);
+                let e = clean_power(cluster.power / (4.0 * PI * d2));
+                (e, (cluster.centre - rx.p).normalize_or_zero())
+            };
             if e > 0.0 {
-                e_w[i] = e;
-                ef_w[i] = e * self.bsdf_weight(scene, i, rx, &f);
-                e_sum += e_w[i];
-                ef_sum += ef_w[i];
+                e_w[c] = e;
+                ef_w[c] = e * Self::bsdf_weight(rx, &f, wi);
+                e_sum += e_w[c];
+                ef_sum += ef_w[c];
             }
         }
         (e_w, ef_w, e_sum, ef_sum)
     }
 
+    /// The sum of the members' `E_i` in cluster `c` (several members).
+    #[inline]
+    fn member_sum(&self, scene: &Scene, c: usize, p: Vec3) -> f32 {
+        self.clusters[c]
+            .members
+            .iter()
+            .map(|&i| self.irradiance(scene, i as usize, p))
+            .sum()
+    }
+
     /// Chooses an emitter for the receiver: `(emitter, probability, u rescaled within it)`.
     #[inline]
     fn choose(&self, scene: &Scene, rx: &Receiver, u: f32) -> Option<(usize, f32, f32)> {
-        if !self.bsdf_aware {
-            let (i, pmf, reused) = self.power.as_ref()?.sample_reuse(u);
-            return (pmf > 0.0).then_some((i, pmf, reused));
-        }
         let (e_w, ef_w, e_sum, ef_sum) = self.weights(scene, rx);
         if !(e_sum > 0.0 && e_sum.is_finite() && ef_sum.is_finite()) {
             return None;
@@ -714,33 +903,37 @@ impl LightSampler {
         } else {
             (&ef_w, ef_sum, (u - share) / (1.0 - share))
         };
-        let target = u_in * sum;
-        let n = self.emitters.len();
-        let mut acc = 0.0f32;
-        let mut chosen = None;
-        for (i, &w) in weights[..n].iter().enumerate() {
-            if w > 0.0 {
-                chosen = Some(i);
-                if target < acc + w {
-                    break;
-                }
-            }
-            acc += w;
+        let n = self.clusters.len();
+        let (c, u_c) = choose_in(weights[..n].iter().copied(), sum, u_in)?;
+        let pmf = self.mixture_pmf(c, &e_w, &ef_w, e_sum, ef_sum);
+        if pmf <= 0.0 {
+            return None;
         }
-        let i = chosen?;
-        let before: f32 = weights[..i].iter().sum();
-        let reused = ((target - before) / weights[i]).clamp(0.0, ONE_MINUS_EPSILON);
-        let pmf = self.mixture_pmf(i, &e_w, &ef_w, e_sum, ef_sum);
-        (pmf > 0.0).then_some((i, pmf, reused))
+        if let Some(i) = self.clusters[c].single {
+            return Some((i as usize, pmf, u_c));
+        }
+        let members = &self.clusters[c].members;
+        // Within a cluster of several: by each member's E.
+        let total = self.member_sum(scene, c, rx.p);
+        if !(total > 0.0 && total.is_finite()) {
+            return None;
+        }
+        let member_e = members
+            .iter()
+            .map(|&i| self.irradiance(scene, i as usize, rx.p));
+        let (k, reused) = choose_in(member_e, total, u_c)?;
+        let e = members[k] as usize;
+        let pmf = pmf * (self.irradiance(scene, e, rx.p) / total);
+        (pmf > 0.0).then_some((e, pmf, reused))
     }
 
-    /// The mixture probability of emitter `i` from the per-point weights.
+    /// The mixture probability of cluster `c` from the per-point weights.
     #[inline]
-    fn mixture_pmf(&self, i: usize, e_w: &[f32], ef_w: &[f32], e_sum: f32, ef_sum: f32) -> f32 {
+    fn mixture_pmf(&self, c: usize, e_w: &[f32], ef_w: &[f32], e_sum: f32, ef_sum: f32) -> f32 {
         if ef_sum > 0.0 {
-            DEFENSIVE_SHARE * e_w[i] / e_sum + (1.0 - DEFENSIVE_SHARE) * ef_w[i] / ef_sum
+            DEFENSIVE_SHARE * e_w[c] / e_sum + (1.0 - DEFENSIVE_SHARE) * ef_w[c] / ef_sum
         } else {
-            e_w[i] / e_sum
+            e_w[c] / e_sum
         }
     }
 
@@ -749,14 +942,20 @@ impl LightSampler {
         if e >= self.emitters.len() {
             return 0.0;
         }
-        if !self.bsdf_aware {
-            return self.power.as_ref().map_or(0.0, |d| d.pmf(e));
-        }
         let (e_w, ef_w, e_sum, ef_sum) = self.weights(scene, rx);
         if !(e_sum > 0.0 && e_sum.is_finite() && ef_sum.is_finite()) {
             return 0.0;
         }
-        self.mixture_pmf(e, &e_w, &ef_w, e_sum, ef_sum)
+        let c = self.cluster_of[e] as usize;
+        let pmf = self.mixture_pmf(c, &e_w, &ef_w, e_sum, ef_sum);
+        if self.clusters[c].single.is_some() || pmf <= 0.0 {
+            return pmf;
+        }
+        let total = self.member_sum(scene, c, rx.p);
+        if !(total > 0.0 && total.is_finite()) {
+            return 0.0;
+        }
+        pmf * (self.irradiance(scene, e, rx.p) / total)
     }
 
     /// Chooses an emitter with `u_light` and samples it with `u` (see [`LightSampler`]). The
@@ -1333,33 +1532,96 @@ mod tests {
         }
     }
 
+    /// With more emitters than clusters: every emitter is in one of at most `MAX_CLUSTERS`
+    /// clusters, the choice is a distribution over every emitter that lights the point,
+    /// sampling follows it, and next-event estimation of the irradiance from 40 point lights
+    /// (whose exact value is a sum) is unbiased.
     #[test]
-    fn many_emitters_are_chosen_by_power() {
-        let lights: Vec<Light> = (0..MAX_BSDF_AWARE_EMITTERS + 1)
-            .map(|i| Light::Point {
-                position: Vec3::new(i as f32, 3.0, 0.0),
-                intensity: Vec3::splat(1.0 + i as f32),
+    fn many_emitters_are_chosen_by_cluster() {
+        let positions: Vec<Vec3> = (0..40)
+            .map(|i| {
+                let i = i as f32;
+                Vec3::new(
+                    (i * 2.3) % 17.0 - 8.0,
+                    2.0 + (i * 0.7) % 3.0,
+                    -2.0 - (i * 1.9) % 23.0,
+                )
+            })
+            .collect();
+        let lights: Vec<Light> = positions
+            .iter()
+            .enumerate()
+            .map(|(i, &position)| Light::Point {
+                position,
+                intensity: Vec3::splat(1.0 + (i % 7) as f32),
                 range: None,
             })
             .collect();
-        let s = lamp_scene(Vec3::new(0.0, 2.0, -3.0), 5.0, lights);
+        let s = lamp_scene(Vec3::new(0.0, 2.0, -3.0), 5.0, lights.clone());
         let ls = LightSampler::new(&s);
-        assert!(!ls.bsdf_aware);
-        let rx = receiver(
-            Vec3::ZERO,
-            Bsdf::Diffuse(crate::bsdf::Diffuse { kd: Vec3::ONE }),
-            Vec3::Y,
-        );
-        let powers: Vec<f32> = (0..ls.emitter_count())
-            .map(|e| match &ls.emitters[e] {
-                Emitter::Punctual(i) => s.lights[*i as usize].power(&s),
-                Emitter::Mesh(m) => m.power,
-            })
-            .collect();
-        let total: f32 = powers.iter().sum();
-        for (e, p) in powers.iter().enumerate() {
-            assert!((ls.emitter_pmf(&s, &rx, e) - p / total).abs() < 1e-6);
+        let n_e = ls.emitter_count();
+        assert_eq!(n_e, 43);
+        assert!(ls.clusters.len() <= MAX_CLUSTERS && ls.clusters.len() > 1);
+        let mut seen = vec![0; n_e];
+        for (c, cluster) in ls.clusters.iter().enumerate() {
+            for &e in &cluster.members {
+                seen[e as usize] += 1;
+                assert_eq!(ls.cluster_of[e as usize] as usize, c);
+            }
         }
+        assert!(seen.iter().all(|&k| k == 1), "{seen:?}");
+
+        let glossy = Bsdf::Ggx(crate::bsdf::Ggx {
+            kd: Vec3::splat(0.3),
+            ks: Vec3::splat(0.6),
+            alpha: 0.1,
+        });
+        let p = Vec3::new(0.5, 0.0, -4.0);
+        let rx = receiver(p, glossy, Vec3::new(0.0, 1.5, 0.0) - p);
+        let pmfs: Vec<f32> = (0..n_e).map(|e| ls.emitter_pmf(&s, &rx, e)).collect();
+        assert!((pmfs.iter().sum::<f32>() - 1.0).abs() < 1e-5, "{pmfs:?}");
+        for (e, pmf) in pmfs.iter().enumerate() {
+            assert_eq!(*pmf > 0.0, ls.irradiance(&s, e, p) > 0.0, "{e}");
+        }
+        let n = 40_000;
+        let mut counts = vec![0usize; n_e];
+        for k in 0..n {
+            let u = (k as f32 + 0.5) / n as f32;
+            let (e, pmf, reused) = ls.choose(&s, &rx, u).unwrap();
+            assert!(
+                (pmf - pmfs[e]).abs() <= 1e-6 * pmfs[e].max(1.0),
+                "{e}: {pmf} {}",
+                pmfs[e]
+            );
+            assert!((0.0..1.0).contains(&reused));
+            counts[e] += 1;
+        }
+        for e in 0..n_e {
+            assert!((counts[e] as f32 / n as f32 - pmfs[e]).abs() < 1e-3, "{e}");
+        }
+
+        // Unbiased: f * L * cos / pdf over many choices against the exact sum over the lights.
+        let diffuse = Bsdf::Diffuse(crate::bsdf::Diffuse { kd: Vec3::ONE });
+        let rx = receiver(p, diffuse, Vec3::Y);
+        let exact: f64 = lights
+            .iter()
+            .map(|l| {
+                let ls = l.sample_li(&s, p, Vec2::ZERO).unwrap();
+                f64::from(luminance(ls.li) * ls.wi.y.max(0.0))
+            })
+            .sum();
+        let mut rng = crate::sampling::Pcg32::new(9, 2);
+        let m = 400_000;
+        let mut sum = 0.0f64;
+        for _ in 0..m {
+            if let Some(sample) = ls.sample_li(&s, &rx, rng.next_f32(), rng.next_2d()) {
+                if sample.delta {
+                    sum += f64::from(luminance(sample.li) * sample.wi.y.max(0.0) / sample.pdf);
+                }
+            }
+        }
+        let est = sum / m as f64;
+        assert!((est / exact - 1.0).abs() < 0.01, "{est} vs {exact}");
     }
 
     #[test]
