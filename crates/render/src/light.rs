@@ -460,8 +460,9 @@ fn choose_in(weights: impl IntoIterator<Item = f32>, sum: f32, u: f32) -> Option
 }
 
 /// Groups the emitters for the light choice: each its own cluster when there are at most
-/// [`MAX_CLUSTERS`]; else directional lights alone and the others by position (the centres of
-/// meshes, the positions of point and spot lights) into the remaining clusters, by k-means
+/// [`MAX_CLUSTERS`]; else directional lights alone (all in one when there are more than half
+/// as many) and the others by position (the centres of meshes, the positions of point and
+/// spot lights) into the remaining clusters, by k-means
 /// weighted by power, started from the most powerful emitter and then the farthest ones.
 fn cluster_emitters(scene: &Scene, emitters: &[Emitter]) -> Vec<Cluster> {
     // Position, bounding radius and power of each emitter (`None`: directional).
@@ -519,7 +520,14 @@ fn cluster_emitters(scene: &Scene, emitters: &[Emitter]) -> Vec<Cluster> {
     let placed: Vec<(u32, Vec3, f32)> = (0..emitters.len() as u32)
         .filter_map(|e| info[e as usize].0.map(|p| (e, p, info[e as usize].2)))
         .collect();
-    let k = MAX_CLUSTERS.saturating_sub(directional.len()).max(1);
+    // Directional lights have no position: each its own cluster while they are few, else all
+    // in one (whose weight is then arbitrary but positive, which keeps the choice unbiased).
+    let directional: Vec<Vec<u32>> = if directional.len() <= MAX_CLUSTERS / 2 {
+        directional.into_iter().map(|e| vec![e]).collect()
+    } else {
+        vec![directional]
+    };
+    let k = MAX_CLUSTERS - directional.len();
     // Start: the most powerful emitter, then each time the one farthest from the centres.
     let mut centres: Vec<Vec3> = Vec::with_capacity(k);
     if let Some(&(_, p, _)) = placed.iter().max_by(|a, b| a.2.total_cmp(&b.2)) {
@@ -574,7 +582,7 @@ fn cluster_emitters(scene: &Scene, emitters: &[Emitter]) -> Vec<Cluster> {
     groups
         .into_iter()
         .filter(|g| !g.is_empty())
-        .chain(directional.into_iter().map(|e| vec![e]))
+        .chain(directional)
         .map(cluster)
         .collect()
 }
@@ -1622,6 +1630,29 @@ mod tests {
         }
         let est = sum / m as f64;
         assert!((est / exact - 1.0).abs() < 0.01, "{est} vs {exact}");
+    }
+
+    /// Many directional lights (no positions) still make at most `MAX_CLUSTERS` clusters.
+    #[test]
+    fn many_directional_lights_share_a_cluster() {
+        let lights: Vec<Light> = (0..MAX_CLUSTERS + 4)
+            .map(|i| Light::Directional {
+                direction: Vec3::new(0.1 * i as f32, -1.0, 0.2).normalize(),
+                irradiance: Vec3::splat(0.1),
+            })
+            .collect();
+        let s = lamp_scene(Vec3::new(0.0, 2.0, -3.0), 5.0, lights);
+        let ls = LightSampler::new(&s);
+        assert!(ls.clusters.len() <= MAX_CLUSTERS);
+        let rx = receiver(
+            Vec3::ZERO,
+            Bsdf::Diffuse(crate::bsdf::Diffuse { kd: Vec3::ONE }),
+            Vec3::Y,
+        );
+        let total: f32 = (0..ls.emitter_count())
+            .map(|e| ls.emitter_pmf(&s, &rx, e))
+            .sum();
+        assert!((total - 1.0).abs() < 1e-5, "{total}");
     }
 
     #[test]
