@@ -388,6 +388,9 @@ struct Cluster {
     radius: f32,
     /// Total power of the members (luminance, W).
     power: f32,
+    /// Where the BSDF weight looks: the most powerful member's position (a lamp's bulb
+    /// rather than the middle of a lamp and its neighbours).
+    anchor: Vec3,
 }
 
 /// Chooses a light and a sample on it for next-event estimation, and gives the density of that
@@ -459,6 +462,61 @@ fn choose_in(weights: impl IntoIterator<Item = f32>, sum: f32, u: f32) -> Option
     Some((i, ((target - before) / w).clamp(0.0, ONE_MINUS_EPSILON)))
 }
 
+/// Whether weights `E` summing to `e_sum` and `E F` summing to `ef_sum` can be chosen from.
+fn mixture_valid(e_sum: f32, ef_sum: f32) -> bool {
+    e_sum > 0.0 && e_sum.is_finite() && ef_sum.is_finite()
+}
+
+/// The probability of an item with weights `e` and `ef` under the mixture: by `E` alone with
+/// probability [`DEFENSIVE_SHARE`] (all of it when every `E F` is 0), else by `E F`.
+fn mixture_pmf(e: f32, ef: f32, e_sum: f32, ef_sum: f32) -> f32 {
+    if !mixture_valid(e_sum, ef_sum) {
+        0.0
+    } else if ef_sum > 0.0 {
+        DEFENSIVE_SHARE * e / e_sum + (1.0 - DEFENSIVE_SHARE) * ef / ef_sum
+    } else {
+        e / e_sum
+    }
+}
+
+/// Chooses an item `(E, E F)` by [`mixture_pmf`] with `u`: `(index, u rescaled within it)`.
+fn choose_mixture_iter(
+    weights: impl Iterator<Item = (f32, f32)>,
+    e_sum: f32,
+    ef_sum: f32,
+    u: f32,
+) -> Option<(usize, f32)> {
+    if !mixture_valid(e_sum, ef_sum) {
+        return None;
+    }
+    let share = if ef_sum > 0.0 { DEFENSIVE_SHARE } else { 1.0 };
+    if u < share {
+        choose_in(weights.map(|(e, _)| e), e_sum, u / share)
+    } else {
+        choose_in(
+            weights.map(|(_, ef)| ef),
+            ef_sum,
+            (u - share) / (1.0 - share),
+        )
+    }
+}
+
+/// [`choose_mixture_iter`] over two slices of weights.
+fn choose_mixture(
+    e_w: &[f32],
+    ef_w: &[f32],
+    e_sum: f32,
+    ef_sum: f32,
+    u: f32,
+) -> Option<(usize, f32)> {
+    choose_mixture_iter(
+        e_w.iter().copied().zip(ef_w.iter().copied()),
+        e_sum,
+        ef_sum,
+        u,
+    )
+}
+
 /// Groups the emitters for the light choice: each its own cluster when there are at most
 /// [`MAX_CLUSTERS`]; else directional lights alone (all in one when there are more than half
 /// as many) and the others by position (the centres of meshes, the positions of point and
@@ -501,7 +559,13 @@ fn cluster_emitters(scene: &Scene, emitters: &[Emitter]) -> Vec<Cluster> {
             .map(|&(p, r)| p.distance(centre) + r)
             .fold(0.0f32, f32::max);
         let power = members.iter().map(|&e| info[e as usize].2).sum();
+        let anchor = members
+            .iter()
+            .filter_map(|&e| info[e as usize].0.map(|p| (p, info[e as usize].2)))
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .map_or(centre, |(p, _)| p);
         Cluster {
+            anchor,
             single: (members.len() == 1).then(|| members[0]),
             members,
             centre,
@@ -853,96 +917,84 @@ impl LightSampler {
         &self,
         scene: &Scene,
         rx: &Receiver,
+        f: &LuminanceEval,
     ) -> ([f32; MAX_CLUSTERS], [f32; MAX_CLUSTERS], f32, f32) {
         let mut e_w = [0.0f32; MAX_CLUSTERS];
         let mut ef_w = [0.0f32; MAX_CLUSTERS];
         let (mut e_sum, mut ef_sum) = (0.0f32, 0.0f32);
-        let f = rx.bsdf.luminance_at(rx.wo_local);
         for (c, cluster) in self.clusters.iter().enumerate() {
-            let (e, wi) = if let Some(i) = cluster.single {
-                let i = i as usize;
-                let e = self.irradiance(scene, i, rx.p);
-                (
-                    e,
-                    if e > 0.0 {
-                        self.direction_to(scene, i, rx.p)
-                    } else {
-                        Vec3::ZERO
-                    },
-                )
-            } else {
-                let d2 = (cluster.centre - rx.p)
-                    .length_squared()
-                    .max(cluster.radius * cluster.radius);
-                let e = clean_power(cluster.power / (4.0 * PI * d2));
-                (e, (cluster.centre - rx.p).normalize_or_zero())
+            let (e, ef) = match cluster.single {
+                Some(i) => self.emitter_weights(scene, rx, f, i as usize),
+                None => {
+                    let d2 = (cluster.centre - rx.p)
+                        .length_squared()
+                        .max(cluster.radius * cluster.radius);
+                    let e = clean_power(cluster.power / (4.0 * PI * d2));
+                    let wi = (cluster.anchor - rx.p).normalize_or_zero();
+                    (e, e * Self::bsdf_weight(rx, f, wi))
+                }
             };
             if e > 0.0 {
                 e_w[c] = e;
-                ef_w[c] = e * Self::bsdf_weight(rx, &f, wi);
-                e_sum += e_w[c];
-                ef_sum += ef_w[c];
+                ef_w[c] = ef;
+                e_sum += e;
+                ef_sum += ef;
             }
         }
         (e_w, ef_w, e_sum, ef_sum)
     }
 
-    /// The sum of the members' `E_i` in cluster `c` (several members).
+    /// `(E_i, E_i F_i)` of emitter `i` at the receiver (always inlined, like `irradiance`).
+    #[inline(always)]
+    fn emitter_weights(
+        &self,
+        scene: &Scene,
+        rx: &Receiver,
+        f: &LuminanceEval,
+        i: usize,
+    ) -> (f32, f32) {
+        let e = self.irradiance(scene, i, rx.p);
+        if e > 0.0 {
+            let wi = self.direction_to(scene, i, rx.p);
+            (e, e * Self::bsdf_weight(rx, f, wi))
+        } else {
+            (0.0, 0.0)
+        }
+    }
+
+    /// The sums of `E_i` and `E_i F_i` over the members of cluster `c`.
     #[inline]
-    fn member_sum(&self, scene: &Scene, c: usize, p: Vec3) -> f32 {
+    fn member_sums(&self, scene: &Scene, rx: &Receiver, f: &LuminanceEval, c: usize) -> (f32, f32) {
         self.clusters[c]
             .members
             .iter()
-            .map(|&i| self.irradiance(scene, i as usize, p))
-            .sum()
+            .map(|&i| self.emitter_weights(scene, rx, f, i as usize))
+            .fold((0.0, 0.0), |(a, b), (e, ef)| (a + e, b + ef))
     }
 
     /// Chooses an emitter for the receiver: `(emitter, probability, u rescaled within it)`.
+    /// The cluster, then (if it has several) the member, each by the mixture of `E` and `E F`.
     #[inline]
     fn choose(&self, scene: &Scene, rx: &Receiver, u: f32) -> Option<(usize, f32, f32)> {
-        let (e_w, ef_w, e_sum, ef_sum) = self.weights(scene, rx);
-        if !(e_sum > 0.0 && e_sum.is_finite() && ef_sum.is_finite()) {
-            return None;
-        }
-        // The mixture: with probability `share` by E alone, else by E F.
-        let share = if ef_sum > 0.0 { DEFENSIVE_SHARE } else { 1.0 };
-        let (weights, sum, u_in) = if u < share {
-            (&e_w, e_sum, u / share)
-        } else {
-            (&ef_w, ef_sum, (u - share) / (1.0 - share))
-        };
+        let f = rx.bsdf.luminance_at(rx.wo_local);
+        let (e_w, ef_w, e_sum, ef_sum) = self.weights(scene, rx, &f);
         let n = self.clusters.len();
-        let (c, u_c) = choose_in(weights[..n].iter().copied(), sum, u_in)?;
-        let pmf = self.mixture_pmf(c, &e_w, &ef_w, e_sum, ef_sum);
-        if pmf <= 0.0 {
-            return None;
-        }
+        let (c, u_c) = choose_mixture(&e_w[..n], &ef_w[..n], e_sum, ef_sum, u)?;
+        let pmf = mixture_pmf(e_w[c], ef_w[c], e_sum, ef_sum);
         if let Some(i) = self.clusters[c].single {
-            return Some((i as usize, pmf, u_c));
+            return (pmf > 0.0).then_some((i as usize, pmf, u_c));
         }
         let members = &self.clusters[c].members;
-        // Within a cluster of several: by each member's E.
-        let total = self.member_sum(scene, c, rx.p);
-        if !(total > 0.0 && total.is_finite()) {
-            return None;
-        }
-        let member_e = members
+        let (m_e_sum, m_ef_sum) = self.member_sums(scene, rx, &f, c);
+        // Two passes over the members (sums, then the choice) keep this allocation-free.
+        let weights = members
             .iter()
-            .map(|&i| self.irradiance(scene, i as usize, rx.p));
-        let (k, reused) = choose_in(member_e, total, u_c)?;
+            .map(|&i| self.emitter_weights(scene, rx, &f, i as usize));
+        let (k, reused) = choose_mixture_iter(weights, m_e_sum, m_ef_sum, u_c)?;
         let e = members[k] as usize;
-        let pmf = pmf * (self.irradiance(scene, e, rx.p) / total);
+        let (m_e, m_ef) = self.emitter_weights(scene, rx, &f, e);
+        let pmf = pmf * mixture_pmf(m_e, m_ef, m_e_sum, m_ef_sum);
         (pmf > 0.0).then_some((e, pmf, reused))
-    }
-
-    /// The mixture probability of cluster `c` from the per-point weights.
-    #[inline]
-    fn mixture_pmf(&self, c: usize, e_w: &[f32], ef_w: &[f32], e_sum: f32, ef_sum: f32) -> f32 {
-        if ef_sum > 0.0 {
-            DEFENSIVE_SHARE * e_w[c] / e_sum + (1.0 - DEFENSIVE_SHARE) * ef_w[c] / ef_sum
-        } else {
-            e_w[c] / e_sum
-        }
     }
 
     /// The probability that [`LightSampler::sample_li`] at the receiver chooses emitter `e`.
@@ -950,20 +1002,16 @@ impl LightSampler {
         if e >= self.emitters.len() {
             return 0.0;
         }
-        let (e_w, ef_w, e_sum, ef_sum) = self.weights(scene, rx);
-        if !(e_sum > 0.0 && e_sum.is_finite() && ef_sum.is_finite()) {
-            return 0.0;
-        }
+        let f = rx.bsdf.luminance_at(rx.wo_local);
+        let (e_w, ef_w, e_sum, ef_sum) = self.weights(scene, rx, &f);
         let c = self.cluster_of[e] as usize;
-        let pmf = self.mixture_pmf(c, &e_w, &ef_w, e_sum, ef_sum);
+        let pmf = mixture_pmf(e_w[c], ef_w[c], e_sum, ef_sum);
         if self.clusters[c].single.is_some() || pmf <= 0.0 {
             return pmf;
         }
-        let total = self.member_sum(scene, c, rx.p);
-        if !(total > 0.0 && total.is_finite()) {
-            return 0.0;
-        }
-        pmf * (self.irradiance(scene, e, rx.p) / total)
+        let (m_e_sum, m_ef_sum) = self.member_sums(scene, rx, &f, c);
+        let (m_e, m_ef) = self.emitter_weights(scene, rx, &f, e);
+        pmf * mixture_pmf(m_e, m_ef, m_e_sum, m_ef_sum)
     }
 
     /// Chooses an emitter with `u_light` and samples it with `u` (see [`LightSampler`]). The
