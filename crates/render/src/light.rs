@@ -375,7 +375,7 @@ struct MeshEmitter {
 }
 
 /// Emitters that the light choice weighs as one: by the irradiance their total power would
-/// give from their bounding sphere, and by the BSDF toward its centre.
+/// give from their bounding sphere, and by the BSDF toward their most powerful member.
 #[derive(Clone, Debug)]
 struct Cluster {
     /// Indices into `LightSampler::emitters`.
@@ -409,8 +409,10 @@ struct Cluster {
 /// streak's pixels to the lamp that makes the streak. With more emitters (a street of lamps,
 /// cars and windows), they are first grouped by position into at most [`MAX_CLUSTERS`]
 /// clusters (k-means, power-weighted); the same weights choose a cluster, with `E` from the
-/// cluster's total power over its bounding sphere and `F` toward its centre, and the member is
-/// then chosen in proportion to its own `E_i`. A one-level light tree: the per-point cost
+/// cluster's total power over its bounding sphere and `F` toward its most powerful member
+/// (toward the middle of a lamp and its neighbours, the glossy lobe would miss the lamp),
+/// and the member is then chosen by the same mixture of its own `E_i` and `E_i F_i`. A
+/// one-level light tree: the per-point cost
 /// stays at [`MAX_CLUSTERS`] BSDF evaluations plus the chosen cluster's members.
 ///
 /// Where on it: punctual lights by [`Light::sample_li`]; a compact emitter mesh (area at
