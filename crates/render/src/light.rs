@@ -328,12 +328,12 @@ pub struct Receiver {
     pub bsdf: Bsdf,
 }
 
-/// The light choice weighs at most this many clusters of emitters by the BSDF toward them
-/// (the per-point weights cost one BSDF evaluation per cluster): up to this many emitters,
-/// each is a cluster of its own; beyond, they are grouped by position.
-pub const MAX_CLUSTERS: usize = 16;
+/// Children per node of the light tree: the light choice weighs at most this many emitters or
+/// groups of emitters at a time by the BSDF toward them (one BSDF evaluation each). Up to this
+/// many emitters the tree is a single node.
+pub const BRANCHING: usize = 16;
 
-/// Lloyd iterations of the clustering of many emitters.
+/// Lloyd iterations of the k-means that splits a node's emitters into groups.
 const CLUSTER_ITERATIONS: usize = 16;
 
 /// Share of the light choice made by irradiance alone when it is BSDF-aware (defensive
@@ -374,22 +374,37 @@ struct MeshEmitter {
     front: Option<(Vec3, f32)>,
 }
 
+/// A node of the light tree: at most [`BRANCHING`] children, each an emitter or a group.
+#[derive(Clone, Debug)]
+struct Node {
+    children: Vec<Child>,
+    /// `(node, slot)` of the group that points here; `None` for the root.
+    parent: Option<(u32, u32)>,
+}
+
+/// A child of a light-tree [`Node`].
+#[derive(Clone, Copy, Debug)]
+enum Child {
+    /// An emitter (index into `LightSampler::emitters`), weighed by its own `E` and `F`.
+    Emitter(u32),
+    /// Several emitters, weighed as one.
+    Group(Group),
+}
+
 /// Emitters that the light choice weighs as one: by the irradiance their total power would
 /// give from their bounding sphere, and by the BSDF toward their most powerful member.
-#[derive(Clone, Debug)]
-struct Cluster {
-    /// Indices into `LightSampler::emitters`.
-    members: Vec<u32>,
-    /// The member when there is only one (read without going through `members`).
-    single: Option<u32>,
-    /// Centre of a sphere that bounds the members (their bounding spheres for meshes).
+#[derive(Clone, Copy, Debug)]
+struct Group {
+    /// The node whose children they are.
+    node: u32,
+    /// Centre of a sphere that bounds them (their bounding spheres for meshes).
     centre: Vec3,
     /// Its radius.
     radius: f32,
-    /// Total power of the members (luminance, W).
+    /// Their total power (luminance, W).
     power: f32,
-    /// Where the BSDF weight looks: the most powerful member's position (a lamp's bulb
-    /// rather than the middle of a lamp and its neighbours).
+    /// Where the BSDF weight looks: the most powerful one's position (a lamp's bulb rather
+    /// than the middle of a lamp and its neighbours).
     anchor: Vec3,
 }
 
@@ -400,20 +415,21 @@ struct Cluster {
 /// positions) of each emissive material. Point, spot and directional lights are emitters of
 /// their own.
 ///
-/// Which emitter: with at most [`MAX_CLUSTERS`] emitters, in proportion to
+/// Which emitter: with at most [`BRANCHING`] emitters, in proportion to
 /// `E_i (0.9 F_i / sum E F + 0.1 / sum E)`-style weights: `E_i` is the irradiance the emitter
 /// would give at the point (intensity, spot falloff and range window over `d^2` for punctual
 /// lights, the directional irradiance, `power / (4 pi max(d, r)^2)` for a mesh of bounding
 /// radius `r`, zero behind a flat one-sided mesh) and `F_i` the luminance of the BSDF times the
 /// cosine toward the emitter's centre. On a glossy wet road this sends the shadow rays of a
 /// streak's pixels to the lamp that makes the streak. With more emitters (a street of lamps,
-/// cars and windows), they are first grouped by position into at most [`MAX_CLUSTERS`]
-/// clusters (k-means, power-weighted); the same weights choose a cluster, with `E` from the
-/// cluster's total power over its bounding sphere and `F` toward its most powerful member
-/// (toward the middle of a lamp and its neighbours, the glossy lobe would miss the lamp),
-/// and the member is then chosen by the same mixture of its own `E_i` and `E_i F_i`. A
-/// one-level light tree: the per-point cost
-/// stays at [`MAX_CLUSTERS`] BSDF evaluations plus the chosen cluster's members.
+/// cars and windows), a light tree: they are grouped by position into at most [`BRANCHING`]
+/// groups (k-means, power-weighted), and groups of more than [`BRANCHING`] again, down to
+/// groups of at most [`BRANCHING`] emitters. The choice descends it: at each node the same
+/// weights choose a child, a group's `E` from its total power over its bounding sphere and
+/// its `F` toward its most powerful member (toward the middle of a lamp and its neighbours,
+/// the glossy lobe would miss the lamp), an emitter's its own. Each node's weights are
+/// computed once per choice, so the per-point cost is at most [`BRANCHING`] BSDF evaluations
+/// per level (two levels for `rainy_street`'s 142 emitters).
 ///
 /// Where on it: punctual lights by [`Light::sample_li`]; a compact emitter mesh (area at
 /// least `2 pi r^2`, e.g. a tessellated sphere lamp) seen from outside its bounding sphere
@@ -427,10 +443,10 @@ struct Cluster {
 pub struct LightSampler {
     /// The emitters.
     emitters: Vec<Emitter>,
-    /// At most [`MAX_CLUSTERS`] groups of emitters (singletons when there are few).
-    clusters: Vec<Cluster>,
-    /// The cluster of each emitter.
-    cluster_of: Vec<u32>,
+    /// The light tree; the root first.
+    nodes: Vec<Node>,
+    /// The `(node, slot)` of each emitter in the tree.
+    slot_of: Vec<(u32, u32)>,
     /// For each scene triangle: `(emitter, index within the emitter)`, `u32::MAX` if none.
     emitter_of_triangle: Vec<(u32, u32)>,
 }
@@ -519,14 +535,10 @@ fn choose_mixture(
     )
 }
 
-/// Groups the emitters for the light choice: each its own cluster when there are at most
-/// [`MAX_CLUSTERS`]; else directional lights alone (all in one when there are more than half
-/// as many) and the others by position (the centres of meshes, the positions of point and
-/// spot lights) into the remaining clusters, by k-means
-/// weighted by power, started from the most powerful emitter and then the farthest ones.
-fn cluster_emitters(scene: &Scene, emitters: &[Emitter]) -> Vec<Cluster> {
-    // Position, bounding radius and power of each emitter (`None`: directional).
-    let info: Vec<(Option<Vec3>, f32, f32)> = emitters
+/// Position, bounding radius and power (luminance) of each emitter; no position for
+/// directional lights.
+fn emitter_info(scene: &Scene, emitters: &[Emitter]) -> Vec<(Option<Vec3>, f32, f32)> {
+    emitters
         .iter()
         .map(|e| match e {
             Emitter::Mesh(m) => (Some(m.centre), m.radius, m.power),
@@ -541,59 +553,103 @@ fn cluster_emitters(scene: &Scene, emitters: &[Emitter]) -> Vec<Cluster> {
                 }
             }
         })
-        .collect();
-    let cluster = |members: Vec<u32>| {
-        let spheres: Vec<(Vec3, f32)> = members
-            .iter()
-            .filter_map(|&e| info[e as usize].0.map(|p| (p, info[e as usize].1)))
-            .collect();
-        let (lo, hi) = spheres.iter().fold(
-            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-            |(lo, hi), &(p, r)| (lo.min(p - r), hi.max(p + r)),
-        );
-        let centre = if spheres.is_empty() {
-            Vec3::ZERO
-        } else {
-            0.5 * (lo + hi)
-        };
-        let radius = spheres
-            .iter()
-            .map(|&(p, r)| p.distance(centre) + r)
-            .fold(0.0f32, f32::max);
-        let power = members.iter().map(|&e| info[e as usize].2).sum();
-        let anchor = members
-            .iter()
-            .filter_map(|&e| info[e as usize].0.map(|p| (p, info[e as usize].2)))
-            .max_by(|a, b| a.1.total_cmp(&b.1))
-            .map_or(centre, |(p, _)| p);
-        Cluster {
-            anchor,
-            single: (members.len() == 1).then(|| members[0]),
-            members,
-            centre,
-            radius,
-            power,
+        .collect()
+}
+
+/// Builds the light tree over the emitters (`info` from [`emitter_info`]): nodes (the root
+/// first) and the `(node, slot)` of each emitter. A node's children are its emitters when they
+/// are at most [`BRANCHING`]; else [`partition`]'s groups, one emitter each or a group with a
+/// node of its own.
+fn build_light_tree(info: &[(Option<Vec3>, f32, f32)]) -> (Vec<Node>, Vec<(u32, u32)>) {
+    let mut nodes: Vec<Node> = Vec::new();
+    let mut slot_of = vec![(0u32, 0u32); info.len()];
+    let mut pending = vec![(None, (0..info.len() as u32).collect::<Vec<u32>>())];
+    while let Some((parent, members)) = pending.pop() {
+        let index = nodes.len() as u32;
+        if let Some((node, slot)) = parent {
+            if let Child::Group(g) = &mut nodes[node as usize].children[slot as usize] {
+                g.node = index;
+            }
         }
-    };
-    if emitters.len() <= MAX_CLUSTERS {
-        return (0..emitters.len() as u32)
-            .map(|e| cluster(vec![e]))
-            .collect();
+        let groups = if members.len() <= BRANCHING {
+            members.iter().map(|&e| vec![e]).collect()
+        } else {
+            partition(info, &members)
+        };
+        let mut children = Vec::with_capacity(groups.len());
+        for (slot, group) in groups.into_iter().enumerate() {
+            let slot = slot as u32;
+            if let [e] = group[..] {
+                slot_of[e as usize] = (index, slot);
+                children.push(Child::Emitter(e));
+            } else {
+                children.push(Child::Group(group_bounds(info, &group)));
+                pending.push((Some((index, slot)), group));
+            }
+        }
+        nodes.push(Node { children, parent });
     }
-    let directional: Vec<u32> = (0..emitters.len() as u32)
+    (nodes, slot_of)
+}
+
+/// The bounds of a group of emitters (its `node` is filled in when the node is made).
+fn group_bounds(info: &[(Option<Vec3>, f32, f32)], members: &[u32]) -> Group {
+    let spheres: Vec<(Vec3, f32)> = members
+        .iter()
+        .filter_map(|&e| info[e as usize].0.map(|p| (p, info[e as usize].1)))
+        .collect();
+    let (lo, hi) = spheres.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), &(p, r)| (lo.min(p - r), hi.max(p + r)),
+    );
+    let centre = if spheres.is_empty() {
+        Vec3::ZERO
+    } else {
+        0.5 * (lo + hi)
+    };
+    let radius = spheres
+        .iter()
+        .map(|&(p, r)| p.distance(centre) + r)
+        .fold(0.0f32, f32::max);
+    let power = members.iter().map(|&e| info[e as usize].2).sum();
+    let anchor = members
+        .iter()
+        .filter_map(|&e| info[e as usize].0.map(|p| (p, info[e as usize].2)))
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .map_or(centre, |(p, _)| p);
+    Group {
+        node: u32::MAX,
+        centre,
+        radius,
+        power,
+        anchor,
+    }
+}
+
+/// Splits more than [`BRANCHING`] emitters into at most [`BRANCHING`] non-empty groups:
+/// directional lights alone (all in one when there are more than half as many) and the
+/// others by position (the centres of meshes, the positions of point and spot lights) into
+/// the remaining groups, by k-means weighted by power, started from the most powerful emitter
+/// and then the farthest ones. When that makes a single group (lights at one position, or
+/// only directional ones), consecutive runs of the input instead, so every level shrinks.
+fn partition(info: &[(Option<Vec3>, f32, f32)], members: &[u32]) -> Vec<Vec<u32>> {
+    let directional: Vec<u32> = members
+        .iter()
+        .copied()
         .filter(|&e| info[e as usize].0.is_none())
         .collect();
-    let placed: Vec<(u32, Vec3, f32)> = (0..emitters.len() as u32)
-        .filter_map(|e| info[e as usize].0.map(|p| (e, p, info[e as usize].2)))
+    let placed: Vec<(u32, Vec3, f32)> = members
+        .iter()
+        .filter_map(|&e| info[e as usize].0.map(|p| (e, p, info[e as usize].2)))
         .collect();
-    // Directional lights have no position: each its own cluster while they are few, else all
+    // Directional lights have no position: each its own group while they are few, else all
     // in one (whose weight is then arbitrary but positive, which keeps the choice unbiased).
-    let directional: Vec<Vec<u32>> = if directional.len() <= MAX_CLUSTERS / 2 {
+    let directional: Vec<Vec<u32>> = if directional.len() <= BRANCHING / 2 {
         directional.into_iter().map(|e| vec![e]).collect()
     } else {
         vec![directional]
     };
-    let k = MAX_CLUSTERS - directional.len();
+    let k = BRANCHING - directional.len();
     // Start: the most powerful emitter, then each time the one farthest from the centres.
     let mut centres: Vec<Vec3> = Vec::with_capacity(k);
     if let Some(&(_, p, _)) = placed.iter().max_by(|a, b| a.2.total_cmp(&b.2)) {
@@ -645,11 +701,17 @@ fn cluster_emitters(scene: &Scene, emitters: &[Emitter]) -> Vec<Cluster> {
     for &(e, p, _) in &placed {
         groups[nearest(&centres, p)].push(e);
     }
-    groups
+    let groups: Vec<Vec<u32>> = groups
         .into_iter()
         .filter(|g| !g.is_empty())
         .chain(directional)
-        .map(cluster)
+        .collect();
+    if groups.len() > 1 {
+        return groups;
+    }
+    members
+        .chunks(members.len().div_ceil(BRANCHING))
+        .map(<[u32]>::to_vec)
         .collect()
 }
 
@@ -851,17 +913,11 @@ impl LightSampler {
                 }
             }
         }
-        let clusters = cluster_emitters(scene, &emitters);
-        let mut cluster_of = vec![0u32; emitters.len()];
-        for (c, cluster) in clusters.iter().enumerate() {
-            for &e in &cluster.members {
-                cluster_of[e as usize] = c as u32;
-            }
-        }
+        let (nodes, slot_of) = build_light_tree(&emitter_info(scene, &emitters));
         Self {
             emitters,
-            clusters,
-            cluster_of,
+            nodes,
+            slot_of,
             emitter_of_triangle,
         }
     }
@@ -912,27 +968,26 @@ impl LightSampler {
         clean_power(f.eval(wi_local) * wi_local.z)
     }
 
-    /// The per-point weights `E_c` and `E_c F_c` of every cluster, with their sums (see
-    /// [`LightSampler`]). A single emitter's cluster has the emitter's own `E` and `F`.
+    /// The per-point weights `E_c` and `E_c F_c` of every child of `node`, with their sums
+    /// (see [`LightSampler`]).
     #[inline]
     fn weights(
         &self,
         scene: &Scene,
         rx: &Receiver,
         f: &LuminanceEval,
-    ) -> ([f32; MAX_CLUSTERS], [f32; MAX_CLUSTERS], f32, f32) {
-        let mut e_w = [0.0f32; MAX_CLUSTERS];
-        let mut ef_w = [0.0f32; MAX_CLUSTERS];
+        node: usize,
+    ) -> ([f32; BRANCHING], [f32; BRANCHING], f32, f32) {
+        let mut e_w = [0.0f32; BRANCHING];
+        let mut ef_w = [0.0f32; BRANCHING];
         let (mut e_sum, mut ef_sum) = (0.0f32, 0.0f32);
-        for (c, cluster) in self.clusters.iter().enumerate() {
-            let (e, ef) = match cluster.single {
-                Some(i) => self.emitter_weights(scene, rx, f, i as usize),
-                None => {
-                    let d2 = (cluster.centre - rx.p)
-                        .length_squared()
-                        .max(cluster.radius * cluster.radius);
-                    let e = clean_power(cluster.power / (4.0 * PI * d2));
-                    let wi = (cluster.anchor - rx.p).normalize_or_zero();
+        for (c, child) in self.nodes[node].children.iter().enumerate() {
+            let (e, ef) = match child {
+                Child::Emitter(i) => self.emitter_weights(scene, rx, f, *i as usize),
+                Child::Group(g) => {
+                    let d2 = (g.centre - rx.p).length_squared().max(g.radius * g.radius);
+                    let e = clean_power(g.power / (4.0 * PI * d2));
+                    let wi = (g.anchor - rx.p).normalize_or_zero();
                     (e, e * Self::bsdf_weight(rx, f, wi))
                 }
             };
@@ -964,56 +1019,41 @@ impl LightSampler {
         }
     }
 
-    /// The sums of `E_i` and `E_i F_i` over the members of cluster `c`.
-    #[inline]
-    fn member_sums(&self, scene: &Scene, rx: &Receiver, f: &LuminanceEval, c: usize) -> (f32, f32) {
-        self.clusters[c]
-            .members
-            .iter()
-            .map(|&i| self.emitter_weights(scene, rx, f, i as usize))
-            .fold((0.0, 0.0), |(a, b), (e, ef)| (a + e, b + ef))
-    }
-
     /// Chooses an emitter for the receiver: `(emitter, probability, u rescaled within it)`.
-    /// The cluster, then (if it has several) the member, each by the mixture of `E` and `E F`.
+    /// From the root down, a child of each node by the mixture of `E` and `E F`.
     #[inline]
     fn choose(&self, scene: &Scene, rx: &Receiver, u: f32) -> Option<(usize, f32, f32)> {
         let f = rx.bsdf.luminance_at(rx.wo_local);
-        let (e_w, ef_w, e_sum, ef_sum) = self.weights(scene, rx, &f);
-        let n = self.clusters.len();
-        let (c, u_c) = choose_mixture(&e_w[..n], &ef_w[..n], e_sum, ef_sum, u)?;
-        let pmf = mixture_pmf(e_w[c], ef_w[c], e_sum, ef_sum);
-        if let Some(i) = self.clusters[c].single {
-            return (pmf > 0.0).then_some((i as usize, pmf, u_c));
+        let (mut node, mut u, mut pmf) = (0, u, 1.0f32);
+        loop {
+            let (e_w, ef_w, e_sum, ef_sum) = self.weights(scene, rx, &f, node);
+            let n = self.nodes[node].children.len();
+            let (c, u_c) = choose_mixture(&e_w[..n], &ef_w[..n], e_sum, ef_sum, u)?;
+            pmf *= mixture_pmf(e_w[c], ef_w[c], e_sum, ef_sum);
+            u = u_c;
+            match self.nodes[node].children[c] {
+                Child::Emitter(e) => return (pmf > 0.0).then_some((e as usize, pmf, u)),
+                Child::Group(g) => node = g.node as usize,
+            }
         }
-        let members = &self.clusters[c].members;
-        let (m_e_sum, m_ef_sum) = self.member_sums(scene, rx, &f, c);
-        // Two passes over the members (sums, then the choice) keep this allocation-free.
-        let weights = members
-            .iter()
-            .map(|&i| self.emitter_weights(scene, rx, &f, i as usize));
-        let (k, reused) = choose_mixture_iter(weights, m_e_sum, m_ef_sum, u_c)?;
-        let e = members[k] as usize;
-        let (m_e, m_ef) = self.emitter_weights(scene, rx, &f, e);
-        let pmf = pmf * mixture_pmf(m_e, m_ef, m_e_sum, m_ef_sum);
-        (pmf > 0.0).then_some((e, pmf, reused))
     }
 
-    /// The probability that [`LightSampler::sample_li`] at the receiver chooses emitter `e`.
+    /// The probability that [`LightSampler::sample_li`] at the receiver chooses emitter `e`:
+    /// the product of the choices on the way from the root to it.
     pub fn emitter_pmf(&self, scene: &Scene, rx: &Receiver, e: usize) -> f32 {
-        if e >= self.emitters.len() {
+        let Some(&(node, slot)) = self.slot_of.get(e) else {
             return 0.0;
-        }
+        };
         let f = rx.bsdf.luminance_at(rx.wo_local);
-        let (e_w, ef_w, e_sum, ef_sum) = self.weights(scene, rx, &f);
-        let c = self.cluster_of[e] as usize;
-        let pmf = mixture_pmf(e_w[c], ef_w[c], e_sum, ef_sum);
-        if self.clusters[c].single.is_some() || pmf <= 0.0 {
-            return pmf;
+        let (mut node, mut slot, mut pmf) = (node as usize, slot as usize, 1.0f32);
+        loop {
+            let (e_w, ef_w, e_sum, ef_sum) = self.weights(scene, rx, &f, node);
+            pmf *= mixture_pmf(e_w[slot], ef_w[slot], e_sum, ef_sum);
+            match self.nodes[node].parent {
+                Some((parent, s)) if pmf > 0.0 => (node, slot) = (parent as usize, s as usize),
+                _ => return pmf,
+            }
         }
-        let (m_e_sum, m_ef_sum) = self.member_sums(scene, rx, &f, c);
-        let (m_e, m_ef) = self.emitter_weights(scene, rx, &f, e);
-        pmf * mixture_pmf(m_e, m_ef, m_e_sum, m_ef_sum)
     }
 
     /// Chooses an emitter with `u_light` and samples it with `u` (see [`LightSampler`]). The
@@ -1590,10 +1630,78 @@ mod tests {
         }
     }
 
-    /// With more emitters than clusters: every emitter is in one of at most `MAX_CLUSTERS`
-    /// clusters, the choice is a distribution over every emitter that lights the point,
-    /// sampling follows it, and next-event estimation of the irradiance from 40 point lights
-    /// (whose exact value is a sum) is unbiased.
+    /// Checks the light tree's structure: every node has at most `BRANCHING` children, every
+    /// emitter is a leaf exactly once at its recorded slot, every group points to a node whose
+    /// parent link points back, and every node but the root is reached. Returns the depth.
+    fn check_tree(ls: &LightSampler) -> usize {
+        let mut seen = vec![0; ls.emitter_count()];
+        let mut reached = vec![0; ls.nodes.len()];
+        reached[0] = 1;
+        assert!(ls.nodes[0].parent.is_none());
+        for (n, node) in ls.nodes.iter().enumerate() {
+            assert!(!node.children.is_empty() && node.children.len() <= BRANCHING);
+            for (slot, child) in node.children.iter().enumerate() {
+                match *child {
+                    Child::Emitter(e) => {
+                        seen[e as usize] += 1;
+                        assert_eq!(ls.slot_of[e as usize], (n as u32, slot as u32));
+                    }
+                    Child::Group(g) => {
+                        reached[g.node as usize] += 1;
+                        assert_eq!(
+                            ls.nodes[g.node as usize].parent,
+                            Some((n as u32, slot as u32))
+                        );
+                    }
+                }
+            }
+        }
+        assert!(seen.iter().all(|&k| k == 1), "{seen:?}");
+        assert!(reached.iter().all(|&k| k == 1), "{reached:?}");
+        let depth = |e: usize| {
+            let mut node = ls.slot_of[e].0;
+            let mut d = 1;
+            while let Some((parent, _)) = ls.nodes[node as usize].parent {
+                node = parent;
+                d += 1;
+            }
+            d
+        };
+        (0..ls.emitter_count()).map(depth).max().unwrap_or(0)
+    }
+
+    /// Checks that the choice at `rx` is a distribution over exactly the emitters that light
+    /// it, that `choose` returns `emitter_pmf`'s probabilities, and that its frequencies follow
+    /// them.
+    fn check_choice(s: &Scene, ls: &LightSampler, rx: &Receiver) {
+        let n_e = ls.emitter_count();
+        let pmfs: Vec<f32> = (0..n_e).map(|e| ls.emitter_pmf(s, rx, e)).collect();
+        assert!((pmfs.iter().sum::<f32>() - 1.0).abs() < 1e-5, "{pmfs:?}");
+        for (e, pmf) in pmfs.iter().enumerate() {
+            assert_eq!(*pmf > 0.0, ls.irradiance(s, e, rx.p) > 0.0, "{e}");
+        }
+        let n = 40_000;
+        let mut counts = vec![0usize; n_e];
+        for k in 0..n {
+            let u = (k as f32 + 0.5) / n as f32;
+            let (e, pmf, reused) = ls.choose(s, rx, u).unwrap();
+            assert!(
+                (pmf - pmfs[e]).abs() <= 1e-6 * pmfs[e].max(1.0),
+                "{e}: {pmf} {}",
+                pmfs[e]
+            );
+            assert!((0.0..1.0).contains(&reused));
+            counts[e] += 1;
+        }
+        for e in 0..n_e {
+            assert!((counts[e] as f32 / n as f32 - pmfs[e]).abs() < 1e-3, "{e}");
+        }
+    }
+
+    /// With more emitters than `BRANCHING`: a two-level tree, the choice is a distribution
+    /// over every emitter that lights the point, sampling follows it, and next-event
+    /// estimation of the irradiance from 40 point lights (whose exact value is a sum) is
+    /// unbiased.
     #[test]
     fn many_emitters_are_chosen_by_cluster() {
         let positions: Vec<Vec3> = (0..40)
@@ -1619,15 +1727,7 @@ mod tests {
         let ls = LightSampler::new(&s);
         let n_e = ls.emitter_count();
         assert_eq!(n_e, 43);
-        assert!(ls.clusters.len() <= MAX_CLUSTERS && ls.clusters.len() > 1);
-        let mut seen = vec![0; n_e];
-        for (c, cluster) in ls.clusters.iter().enumerate() {
-            for &e in &cluster.members {
-                seen[e as usize] += 1;
-                assert_eq!(ls.cluster_of[e as usize] as usize, c);
-            }
-        }
-        assert!(seen.iter().all(|&k| k == 1), "{seen:?}");
+        assert_eq!(check_tree(&ls), 2);
 
         let glossy = Bsdf::Ggx(crate::bsdf::Ggx {
             kd: Vec3::splat(0.3),
@@ -1636,27 +1736,7 @@ mod tests {
         });
         let p = Vec3::new(0.5, 0.0, -4.0);
         let rx = receiver(p, glossy, Vec3::new(0.0, 1.5, 0.0) - p);
-        let pmfs: Vec<f32> = (0..n_e).map(|e| ls.emitter_pmf(&s, &rx, e)).collect();
-        assert!((pmfs.iter().sum::<f32>() - 1.0).abs() < 1e-5, "{pmfs:?}");
-        for (e, pmf) in pmfs.iter().enumerate() {
-            assert_eq!(*pmf > 0.0, ls.irradiance(&s, e, p) > 0.0, "{e}");
-        }
-        let n = 40_000;
-        let mut counts = vec![0usize; n_e];
-        for k in 0..n {
-            let u = (k as f32 + 0.5) / n as f32;
-            let (e, pmf, reused) = ls.choose(&s, &rx, u).unwrap();
-            assert!(
-                (pmf - pmfs[e]).abs() <= 1e-6 * pmfs[e].max(1.0),
-                "{e}: {pmf} {}",
-                pmfs[e]
-            );
-            assert!((0.0..1.0).contains(&reused));
-            counts[e] += 1;
-        }
-        for e in 0..n_e {
-            assert!((counts[e] as f32 / n as f32 - pmfs[e]).abs() < 1e-3, "{e}");
-        }
+        check_choice(&s, &ls, &rx);
 
         // Unbiased: f * L * cos / pdf over many choices against the exact sum over the lights.
         let diffuse = Bsdf::Diffuse(crate::bsdf::Diffuse { kd: Vec3::ONE });
@@ -1682,10 +1762,46 @@ mod tests {
         assert!((est / exact - 1.0).abs() < 0.01, "{est} vs {exact}");
     }
 
-    /// Many directional lights (no positions) still make at most `MAX_CLUSTERS` clusters.
+    /// 400 point lights (a quarter of them at one spot, which k-means cannot split) make a
+    /// tree of three levels or more, and the choice down it is still the distribution that
+    /// `emitter_pmf` gives.
+    #[test]
+    fn a_deep_light_tree_chooses_by_its_pmf() {
+        let lights: Vec<Light> = (0..400)
+            .map(|i| {
+                let f = i as f32;
+                let position = if i % 4 == 0 {
+                    Vec3::new(3.0, 4.0, -6.0)
+                } else {
+                    Vec3::new(
+                        (f * 2.3) % 37.0 - 18.0,
+                        2.0 + (f * 0.7) % 5.0,
+                        -(f * 1.9) % 41.0,
+                    )
+                };
+                Light::Point {
+                    position,
+                    intensity: Vec3::splat(1.0 + (i % 5) as f32),
+                    range: None,
+                }
+            })
+            .collect();
+        let s = lamp_scene(Vec3::new(0.0, 2.0, -3.0), 5.0, lights);
+        let ls = LightSampler::new(&s);
+        assert!(check_tree(&ls) >= 3);
+        let glossy = Bsdf::Ggx(crate::bsdf::Ggx {
+            kd: Vec3::splat(0.3),
+            ks: Vec3::splat(0.6),
+            alpha: 0.1,
+        });
+        let p = Vec3::new(0.5, 0.0, -4.0);
+        check_choice(&s, &ls, &receiver(p, glossy, Vec3::new(2.0, 1.5, -1.0) - p));
+    }
+
+    /// Many directional lights (no positions) share a group, which splits into runs.
     #[test]
     fn many_directional_lights_share_a_cluster() {
-        let lights: Vec<Light> = (0..MAX_CLUSTERS + 4)
+        let lights: Vec<Light> = (0..BRANCHING + 4)
             .map(|i| Light::Directional {
                 direction: Vec3::new(0.1 * i as f32, -1.0, 0.2).normalize(),
                 irradiance: Vec3::splat(0.1),
@@ -1693,7 +1809,7 @@ mod tests {
             .collect();
         let s = lamp_scene(Vec3::new(0.0, 2.0, -3.0), 5.0, lights);
         let ls = LightSampler::new(&s);
-        assert!(ls.clusters.len() <= MAX_CLUSTERS);
+        assert_eq!(check_tree(&ls), 3);
         let rx = receiver(
             Vec3::ZERO,
             Bsdf::Diffuse(crate::bsdf::Diffuse { kd: Vec3::ONE }),
