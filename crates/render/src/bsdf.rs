@@ -568,7 +568,8 @@ impl Bsdf {
 /// `luminance(f(wo, wi))` for one `wo` and many `wi`: the light choice's per-emitter BSDF
 /// weight, a dozen evaluations per path vertex. What depends on `wo` alone (the lobes'
 /// luminances, GGX's masking term of `wo`) is computed once by [`Bsdf::luminance_at`];
-/// each [`LuminanceEval::eval`] then costs a half vector and the lobe's own terms, in scalars.
+/// each [`LuminanceEval::eval`] then costs a half vector and the lobe's own terms, in scalars,
+/// and [`LuminanceEval::eval_all`] evaluates many directions in one loop.
 /// Equal to `luminance(bsdf.eval(wo, wi))` up to rounding (tested).
 #[derive(Clone, Copy, Debug)]
 pub struct LuminanceEval {
@@ -609,34 +610,47 @@ impl LuminanceEval {
     /// `luminance(f(wo, wi))`; zero when either direction is below the surface.
     #[inline]
     pub fn eval(&self, wi: Vec3) -> f32 {
-        let wo = self.wo;
-        if !above(wo, wi) {
-            return 0.0;
-        }
-        match self.lobe {
-            LuminanceLobe::None => self.diffuse,
-            LuminanceLobe::Ggx { a2, go } => {
-                self.diffuse + self.glossy * ggx_spec(wo, wi, a2, go).0
+        let mut f = [0.0];
+        self.eval_all(&[wi], &mut f);
+        f[0]
+    }
+
+    /// [`LuminanceEval::eval`] of each of `wi` into `f` (of the same length): the lobe is
+    /// matched once, so the evaluations run as one straight loop whose iterations overlap.
+    #[inline]
+    pub fn eval_all(&self, wi: &[Vec3], f: &mut [f32]) {
+        debug_assert_eq!(wi.len(), f.len());
+        #[inline(always)]
+        fn each(wo: Vec3, wi: &[Vec3], f: &mut [f32], lobe: impl Fn(Vec3) -> f32) {
+            for (f, &wi) in f.iter_mut().zip(wi) {
+                *f = if above(wo, wi) { lobe(wi) } else { 0.0 };
             }
-            LuminanceLobe::GltfGgx { a2, go } => {
+        }
+        let (wo, diffuse, glossy) = (self.wo, self.diffuse, self.glossy);
+        match self.lobe {
+            LuminanceLobe::None => each(wo, wi, f, |_| diffuse),
+            LuminanceLobe::Ggx { a2, go } => each(wo, wi, f, |wi| {
+                diffuse + glossy * ggx_spec(wo, wi, a2, go).0
+            }),
+            LuminanceLobe::GltfGgx { a2, go } => each(wo, wi, f, |wi| {
                 let spec = ggx_spec(wo, wi, a2, go).0;
                 let h = half_vector(wo, wi);
                 // F = F0 + (1 - F0) s, so luminance(F) = L(F0) + (1 - L(F0)) s, and
                 // 1 - F = (1 - F0)(1 - s) scales the diffuse lobe by (1 - s).
                 let s = (1.0 - wo.dot(h).abs()).clamp(0.0, 1.0).powi(5);
-                self.diffuse * (1.0 - s) + (self.glossy + (1.0 - self.glossy) * s) * spec
-            }
-            LuminanceLobe::Ward { a2 } => {
+                diffuse * (1.0 - s) + (glossy + (1.0 - glossy) * s) * spec
+            }),
+            LuminanceLobe::Ward { a2 } => each(wo, wi, f, |wi| {
                 // tan^2 of the half vector's angle, from the unnormalised wo + wi.
                 let h = wo + wi;
                 let tan2 = (h.x * h.x + h.y * h.y) / (h.z * h.z);
                 let gauss = (-tan2 / a2).exp() / (PI * a2);
-                self.diffuse + self.glossy * (gauss / (4.0 * (wo.z * wi.z).sqrt()))
-            }
-            LuminanceLobe::BlinnPhong { s, norm } => {
+                diffuse + glossy * (gauss / (4.0 * (wo.z * wi.z).sqrt()))
+            }),
+            LuminanceLobe::BlinnPhong { s, norm } => each(wo, wi, f, |wi| {
                 let h = half_vector(wo, wi);
-                self.diffuse + self.glossy * (norm * h.z.powf(s))
-            }
+                diffuse + glossy * (norm * h.z.powf(s))
+            }),
         }
     }
 }

@@ -958,18 +958,10 @@ impl LightSampler {
         }
     }
 
-    /// The luminance of `f * cos` toward `wi` from the receiver (0 below its surface).
-    #[inline]
-    fn bsdf_weight(rx: &Receiver, f: &LuminanceEval, wi: Vec3) -> f32 {
-        let wi_local = rx.frame.to_local(wi);
-        if wi_local.z <= 0.0 || rx.ng.dot(wi) <= 0.0 {
-            return 0.0;
-        }
-        clean_power(f.eval(wi_local) * wi_local.z)
-    }
-
     /// The per-point weights `E_c` and `E_c F_c` of every child of `node`, with their sums
-    /// (see [`LightSampler`]).
+    /// (see [`LightSampler`]). `F_c` is the luminance of the BSDF times the cosine toward the
+    /// child (0 below the shading or the geometric surface). First every child's `E_c` and
+    /// direction, then all the BSDF values in one [`LuminanceEval::eval_all`].
     #[inline]
     fn weights(
         &self,
@@ -978,45 +970,49 @@ impl LightSampler {
         f: &LuminanceEval,
         node: usize,
     ) -> ([f32; BRANCHING], [f32; BRANCHING], f32, f32) {
+        let children = &self.nodes[node].children;
         let mut e_w = [0.0f32; BRANCHING];
-        let mut ef_w = [0.0f32; BRANCHING];
-        let (mut e_sum, mut ef_sum) = (0.0f32, 0.0f32);
-        for (c, child) in self.nodes[node].children.iter().enumerate() {
-            let (e, ef) = match child {
-                Child::Emitter(i) => self.emitter_weights(scene, rx, f, *i as usize),
+        // Zero (below the surface, so F = 0) unless the child is lit and in front.
+        let mut wi_local = [Vec3::ZERO; BRANCHING];
+        for (c, child) in children.iter().enumerate() {
+            let (e, wi) = match child {
+                Child::Emitter(i) => {
+                    let e = self.irradiance(scene, *i as usize, rx.p);
+                    if e > 0.0 {
+                        (e, self.direction_to(scene, *i as usize, rx.p))
+                    } else {
+                        continue;
+                    }
+                }
                 Child::Group(g) => {
                     let d2 = (g.centre - rx.p).length_squared().max(g.radius * g.radius);
                     let e = clean_power(g.power / (4.0 * PI * d2));
-                    let wi = (g.anchor - rx.p).normalize_or_zero();
-                    (e, e * Self::bsdf_weight(rx, f, wi))
+                    (e, (g.anchor - rx.p).normalize_or_zero())
                 }
             };
+            e_w[c] = e;
+            let local = rx.frame.to_local(wi);
+            if local.z > 0.0 && rx.ng.dot(wi) > 0.0 {
+                wi_local[c] = local;
+            }
+        }
+        let n = children.len();
+        let mut f_w = [0.0f32; BRANCHING];
+        f.eval_all(&wi_local[..n], &mut f_w[..n]);
+        let mut ef_w = [0.0f32; BRANCHING];
+        let (mut e_sum, mut ef_sum) = (0.0f32, 0.0f32);
+        for c in 0..n {
+            let e = e_w[c];
             if e > 0.0 {
-                e_w[c] = e;
+                let ef = e * clean_power(f_w[c] * wi_local[c].z);
                 ef_w[c] = ef;
                 e_sum += e;
                 ef_sum += ef;
+            } else {
+                e_w[c] = 0.0;
             }
         }
         (e_w, ef_w, e_sum, ef_sum)
-    }
-
-    /// `(E_i, E_i F_i)` of emitter `i` at the receiver (always inlined, like `irradiance`).
-    #[inline(always)]
-    fn emitter_weights(
-        &self,
-        scene: &Scene,
-        rx: &Receiver,
-        f: &LuminanceEval,
-        i: usize,
-    ) -> (f32, f32) {
-        let e = self.irradiance(scene, i, rx.p);
-        if e > 0.0 {
-            let wi = self.direction_to(scene, i, rx.p);
-            (e, e * Self::bsdf_weight(rx, f, wi))
-        } else {
-            (0.0, 0.0)
-        }
     }
 
     /// Chooses an emitter for the receiver: `(emitter, probability, u rescaled within it)`.
