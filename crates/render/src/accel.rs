@@ -142,24 +142,22 @@ impl Accel {
     pub fn intersect(&self, ray: &Ray) -> Option<AccelHit> {
         let (bvh, r) = self.bvh_ray(ray)?;
         let mut hit = RayHit::none();
+        let mut barycentrics = Vec2::ZERO;
         let tris = &self.tris;
         let t_min = self.t_min;
         if !bvh.ray_traverse(r, &mut hit, |r, id| {
-            let t = tris[id].intersect(r);
-            if t > t_min {
-                t
-            } else {
-                f32::INFINITY
+            let (t, b) = intersect_triangle(&tris[id], r, t_min);
+            // obvhs keeps a hit exactly when it is nearer than the ray's current end.
+            if t < r.tmax {
+                barycentrics = b;
             }
+            t
         }) {
             return None;
         }
-        let slot = hit.primitive_id as usize;
-        // RtTriangle's (u, v) weight its second and third vertices.
-        let barycentrics = tris[slot].compute_barycentric(&r);
         Some(AccelHit {
             t: hit.t,
-            triangle: self.ids[slot],
+            triangle: self.ids[hit.primitive_id as usize],
             barycentrics,
         })
     }
@@ -171,15 +169,30 @@ impl Accel {
         };
         let tris = &self.tris;
         let t_min = self.t_min;
-        !bvh.ray_traverse_miss(r, |r, id| {
-            let t = tris[id].intersect(r);
-            if t > t_min {
-                t
-            } else {
-                f32::INFINITY
-            }
-        })
+        !bvh.ray_traverse_miss(r, |r, id| intersect_triangle(&tris[id], r, t_min).0)
     }
+}
+
+/// obvhs' `RtTriangle::intersect` (Möller-Trumbore, the same operations, so the same `t`),
+/// which also returns the barycentric weights `(u, v)` of the second and third vertices that
+/// it computes on the way; `t` is infinite for a miss or a hit at or before `t_min`.
+#[inline(always)]
+fn intersect_triangle(tri: &RtTriangle, ray: &BvhRay, t_min: f32) -> (f32, Vec2) {
+    let c = tri.v0 - ray.origin;
+    let r = ray.direction.cross(c);
+    let inv_det = 1.0 / tri.ng.dot(ray.direction);
+    let u = r.dot(tri.e2) * inv_det;
+    let v = r.dot(tri.e1) * inv_det;
+    let w = 1.0 - u - v;
+    // All three non-negative, -0.0 included as negative (as in obvhs).
+    let signs = u.to_bits() | v.to_bits() | w.to_bits();
+    if inv_det != 0.0 && signs & 0x8000_0000 == 0 {
+        let t = tri.ng.dot(c) * inv_det;
+        if t >= ray.tmin && t <= ray.tmax && t > t_min {
+            return (t, Vec2::new(u, v));
+        }
+    }
+    (f32::INFINITY, Vec2::ZERO)
 }
 
 /// obvhs' `medium_build` preset, which [`build_cwbvh`] follows step by step.
