@@ -156,34 +156,6 @@ impl Light {
     /// light cannot illuminate `p` (outside the cone or the range, back face, degenerate).
     pub fn sample_li(&self, scene: &Scene, p: Vec3, u: Vec2) -> Option<LightSample> {
         match *self {
-            Light::Point {
-                position,
-                intensity,
-                range,
-            } => punctual(p, position, intensity, range, 1.0),
-            Light::Spot {
-                position,
-                direction,
-                intensity,
-                cos_inner,
-                cos_outer,
-                range,
-            } => {
-                let cos_angle = direction.dot((p - position).normalize_or_zero());
-                let falloff = spot_falloff(cos_angle, cos_inner, cos_outer);
-                punctual(p, position, intensity, range, falloff)
-            }
-            Light::Directional {
-                direction,
-                irradiance,
-            } => Some(LightSample {
-                wi: -direction,
-                dist: f32::INFINITY,
-                li: irradiance,
-                pdf: 1.0,
-                delta: true,
-                visibility: Visibility::ShadowRay,
-            }),
             Light::Triangle { triangle } => {
                 let v = triangle_vertices(scene, triangle);
                 let (n, area) = scene.triangle_normal_area(triangle);
@@ -218,6 +190,44 @@ impl Light {
                     visibility: Visibility::ShadowRay,
                 })
             }
+            _ => self.sample_punctual(p),
+        }
+    }
+
+    /// [`Light::sample_li`] of a point, spot or directional light, which needs no random
+    /// numbers (the sample is the light's whole contribution); `None` for an emissive triangle.
+    #[inline]
+    pub fn sample_punctual(&self, p: Vec3) -> Option<LightSample> {
+        match *self {
+            Light::Point {
+                position,
+                intensity,
+                range,
+            } => punctual(p, position, intensity, range, 1.0),
+            Light::Spot {
+                position,
+                direction,
+                intensity,
+                cos_inner,
+                cos_outer,
+                range,
+            } => {
+                let cos_angle = direction.dot((p - position).normalize_or_zero());
+                let falloff = spot_falloff(cos_angle, cos_inner, cos_outer);
+                punctual(p, position, intensity, range, falloff)
+            }
+            Light::Directional {
+                direction,
+                irradiance,
+            } => Some(LightSample {
+                wi: -direction,
+                dist: f32::INFINITY,
+                li: irradiance,
+                pdf: 1.0,
+                delta: true,
+                visibility: Visibility::ShadowRay,
+            }),
+            Light::Triangle { .. } => None,
         }
     }
 
@@ -927,33 +937,25 @@ impl LightSampler {
         self.emitters.len()
     }
 
-    /// The irradiance-like weight `E_i` of emitter `e` at `p` (see [`LightSampler`]). Always
-    /// inlined: the per-point weights call it for every emitter.
+    /// The irradiance-like weight `E_i` of emitter `e` at `p` (see [`LightSampler`]) and,
+    /// when it is positive, the direction the BSDF weight looks in (toward a mesh's centre, a
+    /// point or spot light, or against a directional light's direction). Always inlined: the
+    /// per-point weights call it for every emitter.
     #[inline(always)]
-    fn irradiance(&self, scene: &Scene, e: usize, p: Vec3) -> f32 {
+    fn irradiance(&self, scene: &Scene, e: usize, p: Vec3) -> (f32, Vec3) {
         match &self.emitters[e] {
-            Emitter::Mesh(m) => m.irradiance(p),
-            Emitter::Punctual(i) => {
-                // A point sample of a punctual light is its irradiance at p.
-                match scene.lights[*i as usize].sample_li(scene, p, Vec2::ZERO) {
-                    Some(ls) => clean_power(luminance(ls.li)),
-                    None => 0.0,
+            Emitter::Mesh(m) => {
+                let e = m.irradiance(p);
+                if e > 0.0 {
+                    (e, (m.centre - p).normalize_or_zero())
+                } else {
+                    (0.0, Vec3::ZERO)
                 }
             }
-        }
-    }
-
-    /// The direction from `p` toward emitter `e` that the BSDF weight uses (toward its centre).
-    #[inline]
-    fn direction_to(&self, scene: &Scene, e: usize, p: Vec3) -> Vec3 {
-        match &self.emitters[e] {
-            Emitter::Mesh(m) => (m.centre - p).normalize_or_zero(),
-            Emitter::Punctual(i) => match scene.lights[*i as usize] {
-                Light::Directional { direction, .. } => -direction,
-                Light::Point { position, .. } | Light::Spot { position, .. } => {
-                    (position - p).normalize_or_zero()
-                }
-                Light::Triangle { .. } => Vec3::ZERO,
+            // A sample of a punctual light is its irradiance at p, and its direction.
+            Emitter::Punctual(i) => match scene.lights[*i as usize].sample_punctual(p) {
+                Some(ls) => (clean_power(luminance(ls.li)), ls.wi),
+                None => (0.0, Vec3::ZERO),
             },
         }
     }
@@ -976,14 +978,10 @@ impl LightSampler {
         let mut wi_local = [Vec3::ZERO; BRANCHING];
         for (c, child) in children.iter().enumerate() {
             let (e, wi) = match child {
-                Child::Emitter(i) => {
-                    let e = self.irradiance(scene, *i as usize, rx.p);
-                    if e > 0.0 {
-                        (e, self.direction_to(scene, *i as usize, rx.p))
-                    } else {
-                        continue;
-                    }
-                }
+                Child::Emitter(i) => match self.irradiance(scene, *i as usize, rx.p) {
+                    (e, wi) if e > 0.0 => (e, wi),
+                    _ => continue,
+                },
                 Child::Group(g) => {
                     let d2 = (g.centre - rx.p).length_squared().max(g.radius * g.radius);
                     let e = clean_power(g.power / (4.0 * PI * d2));
@@ -1674,7 +1672,7 @@ mod tests {
         let pmfs: Vec<f32> = (0..n_e).map(|e| ls.emitter_pmf(s, rx, e)).collect();
         assert!((pmfs.iter().sum::<f32>() - 1.0).abs() < 1e-5, "{pmfs:?}");
         for (e, pmf) in pmfs.iter().enumerate() {
-            assert_eq!(*pmf > 0.0, ls.irradiance(s, e, rx.p) > 0.0, "{e}");
+            assert_eq!(*pmf > 0.0, ls.irradiance(s, e, rx.p).0 > 0.0, "{e}");
         }
         let n = 40_000;
         let mut counts = vec![0usize; n_e];
