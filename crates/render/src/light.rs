@@ -196,7 +196,9 @@ impl Light {
 
     /// [`Light::sample_li`] of a point, spot or directional light, which needs no random
     /// numbers (the sample is the light's whole contribution); `None` for an emissive triangle.
-    #[inline]
+    /// Always inlined: the light choice's weights call it for every punctual emitter, and a
+    /// call returns the sample through memory, which stalls the luminance read after it.
+    #[inline(always)]
     pub fn sample_punctual(&self, p: Vec3) -> Option<LightSample> {
         match *self {
             Light::Point {
