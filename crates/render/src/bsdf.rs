@@ -27,8 +27,9 @@
 //! this file; [`crate::testing::check_bsdf`] checks a model for one `wo`.
 
 use crate::sampling::{luminance, square_to_cosine_hemisphere, square_to_cosine_hemisphere_pdf};
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 use std::f32::consts::{FRAC_1_PI, PI, TAU};
+use std::ops::{Add, Div, Mul, Neg};
 
 /// Which part of a model produced a sampled or evaluated contribution.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -184,8 +185,9 @@ fn glossy_probability(ks_luminance: f32, glossy_factor: f32, diffuse_weight: f32
 /// `2 / (1 + sqrt(1 + alpha^2 tan^2(theta_v)))`, 0 when `v` sees the back of the microfacet,
 /// which never happens for the half vector of two directions above the surface.)
 #[inline]
-fn ggx_g1_denominator(v: Vec3, a2: f32) -> f32 {
-    v.z + (v.z * v.z + a2 * (v.x * v.x + v.y * v.y)).sqrt()
+fn ggx_g1_denominator<L: Lanes>(v: [L; 3], a2: f32) -> L {
+    let [x, y, z] = v;
+    z + (z * z + (x * x + y * y) * a2).sqrt()
 }
 
 /// Samples a GGX visible normal for `wo` (density `D(h) G1(wo, h) max(0, wo.h) / wo.z`) by
@@ -214,13 +216,15 @@ fn sample_ggx_visible_normal(wo: Vec3, alpha: f32, u: Vec2) -> Option<Vec3> {
 /// is `alpha^2 |h|^4 / (pi q^2)`, so the lobe is `alpha^2 |h|^4 / (pi q^2 go gi)`: one division
 /// and one square root besides `go`. (Mitsuba also cuts `D` to 0 below 1e-20; that is not
 /// done here.)
+/// Generic in [`Lanes`] for the light choice; the operations are those of the scalar formula
+/// above, in its order, so every lane gives the scalar result bit for bit.
 #[inline]
-fn ggx_spec(wo: Vec3, wi: Vec3, a2: f32, go: f32) -> (f32, f32) {
-    let h = wo + wi;
-    let h2 = h.length_squared();
-    let q = h.x * h.x + h.y * h.y + a2 * h.z * h.z;
+fn ggx_spec<L: Lanes>(wo: Vec3, wi: [L; 3], a2: f32, go: f32) -> (L, L) {
+    let [hx, hy, hz] = [wi[0] + wo.x, wi[1] + wo.y, wi[2] + wo.z];
+    let h2 = hx * hx + hy * hy + hz * hz;
+    let q = hx * hx + hy * hy + hz * a2 * hz;
     let gi = ggx_g1_denominator(wi, a2);
-    (a2 * h2 * h2 / (PI * q * q * go * gi), gi)
+    (h2 * a2 * h2 / (q * PI * q * go * gi), gi)
 }
 
 /// [`ggx_spec`] and the solid-angle density of `wi` when the lobe samples visible normals,
@@ -229,7 +233,7 @@ fn ggx_spec(wo: Vec3, wi: Vec3, a2: f32, go: f32) -> (f32, f32) {
 #[inline]
 fn ggx_spec_pdf(wo: Vec3, wi: Vec3, alpha: f32) -> (f32, f32) {
     let a2 = alpha * alpha;
-    let (spec, gi) = ggx_spec(wo, wi, a2, ggx_g1_denominator(wo, a2));
+    let (spec, gi) = ggx_spec(wo, wi.to_array(), a2, ggx_g1_denominator(wo.to_array(), a2));
     (spec, 0.5 * spec * gi)
 }
 
@@ -257,6 +261,121 @@ fn mixture_pdf(wi: Vec3, glossy_pdf: f32, p_glossy: f32) -> f32 {
         pdf += p_glossy * glossy_pdf;
     }
     pdf
+}
+
+/// A number, or four of them in SIMD lanes: [`LuminanceEval`]'s lobes and the GGX terms are
+/// written once for both, and the light choice evaluates four emitters at a time. Every
+/// operation is the IEEE one in each lane, so a lane holds exactly the scalar result.
+pub(crate) trait Lanes:
+    Copy
+    + Add<Output = Self>
+    + Add<f32, Output = Self>
+    + Mul<Output = Self>
+    + Mul<f32, Output = Self>
+    + Div<Output = Self>
+    + Div<f32, Output = Self>
+    + Neg<Output = Self>
+{
+    /// The same value in every lane.
+    fn splat(x: f32) -> Self;
+    /// Square root.
+    fn sqrt(self) -> Self;
+    /// Absolute value.
+    fn abs(self) -> Self;
+    /// `e^self`.
+    fn exp(self) -> Self;
+    /// `self^e`.
+    fn powf(self, e: f32) -> Self;
+    /// `self^5`, as `f32::powi(self, 5)` computes it.
+    fn pow5(self) -> Self;
+    /// `1 - self`.
+    fn one_minus(self) -> Self;
+    /// Clamped to `[0, 1]`.
+    fn saturate(self) -> Self;
+    /// `self` where `z > 0`, else 0.
+    fn where_positive(self, z: Self) -> Self;
+}
+
+impl Lanes for f32 {
+    #[inline(always)]
+    fn splat(x: f32) -> Self {
+        x
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        f32::sqrt(self)
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        f32::abs(self)
+    }
+    #[inline(always)]
+    fn exp(self) -> Self {
+        f32::exp(self)
+    }
+    #[inline(always)]
+    fn powf(self, e: f32) -> Self {
+        f32::powf(self, e)
+    }
+    #[inline(always)]
+    fn pow5(self) -> Self {
+        self.powi(5)
+    }
+    #[inline(always)]
+    fn one_minus(self) -> Self {
+        1.0 - self
+    }
+    #[inline(always)]
+    fn saturate(self) -> Self {
+        self.clamp(0.0, 1.0)
+    }
+    #[inline(always)]
+    fn where_positive(self, z: Self) -> Self {
+        if z > 0.0 {
+            self
+        } else {
+            0.0
+        }
+    }
+}
+
+impl Lanes for Vec4 {
+    #[inline(always)]
+    fn splat(x: f32) -> Self {
+        Vec4::splat(x)
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        Vec4::sqrt(self)
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        Vec4::abs(self)
+    }
+    #[inline(always)]
+    fn exp(self) -> Self {
+        Vec4::from_array(self.to_array().map(f32::exp))
+    }
+    #[inline(always)]
+    fn powf(self, e: f32) -> Self {
+        Vec4::from_array(self.to_array().map(|x| x.powf(e)))
+    }
+    #[inline(always)]
+    fn pow5(self) -> Self {
+        Vec4::from_array(self.to_array().map(|x| x.powi(5)))
+    }
+    #[inline(always)]
+    fn one_minus(self) -> Self {
+        1.0 - self
+    }
+    #[inline(always)]
+    fn saturate(self) -> Self {
+        self.clamp(Vec4::ZERO, Vec4::ONE)
+    }
+    #[inline(always)]
+    fn where_positive(self, z: Self) -> Self {
+        Vec4::select(z.cmpgt(Vec4::ZERO), self, Vec4::ZERO)
+    }
 }
 
 /// Hemisphere check shared by every model.
@@ -568,8 +687,8 @@ impl Bsdf {
 /// `luminance(f(wo, wi))` for one `wo` and many `wi`: the light choice's per-emitter BSDF
 /// weight, a dozen evaluations per path vertex. What depends on `wo` alone (the lobes'
 /// luminances, GGX's masking term of `wo`) is computed once by [`Bsdf::luminance_at`];
-/// each [`LuminanceEval::eval`] then costs a half vector and the lobe's own terms, in scalars,
-/// and [`LuminanceEval::eval_all`] evaluates many directions in one loop.
+/// each [`LuminanceEval::eval`] then costs a half vector and the lobe's own terms, and
+/// [`LuminanceEval::eval4`] evaluates four directions at once in SIMD lanes.
 /// Equal to `luminance(bsdf.eval(wo, wi))` up to rounding (tested).
 #[derive(Clone, Copy, Debug)]
 pub struct LuminanceEval {
@@ -610,48 +729,49 @@ impl LuminanceEval {
     /// `luminance(f(wo, wi))`; zero when either direction is below the surface.
     #[inline]
     pub fn eval(&self, wi: Vec3) -> f32 {
-        let mut f = [0.0];
-        self.eval_all(&[wi], &mut f);
-        f[0]
+        self.eval_lanes(wi.to_array())
     }
 
-    /// [`LuminanceEval::eval`] of each of `wi` into `f` (of the same length): the lobe is
-    /// matched once, so the evaluations run as one straight loop whose iterations overlap.
+    /// [`LuminanceEval::eval`] of four directions at once, given as their x, y and z lanes.
     #[inline]
-    pub fn eval_all(&self, wi: &[Vec3], f: &mut [f32]) {
-        debug_assert_eq!(wi.len(), f.len());
-        #[inline(always)]
-        fn each(wo: Vec3, wi: &[Vec3], f: &mut [f32], lobe: impl Fn(Vec3) -> f32) {
-            for (f, &wi) in f.iter_mut().zip(wi) {
-                *f = if above(wo, wi) { lobe(wi) } else { 0.0 };
-            }
-        }
+    pub fn eval4(&self, wi: [Vec4; 3]) -> Vec4 {
+        self.eval_lanes(wi)
+    }
+
+    #[inline(always)]
+    fn eval_lanes<L: Lanes>(&self, wi: [L; 3]) -> L {
         let (wo, diffuse, glossy) = (self.wo, self.diffuse, self.glossy);
-        match self.lobe {
-            LuminanceLobe::None => each(wo, wi, f, |_| diffuse),
-            LuminanceLobe::Ggx { a2, go } => each(wo, wi, f, |wi| {
-                diffuse + glossy * ggx_spec(wo, wi, a2, go).0
-            }),
-            LuminanceLobe::GltfGgx { a2, go } => each(wo, wi, f, |wi| {
+        if !above(wo, Vec3::Z) {
+            return L::splat(0.0);
+        }
+        // The half vector normalised as `Vec3::normalize` does it.
+        let half = || {
+            let h = [wi[0] + wo.x, wi[1] + wo.y, wi[2] + wo.z];
+            let r = L::splat(1.0) / (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]).sqrt();
+            h.map(|c| c * r)
+        };
+        let f = match self.lobe {
+            LuminanceLobe::None => L::splat(diffuse),
+            LuminanceLobe::Ggx { a2, go } => ggx_spec(wo, wi, a2, go).0 * glossy + diffuse,
+            LuminanceLobe::GltfGgx { a2, go } => {
                 let spec = ggx_spec(wo, wi, a2, go).0;
-                let h = half_vector(wo, wi);
+                let h = half();
                 // F = F0 + (1 - F0) s, so luminance(F) = L(F0) + (1 - L(F0)) s, and
                 // 1 - F = (1 - F0)(1 - s) scales the diffuse lobe by (1 - s).
-                let s = (1.0 - wo.dot(h).abs()).clamp(0.0, 1.0).powi(5);
-                diffuse * (1.0 - s) + (glossy + (1.0 - glossy) * s) * spec
-            }),
-            LuminanceLobe::Ward { a2 } => each(wo, wi, f, |wi| {
+                let cos = h[0] * wo.x + h[1] * wo.y + h[2] * wo.z;
+                let s = cos.abs().one_minus().saturate().pow5();
+                s.one_minus() * diffuse + (s * (1.0 - glossy) + glossy) * spec
+            }
+            LuminanceLobe::Ward { a2 } => {
                 // tan^2 of the half vector's angle, from the unnormalised wo + wi.
-                let h = wo + wi;
-                let tan2 = (h.x * h.x + h.y * h.y) / (h.z * h.z);
+                let [hx, hy, hz] = [wi[0] + wo.x, wi[1] + wo.y, wi[2] + wo.z];
+                let tan2 = (hx * hx + hy * hy) / (hz * hz);
                 let gauss = (-tan2 / a2).exp() / (PI * a2);
-                diffuse + glossy * (gauss / (4.0 * (wo.z * wi.z).sqrt()))
-            }),
-            LuminanceLobe::BlinnPhong { s, norm } => each(wo, wi, f, |wi| {
-                let h = half_vector(wo, wi);
-                diffuse + glossy * (norm * h.z.powf(s))
-            }),
-        }
+                (gauss / ((wi[2] * wo.z).sqrt() * 4.0)) * glossy + diffuse
+            }
+            LuminanceLobe::BlinnPhong { s, norm } => half()[2].powf(s) * norm * glossy + diffuse,
+        };
+        f.where_positive(wi[2])
     }
 }
 
@@ -662,7 +782,7 @@ impl Bsdf {
     pub fn luminance_at(&self, wo: Vec3) -> LuminanceEval {
         let ggx = |alpha: f32| {
             let a2 = alpha * alpha;
-            (a2, ggx_g1_denominator(wo, a2))
+            (a2, ggx_g1_denominator(wo.to_array(), a2))
         };
         let (diffuse, glossy, lobe) = match self {
             Bsdf::Diffuse(m) => (luminance(m.kd), 0.0, LuminanceLobe::None),
@@ -975,6 +1095,33 @@ mod identity_tests {
                     (got - want).abs() <= 1e-5 * want.abs().max(1e-3),
                     "{b:?} {wo} {wi}: {got} vs {want}"
                 );
+            }
+        }
+    }
+
+    /// Four directions in SIMD lanes give exactly the four scalar values, below the surface
+    /// included, for every model.
+    #[test]
+    fn luminance_eval_lanes_are_the_scalar_values() {
+        let mut rng = Pcg32::new(12, 5);
+        for b in all_models() {
+            for _ in 0..500 {
+                let wo = random_dir(&mut rng);
+                let f = b.luminance_at(wo);
+                let wi: [Vec3; 4] = std::array::from_fn(|_| {
+                    let w = random_dir(&mut rng);
+                    // Some below the surface.
+                    if rng.next_f32() < 0.2 {
+                        -w
+                    } else {
+                        w
+                    }
+                });
+                let lanes = [0, 1, 2].map(|k| Vec4::from_array(wi.map(|w| w.to_array()[k])));
+                let got = f.eval4(lanes).to_array();
+                for (w, g) in wi.iter().zip(got) {
+                    assert_eq!(g.to_bits(), f.eval(*w).to_bits(), "{b:?} {wo} {w}");
+                }
             }
         }
     }

@@ -33,7 +33,7 @@ use crate::sampling::{
     DiscreteDistribution, ONE_MINUS_EPSILON,
 };
 use crate::scene::{Scene, SurfaceHit};
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 use std::collections::HashMap;
 use std::f32::consts::PI;
 
@@ -965,7 +965,8 @@ impl LightSampler {
     /// The per-point weights `E_c` and `E_c F_c` of every child of `node`, with their sums
     /// (see [`LightSampler`]). `F_c` is the luminance of the BSDF times the cosine toward the
     /// child (0 below the shading or the geometric surface). First every child's `E_c` and
-    /// direction, then all the BSDF values in one [`LuminanceEval::eval_all`].
+    /// direction, then the directions' normalisation, shading-frame coordinates and BSDF
+    /// values four children at a time in SIMD lanes ([`LuminanceEval::eval4`]).
     #[inline]
     fn weights(
         &self,
@@ -976,35 +977,48 @@ impl LightSampler {
     ) -> ([f32; BRANCHING], [f32; BRANCHING], f32, f32) {
         let children = &self.nodes[node].children;
         let mut e_w = [0.0f32; BRANCHING];
-        // Zero (below the surface, so F = 0) unless the child is lit and in front.
-        let mut wi_local = [Vec3::ZERO; BRANCHING];
+        // The directions toward the children (not normalised), by coordinate; zero (so no
+        // BSDF weight) unless the child lights the point.
+        let mut dir = [[0.0f32; BRANCHING]; 3];
         for (c, child) in children.iter().enumerate() {
-            let (e, wi) = match child {
+            let (e, d) = match child {
                 Child::Emitter(i) => match self.irradiance(scene, *i as usize, rx.p) {
                     (e, wi) if e > 0.0 => (e, wi),
                     _ => continue,
                 },
                 Child::Group(g) => {
                     let d2 = (g.centre - rx.p).length_squared().max(g.radius * g.radius);
-                    let e = clean_power(g.power / (4.0 * PI * d2));
-                    (e, (g.anchor - rx.p).normalize_or_zero())
+                    (clean_power(g.power / (4.0 * PI * d2)), g.anchor - rx.p)
                 }
             };
             e_w[c] = e;
-            let local = rx.frame.to_local(wi);
-            if local.z > 0.0 && rx.ng.dot(wi) > 0.0 {
-                wi_local[c] = local;
-            }
+            [dir[0][c], dir[1][c], dir[2][c]] = d.to_array();
         }
         let n = children.len();
         let mut f_w = [0.0f32; BRANCHING];
-        f.eval_all(&wi_local[..n], &mut f_w[..n]);
+        let mut cos_w = [0.0f32; BRANCHING];
+        let (frame, ng) = (&rx.frame, rx.ng);
+        for k in (0..n).step_by(4) {
+            let [x, y, z] = dir.map(|d| Vec4::from_slice(&d[k..k + 4]));
+            // `normalize_or_zero`, lane by lane.
+            let r = Vec4::ONE / (x * x + y * y + z * z).sqrt();
+            let r = Vec4::select(r.is_finite_mask() & r.cmpgt(Vec4::ZERO), r, Vec4::ZERO);
+            let [x, y, z] = [x * r, y * r, z * r];
+            // `Frame::to_local` and the geometric normal's side.
+            let dot = |v: Vec3| x * v.x + y * v.y + z * v.z;
+            let local = [dot(frame.s), dot(frame.t), dot(frame.n)];
+            let lit = dot(ng).cmpgt(Vec4::ZERO) & local[2].cmpgt(Vec4::ZERO);
+            let cos = Vec4::select(lit, local[2], Vec4::ZERO);
+            f.eval4([local[0], local[1], cos])
+                .write_to_slice(&mut f_w[k..k + 4]);
+            cos.write_to_slice(&mut cos_w[k..k + 4]);
+        }
         let mut ef_w = [0.0f32; BRANCHING];
         let (mut e_sum, mut ef_sum) = (0.0f32, 0.0f32);
         for c in 0..n {
             let e = e_w[c];
             if e > 0.0 {
-                let ef = e * clean_power(f_w[c] * wi_local[c].z);
+                let ef = e * clean_power(f_w[c] * cos_w[c]);
                 ef_w[c] = ef;
                 e_sum += e;
                 ef_sum += ef;
