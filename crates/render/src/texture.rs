@@ -154,10 +154,8 @@ impl Texture {
         let y = v * self.height as f32 - 0.5;
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
-        let (x0, y0) = (x0 as i64, y0 as i64);
-        let (w, h) = (i64::from(self.width), i64::from(self.height));
-        let (xa, xb) = (x0.rem_euclid(w) as usize, (x0 + 1).rem_euclid(w) as usize);
-        let (ya, yb) = (y0.rem_euclid(h) as usize, (y0 + 1).rem_euclid(h) as usize);
+        let (xa, xb) = wrap_pair(x0, self.width);
+        let (ya, yb) = wrap_pair(y0, self.height);
         let row = self.width as usize;
         let [i00, i10, i01, i11] = [ya * row + xa, ya * row + xb, yb * row + xa, yb * row + xb];
         let [c00, c10, c01, c11] = match &self.texels {
@@ -172,6 +170,18 @@ impl Texture {
         };
         c00.lerp(c10, fx).lerp(c01.lerp(c11, fx), fy)
     }
+}
+
+/// The texel indices of `x0` and `x0 + 1` on an axis of `n` texels, repeated: `x0` is the
+/// floor of `u n - 0.5` for `u` in `[0, 1]`, so it lies in `[-1, n - 1]` and one comparison
+/// per end wraps it (what `rem_euclid` would give, without its two divisions).
+#[inline]
+fn wrap_pair(x0: f32, n: u32) -> (usize, usize) {
+    let (x0, n) = (x0 as i64, i64::from(n));
+    debug_assert!((-1..n).contains(&x0), "{x0} outside [-1, {n})");
+    let a = if x0 < 0 { n - 1 } else { x0.min(n - 1) };
+    let b = if x0 + 1 >= n { 0 } else { (x0 + 1).max(0) };
+    (a as usize, b as usize)
 }
 
 /// One 8-bit texel's linear value: RGB through `rgb`, alpha through `alpha`.
@@ -194,6 +204,35 @@ mod tests {
         let b = Vec4::new(0.0, 0.0, 0.0, 1.0);
         let w = Vec4::ONE;
         Texture::from_rgba(2, 2, vec![b, w, w, b], ColorSpace::Linear).unwrap()
+    }
+
+    /// The comparison wrap is `rem_euclid` over the floors a `uv` in one period gives, and
+    /// uvs at the ends of a period (including those that round to 1) stay in range.
+    #[test]
+    fn wrapping_is_rem_euclid() {
+        for n in [1u32, 2, 3, 256] {
+            for x0 in -1..n as i64 {
+                let want = (
+                    x0.rem_euclid(i64::from(n)) as usize,
+                    (x0 + 1).rem_euclid(i64::from(n)) as usize,
+                );
+                assert_eq!(wrap_pair(x0 as f32, n), want, "{x0} of {n}");
+            }
+        }
+        let t = checker();
+        for u in [
+            -1e-10f32,
+            -0.0,
+            0.0,
+            1e-10,
+            0.999_999_94,
+            1.0 - 1e-10,
+            3.0,
+            -7.5,
+        ] {
+            let c = t.sample(Vec2::new(u, 0.25));
+            assert!((0.0..=1.0).contains(&c.x), "{u}: {c}");
+        }
     }
 
     #[test]
