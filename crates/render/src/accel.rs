@@ -208,6 +208,7 @@ const REINSERTION_BUDGET: f32 = 50_000.0;
 fn reinsertion_ratio(triangles: usize) -> f32 {
     (REINSERTION_BUDGET / triangles.max(1) as f32).clamp(BUILD_PARAMS.reinsertion_batch_ratio, 1.0)
 }
+
 /// The PLOC search distance of `BUILD_PARAMS` (`PlocSearchDistance::Medium` is 14 in obvhs
 /// 0.4), a const generic of `build_ploc_from_leaves`.
 const PLOC_SEARCH_DISTANCE: usize = 14;

@@ -34,7 +34,7 @@ use crate::sampling::{
 };
 use crate::scene::{Scene, SurfaceHit};
 use glam::{Vec2, Vec3, Vec4};
-use std::collections::HashMap;
+use std::collections::{HashMap, VecDeque};
 use std::f32::consts::PI;
 
 /// A light source.
@@ -575,14 +575,11 @@ fn emitter_info(scene: &Scene, emitters: &[Emitter]) -> Vec<(Option<Vec3>, f32, 
 fn build_light_tree(info: &[(Option<Vec3>, f32, f32)]) -> (Vec<Node>, Vec<(u32, u32)>) {
     let mut nodes: Vec<Node> = Vec::new();
     let mut slot_of = vec![(0u32, 0u32); info.len()];
-    let mut pending = vec![(None, (0..info.len() as u32).collect::<Vec<u32>>())];
-    while let Some((parent, members)) = pending.pop() {
+    // Breadth first: the nodes are made in the order their groups are queued, so a group's
+    // node index is known when it is queued.
+    let mut queue = VecDeque::from([(None, (0..info.len() as u32).collect::<Vec<u32>>())]);
+    while let Some((parent, members)) = queue.pop_front() {
         let index = nodes.len() as u32;
-        if let Some((node, slot)) = parent {
-            if let Child::Group(g) = &mut nodes[node as usize].children[slot as usize] {
-                g.node = index;
-            }
-        }
         let groups = if members.len() <= BRANCHING {
             members.iter().map(|&e| vec![e]).collect()
         } else {
@@ -595,8 +592,9 @@ fn build_light_tree(info: &[(Option<Vec3>, f32, f32)]) -> (Vec<Node>, Vec<(u32, 
                 slot_of[e as usize] = (index, slot);
                 children.push(Child::Emitter(e));
             } else {
-                children.push(Child::Group(group_bounds(info, &group)));
-                pending.push((Some((index, slot)), group));
+                let node = index + queue.len() as u32 + 1;
+                children.push(Child::Group(group_bounds(info, &group, node)));
+                queue.push_back((Some((index, slot)), group));
             }
         }
         nodes.push(Node { children, parent });
@@ -604,8 +602,8 @@ fn build_light_tree(info: &[(Option<Vec3>, f32, f32)]) -> (Vec<Node>, Vec<(u32, 
     (nodes, slot_of)
 }
 
-/// The bounds of a group of emitters (its `node` is filled in when the node is made).
-fn group_bounds(info: &[(Option<Vec3>, f32, f32)], members: &[u32]) -> Group {
+/// The bounds of a group of emitters, whose children are node `node`.
+fn group_bounds(info: &[(Option<Vec3>, f32, f32)], members: &[u32], node: u32) -> Group {
     let spheres: Vec<(Vec3, f32)> = members
         .iter()
         .filter_map(|&e| info[e as usize].0.map(|p| (p, info[e as usize].1)))
@@ -630,7 +628,7 @@ fn group_bounds(info: &[(Option<Vec3>, f32, f32)], members: &[u32]) -> Group {
         .max_by(|a, b| a.1.total_cmp(&b.1))
         .map_or(centre, |(p, _)| p);
     Group {
-        node: u32::MAX,
+        node,
         centre,
         radius,
         power,
