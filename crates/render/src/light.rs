@@ -1020,8 +1020,6 @@ impl LightSampler {
                 ef_w[c] = ef;
                 e_sum += e;
                 ef_sum += ef;
-            } else {
-                e_w[c] = 0.0;
             }
         }
         (e_w, ef_w, e_sum, ef_sum)
