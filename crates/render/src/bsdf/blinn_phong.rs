@@ -3,7 +3,7 @@
 
 use super::diffuse::lambert;
 use super::lanes::{Lanes, Spectrum};
-use super::{glossy_probability, half_vector, reflect, Lobes, Model};
+use super::{glossy_probability, half_vector, reflect_about_half, Lobes, Model};
 use crate::sampling::luminance;
 use glam::{Vec2, Vec3};
 use std::f32::consts::{PI, TAU};
@@ -66,9 +66,7 @@ impl Model for BlinnPhong {
     fn sample_glossy(&self, wo: Vec3, u: Vec2) -> Option<Vec3> {
         let cos_t = (1.0 - u.x).powf(1.0 / (self.shininess() + 1.0));
         let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
-        let (s, c) = (TAU * u.y).sin_cos();
-        let h = Vec3::new(sin_t * c, sin_t * s, cos_t);
-        (wo.dot(h) > 0.0).then(|| reflect(wo, h))
+        reflect_about_half(wo, cos_t, sin_t, u.y)
     }
 
     #[inline]

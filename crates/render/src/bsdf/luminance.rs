@@ -32,11 +32,12 @@ impl LuminanceEval {
 
     #[inline(always)]
     fn eval_lanes<L: Lanes>(&self, wi: [L; 3]) -> L {
-        if self.wo.z <= 0.0 {
-            return L::splat(0.0);
+        if self.wo.z > 0.0 {
+            let lobes: Lobes<L, L> = self.bsdf.lobes(self.wo, wi);
+            (lobes.diffuse + lobes.glossy).where_positive(wi[2])
+        } else {
+            L::splat(0.0)
         }
-        let lobes: Lobes<L, L> = self.bsdf.lobes(self.wo, wi);
-        (lobes.diffuse + lobes.glossy).where_positive(wi[2])
     }
 }
 

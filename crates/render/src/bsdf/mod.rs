@@ -27,8 +27,9 @@
 //!
 //! - this file: [`Bsdf`] and its dispatch, the `Model` trait every model implements (its lobes,
 //!   its lobe-choice probability, the sampling of its glossy lobe, its albedo), [`Lobe`],
-//!   [`LobeValues`], [`BsdfSample`], [`MIN_ALPHA`], and the lobe mixture (the glossy-lobe
-//!   probability and the mixture density);
+//!   [`LobeValues`], [`BsdfSample`], [`MIN_ALPHA`], the direction helpers the models share
+//!   (reflection, half vector), and the lobe mixture (the glossy-lobe probability and the
+//!   mixture density);
 //! - `lanes.rs`: the number types every lobe is written in, a scalar or four SIMD lanes
 //!   (`Lanes`) and a reflectance as RGB or as its luminance (`Spectrum`);
 //! - `diffuse.rs`: the Lambertian lobe and [`Diffuse`];
@@ -63,6 +64,7 @@ pub use ward::Ward;
 use crate::sampling::{square_to_cosine_hemisphere, square_to_cosine_hemisphere_pdf};
 use glam::{Vec2, Vec3};
 use lanes::{Lanes, Spectrum};
+use std::f32::consts::TAU;
 
 /// Which part of a model produced a sampled or evaluated contribution.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -162,6 +164,15 @@ trait Model {
 #[inline]
 fn reflect(wo: Vec3, h: Vec3) -> Vec3 {
     2.0 * wo.dot(h) * h - wo
+}
+
+/// `wo` mirrored about the half vector of polar angle `(cos_h, sin_h)` and azimuth
+/// `2 pi u_phi`, for a glossy lobe that samples half vectors; `None` when `wo` is behind it.
+#[inline]
+fn reflect_about_half(wo: Vec3, cos_h: f32, sin_h: f32, u_phi: f32) -> Option<Vec3> {
+    let (s, c) = (TAU * u_phi).sin_cos();
+    let h = Vec3::new(sin_h * c, sin_h * s, cos_h);
+    (wo.dot(h) > 0.0).then(|| reflect(wo, h))
 }
 
 /// The half vector `(wo + wi).normalize()` of two directions above the surface, in lanes, with

@@ -3,10 +3,10 @@
 
 use super::diffuse::lambert;
 use super::lanes::{Lanes, Spectrum};
-use super::{glossy_probability, reflect, Lobes, Model, MIN_ALPHA};
+use super::{glossy_probability, reflect_about_half, Lobes, Model, MIN_ALPHA};
 use crate::sampling::luminance;
 use glam::{Vec2, Vec3};
-use std::f32::consts::{PI, TAU};
+use std::f32::consts::PI;
 
 /// The paper's isotropic Ward model:
 /// `f = kd/pi + ks exp(-tan^2(delta)/alpha^2) / (4 pi alpha^2 sqrt(cos_i cos_o))`.
@@ -74,9 +74,7 @@ impl Model for Ward {
         let tan2 = -self.alpha() * self.alpha() * (1.0 - u.x).ln();
         let cos_d = 1.0 / (1.0 + tan2).sqrt();
         let sin_d = (tan2 * cos_d * cos_d).sqrt();
-        let (s, c) = (TAU * u.y).sin_cos();
-        let h = Vec3::new(sin_d * c, sin_d * s, cos_d);
-        (wo.dot(h) > 0.0).then(|| reflect(wo, h))
+        reflect_about_half(wo, cos_d, sin_d, u.y)
     }
 
     #[inline]
