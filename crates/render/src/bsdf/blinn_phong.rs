@@ -3,7 +3,7 @@
 
 use super::diffuse::lambert;
 use super::lanes::{Lanes, Spectrum};
-use super::{glossy_probability, half_vector, reflect_about_half, Lobes, Model};
+use super::{glossy_probability, half_vector, reflect_about_half, Lobes, Model, Reflectances};
 use crate::sampling::luminance;
 use glam::{Vec2, Vec3};
 use std::f32::consts::{PI, TAU};
@@ -42,12 +42,25 @@ fn lobe<L: Lanes>(wo: Vec3, wi: [L; 3], s: f32) -> (L, L) {
 }
 
 impl Model for BlinnPhong {
+    #[inline]
+    fn reflectances(&self) -> Reflectances<Vec3> {
+        Reflectances {
+            diffuse: self.kd,
+            glossy: self.ks,
+        }
+    }
+
     #[inline(always)]
-    fn lobes<L: Lanes, S: Spectrum<L>>(&self, wo: Vec3, wi: [L; 3]) -> Lobes<S, L> {
+    fn lobes<L: Lanes, S: Spectrum<L>>(
+        &self,
+        r: Reflectances<S>,
+        wo: Vec3,
+        wi: [L; 3],
+    ) -> Lobes<S, L> {
         let (f, pdf) = lobe(wo, wi, self.shininess());
         Lobes {
-            diffuse: lambert(self.kd),
-            glossy: S::from_rgb(self.ks) * f,
+            diffuse: lambert(r.diffuse),
+            glossy: r.glossy * f,
             glossy_pdf: pdf,
         }
     }

@@ -2,7 +2,7 @@
 //! only that, [`Diffuse`]. (The lobe mixture in the parent module samples it cosine-weighted.)
 
 use super::lanes::{Lanes, Spectrum};
-use super::{Lobes, Model};
+use super::{Lobes, Model, Reflectances};
 use glam::{Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;
 
@@ -15,16 +15,29 @@ pub struct Diffuse {
 
 /// The Lambertian lobe of reflectance `kd`: `kd / pi`.
 #[inline(always)]
-pub(super) fn lambert<L: Lanes, S: Spectrum<L>>(kd: Vec3) -> S {
-    S::from_rgb(kd) * FRAC_1_PI
+pub(super) fn lambert<L: Lanes, S: Spectrum<L>>(kd: S) -> S {
+    kd * FRAC_1_PI
 }
 
 impl Model for Diffuse {
+    #[inline]
+    fn reflectances(&self) -> Reflectances<Vec3> {
+        Reflectances {
+            diffuse: self.kd,
+            glossy: Vec3::ZERO,
+        }
+    }
+
     #[inline(always)]
-    fn lobes<L: Lanes, S: Spectrum<L>>(&self, _wo: Vec3, _wi: [L; 3]) -> Lobes<S, L> {
+    fn lobes<L: Lanes, S: Spectrum<L>>(
+        &self,
+        r: Reflectances<S>,
+        _wo: Vec3,
+        _wi: [L; 3],
+    ) -> Lobes<S, L> {
         Lobes {
-            diffuse: lambert(self.kd),
-            glossy: S::from_rgb(Vec3::ZERO),
+            diffuse: lambert(r.diffuse),
+            glossy: r.glossy,
             glossy_pdf: L::splat(0.0),
         }
     }

@@ -4,7 +4,7 @@
 
 use super::diffuse::lambert;
 use super::lanes::{Lanes, Spectrum};
-use super::{glossy_probability, reflect, Lobes, Model, MIN_ALPHA};
+use super::{glossy_probability, reflect, Lobes, Model, Reflectances, MIN_ALPHA};
 use crate::sampling::luminance;
 use glam::{Vec2, Vec3};
 use std::f32::consts::{PI, TAU};
@@ -30,12 +30,25 @@ impl Ggx {
 }
 
 impl Model for Ggx {
+    #[inline]
+    fn reflectances(&self) -> Reflectances<Vec3> {
+        Reflectances {
+            diffuse: self.kd,
+            glossy: self.ks,
+        }
+    }
+
     #[inline(always)]
-    fn lobes<L: Lanes, S: Spectrum<L>>(&self, wo: Vec3, wi: [L; 3]) -> Lobes<S, L> {
+    fn lobes<L: Lanes, S: Spectrum<L>>(
+        &self,
+        r: Reflectances<S>,
+        wo: Vec3,
+        wi: [L; 3],
+    ) -> Lobes<S, L> {
         let (spec, pdf) = microfacet(wo, wi, self.alpha());
         Lobes {
-            diffuse: lambert(self.kd),
-            glossy: S::from_rgb(self.ks) * spec,
+            diffuse: lambert(r.diffuse),
+            glossy: r.glossy * spec,
             glossy_pdf: pdf,
         }
     }

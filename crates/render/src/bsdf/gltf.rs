@@ -4,7 +4,7 @@
 use super::diffuse::lambert;
 use super::ggx;
 use super::lanes::{Lanes, Spectrum};
-use super::{glossy_probability, half_vector, reflect, Lobes, Model, MIN_ALPHA};
+use super::{glossy_probability, half_vector, reflect, Lobes, Model, Reflectances, MIN_ALPHA};
 use crate::sampling::luminance;
 use glam::{Vec2, Vec3};
 
@@ -58,19 +58,31 @@ fn schlick<L: Lanes, S: Spectrum<L>>(f0: S, s: L) -> S {
 }
 
 impl Model for GltfPbr {
-    /// With `1 - F = (1 - F0)(1 - s)`, the diffuse lobe is the Lambertian lobe of
-    /// `(1 - F0) c_diff` times `1 - s`: its colour stays a constant, so the luminance of the
-    /// lobes is that of their constant colours (as the other models'), and `s` a lane term.
+    /// `(1 - F0) c_diff` and `F0`: with `1 - F = (1 - F0)(1 - s)`, the diffuse lobe is the
+    /// Lambertian lobe of `(1 - F0) c_diff` times the lane term `1 - s`, and the glossy lobe
+    /// `F0 + (1 - F0) s` times the microfacet lobe.
+    #[inline]
+    fn reflectances(&self) -> Reflectances<Vec3> {
+        let f0 = self.f0();
+        Reflectances {
+            diffuse: (Vec3::ONE - f0) * self.diffuse_color(),
+            glossy: f0,
+        }
+    }
+
     #[inline(always)]
-    fn lobes<L: Lanes, S: Spectrum<L>>(&self, wo: Vec3, wi: [L; 3]) -> Lobes<S, L> {
+    fn lobes<L: Lanes, S: Spectrum<L>>(
+        &self,
+        r: Reflectances<S>,
+        wo: Vec3,
+        wi: [L; 3],
+    ) -> Lobes<S, L> {
         let (spec, pdf) = ggx::microfacet(wo, wi, self.alpha());
         let h = half_vector(wo, wi);
         let s = schlick_weight(h[0] * wo.x + h[1] * wo.y + h[2] * wo.z);
-        let f0 = self.f0();
-        let diffuse: S = lambert((Vec3::ONE - f0) * self.diffuse_color());
         Lobes {
-            diffuse: diffuse * s.one_minus(),
-            glossy: schlick(S::from_rgb(f0), s) * spec,
+            diffuse: lambert(r.diffuse) * s.one_minus(),
+            glossy: schlick(r.glossy, s) * spec,
             glossy_pdf: pdf,
         }
     }

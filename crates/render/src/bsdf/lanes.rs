@@ -6,7 +6,6 @@
 //!
 //! Every operation is the IEEE one in each lane, so a lane holds exactly the scalar result.
 
-use crate::sampling::luminance;
 use glam::{Vec3, Vec4};
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
@@ -116,23 +115,17 @@ impl Lanes for Vec4 {
 }
 
 /// A reflectance while a lobe is evaluated in lanes `L`: linear RGB (`Vec3`, for `L = f32`), or
-/// its luminance (`L` itself). A model turns each of its RGB reflectances into one with
-/// [`Spectrum::from_rgb`] and then only adds them and scales them by lane terms, so its
-/// luminance evaluation is the luminance of its RGB one (luminance is linear).
+/// its luminance (`L` itself). A lobe only adds reflectances, scales them by lane terms and
+/// takes `1 -` them, so evaluated on luminances it gives the luminance of its RGB value
+/// (luminance is linear, and `1 - luminance(c) = luminance(1 - c)` as the weights sum to 1).
 pub(crate) trait Spectrum<L: Lanes>:
     Copy + Add<Output = Self> + Mul<L, Output = Self> + Mul<f32, Output = Self>
 {
-    /// The reflectance `rgb`: itself, or its luminance in every lane.
-    fn from_rgb(rgb: Vec3) -> Self;
     /// `1 - self`, per channel.
     fn one_minus(self) -> Self;
 }
 
 impl Spectrum<f32> for Vec3 {
-    #[inline(always)]
-    fn from_rgb(rgb: Vec3) -> Self {
-        rgb
-    }
     #[inline(always)]
     fn one_minus(self) -> Self {
         Vec3::ONE - self
@@ -140,10 +133,6 @@ impl Spectrum<f32> for Vec3 {
 }
 
 impl<L: Lanes> Spectrum<L> for L {
-    #[inline(always)]
-    fn from_rgb(rgb: Vec3) -> Self {
-        L::splat(luminance(rgb))
-    }
     #[inline(always)]
     fn one_minus(self) -> Self {
         L::splat(1.0) - self

@@ -1,10 +1,11 @@
 //! [`LuminanceEval`]: `luminance(f(wo, wi))` for one `wo` and many `wi`, the light choice's
 //! per-emitter BSDF weight, one direction at a time or four in SIMD lanes. It evaluates each
-//! model's own lobes (the functions `eval` uses) with reflectances replaced by their
-//! luminances, so it is the luminance of `eval` up to rounding (luminance is linear).
+//! model's own lobes (the functions `eval` uses) with the model's reflectances replaced by
+//! their luminances, taken once per `wo`, so it is the luminance of `eval` up to rounding.
 
 use super::lanes::Lanes;
-use super::{Bsdf, Lobes};
+use super::{Bsdf, Lobes, Reflectances};
+use crate::sampling::luminance;
 use glam::{Vec3, Vec4};
 
 /// `luminance(f(wo, wi))` for one `wo` and any `wi` (see [`Bsdf::luminance_at`]):
@@ -15,6 +16,8 @@ use glam::{Vec3, Vec4};
 pub struct LuminanceEval {
     bsdf: Bsdf,
     wo: Vec3,
+    /// The luminances of the model's reflectances.
+    reflectances: Reflectances<f32>,
 }
 
 impl LuminanceEval {
@@ -33,7 +36,8 @@ impl LuminanceEval {
     #[inline(always)]
     fn eval_lanes<L: Lanes>(&self, wi: [L; 3]) -> L {
         if self.wo.z > 0.0 {
-            let lobes: Lobes<L, L> = self.bsdf.lobes(self.wo, wi);
+            let r = self.reflectances.map(L::splat);
+            let lobes: Lobes<L, L> = self.bsdf.lobes(r, self.wo, wi);
             (lobes.diffuse + lobes.glossy).where_positive(wi[2])
         } else {
             L::splat(0.0)
@@ -46,7 +50,11 @@ impl Bsdf {
     /// [`LuminanceEval`]).
     #[inline]
     pub fn luminance_at(&self, wo: Vec3) -> LuminanceEval {
-        LuminanceEval { bsdf: *self, wo }
+        LuminanceEval {
+            bsdf: *self,
+            wo,
+            reflectances: self.reflectances().map(luminance),
+        }
     }
 }
 
@@ -55,7 +63,7 @@ mod tests {
     use super::*;
     use crate::bsdf::tests::{all_models, random_dir};
     use crate::bsdf::{Ggx, MIN_ALPHA};
-    use crate::sampling::{luminance, Pcg32};
+    use crate::sampling::Pcg32;
 
     #[test]
     fn luminance_eval_is_luminance_of_eval() {

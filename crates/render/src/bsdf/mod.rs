@@ -127,6 +127,26 @@ pub const MIN_ALPHA: f32 = 1e-4;
 // ---------------------------------------------------------------------------------------------
 // What a model provides
 
+/// A model's two reflectances, the colours its lobes scale: the diffuse lobe's and the glossy
+/// lobe's (`kd` and `ks` for the paper models; `(1 - F0) c_diff` and `F0` for glTF), as RGB
+/// or as luminances. [`LuminanceEval`] takes their luminances once per `wo`.
+#[derive(Clone, Copy, Debug)]
+struct Reflectances<S> {
+    diffuse: S,
+    glossy: S,
+}
+
+impl<S> Reflectances<S> {
+    /// Both reflectances through `f`.
+    #[inline(always)]
+    fn map<T>(self, f: impl Fn(S) -> T) -> Reflectances<T> {
+        Reflectances {
+            diffuse: f(self.diffuse),
+            glossy: f(self.glossy),
+        }
+    }
+}
+
 /// A model's lobes at one `wo` and one or four `wi`: `f(wo, wi)` split by lobe, as reflectances
 /// `S` (RGB, or luminance in lanes), and the glossy lobe's own sampling density of `wi`.
 struct Lobes<S, L> {
@@ -138,12 +158,20 @@ struct Lobes<S, L> {
 /// What every reflectance model provides; [`Bsdf`] dispatches to it by `match` (statically,
 /// never through a trait object).
 trait Model {
+    /// The model's [`Reflectances`], RGB.
+    fn reflectances(&self) -> Reflectances<Vec3>;
+
     /// `f(wo, wi)` split by lobe, with the glossy lobe's own sampling density of `wi`, for `wo`
-    /// and `wi` above the surface (the caller checks), `wi` given as its x, y and z lanes.
-    /// Every reflectance enters through [`Spectrum::from_rgb`] and is only added and scaled by
-    /// lane terms, so `S = Vec3, L = f32` gives `eval` and `pdf`, and `S = L` the luminance of
-    /// `eval` for [`LuminanceEval`], lane by lane.
-    fn lobes<L: Lanes, S: Spectrum<L>>(&self, wo: Vec3, wi: [L; 3]) -> Lobes<S, L>;
+    /// and `wi` above the surface (the caller checks), `wi` given as its x, y and z lanes, and
+    /// `r` the model's [`Model::reflectances`] as `S`. The reflectances are only added and
+    /// scaled by lane terms, so `S = Vec3, L = f32` gives `eval` and `pdf`, and `S = L` with
+    /// the reflectances' luminances the luminance of `eval` for [`LuminanceEval`], lane by lane.
+    fn lobes<L: Lanes, S: Spectrum<L>>(
+        &self,
+        r: Reflectances<S>,
+        wo: Vec3,
+        wi: [L; 3],
+    ) -> Lobes<S, L>;
 
     /// The probability of sampling the glossy lobe for `wo` above the surface (see the module
     /// documentation); usually [`glossy_probability`] of the lobes' albedo estimates.
@@ -155,6 +183,18 @@ trait Model {
 
     /// Hemispherical albedo estimate for the albedo layer.
     fn albedo(&self) -> Vec3;
+}
+
+/// A model's [`Model::lobes`] in RGB (`f` split by lobe, and the glossy lobe's density), for
+/// `wo` and `wi` above the surface.
+#[inline(always)]
+fn rgb_lobes<M: Model>(m: &M, wo: Vec3, wi: Vec3) -> (LobeValues, f32) {
+    let lobes: Lobes<Vec3, f32> = m.lobes(m.reflectances(), wo, wi.to_array());
+    let f = LobeValues {
+        diffuse: lobes.diffuse,
+        glossy: lobes.glossy,
+    };
+    (f, lobes.glossy_pdf)
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -230,15 +270,32 @@ fn mixture_pdf(wi: Vec3, glossy_pdf: f32, p_glossy: f32) -> f32 {
 // Dispatch
 
 impl Bsdf {
-    /// The model's [`Model::lobes`], for `wo` and `wi` above the surface.
+    /// The model's [`Model::reflectances`] (for [`LuminanceEval`]).
     #[inline(always)]
-    fn lobes<L: Lanes, S: Spectrum<L>>(&self, wo: Vec3, wi: [L; 3]) -> Lobes<S, L> {
+    fn reflectances(&self) -> Reflectances<Vec3> {
         match self {
-            Bsdf::Diffuse(m) => m.lobes(wo, wi),
-            Bsdf::Ggx(m) => m.lobes(wo, wi),
-            Bsdf::Ward(m) => m.lobes(wo, wi),
-            Bsdf::BlinnPhong(m) => m.lobes(wo, wi),
-            Bsdf::GltfPbr(m) => m.lobes(wo, wi),
+            Bsdf::Diffuse(m) => m.reflectances(),
+            Bsdf::Ggx(m) => m.reflectances(),
+            Bsdf::Ward(m) => m.reflectances(),
+            Bsdf::BlinnPhong(m) => m.reflectances(),
+            Bsdf::GltfPbr(m) => m.reflectances(),
+        }
+    }
+
+    /// The model's [`Model::lobes`], for `wo` and `wi` above the surface (for [`LuminanceEval`]).
+    #[inline(always)]
+    fn lobes<L: Lanes, S: Spectrum<L>>(
+        &self,
+        r: Reflectances<S>,
+        wo: Vec3,
+        wi: [L; 3],
+    ) -> Lobes<S, L> {
+        match self {
+            Bsdf::Diffuse(m) => m.lobes(r, wo, wi),
+            Bsdf::Ggx(m) => m.lobes(r, wo, wi),
+            Bsdf::Ward(m) => m.lobes(r, wo, wi),
+            Bsdf::BlinnPhong(m) => m.lobes(r, wo, wi),
+            Bsdf::GltfPbr(m) => m.lobes(r, wo, wi),
         }
     }
 
@@ -291,12 +348,13 @@ impl Bsdf {
         if !above(wo, wi) {
             return (LobeValues::default(), 0.0);
         }
-        let lobes: Lobes<Vec3, f32> = self.lobes(wo, wi.to_array());
-        let f = LobeValues {
-            diffuse: lobes.diffuse,
-            glossy: lobes.glossy,
-        };
-        (f, lobes.glossy_pdf)
+        match self {
+            Bsdf::Diffuse(m) => rgb_lobes(m, wo, wi),
+            Bsdf::Ggx(m) => rgb_lobes(m, wo, wi),
+            Bsdf::Ward(m) => rgb_lobes(m, wo, wi),
+            Bsdf::BlinnPhong(m) => rgb_lobes(m, wo, wi),
+            Bsdf::GltfPbr(m) => rgb_lobes(m, wo, wi),
+        }
     }
 
     /// `f(wo, wi)` split by lobe; zero when either direction is below the surface.

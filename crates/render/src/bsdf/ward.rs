@@ -3,7 +3,7 @@
 
 use super::diffuse::lambert;
 use super::lanes::{Lanes, Spectrum};
-use super::{glossy_probability, reflect_about_half, Lobes, Model, MIN_ALPHA};
+use super::{glossy_probability, reflect_about_half, Lobes, Model, Reflectances, MIN_ALPHA};
 use crate::sampling::luminance;
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
@@ -47,12 +47,25 @@ fn lobe<L: Lanes>(wo: Vec3, wi: [L; 3], a2: f32) -> (L, L) {
 }
 
 impl Model for Ward {
+    #[inline]
+    fn reflectances(&self) -> Reflectances<Vec3> {
+        Reflectances {
+            diffuse: self.kd,
+            glossy: self.ks,
+        }
+    }
+
     #[inline(always)]
-    fn lobes<L: Lanes, S: Spectrum<L>>(&self, wo: Vec3, wi: [L; 3]) -> Lobes<S, L> {
+    fn lobes<L: Lanes, S: Spectrum<L>>(
+        &self,
+        r: Reflectances<S>,
+        wo: Vec3,
+        wi: [L; 3],
+    ) -> Lobes<S, L> {
         let (f, pdf) = lobe(wo, wi, self.alpha() * self.alpha());
         Lobes {
-            diffuse: lambert(self.kd),
-            glossy: S::from_rgb(self.ks) * f,
+            diffuse: lambert(r.diffuse),
+            glossy: r.glossy * f,
             glossy_pdf: pdf,
         }
     }
