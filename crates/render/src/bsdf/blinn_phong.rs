@@ -1,7 +1,6 @@
 //! Normalised Blinn-Phong [`BlinnPhong`]: its glossy lobe, sampled by `cos^s` of the half
 //! vector.
 
-use super::diffuse::lambert;
 use super::lanes::{Lanes, Spectrum};
 use super::{glossy_probability, half_vector, reflect_about_half, Lobes, Model, Reflectances};
 use crate::sampling::luminance;
@@ -57,12 +56,7 @@ impl Model for BlinnPhong {
         wo: Vec3,
         wi: [L; 3],
     ) -> Lobes<S, L> {
-        let (f, pdf) = lobe(wo, wi, self.shininess());
-        Lobes {
-            diffuse: lambert(r.diffuse),
-            glossy: r.glossy * f,
-            glossy_pdf: pdf,
-        }
+        Lobes::paper(r, lobe(wo, wi, self.shininess()))
     }
 
     #[inline]

@@ -2,7 +2,6 @@
 //! masking, the microfacet BRDF with its visible-normal density, visible-normal sampling, and
 //! the albedo estimate of the lobe choice), and the paper's `ggx` model [`Ggx`].
 
-use super::diffuse::lambert;
 use super::lanes::{Lanes, Spectrum};
 use super::{glossy_probability, reflect, Lobes, Model, Reflectances, MIN_ALPHA};
 use crate::sampling::luminance;
@@ -45,12 +44,7 @@ impl Model for Ggx {
         wo: Vec3,
         wi: [L; 3],
     ) -> Lobes<S, L> {
-        let (spec, pdf) = microfacet(wo, wi, self.alpha());
-        Lobes {
-            diffuse: lambert(r.diffuse),
-            glossy: r.glossy * spec,
-            glossy_pdf: pdf,
-        }
+        Lobes::paper(r, microfacet(wo, wi, self.alpha()))
     }
 
     #[inline]

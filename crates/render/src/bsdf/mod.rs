@@ -25,8 +25,9 @@
 //!
 //! # Files
 //!
-//! - this file: [`Bsdf`] and its dispatch, the `Model` trait every model implements (its lobes,
-//!   its lobe-choice probability, the sampling of its glossy lobe, its albedo), [`Lobe`],
+//! - this file: [`Bsdf`] and its dispatch, the `Model` trait every model implements (its two
+//!   reflectances, its lobes, its lobe-choice probability, the sampling of its glossy lobe,
+//!   its albedo) with the `Reflectances` it takes and the `Lobes` it returns, [`Lobe`],
 //!   [`LobeValues`], [`BsdfSample`], [`MIN_ALPHA`], the direction helpers the models share
 //!   (reflection, half vector), and the lobe mixture (the glossy-lobe probability and the
 //!   mixture density);
@@ -62,6 +63,7 @@ pub use luminance::LuminanceEval;
 pub use ward::Ward;
 
 use crate::sampling::{square_to_cosine_hemisphere, square_to_cosine_hemisphere_pdf};
+use diffuse::lambert;
 use glam::{Vec2, Vec3};
 use lanes::{Lanes, Spectrum};
 use std::f32::consts::TAU;
@@ -153,6 +155,19 @@ struct Lobes<S, L> {
     diffuse: S,
     glossy: S,
     glossy_pdf: L,
+}
+
+impl<L: Lanes, S: Spectrum<L>> Lobes<S, L> {
+    /// The paper models' lobes: the Lambertian lobe of `r.diffuse` (`kd`), and `r.glossy`
+    /// (`ks`) times the glossy lobe's value `glossy.0`, of density `glossy.1`.
+    #[inline(always)]
+    fn paper(r: Reflectances<S>, (glossy, glossy_pdf): (L, L)) -> Self {
+        Lobes {
+            diffuse: lambert(r.diffuse),
+            glossy: r.glossy * glossy,
+            glossy_pdf,
+        }
+    }
 }
 
 /// What every reflectance model provides; [`Bsdf`] dispatches to it by `match` (statically,

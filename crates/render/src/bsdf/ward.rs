@@ -1,7 +1,6 @@
 //! The paper's isotropic Ward model [`Ward`]: its glossy lobe, sampled by the Gaussian in
 //! `tan(delta)` (Walter 2005, "Notes on the Ward BRDF").
 
-use super::diffuse::lambert;
 use super::lanes::{Lanes, Spectrum};
 use super::{glossy_probability, reflect_about_half, Lobes, Model, Reflectances, MIN_ALPHA};
 use crate::sampling::luminance;
@@ -62,12 +61,7 @@ impl Model for Ward {
         wo: Vec3,
         wi: [L; 3],
     ) -> Lobes<S, L> {
-        let (f, pdf) = lobe(wo, wi, self.alpha() * self.alpha());
-        Lobes {
-            diffuse: lambert(r.diffuse),
-            glossy: r.glossy * f,
-            glossy_pdf: pdf,
-        }
+        Lobes::paper(r, lobe(wo, wi, self.alpha() * self.alpha()))
     }
 
     #[inline]
