@@ -26,21 +26,37 @@ impl BlinnPhong {
     }
 }
 
+/// The Blinn-Phong exponent `s` and the lobe's normalisation `(s + 8) / (8 pi)`.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct BlinnPhongAtWo {
+    s: f32,
+    norm: f32,
+}
+
 /// The Blinn-Phong glossy lobe without its colour, `(s + 8) / (8 pi) cos^s(theta_h)`, and its
 /// sampling density, for `wo` and `wi` above the surface: the half vector is drawn with density
 /// `(s + 1) / (2 pi) cos^s(theta_h)`, and `1 / (4 wo.h)` turns it into a density of `wi`.
 #[inline(always)]
-fn lobe<L: Lanes>(wo: Vec3, wi: [L; 3], s: f32) -> (L, L) {
+fn lobe<L: Lanes>(at: &BlinnPhongAtWo, wo: Vec3, wi: [L; 3]) -> (L, L) {
+    let BlinnPhongAtWo { s, norm } = *at;
     let h = half_vector(wo, wi);
     let cos_s = h[2].powf(s);
     let wo_h = h[0] * wo.x + h[1] * wo.y + h[2] * wo.z;
-    (
-        cos_s * ((s + 8.0) / (8.0 * PI)),
-        cos_s * ((s + 1.0) / TAU) / (wo_h * 4.0),
-    )
+    (cos_s * norm, cos_s * ((s + 1.0) / TAU) / (wo_h * 4.0))
 }
 
 impl Model for BlinnPhong {
+    type AtWo = BlinnPhongAtWo;
+
+    #[inline]
+    fn at_wo(&self, _wo: Vec3) -> BlinnPhongAtWo {
+        let s = self.shininess();
+        BlinnPhongAtWo {
+            s,
+            norm: (s + 8.0) / (8.0 * PI),
+        }
+    }
+
     #[inline]
     fn reflectances(&self) -> Reflectances<Vec3> {
         Reflectances {
@@ -51,12 +67,12 @@ impl Model for BlinnPhong {
 
     #[inline(always)]
     fn lobes<L: Lanes, S: Spectrum<L>>(
-        &self,
+        at: &BlinnPhongAtWo,
         r: Reflectances<S>,
         wo: Vec3,
         wi: [L; 3],
     ) -> Lobes<S, L> {
-        Lobes::paper(r, lobe(wo, wi, self.shininess()))
+        Lobes::paper(r, lobe(at, wo, wi))
     }
 
     #[inline]

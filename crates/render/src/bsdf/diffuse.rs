@@ -20,6 +20,11 @@ pub(super) fn lambert<L: Lanes, S: Spectrum<L>>(kd: S) -> S {
 }
 
 impl Model for Diffuse {
+    type AtWo = ();
+
+    #[inline]
+    fn at_wo(&self, _wo: Vec3) {}
+
     #[inline]
     fn reflectances(&self) -> Reflectances<Vec3> {
         Reflectances {
@@ -30,7 +35,7 @@ impl Model for Diffuse {
 
     #[inline(always)]
     fn lobes<L: Lanes, S: Spectrum<L>>(
-        &self,
+        _at: &(),
         r: Reflectances<S>,
         _wo: Vec3,
         _wi: [L; 3],

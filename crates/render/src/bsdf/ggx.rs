@@ -29,6 +29,13 @@ impl Ggx {
 }
 
 impl Model for Ggx {
+    type AtWo = GgxAtWo;
+
+    #[inline]
+    fn at_wo(&self, wo: Vec3) -> GgxAtWo {
+        GgxAtWo::new(self.alpha(), wo)
+    }
+
     #[inline]
     fn reflectances(&self) -> Reflectances<Vec3> {
         Reflectances {
@@ -39,12 +46,12 @@ impl Model for Ggx {
 
     #[inline(always)]
     fn lobes<L: Lanes, S: Spectrum<L>>(
-        &self,
+        at: &GgxAtWo,
         r: Reflectances<S>,
         wo: Vec3,
         wi: [L; 3],
     ) -> Lobes<S, L> {
-        Lobes::paper(r, microfacet(wo, wi, self.alpha()))
+        Lobes::paper(r, microfacet(at, wo, wi))
     }
 
     #[inline]
@@ -74,9 +81,30 @@ fn g1_denominator<L: Lanes>(v: [L; 3], a2: f32) -> L {
     z + (z * z + (x * x + y * y) * a2).sqrt()
 }
 
+/// A GGX lobe's terms that depend on its alpha and `wo` alone.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct GgxAtWo {
+    /// `alpha^2`.
+    a2: f32,
+    /// [`g1_denominator`] of `wo`.
+    go: f32,
+}
+
+impl GgxAtWo {
+    /// The terms for `alpha` (already at or above [`MIN_ALPHA`]) and `wo`.
+    #[inline]
+    pub(super) fn new(alpha: f32, wo: Vec3) -> Self {
+        let a2 = alpha * alpha;
+        GgxAtWo {
+            a2,
+            go: g1_denominator(wo.to_array(), a2),
+        }
+    }
+}
+
 /// The GGX microfacet lobe without its colour, `D(h) G1(wo) G1(wi) / (4 wo.z wi.z)`, and the
 /// solid-angle density of `wi` when the lobe samples visible normals, for `wo` and `wi` above
-/// the surface.
+/// the surface and `at` the lobe's [`GgxAtWo`] for `wo`.
 ///
 /// With the half vector left unnormalised, `h = wo + wi`, and
 /// `q = h.x^2 + h.y^2 + alpha^2 h.z^2`, Mitsuba 3's GGX
@@ -86,9 +114,8 @@ fn g1_denominator<L: Lanes>(v: [L; 3], a2: f32) -> L {
 /// is not done here.) The visible-normal density `D(h) G1(wo, h) / (4 wo.z)` (the Jacobian
 /// `1 / (4 wo.h)` cancels `wo.h`) is the lobe times `wi.z / G1(wi)`, i.e. times `gi / 2`.
 #[inline(always)]
-pub(super) fn microfacet<L: Lanes>(wo: Vec3, wi: [L; 3], alpha: f32) -> (L, L) {
-    let a2 = alpha * alpha;
-    let go = g1_denominator(wo.to_array(), a2);
+pub(super) fn microfacet<L: Lanes>(at: &GgxAtWo, wo: Vec3, wi: [L; 3]) -> (L, L) {
+    let GgxAtWo { a2, go } = *at;
     let [hx, hy, hz] = [wi[0] + wo.x, wi[1] + wo.y, wi[2] + wo.z];
     let h2 = hx * hx + hy * hy + hz * hz;
     let q = hx * hx + hy * hy + hz * a2 * hz;

@@ -58,6 +58,13 @@ fn schlick<L: Lanes, S: Spectrum<L>>(f0: S, s: L) -> S {
 }
 
 impl Model for GltfPbr {
+    type AtWo = ggx::GgxAtWo;
+
+    #[inline]
+    fn at_wo(&self, wo: Vec3) -> ggx::GgxAtWo {
+        ggx::GgxAtWo::new(self.alpha(), wo)
+    }
+
     /// `(1 - F0) c_diff` and `F0`: with `1 - F = (1 - F0)(1 - s)`, the diffuse lobe is the
     /// Lambertian lobe of `(1 - F0) c_diff` times the lane term `1 - s`, and the glossy lobe
     /// `F0 + (1 - F0) s` times the microfacet lobe.
@@ -72,12 +79,12 @@ impl Model for GltfPbr {
 
     #[inline(always)]
     fn lobes<L: Lanes, S: Spectrum<L>>(
-        &self,
+        at: &ggx::GgxAtWo,
         r: Reflectances<S>,
         wo: Vec3,
         wi: [L; 3],
     ) -> Lobes<S, L> {
-        let (spec, pdf) = ggx::microfacet(wo, wi, self.alpha());
+        let (spec, pdf) = ggx::microfacet(at, wo, wi);
         let h = half_vector(wo, wi);
         let s = schlick_weight(h[0] * wo.x + h[1] * wo.y + h[2] * wo.z);
         Lobes {

@@ -1,10 +1,13 @@
 //! [`LuminanceEval`]: `luminance(f(wo, wi))` for one `wo` and many `wi`, the light choice's
 //! per-emitter BSDF weight, one direction at a time or four in SIMD lanes. It evaluates each
 //! model's own lobes (the functions `eval` uses) with the model's reflectances replaced by
-//! their luminances, taken once per `wo`, so it is the luminance of `eval` up to rounding.
+//! their luminances, so it is the luminance of `eval` up to rounding. What depends on `wo`
+//! alone (the reflectances' luminances, the model's `Model::AtWo`) is computed once, by
+//! [`Bsdf::luminance_at`]; [`AtWo`] holds the model's, one variant per [`Bsdf`] variant, and
+//! no formula.
 
 use super::lanes::Lanes;
-use super::{Bsdf, Lobes, Reflectances};
+use super::{BlinnPhong, Bsdf, Diffuse, Ggx, GltfPbr, Lobes, Model, Reflectances, Ward};
 use crate::sampling::luminance;
 use glam::{Vec3, Vec4};
 
@@ -14,10 +17,21 @@ use glam::{Vec3, Vec4};
 /// up to rounding (tested).
 #[derive(Clone, Copy, Debug)]
 pub struct LuminanceEval {
-    bsdf: Bsdf,
     wo: Vec3,
     /// The luminances of the model's reflectances.
     reflectances: Reflectances<f32>,
+    /// The model's terms for `wo`.
+    at: AtWo,
+}
+
+/// A [`Bsdf`]'s [`Model::AtWo`], for the model its variant names.
+#[derive(Clone, Copy, Debug)]
+enum AtWo {
+    Diffuse(<Diffuse as Model>::AtWo),
+    Ggx(<Ggx as Model>::AtWo),
+    Ward(<Ward as Model>::AtWo),
+    BlinnPhong(<BlinnPhong as Model>::AtWo),
+    GltfPbr(<GltfPbr as Model>::AtWo),
 }
 
 impl LuminanceEval {
@@ -36,8 +50,14 @@ impl LuminanceEval {
     #[inline(always)]
     fn eval_lanes<L: Lanes>(&self, wi: [L; 3]) -> L {
         if self.wo.z > 0.0 {
-            let r = self.reflectances.map(L::splat);
-            let lobes: Lobes<L, L> = self.bsdf.lobes(r, self.wo, wi);
+            let (r, wo) = (self.reflectances.map(L::splat), self.wo);
+            let lobes: Lobes<L, L> = match &self.at {
+                AtWo::Diffuse(at) => Diffuse::lobes(at, r, wo, wi),
+                AtWo::Ggx(at) => Ggx::lobes(at, r, wo, wi),
+                AtWo::Ward(at) => Ward::lobes(at, r, wo, wi),
+                AtWo::BlinnPhong(at) => BlinnPhong::lobes(at, r, wo, wi),
+                AtWo::GltfPbr(at) => GltfPbr::lobes(at, r, wo, wi),
+            };
             (lobes.diffuse + lobes.glossy).where_positive(wi[2])
         } else {
             L::splat(0.0)
@@ -50,10 +70,17 @@ impl Bsdf {
     /// [`LuminanceEval`]).
     #[inline]
     pub fn luminance_at(&self, wo: Vec3) -> LuminanceEval {
+        let (at, reflectances) = match self {
+            Bsdf::Diffuse(m) => (AtWo::Diffuse(m.at_wo(wo)), m.reflectances()),
+            Bsdf::Ggx(m) => (AtWo::Ggx(m.at_wo(wo)), m.reflectances()),
+            Bsdf::Ward(m) => (AtWo::Ward(m.at_wo(wo)), m.reflectances()),
+            Bsdf::BlinnPhong(m) => (AtWo::BlinnPhong(m.at_wo(wo)), m.reflectances()),
+            Bsdf::GltfPbr(m) => (AtWo::GltfPbr(m.at_wo(wo)), m.reflectances()),
+        };
         LuminanceEval {
-            bsdf: *self,
             wo,
-            reflectances: self.reflectances().map(luminance),
+            reflectances: reflectances.map(luminance),
+            at,
         }
     }
 }

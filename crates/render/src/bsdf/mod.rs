@@ -37,12 +37,15 @@
 //! - `ggx.rs`: the GGX microfacet lobe (masking, visible-normal density and sampling), shared
 //!   by [`Ggx`] and [`GltfPbr`], and the paper's [`Ggx`];
 //! - `ward.rs`: [`Ward`]; `blinn_phong.rs`: [`BlinnPhong`]; `gltf.rs`: [`GltfPbr`];
-//! - `luminance.rs`: [`LuminanceEval`], the light choice's `luminance(f(wo, wi))`.
+//! - `luminance.rs`: [`LuminanceEval`], the light choice's `luminance(f(wo, wi))`: the
+//!   luminances of a model's reflectances and its `Model::AtWo`, taken once per `wo`, and
+//!   its lobes.
 //!
 //! Each model's lobes are one function, generic over the lanes and the reflectance type, used
 //! by `eval`, `pdf`, `sample` and [`LuminanceEval`] alike. A new model is a new file with its
-//! struct and its `Model` implementation, a [`Bsdf`] variant, and one arm in each `match` of
-//! this file (the compiler lists them).
+//! struct and its `Model` implementation, a [`Bsdf`] variant, one arm in each `match` of this
+//! file and of `luminance.rs`, and there a variant holding its `Model::AtWo` (the compiler
+//! lists them all).
 //!
 //! The chi-square, reciprocity, white-furnace and Mitsuba-identity tests are at the bottom of
 //! each model's file and of this one; [`crate::testing::check_bsdf`] checks a model for one `wo`.
@@ -173,16 +176,25 @@ impl<L: Lanes, S: Spectrum<L>> Lobes<S, L> {
 /// What every reflectance model provides; [`Bsdf`] dispatches to it by `match` (statically,
 /// never through a trait object).
 trait Model {
+    /// What the model's lobes need besides its reflectances that depends on the model and `wo`
+    /// alone (`alpha^2`, a microfacet lobe's masking of `wo`, a normalisation): `eval` computes
+    /// it at each call, [`LuminanceEval`] once per `wo`.
+    type AtWo: Copy + std::fmt::Debug;
+
+    /// The model's [`Model::AtWo`] for `wo`.
+    fn at_wo(&self, wo: Vec3) -> Self::AtWo;
+
     /// The model's [`Reflectances`], RGB.
     fn reflectances(&self) -> Reflectances<Vec3>;
 
     /// `f(wo, wi)` split by lobe, with the glossy lobe's own sampling density of `wi`, for `wo`
-    /// and `wi` above the surface (the caller checks), `wi` given as its x, y and z lanes, and
-    /// `r` the model's [`Model::reflectances`] as `S`. The reflectances are only added and
-    /// scaled by lane terms, so `S = Vec3, L = f32` gives `eval` and `pdf`, and `S = L` with
-    /// the reflectances' luminances the luminance of `eval` for [`LuminanceEval`], lane by lane.
+    /// and `wi` above the surface (the caller checks), `wi` given as its x, y and z lanes, `at`
+    /// the model's [`Model::at_wo`] and `r` its [`Model::reflectances`] as `S`. The
+    /// reflectances are only added and scaled by lane terms, so `S = Vec3, L = f32` gives
+    /// `eval` and `pdf`, and `S = L` with the reflectances' luminances the luminance of `eval`
+    /// for [`LuminanceEval`], lane by lane.
     fn lobes<L: Lanes, S: Spectrum<L>>(
-        &self,
+        at: &Self::AtWo,
         r: Reflectances<S>,
         wo: Vec3,
         wi: [L; 3],
@@ -204,7 +216,7 @@ trait Model {
 /// `wo` and `wi` above the surface.
 #[inline(always)]
 fn rgb_lobes<M: Model>(m: &M, wo: Vec3, wi: Vec3) -> (LobeValues, f32) {
-    let lobes: Lobes<Vec3, f32> = m.lobes(m.reflectances(), wo, wi.to_array());
+    let lobes: Lobes<Vec3, f32> = M::lobes(&m.at_wo(wo), m.reflectances(), wo, wi.to_array());
     let f = LobeValues {
         diffuse: lobes.diffuse,
         glossy: lobes.glossy,
@@ -285,35 +297,6 @@ fn mixture_pdf(wi: Vec3, glossy_pdf: f32, p_glossy: f32) -> f32 {
 // Dispatch
 
 impl Bsdf {
-    /// The model's [`Model::reflectances`] (for [`LuminanceEval`]).
-    #[inline(always)]
-    fn reflectances(&self) -> Reflectances<Vec3> {
-        match self {
-            Bsdf::Diffuse(m) => m.reflectances(),
-            Bsdf::Ggx(m) => m.reflectances(),
-            Bsdf::Ward(m) => m.reflectances(),
-            Bsdf::BlinnPhong(m) => m.reflectances(),
-            Bsdf::GltfPbr(m) => m.reflectances(),
-        }
-    }
-
-    /// The model's [`Model::lobes`], for `wo` and `wi` above the surface (for [`LuminanceEval`]).
-    #[inline(always)]
-    fn lobes<L: Lanes, S: Spectrum<L>>(
-        &self,
-        r: Reflectances<S>,
-        wo: Vec3,
-        wi: [L; 3],
-    ) -> Lobes<S, L> {
-        match self {
-            Bsdf::Diffuse(m) => m.lobes(r, wo, wi),
-            Bsdf::Ggx(m) => m.lobes(r, wo, wi),
-            Bsdf::Ward(m) => m.lobes(r, wo, wi),
-            Bsdf::BlinnPhong(m) => m.lobes(r, wo, wi),
-            Bsdf::GltfPbr(m) => m.lobes(r, wo, wi),
-        }
-    }
-
     /// Probability that [`Bsdf::sample`] picks the glossy lobe for this `wo` (0 for diffuse).
     #[inline]
     pub fn glossy_probability(&self, wo: Vec3) -> f32 {

@@ -46,6 +46,14 @@ fn lobe<L: Lanes>(wo: Vec3, wi: [L; 3], a2: f32) -> (L, L) {
 }
 
 impl Model for Ward {
+    /// `alpha^2`.
+    type AtWo = f32;
+
+    #[inline]
+    fn at_wo(&self, _wo: Vec3) -> f32 {
+        self.alpha() * self.alpha()
+    }
+
     #[inline]
     fn reflectances(&self) -> Reflectances<Vec3> {
         Reflectances {
@@ -56,12 +64,12 @@ impl Model for Ward {
 
     #[inline(always)]
     fn lobes<L: Lanes, S: Spectrum<L>>(
-        &self,
+        a2: &f32,
         r: Reflectances<S>,
         wo: Vec3,
         wi: [L; 3],
     ) -> Lobes<S, L> {
-        Lobes::paper(r, lobe(wo, wi, self.alpha() * self.alpha()))
+        Lobes::paper(r, lobe(wo, wi, *a2))
     }
 
     #[inline]
