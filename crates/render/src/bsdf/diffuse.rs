@@ -19,11 +19,17 @@ pub(super) fn lambert<L: Lanes, S: Spectrum<L>>(kd: S) -> S {
     kd * FRAC_1_PI
 }
 
+/// The Lambertian lobe has no terms that depend on `wo`.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct DiffuseAtWo;
+
 impl Model for Diffuse {
-    type AtWo = ();
+    type AtWo = DiffuseAtWo;
 
     #[inline]
-    fn at_wo(&self, _wo: Vec3) {}
+    fn at_wo(&self, _wo: Vec3) -> DiffuseAtWo {
+        DiffuseAtWo
+    }
 
     #[inline]
     fn reflectances(&self) -> Reflectances<Vec3> {
@@ -35,7 +41,7 @@ impl Model for Diffuse {
 
     #[inline(always)]
     fn lobes<L: Lanes, S: Spectrum<L>>(
-        _at: &(),
+        _at: &DiffuseAtWo,
         r: Reflectances<S>,
         _wo: Vec3,
         _wi: [L; 3],
