@@ -415,3 +415,77 @@ fn rendered_fronto_parallel_plane_has_disparity_f_b_over_z() {
     );
     assert!(worst < 0.1, "worst row off by {worst} px");
 }
+
+/// `rig.json` lists exactly the renderer's emitters: the same count, kinds and order, each lamp
+/// at the centre the light choice uses (and that centre is where the lamp is: near the
+/// area-weighted centroid of its triangles).
+#[test]
+fn rig_json_lists_the_renderers_emitters() {
+    use streaks_render::light::Emitter;
+    let t = TestDir::new();
+    let scene_path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/rainy_street_small.gltf");
+    t.streaks(&[
+        "stereo",
+        scene_path.to_str().unwrap(),
+        "-o",
+        "out",
+        "--spp",
+        "1",
+        "--height",
+        "16",
+    ])
+    .assert_success();
+    let file = RigFile::load(&t.join("out/rig.json")).unwrap();
+    let scene = streaks_render::scene::Scene::load(&scene_path).unwrap();
+    let emitters = scene.light_sampler.emitters();
+    assert_eq!(file.lights.len(), emitters.len());
+    let mut lamps = 0;
+    for (record, emitter) in file.lights.iter().zip(emitters.list()) {
+        match (record, emitter) {
+            (
+                LightRecord::Emissive {
+                    centroid,
+                    triangles,
+                    area,
+                    ..
+                },
+                Emitter::Mesh(m),
+            ) => {
+                lamps += 1;
+                assert_eq!(glam::Vec3::from(centroid.world), m.centre());
+                assert_eq!((*triangles, *area), (m.triangle_count(), m.area()));
+                // The lamp's own triangles, found independently of the renderer's grouping:
+                // those of its material within its bounding sphere.
+                let (mut weighted, mut total) = (glam::Vec3::ZERO, 0.0);
+                for (t, &mat) in scene.triangle_materials.iter().enumerate() {
+                    let [a, b, c] = scene.triangles[t].map(|v| scene.positions[v as usize]);
+                    let near = [a, b, c]
+                        .iter()
+                        .all(|v| v.distance(m.centre()) <= m.radius());
+                    if mat == m.material() && near {
+                        let area = 0.5 * (b - a).cross(c - a).length();
+                        weighted += area * (a + b + c) / 3.0;
+                        total += area;
+                    }
+                }
+                let centroid = weighted / total;
+                assert!(
+                    centroid.distance(m.centre()) < 0.05 * m.radius(),
+                    "lamp {} centred at {} but its triangles' centroid is {centroid}",
+                    lamps,
+                    m.centre()
+                );
+            }
+            (LightRecord::Point { position, .. }, Emitter::Punctual(l))
+            | (LightRecord::Spot { position, .. }, Emitter::Punctual(l)) => {
+                assert_eq!(Some(glam::Vec3::from(position.world)), l.position());
+            }
+            (LightRecord::Directional { .. }, Emitter::Punctual(l)) => {
+                assert_eq!(l.position(), None);
+            }
+            (r, e) => panic!("rig.json has {r:?} where the renderer has {e:?}"),
+        }
+    }
+    assert!(lamps > 0, "rainy_street_small has emissive lamps");
+}

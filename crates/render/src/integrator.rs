@@ -49,7 +49,7 @@ use crate::bsdf::Bsdf;
 use crate::camera::Camera;
 use crate::film::{Film, Pixel};
 use crate::geometry::{offset_ray_origin, Frame, Ray};
-use crate::light::{emitted_radiance, LightSampler, Receiver, Visibility};
+use crate::light::{LightSampler, Receiver, Visibility};
 use crate::output::RgbImage;
 use crate::sampling::{power_heuristic, Sampler};
 use crate::scene::Scene;
@@ -144,7 +144,6 @@ pub fn render(
     progress: &(dyn Fn(u64) + Sync),
 ) -> RenderOutput {
     let start = Instant::now();
-    let lights = LightSampler::new(scene);
     let (width, height) = (settings.width, settings.height);
     let mut film = Film::new(width, height);
     let rays = AtomicU64::new(0);
@@ -172,7 +171,6 @@ pub fn render(
                 let ray = camera.generate_ray(film_pos, width, height);
                 let path = trace_path(
                     scene,
-                    &lights,
                     ray,
                     &mut sampler,
                     settings.max_depth,
@@ -219,12 +217,12 @@ fn first_hit_layers(scene: &Scene, ray: &Ray, origin: Vec3, forward: Vec3, pixel
 /// Traces one camera path (see the module documentation).
 fn trace_path(
     scene: &Scene,
-    lights: &LightSampler,
     mut ray: Ray,
     sampler: &mut Sampler,
     max_depth: u32,
     want_specular: bool,
 ) -> PathResult {
+    let lights: &LightSampler = &scene.light_sampler;
     let mut out = PathResult::default();
     let mut throughput = Vec3::ONE;
     // Number of segments before the current one (Mitsuba's `depth`).
@@ -243,12 +241,12 @@ fn trace_path(
         let wo = -ray.direction;
 
         // 1. Emission of the surface hit.
-        let le = emitted_radiance(scene, &hit, wo);
+        let le = scene.emitted_radiance(&hit, wo);
         if le.max_element() > 0.0 {
             if depth == 0 {
                 out.radiance += throughput * le;
             } else {
-                let light_pdf = prev.map_or(0.0, |rx| lights.pdf_li(scene, &rx, &hit));
+                let light_pdf = prev.map_or(0.0, |rx| lights.pdf_li(&rx, &hit));
                 let weight = power_heuristic(1.0, prev_bsdf_pdf, 1.0, light_pdf);
                 out.radiance += throughput * le * weight;
                 if let (1, Some((bsdf, frame, wo_local))) = (depth, first_bsdf) {
@@ -294,7 +292,8 @@ fn trace_path(
             wo_local,
             bsdf,
         };
-        if let Some(ls) = lights.sample_li(scene, &rx, u_light, u_point) {
+        if let Some(ls) = lights.sample_li(&scene.materials, &scene.textures, &rx, u_light, u_point)
+        {
             let wi_local = frame.to_local(ls.wi);
             if wi_local.z > 0.0 && ng.dot(ls.wi) > 0.0 {
                 // The BSDF's density of wi matters only for MIS against an area light.
@@ -334,10 +333,11 @@ fn trace_path(
                             match scene.intersect(&ray) {
                                 Some(h)
                                     if lights
+                                        .emitters()
                                         .emitter_of(h.triangle)
                                         .is_some_and(|(e, _)| e == emitter as usize) =>
                                 {
-                                    emitted_radiance(scene, &h, -ls.wi)
+                                    scene.emitted_radiance(&h, -ls.wi)
                                 }
                                 _ => Vec3::ZERO,
                             }

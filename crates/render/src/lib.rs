@@ -11,7 +11,9 @@
 //!   `ggx`, `ward` and `blinn_phong`, and the glTF metallic-roughness BRDF.
 //! - [`material`] and [`texture`]: what a scene stores; a material turns into a [`bsdf::Bsdf`]
 //!   at a surface point.
-//! - [`light`]: point, spot, directional lights and emissive triangles, with light selection.
+//! - [`light`]: one file per concept: the punctual lights ([`light::Light`]), the emitters
+//!   ([`light::Emitters`]: punctual lights and meshes of emissive triangles, built once with the
+//!   scene), the light tree ([`light::LightTree`]) and the light choice ([`light::LightSampler`]).
 //! - [`accel`]: the only module that sees obvhs; closest-hit and shadow queries.
 //! - [`scene`]: loading glTF 2.0 and OBJ into a [`scene::Scene`], with errors that name the file
 //!   and the element.

@@ -493,8 +493,8 @@ impl<'a> MaterialWriter<'a> {
     }
 }
 
-/// The light elements for the non-triangle lights.
-fn light_xml(light: &Light, warnings: &mut Vec<String>) -> Option<String> {
+/// The emitter element of a punctual light.
+fn light_xml(light: &Light, warnings: &mut Vec<String>) -> String {
     match *light {
         Light::Point {
             position,
@@ -507,11 +507,11 @@ fn light_xml(light: &Light, warnings: &mut Vec<String>) -> Option<String> {
                      light has no range)"
                 ));
             }
-            Some(format!(
+            format!(
                 "<emitter type=\"point\"><point name=\"position\" value=\"{}\"/>{}</emitter>",
                 v3(position),
                 rgb("intensity", intensity)
-            ))
+            )
         }
         Light::Spot {
             position,
@@ -537,7 +537,7 @@ fn light_xml(light: &Light, warnings: &mut Vec<String>) -> Option<String> {
             } else {
                 Vec3::X
             };
-            Some(format!(
+            format!(
                 "<emitter type=\"spot\"><transform name=\"to_world\">\
                  <lookat origin=\"{}\" target=\"{}\" up=\"{}\"/></transform>{}\
                  <float name=\"cutoff_angle\" value=\"{outer:?}\"/>\
@@ -546,17 +546,16 @@ fn light_xml(light: &Light, warnings: &mut Vec<String>) -> Option<String> {
                 v3(position + direction),
                 v3(up),
                 rgb("intensity", intensity)
-            ))
+            )
         }
         Light::Directional {
             direction,
             irradiance,
-        } => Some(format!(
+        } => format!(
             "<emitter type=\"directional\"><vector name=\"direction\" value=\"{}\"/>{}</emitter>",
             v3(direction),
             rgb("irradiance", irradiance)
-        )),
-        Light::Triangle { .. } => None,
+        ),
     }
 }
 
@@ -663,9 +662,7 @@ pub(crate) fn export_parts(
     );
     let _ = writeln!(xml, "{}", sensor_xml(camera, opts));
     for light in parts.lights {
-        if let Some(e) = light_xml(light, &mut warnings) {
-            let _ = writeln!(xml, "{e}");
-        }
+        let _ = writeln!(xml, "{}", light_xml(light, &mut warnings));
     }
     let meshes = meshes_by_material(parts);
     let mut mw = MaterialWriter {
@@ -812,7 +809,6 @@ mod tests {
                         cos_outer: 0.8,
                         range: Some(20.0),
                     },
-                    Light::Triangle { triangle: 2 },
                 ],
                 cameras: vec![Camera {
                     name: "cam".into(),

@@ -142,9 +142,11 @@ pub enum LightRecord {
         /// Irradiance (W/m^2).
         irradiance: [f32; 3],
     },
-    /// A group of connected emissive triangles with the same material (a lamp).
+    /// One of the renderer's emitter meshes: connected emissive triangles of one material (a
+    /// lamp).
     Emissive {
-        /// Area-weighted centroid.
+        /// Centre of the emitter's bounding sphere (the centre of its vertices' bounding box),
+        /// the point the renderer's light choice aims at.
         centroid: Placed,
         /// Total area (m^2).
         area: f32,
