@@ -515,6 +515,83 @@ mod tests {
         assert!(out.image.pixels.iter().all(|p| *p == Vec3::ZERO));
     }
 
+    /// A closed cube of half-size 1 around the origin whose walls face inward, are Lambertian of
+    /// albedo `albedo` and emit `le` (one-sided, toward the inside).
+    fn furnace_box(albedo: Vec3, le: Vec3) -> Scene {
+        let mut wall = Material::diffuse("wall", albedo);
+        wall.emission = le;
+        let mut parts = SceneParts {
+            materials: vec![wall],
+            ..Default::default()
+        };
+        for axis in 0..3 {
+            for side in [-1.0f32, 1.0] {
+                // The face at coordinate `side` on `axis`; its two in-plane axes `u`, `v` are
+                // ordered so that the winding's normal points inward (-side along `axis`).
+                let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+                let (u, v) = if side > 0.0 { (u, v) } else { (v, u) };
+                let corner = |a: f32, b: f32| {
+                    let mut c = Vec3::ZERO;
+                    c[axis] = side;
+                    c[u] = a;
+                    c[v] = b;
+                    c
+                };
+                let corners = [
+                    corner(-1.0, -1.0),
+                    corner(-1.0, 1.0),
+                    corner(1.0, 1.0),
+                    corner(1.0, -1.0),
+                ];
+                let n = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
+                debug_assert!(n[axis] * side < 0.0, "the wall faces inward");
+                quad(&mut parts, corners, 0);
+            }
+        }
+        Scene::from_parts(parts).unwrap()
+    }
+
+    /// The multi-bounce furnace: inside a closed box of albedo `a` whose walls all emit `Le`,
+    /// the radiance in every direction is `L = Le + a L = Le / (1 - a)`. Every path vertex hits
+    /// an emitter, so this checks emission, next-event estimation and BSDF sampling combined
+    /// by MIS at every depth, and Russian roulette, against an exact answer.
+    #[test]
+    fn multi_bounce_furnace_gives_le_over_one_minus_albedo() {
+        let le = Vec3::new(1.0, 0.5, 0.25);
+        for a in [0.0f32, 0.5, 0.8] {
+            let scene = furnace_box(Vec3::splat(a), le);
+            let cam = camera(Vec3::new(0.1, -0.2, 0.3), 0.3, 1.2);
+            let out = render(&scene, &cam, &settings(24, 16, 64, u32::MAX), &|_| {});
+            let expected = le / (1.0 - a);
+            let n = out.image.pixels.len() as f64;
+            for c in 0..3 {
+                let values: Vec<f64> = out.image.pixels.iter().map(|p| p[c] as f64).collect();
+                let mean = values.iter().sum::<f64>() / n;
+                let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+                let stderr = (var / n).sqrt();
+                let want = expected[c] as f64;
+                // Four standard errors, and a floor for the noiseless albedo-0 case.
+                assert!(
+                    (mean - want).abs() <= 4.0 * stderr + 1e-5 * want,
+                    "albedo {a}, channel {c}: mean {mean} vs {want} (standard error {stderr})"
+                );
+                // Each pixel is an estimate of the same value.
+                assert!(
+                    values.iter().all(|v| (v - want).abs() < 0.25 * want),
+                    "albedo {a}, channel {c}: a pixel off by more than 25%"
+                );
+            }
+            if a == 0.0 {
+                // Without reflection every pixel is exactly the emission seen directly.
+                assert!(out
+                    .image
+                    .pixels
+                    .iter()
+                    .all(|p| (*p - le).abs().max_element() < 1e-6));
+            }
+        }
+    }
+
     /// A wall of emission `le` at z = -2 in front of a camera at the origin, whose front faces
     /// the camera if `facing`, and a floor of material 0.
     fn emitter_scene(le: Vec3, facing: bool, double_sided: bool) -> Scene {
