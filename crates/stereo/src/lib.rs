@@ -4,8 +4,11 @@
 //! the ground-plane texture map. Everything but [`render`] works without the renderer (build
 //! with `--no-default-features`), so the analysis can use it on photographs.
 //!
-//! - [`rig`]: [`rig::Rig`] (intrinsics, baseline, pose), its eyes ([`rig::EyeCamera`]:
-//!   projection, back-projection), disparity <-> depth (Eq. 5) and the road frame.
+//! - [`rig`]: the camera model. [`rig::Rig`] (intrinsics, baseline, pose), its eyes
+//!   ([`rig::EyeCamera`]: projection, back-projection), disparity <-> depth (Eq. 5) and the road
+//!   frame; and the same rig in `f64` road coordinates ([`rig::RoadRig`]: projection, ground
+//!   points, horizon, elevation, disparity in pixels and the one definition of angular
+//!   disparity), which the analysis crate uses for all its angles.
 //! - [`rigfile`]: `rig.json` ([`rigfile::RigFile`]), with the scene's lights in world and road
 //!   coordinates.
 //! - [`image`]: the single-channel float image [`image::GrayImage`]; PNG and atomic writing.
