@@ -66,7 +66,7 @@ fn stereo_writes_the_pair_ground_truth_and_rig_then_maps_and_prepares_it() {
         .expect("the emissive sign");
     assert_eq!(sign.1, 2);
     assert!((glam::Vec3::from(sign.0) - glam::Vec3::new(0.0, 1.75, -3.0)).length() < 1e-5);
-    let disp = streaks_stereo::pfm::read_pfm(&t.join("out/disparity_left.pfm")).unwrap();
+    let disp = streaks_image::pfm::read_pfm(&t.join("out/disparity_left.pfm")).unwrap();
     // The floor at the bottom: positive finite disparity; the sky at the top corner: inf.
     assert!(disp.get(15, 19).is_finite() && disp.get(15, 19) > 0.0);
     assert!(disp.get(0, 0).is_infinite());
@@ -147,21 +147,15 @@ fn bad_inputs_are_clear_errors() {
 
 use glam::Vec3;
 use std::path::{Path, PathBuf};
-use streaks_analysis::lk::{lk_region, LkParams, Region};
-use streaks_render::output::RgbImage;
+use streaks_analysis::lk::{lk_region, LkParams};
+use streaks_image::{GrayImage, Region, RgbImage};
 use streaks_render::scene::Scene;
-use streaks_stereo::image::GrayImage;
 use streaks_stereo::render::{render_pair, rig_from_camera, write_pair, EyeView, PairSettings};
 use streaks_stereo::rig::Eye;
 use streaks_stereo::streak_mask::StreakMaskParams;
 
 fn luminance_image(img: &RgbImage) -> GrayImage {
-    let data = img
-        .pixels
-        .iter()
-        .map(|p| 0.2126 * p.x + 0.7152 * p.y + 0.0722 * p.z)
-        .collect();
-    GrayImage::from_vec(img.width as usize, img.height as usize, data).unwrap()
+    GrayImage::luminance_of(img).unwrap()
 }
 
 /// Writes a glTF scene: a camera at `camera` (looking along -Z, pitched by `pitch`
@@ -325,7 +319,7 @@ fn road_plane_disparity_matches_the_analytic_plane() {
     ] {
         assert!(dir.path().join(name).exists(), "{name}");
     }
-    let disp = streaks_stereo::pfm::read_pfm(&dir.path().join("disparity_left.pfm")).unwrap();
+    let disp = streaks_image::pfm::read_pfm(&dir.path().join("disparity_left.pfm")).unwrap();
     assert_eq!(disp, views[0].disparity);
     let file = RigFile::load(&dir.path().join("rig.json")).unwrap();
     assert_eq!(file.rig().unwrap().intrinsics(), rig.intrinsics());

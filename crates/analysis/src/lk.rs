@@ -25,7 +25,7 @@
 //! Coordinates follow DESIGN.md: `x` is an image coordinate in pixels (pixel `i` covers
 //! `[i, i+1)`, its centre is `i + 0.5`); rows are pixel indices; `d = x_left - x_right`.
 
-use streaks_stereo::image::GrayImage;
+use streaks_image::{GrayImage, Region};
 
 /// Errors of the Lucas-Kanade estimator (all about user-supplied sizes and parameters).
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -380,26 +380,6 @@ pub fn lk_row(
         gradient_energy,
         residual,
         converged,
-    }
-}
-
-/// A rectangle of pixel indices, half-open: columns `[x0, x1)`, rows `[y0, y1)`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
-pub struct Region {
-    /// First column.
-    pub x0: usize,
-    /// First row.
-    pub y0: usize,
-    /// One past the last column.
-    pub x1: usize,
-    /// One past the last row.
-    pub y1: usize,
-}
-
-impl Region {
-    /// The image x coordinate of the region's centre column.
-    pub fn centre_x(&self) -> f32 {
-        0.5 * (self.x0 + self.x1) as f32
     }
 }
 

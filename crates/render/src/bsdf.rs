@@ -26,10 +26,11 @@
 //! The chi-square, reciprocity, white-furnace and Mitsuba-identity tests are at the bottom of
 //! this file; [`crate::testing::check_bsdf`] checks a model for one `wo`.
 
-use crate::sampling::{luminance, square_to_cosine_hemisphere, square_to_cosine_hemisphere_pdf};
+use crate::sampling::{square_to_cosine_hemisphere, square_to_cosine_hemisphere_pdf};
 use glam::{Vec2, Vec3, Vec4};
 use std::f32::consts::{FRAC_1_PI, PI, TAU};
 use std::ops::{Add, Div, Mul, Neg};
+use streaks_image::luminance;
 
 /// Which part of a model produced a sampled or evaluated contribution.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

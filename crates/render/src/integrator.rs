@@ -50,13 +50,13 @@ use crate::camera::Camera;
 use crate::film::{Film, Pixel};
 use crate::geometry::{offset_ray_origin, Frame, Ray};
 use crate::light::{LightSampler, Receiver, Visibility};
-use crate::output::RgbImage;
 use crate::sampling::{power_heuristic, Sampler};
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
+use streaks_image::RgbImage;
 
 /// Depth from which Russian roulette may end a path (Mitsuba 3's default `rr_depth`).
 pub const RR_DEPTH: u32 = 5;

@@ -19,15 +19,14 @@
 //!   and the element.
 //! - [`camera`]: the pinhole camera of DESIGN.md (pixel centres at `i + 0.5`, `f = (H/2)/tan(yfov/2)`).
 //! - [`integrator`]: unidirectional path tracing with next-event estimation and MIS.
-//! - [`film`] and [`output`]: the box-filtered film with its layers, EXR and PNG writing.
-//! - [`mitsuba`]: export to Mitsuba 3 (the reference renderer); [`compare`]: statistics of the
-//!   difference between two renders.
+//! - [`film`]: the box-filtered film with its layers; [`output`]: the renderer's EXR layout
+//!   (images, regions, file formats and comparisons are the `streaks-image` crate's).
+//! - [`mitsuba`]: export to Mitsuba 3 (the reference renderer).
 #![deny(missing_docs)]
 
 pub mod accel;
 pub mod bsdf;
 pub mod camera;
-pub mod compare;
 pub mod film;
 pub mod geometry;
 pub mod integrator;

@@ -21,18 +21,18 @@
 //! `tests/cli/stereo.rs`.
 
 use crate::error::StereoError;
-use crate::image::GrayImage;
 use crate::pair::write_pair_views;
-use crate::pfm::write_pfm;
 use crate::rig::{Eye, Intrinsics, Rig, RoadFrame};
 use crate::rigfile::{LightRecord, Placed, RigFile};
 use crate::streak_mask::{streak_mask, StreakMaskParams};
-use glam::Vec3;
 use std::path::Path;
+use streaks_image::pfm::write_pfm;
+use streaks_image::png::{to_srgb8_image, write_png_buffer};
+use streaks_image::GrayImage;
 use streaks_render::camera::Camera;
 use streaks_render::integrator::{render, Layers, RenderOutput, RenderSettings};
 use streaks_render::light::{Emitter, Light};
-use streaks_render::output::{to_srgb8, write_exr, write_png, RgbImage};
+use streaks_render::output::write_exr;
 use streaks_render::scene::Scene;
 
 /// A road pixel's first-hit normal is within this angle's cosine of +Y (10 degrees).
@@ -98,18 +98,6 @@ pub struct EyeView {
     pub streak_threshold: f32,
 }
 
-fn luminance(rgb: Vec3) -> f32 {
-    0.2126 * rgb.x + 0.7152 * rgb.y + 0.0722 * rgb.z
-}
-
-fn luminance_image(img: &RgbImage) -> Result<GrayImage, StereoError> {
-    Ok(GrayImage::from_vec(
-        img.width as usize,
-        img.height as usize,
-        img.pixels.iter().map(|&p| luminance(p)).collect(),
-    )?)
-}
-
 /// Renders one eye and derives its ground truth and streak mask.
 pub fn render_eye(
     scene: &Scene,
@@ -169,8 +157,8 @@ pub fn render_eye(
         .map(|(n, z)| z.is_finite() && n.y > ROAD_COS)
         .collect();
     let (streak_mask, streak_threshold) = streak_mask(
-        &luminance_image(specular)?,
-        &luminance_image(&output.image)?,
+        &GrayImage::luminance_of(specular)?,
+        &GrayImage::luminance_of(&output.image)?,
         Some(&road),
         &settings.mask,
     )?;
@@ -268,13 +256,11 @@ pub fn write_pair(
     let mut srgb = Vec::with_capacity(2);
     for (eye, view) in Eye::BOTH.into_iter().zip(views) {
         let name = eye.name();
-        write_exr(&dir.join(format!("{name}.exr")), &view.output).map_err(output_err)?;
-        let img = &view.output.image;
-        write_png(&dir.join(format!("{name}.png")), img, exposure_ev).map_err(output_err)?;
-        srgb.push(
-            image::RgbImage::from_raw(img.width, img.height, to_srgb8(img, exposure_ev))
-                .ok_or_else(|| output_err("image size does not match its pixels"))?,
-        );
+        write_exr(&dir.join(format!("{name}.exr")), &view.output)?;
+        let img = to_srgb8_image(&view.output.image, exposure_ev)
+            .ok_or_else(|| output_err("image size does not match its pixels"))?;
+        write_png_buffer(&dir.join(format!("{name}.png")), &img)?;
+        srgb.push(img);
         write_pfm(&dir.join(format!("disparity_{name}.pfm")), &view.disparity)?;
         write_pfm(&dir.join(format!("depth_{name}.pfm")), &view.depth)?;
         view.streak_mask
@@ -288,7 +274,7 @@ pub fn write_pair(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::Affine3A;
+    use glam::{Affine3A, Vec3};
 
     #[test]
     fn bad_inputs_are_errors() {

@@ -7,7 +7,7 @@ use super::ReportError;
 use crate::sgm::{compare_disparity_where, DisparityErrors, SgmError};
 use glam::{DVec2, Vec3};
 use serde::Serialize;
-use streaks_stereo::image::GrayImage;
+use streaks_image::GrayImage;
 
 /// Summary of the dense disparity.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]

@@ -3,8 +3,8 @@
 use super::ReportError;
 use glam::{Vec2, Vec3};
 use std::path::Path;
-use streaks_stereo::image::GrayImage;
-use streaks_stereo::pfm::read_pfm;
+use streaks_image::pfm::read_pfm;
+use streaks_image::GrayImage;
 use streaks_stereo::rig::{Eye, EyeCamera, Rig, RoadFrame, RoadRig};
 use streaks_stereo::rigfile::{LightRecord, RigFile};
 

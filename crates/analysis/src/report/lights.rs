@@ -5,6 +5,7 @@ use super::input::RigView;
 use crate::detect::Streak;
 use glam::DVec3;
 use serde::Serialize;
+use streaks_image::luminance;
 use streaks_stereo::rigfile::LightRecord;
 
 /// The light a streak was matched to.
@@ -25,7 +26,7 @@ pub struct MatchedLight {
 /// A light's kind, road-frame position and strength (radiant intensity, luminance; an emissive
 /// group's radiance times its area).
 fn light_position(light: &LightRecord) -> Option<(&'static str, [f32; 3], f64)> {
-    let lum = |c: [f32; 3]| (0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]) as f64;
+    let lum = |c: [f32; 3]| luminance(c.into()) as f64;
     match light {
         LightRecord::Point {
             position,

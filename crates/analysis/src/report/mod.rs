@@ -53,18 +53,18 @@ pub use dense::{dense_accuracy, DenseAccuracy, DenseSummary};
 pub use input::StereoInput;
 pub use lights::MatchedLight;
 pub use output::{rows_plot, summary_table, write_outputs, write_report_json};
-pub use pipeline::{analyze, AnalyzeParams, NamedRegion};
+pub use pipeline::{analyze, AnalyzeParams};
 pub use stats::{compare, fit_line, Comparison, LineFit};
 
 use crate::detect::{DetectError, MaskScore};
-use crate::lk::{LkError, Region};
+use crate::lk::LkError;
 use crate::model::ModelError;
 use crate::plot::PlotError;
 use crate::sgm::SgmError;
 use serde::Serialize;
 use std::path::PathBuf;
+use streaks_image::{GrayImage, ImageError, Region};
 use streaks_stereo::error::StereoError;
-use streaks_stereo::image::{GrayImage, ImageError};
 
 /// Errors of the analysis.
 #[derive(Debug, thiserror::Error)]

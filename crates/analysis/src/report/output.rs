@@ -9,7 +9,8 @@ use super::{Analysis, Report, ReportError, RowRecord};
 use crate::plot::{Marker, Plot, Series, BLACK_RGB, BLUE, GREY, RED};
 use crate::sgm::disparity_preview;
 use std::path::{Path, PathBuf};
-use streaks_stereo::image::{save_rgb8_png, write_file_atomic};
+use streaks_image::png::write_png_buffer;
+use streaks_image::write_bytes_atomically;
 
 /// The disparity-against-row plot of one region: measured black, predicted blue, and for a
 /// streak the road's disparity grey. Given `min_ncc`, the rows whose match has a lower NCC
@@ -62,7 +63,7 @@ fn write_err(path: &Path) -> impl FnOnce(String) -> ReportError + '_ {
 /// Writes `report.json` atomically.
 pub fn write_report_json(path: &Path, report: &Report) -> Result<(), ReportError> {
     let text = serde_json::to_string_pretty(report).map_err(|e| write_err(path)(e.to_string()))?;
-    write_file_atomic(path, text.as_bytes()).map_err(|e| write_err(path)(e.to_string()))
+    write_bytes_atomically(path, text.as_bytes()).map_err(|e| write_err(path)(e.to_string()))
 }
 
 /// Writes everything into `dir` (created if missing): `report.json`, `streak<i>.png` and
@@ -124,7 +125,7 @@ pub fn write_outputs(
         }
     }
     let path = dir.join("depth.png");
-    save_rgb8_png(&path, &img)?;
+    write_png_buffer(&path, &img)?;
     written.push(path);
     let path = dir.join("streak_mask.png");
     analysis

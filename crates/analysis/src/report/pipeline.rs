@@ -9,20 +9,11 @@ use super::stats::{compare, median, span};
 use super::targets::{find_objects, find_road};
 use super::{Analysis, RegionReport, Report, ReportError, RigSummary, RowRecord, StreakReport};
 use crate::detect::{detect_streaks, score_mask, vertical_truth, DetectParams, Streak};
-use crate::lk::{lk_rows, prepare_pair, LkError, LkParams, Region, RowDisparity};
+use crate::lk::{lk_rows, prepare_pair, LkError, LkParams, RowDisparity};
 use crate::model::streak_rows;
 use crate::sgm::{sgm, SgmParams};
 use glam::{DVec3, Vec3};
-use streaks_stereo::image::GrayImage;
-
-/// A region named on the command line.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct NamedRegion {
-    /// Its name in the report.
-    pub name: String,
-    /// The pixels.
-    pub region: Region,
-}
+use streaks_image::{GrayImage, NamedRegion, Region};
 
 /// Parameters of [`analyze`].
 #[derive(Clone, Debug)]

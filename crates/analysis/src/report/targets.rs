@@ -2,8 +2,7 @@
 //! objects ([`find_objects`]: poles, posts) and plain road ([`find_road`]), as in Fig. 8.
 
 use super::input::RigView;
-use crate::lk::Region;
-use streaks_stereo::image::GrayImage;
+use streaks_image::{GrayImage, Region};
 
 /// Height above the road of the ground-truth point at pixel `(x, y)`.
 fn truth_road_y(depth: &GrayImage, view: &RigView, x: usize, y: usize) -> f32 {

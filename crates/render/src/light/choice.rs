@@ -28,12 +28,13 @@ use super::{Light, LightSample};
 use crate::bsdf::{Bsdf, LuminanceEval};
 use crate::geometry::Frame;
 use crate::material::Material;
-use crate::sampling::{luminance, ONE_MINUS_EPSILON};
+use crate::sampling::ONE_MINUS_EPSILON;
 use crate::scene::SurfaceHit;
 use crate::texture::Texture;
 use glam::{Vec2, Vec3, Vec4};
 use std::f32::consts::PI;
 use std::ops::Range;
+use streaks_image::luminance;
 
 /// Share of the light choice made by irradiance alone when it is BSDF-aware (defensive
 /// sampling, see the module documentation).

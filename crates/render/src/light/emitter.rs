@@ -22,7 +22,7 @@ use super::{Light, LightSample, Visibility};
 use crate::geometry::Frame;
 use crate::material::Material;
 use crate::sampling::{
-    luminance, square_to_uniform_cone, square_to_uniform_cone_pdf, square_to_uniform_triangle,
+    square_to_uniform_cone, square_to_uniform_cone_pdf, square_to_uniform_triangle,
     DiscreteDistribution,
 };
 use crate::scene::SurfaceHit;
@@ -30,6 +30,7 @@ use crate::texture::Texture;
 use glam::{Vec2, Vec3};
 use std::collections::HashMap;
 use std::f32::consts::PI;
+use streaks_image::luminance;
 
 /// An emitter mesh is sampled by its bounding cone when its area is at least this many times
 /// `pi r^2` (r: its bounding radius): a closed, roughly round shape (a tessellated sphere has

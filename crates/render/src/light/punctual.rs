@@ -16,9 +16,9 @@
 //! contribution (see [`super::LightSample`]).
 
 use super::{LightSample, Visibility};
-use crate::sampling::luminance;
 use glam::Vec3;
 use std::f32::consts::PI;
+use streaks_image::luminance;
 
 /// A punctual light source.
 #[derive(Clone, Copy, Debug, PartialEq)]
