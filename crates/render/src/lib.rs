@@ -34,6 +34,7 @@ pub mod light;
 pub mod material;
 pub mod mitsuba;
 pub mod output;
+pub mod regression;
 pub mod sampling;
 pub mod scene;
 pub mod testing;
