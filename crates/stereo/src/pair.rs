@@ -3,6 +3,7 @@
 //! moves a chosen disparity to zero).
 
 use crate::error::StereoError;
+use crate::pair_dir::PairDir;
 use std::path::Path;
 use streaks_image::png::write_png_buffer;
 use streaks_image::GrayImage;
@@ -59,8 +60,9 @@ pub fn write_pair_views(
     left: &image::RgbImage,
     right: &image::RgbImage,
 ) -> Result<(), StereoError> {
-    write_png_buffer(&dir.join("side_by_side.png"), &side_by_side(left, right)?)?;
-    write_png_buffer(&dir.join("anaglyph.png"), &anaglyph(left, right)?)?;
+    let files = PairDir::new(dir);
+    write_png_buffer(&files.side_by_side(), &side_by_side(left, right)?)?;
+    write_png_buffer(&files.anaglyph(), &anaglyph(left, right)?)?;
     Ok(())
 }
 

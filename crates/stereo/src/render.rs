@@ -22,6 +22,7 @@
 
 use crate::error::StereoError;
 use crate::pair::write_pair_views;
+use crate::pair_dir::PairDir;
 use crate::rig::{Eye, Intrinsics, Rig, RoadFrame};
 use crate::rigfile::{LightRecord, Placed, RigFile};
 use crate::streak_mask::{streak_mask, StreakMaskParams};
@@ -253,22 +254,21 @@ pub fn write_pair(
     views: &[EyeView; 2],
     exposure_ev: f32,
 ) -> Result<(), StereoError> {
+    let files = PairDir::new(dir);
     let mut srgb = Vec::with_capacity(2);
     for (eye, view) in Eye::BOTH.into_iter().zip(views) {
-        let name = eye.name();
-        write_exr(&dir.join(format!("{name}.exr")), &view.output)?;
+        write_exr(&files.exr(eye), &view.output)?;
         let img = to_srgb8_image(&view.output.image, exposure_ev)
             .ok_or_else(|| output_err("image size does not match its pixels"))?;
-        write_png_buffer(&dir.join(format!("{name}.png")), &img)?;
+        write_png_buffer(&files.png(eye), &img)?;
         srgb.push(img);
-        write_pfm(&dir.join(format!("disparity_{name}.pfm")), &view.disparity)?;
-        write_pfm(&dir.join(format!("depth_{name}.pfm")), &view.depth)?;
-        view.streak_mask
-            .save_png(&dir.join(format!("streak_mask_{name}.png")))?;
+        write_pfm(&files.disparity(eye), &view.disparity)?;
+        write_pfm(&files.depth(eye), &view.depth)?;
+        view.streak_mask.save_png(&files.streak_mask(eye))?;
     }
     write_pair_views(dir, &srgb[0], &srgb[1])?;
     let road = rig.road_frame().ok();
-    RigFile::new(rig, light_records(scene, road.as_ref())).save(&dir.join("rig.json"))
+    RigFile::new(rig, light_records(scene, road.as_ref())).save(&files.rig())
 }
 
 #[cfg(test)]

@@ -2,9 +2,10 @@
 
 use super::ReportError;
 use glam::{Vec2, Vec3};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use streaks_image::pfm::read_pfm;
-use streaks_image::GrayImage;
+use streaks_image::{GrayImage, ImageError};
+use streaks_stereo::pair_dir::PairDir;
 use streaks_stereo::rig::{Eye, EyeCamera, Rig, RoadFrame, RoadRig};
 use streaks_stereo::rigfile::{LightRecord, RigFile};
 
@@ -32,41 +33,22 @@ impl StereoInput {
     /// ground truth `dir/disparity_left.pfm`, `dir/depth_left.pfm` and the renderer's streak
     /// mask `dir/streak_mask_left.png` if present.
     pub fn load(dir: &Path) -> Result<Self, ReportError> {
-        let image = |name: &str| -> Result<GrayImage, ReportError> {
-            let exr = dir.join(format!("{name}.exr"));
-            let path = if exr.exists() {
-                exr
-            } else {
-                dir.join(format!("{name}.png"))
-            };
-            Ok(GrayImage::load(&path)?)
-        };
-        let (left, right) = (image("left")?, image("right")?);
-        let file = RigFile::load(&dir.join("rig.json"))?;
+        let files = PairDir::new(dir);
+        let left = GrayImage::load(&files.image(Eye::Left))?;
+        let right = GrayImage::load(&files.image(Eye::Right))?;
+        let file = RigFile::load(&files.rig())?;
         let rig = file.rig()?;
-        let optional = |name: &str| -> Result<Option<GrayImage>, ReportError> {
-            let p = dir.join(name);
-            Ok(if p.exists() {
-                Some(read_pfm(&p)?)
-            } else {
-                None
-            })
+        let optional = |p: PathBuf, read: fn(&Path) -> Result<GrayImage, ImageError>| {
+            p.exists().then(|| read(&p)).transpose()
         };
         let input = Self {
             left,
             right,
             rig,
             lights: file.lights,
-            truth_disparity: optional("disparity_left.pfm")?,
-            truth_depth: optional("depth_left.pfm")?,
-            truth_streak_mask: {
-                let p = dir.join("streak_mask_left.png");
-                if p.exists() {
-                    Some(GrayImage::load(&p)?)
-                } else {
-                    None
-                }
-            },
+            truth_disparity: optional(files.disparity(Eye::Left), read_pfm)?,
+            truth_depth: optional(files.depth(Eye::Left), read_pfm)?,
+            truth_streak_mask: optional(files.streak_mask(Eye::Left), GrayImage::load)?,
         };
         let i = input.rig.intrinsics();
         let size = (i.width() as usize, i.height() as usize);
