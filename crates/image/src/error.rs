@@ -2,6 +2,15 @@
 
 use std::path::PathBuf;
 
+/// A region's name followed by a space, or nothing for an unnamed region.
+fn labelled(name: &str) -> String {
+    if name.is_empty() {
+        String::new()
+    } else {
+        format!("{name} ")
+    }
+}
+
 /// An error of this crate.
 #[derive(Debug, thiserror::Error)]
 pub enum ImageError {
@@ -91,7 +100,8 @@ pub enum ImageError {
     },
     /// A region is empty or extends past the image.
     #[error(
-        "region {name} ({x0},{y0})-({x1},{y1}) is empty or outside the {width}x{height} image"
+        "region {}({x0},{y0})-({x1},{y1}) is empty or outside the {width}x{height} image",
+        labelled(.name)
     )]
     RegionOutside {
         /// Region name (empty for an unnamed one).

@@ -297,19 +297,7 @@ pub fn analyze(input: &StereoInput, params: &AnalyzeParams) -> Result<Analysis, 
     let mut regions = Vec::new();
     for r in &params.regions {
         let g = r.region;
-        if g.x0 >= g.x1 || g.y0 >= g.y1 || g.x1 > input.left.width || g.y1 > input.left.height {
-            return Err(ReportError::Lk {
-                what: format!("region {}", r.name),
-                source: LkError::Region {
-                    x0: g.x0,
-                    y0: g.y0,
-                    x1: g.x1,
-                    y1: g.y1,
-                    width: input.left.width,
-                    height: input.left.height,
-                },
-            });
-        }
+        g.check_fits(&r.name, input.left.width, input.left.height)?;
         let centres: Vec<(usize, f32)> = (g.y0..g.y1).map(|y| (y, g.centre_x())).collect();
         regions.push(measure_region(
             r.name.clone(),
