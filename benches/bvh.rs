@@ -140,10 +140,7 @@ struct RaySets {
 
 fn ray_sets(scene: &Scene) -> RaySets {
     let camera = &scene.cameras[0];
-    let light = scene.lights.iter().find_map(|l| match *l {
-        Light::Point { position, .. } | Light::Spot { position, .. } => Some(position),
-        _ => None,
-    });
+    let light = scene.lights.iter().find_map(Light::position);
     let mut rng = Pcg32::new(11, 0);
     let mut primary = Vec::new();
     let mut bounce = Vec::new();

@@ -6,10 +6,11 @@
 use anyhow::{Context, Result};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-use streaks_analysis::lk::{LkParams, Region};
+use streaks_analysis::lk::LkParams;
 use streaks_analysis::report::{
-    analyze, summary_table, write_outputs, AnalyzeParams, NamedRegion, Report, StereoInput,
+    analyze, summary_table, write_outputs, AnalyzeParams, Report, StereoInput,
 };
+use streaks_image::{ImageError, NamedRegion};
 
 /// Analyse a rendered stereo pair: streak disparities against the virtual light column model.
 #[derive(clap::Args, Debug)]
@@ -41,33 +42,14 @@ pub struct Args {
     pub match_tolerance: f32,
 }
 
-/// Parses `name=x0,y0,x1,y1`.
+/// Parses `name=x0,y0,x1,y1` ([`NamedRegion`]'s parser, with the name required: it names the
+/// region's plot file).
 pub fn parse_named_region(s: &str) -> Result<NamedRegion, String> {
-    let (name, rest) = s
-        .split_once('=')
-        .ok_or_else(|| format!("expected name=x0,y0,x1,y1, got {s:?}"))?;
-    let name = name.trim();
-    if name.is_empty()
-        || !name
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
-    {
-        return Err(format!(
-            "region name {name:?} must be letters, digits, _ or -"
-        ));
+    let region: NamedRegion = s.parse().map_err(|e: ImageError| e.to_string())?;
+    if region.name.is_empty() {
+        return Err(format!("expected name=x0,y0,x1,y1, got {s:?}"));
     }
-    let v: Vec<usize> = rest
-        .split(',')
-        .map(|t| t.trim().parse::<usize>())
-        .collect::<Result<_, _>>()
-        .map_err(|e| format!("expected x0,y0,x1,y1 as non-negative integers: {e}"))?;
-    match v[..] {
-        [x0, y0, x1, y1] => Ok(NamedRegion {
-            name: name.to_string(),
-            region: Region { x0, y0, x1, y1 },
-        }),
-        _ => Err(format!("expected 4 numbers x0,y0,x1,y1, got {}", v.len())),
-    }
+    Ok(region)
 }
 
 impl Args {
@@ -132,6 +114,7 @@ pub fn run(args: Args) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use streaks_image::Region;
 
     #[test]
     fn named_regions_parse() {

@@ -1,12 +1,13 @@
 //! `streaks compare`: relative RMSE and bias of one render against a reference, overall, per
 //! region and for the worst 8x8 block, optionally with the noise test (second renders with
-//! other seeds) and a false-colour difference PNG. See `streaks_render::compare` for the
+//! other seeds) and a false-colour difference PNG. See `streaks_image::compare` for the
 //! statistics.
 
 use anyhow::Context;
 use std::path::{Path, PathBuf};
-use streaks_render::compare::{compare, write_diff_png, Inputs, Region};
-use streaks_render::output::{read_exr_rgb, RgbImage};
+use streaks_image::compare::{compare, write_diff_png, Inputs};
+use streaks_image::exr::read_exr_rgb;
+use streaks_image::{NamedRegion, RgbImage};
 
 /// Arguments of `streaks compare`.
 #[derive(clap::Args, Debug)]
@@ -17,7 +18,7 @@ pub struct Args {
     pub b: PathBuf,
     /// A region `[name=]x0,y0,x1,y1` (pixels, x1 and y1 exclusive); repeatable.
     #[arg(long = "region", value_name = "[NAME=]X0,Y0,X1,Y1")]
-    pub regions: Vec<Region>,
+    pub regions: Vec<NamedRegion>,
     /// Print the comparison as JSON instead of a table.
     #[arg(long)]
     pub json: bool,

@@ -7,8 +7,8 @@ use std::path::PathBuf;
 use streaks_analysis::sgm::{
     compare_disparity, sgm, write_disparity_png, Census, Paths, SgmParams,
 };
-use streaks_stereo::image::GrayImage;
-use streaks_stereo::pfm::{read_pfm, write_pfm};
+use streaks_image::pfm::{read_pfm, write_pfm};
+use streaks_image::GrayImage;
 
 /// Arguments of `streaks disparity`.
 #[derive(clap::Args, Debug)]

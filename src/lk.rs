@@ -5,9 +5,9 @@ use anyhow::{bail, Context};
 use std::path::PathBuf;
 use streaks_analysis::detect::{detect_streaks, DetectParams};
 use streaks_analysis::lk::{
-    lk_region, lk_rows, prepare_pair, Interp, LkParams, Photometric, Region, RowDisparity,
+    lk_region, lk_rows, prepare_pair, Interp, LkParams, Photometric, RowDisparity,
 };
-use streaks_stereo::image::GrayImage;
+use streaks_image::{GrayImage, Region};
 
 /// Output format.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -27,7 +27,7 @@ pub struct Args {
     /// Right image.
     pub right: PathBuf,
     /// Region of the left image, pixel indices x0,y0,x1,y1 (half-open: x0 <= x < x1).
-    #[arg(long, value_parser = parse_region)]
+    #[arg(long, value_name = "X0,Y0,X1,Y1")]
     pub region: Option<Region>,
     /// Instead of a region: detect streaks in the left image and estimate along each one's
     /// centre (adds a `streak` column: the streak's index).
@@ -66,18 +66,6 @@ pub struct Args {
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Csv)]
     pub format: Format,
-}
-
-fn parse_region(s: &str) -> Result<Region, String> {
-    let v: Vec<usize> = s
-        .split(',')
-        .map(|t| t.trim().parse::<usize>())
-        .collect::<Result<_, _>>()
-        .map_err(|e| format!("expected x0,y0,x1,y1 as non-negative integers: {e}"))?;
-    match v[..] {
-        [x0, y0, x1, y1] => Ok(Region { x0, y0, x1, y1 }),
-        _ => Err(format!("expected 4 numbers x0,y0,x1,y1, got {}", v.len())),
-    }
 }
 
 /// Runs the command.

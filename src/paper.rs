@@ -13,9 +13,9 @@ use std::time::Instant;
 use streaks_analysis::figures;
 use streaks_analysis::plot::{Marker, Plot, Series, BLACK_RGB, BLUE, GREY};
 use streaks_analysis::report::{Comparison, Report, RowRecord, StreakReport};
-use streaks_render::output::write_png;
+use streaks_image::png::write_png;
+use streaks_image::{write_bytes_atomically, GrayImage};
 use streaks_render::scene::Scene;
-use streaks_stereo::image::{write_file_atomic, GrayImage};
 use streaks_stereo::render::{render_eye, render_pair, rig_from_camera, write_pair, PairSettings};
 use streaks_stereo::rig::{Eye, Rig};
 use streaks_stereo::streak_mask::StreakMaskParams;
@@ -322,7 +322,7 @@ pub fn run(args: Args) -> Result<()> {
     fig6(&args, out, &mut index)?;
     let _ = writeln!(index, "Made in {:.0} s.", start.elapsed().as_secs_f64());
     let path = out.join("index.md");
-    write_file_atomic(&path, index.as_bytes())
+    write_bytes_atomically(&path, index.as_bytes())
         .with_context(|| format!("writing {}", path.display()))?;
     eprintln!(
         "wrote {} in {:.1} s",

@@ -4,7 +4,7 @@
 
 use anyhow::Context;
 use std::path::PathBuf;
-use streaks_stereo::image::GrayImage;
+use streaks_image::GrayImage;
 use streaks_stereo::pair::{prepare_pair, write_pair_views};
 
 /// Treat a photographed pair as in the paper's Fig. 7.

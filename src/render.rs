@@ -4,6 +4,7 @@ use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
+use streaks_image::png::write_png;
 use streaks_render::camera::Camera;
 use streaks_render::integrator::{self, Layers, RenderOutput, RenderSettings};
 use streaks_render::output;
@@ -276,10 +277,10 @@ pub fn run(args: Args) -> Result<()> {
 
     match format {
         Format::Exr => output::write_exr(&args.output, &out)?,
-        Format::Png => output::write_png(&args.output, &out.image, opts.exposure)?,
+        Format::Png => write_png(&args.output, &out.image, opts.exposure)?,
     }
     if let Some(png) = &args.png {
-        output::write_png(png, &out.image, opts.exposure)?;
+        write_png(png, &out.image, opts.exposure)?;
     }
     let s = &out.stats;
     let secs = s.seconds.max(1e-9);

@@ -3,9 +3,10 @@
 
 use anyhow::Context;
 use std::path::PathBuf;
+use streaks_image::gray::load_rgb_channels;
 use streaks_stereo::rig::Eye;
 use streaks_stereo::rigfile::RigFile;
-use streaks_stereo::texture_map::{load_rgb_channels, plot_texture_map, texture_map, MapSpec};
+use streaks_stereo::texture_map::{plot_texture_map, texture_map, MapSpec};
 
 /// Which eye saw the image.
 #[derive(clap::ValueEnum, Clone, Copy, Debug)]

@@ -1,7 +1,8 @@
 //! End-to-end tests of `streaks render`, and of every shipped scene through it.
 
 use crate::common::TestDir;
-use streaks_render::output::{read_exr_layer, read_exr_rgb};
+use streaks_image::exr::read_exr_rgb;
+use streaks_render::output::read_exr_layer;
 
 #[test]
 fn render_writes_exr_with_layers_and_png() {

@@ -66,7 +66,7 @@ fn stereo_writes_the_pair_ground_truth_and_rig_then_maps_and_prepares_it() {
         .expect("the emissive sign");
     assert_eq!(sign.1, 2);
     assert!((glam::Vec3::from(sign.0) - glam::Vec3::new(0.0, 1.75, -3.0)).length() < 1e-5);
-    let disp = streaks_stereo::pfm::read_pfm(&t.join("out/disparity_left.pfm")).unwrap();
+    let disp = streaks_image::pfm::read_pfm(&t.join("out/disparity_left.pfm")).unwrap();
     // The floor at the bottom: positive finite disparity; the sky at the top corner: inf.
     assert!(disp.get(15, 19).is_finite() && disp.get(15, 19) > 0.0);
     assert!(disp.get(0, 0).is_infinite());
@@ -147,21 +147,15 @@ fn bad_inputs_are_clear_errors() {
 
 use glam::Vec3;
 use std::path::{Path, PathBuf};
-use streaks_analysis::lk::{lk_region, LkParams, Region};
-use streaks_render::output::RgbImage;
+use streaks_analysis::lk::{lk_region, LkParams};
+use streaks_image::{GrayImage, Region, RgbImage};
 use streaks_render::scene::Scene;
-use streaks_stereo::image::GrayImage;
 use streaks_stereo::render::{render_pair, rig_from_camera, write_pair, EyeView, PairSettings};
 use streaks_stereo::rig::Eye;
 use streaks_stereo::streak_mask::StreakMaskParams;
 
 fn luminance_image(img: &RgbImage) -> GrayImage {
-    let data = img
-        .pixels
-        .iter()
-        .map(|p| 0.2126 * p.x + 0.7152 * p.y + 0.0722 * p.z)
-        .collect();
-    GrayImage::from_vec(img.width as usize, img.height as usize, data).unwrap()
+    GrayImage::luminance_of(img).unwrap()
 }
 
 /// Writes a glTF scene: a camera at `camera` (looking along -Z, pitched by `pitch`
@@ -325,7 +319,7 @@ fn road_plane_disparity_matches_the_analytic_plane() {
     ] {
         assert!(dir.path().join(name).exists(), "{name}");
     }
-    let disp = streaks_stereo::pfm::read_pfm(&dir.path().join("disparity_left.pfm")).unwrap();
+    let disp = streaks_image::pfm::read_pfm(&dir.path().join("disparity_left.pfm")).unwrap();
     assert_eq!(disp, views[0].disparity);
     let file = RigFile::load(&dir.path().join("rig.json")).unwrap();
     assert_eq!(file.rig().unwrap().intrinsics(), rig.intrinsics());
@@ -414,4 +408,78 @@ fn rendered_fronto_parallel_plane_has_disparity_f_b_over_z() {
         "measured {d} px, f b / Z = {expect} px"
     );
     assert!(worst < 0.1, "worst row off by {worst} px");
+}
+
+/// `rig.json` lists exactly the renderer's emitters: the same count, kinds and order, each lamp
+/// at the centre the light choice uses (and that centre is where the lamp is: near the
+/// area-weighted centroid of its triangles).
+#[test]
+fn rig_json_lists_the_renderers_emitters() {
+    use streaks_render::light::Emitter;
+    let t = TestDir::new();
+    let scene_path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/rainy_street_small.gltf");
+    t.streaks(&[
+        "stereo",
+        scene_path.to_str().unwrap(),
+        "-o",
+        "out",
+        "--spp",
+        "1",
+        "--height",
+        "16",
+    ])
+    .assert_success();
+    let file = RigFile::load(&t.join("out/rig.json")).unwrap();
+    let scene = streaks_render::scene::Scene::load(&scene_path).unwrap();
+    let emitters = scene.light_sampler.emitters();
+    assert_eq!(file.lights.len(), emitters.len());
+    let mut lamps = 0;
+    for (record, emitter) in file.lights.iter().zip(emitters.list()) {
+        match (record, emitter) {
+            (
+                LightRecord::Emissive {
+                    centroid,
+                    triangles,
+                    area,
+                    ..
+                },
+                Emitter::Mesh(m),
+            ) => {
+                lamps += 1;
+                assert_eq!(glam::Vec3::from(centroid.world), m.centre());
+                assert_eq!((*triangles, *area), (m.triangle_count(), m.area()));
+                // The lamp's own triangles, found independently of the renderer's grouping:
+                // those of its material within its bounding sphere.
+                let (mut weighted, mut total) = (glam::Vec3::ZERO, 0.0);
+                for (t, &mat) in scene.triangle_materials.iter().enumerate() {
+                    let [a, b, c] = scene.triangles[t].map(|v| scene.positions[v as usize]);
+                    let near = [a, b, c]
+                        .iter()
+                        .all(|v| v.distance(m.centre()) <= m.radius());
+                    if mat == m.material() && near {
+                        let area = 0.5 * (b - a).cross(c - a).length();
+                        weighted += area * (a + b + c) / 3.0;
+                        total += area;
+                    }
+                }
+                let centroid = weighted / total;
+                assert!(
+                    centroid.distance(m.centre()) < 0.05 * m.radius(),
+                    "lamp {} centred at {} but its triangles' centroid is {centroid}",
+                    lamps,
+                    m.centre()
+                );
+            }
+            (LightRecord::Point { position, .. }, Emitter::Punctual(l))
+            | (LightRecord::Spot { position, .. }, Emitter::Punctual(l)) => {
+                assert_eq!(Some(glam::Vec3::from(position.world)), l.position());
+            }
+            (LightRecord::Directional { .. }, Emitter::Punctual(l)) => {
+                assert_eq!(l.position(), None);
+            }
+            (r, e) => panic!("rig.json has {r:?} where the renderer has {e:?}"),
+        }
+    }
+    assert!(lamps > 0, "rainy_street_small has emissive lamps");
 }

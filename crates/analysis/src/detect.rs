@@ -25,7 +25,7 @@
 //! [`score_mask`] compares a detection mask with a ground-truth mask (precision and recall).
 //! Coordinates follow DESIGN.md: image x and y with pixel centres at `i + 0.5`; rows are indices.
 
-use streaks_stereo::image::GrayImage;
+use streaks_image::GrayImage;
 
 /// Errors of streak detection.
 #[derive(Debug, thiserror::Error, PartialEq)]

@@ -4,10 +4,10 @@
 //! plots that show it. Works on geometry and images only; it never depends on the renderer.
 //!
 //! - [`model`]: Eq. 2 and Eq. 4 in the road frame ([`model::ColumnModel`]: a light and a
-//!   viewer; the locus of `L_virtual`, the proposition's invariance check), pinhole cameras
-//!   and a rectified rig ([`model::RoadCamera`], [`model::StereoRig`]) with the disparity of
-//!   Eq. 5 in pixels and degrees, and the prediction per image row of a streak
-//!   ([`model::streak_rows`]).
+//!   viewer; the locus of `L_virtual`, the proposition's invariance check) and the prediction
+//!   per image row of a streak ([`model::streak_rows`]). Its cameras, their horizon, elevation
+//!   angles and disparities in pixels and degrees are the stereo crate's
+//!   ([`streaks_stereo::rig::RoadRig`], in `f64`), as are the report's: one camera model.
 //! - [`plot`]: line, scatter and arrow plots with labelled axes and legends, written
 //!   atomically to PNG (plotters, with a font bundled in the crate).
 //! - [`figures`]: the paper's figures made from the model (Fig. 4, Fig. 5).
@@ -18,7 +18,13 @@
 //! - [`report`]: the per-streak analysis of a rendered or photographed pair (Fig. 6, Fig. 8):
 //!   measured against predicted disparity per row, poles and road against their ground truth,
 //!   the dense disparity scored on streak and other pixels, implied depths, plots and
-//!   `report.json`.
+//!   `report.json`. One file per stage under `report/`: `input.rs` (loading a pair),
+//!   `stats.rs` (line fits, comparisons), `lights.rs` (matching streaks to lights), `targets.rs`
+//!   (picking poles and road), `dense.rs` (the SGM point cloud and its score), `pipeline.rs`
+//!   ([`report::analyze`]) and `output.rs` (plots, `report.json`, the console table); `mod.rs`
+//!   holds the report's types.
+//! - [`synth`]: synthetic pairs and streak images with known answers, for the tests and the
+//!   benchmarks.
 //!
 //! ```
 //! use glam::DVec3;

@@ -25,10 +25,10 @@
 //! Coordinates follow DESIGN.md: `x` is an image coordinate in pixels (pixel `i` covers
 //! `[i, i+1)`, its centre is `i + 0.5`); rows are pixel indices; `d = x_left - x_right`.
 
-use streaks_stereo::image::GrayImage;
+use streaks_image::{GrayImage, ImageError, Region};
 
 /// Errors of the Lucas-Kanade estimator (all about user-supplied sizes and parameters).
-#[derive(Debug, thiserror::Error, PartialEq)]
+#[derive(Debug, thiserror::Error)]
 pub enum LkError {
     /// Left and right images differ in size.
     #[error("left image is {lw}x{lh} but right image is {rw}x{rh}")]
@@ -51,21 +51,8 @@ pub enum LkError {
         reason: String,
     },
     /// The region is empty or leaves the image.
-    #[error("region {x0},{y0},{x1},{y1} is empty or outside the {width}x{height} image")]
-    Region {
-        /// First column.
-        x0: usize,
-        /// First row.
-        y0: usize,
-        /// One past the last column.
-        x1: usize,
-        /// One past the last row.
-        y1: usize,
-        /// Image width.
-        width: usize,
-        /// Image height.
-        height: usize,
-    },
+    #[error(transparent)]
+    Region(ImageError),
 }
 
 /// Sub-pixel interpolation of the images along a row.
@@ -383,26 +370,6 @@ pub fn lk_row(
     }
 }
 
-/// A rectangle of pixel indices, half-open: columns `[x0, x1)`, rows `[y0, y1)`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
-pub struct Region {
-    /// First column.
-    pub x0: usize,
-    /// First row.
-    pub y0: usize,
-    /// One past the last column.
-    pub x1: usize,
-    /// One past the last row.
-    pub y1: usize,
-}
-
-impl Region {
-    /// The image x coordinate of the region's centre column.
-    pub fn centre_x(&self) -> f32 {
-        0.5 * (self.x0 + self.x1) as f32
-    }
-}
-
 fn check(left: &GrayImage, right: &GrayImage, params: &LkParams) -> Result<(), LkError> {
     if (left.width, left.height) != (right.width, right.height) {
         return Err(LkError::SizeMismatch {
@@ -505,19 +472,11 @@ pub fn lk_region(
     region: Region,
     params: &LkParams,
 ) -> Result<Vec<RowDisparity>, LkError> {
-    let Region { x0, y0, x1, y1 } = region;
-    if x0 >= x1 || y0 >= y1 || x1 > left.width || y1 > left.height {
-        return Err(LkError::Region {
-            x0,
-            y0,
-            x1,
-            y1,
-            width: left.width,
-            height: left.height,
-        });
-    }
+    region
+        .check_fits("", left.width, left.height)
+        .map_err(LkError::Region)?;
     let x = region.centre_x();
-    let centres: Vec<(usize, f32)> = (y0..y1).map(|y| (y, x)).collect();
+    let centres: Vec<(usize, f32)> = (region.y0..region.y1).map(|y| (y, x)).collect();
     lk_rows(left, right, &centres, params)
 }
 
@@ -790,7 +749,7 @@ mod tests {
         };
         assert!(matches!(
             lk_region(&l, &l, r, &LkParams::default()),
-            Err(LkError::Region { .. })
+            Err(LkError::Region(_))
         ));
         assert!(lk_rows(&l, &l, &[(4, 1.0)], &LkParams::default()).is_err());
     }

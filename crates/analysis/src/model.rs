@@ -46,13 +46,12 @@
 //!
 //! # Disparity along a streak
 //!
-//! [`StereoRig`] is a rectified pair of pinhole cameras ([`RoadCamera`]) `b` apart along X,
-//! centred on the viewer. For a point at depth `Z_l` along the optical axis (Eq. 5) the pixel
-//! disparity is `d = x_left - x_right = f b / Z_l` ([`StereoRig::pixel_disparity`]). The
-//! angular disparity ([`StereoRig::angular_disparity_deg`]) is exactly the difference of the
-//! point's horizontal visual angles in the two eyes, `atan(x_left / z) - atan(x_right / z)`
-//! with `(x, z)` the point's lateral offset from each eye and its depth in the camera frame
-//! (Fick azimuths); for a point straight ahead it is `2 atan(b / 2Z)`.
+//! The disparities come from the stereo crate's camera model,
+//! [`streaks_stereo::rig::RoadRig`]: a rectified pair of pinhole eyes `b` apart along X, centred
+//! on the viewer, in `f64`. For a point at depth `Z_l` along the optical axis (Eq. 5) the pixel
+//! disparity is `d = x_left - x_right = f b / Z_l`; the angular disparity is the difference of
+//! the point's horizontal visual angles (azimuths) in the two eyes; for a point straight ahead
+//! it is `2 atan(b / 2Z)`. [`streak_rows`] predicts them for every image row of a streak.
 //!
 //! # The paper's Fig. 6 configuration
 //!
@@ -79,9 +78,11 @@
 //! streak rather than a tilt filter; its two numbers agree with the model to about 25 %.
 
 use glam::{DVec2, DVec3};
+use streaks_stereo::error::StereoError;
+use streaks_stereo::rig::RoadRig;
 
 /// What went wrong building or evaluating the model; each names the offending input.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Debug, thiserror::Error)]
 pub enum ModelError {
     /// An input is NaN or infinite.
     #[error("{what} must be finite, got {value}")]
@@ -128,24 +129,9 @@ pub enum ModelError {
         /// The limit as given.
         value: f64,
     },
-    /// A baseline that is not positive.
-    #[error("the baseline must be positive, got {value} m")]
-    BadBaseline {
-        /// The baseline as given.
-        value: f64,
-    },
-    /// A focal length that is not positive.
-    #[error("the focal length must be positive, got {value} px")]
-    BadFocal {
-        /// The focal length as given.
-        value: f64,
-    },
-    /// A camera pitch outside (-90, 90) degrees.
-    #[error("the camera pitch must be in (-90, 90) degrees, got {value}")]
-    BadPitch {
-        /// The pitch as given, in degrees.
-        value: f64,
-    },
+    /// The stereo rig the disparities are measured with (a baseline that is not positive).
+    #[error(transparent)]
+    Rig(#[from] StereoError),
     /// A ground depth outside the interval between viewer and light.
     #[error("ground depth {depth} m is not between the viewer ({near} m) and the light ({far} m)")]
     DepthOutOfRange {
@@ -212,13 +198,6 @@ pub fn virtual_light(x: DVec3, h: DVec3, light: DVec3) -> DVec3 {
 /// The angle of a unit vector `h` from the vertical `+Y`, in degrees.
 pub fn tilt_deg(h: DVec3) -> f64 {
     h.x.hypot(h.z).atan2(h.y).to_degrees()
-}
-
-/// The angle below the horizon at which `viewer` sees `point`, in degrees (the true elevation:
-/// the angle between the sight line and the horizontal plane; positive below the horizon).
-pub fn elevation_below_horizon_deg(viewer: DVec3, point: DVec3) -> f64 {
-    let d = point - viewer;
-    (-d.y).atan2(d.x.hypot(d.z)).to_degrees()
 }
 
 /// Finds a zero of `f` in `[lo, hi]`, given `f(lo)` and `f(hi)` of opposite signs (or zero),
@@ -416,14 +395,15 @@ impl ColumnModel {
 
     /// The locus with what a stereo rig centred on the viewer (looking along +Z, level, eyes
     /// `baseline` apart along X) sees of it: elevation of each ground point and angular
-    /// disparity of each `L_virtual`.
+    /// disparity of each `L_virtual` ([`RoadRig::elevation_deg`],
+    /// [`RoadRig::angular_disparity_deg`]).
     pub fn locus_profile(
         &self,
         max_tilt_deg: Option<f64>,
         samples: usize,
         baseline: f64,
     ) -> Result<Vec<LocusPoint>, ModelError> {
-        let rig = StereoRig::new(RoadCamera::level(self.viewer, 1.0)?, baseline)?;
+        let rig = RoadRig::level(self.viewer, 1.0, baseline)?;
         Ok(self
             .locus(max_tilt_deg, samples)?
             .into_iter()
@@ -518,162 +498,23 @@ pub struct InvarianceReport {
 pub struct LocusPoint {
     /// The glint.
     pub reflection: Reflection,
-    /// Elevation angle below the horizon of the ground point seen from the rig centre, degrees.
+    /// Elevation angle below the horizon of the ground point seen from the rig centre, degrees
+    /// ([`RoadRig::elevation_deg`]).
     pub elevation_deg: f64,
-    /// Angular disparity of `L_virtual`, degrees ([`StereoRig::angular_disparity_deg`]).
+    /// Angular disparity of `L_virtual`, degrees ([`RoadRig::angular_disparity_deg`]).
     pub disparity_deg: f64,
-    /// Pixel disparity of `L_virtual` (Eq. 5, [`StereoRig::pixel_disparity`]).
+    /// Pixel disparity of `L_virtual` (Eq. 5, [`RoadRig::disparity_px`]).
     pub disparity_px: f64,
 }
 
 impl LocusPoint {
-    fn new(reflection: Reflection, rig: &StereoRig) -> Self {
+    fn new(reflection: Reflection, rig: &RoadRig) -> Self {
         Self {
             reflection,
-            elevation_deg: elevation_below_horizon_deg(rig.camera.position, reflection.ground),
+            elevation_deg: rig.elevation_deg(reflection.ground),
             disparity_deg: rig.angular_disparity_deg(reflection.virtual_light),
-            disparity_px: rig.pixel_disparity(reflection.virtual_light),
+            disparity_px: rig.disparity_px(reflection.virtual_light),
         }
-    }
-}
-
-/// A pinhole camera in the road frame, with no roll: its X axis is the road frame's X, and it
-/// is pitched down by `pitch` about that axis. Pixels as in DESIGN.md: x right, y down,
-/// pixel `(i, j)` has its centre at `(i + 0.5, j + 0.5)`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct RoadCamera {
-    /// The centre of projection (its Y is the camera height).
-    pub position: DVec3,
-    /// Downward pitch of the optical axis from +Z, radians (0: level).
-    pub pitch: f64,
-    /// Focal length in pixels.
-    pub focal_px: f64,
-    /// Principal point in pixels.
-    pub principal: DVec2,
-}
-
-impl RoadCamera {
-    /// A checked camera; `pitch_deg` is the downward pitch in degrees.
-    pub fn new(
-        position: DVec3,
-        pitch_deg: f64,
-        focal_px: f64,
-        principal: DVec2,
-    ) -> Result<Self, ModelError> {
-        finite3("the camera position", position)?;
-        finite("the camera pitch", pitch_deg)?;
-        finite("the focal length", focal_px)?;
-        if !principal.is_finite() {
-            return Err(ModelError::NotFinite {
-                what: "the principal point",
-                value: format!("({}, {})", principal.x, principal.y),
-            });
-        }
-        if focal_px <= 0.0 {
-            return Err(ModelError::BadFocal { value: focal_px });
-        }
-        if pitch_deg.abs() >= 90.0 {
-            return Err(ModelError::BadPitch { value: pitch_deg });
-        }
-        Ok(Self {
-            position,
-            pitch: pitch_deg.to_radians(),
-            focal_px,
-            principal,
-        })
-    }
-
-    /// A level camera at `position` with its principal point at the origin.
-    pub fn level(position: DVec3, focal_px: f64) -> Result<Self, ModelError> {
-        Self::new(position, 0.0, focal_px, DVec2::ZERO)
-    }
-
-    /// The optical axis in the road frame.
-    pub fn forward(&self) -> DVec3 {
-        DVec3::new(0.0, -self.pitch.sin(), self.pitch.cos())
-    }
-
-    /// The camera's up axis in the road frame.
-    pub fn up(&self) -> DVec3 {
-        DVec3::new(0.0, self.pitch.cos(), self.pitch.sin())
-    }
-
-    /// A road-frame point in camera coordinates: (right, up, depth along the optical axis).
-    pub fn to_camera(&self, p: DVec3) -> DVec3 {
-        let d = p - self.position;
-        DVec3::new(d.x, d.dot(self.up()), d.dot(self.forward()))
-    }
-
-    /// The pixel where `p` projects, or `None` if it is not in front of the camera.
-    pub fn project(&self, p: DVec3) -> Option<DVec2> {
-        let c = self.to_camera(p);
-        (c.z > 0.0).then(|| {
-            DVec2::new(
-                self.principal.x + self.focal_px * c.x / c.z,
-                self.principal.y - self.focal_px * c.y / c.z,
-            )
-        })
-    }
-
-    /// The (unnormalised) road-frame direction of the ray through `pixel`.
-    pub fn ray(&self, pixel: DVec2) -> DVec3 {
-        let x = (pixel.x - self.principal.x) / self.focal_px;
-        let y = -(pixel.y - self.principal.y) / self.focal_px;
-        DVec3::X * x + self.up() * y + self.forward()
-    }
-
-    /// The road point seen through `pixel`, or `None` if the ray does not go down to the road
-    /// (or the camera is not above it).
-    pub fn ground_point(&self, pixel: DVec2) -> Option<DVec3> {
-        let d = self.ray(pixel);
-        if d.y >= 0.0 || self.position.y <= 0.0 {
-            return None;
-        }
-        let p = self.position + d * (-self.position.y / d.y);
-        Some(DVec3::new(p.x, 0.0, p.z))
-    }
-}
-
-/// A rectified stereo rig: two copies of `camera` at `camera.position -/+ baseline/2` along
-/// X (left, right).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StereoRig {
-    /// The rig centre's camera (the cyclopean eye).
-    pub camera: RoadCamera,
-    /// Distance between the eyes, metres.
-    pub baseline: f64,
-}
-
-impl StereoRig {
-    /// A checked rig.
-    pub fn new(camera: RoadCamera, baseline: f64) -> Result<Self, ModelError> {
-        finite("the baseline", baseline)?;
-        if baseline <= 0.0 {
-            return Err(ModelError::BadBaseline { value: baseline });
-        }
-        Ok(Self { camera, baseline })
-    }
-
-    /// The left (`-1`) or right (`+1`) eye's camera.
-    pub fn eye(&self, side: f64) -> RoadCamera {
-        RoadCamera {
-            position: self.camera.position + DVec3::X * (0.5 * side * self.baseline),
-            ..self.camera
-        }
-    }
-
-    /// Eq. 5: `f b / Z_l` pixels, `Z_l` the point's depth along the optical axis (equal to
-    /// `x_left - x_right` of its two projections). Infinite or negative if not in front.
-    pub fn pixel_disparity(&self, p: DVec3) -> f64 {
-        self.camera.focal_px * self.baseline / self.camera.to_camera(p).z
-    }
-
-    /// The angular disparity in degrees: the point's horizontal visual angle (Fick azimuth,
-    /// `atan2(x, z)` in the camera frame) in the left eye minus that in the right eye.
-    pub fn angular_disparity_deg(&self, p: DVec3) -> f64 {
-        let c = self.camera.to_camera(p);
-        let half = 0.5 * self.baseline;
-        ((c.x + half).atan2(c.z) - (c.x - half).atan2(c.z)).to_degrees()
     }
 }
 
@@ -695,18 +536,17 @@ pub struct StreakRow {
 /// `max_tilt_deg`, are left out. Off the light's X plane the ground points have `h_X != 0`.
 pub fn streak_rows(
     light: DVec3,
-    rig: &StereoRig,
+    rig: &RoadRig,
     rows: std::ops::Range<u32>,
     column: Option<f64>,
     max_tilt_deg: Option<f64>,
 ) -> Result<Vec<StreakRow>, ModelError> {
-    let model = ColumnModel::new(light, rig.camera.position)?;
+    let model = ColumnModel::new(light, rig.centre())?;
     let max_tilt = check_tilt(max_tilt_deg)?;
     let column = match column {
         Some(c) => finite("the streak's column", c)?,
         None => {
-            rig.camera
-                .project(light * DVec3::new(1.0, -1.0, 1.0))
+            rig.project(light * DVec3::new(1.0, -1.0, 1.0))
                 .ok_or(ModelError::MirrorBehindCamera)?
                 .x
         }
@@ -714,10 +554,7 @@ pub fn streak_rows(
     let (near, far) = (model.viewer().z, model.light().z);
     let mut out = Vec::new();
     for row in rows {
-        let Some(g) = rig
-            .camera
-            .ground_point(DVec2::new(column, row as f64 + 0.5))
-        else {
+        let Some(g) = rig.ground_point(DVec2::new(column, row as f64 + 0.5)) else {
             continue;
         };
         if g.z < near || g.z > far {
@@ -865,7 +702,7 @@ mod tests {
         assert!(all
             .iter()
             .all(|p| p.disparity_deg > 0.2 && p.disparity_deg < 0.3));
-        assert_eq!(m.locus(Some(4.0), 0), Err(ModelError::NoSamples));
+        assert!(matches!(m.locus(Some(4.0), 0), Err(ModelError::NoSamples)));
         assert!(matches!(
             m.locus(Some(0.0), 3),
             Err(ModelError::BadTilt { .. })
@@ -911,67 +748,19 @@ mod tests {
     }
 
     #[test]
-    fn disparity_conversions() {
-        let cam = RoadCamera::new(
-            DVec3::new(0.2, 1.5, 0.0),
-            0.0,
-            1000.0,
-            DVec2::new(640.0, 360.0),
-        )
-        .unwrap();
-        let rig = StereoRig::new(cam, 0.065).unwrap();
-        // Straight ahead: 2 atan(b / 2Z), and f b / Z pixels.
-        let p = DVec3::new(0.2, 1.5, 15.0);
-        assert!(
-            (rig.angular_disparity_deg(p) - 2.0 * (0.0325f64 / 15.0).atan().to_degrees()).abs()
-                < 1e-14
-        );
-        assert!((rig.pixel_disparity(p) - 1000.0 * 0.065 / 15.0).abs() < 1e-12);
-        // Off axis, below the horizon, pitched camera: the pixel disparity is x_left - x_right
-        // of the two projections, and the angular one the difference of atan((x - cx) / f).
-        let cam = RoadCamera::new(
-            DVec3::new(0.2, 1.5, 0.0),
-            3.0,
-            1000.0,
-            DVec2::new(640.0, 360.0),
-        )
-        .unwrap();
-        let rig = StereoRig::new(cam, 0.065).unwrap();
-        let p = DVec3::new(-2.0, -1.0, 12.0);
-        let (l, r) = (
-            rig.eye(-1.0).project(p).unwrap(),
-            rig.eye(1.0).project(p).unwrap(),
-        );
-        assert!((l.y - r.y).abs() < 1e-9, "rectified: same row");
-        assert!((rig.pixel_disparity(p) - (l.x - r.x)).abs() < 1e-9);
-        let az = |q: DVec2| ((q.x - 640.0) / 1000.0).atan().to_degrees();
-        assert!((rig.angular_disparity_deg(p) - (az(l) - az(r))).abs() < 1e-12);
-        // Behind: negative.
-        assert!(rig.pixel_disparity(DVec3::new(0.0, 0.0, -3.0)) < 0.0);
-    }
-
-    #[test]
-    fn camera_round_trip_and_streak_rows() {
-        let cam = RoadCamera::new(
+    fn streak_rows_follow_the_locus() {
+        let rig = RoadRig::new(
             DVec3::new(0.0, 1.5, 0.0),
-            2.0,
+            2f64.to_radians(),
             800.0,
             DVec2::new(400.0, 300.0),
+            0.065,
         )
         .unwrap();
-        let g = cam.ground_point(DVec2::new(450.5, 400.5)).unwrap();
-        let back = cam.project(g).unwrap();
-        assert!((back - DVec2::new(450.5, 400.5)).length() < 1e-9);
-        assert!(
-            cam.ground_point(DVec2::new(400.0, 0.5)).is_none(),
-            "above the horizon"
-        );
-
-        let rig = StereoRig::new(cam, 0.065).unwrap();
         let light = DVec3::new(0.0, 1.5, 15.0);
         let rows = streak_rows(light, &rig, 0..600, None, Some(4.0)).unwrap();
         assert!(rows.len() > 10);
-        let m = ColumnModel::new(light, cam.position).unwrap();
+        let m = ColumnModel::new(light, rig.centre()).unwrap();
         for s in &rows {
             // The light is in the viewer's X plane, so the streak column's ground points are
             // the h_X = 0 family: the same L_virtual as the locus at that depth.
@@ -1021,11 +810,10 @@ mod tests {
         ));
         assert!(matches!(
             m.locus_profile(None, 3, 0.0),
-            Err(ModelError::BadBaseline { .. })
-        ));
-        assert!(matches!(
-            RoadCamera::new(v, 95.0, 100.0, DVec2::ZERO),
-            Err(ModelError::BadPitch { .. })
+            Err(ModelError::Rig(StereoError::Parameter {
+                name: "baseline",
+                ..
+            }))
         ));
     }
 }

@@ -510,7 +510,7 @@ impl Plot {
     /// Renders the plot and writes it as PNG to `path`, atomically.
     pub fn write_png(&self, path: &Path) -> Result<(), PlotError> {
         let img = self.render()?;
-        streaks_stereo::image::write_png_atomic(path, &img).map_err(|e| PlotError::Write {
+        streaks_image::png::write_png_buffer(path, &img).map_err(|e| PlotError::Write {
             path: path.to_path_buf(),
             reason: e.to_string(),
         })

@@ -21,7 +21,7 @@
 //! include negative values (photographs aligned by hand).
 
 use rayon::prelude::*;
-use streaks_stereo::image::{GrayImage, ImageError};
+use streaks_image::{GrayImage, ImageError};
 
 /// Errors of the dense matcher (about user-supplied sizes and parameters).
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -626,7 +626,7 @@ pub fn write_disparity_png(
     disp: &GrayImage,
     range: Option<(f32, f32)>,
 ) -> Result<(), ImageError> {
-    streaks_stereo::image::write_png_atomic(path, &disparity_preview(disp, range))
+    streaks_image::png::write_png_buffer(path, &disparity_preview(disp, range))
 }
 
 /// Google's turbo colour map (the polynomial approximation by Mikhailov, 2019).

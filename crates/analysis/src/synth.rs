@@ -10,8 +10,8 @@
 //! their centres; disparity follows DESIGN.md: `d = x_left - x_right`.
 
 use std::path::Path;
-use streaks_stereo::image::{GrayImage, ImageError};
-use streaks_stereo::pfm::write_pfm;
+use streaks_image::pfm::write_pfm;
+use streaks_image::{GrayImage, ImageError};
 
 /// A fronto-parallel rectangle in front of the background, in left-image pixel indices
 /// (half-open `[x0, x1) x [y0, y1)`), with a constant disparity.
@@ -105,7 +105,7 @@ impl SynthPair {
                     ::image::Luma([(v * 65535.0).round() as u16])
                 },
             );
-            streaks_stereo::image::write_png_atomic(&path, &buf)?;
+            streaks_image::png::write_png_buffer(&path, &buf)?;
         }
         write_pfm(&dir.join("disparity_left.pfm"), &self.disparity)
     }
@@ -332,7 +332,7 @@ mod tests {
             .iter()
             .zip(&pair.left.data)
             .all(|(a, b)| (a - b).abs() < 1e-4));
-        let d = streaks_stereo::pfm::read_pfm(&dir.path().join("disparity_left.pfm")).unwrap();
+        let d = streaks_image::pfm::read_pfm(&dir.path().join("disparity_left.pfm")).unwrap();
         assert_eq!(d, pair.disparity);
         assert!(pair.save(&dir.path().join("missing")).is_err());
     }
@@ -361,6 +361,7 @@ mod tests {
             ::image::Rgb32FImage::from_fn(4, 2, |x, _| ::image::Rgb([x as f32 * 2.5, 0.0, 0.0]));
         img.save(&path).unwrap();
         let gray = GrayImage::load(&path).unwrap();
-        assert!((gray.get(3, 1) - 0.2126 * 7.5).abs() < 1e-5, "{gray:?}");
+        // Rec. 709 red weight times the stored (linear) value.
+        assert!((gray.get(3, 1) - 0.212_671 * 7.5).abs() < 1e-5, "{gray:?}");
     }
 }

@@ -199,9 +199,9 @@ fn intersect_triangle(tri: &RtTriangle, ray: &BvhRay, t_min: f32) -> (f32, Vec2)
 const BUILD_PARAMS: BvhBuildParams = BvhBuildParams::medium_build();
 
 /// How many nodes the reinsertion optimiser moves, at most: all of them up to this many
-/// triangles, `BUILD_PARAMS`' 5% from twenty times as many on (1M triangles build in 0.6 s;
-/// all of them would take 2.8 s). On street scenes the full pass pays: `rainy_street` renders
-/// 9% faster, `rainy_street_small` 4% (320x240, 32 spp), for a few milliseconds of build.
+/// triangles, `BUILD_PARAMS`' 5% from twenty times as many on. A full pass gives street-size
+/// scenes a better BVH for a build time that grows with the triangle count, so large scenes
+/// keep the preset's share (BENCHMARKS.md has the measurements).
 const REINSERTION_BUDGET: f32 = 50_000.0;
 
 /// The reinsertion batch ratio for `triangles` triangles (see [`REINSERTION_BUDGET`]).
@@ -215,8 +215,8 @@ const PLOC_SEARCH_DISTANCE: usize = 14;
 
 /// Builds a CWBVH over primitives given by their bounding boxes, as obvhs'
 /// `build_cwbvh_from_tris` does with `medium_build` but with `reinsertion_ratio` as the
-/// reinsertion batch ratio, and with its peak memory cut from 352 to 296 bytes per triangle
-/// (1M triangles) (with the preset's ratio, the BVH is the same):
+/// reinsertion batch ratio, and with a lower peak memory (with the preset's ratio, the BVH is
+/// the same; BENCHMARKS.md has the figures):
 /// - the PLOC leaves are made straight from the boxes, without a triangle soup (48 bytes per
 ///   triangle) or a pre-sized builder (whose Morton buffer is twice what a 64-bit sort needs);
 /// - the builder's buffers are freed before reinsertion, and the reinsertion's parent links

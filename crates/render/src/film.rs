@@ -9,8 +9,8 @@
 //! A sample whose radiance (or specular part) is NaN or infinite is dropped and counted,
 //! never accumulated (DESIGN.md).
 
-use crate::output::RgbImage;
 use glam::Vec3;
+use streaks_image::RgbImage;
 
 /// One pixel's accumulators.
 #[derive(Clone, Copy, Debug, PartialEq)]

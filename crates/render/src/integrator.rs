@@ -49,14 +49,14 @@ use crate::bsdf::Bsdf;
 use crate::camera::Camera;
 use crate::film::{Film, Pixel};
 use crate::geometry::{offset_ray_origin, Frame, Ray};
-use crate::light::{emitted_radiance, LightSampler, Receiver, Visibility};
-use crate::output::RgbImage;
+use crate::light::{LightSampler, Receiver, Visibility};
 use crate::sampling::{power_heuristic, Sampler};
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
+use streaks_image::RgbImage;
 
 /// Depth from which Russian roulette may end a path (Mitsuba 3's default `rr_depth`).
 pub const RR_DEPTH: u32 = 5;
@@ -144,7 +144,6 @@ pub fn render(
     progress: &(dyn Fn(u64) + Sync),
 ) -> RenderOutput {
     let start = Instant::now();
-    let lights = LightSampler::new(scene);
     let (width, height) = (settings.width, settings.height);
     let mut film = Film::new(width, height);
     let rays = AtomicU64::new(0);
@@ -172,7 +171,6 @@ pub fn render(
                 let ray = camera.generate_ray(film_pos, width, height);
                 let path = trace_path(
                     scene,
-                    &lights,
                     ray,
                     &mut sampler,
                     settings.max_depth,
@@ -219,12 +217,12 @@ fn first_hit_layers(scene: &Scene, ray: &Ray, origin: Vec3, forward: Vec3, pixel
 /// Traces one camera path (see the module documentation).
 fn trace_path(
     scene: &Scene,
-    lights: &LightSampler,
     mut ray: Ray,
     sampler: &mut Sampler,
     max_depth: u32,
     want_specular: bool,
 ) -> PathResult {
+    let lights: &LightSampler = &scene.light_sampler;
     let mut out = PathResult::default();
     let mut throughput = Vec3::ONE;
     // Number of segments before the current one (Mitsuba's `depth`).
@@ -243,12 +241,12 @@ fn trace_path(
         let wo = -ray.direction;
 
         // 1. Emission of the surface hit.
-        let le = emitted_radiance(scene, &hit, wo);
+        let le = scene.emitted_radiance(&hit, wo);
         if le.max_element() > 0.0 {
             if depth == 0 {
                 out.radiance += throughput * le;
             } else {
-                let light_pdf = prev.map_or(0.0, |rx| lights.pdf_li(scene, &rx, &hit));
+                let light_pdf = prev.map_or(0.0, |rx| lights.pdf_li(&rx, &hit));
                 let weight = power_heuristic(1.0, prev_bsdf_pdf, 1.0, light_pdf);
                 out.radiance += throughput * le * weight;
                 if let (1, Some((bsdf, frame, wo_local))) = (depth, first_bsdf) {
@@ -294,7 +292,8 @@ fn trace_path(
             wo_local,
             bsdf,
         };
-        if let Some(ls) = lights.sample_li(scene, &rx, u_light, u_point) {
+        if let Some(ls) = lights.sample_li(&scene.materials, &scene.textures, &rx, u_light, u_point)
+        {
             let wi_local = frame.to_local(ls.wi);
             if wi_local.z > 0.0 && ng.dot(ls.wi) > 0.0 {
                 // The BSDF's density of wi matters only for MIS against an area light.
@@ -334,10 +333,11 @@ fn trace_path(
                             match scene.intersect(&ray) {
                                 Some(h)
                                     if lights
+                                        .emitters()
                                         .emitter_of(h.triangle)
                                         .is_some_and(|(e, _)| e == emitter as usize) =>
                                 {
-                                    emitted_radiance(scene, &h, -ls.wi)
+                                    scene.emitted_radiance(&h, -ls.wi)
                                 }
                                 _ => Vec3::ZERO,
                             }
@@ -513,6 +513,83 @@ mod tests {
         // max_depth 1: only emitters seen directly, so black.
         let out = render(&scene, &cam, &settings(w, h, 2, 1), &|_| {});
         assert!(out.image.pixels.iter().all(|p| *p == Vec3::ZERO));
+    }
+
+    /// A closed cube of half-size 1 around the origin whose walls face inward, are Lambertian of
+    /// albedo `albedo` and emit `le` (one-sided, toward the inside).
+    fn furnace_box(albedo: Vec3, le: Vec3) -> Scene {
+        let mut wall = Material::diffuse("wall", albedo);
+        wall.emission = le;
+        let mut parts = SceneParts {
+            materials: vec![wall],
+            ..Default::default()
+        };
+        for axis in 0..3 {
+            for side in [-1.0f32, 1.0] {
+                // The face at coordinate `side` on `axis`; its two in-plane axes `u`, `v` are
+                // ordered so that the winding's normal points inward (-side along `axis`).
+                let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+                let (u, v) = if side > 0.0 { (u, v) } else { (v, u) };
+                let corner = |a: f32, b: f32| {
+                    let mut c = Vec3::ZERO;
+                    c[axis] = side;
+                    c[u] = a;
+                    c[v] = b;
+                    c
+                };
+                let corners = [
+                    corner(-1.0, -1.0),
+                    corner(-1.0, 1.0),
+                    corner(1.0, 1.0),
+                    corner(1.0, -1.0),
+                ];
+                let n = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
+                debug_assert!(n[axis] * side < 0.0, "the wall faces inward");
+                quad(&mut parts, corners, 0);
+            }
+        }
+        Scene::from_parts(parts).unwrap()
+    }
+
+    /// The multi-bounce furnace: inside a closed box of albedo `a` whose walls all emit `Le`,
+    /// the radiance in every direction is `L = Le + a L = Le / (1 - a)`. Every path vertex hits
+    /// an emitter, so this checks emission, next-event estimation and BSDF sampling combined
+    /// by MIS at every depth, and Russian roulette, against an exact answer.
+    #[test]
+    fn multi_bounce_furnace_gives_le_over_one_minus_albedo() {
+        let le = Vec3::new(1.0, 0.5, 0.25);
+        for a in [0.0f32, 0.5, 0.8] {
+            let scene = furnace_box(Vec3::splat(a), le);
+            let cam = camera(Vec3::new(0.1, -0.2, 0.3), 0.3, 1.2);
+            let out = render(&scene, &cam, &settings(24, 16, 64, u32::MAX), &|_| {});
+            let expected = le / (1.0 - a);
+            let n = out.image.pixels.len() as f64;
+            for c in 0..3 {
+                let values: Vec<f64> = out.image.pixels.iter().map(|p| p[c] as f64).collect();
+                let mean = values.iter().sum::<f64>() / n;
+                let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+                let stderr = (var / n).sqrt();
+                let want = expected[c] as f64;
+                // Four standard errors, and a floor for the noiseless albedo-0 case.
+                assert!(
+                    (mean - want).abs() <= 4.0 * stderr + 1e-5 * want,
+                    "albedo {a}, channel {c}: mean {mean} vs {want} (standard error {stderr})"
+                );
+                // Each pixel is an estimate of the same value.
+                assert!(
+                    values.iter().all(|v| (v - want).abs() < 0.25 * want),
+                    "albedo {a}, channel {c}: a pixel off by more than 25%"
+                );
+            }
+            if a == 0.0 {
+                // Without reflection every pixel is exactly the emission seen directly.
+                assert!(out
+                    .image
+                    .pixels
+                    .iter()
+                    .all(|p| (*p - le).abs().max_element() < 1e-6));
+            }
+        }
     }
 
     /// A wall of emission `le` at z = -2 in front of a camera at the origin, whose front faces

@@ -11,21 +11,22 @@
 //!   `ggx`, `ward` and `blinn_phong`, and the glTF metallic-roughness BRDF.
 //! - [`material`] and [`texture`]: what a scene stores; a material turns into a [`bsdf::Bsdf`]
 //!   at a surface point.
-//! - [`light`]: point, spot, directional lights and emissive triangles, with light selection.
+//! - [`light`]: one file per concept: the punctual lights ([`light::Light`]), the emitters
+//!   ([`light::Emitters`]: punctual lights and meshes of emissive triangles, built once with the
+//!   scene), the light tree ([`light::LightTree`]) and the light choice ([`light::LightSampler`]).
 //! - [`accel`]: the only module that sees obvhs; closest-hit and shadow queries.
 //! - [`scene`]: loading glTF 2.0 and OBJ into a [`scene::Scene`], with errors that name the file
 //!   and the element.
 //! - [`camera`]: the pinhole camera of DESIGN.md (pixel centres at `i + 0.5`, `f = (H/2)/tan(yfov/2)`).
 //! - [`integrator`]: unidirectional path tracing with next-event estimation and MIS.
-//! - [`film`] and [`output`]: the box-filtered film with its layers, EXR and PNG writing.
-//! - [`mitsuba`]: export to Mitsuba 3 (the reference renderer); [`compare`]: statistics of the
-//!   difference between two renders.
+//! - [`film`]: the box-filtered film with its layers; [`output`]: the renderer's EXR layout
+//!   (images, regions, file formats and comparisons are the `streaks-image` crate's).
+//! - [`mitsuba`]: export to Mitsuba 3 (the reference renderer).
 #![deny(missing_docs)]
 
 pub mod accel;
 pub mod bsdf;
 pub mod camera;
-pub mod compare;
 pub mod film;
 pub mod geometry;
 pub mod integrator;
@@ -33,6 +34,7 @@ pub mod light;
 pub mod material;
 pub mod mitsuba;
 pub mod output;
+pub mod regression;
 pub mod sampling;
 pub mod scene;
 pub mod testing;

@@ -34,14 +34,14 @@
 use crate::camera::Camera;
 use crate::light::Light;
 use crate::material::{Material, PaperModel, Reflectance};
-use crate::output::{write_atomically, OutputError, WriteFailure};
 use crate::scene::{Scene, SceneError};
 use crate::texture::{Texture, TextureId};
 use glam::{Vec2, Vec3};
 use std::collections::HashMap;
 use std::fmt::Write as _;
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
+use streaks_image::exr::write_exr_rgb;
+use streaks_image::{write_bytes_atomically, ImageError, RgbImage};
 
 /// Errors of the Mitsuba export.
 #[derive(Debug, thiserror::Error)]
@@ -72,7 +72,7 @@ pub enum MitsubaError {
     },
     /// Writing a file failed.
     #[error(transparent)]
-    Output(#[from] OutputError),
+    Output(#[from] ImageError),
 }
 
 /// Render settings written into the Mitsuba scene (the same as `streaks render`'s).
@@ -143,12 +143,8 @@ impl PlyMesh {
 pub struct BakedTexture {
     /// File name relative to the export folder (e.g. `textures/mat0_kd.exr`).
     pub file_name: String,
-    /// Width in texels.
-    pub width: u32,
-    /// Height in texels.
-    pub height: u32,
-    /// Row-major linear RGB texels, top row first.
-    pub texels: Vec<Vec3>,
+    /// The linear RGB texels.
+    pub image: RgbImage,
 }
 
 /// A Mitsuba scene ready to be written: the XML, its meshes and textures, and the warnings
@@ -174,32 +170,16 @@ impl MitsubaExport {
             std::fs::create_dir_all(&d).map_err(|source| MitsubaError::Io { path: d, source })?;
         }
         for mesh in &self.meshes {
-            write_bytes(&dir.join(&mesh.file_name), &mesh.to_bytes())?;
+            write_bytes_atomically(&dir.join(&mesh.file_name), &mesh.to_bytes())?;
         }
         for tex in &self.textures {
-            write_texture_exr(&dir.join(&tex.file_name), tex)?;
+            write_exr_rgb(&dir.join(&tex.file_name), &tex.image)?;
         }
-        Ok(write_bytes(&dir.join("scene.xml"), self.xml.as_bytes())?)
+        Ok(write_bytes_atomically(
+            &dir.join("scene.xml"),
+            self.xml.as_bytes(),
+        )?)
     }
-}
-
-fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
-    write_atomically(path, |w| w.write_all(bytes).map_err(WriteFailure::Io))
-}
-
-fn write_texture_exr(path: &Path, tex: &BakedTexture) -> Result<(), OutputError> {
-    use exr::prelude::{Image, SpecificChannels, WritableImage};
-    let w = tex.width as usize;
-    let image = Image::from_channels(
-        (w, tex.height as usize),
-        SpecificChannels::rgb(|pos: exr::math::Vec2<usize>| {
-            let t = tex.texels[pos.y() * w + pos.x()];
-            (t.x, t.y, t.z)
-        }),
-    );
-    write_atomically(path, |out| {
-        image.write().to_buffered(out).map_err(WriteFailure::Exr)
-    })
 }
 
 /// The parts of a scene the exporter reads (everything but the BVH).
@@ -299,9 +279,11 @@ impl<'a> MaterialWriter<'a> {
         let file_name = format!("textures/{stem}_{name}.exr");
         self.textures.push(BakedTexture {
             file_name: file_name.clone(),
-            width: tex.width,
-            height: tex.height,
-            texels,
+            image: RgbImage {
+                width: tex.width,
+                height: tex.height,
+                pixels: texels,
+            },
         });
         format!(
             "<texture type=\"bitmap\" name=\"{name}\">\
@@ -493,8 +475,8 @@ impl<'a> MaterialWriter<'a> {
     }
 }
 
-/// The light elements for the non-triangle lights.
-fn light_xml(light: &Light, warnings: &mut Vec<String>) -> Option<String> {
+/// The emitter element of a punctual light.
+fn light_xml(light: &Light, warnings: &mut Vec<String>) -> String {
     match *light {
         Light::Point {
             position,
@@ -507,11 +489,11 @@ fn light_xml(light: &Light, warnings: &mut Vec<String>) -> Option<String> {
                      light has no range)"
                 ));
             }
-            Some(format!(
+            format!(
                 "<emitter type=\"point\"><point name=\"position\" value=\"{}\"/>{}</emitter>",
                 v3(position),
                 rgb("intensity", intensity)
-            ))
+            )
         }
         Light::Spot {
             position,
@@ -537,7 +519,7 @@ fn light_xml(light: &Light, warnings: &mut Vec<String>) -> Option<String> {
             } else {
                 Vec3::X
             };
-            Some(format!(
+            format!(
                 "<emitter type=\"spot\"><transform name=\"to_world\">\
                  <lookat origin=\"{}\" target=\"{}\" up=\"{}\"/></transform>{}\
                  <float name=\"cutoff_angle\" value=\"{outer:?}\"/>\
@@ -546,17 +528,16 @@ fn light_xml(light: &Light, warnings: &mut Vec<String>) -> Option<String> {
                 v3(position + direction),
                 v3(up),
                 rgb("intensity", intensity)
-            ))
+            )
         }
         Light::Directional {
             direction,
             irradiance,
-        } => Some(format!(
+        } => format!(
             "<emitter type=\"directional\"><vector name=\"direction\" value=\"{}\"/>{}</emitter>",
             v3(direction),
             rgb("irradiance", irradiance)
-        )),
-        Light::Triangle { .. } => None,
+        ),
     }
 }
 
@@ -663,9 +644,7 @@ pub(crate) fn export_parts(
     );
     let _ = writeln!(xml, "{}", sensor_xml(camera, opts));
     for light in parts.lights {
-        if let Some(e) = light_xml(light, &mut warnings) {
-            let _ = writeln!(xml, "{e}");
-        }
+        let _ = writeln!(xml, "{}", light_xml(light, &mut warnings));
     }
     let meshes = meshes_by_material(parts);
     let mut mw = MaterialWriter {
@@ -812,7 +791,6 @@ mod tests {
                         cos_outer: 0.8,
                         range: Some(20.0),
                     },
-                    Light::Triangle { triangle: 2 },
                 ],
                 cameras: vec![Camera {
                     name: "cam".into(),
@@ -944,9 +922,9 @@ mod tests {
         assert_eq!(bitmaps[1].parent(), Some(cond[0]));
         assert_eq!(bitmaps[2].parent(), Some(cond[0]));
         assert_eq!(ex.textures.len(), 3);
-        assert_eq!(ex.textures[0].texels[0], Vec3::new(0.1, 0.05, 0.025));
+        assert_eq!(ex.textures[0].image.pixels[0], Vec3::new(0.1, 0.05, 0.025));
         let close = |a: Vec3, b: f32| (a - Vec3::splat(b)).abs().max_element() < 1e-6;
-        let (alpha, spec) = (&ex.textures[1].texels, &ex.textures[2].texels);
+        let (alpha, spec) = (&ex.textures[1].image.pixels, &ex.textures[2].image.pixels);
         assert!(close(alpha[0], 0.3) && close(alpha[1], 0.5), "{alpha:?}");
         assert!(close(spec[0], 0.06) && close(spec[1], 0.04), "{spec:?}");
         // Lamp: an area emitter of the same radiance.

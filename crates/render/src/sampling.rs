@@ -11,12 +11,6 @@ use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, PI, TAU};
 use std::sync::LazyLock;
 
-/// Rec. 709 / sRGB-primaries luminance of a linear RGB colour.
-#[inline]
-pub fn luminance(rgb: Vec3) -> f32 {
-    0.212_671 * rgb.x + 0.715_160 * rgb.y + 0.072_169 * rgb.z
-}
-
 // ---------------------------------------------------------------------------------------------
 // Disk
 

@@ -4,6 +4,7 @@
 
 use glam::{Vec2, Vec4};
 use std::sync::LazyLock;
+use streaks_image::color::srgb_to_linear;
 
 /// Index of a texture in [`crate::scene::Scene::textures`].
 pub type TextureId = u32;
@@ -15,17 +16,6 @@ pub enum ColorSpace {
     Srgb,
     /// Linear data (metallic-roughness, wetness).
     Linear,
-}
-
-/// The sRGB electro-optical transfer function (IEC 61966-2-1): encoded value in [0, 1] to
-/// linear.
-#[inline]
-pub fn srgb_to_linear(c: f32) -> f32 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
 }
 
 /// Linear values of the 256 byte values: `i / 255`.

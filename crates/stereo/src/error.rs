@@ -1,7 +1,7 @@
 //! The crate's error type.
 
-use crate::image::ImageError;
 use std::path::PathBuf;
+use streaks_image::ImageError;
 
 /// Errors from the stereo rig, its files and the image treatments.
 #[derive(Debug, thiserror::Error)]

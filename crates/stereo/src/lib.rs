@@ -2,15 +2,19 @@
 //!
 //! Rectified stereo for the streaks project: the rig geometry, ground truth, viewing aids and
 //! the ground-plane texture map. Everything but [`render`] works without the renderer (build
-//! with `--no-default-features`), so the analysis can use it on photographs.
+//! with `--no-default-features`), so the analysis can use it on photographs. Images, PFM maps
+//! and atomic writes are the `streaks-image` crate's.
 //!
-//! - [`rig`]: [`rig::Rig`] (intrinsics, baseline, pose), its eyes ([`rig::EyeCamera`]:
-//!   projection, back-projection), disparity <-> depth (Eq. 5) and the road frame.
+//! - [`rig`]: the camera model. [`rig::Rig`] (intrinsics, baseline, pose), its eyes
+//!   ([`rig::EyeCamera`]: projection, back-projection), disparity <-> depth (Eq. 5) and the road
+//!   frame; and the same rig in `f64` road coordinates ([`rig::RoadRig`]: projection, ground
+//!   points, horizon, elevation, disparity in pixels and the one definition of angular
+//!   disparity), which the analysis crate uses for all its angles.
 //! - [`rigfile`]: `rig.json` ([`rigfile::RigFile`]), with the scene's lights in world and road
 //!   coordinates.
-//! - [`image`]: the single-channel float image [`image::GrayImage`]; PNG and atomic writing.
-//! - [`pfm`]: PFM disparity and depth maps (Middlebury convention).
 //! - [`pair`]: side-by-side and anaglyph views; the paper's Fig. 7 treatment of photographs.
+//! - [`pair_dir`]: the names of a pair folder's files ([`pair_dir::PairDir`]), for its writer
+//!   and its readers.
 //! - [`streak_mask`]: which pixels are specular streaks, from the renderer's specular layer.
 //! - [`texture_map`]: the paper's Fig. 3 ground-plane texture map.
 //! - [`font`]: the bundled plot font (plotters + `ab_glyph`, no system fonts).
@@ -34,9 +38,8 @@
 
 pub mod error;
 pub mod font;
-pub mod image;
 pub mod pair;
-pub mod pfm;
+pub mod pair_dir;
 #[cfg(feature = "render")]
 pub mod render;
 pub mod rig;

@@ -3,8 +3,10 @@
 //! moves a chosen disparity to zero).
 
 use crate::error::StereoError;
-use crate::image::{save_rgb8_png, GrayImage};
+use crate::pair_dir::PairDir;
 use std::path::Path;
+use streaks_image::png::write_png_buffer;
+use streaks_image::GrayImage;
 
 fn check_same_size(what: &'static str, l: (u32, u32), r: (u32, u32)) -> Result<(), StereoError> {
     if l != r {
@@ -58,8 +60,9 @@ pub fn write_pair_views(
     left: &image::RgbImage,
     right: &image::RgbImage,
 ) -> Result<(), StereoError> {
-    save_rgb8_png(&dir.join("side_by_side.png"), &side_by_side(left, right)?)?;
-    save_rgb8_png(&dir.join("anaglyph.png"), &anaglyph(left, right)?)?;
+    let files = PairDir::new(dir);
+    write_png_buffer(&files.side_by_side(), &side_by_side(left, right)?)?;
+    write_png_buffer(&files.anaglyph(), &anaglyph(left, right)?)?;
     Ok(())
 }
 

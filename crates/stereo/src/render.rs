@@ -21,19 +21,19 @@
 //! `tests/cli/stereo.rs`.
 
 use crate::error::StereoError;
-use crate::image::GrayImage;
 use crate::pair::write_pair_views;
-use crate::pfm::write_pfm;
+use crate::pair_dir::PairDir;
 use crate::rig::{Eye, Intrinsics, Rig, RoadFrame};
 use crate::rigfile::{LightRecord, Placed, RigFile};
 use crate::streak_mask::{streak_mask, StreakMaskParams};
-use glam::Vec3;
-use std::collections::HashMap;
 use std::path::Path;
+use streaks_image::pfm::write_pfm;
+use streaks_image::png::{to_srgb8_image, write_png_buffer};
+use streaks_image::GrayImage;
 use streaks_render::camera::Camera;
 use streaks_render::integrator::{render, Layers, RenderOutput, RenderSettings};
-use streaks_render::light::Light;
-use streaks_render::output::{to_srgb8, write_exr, write_png, RgbImage};
+use streaks_render::light::{Emitter, Light};
+use streaks_render::output::write_exr;
 use streaks_render::scene::Scene;
 
 /// A road pixel's first-hit normal is within this angle's cosine of +Y (10 degrees).
@@ -99,18 +99,6 @@ pub struct EyeView {
     pub streak_threshold: f32,
 }
 
-fn luminance(rgb: Vec3) -> f32 {
-    0.2126 * rgb.x + 0.7152 * rgb.y + 0.0722 * rgb.z
-}
-
-fn luminance_image(img: &RgbImage) -> Result<GrayImage, StereoError> {
-    Ok(GrayImage::from_vec(
-        img.width as usize,
-        img.height as usize,
-        img.pixels.iter().map(|&p| luminance(p)).collect(),
-    )?)
-}
-
 /// Renders one eye and derives its ground truth and streak mask.
 pub fn render_eye(
     scene: &Scene,
@@ -170,8 +158,8 @@ pub fn render_eye(
         .map(|(n, z)| z.is_finite() && n.y > ROAD_COS)
         .collect();
     let (streak_mask, streak_threshold) = streak_mask(
-        &luminance_image(specular)?,
-        &luminance_image(&output.image)?,
+        &GrayImage::luminance_of(specular)?,
+        &GrayImage::luminance_of(&output.image)?,
         Some(&road),
         &settings.mask,
     )?;
@@ -198,107 +186,56 @@ pub fn render_pair(
     Ok([left, right])
 }
 
-/// The scene's lights as `rig.json` records: point, spot and directional lights as they are;
-/// emissive triangles grouped into lamps (triangles of one material that share vertex
-/// positions), each with its area-weighted centroid.
+/// The scene's emitters as `rig.json` records, exactly the renderer's
+/// ([`streaks_render::light::Emitters`]): point, spot and directional lights as they are, then
+/// each emitter mesh (connected emissive triangles of one material: a lamp) with the centre
+/// the renderer uses for it.
 pub fn light_records(scene: &Scene, road: Option<&RoadFrame>) -> Vec<LightRecord> {
-    let mut out = Vec::new();
-    let mut emissive = Vec::new();
-    for light in &scene.lights {
-        match *light {
-            Light::Point {
+    let emitters = scene.light_sampler.emitters();
+    emitters
+        .list()
+        .iter()
+        .map(|emitter| match emitter {
+            Emitter::Punctual(Light::Point {
                 position,
                 intensity,
                 range,
-            } => out.push(LightRecord::Point {
-                position: Placed::point(position, road),
-                intensity: intensity.into(),
-                range,
-            }),
-            Light::Spot {
+            }) => LightRecord::Point {
+                position: Placed::point(*position, road),
+                intensity: (*intensity).into(),
+                range: *range,
+            },
+            Emitter::Punctual(Light::Spot {
                 position,
                 direction,
                 intensity,
                 cos_inner,
                 cos_outer,
                 range,
-            } => out.push(LightRecord::Spot {
-                position: Placed::point(position, road),
-                direction: Placed::vector(direction, road),
-                intensity: intensity.into(),
-                cos_inner,
-                cos_outer,
-                range,
-            }),
-            Light::Directional {
+            }) => LightRecord::Spot {
+                position: Placed::point(*position, road),
+                direction: Placed::vector(*direction, road),
+                intensity: (*intensity).into(),
+                cos_inner: *cos_inner,
+                cos_outer: *cos_outer,
+                range: *range,
+            },
+            Emitter::Punctual(Light::Directional {
                 direction,
                 irradiance,
-            } => out.push(LightRecord::Directional {
-                direction: Placed::vector(direction, road),
-                irradiance: irradiance.into(),
-            }),
-            Light::Triangle { triangle } => emissive.push(triangle as usize),
-        }
-    }
-    out.extend(emissive_groups(scene, &emissive, road));
-    out
-}
-
-/// Union-find root with path halving.
-fn find(parent: &mut [usize], mut i: usize) -> usize {
-    while parent[i] != i {
-        parent[i] = parent[parent[i]];
-        i = parent[i];
-    }
-    i
-}
-
-fn emissive_groups(scene: &Scene, tris: &[usize], road: Option<&RoadFrame>) -> Vec<LightRecord> {
-    let valid: Vec<usize> = tris
-        .iter()
-        .copied()
-        .filter(|&t| t < scene.triangles.len())
-        .collect();
-    let mut parent: Vec<usize> = (0..valid.len()).collect();
-    // Triangles touching the same vertex position with the same material are one lamp.
-    let mut first_at: HashMap<([u32; 3], u32), usize> = HashMap::new();
-    for (k, &t) in valid.iter().enumerate() {
-        let material = scene.triangle_materials.get(t).copied().unwrap_or(u32::MAX);
-        for &v in &scene.triangles[t] {
-            let p = scene.positions[v as usize];
-            let key = ([p.x.to_bits(), p.y.to_bits(), p.z.to_bits()], material);
-            let other = *first_at.entry(key).or_insert(k);
-            let (a, b) = (find(&mut parent, k), find(&mut parent, other));
-            parent[a] = b;
-        }
-    }
-    // Accumulate per root, in order of first appearance.
-    let mut order: Vec<usize> = Vec::new();
-    let mut acc: HashMap<usize, (Vec3, f32, usize, u32)> = HashMap::new();
-    for (k, &t) in valid.iter().enumerate() {
-        let root = find(&mut parent, k);
-        let [a, b, c] = scene.triangles[t].map(|v| scene.positions[v as usize]);
-        let area = 0.5 * (b - a).cross(c - a).length();
-        let material = scene.triangle_materials.get(t).copied().unwrap_or(u32::MAX);
-        let e = acc.entry(root).or_insert_with(|| {
-            order.push(root);
-            (Vec3::ZERO, 0.0, 0, material)
-        });
-        e.0 += area * (a + b + c) / 3.0;
-        e.1 += area;
-        e.2 += 1;
-    }
-    order
-        .into_iter()
-        .map(|root| {
-            let (weighted, area, n, material) = acc[&root];
-            let m = scene.materials.get(material as usize);
-            LightRecord::Emissive {
-                centroid: Placed::point(weighted / area.max(f32::MIN_POSITIVE), road),
-                area,
-                triangles: n,
-                radiance: m.map(|m| m.emission.into()).unwrap_or([0.0; 3]),
-                material: m.map(|m| m.name.clone()).unwrap_or_default(),
+            }) => LightRecord::Directional {
+                direction: Placed::vector(*direction, road),
+                irradiance: (*irradiance).into(),
+            },
+            Emitter::Mesh(m) => {
+                let material = &scene.materials[m.material() as usize];
+                LightRecord::Emissive {
+                    centroid: Placed::point(m.centre(), road),
+                    area: m.area(),
+                    triangles: m.triangle_count(),
+                    radiance: material.emission.into(),
+                    material: material.name.clone(),
+                }
             }
         })
         .collect()
@@ -317,30 +254,27 @@ pub fn write_pair(
     views: &[EyeView; 2],
     exposure_ev: f32,
 ) -> Result<(), StereoError> {
+    let files = PairDir::new(dir);
     let mut srgb = Vec::with_capacity(2);
     for (eye, view) in Eye::BOTH.into_iter().zip(views) {
-        let name = eye.name();
-        write_exr(&dir.join(format!("{name}.exr")), &view.output).map_err(output_err)?;
-        let img = &view.output.image;
-        write_png(&dir.join(format!("{name}.png")), img, exposure_ev).map_err(output_err)?;
-        srgb.push(
-            image::RgbImage::from_raw(img.width, img.height, to_srgb8(img, exposure_ev))
-                .ok_or_else(|| output_err("image size does not match its pixels"))?,
-        );
-        write_pfm(&dir.join(format!("disparity_{name}.pfm")), &view.disparity)?;
-        write_pfm(&dir.join(format!("depth_{name}.pfm")), &view.depth)?;
-        view.streak_mask
-            .save_png(&dir.join(format!("streak_mask_{name}.png")))?;
+        write_exr(&files.exr(eye), &view.output)?;
+        let img = to_srgb8_image(&view.output.image, exposure_ev)
+            .ok_or_else(|| output_err("image size does not match its pixels"))?;
+        write_png_buffer(&files.png(eye), &img)?;
+        srgb.push(img);
+        write_pfm(&files.disparity(eye), &view.disparity)?;
+        write_pfm(&files.depth(eye), &view.depth)?;
+        view.streak_mask.save_png(&files.streak_mask(eye))?;
     }
     write_pair_views(dir, &srgb[0], &srgb[1])?;
     let road = rig.road_frame().ok();
-    RigFile::new(rig, light_records(scene, road.as_ref())).save(&dir.join("rig.json"))
+    RigFile::new(rig, light_records(scene, road.as_ref())).save(&files.rig())
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::Affine3A;
+    use glam::{Affine3A, Vec3};
 
     #[test]
     fn bad_inputs_are_errors() {

@@ -14,9 +14,31 @@
 //!   forward, X to the right makes this frame **left-handed**: `road_from_world` is a rotation
 //!   composed with a reflection (determinant -1). For a level camera the road frame's (X, Y, Z)
 //!   are the eye's camera-space (x, y, -z) shifted down by the rig height.
+//!
+//! # One camera, two precisions
+//!
+//! [`Rig`] and its eyes ([`EyeCamera`]) work in `f32` world space with the full pose: they
+//! render the pair and its ground truth. The analysis measures much smaller things (disparity
+//! spans of 0.01 px, 0.008 degrees along a streak), so it works with [`RoadRig`]: the same
+//! rig in `f64` road coordinates ([`Rig::road_rig`]), with its projection and ground points,
+//! its horizon, elevation angles and disparities in pixels and degrees. The Eq. 4 model of the
+//! analysis crate and its report both use it; nothing else computes these angles.
+//!
+//! # Angular disparity
+//!
+//! The paper's angular disparity is the difference of the angles under which the two eyes see
+//! a point: its horizontal visual angle (Fick azimuth) in the left eye minus that in the right
+//! eye. In an eye's camera frame a point `x` metres to the right of the eye at depth `z` along
+//! the optical axis has azimuth `atan(x / z)`; at pixel column `u` that is `atan((u - c_x) / f)`.
+//! So a point seen at `u_left` with pixel disparity `d` has the angular disparity
+//! `atan((u_left - c_x) / f) - atan((u_left - d - c_x) / f)`
+//! ([`RoadRig::angular_disparity_deg_px`]), the same number as from its position
+//! ([`RoadRig::angular_disparity_deg`]). Straight ahead of the rig centre it is the vergence
+//! angle `2 atan(b / 2Z)`; elsewhere it is not a function of the pixel disparity alone, which is
+//! why there is no `d -> degrees` conversion without a column.
 
 use crate::error::StereoError;
-use glam::{Affine3A, Vec2, Vec3};
+use glam::{Affine3A, DVec2, DVec3, Vec2, Vec3};
 use std::fmt;
 use std::str::FromStr;
 
@@ -268,17 +290,6 @@ impl Rig {
         self.intrinsics.focal_px * self.baseline / d
     }
 
-    /// A disparity in pixels as an angle in degrees of visual angle: `2 atan(d / 2f)`, the
-    /// vergence angle of the two eyes' rays, exact for a point on the rig's midline.
-    pub fn disparity_deg_from_px(&self, d: f32) -> f32 {
-        (2.0 * (0.5 * d / self.intrinsics.focal_px).atan()).to_degrees()
-    }
-
-    /// The inverse of [`Rig::disparity_deg_from_px`]: `2 f tan(angle / 2)`.
-    pub fn disparity_px_from_deg(&self, deg: f32) -> f32 {
-        2.0 * self.intrinsics.focal_px * (0.5 * deg.to_radians()).tan()
-    }
-
     /// The road frame below the rig centre; an error when the camera looks (almost) straight up
     /// or down, so that its forward direction has no horizontal part.
     pub fn road_frame(&self) -> Result<RoadFrame, StereoError> {
@@ -300,6 +311,23 @@ impl Rig {
             y_axis,
             z_axis,
         })
+    }
+
+    /// The rig in `f64` road coordinates, for the analysis: its centre at `(0, height, 0)`,
+    /// pitched down by `asin(-forward.y)`, with the rig's focal length, principal point and
+    /// baseline. The same errors as [`Rig::road_frame`]. The rig's roll is not represented:
+    /// [`RoadRig`] keeps its eyes on the road frame's X axis, as a level horizon needs.
+    pub fn road_rig(&self) -> Result<RoadRig, StereoError> {
+        self.road_frame()?;
+        let pitch = (-self.forward().y as f64).clamp(-1.0, 1.0).asin();
+        let pp = self.intrinsics.principal_point();
+        RoadRig::new(
+            DVec3::new(0.0, self.height() as f64, 0.0),
+            pitch,
+            self.focal_px() as f64,
+            DVec2::new(pp.x as f64, pp.y as f64),
+            self.baseline as f64,
+        )
     }
 }
 
@@ -405,6 +433,221 @@ impl RoadFrame {
     }
 }
 
+/// A rectified rig in the road frame, in `f64`: two pinhole eyes `b` apart along the road
+/// frame's X, centred on `centre`, both pitched down by `pitch` about that axis (no roll, no
+/// yaw: the road frame's Z is the rig's forward direction made horizontal). Pixels as in the
+/// module documentation. This is the camera of the analysis (see the module documentation for
+/// why `f64`); [`Rig::road_rig`] makes it from a rig, [`RoadRig::new`] from numbers.
+///
+/// Camera coordinates, relative to an eye or the centre: `(right, up, depth along the optical
+/// axis)`, so a point in front has positive depth.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RoadRig {
+    centre: DVec3,
+    pitch: f64,
+    focal_px: f64,
+    principal: DVec2,
+    baseline: f64,
+}
+
+impl RoadRig {
+    /// A checked rig: `centre` (the cyclopean eye, road coordinates) finite, `pitch` (radians,
+    /// downward) inside (-pi/2, pi/2), `focal_px` positive and finite, `principal` finite,
+    /// `baseline` (metres) positive and finite.
+    pub fn new(
+        centre: DVec3,
+        pitch: f64,
+        focal_px: f64,
+        principal: DVec2,
+        baseline: f64,
+    ) -> Result<Self, StereoError> {
+        if !centre.is_finite() {
+            return Err(StereoError::Pose(format!(
+                "the rig centre {centre} is not finite"
+            )));
+        }
+        if !(pitch.is_finite() && pitch.abs() < std::f64::consts::FRAC_PI_2) {
+            return Err(StereoError::Pose(format!(
+                "the pitch {} degrees must lie in (-90, 90)",
+                pitch.to_degrees()
+            )));
+        }
+        if !(focal_px.is_finite() && focal_px > 0.0) {
+            return Err(StereoError::Intrinsics(format!(
+                "focal length {focal_px} px must be positive and finite"
+            )));
+        }
+        if !principal.is_finite() {
+            return Err(StereoError::Intrinsics(format!(
+                "principal point {principal} is not finite"
+            )));
+        }
+        if !(baseline.is_finite() && baseline > 0.0) {
+            return Err(StereoError::Parameter {
+                name: "baseline",
+                reason: format!("{baseline} m must be positive and finite"),
+            });
+        }
+        Ok(Self {
+            centre,
+            pitch,
+            focal_px,
+            principal,
+            baseline,
+        })
+    }
+
+    /// A level rig at `centre` with its principal point at pixel (0, 0): with `focal_px` 1 its
+    /// pixels are the tangents of the visual angles.
+    pub fn level(centre: DVec3, focal_px: f64, baseline: f64) -> Result<Self, StereoError> {
+        Self::new(centre, 0.0, focal_px, DVec2::ZERO, baseline)
+    }
+
+    /// The rig centre (the cyclopean eye) in road coordinates; its Y is the rig height.
+    pub fn centre(&self) -> DVec3 {
+        self.centre
+    }
+
+    /// Downward pitch of the optical axis from the road's +Z, radians (0: level).
+    pub fn pitch(&self) -> f64 {
+        self.pitch
+    }
+
+    /// Focal length in pixels.
+    pub fn focal_px(&self) -> f64 {
+        self.focal_px
+    }
+
+    /// Principal point in pixels.
+    pub fn principal(&self) -> DVec2 {
+        self.principal
+    }
+
+    /// The baseline b in metres.
+    pub fn baseline(&self) -> f64 {
+        self.baseline
+    }
+
+    /// An eye's position: the centre moved by `sign * b/2` along the road's X.
+    pub fn eye_position(&self, eye: Eye) -> DVec3 {
+        self.centre + DVec3::X * (0.5 * eye.sign() as f64 * self.baseline)
+    }
+
+    /// The optical axis in road coordinates.
+    pub fn forward(&self) -> DVec3 {
+        DVec3::new(0.0, -self.pitch.sin(), self.pitch.cos())
+    }
+
+    /// The cameras' up axis in road coordinates.
+    pub fn up(&self) -> DVec3 {
+        DVec3::new(0.0, self.pitch.cos(), self.pitch.sin())
+    }
+
+    /// A road point in the centre's camera coordinates: (right, up, depth).
+    pub fn to_camera(&self, p: DVec3) -> DVec3 {
+        self.camera_from(self.centre, p)
+    }
+
+    /// `p` in the camera coordinates of a camera at `origin` with the rig's orientation.
+    fn camera_from(&self, origin: DVec3, p: DVec3) -> DVec3 {
+        let d = p - origin;
+        DVec3::new(d.x, d.dot(self.up()), d.dot(self.forward()))
+    }
+
+    /// The pixel of camera coordinates `c`, or `None` unless `c` is in front (depth > 0).
+    fn pixel(&self, c: DVec3) -> Option<DVec2> {
+        (c.z > 0.0).then(|| {
+            DVec2::new(
+                self.principal.x + self.focal_px * c.x / c.z,
+                self.principal.y - self.focal_px * c.y / c.z,
+            )
+        })
+    }
+
+    /// Where the rig centre (the cyclopean eye) sees road point `p`, or `None` if it is not in
+    /// front.
+    pub fn project(&self, p: DVec3) -> Option<DVec2> {
+        self.pixel(self.to_camera(p))
+    }
+
+    /// Where `eye` sees road point `p`, or `None` if it is not in front.
+    pub fn project_eye(&self, eye: Eye, p: DVec3) -> Option<DVec2> {
+        self.pixel(self.camera_from(self.eye_position(eye), p))
+    }
+
+    /// The (unnormalised) road direction of the centre's ray through `pixel`; its component
+    /// along the optical axis is 1.
+    pub fn ray(&self, pixel: DVec2) -> DVec3 {
+        let x = (pixel.x - self.principal.x) / self.focal_px;
+        let y = -(pixel.y - self.principal.y) / self.focal_px;
+        DVec3::X * x + self.up() * y + self.forward()
+    }
+
+    /// The road point (Y = 0) the centre sees through `pixel`, or `None` if the ray does not
+    /// go down to the road (or the rig is not above it).
+    pub fn ground_point(&self, pixel: DVec2) -> Option<DVec3> {
+        let d = self.ray(pixel);
+        if d.y >= 0.0 || self.centre.y <= 0.0 {
+            return None;
+        }
+        let p = self.centre + d * (-self.centre.y / d.y);
+        Some(DVec3::new(p.x, 0.0, p.z))
+    }
+
+    /// The image row of the horizon, `c_y - f tan(pitch)` (continuous pixel coordinates).
+    pub fn horizon_row(&self) -> f64 {
+        self.principal.y - self.focal_px * self.pitch.tan()
+    }
+
+    /// The angle below the horizon at which the rig centre sees `p`, degrees: the angle between
+    /// the sight line and the horizontal plane, positive below the horizon.
+    pub fn elevation_deg(&self, p: DVec3) -> f64 {
+        let d = p - self.centre;
+        (-d.y).atan2(d.x.hypot(d.z)).to_degrees()
+    }
+
+    /// The elevation below the horizon of the centre's ray through image row `y` at the
+    /// principal column, degrees: `atan((y - c_y) / f) + pitch`, the
+    /// [`RoadRig::elevation_deg`] of every point on that ray.
+    pub fn row_elevation_deg(&self, y: f64) -> f64 {
+        (((y - self.principal.y) / self.focal_px).atan() + self.pitch).to_degrees()
+    }
+
+    /// Eq. 5: the pixel disparity `x_left - x_right = f b / Z` of road point `p`, `Z` its depth
+    /// along the optical axis. Infinite or negative if it is not in front.
+    pub fn disparity_px(&self, p: DVec3) -> f64 {
+        self.focal_px * self.baseline / self.to_camera(p).z
+    }
+
+    /// The depth along the optical axis of a pixel disparity, `f b / d` (infinite at 0).
+    pub fn depth_from_disparity_px(&self, d: f64) -> f64 {
+        self.focal_px * self.baseline / d
+    }
+
+    /// The angular disparity of road point `p`, degrees: its azimuth in the left eye minus that
+    /// in the right eye (see the module documentation).
+    pub fn angular_disparity_deg(&self, p: DVec3) -> f64 {
+        let c = self.to_camera(p);
+        let half = 0.5 * self.baseline;
+        angular_disparity_deg(c.x + half, c.x - half, c.z)
+    }
+
+    /// The angular disparity, degrees, of a point the left eye sees at column `x_left` with
+    /// pixel disparity `d` (so the right eye sees it at `x_left - d`): the same definition as
+    /// [`RoadRig::angular_disparity_deg`], from pixels.
+    pub fn angular_disparity_deg_px(&self, x_left: f64, d: f64) -> f64 {
+        let cx = self.principal.x;
+        angular_disparity_deg(x_left - cx, x_left - d - cx, self.focal_px)
+    }
+}
+
+/// The angular disparity, degrees, of a point `left` and `right` to the right of the left and
+/// the right eye at `depth` along their optical axes (metres, or pixels with `depth = f`): the
+/// difference of its azimuths `atan(lateral / depth)` in the two eyes.
+fn angular_disparity_deg(left: f64, right: f64, depth: f64) -> f64 {
+    ((left / depth).atan() - (right / depth).atan()).to_degrees()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -416,6 +659,11 @@ mod tests {
             Vec3::new(2.0, 1.5, -3.0),
         );
         Rig::new(Intrinsics::from_yfov(640, 480, 0.7).unwrap(), 0.065, pose).unwrap()
+    }
+
+    /// A road rig with a 6.5 cm baseline, pitched down by `pitch_deg`.
+    fn pitched(centre: DVec3, pitch_deg: f64, focal_px: f64, principal: DVec2) -> RoadRig {
+        RoadRig::new(centre, pitch_deg.to_radians(), focal_px, principal, 0.065).unwrap()
     }
 
     #[test]
@@ -468,15 +716,109 @@ mod tests {
     #[test]
     fn disparity_angles() {
         let rig = test_rig();
-        let f = rig.focal_px();
-        // A midline point at depth Z: vergence angle 2 atan(b / 2Z).
-        let z = 10.0f32;
-        let expect = (2.0 * (0.5 * 0.065 / z).atan()).to_degrees();
-        let got = rig.disparity_deg_from_px(rig.disparity_px(z));
-        assert!((got - expect).abs() < 1e-6, "{got} vs {expect}");
-        assert!((rig.disparity_px_from_deg(got) - f * 0.065 / z).abs() < 1e-3);
-        assert_eq!(rig.disparity_deg_from_px(0.0), 0.0);
+        let road = rig.road_rig().unwrap();
+        // A point straight ahead of the rig centre at depth Z: the vergence angle 2 atan(b / 2Z),
+        // from its position and from its pixels alike.
+        let z = 10.0f64;
+        let p = road.centre() + road.forward() * z;
+        let b = road.baseline();
+        let expect = (2.0 * (0.5 * b / z).atan()).to_degrees();
+        let got = road.angular_disparity_deg(p);
+        assert!((got - expect).abs() < 1e-14, "{got} vs {expect}");
+        let d = road.disparity_px(p);
+        assert!((d - road.focal_px() * b / z).abs() < 1e-9);
+        let xl = road.project_eye(Eye::Left, p).unwrap().x;
+        assert!((road.angular_disparity_deg_px(xl, d) - expect).abs() < 1e-12);
+        assert_eq!(road.angular_disparity_deg_px(xl, 0.0), 0.0);
         assert!(rig.depth_from_disparity_px(0.0).is_infinite());
+        assert!(road.depth_from_disparity_px(0.0).is_infinite());
+        assert!((road.depth_from_disparity_px(d) - z).abs() < 1e-9);
+    }
+
+    /// Off the rig's midline the angular disparity is the difference of the eyes' azimuths
+    /// `atan((x - c_x) / f)`, not a function of the pixel disparity alone.
+    #[test]
+    fn angular_disparity_is_the_difference_of_the_eyes_azimuths() {
+        let road = pitched(
+            DVec3::new(0.2, 1.5, 0.0),
+            3.0,
+            1000.0,
+            DVec2::new(640.0, 360.0),
+        );
+        let p = DVec3::new(-2.0, -1.0, 12.0);
+        let (l, r) = (
+            road.project_eye(Eye::Left, p).unwrap(),
+            road.project_eye(Eye::Right, p).unwrap(),
+        );
+        assert!((l.y - r.y).abs() < 1e-9, "rectified: same row");
+        assert!((road.disparity_px(p) - (l.x - r.x)).abs() < 1e-9);
+        let az = |q: DVec2| ((q.x - 640.0) / 1000.0).atan().to_degrees();
+        let deg = road.angular_disparity_deg(p);
+        assert!((deg - (az(l) - az(r))).abs() < 1e-12);
+        assert!((road.angular_disparity_deg_px(l.x, l.x - r.x) - deg).abs() < 1e-12);
+        // The vergence formula 2 atan(d / 2f) holds on the midline only.
+        let vergence = (2.0 * (0.5 * (l.x - r.x) / 1000.0f64).atan()).to_degrees();
+        assert!((vergence - deg).abs() > 1e-5, "{vergence} vs {deg}");
+        // Behind: negative disparity, no projection.
+        assert!(road.disparity_px(DVec3::new(0.0, 0.0, -3.0)) < 0.0);
+        assert!(road.project(DVec3::new(0.0, 0.0, -3.0)).is_none());
+    }
+
+    /// The f64 road rig sees what the f32 eyes see: the same pixels, the horizon where far
+    /// level points project, and row elevations that are the elevations of the ground points.
+    #[test]
+    fn road_rig_agrees_with_the_eyes() {
+        let rig = test_rig();
+        let frame = rig.road_frame().unwrap();
+        let road = rig.road_rig().unwrap();
+        assert!((road.centre() - DVec3::new(0.0, 1.5, 0.0)).length() < 1e-6);
+        assert!((road.pitch() - 0.1).abs() < 1e-6, "{}", road.pitch());
+        for q in [
+            Vec3::new(0.5, 0.0, 6.0),
+            Vec3::new(-3.0, 4.0, 20.0),
+            Vec3::new(1.0, -1.5, 12.0),
+        ] {
+            let world = frame.world_from_road_point(q);
+            let dq = DVec3::new(q.x as f64, q.y as f64, q.z as f64);
+            for eye in Eye::BOTH {
+                let a = rig.eye(eye).project(world).unwrap();
+                let b = road.project_eye(eye, dq).unwrap();
+                assert!((a.x as f64 - b.x).abs() < 2e-3 && (a.y as f64 - b.y).abs() < 2e-3);
+            }
+            let depth = rig.eye(Eye::Left).depth(world) as f64;
+            assert!((road.disparity_px(dq) - rig.disparity_px(depth as f32) as f64).abs() < 1e-3);
+        }
+        let far = road.project(DVec3::new(0.0, 1.5, 1e7)).unwrap();
+        assert!(
+            (far.y - road.horizon_row()).abs() < 1e-6,
+            "{far} {}",
+            road.horizon_row()
+        );
+        let cx = road.principal().x;
+        for y in [300.5, 400.5, 479.5] {
+            let g = road.ground_point(DVec2::new(cx, y)).unwrap();
+            assert!((road.project(g).unwrap() - DVec2::new(cx, y)).length() < 1e-9);
+            assert!((road.elevation_deg(g) - road.row_elevation_deg(y)).abs() < 1e-12);
+        }
+        let above = road.horizon_row() - 1.0;
+        assert!(
+            road.ground_point(DVec2::new(cx, above)).is_none(),
+            "above the horizon"
+        );
+        // Off the principal column too.
+        let road = pitched(
+            DVec3::new(0.0, 1.5, 0.0),
+            2.0,
+            800.0,
+            DVec2::new(400.0, 300.0),
+        );
+        let g = road.ground_point(DVec2::new(450.5, 400.5)).unwrap();
+        let back = road.project(g).unwrap();
+        assert!((back - DVec2::new(450.5, 400.5)).length() < 1e-9);
+        assert!(
+            road.ground_point(DVec2::new(400.0, 0.5)).is_none(),
+            "above the horizon"
+        );
     }
 
     #[test]
@@ -538,5 +880,20 @@ mod tests {
         assert_eq!("right".parse::<Eye>().unwrap(), Eye::Right);
         let i = Intrinsics::from_yfov(640, 480, 0.7).unwrap();
         assert!((i.yfov() - 0.7).abs() < 1e-6);
+        let c = DVec3::new(0.0, 1.5, 0.0);
+        let new = |pitch_deg: f64, f: f64, b: f64| {
+            RoadRig::new(c, f64::to_radians(pitch_deg), f, DVec2::ZERO, b)
+        };
+        assert!(matches!(new(95.0, 100.0, 0.1), Err(StereoError::Pose(_))));
+        assert!(matches!(
+            new(0.0, 0.0, 0.1),
+            Err(StereoError::Intrinsics(_))
+        ));
+        assert!(matches!(
+            new(0.0, 100.0, 0.0),
+            Err(StereoError::Parameter { .. })
+        ));
+        assert!(RoadRig::new(DVec3::NAN, 0.0, 1.0, DVec2::ZERO, 0.1).is_err());
+        assert!(RoadRig::new(c, 0.0, 1.0, DVec2::NAN, 0.1).is_err());
     }
 }

@@ -7,7 +7,6 @@
 //! rigid pose, a principal point at the image centre, eyes where the baseline puts them.
 
 use crate::error::StereoError;
-use crate::image::write_file_atomic;
 use crate::rig::{Eye, Intrinsics, Rig, RoadFrame};
 use glam::{Affine3A, Mat3A, Vec3, Vec3A};
 use serde::{Deserialize, Serialize};
@@ -142,9 +141,11 @@ pub enum LightRecord {
         /// Irradiance (W/m^2).
         irradiance: [f32; 3],
     },
-    /// A group of connected emissive triangles with the same material (a lamp).
+    /// One of the renderer's emitter meshes: connected emissive triangles of one material (a
+    /// lamp).
     Emissive {
-        /// Area-weighted centroid.
+        /// Centre of the emitter's bounding sphere (the centre of its vertices' bounding box),
+        /// the point the renderer's light choice aims at.
         centroid: Placed,
         /// Total area (m^2).
         area: f32,
@@ -240,7 +241,7 @@ impl RigFile {
             reason,
         };
         let text = serde_json::to_string_pretty(self).map_err(|e| err(e.to_string()))?;
-        write_file_atomic(path, text.as_bytes()).map_err(|e| err(e.to_string()))
+        streaks_image::write_bytes_atomically(path, text.as_bytes()).map_err(|e| err(e.to_string()))
     }
 
     /// Reads a file written by [`RigFile::save`] (lights are optional when written by hand).

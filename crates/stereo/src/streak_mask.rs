@@ -14,7 +14,7 @@
 //! depend on the exposure. A view without specular radiance has an empty mask (`S > 0` fails).
 
 use crate::error::StereoError;
-use crate::image::GrayImage;
+use streaks_image::GrayImage;
 
 /// Parameters of the streak mask (see the module documentation).
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -14,11 +14,12 @@
 //! system fonts are needed).
 
 use crate::error::StereoError;
-use crate::image::{save_rgb8_png, GrayImage};
 use crate::rig::{Eye, Rig};
 use glam::{Vec2, Vec3};
 use plotters::prelude::*;
 use std::path::Path;
+use streaks_image::png::write_png_buffer;
+use streaks_image::GrayImage;
 
 /// Largest map, in cells.
 const MAX_CELLS: usize = 1 << 26;
@@ -96,22 +97,6 @@ pub struct TextureMap {
     pub spec: MapSpec,
     /// The channels (1 for grey, 3 for RGB), `nx` x `nz` each.
     pub channels: Vec<GrayImage>,
-}
-
-/// Loads an image as three channels (R, G, B as stored: sRGB values in [0, 1] for PNG/JPEG).
-pub fn load_rgb_channels(path: &Path) -> Result<Vec<GrayImage>, StereoError> {
-    let img = image::open(path).map_err(|e| crate::image::ImageError::Read {
-        path: path.to_path_buf(),
-        reason: e.to_string(),
-    })?;
-    let rgb = img.to_rgb32f();
-    let (w, h) = (rgb.width() as usize, rgb.height() as usize);
-    (0..3)
-        .map(|c| {
-            let data = rgb.pixels().map(|p| p[c]).collect();
-            GrayImage::from_vec(w, h, data).map_err(StereoError::from)
-        })
-        .collect()
 }
 
 /// Resamples `channels` (an image seen by `eye` of `rig`, the rig's size) onto the road.
@@ -237,7 +222,7 @@ pub fn plot_texture_map(map: &TextureMap, path: &Path, title: &str) -> Result<()
     }
     let img = image::RgbImage::from_raw(cw as u32, ch as u32, buf)
         .ok_or_else(|| plot_err("canvas size".into()))?;
-    Ok(save_rgb8_png(path, &img)?)
+    Ok(write_png_buffer(path, &img)?)
 }
 
 #[cfg(test)]

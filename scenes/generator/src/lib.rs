@@ -194,8 +194,8 @@ mod tests {
                 .filter(|l| matches!(l, Light::Point { .. } | Light::Spot { .. }))
                 .count();
             assert_eq!(n_punctual, punctual, "{name}");
-            let n_area = scene.lights.len() - n_punctual;
-            assert_eq!(n_area > 0, emissive, "{name}: {n_area} emissive triangles");
+            let n_area = scene.light_sampler.emitters().len() - scene.lights.len();
+            assert_eq!(n_area > 0, emissive, "{name}: {n_area} emitter meshes");
             if name.starts_with("rainy") {
                 let road = scene
                     .materials

@@ -3,9 +3,9 @@
 
 use super::lanes::{Lanes, Spectrum};
 use super::{glossy_probability, half_vector, reflect_about_half, Lobes, Model, Reflectances};
-use crate::sampling::luminance;
 use glam::{Vec2, Vec3};
 use std::f32::consts::{PI, TAU};
+use streaks_image::luminance;
 
 /// Normalised Blinn-Phong: `f = kd/pi + ks (s+8)/(8 pi) (n.h)^s`.
 #[derive(Clone, Copy, Debug, PartialEq)]

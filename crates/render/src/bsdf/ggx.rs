@@ -4,9 +4,9 @@
 
 use super::lanes::{Lanes, Spectrum};
 use super::{glossy_probability, reflect, Lobes, Model, Reflectances, MIN_ALPHA};
-use crate::sampling::luminance;
 use glam::{Vec2, Vec3};
 use std::f32::consts::{PI, TAU};
+use streaks_image::luminance;
 
 /// The paper's GGX model: `f = kd/pi + ks D(h) G1(wi) G1(wo) / (4 cos_i cos_o)`; exactly Mitsuba 3's
 /// `blendbsdf` (weight 0.5) of `diffuse` (2 kd) and `roughconductor` (ggx, material none, 2 ks).

@@ -5,8 +5,8 @@ use super::diffuse::lambert;
 use super::ggx;
 use super::lanes::{Lanes, Spectrum};
 use super::{glossy_probability, half_vector, reflect, Lobes, Model, Reflectances, MIN_ALPHA};
-use crate::sampling::luminance;
 use glam::{Vec2, Vec3};
+use streaks_image::luminance;
 
 /// The glTF 2.0 metallic-roughness BRDF (specification appendix B): Lambert diffuse of
 /// `base_color (1 - metallic)` mixed with a GGX/Smith specular lobe of alpha = roughness^2

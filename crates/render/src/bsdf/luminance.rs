@@ -8,8 +8,8 @@
 
 use super::lanes::Lanes;
 use super::{BlinnPhong, Bsdf, Diffuse, Ggx, GltfPbr, Lobes, Model, Reflectances, Ward};
-use crate::sampling::luminance;
 use glam::{Vec3, Vec4};
+use streaks_image::luminance;
 
 /// `luminance(f(wo, wi))` for one `wo` and any `wi` (see [`Bsdf::luminance_at`]):
 /// [`LuminanceEval::eval`] evaluates one direction and [`LuminanceEval::eval4`] four at once

@@ -426,8 +426,9 @@ mod tests {
     //! over every chi-square test of the module; a set of every model), and the tests of all
     //! models at once: reciprocity, the hemisphere, the lobe choice, the albedo estimates.
     use super::*;
-    use crate::sampling::{luminance, Pcg32};
+    use crate::sampling::Pcg32;
     use crate::testing::{check_bsdf, ChiSquareConfig};
+    use streaks_image::luminance;
 
     pub(super) const ANGLES: [f32; 5] = [0.0, 45.0, 75.0, 85.0, 88.0];
     pub(super) const ALPHAS: [f32; 4] = [0.02, 0.1, 0.3, 0.7];

@@ -3,9 +3,9 @@
 
 use super::lanes::{Lanes, Spectrum};
 use super::{glossy_probability, reflect_about_half, Lobes, Model, Reflectances, MIN_ALPHA};
-use crate::sampling::luminance;
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
+use streaks_image::luminance;
 
 /// The paper's isotropic Ward model:
 /// `f = kd/pi + ks exp(-tan^2(delta)/alpha^2) / (4 pi alpha^2 sqrt(cos_i cos_o))`.

@@ -1020,8 +1020,8 @@ mod tests {
             err.contains("nope") && err.contains("\"cam_node\""),
             "{err}"
         );
-        // Lights: three punctual ones, then the emissive triangle.
-        assert_eq!(scene.lights.len(), 4);
+        // Lights: three punctual ones; emitters: those and the emissive triangle.
+        assert_eq!(scene.lights.len(), 3);
         assert_eq!(
             scene.lights[0],
             Light::Point {
@@ -1048,7 +1048,9 @@ mod tests {
             matches!(scene.lights[2], Light::Directional { direction, irradiance }
             if approx(direction, -Vec3::Z) && approx(irradiance, Vec3::splat(2.0)))
         );
-        assert_eq!(scene.lights[3], Light::Triangle { triangle: 2 });
+        let emitters = scene.light_sampler.emitters();
+        assert_eq!(emitters.len(), 4);
+        assert_eq!(emitters.emitter_of(2), Some((3, 0)));
     }
 
     #[test]

@@ -18,9 +18,9 @@
 //!   "alpha": a, "shininess": s}` (`alpha` for ggx and ward, `shininess` for blinn_phong;
 //!   `kd` and `ks` default to black). The baseColorTexture, if any, multiplies `kd`.
 //! - Emission `emissiveFactor * KHR_materials_emissive_strength` (times the emissive texture)
-//!   is radiance; every triangle of an emissive material becomes a
-//!   [`Light::Triangle`]. Emission is one-sided (the winding's front face) unless the material
-//!   is `doubleSided`.
+//!   is radiance; the triangles of an emissive material are area lights, grouped into the
+//!   scene's emitters ([`crate::light::Emitters`]) when it is built. Emission is one-sided (the
+//!   winding's front face) unless the material is `doubleSided`.
 //!
 //! ## Wet and dry patches (an extension of the contract)
 //!
@@ -52,7 +52,7 @@ pub use error::SceneError;
 use crate::accel::Accel;
 use crate::camera::Camera;
 use crate::geometry::Ray;
-use crate::light::Light;
+use crate::light::{Light, LightSampler, SurfaceMesh};
 use crate::material::Material;
 use crate::texture::Texture;
 use glam::{Vec2, Vec3};
@@ -78,12 +78,15 @@ pub struct Scene {
     pub materials: Vec<Material>,
     /// Decoded textures.
     pub textures: Vec<Texture>,
-    /// All lights, emissive triangles included.
+    /// The point, spot and directional lights, in file order.
     pub lights: Vec<Light>,
     /// Cameras, in file order.
     pub cameras: Vec<Camera>,
     /// The BVH over `triangles`.
     pub accel: Accel,
+    /// The emitters (`lights` and the emissive triangles) and the light tree over them, built
+    /// with the scene from its triangles, materials and lights.
+    pub light_sampler: LightSampler,
     /// Things in the file that were skipped or defaulted, for the command to print.
     pub warnings: Vec<String>,
 }
@@ -107,7 +110,7 @@ pub struct SceneParts {
     pub materials: Vec<Material>,
     /// Textures.
     pub textures: Vec<Texture>,
-    /// Point, spot and directional lights (triangle lights are added by `from_parts`).
+    /// Point, spot and directional lights (emissive triangles become emitters by themselves).
     pub lights: Vec<Light>,
     /// Cameras.
     pub cameras: Vec<Camera>,
@@ -152,8 +155,8 @@ impl Scene {
     }
 
     /// Builds a scene from in-memory parts: checks every index, fills absent normals and uvs,
-    /// adds a [`Light::Triangle`] for each non-degenerate triangle of an emissive material, and
-    /// builds the BVH.
+    /// builds the BVH, and builds the emitters and the light tree ([`LightSampler`]) from the
+    /// lights and the non-degenerate triangles of emissive materials.
     pub fn from_parts(parts: SceneParts) -> Result<Scene, SceneError> {
         let SceneParts {
             source,
@@ -164,7 +167,7 @@ impl Scene {
             triangle_materials,
             materials,
             textures,
-            mut lights,
+            lights,
             cameras,
             warnings,
         } = parts;
@@ -234,13 +237,15 @@ impl Scene {
                 ));
             }
         }
-        for (i, (t, &m)) in triangles.iter().zip(&triangle_materials).enumerate() {
-            let [a, b, c] = t.map(|v| positions[v as usize]);
-            if materials[m as usize].is_emissive() && (b - a).cross(c - a) != Vec3::ZERO {
-                lights.push(Light::Triangle { triangle: i as u32 });
-            }
-        }
         let accel = Accel::build(&positions, &triangles);
+        let mesh = SurfaceMesh {
+            positions: &positions,
+            uvs: &uvs,
+            triangles: &triangles,
+            triangle_materials: &triangle_materials,
+            materials: &materials,
+        };
+        let light_sampler = LightSampler::new(&lights, mesh, bounding_sphere(&positions).1);
         Ok(Scene {
             source,
             positions,
@@ -253,6 +258,7 @@ impl Scene {
             lights,
             cameras,
             accel,
+            light_sampler,
             warnings,
         })
     }
@@ -283,24 +289,19 @@ impl Scene {
     /// Centre and radius of a sphere enclosing all vertices (the centre of their bounding box
     /// and its half diagonal); `(0, 0)` for an empty scene.
     pub fn bounding_sphere(&self) -> (Vec3, f32) {
-        if self.positions.is_empty() {
-            return (Vec3::ZERO, 0.0);
-        }
-        let (lo, hi) = self.positions.iter().fold(
-            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-            |(lo, hi), &p| (lo.min(p), hi.max(p)),
-        );
-        ((lo + hi) * 0.5, (hi - lo).length() * 0.5)
+        bounding_sphere(&self.positions)
     }
 
-    /// Unit geometric normal of triangle `triangle` from its winding, and its area (the normal
-    /// is NaN for a zero-area triangle; [`Light::Triangle`] entries never are).
+    /// Radiance emitted from `hit` toward `wo` (unit, pointing away from the surface): the
+    /// material's emission on the front face (by winding), on both faces if it is
+    /// double-sided, zero otherwise.
     #[inline]
-    pub fn triangle_normal_area(&self, triangle: u32) -> (Vec3, f32) {
-        let [a, b, c] = self.triangles[triangle as usize].map(|v| self.positions[v as usize]);
-        let n = (b - a).cross(c - a);
-        let len = n.length();
-        (n / len, 0.5 * len)
+    pub fn emitted_radiance(&self, hit: &SurfaceHit, wo: Vec3) -> Vec3 {
+        let material = &self.materials[hit.material as usize];
+        if !material.is_emissive() || (!material.double_sided && hit.ng.dot(wo) <= 0.0) {
+            return Vec3::ZERO;
+        }
+        material.emission_at(hit.uv, &self.textures)
     }
 
     /// Closest hit along `ray` within `(t_min, ray.t_max)` (see [`Accel::t_min`]).
@@ -337,6 +338,18 @@ impl Scene {
     pub fn occluded(&self, ray: &Ray) -> bool {
         self.accel.occluded(ray)
     }
+}
+
+/// Centre and radius of a sphere enclosing `positions` (see [`Scene::bounding_sphere`]).
+fn bounding_sphere(positions: &[Vec3]) -> (Vec3, f32) {
+    if positions.is_empty() {
+        return (Vec3::ZERO, 0.0);
+    }
+    let (lo, hi) = positions.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), &p| (lo.min(p), hi.max(p)),
+    );
+    ((lo + hi) * 0.5, (hi - lo).length() * 0.5)
 }
 
 #[cfg(test)]
@@ -452,7 +465,7 @@ mod tests {
     }
 
     #[test]
-    fn from_parts_checks_indices_and_adds_triangle_lights() {
+    fn from_parts_checks_indices_and_builds_emitters() {
         let mut rng = Rng(3);
         let mut parts = soup(&mut rng, 4);
         let mut glow = Material::diffuse("glow", Vec3::ZERO);
@@ -460,7 +473,13 @@ mod tests {
         parts.materials.push(glow);
         parts.triangle_materials[2] = 1;
         let scene = Scene::from_parts(parts.clone()).unwrap();
-        assert_eq!(scene.lights, vec![Light::Triangle { triangle: 2 }]);
+        assert!(scene.lights.is_empty());
+        let emitters = scene.light_sampler.emitters();
+        assert_eq!(emitters.len(), 1);
+        assert_eq!(emitters.emitter_of(2), Some((0, 0)));
+        assert!((0..4)
+            .filter(|&t| t != 2)
+            .all(|t| emitters.emitter_of(t).is_none()));
         let (c, r) = scene.bounding_sphere();
         assert!(scene
             .positions
@@ -481,6 +500,33 @@ mod tests {
         let mut bad = parts;
         bad.positions[0].x = f32::NAN;
         assert!(Scene::from_parts(bad).is_err());
+    }
+
+    #[test]
+    fn emitted_radiance_is_one_sided_unless_double_sided() {
+        for double_sided in [false, true] {
+            let mut glow = Material::diffuse("glow", Vec3::ZERO);
+            glow.emission = Vec3::new(2.0, 1.0, 0.5);
+            glow.double_sided = double_sided;
+            // A triangle in the plane z = 1 facing -Z, toward the origin.
+            let s = Scene::from_parts(SceneParts {
+                source: "glow".into(),
+                positions: vec![
+                    Vec3::new(-0.5, -0.3, 1.0),
+                    Vec3::new(0.2, 0.6, 1.0),
+                    Vec3::new(0.7, -0.4, 1.0),
+                ],
+                triangles: vec![[0, 1, 2]],
+                triangle_materials: vec![0],
+                materials: vec![glow],
+                ..SceneParts::default()
+            })
+            .unwrap();
+            let hit = s.intersect(&Ray::new(Vec3::ZERO, Vec3::Z)).unwrap();
+            assert_eq!(s.emitted_radiance(&hit, -Vec3::Z), Vec3::new(2.0, 1.0, 0.5));
+            let back = s.emitted_radiance(&hit, Vec3::Z);
+            assert_eq!(back != Vec3::ZERO, double_sided);
+        }
     }
 
     #[test]

@@ -208,7 +208,6 @@ fn load_texture(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::light::Light;
 
     const OBJ: &str = "mtllib road.mtl
 v 0 0 0
@@ -270,7 +269,9 @@ illum 1
         );
         let glow = &scene.materials[scene.triangle_materials[2] as usize];
         assert_eq!(glow.emission, Vec3::new(4.0, 3.0, 2.0));
-        assert_eq!(scene.lights, vec![Light::Triangle { triangle: 2 }]);
+        assert!(scene.lights.is_empty());
+        assert_eq!(scene.light_sampler.emitters().emitter_of(2), Some((0, 0)));
+        assert_eq!(scene.light_sampler.emitters().len(), 1);
         // The road faces up, with flipped v, and normals from the file.
         let h = scene
             .intersect(&crate::geometry::Ray::new(

@@ -1,16 +1,12 @@
 //! PFM maps (disparity, depth) in the Middlebury convention: greyscale `Pf`, little-endian
-//! (negative scale), rows stored bottom to top, `inf` for "no value".
-//! Written atomically: a temporary file beside the target, then a rename.
+//! (negative scale), rows stored bottom to top, `inf` for "no value". Written atomically.
 
-use crate::image::{write_file_atomic, GrayImage, ImageError};
+use crate::atomic::write_bytes_atomically;
+use crate::{GrayImage, ImageError};
 use std::path::Path;
 
 /// Writes `img` as a little-endian greyscale PFM.
 pub fn write_pfm(path: &Path, img: &GrayImage) -> Result<(), ImageError> {
-    let err = |reason: String| ImageError::Write {
-        path: path.to_path_buf(),
-        reason,
-    };
     let mut bytes = format!("Pf\n{} {}\n-1.0\n", img.width, img.height).into_bytes();
     bytes.reserve(img.data.len() * 4);
     for y in (0..img.height).rev() {
@@ -18,7 +14,7 @@ pub fn write_pfm(path: &Path, img: &GrayImage) -> Result<(), ImageError> {
             bytes.extend_from_slice(&v.to_le_bytes());
         }
     }
-    write_file_atomic(path, &bytes).map_err(|e| err(e.to_string()))
+    write_bytes_atomically(path, &bytes)
 }
 
 /// Reads a greyscale PFM (either byte order); rows are returned top row first.
@@ -99,7 +95,7 @@ mod tests {
             -4.0
         );
         assert_eq!(read_pfm(&p).unwrap(), img);
-        assert!(!dir.path().join("d.pfm.tmp").exists());
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     }
 
     #[test]

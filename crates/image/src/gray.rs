@@ -1,38 +1,11 @@
-//! A single-channel float image, the currency of the stereo and analysis code.
+//! [`GrayImage`]: a single-channel float image, the currency of the stereo and analysis code
+//! (grey levels, disparity and depth maps, masks).
 
-use std::io::Write;
+use crate::color::luminance;
+use crate::png::write_png_buffer;
+use crate::{ImageError, RgbImage};
+use glam::Vec3;
 use std::path::Path;
-
-/// Errors reading or writing images.
-#[derive(Debug, thiserror::Error)]
-pub enum ImageError {
-    /// The file could not be read or decoded.
-    #[error("cannot read image {path}: {reason}")]
-    Read {
-        /// The file.
-        path: std::path::PathBuf,
-        /// Why.
-        reason: String,
-    },
-    /// The file could not be written.
-    #[error("cannot write image {path}: {reason}")]
-    Write {
-        /// The file.
-        path: std::path::PathBuf,
-        /// Why.
-        reason: String,
-    },
-    /// A zero or overflowing size, or data that does not fit the size.
-    #[error("invalid image size {width}x{height}: {reason}")]
-    Size {
-        /// Width asked for.
-        width: u64,
-        /// Height asked for.
-        height: u64,
-        /// Why it is invalid.
-        reason: &'static str,
-    },
-}
 
 /// A grey-level image of `f32` values, row-major, top row first (pixel (x, y) at `y * width + x`).
 #[derive(Clone, Debug, PartialEq)]
@@ -125,74 +98,46 @@ impl GrayImage {
 
     /// Writes the image as an 8-bit greyscale PNG (see [`GrayImage::to_gray8`]), atomically.
     pub fn save_png(&self, path: &Path) -> Result<(), ImageError> {
-        write_png_atomic(path, &self.to_gray8())
+        write_png_buffer(path, &self.to_gray8())
     }
 
-    /// Loads any image the `image` crate reads (PNG, JPEG, EXR; 8/16-bit or float) as luminance
-    /// (Rec. 709 weights) in [0, 1] for integer formats.
+    /// The luminance ([`luminance`]) of every pixel of a linear RGB image.
+    pub fn luminance_of(img: &RgbImage) -> Result<Self, ImageError> {
+        let data = img.pixels.iter().map(|&p| luminance(p)).collect();
+        Self::from_vec(img.width as usize, img.height as usize, data)
+    }
+
+    /// Loads any image the `image` crate reads (PNG, JPEG, EXR; 8/16-bit or float) as its
+    /// [`luminance`] (of the stored values: sRGB-encoded for PNG and JPEG, linear for EXR), in
+    /// [0, 1] for integer formats.
     pub fn load(path: &Path) -> Result<Self, ImageError> {
-        let img = ::image::open(path).map_err(|e| ImageError::Read {
-            path: path.to_path_buf(),
-            reason: e.to_string(),
-        })?;
-        let rgb = img.to_rgb32f();
-        let (w, h) = (rgb.width() as usize, rgb.height() as usize);
-        let data = rgb
-            .pixels()
-            .map(|p| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2])
+        let [r, g, b] = load_rgb_channels(path)?;
+        let data = r
+            .data
+            .iter()
+            .zip(&g.data)
+            .zip(&b.data)
+            .map(|((&r, &g), &b)| luminance(Vec3::new(r, g, b)))
             .collect();
-        Self::from_vec(w, h, data).map_err(|e| ImageError::Read {
-            path: path.to_path_buf(),
-            reason: e.to_string(),
-        })
+        Self::from_vec(r.width, r.height, data)
     }
 }
 
-/// Writes `bytes` to `path` atomically: a temporary file beside it, synced, then renamed, so an
-/// interrupted run never leaves a half-written file. The temporary file is removed on failure.
-pub fn write_file_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let mut name = path.file_name().unwrap_or_default().to_os_string();
-    name.push(".tmp");
-    let tmp = path.with_file_name(name);
-    let write = || -> std::io::Result<()> {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    };
-    write().inspect_err(|_| {
-        let _ = std::fs::remove_file(&tmp);
-    })
-}
-
-/// Encodes an 8-bit RGB image as PNG and writes it atomically.
-pub fn save_rgb8_png(path: &Path, img: &::image::RgbImage) -> Result<(), ImageError> {
-    write_png_atomic(path, img)
-}
-
-/// Encodes any `image` crate buffer (8- or 16-bit grey or colour) as PNG and writes it with
-/// [`write_file_atomic`]: the one way the stereo and analysis crates write PNG files.
-pub fn write_png_atomic<
-    P: ::image::PixelWithColorType,
-    C: std::ops::Deref<Target = [P::Subpixel]>,
->(
-    path: &Path,
-    img: &::image::ImageBuffer<P, C>,
-) -> Result<(), ImageError>
-where
-    [P::Subpixel]: ::image::EncodableLayout,
-{
-    let err = |reason: String| ImageError::Write {
+/// Loads any image the `image` crate reads as its three channels R, G, B as stored (sRGB
+/// values in [0, 1] for PNG and JPEG, linear for EXR).
+pub fn load_rgb_channels(path: &Path) -> Result<[GrayImage; 3], ImageError> {
+    let read_err = |reason: String| ImageError::Read {
         path: path.to_path_buf(),
         reason,
     };
-    let mut bytes = Vec::new();
-    img.write_to(
-        &mut std::io::Cursor::new(&mut bytes),
-        ::image::ImageFormat::Png,
-    )
-    .map_err(|e| err(e.to_string()))?;
-    write_file_atomic(path, &bytes).map_err(|e| err(e.to_string()))
+    let img = ::image::open(path).map_err(|e| read_err(e.to_string()))?;
+    let rgb = img.to_rgb32f();
+    let (w, h) = (rgb.width() as usize, rgb.height() as usize);
+    let channel = |c: usize| {
+        let data = rgb.pixels().map(|p| p[c]).collect();
+        GrayImage::from_vec(w, h, data).map_err(|e| read_err(e.to_string()))
+    };
+    Ok([channel(0)?, channel(1)?, channel(2)?])
 }
 
 fn checked_len(width: usize, height: usize) -> Result<usize, ImageError> {
@@ -253,7 +198,7 @@ mod tests {
         let p = dir.path().join("g.png");
         let g = GrayImage::from_vec(3, 1, vec![0.0, 0.5, 2.0]).unwrap();
         g.save_png(&p).unwrap();
-        assert!(!dir.path().join("g.png.tmp").exists());
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
         let back = GrayImage::load(&p).unwrap();
         assert_eq!(back.data[0], 0.0);
         assert!((back.data[1] - 128.0 / 255.0).abs() < 1e-6);

@@ -23,120 +23,17 @@
 //! (`k` = 4 by default: a false alarm rate of 6e-5 per region when the renderers agree).
 //! A bias that noise cannot explain is a real difference between the renderers.
 
-use crate::output::{write_atomically, OutputError, RgbImage, WriteFailure};
+use crate::png::write_png_buffer;
+use crate::{ImageError, NamedRegion, Region, RgbImage};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
-use std::io::Write as _;
 use std::path::Path;
-use std::str::FromStr;
-
-/// Errors of the comparison.
-#[derive(Debug, thiserror::Error)]
-pub enum CompareError {
-    /// Two images that must have the same size do not.
-    #[error("image sizes differ: {first} is {w0}x{h0}, {second} is {w1}x{h1}")]
-    SizeMismatch {
-        /// Which image (A, B, A2, B2).
-        first: &'static str,
-        /// Its width.
-        w0: u32,
-        /// Its height.
-        h0: u32,
-        /// The other image.
-        second: &'static str,
-        /// Its width.
-        w1: u32,
-        /// Its height.
-        h1: u32,
-    },
-    /// A region does not parse.
-    #[error("bad region {text:?}: {reason} (expected [name=]x0,y0,x1,y1)")]
-    BadRegion {
-        /// The text given.
-        text: String,
-        /// What is wrong.
-        reason: String,
-    },
-    /// A region is empty or extends past the image.
-    #[error(
-        "region {name} ({x0},{y0})-({x1},{y1}) is empty or outside the {width}x{height} image"
-    )]
-    RegionOutside {
-        /// Region name.
-        name: String,
-        /// Left.
-        x0: u32,
-        /// Top.
-        y0: u32,
-        /// Right (exclusive).
-        x1: u32,
-        /// Bottom (exclusive).
-        y1: u32,
-        /// Image width.
-        width: u32,
-        /// Image height.
-        height: u32,
-    },
-    /// Writing the difference image failed.
-    #[error(transparent)]
-    Write(#[from] OutputError),
-}
-
-/// A named rectangle of pixels `[x0, x1) x [y0, y1)`.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub struct Region {
-    /// Name (`region<i>` where none was given).
-    pub name: String,
-    /// Left column.
-    pub x0: u32,
-    /// Top row.
-    pub y0: u32,
-    /// Right column (exclusive).
-    pub x1: u32,
-    /// Bottom row (exclusive).
-    pub y1: u32,
-}
-
-impl FromStr for Region {
-    type Err = CompareError;
-
-    /// Parses `x0,y0,x1,y1` or `name=x0,y0,x1,y1` (an unnamed region gets the empty name; the
-    /// caller names it).
-    fn from_str(text: &str) -> Result<Self, Self::Err> {
-        let bad = |reason: &str| CompareError::BadRegion {
-            text: text.to_owned(),
-            reason: reason.to_owned(),
-        };
-        let (name, coords) = match text.split_once('=') {
-            Some((n, c)) => (n.trim().to_owned(), c),
-            None => (String::new(), text),
-        };
-        let v: Vec<u32> = coords
-            .split(',')
-            .map(|s| s.trim().parse::<u32>())
-            .collect::<Result<_, _>>()
-            .map_err(|e| bad(&format!("not a pixel coordinate ({e})")))?;
-        let [x0, y0, x1, y1] = v[..] else {
-            return Err(bad("needs four numbers"));
-        };
-        if x1 <= x0 || y1 <= y0 {
-            return Err(bad("empty: x1 must exceed x0 and y1 must exceed y0"));
-        }
-        Ok(Region {
-            name,
-            x0,
-            y0,
-            x1,
-            y1,
-        })
-    }
-}
 
 /// Statistics of one region.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RegionStats {
     /// The region (the whole image for [`Comparison::overall`]).
-    pub region: Region,
+    pub region: NamedRegion,
     /// Mean of A over pixels and channels.
     pub mean_a: f64,
     /// Mean of B over pixels and channels.
@@ -215,10 +112,10 @@ impl Comparison {
         }
         s.push('\n');
         for r in std::iter::once(&self.overall).chain(&self.regions) {
-            let g = &r.region;
+            let g = &r.region.region;
             s.push_str(&format!(
                 "{:<12} {:>17} {:>12.5e} {:>12.5e} {:>+9.3}% {:>9.3}%",
-                g.name,
+                r.region.name,
                 format!("{},{}-{},{}", g.x0, g.y0, g.x1, g.y1),
                 r.mean_a,
                 r.mean_b,
@@ -274,15 +171,15 @@ fn check_size(
     a: &RgbImage,
     second: &'static str,
     b: &RgbImage,
-) -> Result<(), CompareError> {
+) -> Result<(), ImageError> {
     if (a.width, a.height) != (b.width, b.height) {
-        return Err(CompareError::SizeMismatch {
+        return Err(ImageError::SizeMismatch {
             first,
-            w0: a.width,
-            h0: a.height,
+            w0: a.width as usize,
+            h0: a.height as usize,
             second,
-            w1: b.width,
-            h1: b.height,
+            w1: b.width as usize,
+            h1: b.height as usize,
         });
     }
     Ok(())
@@ -321,7 +218,7 @@ fn region_sums(inputs: &Inputs<'_>, r: &Region) -> Sums {
     let w = inputs.a.width as usize;
     for y in r.y0..r.y1 {
         for x in r.x0..r.x1 {
-            let (a, b, da, db) = pixel(inputs, y as usize * w + x as usize);
+            let (a, b, da, db) = pixel(inputs, y * w + x);
             s.n += 1;
             for c in 0..3 {
                 s.a[c] += f64::from(a[c]);
@@ -336,8 +233,8 @@ fn region_sums(inputs: &Inputs<'_>, r: &Region) -> Sums {
     s
 }
 
-fn region_stats(inputs: &Inputs<'_>, region: Region, k: f64) -> RegionStats {
-    let s = region_sums(inputs, &region);
+fn region_stats(inputs: &Inputs<'_>, region: NamedRegion, k: f64) -> RegionStats {
+    let s = region_sums(inputs, &region.region);
     let n = s.n as f64;
     let mean_a = s.a.iter().sum::<f64>() / (3.0 * n);
     let mean_b = s.b.iter().sum::<f64>() / (3.0 * n);
@@ -373,10 +270,10 @@ fn region_stats(inputs: &Inputs<'_>, region: Region, k: f64) -> RegionStats {
 /// second renders).
 pub fn compare(
     inputs: &Inputs<'_>,
-    regions: &[Region],
+    regions: &[NamedRegion],
     block: u32,
     k: f64,
-) -> Result<Comparison, CompareError> {
+) -> Result<Comparison, ImageError> {
     let (a, b) = (inputs.a, inputs.b);
     check_size("A", a, "B", b)?;
     if let Some((a2, b2)) = inputs.seconds {
@@ -384,41 +281,21 @@ pub fn compare(
         check_size("A", a, "B2", b2)?;
     }
     let (width, height) = (a.width, a.height);
-    let whole = Region {
+    let whole = NamedRegion {
         name: "image".into(),
-        x0: 0,
-        y0: 0,
-        x1: width,
-        y1: height,
+        region: Region::whole(width as usize, height as usize),
     };
-    if width == 0 || height == 0 {
-        return Err(CompareError::RegionOutside {
-            name: whole.name,
-            x0: 0,
-            y0: 0,
-            x1: 0,
-            y1: 0,
-            width,
-            height,
-        });
-    }
+    whole
+        .region
+        .check_fits(&whole.name, width as usize, height as usize)?;
     let mut stats = Vec::with_capacity(regions.len());
     for (i, r) in regions.iter().enumerate() {
         let mut r = r.clone();
         if r.name.is_empty() {
             r.name = format!("region{i}");
         }
-        if r.x1 > width || r.y1 > height || r.x1 <= r.x0 || r.y1 <= r.y0 {
-            return Err(CompareError::RegionOutside {
-                name: r.name,
-                x0: r.x0,
-                y0: r.y0,
-                x1: r.x1,
-                y1: r.y1,
-                width,
-                height,
-            });
-        }
+        r.region
+            .check_fits(&r.name, width as usize, height as usize)?;
         stats.push(region_stats(inputs, r, k));
     }
     let overall = region_stats(inputs, whole, k);
@@ -427,11 +304,10 @@ pub fn compare(
     for y0 in (0..height).step_by(block as usize) {
         for x0 in (0..width).step_by(block as usize) {
             let tile = Region {
-                name: String::new(),
-                x0,
-                y0,
-                x1: (x0 + block).min(width),
-                y1: (y0 + block).min(height),
+                x0: x0 as usize,
+                y0: y0 as usize,
+                x1: (x0 + block).min(width) as usize,
+                y1: (y0 + block).min(height) as usize,
             };
             let s = region_sums(inputs, &tile);
             let n = 3.0 * s.n as f64;
@@ -488,7 +364,7 @@ pub fn diverging_colour(t: f64) -> [u8; 3] {
 /// `d = (a - b) / ((a + b) / 2 + 0.01 mean(b))` of the channel means (the small offset keeps
 /// black pixels from dividing by zero), mapped by [`diverging_colour`] with `d = +-scale` at
 /// full red or blue.
-pub fn diff_image(a: &RgbImage, b: &RgbImage, scale: f64) -> Result<image::RgbImage, CompareError> {
+pub fn diff_image(a: &RgbImage, b: &RgbImage, scale: f64) -> Result<image::RgbImage, ImageError> {
     check_size("A", a, "B", b)?;
     let n = b.pixels.len().max(1) as f64;
     let mean_b = b.pixels.iter().map(|&p| grey(p)).sum::<f64>() / n;
@@ -508,20 +384,8 @@ pub fn write_diff_png(
     a: &RgbImage,
     b: &RgbImage,
     scale: f64,
-) -> Result<(), CompareError> {
-    use image::ImageEncoder;
-    let img = diff_image(a, b, scale)?;
-    write_atomically(path, |w| {
-        image::codecs::png::PngEncoder::new(w.by_ref())
-            .write_image(
-                img.as_raw(),
-                img.width(),
-                img.height(),
-                image::ExtendedColorType::Rgb8,
-            )
-            .map_err(WriteFailure::Png)
-    })?;
-    Ok(())
+) -> Result<(), ImageError> {
+    write_png_buffer(path, &diff_image(a, b, scale)?)
 }
 
 #[cfg(test)]
@@ -600,7 +464,7 @@ mod tests {
                 Vec3::ONE
             }
         });
-        let regions: Vec<Region> = ["hot=16,8,24,16", "0,0,8,8"]
+        let regions: Vec<NamedRegion> = ["hot=16,8,24,16", "0,0,8,8"]
             .iter()
             .map(|s| s.parse().unwrap())
             .collect();
@@ -658,7 +522,7 @@ mod tests {
         .unwrap_err();
         assert!(err.to_string().contains("B2 is 4x5"), "{err}");
         assert!(diff_image(&a, &b, 1.0).is_err());
-        let outside: Region = "road=0,0,5,4".parse().unwrap();
+        let outside: NamedRegion = "road=0,0,5,4".parse().unwrap();
         let err = compare(
             &Inputs {
                 a: &a,
@@ -672,7 +536,7 @@ mod tests {
         .unwrap_err();
         assert!(err.to_string().contains("road"), "{err}");
         for bad in ["1,2,3", "a=1,2,x,4", "0,0,0,4", ""] {
-            assert!(bad.parse::<Region>().is_err(), "{bad}");
+            assert!(bad.parse::<NamedRegion>().is_err(), "{bad}");
         }
     }
 

@@ -1,0 +1,108 @@
+//! Loading a pair ([`StereoInput`]) and its rig as the stages use it ([`RigView`]).
+
+use super::ReportError;
+use glam::{Vec2, Vec3};
+use std::path::{Path, PathBuf};
+use streaks_image::pfm::read_pfm;
+use streaks_image::{GrayImage, ImageError};
+use streaks_stereo::pair_dir::PairDir;
+use streaks_stereo::rig::{Eye, EyeCamera, Rig, RoadFrame, RoadRig};
+use streaks_stereo::rigfile::{LightRecord, RigFile};
+
+/// A pair and what is known about it.
+#[derive(Clone, Debug)]
+pub struct StereoInput {
+    /// Left image (linear luminance).
+    pub left: GrayImage,
+    /// Right image.
+    pub right: GrayImage,
+    /// The rig.
+    pub rig: Rig,
+    /// The scene's lights.
+    pub lights: Vec<LightRecord>,
+    /// Ground-truth disparity of the left image (`inf` where nothing was hit), if known.
+    pub truth_disparity: Option<GrayImage>,
+    /// Ground-truth depth of the left image, if known.
+    pub truth_depth: Option<GrayImage>,
+    /// The renderer's streak mask of the left image (`streak_mask_left.png`), if present.
+    pub truth_streak_mask: Option<GrayImage>,
+}
+
+impl StereoInput {
+    /// Loads `dir/{left,right}.exr` (or `.png` when there is no EXR), `dir/rig.json` and the
+    /// ground truth `dir/disparity_left.pfm`, `dir/depth_left.pfm` and the renderer's streak
+    /// mask `dir/streak_mask_left.png` if present.
+    pub fn load(dir: &Path) -> Result<Self, ReportError> {
+        let files = PairDir::new(dir);
+        let left = GrayImage::load(&files.image(Eye::Left))?;
+        let right = GrayImage::load(&files.image(Eye::Right))?;
+        let file = RigFile::load(&files.rig())?;
+        let rig = file.rig()?;
+        let optional = |p: PathBuf, read: fn(&Path) -> Result<GrayImage, ImageError>| {
+            p.exists().then(|| read(&p)).transpose()
+        };
+        let input = Self {
+            left,
+            right,
+            rig,
+            lights: file.lights,
+            truth_disparity: optional(files.disparity(Eye::Left), read_pfm)?,
+            truth_depth: optional(files.depth(Eye::Left), read_pfm)?,
+            truth_streak_mask: optional(files.streak_mask(Eye::Left), GrayImage::load)?,
+        };
+        let i = input.rig.intrinsics();
+        let size = (i.width() as usize, i.height() as usize);
+        let named = [
+            ("left image", Some(&input.left)),
+            ("right image", Some(&input.right)),
+            ("disparity_left.pfm", input.truth_disparity.as_ref()),
+            ("depth_left.pfm", input.truth_depth.as_ref()),
+            ("streak_mask_left.png", input.truth_streak_mask.as_ref()),
+        ];
+        for (what, img) in named {
+            if let Some(img) = img {
+                if (img.width, img.height) != size {
+                    return Err(ReportError::Input {
+                        path: dir.to_path_buf(),
+                        reason: format!(
+                            "the {what} is {}x{}, rig.json says {}x{}",
+                            img.width, img.height, size.0, size.1
+                        ),
+                    });
+                }
+            }
+        }
+        Ok(input)
+    }
+}
+
+/// The input's rig as the stages use it, made once from the stereo crate's camera model: the
+/// rig in `f64` road coordinates ([`RoadRig`]: projection, horizon, elevations, disparities in
+/// pixels and degrees, Eq. 4's predictions), and the `f32` rig with its left eye and road frame,
+/// as the ground truth was rendered (the points a disparity or a true depth implies).
+pub(super) struct RigView {
+    /// The rig as rig.json gives it.
+    pub rig: Rig,
+    /// The same rig in `f64` road coordinates.
+    pub camera: RoadRig,
+    road: RoadFrame,
+    left: EyeCamera,
+}
+
+impl RigView {
+    /// The view of `rig`; an error when it has no road frame (it looks straight up or down).
+    pub fn new(rig: &Rig) -> Result<Self, ReportError> {
+        Ok(Self {
+            rig: *rig,
+            camera: rig.road_rig()?,
+            road: rig.road_frame()?,
+            left: rig.eye(Eye::Left),
+        })
+    }
+
+    /// The road-frame point the left eye sees through `(x, y)` at depth `z`.
+    pub fn implied(&self, x: f32, y: f32, z: f32) -> Vec3 {
+        let w = self.left.back_project(Vec2::new(x, y), z);
+        self.road.road_from_world_point(w)
+    }
+}

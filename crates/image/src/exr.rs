@@ -1,0 +1,165 @@
+//! EXR reading and writing: float32 channels with arbitrary names in one part, so a render's
+//! layers travel in one file (OpenEXR's `layer.channel` naming, which Blender, Nuke and
+//! `exrheader` show as layers; the renderer's layout is in `streaks_render::output`).
+
+use crate::atomic::{write_atomically, WriteFailure};
+use crate::{ImageError, RgbImage};
+use std::path::Path;
+
+/// One channel to write: its full name (`R`, `depth.Z`, ...) and `width * height` values.
+pub type ExrChannel<'a> = (&'a str, Vec<f32>);
+
+/// Writes float32 `channels` of a `width` x `height` image as one EXR part (named `streaks`,
+/// lossless compression), atomically.
+pub fn write_exr(
+    path: &Path,
+    width: u32,
+    height: u32,
+    channels: Vec<ExrChannel<'_>>,
+) -> Result<(), ImageError> {
+    use exr::prelude::*;
+    let n = width as usize * height as usize;
+    if n == 0 || channels.is_empty() {
+        return Err(ImageError::BadImage {
+            path: path.to_path_buf(),
+            reason: format!("{width}x{height} image with {} channels", channels.len()),
+        });
+    }
+    if let Some((name, values)) = channels.iter().find(|(_, v)| v.len() != n) {
+        return Err(ImageError::BadImage {
+            path: path.to_path_buf(),
+            reason: format!(
+                "channel {name} has {} values for a {width}x{height} image",
+                values.len()
+            ),
+        });
+    }
+    let channels: Vec<AnyChannel<FlatSamples>> = channels
+        .into_iter()
+        .map(|(name, values)| AnyChannel::new(name, FlatSamples::F32(values)))
+        .collect();
+    let layer = Layer::new(
+        (width as usize, height as usize),
+        LayerAttributes::named("streaks"),
+        Encoding::FAST_LOSSLESS,
+        AnyChannels::sort(SmallVec::from_vec(channels)),
+    );
+    let image = Image::from_layer(layer);
+    write_atomically(path, |w| {
+        image.write().to_buffered(w).map_err(WriteFailure::Exr)
+    })
+}
+
+/// Writes a linear RGB image as an EXR with channels `R`, `G`, `B`.
+pub fn write_exr_rgb(path: &Path, image: &RgbImage) -> Result<(), ImageError> {
+    let channels = ["R", "G", "B"]
+        .into_iter()
+        .enumerate()
+        .map(|(c, name)| (name, image.plane(c)))
+        .collect();
+    write_exr(path, image.width, image.height, channels)
+}
+
+/// The channels of the first EXR part that has all of `names` (any sample type, converted to
+/// f32), in that order, with the part's width and height.
+pub fn read_exr_channels(
+    path: &Path,
+    names: &[&str],
+) -> Result<(u32, u32, Vec<Vec<f32>>), ImageError> {
+    let image =
+        exr::prelude::read_all_flat_layers_from_file(path).map_err(|source| ImageError::Exr {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    for layer in &image.layer_data {
+        let found: Option<Vec<Vec<f32>>> = names
+            .iter()
+            .map(|name| {
+                layer
+                    .channel_data
+                    .list
+                    .iter()
+                    .find(|c| c.name.to_string() == *name)
+                    .map(|c| c.sample_data.values_as_f32().collect())
+            })
+            .collect();
+        if let Some(planes) = found {
+            return Ok((layer.size.0 as u32, layer.size.1 as u32, planes));
+        }
+    }
+    Err(ImageError::MissingChannels {
+        path: path.to_path_buf(),
+        what: format!("{} channels", names.join(", ")),
+    })
+}
+
+/// Reads three channels of an EXR as an RGB image (for example `R`, `G`, `B`).
+pub fn read_exr_rgb_channels(path: &Path, names: [&str; 3]) -> Result<RgbImage, ImageError> {
+    let (w, h, planes) = read_exr_channels(path, &names)?;
+    Ok(RgbImage::from_planes(
+        w,
+        h,
+        [&planes[0], &planes[1], &planes[2]],
+    ))
+}
+
+/// Reads the main `R`, `G`, `B` channels of any EXR.
+pub fn read_exr_rgb(path: &Path) -> Result<RgbImage, ImageError> {
+    read_exr_rgb_channels(path, ["R", "G", "B"])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    fn gradient(w: u32, h: u32) -> RgbImage {
+        let pixels = (0..w * h)
+            .map(|i| Vec3::new(i as f32, 0.5 * i as f32, -(i as f32)))
+            .collect();
+        RgbImage {
+            width: w,
+            height: h,
+            pixels,
+        }
+    }
+
+    #[test]
+    fn exr_round_trip_with_named_channels() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.exr");
+        let img = gradient(5, 3);
+        let mut depth: Vec<f32> = (0..15).map(|i| i as f32 + 0.25).collect();
+        depth[4] = f32::INFINITY;
+        let mut channels: Vec<ExrChannel> = vec![("R", img.plane(0)), ("G", img.plane(1))];
+        channels.push(("B", img.plane(2)));
+        channels.push(("depth.Z", depth.clone()));
+        write_exr(&path, 5, 3, channels).unwrap();
+        assert_eq!(read_exr_rgb(&path).unwrap(), img);
+        let (w, h, planes) = read_exr_channels(&path, &["depth.Z"]).unwrap();
+        assert_eq!((w, h), (5, 3));
+        assert_eq!(planes[0], depth);
+        let err = read_exr_channels(&path, &["albedo.R"]).unwrap_err();
+        assert!(err.to_string().contains("albedo.R"), "{err}");
+        // Only the image is left in the folder (no temporary files).
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+        write_exr_rgb(&path, &img).unwrap();
+        assert_eq!(read_exr_rgb(&path).unwrap(), img);
+    }
+
+    #[test]
+    fn bad_input_is_a_clear_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("not.exr");
+        std::fs::write(&path, b"hello").unwrap();
+        let err = read_exr_rgb(&path).unwrap_err().to_string();
+        assert!(err.contains("not.exr"), "{err}");
+        let err = read_exr_rgb(&dir.path().join("missing.exr")).unwrap_err();
+        assert!(err.to_string().contains("missing.exr"), "{err}");
+        let out = dir.path().join("short.exr");
+        let err = write_exr(&out, 2, 2, vec![("R", vec![0.0; 3])]).unwrap_err();
+        assert!(err.to_string().contains("channel R has 3 values"), "{err}");
+        assert!(write_exr(&out, 0, 2, vec![("R", vec![])]).is_err());
+        assert!(!out.exists());
+    }
+}

@@ -1,0 +1,52 @@
+//! # streaks-image
+//!
+//! The image layer that the renderer, the stereo code and the analysis share, one concept per
+//! module:
+//!
+//! - [`rgb`]: [`RgbImage`], a linear RGB float image (a render);
+//! - [`gray`]: [`GrayImage`], a single-channel float image (grey levels, disparity, depth,
+//!   masks), and loading any image file as grey levels or channels;
+//! - [`region`]: [`Region`] and [`NamedRegion`], rectangles of pixels, with the one parser of
+//!   `[name=]x0,y0,x1,y1`;
+//! - [`color`]: [`luminance`] and the sRGB transfer functions;
+//! - [`atomic`]: [`write_atomically`], through which every file of the project is written
+//!   (a uniquely named temporary file, then a rename);
+//! - [`exr`], [`png`], [`pfm`]: reading and writing the three formats (EXR with named float
+//!   channels; PNG as 8-bit sRGB or any 8/16-bit buffer; PFM in the Middlebury convention);
+//! - [`compare`]: statistics of the difference between two images (relative RMSE, bias, the
+//!   noise test), per region;
+//! - [`error`]: [`ImageError`], which names the file or the region.
+//!
+//! ```
+//! use streaks_image::{pfm, GrayImage, NamedRegion};
+//!
+//! let dir = tempfile::tempdir()?;
+//! let path = dir.path().join("disparity.pfm");
+//! let mut map = GrayImage::new(4, 3, f32::INFINITY)?;
+//! map.set(1, 2, 12.5);
+//! pfm::write_pfm(&path, &map)?;
+//! assert_eq!(pfm::read_pfm(&path)?, map);
+//!
+//! let road: NamedRegion = "road=0,2,4,3".parse()?;
+//! assert!(road.region.fits(map.width, map.height));
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+#![deny(missing_docs)]
+
+pub mod atomic;
+pub mod color;
+pub mod compare;
+pub mod error;
+pub mod exr;
+pub mod gray;
+pub mod pfm;
+pub mod png;
+pub mod region;
+pub mod rgb;
+
+pub use atomic::{write_atomically, write_bytes_atomically, WriteFailure};
+pub use color::luminance;
+pub use error::ImageError;
+pub use gray::GrayImage;
+pub use region::{NamedRegion, Region};
+pub use rgb::RgbImage;

@@ -1,0 +1,609 @@
+//! The light choice: which emitter a shading point sends its shadow ray to, and the density of
+//! that choice for multiple importance sampling.
+//!
+//! At a node of the [light tree](super::tree) a child `c` is chosen with probability
+//! `0.1 E_c / sum E + 0.9 E_c F_c / sum E F` (all by `E` when every `E F` is 0): `E_c` is the
+//! irradiance the child would give at the point and `F_c` the luminance of the BSDF times the
+//! cosine toward it (zero below the shading or the geometric surface). The 10% share by `E`
+//! alone is defensive sampling: every emitter that can light the point keeps a positive
+//! probability even where the BSDF toward its centre is zero. On a glossy wet road the
+//! mixture sends a streak's shadow rays to the lamp that makes the streak.
+//!
+//! - An emitter's `E`: intensity, spot falloff and range window over `d^2` for point and spot
+//!   lights, the irradiance for a directional light, `power / (4 pi max(d, r)^2)` for a mesh of
+//!   bounding radius `r` (zero behind a flat one-sided mesh); its `F` looks toward the light or
+//!   the mesh's centre.
+//! - A group's `E`: its total power over its bounding sphere, the same way; its `F` looks toward
+//!   its most powerful member (toward the middle of a lamp and its neighbours, the glossy lobe
+//!   would miss the lamp).
+//!
+//! The choice descends the tree from the root, one child per level, weighing a node's children
+//! once: at most [`BRANCHING`] BSDF evaluations per level, four at a time in SIMD lanes
+//! ([`LuminanceEval::eval4`]). Every choice is a deterministic function of the point, so
+//! [`LightSampler::sample_li`] and [`LightSampler::pdf_li`] agree exactly, which MIS needs.
+
+use super::emitter::{clean_power, Emitter, Emitters, SurfaceMesh};
+use super::tree::{LightTree, Node, BRANCHING};
+use super::{Light, LightSample};
+use crate::bsdf::{Bsdf, LuminanceEval};
+use crate::geometry::Frame;
+use crate::material::Material;
+use crate::sampling::ONE_MINUS_EPSILON;
+use crate::scene::SurfaceHit;
+use crate::texture::Texture;
+use glam::{Vec2, Vec3, Vec4};
+use std::f32::consts::PI;
+use std::ops::Range;
+use streaks_image::luminance;
+
+/// Share of the light choice made by irradiance alone when it is BSDF-aware (defensive
+/// sampling, see the module documentation).
+const DEFENSIVE_SHARE: f32 = 0.1;
+
+/// What the light choice may know about the shading point: position, geometric normal,
+/// shading frame, outgoing direction and BSDF.
+#[derive(Clone, Copy, Debug)]
+pub struct Receiver {
+    /// Shading point.
+    pub p: Vec3,
+    /// Geometric normal, on the side of `wo`.
+    pub ng: Vec3,
+    /// Shading frame (normal on the side of `wo`).
+    pub frame: Frame,
+    /// Outgoing direction in the shading frame.
+    pub wo_local: Vec3,
+    /// BSDF at the point.
+    pub bsdf: Bsdf,
+}
+
+/// The weights `E_c` and `E_c F_c` of a node's children, with their sums.
+type Weights = ([f32; BRANCHING], [f32; BRANCHING], f32, f32);
+
+/// Chooses an emitter and a sample on it for next-event estimation (see the module
+/// documentation). Built once per scene, with the scene.
+#[derive(Clone, Debug, Default)]
+pub struct LightSampler {
+    emitters: Emitters,
+    tree: LightTree,
+}
+
+/// Chooses index `i` with probability `w_i / sum` by inverting the cumulative sum at `u sum`
+/// (`u` in [0, 1)): the first positive weight whose cumulative sum exceeds it (else the last
+/// positive one), with `u` rescaled to [0, 1) within that weight.
+fn choose_in(weights: impl IntoIterator<Item = f32>, sum: f32, u: f32) -> Option<(usize, f32)> {
+    let target = u * sum;
+    let mut acc = 0.0f32;
+    let mut chosen = None;
+    for (i, w) in weights.into_iter().enumerate() {
+        if w > 0.0 {
+            chosen = Some((i, acc, w));
+            if target < acc + w {
+                break;
+            }
+        }
+        acc += w;
+    }
+    let (i, before, w) = chosen?;
+    Some((i, ((target - before) / w).clamp(0.0, ONE_MINUS_EPSILON)))
+}
+
+/// Whether weights `E` summing to `e_sum` and `E F` summing to `ef_sum` can be chosen from.
+fn mixture_valid(e_sum: f32, ef_sum: f32) -> bool {
+    e_sum > 0.0 && e_sum.is_finite() && ef_sum.is_finite()
+}
+
+/// The probability of an item with weights `e` and `ef` under the mixture: by `E` alone with
+/// probability [`DEFENSIVE_SHARE`] (all of it when every `E F` is 0), else by `E F`.
+fn mixture_pmf(e: f32, ef: f32, e_sum: f32, ef_sum: f32) -> f32 {
+    if !mixture_valid(e_sum, ef_sum) {
+        0.0
+    } else if ef_sum > 0.0 {
+        DEFENSIVE_SHARE * e / e_sum + (1.0 - DEFENSIVE_SHARE) * ef / ef_sum
+    } else {
+        e / e_sum
+    }
+}
+
+/// Chooses an item by [`mixture_pmf`] with `u`: `(index, u rescaled within it)`.
+fn choose_mixture(
+    e_w: &[f32],
+    ef_w: &[f32],
+    e_sum: f32,
+    ef_sum: f32,
+    u: f32,
+) -> Option<(usize, f32)> {
+    if !mixture_valid(e_sum, ef_sum) {
+        return None;
+    }
+    let share = if ef_sum > 0.0 { DEFENSIVE_SHARE } else { 1.0 };
+    if u < share {
+        choose_in(e_w.iter().copied(), e_sum, u / share)
+    } else {
+        choose_in(ef_w.iter().copied(), ef_sum, (u - share) / (1.0 - share))
+    }
+}
+
+impl LightSampler {
+    /// Builds the emitters of `lights` and of the emissive triangles of `mesh`, and the light
+    /// tree over them; `scene_radius` is the radius of the scene's bounding sphere (a
+    /// directional light's power is its irradiance over that disc).
+    pub fn new(lights: &[Light], mesh: SurfaceMesh<'_>, scene_radius: f32) -> Self {
+        let emitters = Emitters::build(lights, mesh);
+        let tree = LightTree::build(&emitters.bounds(scene_radius));
+        Self { emitters, tree }
+    }
+
+    /// The emitters (punctual lights first, then the emitter meshes).
+    #[inline]
+    pub fn emitters(&self) -> &Emitters {
+        &self.emitters
+    }
+
+    /// The light tree over the emitters.
+    #[inline]
+    pub fn tree(&self) -> &LightTree {
+        &self.tree
+    }
+
+    /// The irradiance-like weight `E` of emitter `e` at `p` and, when it is positive, the
+    /// direction the BSDF weight looks in (toward a mesh's centre, a point or spot light, or
+    /// against a directional light's direction).
+    #[inline(always)]
+    fn irradiance(&self, e: usize, p: Vec3) -> (f32, Vec3) {
+        match self.emitters.get(e) {
+            Emitter::Mesh(m) => {
+                let e = m.irradiance(p);
+                if e > 0.0 {
+                    (e, (m.centre() - p).normalize_or_zero())
+                } else {
+                    (0.0, Vec3::ZERO)
+                }
+            }
+            // A punctual light's sample is its irradiance at p, and its direction.
+            Emitter::Punctual(light) => match light.sample_li(p) {
+                Some(ls) => (clean_power(luminance(ls.li)), ls.wi),
+                None => (0.0, Vec3::ZERO),
+            },
+        }
+    }
+
+    /// The weights `E_c` and `E_c F_c` of the nodes `nodes` (one node's children), with their
+    /// sums. First every child's `E_c` and direction, then the directions' normalisation,
+    /// shading-frame coordinates and BSDF values four children at a time in SIMD lanes.
+    #[inline]
+    fn weights(&self, rx: &Receiver, f: &LuminanceEval, nodes: Range<usize>) -> Weights {
+        let children = &self.tree.nodes()[nodes];
+        let mut e_w = [0.0f32; BRANCHING];
+        // The directions toward the children (not normalised), by coordinate; zero (so no
+        // BSDF weight) unless the child lights the point.
+        let mut dir = [[0.0f32; BRANCHING]; 3];
+        for (c, child) in children.iter().enumerate() {
+            let (e, d) = match child {
+                Node::Emitter(i) => match self.irradiance(*i as usize, rx.p) {
+                    (e, wi) if e > 0.0 => (e, wi),
+                    _ => continue,
+                },
+                Node::Group(g) => {
+                    let d2 = (g.centre - rx.p).length_squared().max(g.radius * g.radius);
+                    (clean_power(g.power / (4.0 * PI * d2)), g.anchor - rx.p)
+                }
+            };
+            e_w[c] = e;
+            [dir[0][c], dir[1][c], dir[2][c]] = d.to_array();
+        }
+        let n = children.len();
+        let mut f_w = [0.0f32; BRANCHING];
+        let mut cos_w = [0.0f32; BRANCHING];
+        let (frame, ng) = (&rx.frame, rx.ng);
+        for k in (0..n).step_by(4) {
+            let [x, y, z] = dir.map(|d| Vec4::from_slice(&d[k..k + 4]));
+            // `normalize_or_zero`, lane by lane.
+            let r = Vec4::ONE / (x * x + y * y + z * z).sqrt();
+            let r = Vec4::select(r.is_finite_mask() & r.cmpgt(Vec4::ZERO), r, Vec4::ZERO);
+            let [x, y, z] = [x * r, y * r, z * r];
+            // `Frame::to_local` and the geometric normal's side.
+            let dot = |v: Vec3| x * v.x + y * v.y + z * v.z;
+            let local = [dot(frame.s), dot(frame.t), dot(frame.n)];
+            let lit = dot(ng).cmpgt(Vec4::ZERO) & local[2].cmpgt(Vec4::ZERO);
+            let cos = Vec4::select(lit, local[2], Vec4::ZERO);
+            f.eval4([local[0], local[1], cos])
+                .write_to_slice(&mut f_w[k..k + 4]);
+            cos.write_to_slice(&mut cos_w[k..k + 4]);
+        }
+        let mut ef_w = [0.0f32; BRANCHING];
+        let (mut e_sum, mut ef_sum) = (0.0f32, 0.0f32);
+        for c in 0..n {
+            let e = e_w[c];
+            if e > 0.0 {
+                let ef = e * clean_power(f_w[c] * cos_w[c]);
+                ef_w[c] = ef;
+                e_sum += e;
+                ef_sum += ef;
+            }
+        }
+        (e_w, ef_w, e_sum, ef_sum)
+    }
+
+    /// Chooses an emitter for the receiver: `(emitter, probability, u rescaled within it)`.
+    /// From the root down, a child of each node by the mixture of `E` and `E F`.
+    #[inline]
+    fn choose(&self, rx: &Receiver, u: f32) -> Option<(usize, f32, f32)> {
+        let f = rx.bsdf.luminance_at(rx.wo_local);
+        let (mut nodes, mut u, mut pmf) = (self.tree.root(), u, 1.0f32);
+        loop {
+            let (e_w, ef_w, e_sum, ef_sum) = self.weights(rx, &f, nodes.clone());
+            let n = nodes.len();
+            let (c, u_c) = choose_mixture(&e_w[..n], &ef_w[..n], e_sum, ef_sum, u)?;
+            pmf *= mixture_pmf(e_w[c], ef_w[c], e_sum, ef_sum);
+            u = u_c;
+            match self.tree.nodes()[nodes.start + c] {
+                Node::Emitter(e) => return (pmf > 0.0).then_some((e as usize, pmf, u)),
+                Node::Group(g) => nodes = g.children(),
+            }
+        }
+    }
+
+    /// The probability that [`LightSampler::sample_li`] at the receiver chooses emitter `e`:
+    /// the product of the choices on the way from the root to it.
+    pub fn emitter_pmf(&self, rx: &Receiver, e: usize) -> f32 {
+        let Some(mut node) = self.tree.node_of_emitter(e) else {
+            return 0.0;
+        };
+        let f = rx.bsdf.luminance_at(rx.wo_local);
+        let mut pmf = 1.0f32;
+        loop {
+            let siblings = self.tree.siblings(node);
+            let slot = node - siblings.start;
+            let (e_w, ef_w, e_sum, ef_sum) = self.weights(rx, &f, siblings);
+            pmf *= mixture_pmf(e_w[slot], ef_w[slot], e_sum, ef_sum);
+            match self.tree.parent(node) {
+                Some(parent) if pmf > 0.0 => node = parent,
+                _ => return pmf,
+            }
+        }
+    }
+
+    /// Chooses an emitter with `u_light` and samples it with `u` (see the module
+    /// documentation); `materials` and `textures` are the scene's, for the emission of an
+    /// area sample. The returned `pdf` includes the probability of the choice; `None` when
+    /// nothing was sampled.
+    pub fn sample_li(
+        &self,
+        materials: &[Material],
+        textures: &[Texture],
+        rx: &Receiver,
+        u_light: f32,
+        u: Vec2,
+    ) -> Option<LightSample> {
+        let (e, pmf, reused) = self.choose(rx, u_light)?;
+        let mut ls = match self.emitters.get(e) {
+            Emitter::Punctual(light) => light.sample_li(rx.p)?,
+            Emitter::Mesh(m) => m.sample_li(materials, textures, e as u32, rx.p, reused, u)?,
+        };
+        ls.pdf *= pmf;
+        Some(ls)
+    }
+
+    /// The density (choice included) with which [`LightSampler::sample_li`] at the receiver
+    /// returns the direction toward `hit`, a point on an emissive triangle; 0 if `hit` is not on
+    /// an emitter.
+    pub fn pdf_li(&self, rx: &Receiver, hit: &SurfaceHit) -> f32 {
+        let Some((e, k)) = self.emitters.emitter_of(hit.triangle) else {
+            return 0.0;
+        };
+        let Emitter::Mesh(m) = self.emitters.get(e) else {
+            return 0.0;
+        };
+        self.emitter_pmf(rx, e) * m.pdf_li(rx.p, k, hit)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bsdf::{Diffuse, Ggx};
+    use crate::light::test_scenes::{
+        check_tree, cone_emitter, estimate_irradiance, lamp_scene, normal, polygon_irradiance,
+        receiver, vertices,
+    };
+    use crate::material::Material;
+    use crate::scene::{Scene, SceneParts};
+
+    #[test]
+    fn cone_sampling_of_a_sphere_lamp_gives_its_exact_irradiance() {
+        let centre = Vec3::new(0.5, 2.0, -3.0);
+        let s = lamp_scene(centre, 1.0, vec![]);
+        let p = Vec3::new(0.0, 0.0, 0.0);
+        // Exact: the sum over the sphere triangles that face p (a convex polyhedron: they tile
+        // its silhouette once).
+        let mut exact = 0.0f64;
+        for (t, &m) in s.triangle_materials.iter().enumerate() {
+            if m == 1 {
+                let v = vertices(&s, t);
+                if normal(&s, t).dot(p - v[0]) > 0.0 {
+                    exact += polygon_irradiance(p, Vec3::Y, &v);
+                }
+            }
+        }
+        // Lenses add a little; count them with their own exact irradiance.
+        for c in [Vec3::new(4.0, 3.0, 0.0), Vec3::new(-4.0, 3.0, 0.0)] {
+            let h = 0.2;
+            let quad = [
+                c + Vec3::new(-h, 0.0, -h),
+                c + Vec3::new(h, 0.0, -h),
+                c + Vec3::new(h, 0.0, h),
+                c + Vec3::new(-h, 0.0, h),
+            ];
+            exact += 3.0 * polygon_irradiance(p, Vec3::Y, &quad);
+        }
+        for bsdf in [
+            Bsdf::Diffuse(Diffuse {
+                kd: Vec3::splat(0.5),
+            }),
+            Bsdf::Ggx(Ggx {
+                kd: Vec3::splat(0.05),
+                ks: Vec3::splat(0.5),
+                alpha: 0.1,
+            }),
+        ] {
+            let rx = receiver(p, bsdf, Vec3::new(0.0, 1.0, 6.0));
+            let est = estimate_irradiance(&s, &rx, 256);
+            assert!(
+                (est - exact).abs() < 5e-3 * exact,
+                "{bsdf:?}: {est} vs {exact}"
+            );
+        }
+    }
+
+    #[test]
+    fn emitter_choice_is_a_distribution_and_follows_the_bsdf() {
+        let lights = vec![
+            Light::Point {
+                position: Vec3::new(3.0, 4.0, -10.0),
+                intensity: Vec3::splat(40.0),
+                range: None,
+            },
+            Light::Spot {
+                position: Vec3::new(0.0, 4.0, 0.0),
+                direction: -Vec3::Y,
+                intensity: Vec3::splat(30.0),
+                cos_inner: 0.9,
+                cos_outer: 0.8,
+                range: None,
+            },
+            Light::Directional {
+                direction: -Vec3::Y,
+                irradiance: Vec3::splat(0.01),
+            },
+        ];
+        let s = lamp_scene(Vec3::new(-3.0, 2.0, -10.0), 50.0, lights);
+        let ls = &s.light_sampler;
+        let n_e = ls.emitters().len();
+        assert_eq!(n_e, 6);
+        let glossy = Bsdf::Ggx(Ggx {
+            kd: Vec3::splat(0.02),
+            ks: Vec3::splat(0.6),
+            alpha: 0.05,
+        });
+        // Receivers on the mirror paths of the sphere and of the point light, seen from the eye.
+        let eye = Vec3::new(0.0, 1.5, 0.0);
+        let mirror = |l: Vec3| {
+            let t = eye.y / (eye.y + l.y);
+            eye + (Vec3::new(l.x, 0.0, l.z) - Vec3::new(eye.x, 0.0, eye.z)) * t - Vec3::Y * eye.y
+        };
+        let on_sphere = mirror(Vec3::new(-3.0, 2.0, -10.0));
+        let on_point = mirror(Vec3::new(3.0, 4.0, -10.0));
+        for (p, favoured) in [(on_sphere, 3usize), (on_point, 0usize)] {
+            let rx = receiver(p, glossy, eye - p);
+            let pmfs: Vec<f32> = (0..n_e).map(|e| ls.emitter_pmf(&rx, e)).collect();
+            let total: f32 = pmfs.iter().sum();
+            assert!((total - 1.0).abs() < 1e-5, "{pmfs:?}");
+            // The spot (emitter 1) lights its cone only, which holds the second point only.
+            assert_eq!(pmfs[1] == 0.0, favoured == 3, "{pmfs:?}");
+            // The lamp whose streak this is gets most of the samples.
+            let favoured = if favoured == 3 {
+                cone_emitter(ls)
+            } else {
+                favoured
+            };
+            assert!(pmfs[favoured] > 0.8, "{favoured} {pmfs:?}");
+            // Sampling frequencies follow the pmf.
+            let n = 20_000;
+            let mut counts = vec![0usize; n_e];
+            for k in 0..n {
+                let u = (k as f32 + 0.5) / n as f32;
+                let (e, pmf, reused) = ls.choose(&rx, u).unwrap();
+                assert!((pmf - pmfs[e]).abs() < 1e-6 && (0.0..1.0).contains(&reused));
+                counts[e] += 1;
+            }
+            for e in 0..n_e {
+                assert!((counts[e] as f32 / n as f32 - pmfs[e]).abs() < 1e-3, "{e}");
+            }
+        }
+        // Below a one-sided lens nothing; above it (behind its front face), the lens gets 0.
+        let above = receiver(Vec3::new(4.0, 3.5, 0.0), glossy, Vec3::Y);
+        for e in 0..n_e {
+            if let Emitter::Mesh(m) = ls.emitters().get(e) {
+                if m.is_flat_one_sided() && m.centre().x > 0.0 {
+                    assert_eq!(ls.emitter_pmf(&above, e), 0.0);
+                }
+            }
+        }
+    }
+
+    /// Checks that the choice at `rx` is a distribution over exactly the emitters that light
+    /// it, that `choose` returns `emitter_pmf`'s probabilities, and that its frequencies follow
+    /// them.
+    fn check_choice(ls: &LightSampler, rx: &Receiver) {
+        let n_e = ls.emitters().len();
+        let pmfs: Vec<f32> = (0..n_e).map(|e| ls.emitter_pmf(rx, e)).collect();
+        assert!((pmfs.iter().sum::<f32>() - 1.0).abs() < 1e-5, "{pmfs:?}");
+        for (e, pmf) in pmfs.iter().enumerate() {
+            assert_eq!(*pmf > 0.0, ls.irradiance(e, rx.p).0 > 0.0, "{e}");
+        }
+        let n = 40_000;
+        let mut counts = vec![0usize; n_e];
+        for k in 0..n {
+            let u = (k as f32 + 0.5) / n as f32;
+            let (e, pmf, reused) = ls.choose(rx, u).unwrap();
+            assert!(
+                (pmf - pmfs[e]).abs() <= 1e-6 * pmfs[e].max(1.0),
+                "{e}: {pmf} {}",
+                pmfs[e]
+            );
+            assert!((0.0..1.0).contains(&reused));
+            counts[e] += 1;
+        }
+        for e in 0..n_e {
+            assert!((counts[e] as f32 / n as f32 - pmfs[e]).abs() < 1e-3, "{e}");
+        }
+    }
+
+    /// With more emitters than `BRANCHING`: a two-level tree, the choice is a distribution
+    /// over every emitter that lights the point, sampling follows it, and next-event
+    /// estimation of the irradiance from 40 point lights (whose exact value is a sum) is
+    /// unbiased.
+    #[test]
+    fn many_emitters_are_chosen_by_cluster() {
+        let positions: Vec<Vec3> = (0..40)
+            .map(|i| {
+                let i = i as f32;
+                Vec3::new(
+                    (i * 2.3) % 17.0 - 8.0,
+                    2.0 + (i * 0.7) % 3.0,
+                    -2.0 - (i * 1.9) % 23.0,
+                )
+            })
+            .collect();
+        let lights: Vec<Light> = positions
+            .iter()
+            .enumerate()
+            .map(|(i, &position)| Light::Point {
+                position,
+                intensity: Vec3::splat(1.0 + (i % 7) as f32),
+                range: None,
+            })
+            .collect();
+        let s = lamp_scene(Vec3::new(0.0, 2.0, -3.0), 5.0, lights.clone());
+        let ls = &s.light_sampler;
+        let n_e = ls.emitters().len();
+        assert_eq!(n_e, 43);
+        assert_eq!(check_tree(ls.tree(), n_e), 2);
+
+        let glossy = Bsdf::Ggx(Ggx {
+            kd: Vec3::splat(0.3),
+            ks: Vec3::splat(0.6),
+            alpha: 0.1,
+        });
+        let p = Vec3::new(0.5, 0.0, -4.0);
+        let rx = receiver(p, glossy, Vec3::new(0.0, 1.5, 0.0) - p);
+        check_choice(ls, &rx);
+
+        // Unbiased: f * L * cos / pdf over many choices against the exact sum over the lights.
+        let diffuse = Bsdf::Diffuse(Diffuse { kd: Vec3::ONE });
+        let rx = receiver(p, diffuse, Vec3::Y);
+        let exact: f64 = lights
+            .iter()
+            .map(|l| {
+                let ls = l.sample_li(p).unwrap();
+                f64::from(luminance(ls.li) * ls.wi.y.max(0.0))
+            })
+            .sum();
+        let mut rng = crate::sampling::Pcg32::new(9, 2);
+        let m = 400_000;
+        let mut sum = 0.0f64;
+        for _ in 0..m {
+            let u = (rng.next_f32(), rng.next_2d());
+            if let Some(sample) = ls.sample_li(&s.materials, &s.textures, &rx, u.0, u.1) {
+                if sample.delta {
+                    sum += f64::from(luminance(sample.li) * sample.wi.y.max(0.0) / sample.pdf);
+                }
+            }
+        }
+        let est = sum / m as f64;
+        assert!((est / exact - 1.0).abs() < 0.01, "{est} vs {exact}");
+    }
+
+    /// 400 point lights (a quarter of them at one spot, which k-means cannot split) make a
+    /// tree of three levels or more, and the choice down it is still the distribution that
+    /// `emitter_pmf` gives.
+    #[test]
+    fn a_deep_light_tree_chooses_by_its_pmf() {
+        let lights: Vec<Light> = (0..400)
+            .map(|i| {
+                let f = i as f32;
+                let position = if i % 4 == 0 {
+                    Vec3::new(3.0, 4.0, -6.0)
+                } else {
+                    Vec3::new(
+                        (f * 2.3) % 37.0 - 18.0,
+                        2.0 + (f * 0.7) % 5.0,
+                        -(f * 1.9) % 41.0,
+                    )
+                };
+                Light::Point {
+                    position,
+                    intensity: Vec3::splat(1.0 + (i % 5) as f32),
+                    range: None,
+                }
+            })
+            .collect();
+        let s = lamp_scene(Vec3::new(0.0, 2.0, -3.0), 5.0, lights);
+        let ls = &s.light_sampler;
+        assert!(check_tree(ls.tree(), ls.emitters().len()) >= 3);
+        let glossy = Bsdf::Ggx(Ggx {
+            kd: Vec3::splat(0.3),
+            ks: Vec3::splat(0.6),
+            alpha: 0.1,
+        });
+        let p = Vec3::new(0.5, 0.0, -4.0);
+        check_choice(ls, &receiver(p, glossy, Vec3::new(2.0, 1.5, -1.0) - p));
+    }
+
+    /// Many directional lights (no positions) share a group, which splits into runs.
+    #[test]
+    fn many_directional_lights_share_a_cluster() {
+        let lights: Vec<Light> = (0..BRANCHING + 4)
+            .map(|i| Light::Directional {
+                direction: Vec3::new(0.1 * i as f32, -1.0, 0.2).normalize(),
+                irradiance: Vec3::splat(0.1),
+            })
+            .collect();
+        let s = lamp_scene(Vec3::new(0.0, 2.0, -3.0), 5.0, lights);
+        let ls = &s.light_sampler;
+        assert_eq!(check_tree(ls.tree(), ls.emitters().len()), 3);
+        let rx = receiver(
+            Vec3::ZERO,
+            Bsdf::Diffuse(Diffuse { kd: Vec3::ONE }),
+            Vec3::Y,
+        );
+        let total: f32 = (0..ls.emitters().len())
+            .map(|e| ls.emitter_pmf(&rx, e))
+            .sum();
+        assert!((total - 1.0).abs() < 1e-5, "{total}");
+    }
+
+    #[test]
+    fn no_lights_no_samples() {
+        let s = Scene::from_parts(SceneParts {
+            source: "dark".into(),
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::Z],
+            triangles: vec![[0, 2, 1]],
+            triangle_materials: vec![0],
+            materials: vec![Material::diffuse("floor", Vec3::splat(0.5))],
+            ..SceneParts::default()
+        })
+        .unwrap();
+        assert!(s.light_sampler.emitters().is_empty());
+        let rx = receiver(
+            Vec3::ZERO,
+            Bsdf::Diffuse(Diffuse { kd: Vec3::ONE }),
+            Vec3::Y,
+        );
+        let sample =
+            s.light_sampler
+                .sample_li(&s.materials, &s.textures, &rx, 0.5, Vec2::splat(0.5));
+        assert!(sample.is_none());
+        assert_eq!(s.light_sampler.emitter_pmf(&rx, 0), 0.0);
+    }
+}
