@@ -1,13 +1,15 @@
 //! BSDF benchmarks: each model's `sample`, `eval` and `pdf` on a batch of fixed random
-//! directions, and the closed-enum dispatch of [`Bsdf`] against a trait-object version of the
-//! same calls (DESIGN.md and STYLE.md choose the enum; this measures the choice).
+//! directions, its luminance evaluator as the light choice uses it (`luminance_at` once per
+//! vertex, then `eval4` toward 16 emitters), and the closed-enum dispatch of [`Bsdf`] against
+//! a trait-object version of the same calls (DESIGN.md and STYLE.md choose the enum; this
+//! measures the choice).
 //!
 //! The Owen-scrambled Sobol sampler's `next_1d` and `next_2d` are measured here too.
 //!
 //! Run: `cargo bench --bench bsdf`. Throughput is reported in calls per second.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 use std::hint::black_box;
 use streaks_render::bsdf::{BlinnPhong, Bsdf, BsdfSample, Diffuse, Ggx, GltfPbr, Ward};
 use streaks_render::sampling::{square_to_cosine_hemisphere, Pcg32, Sampler};
@@ -99,6 +101,46 @@ fn bench_models(c: &mut Criterion) {
                 let mut acc = 0.0f32;
                 for i in &input {
                     acc += black_box(bsdf).pdf(i.wo, i.wi);
+                }
+                acc
+            })
+        });
+    }
+    group.finish();
+}
+
+/// Directions toward a light-tree node's children per vertex (four SIMD groups of four).
+const CHILDREN: usize = 16;
+
+/// The light choice's BSDF weights: per vertex, [`Bsdf::luminance_at`] once and
+/// `LuminanceEval::eval4` toward [`CHILDREN`] directions, some below the surface.
+fn bench_luminance(c: &mut Criterion) {
+    let input = inputs(3);
+    let mut rng = Pcg32::new(4, 7);
+    let groups: Vec<[Vec4; 3]> = (0..BATCH * CHILDREN / 4)
+        .map(|_| {
+            let w: [Vec3; 4] = std::array::from_fn(|_| {
+                let w = square_to_cosine_hemisphere(rng.next_2d());
+                if rng.next_f32() < 0.2 {
+                    -w
+                } else {
+                    w
+                }
+            });
+            [0, 1, 2].map(|k| Vec4::from_array(w.map(|w| w.to_array()[k])))
+        })
+        .collect();
+    let mut group = c.benchmark_group("luminance");
+    group.throughput(Throughput::Elements((BATCH * CHILDREN) as u64));
+    for (name, bsdf) in models() {
+        group.bench_with_input(BenchmarkId::new("eval4", name), &bsdf, |b, bsdf| {
+            b.iter(|| {
+                let mut acc = Vec4::ZERO;
+                for (i, dirs) in input.iter().zip(groups.chunks_exact(CHILDREN / 4)) {
+                    let f = black_box(bsdf).luminance_at(i.wo);
+                    for d in dirs {
+                        acc += f.eval4(*d);
+                    }
                 }
                 acc
             })
@@ -264,5 +306,11 @@ fn bench_sampler(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench_models, bench_dispatch, bench_sampler);
+criterion_group!(
+    benches,
+    bench_models,
+    bench_luminance,
+    bench_dispatch,
+    bench_sampler
+);
 criterion_main!(benches);

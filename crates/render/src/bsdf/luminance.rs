@@ -1,0 +1,139 @@
+//! [`LuminanceEval`]: `luminance(f(wo, wi))` for one `wo` and many `wi`, the light choice's
+//! per-emitter BSDF weight, one direction at a time or four in SIMD lanes. It evaluates each
+//! model's own lobes (the functions `eval` uses) with the model's reflectances replaced by
+//! their luminances, so it is the luminance of `eval` up to rounding. What depends on `wo`
+//! alone (the reflectances' luminances, the model's `Model::AtWo`) is computed once, by
+//! [`Bsdf::luminance_at`]; [`AtWo`] holds the model's, one variant per [`Bsdf`] variant, and
+//! no formula.
+
+use super::lanes::Lanes;
+use super::{BlinnPhong, Bsdf, Diffuse, Ggx, GltfPbr, Lobes, Model, Reflectances, Ward};
+use glam::{Vec3, Vec4};
+use streaks_image::luminance;
+
+/// `luminance(f(wo, wi))` for one `wo` and any `wi` (see [`Bsdf::luminance_at`]):
+/// [`LuminanceEval::eval`] evaluates one direction and [`LuminanceEval::eval4`] four at once
+/// in SIMD lanes, each lane exactly the scalar value. Equal to `luminance(bsdf.eval(wo, wi))`
+/// up to rounding (tested).
+#[derive(Clone, Copy, Debug)]
+pub struct LuminanceEval {
+    wo: Vec3,
+    /// The luminances of the model's reflectances.
+    reflectances: Reflectances<f32>,
+    /// The model's terms for `wo`.
+    at: AtWo,
+}
+
+/// A [`Bsdf`]'s [`Model::AtWo`], for the model its variant names.
+#[derive(Clone, Copy, Debug)]
+enum AtWo {
+    Diffuse(<Diffuse as Model>::AtWo),
+    Ggx(<Ggx as Model>::AtWo),
+    Ward(<Ward as Model>::AtWo),
+    BlinnPhong(<BlinnPhong as Model>::AtWo),
+    GltfPbr(<GltfPbr as Model>::AtWo),
+}
+
+impl LuminanceEval {
+    /// `luminance(f(wo, wi))`; zero when either direction is below the surface.
+    #[inline]
+    pub fn eval(&self, wi: Vec3) -> f32 {
+        self.eval_lanes(wi.to_array())
+    }
+
+    /// [`LuminanceEval::eval`] of four directions at once, given as their x, y and z lanes.
+    #[inline]
+    pub fn eval4(&self, wi: [Vec4; 3]) -> Vec4 {
+        self.eval_lanes(wi)
+    }
+
+    #[inline(always)]
+    fn eval_lanes<L: Lanes>(&self, wi: [L; 3]) -> L {
+        if self.wo.z > 0.0 {
+            let (r, wo) = (self.reflectances.map(L::splat), self.wo);
+            let lobes: Lobes<L, L> = match &self.at {
+                AtWo::Diffuse(at) => Diffuse::lobes(at, r, wo, wi),
+                AtWo::Ggx(at) => Ggx::lobes(at, r, wo, wi),
+                AtWo::Ward(at) => Ward::lobes(at, r, wo, wi),
+                AtWo::BlinnPhong(at) => BlinnPhong::lobes(at, r, wo, wi),
+                AtWo::GltfPbr(at) => GltfPbr::lobes(at, r, wo, wi),
+            };
+            (lobes.diffuse + lobes.glossy).where_positive(wi[2])
+        } else {
+            L::splat(0.0)
+        }
+    }
+}
+
+impl Bsdf {
+    /// The evaluator of `luminance(f(wo, wi))` for this `wo` and any `wi` (see
+    /// [`LuminanceEval`]).
+    #[inline]
+    pub fn luminance_at(&self, wo: Vec3) -> LuminanceEval {
+        let (at, reflectances) = match self {
+            Bsdf::Diffuse(m) => (AtWo::Diffuse(m.at_wo(wo)), m.reflectances()),
+            Bsdf::Ggx(m) => (AtWo::Ggx(m.at_wo(wo)), m.reflectances()),
+            Bsdf::Ward(m) => (AtWo::Ward(m.at_wo(wo)), m.reflectances()),
+            Bsdf::BlinnPhong(m) => (AtWo::BlinnPhong(m.at_wo(wo)), m.reflectances()),
+            Bsdf::GltfPbr(m) => (AtWo::GltfPbr(m.at_wo(wo)), m.reflectances()),
+        };
+        LuminanceEval {
+            wo,
+            reflectances: reflectances.map(luminance),
+            at,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bsdf::tests::{all_models, random_dir};
+    use crate::bsdf::{Ggx, MIN_ALPHA};
+    use crate::sampling::Pcg32;
+
+    #[test]
+    fn luminance_eval_is_luminance_of_eval() {
+        let mut rng = Pcg32::new(11, 3);
+        let (kd, ks) = (Vec3::new(0.2, 0.3, 0.1), Vec3::new(0.7, 0.5, 0.9));
+        let narrow = [0.01, MIN_ALPHA].map(|alpha| Bsdf::Ggx(Ggx { kd, ks, alpha }));
+        for b in all_models().into_iter().chain(narrow) {
+            for _ in 0..2000 {
+                let (wo, wi) = (random_dir(&mut rng), random_dir(&mut rng));
+                let want = luminance(b.eval(wo, wi));
+                let got = b.luminance_at(wo).eval(wi);
+                assert!(
+                    (got - want).abs() <= 1e-5 * want.abs().max(1e-3),
+                    "{b:?} {wo} {wi}: {got} vs {want}"
+                );
+            }
+        }
+    }
+
+    /// Four directions in SIMD lanes give exactly the four scalar values, below the surface
+    /// included, for every model.
+    #[test]
+    fn luminance_eval_lanes_are_the_scalar_values() {
+        let mut rng = Pcg32::new(12, 5);
+        for b in all_models() {
+            for _ in 0..500 {
+                let wo = random_dir(&mut rng);
+                let f = b.luminance_at(wo);
+                let wi: [Vec3; 4] = std::array::from_fn(|_| {
+                    let w = random_dir(&mut rng);
+                    // Some below the surface.
+                    if rng.next_f32() < 0.2 {
+                        -w
+                    } else {
+                        w
+                    }
+                });
+                let lanes = [0, 1, 2].map(|k| Vec4::from_array(wi.map(|w| w.to_array()[k])));
+                let got = f.eval4(lanes).to_array();
+                for (w, g) in wi.iter().zip(got) {
+                    assert_eq!(g.to_bits(), f.eval(*w).to_bits(), "{b:?} {wo} {w}");
+                }
+            }
+        }
+    }
+}
