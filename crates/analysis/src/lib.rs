@@ -1,7 +1,8 @@
 //! # streaks-analysis
 //!
 //! What specular streaks do to stereo depth: the paper's virtual light column model and the
-//! plots that show it. Works on geometry and images only; it never depends on the renderer.
+//! plots that show it. Works on geometry (the stereo crate's rig) and images (`streaks-image`:
+//! grey images, regions, PFM and PNG files) only; it never depends on the renderer.
 //!
 //! - [`model`]: Eq. 2 and Eq. 4 in the road frame ([`model::ColumnModel`]: a light and a
 //!   viewer; the locus of `L_virtual`, the proposition's invariance check) and the prediction

@@ -1,6 +1,6 @@
 //! Rays, shading frames and robust ray offsets.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 /// A ray `origin + t * direction` for `t` in `[0, t_max)`; `direction` is unit length.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -29,6 +29,26 @@ impl Ray {
     pub fn at(&self, t: f32) -> Vec3 {
         self.origin + t * self.direction
     }
+}
+
+/// A ray's closest intersection with a scene's triangles (what [`crate::scene::Scene::intersect`]
+/// returns).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceHit {
+    /// Ray parameter of the hit.
+    pub t: f32,
+    /// World position.
+    pub p: Vec3,
+    /// Unit geometric normal (from the winding, not flipped toward the ray).
+    pub ng: Vec3,
+    /// Unit interpolated shading normal (oriented to the same side as `ng`).
+    pub ns: Vec3,
+    /// Texture coordinates.
+    pub uv: Vec2,
+    /// Triangle index.
+    pub triangle: u32,
+    /// Material index.
+    pub material: u32,
 }
 
 /// An orthonormal frame; `n` is the local +Z axis (the shading normal).

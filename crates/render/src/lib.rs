@@ -4,7 +4,8 @@
 //!
 //! The main types, by concept (one module each, after pbrt-v4's division):
 //!
-//! - [`geometry`]: [`geometry::Ray`], the shading [`geometry::Frame`], robust ray offsets.
+//! - [`geometry`]: [`geometry::Ray`], the hit record [`geometry::SurfaceHit`], the shading
+//!   [`geometry::Frame`], robust ray offsets.
 //! - [`sampling`]: warps with their pdfs and inverses, MIS weights, discrete distributions and
 //!   the Owen-scrambled Sobol sampler.
 //! - [`bsdf`]: the closed set of reflectance models ([`bsdf::Bsdf`]): diffuse, the paper's
@@ -22,6 +23,51 @@
 //! - [`film`]: the box-filtered film with its layers; [`output`]: the renderer's EXR layout
 //!   (images, regions, file formats and comparisons are the `streaks-image` crate's).
 //! - [`mitsuba`]: export to Mitsuba 3 (the reference renderer).
+//! - [`testing`]: the chi-square harness for warps and BSDFs; [`regression`]: render
+//!   regression tests against stored mean and variance images.
+//!
+//! ```
+//! use glam::{Affine3A, Vec3};
+//! use streaks_render::camera::Camera;
+//! use streaks_render::integrator::{render, Layers, RenderSettings};
+//! use streaks_render::material::Material;
+//! use streaks_render::scene::{Scene, SceneParts};
+//!
+//! // An emissive quad of radiance 2 filling the view of a camera at the origin.
+//! let mut glow = Material::diffuse("glow", Vec3::ZERO);
+//! glow.emission = Vec3::splat(2.0);
+//! let scene = Scene::from_parts(SceneParts {
+//!     positions: vec![
+//!         Vec3::new(-9.0, -9.0, -1.0),
+//!         Vec3::new(9.0, -9.0, -1.0),
+//!         Vec3::new(9.0, 9.0, -1.0),
+//!         Vec3::new(-9.0, 9.0, -1.0),
+//!     ],
+//!     triangles: vec![[0, 1, 2], [0, 2, 3]],
+//!     triangle_materials: vec![0, 0],
+//!     materials: vec![glow],
+//!     ..SceneParts::default()
+//! })?;
+//! // The scene's emitters are built with it: one mesh of two triangles.
+//! assert_eq!(scene.light_sampler.emitters().len(), 1);
+//! let camera = Camera {
+//!     name: "cam".into(),
+//!     world_from_camera: Affine3A::IDENTITY,
+//!     yfov: 0.8,
+//!     aspect_ratio: None,
+//! };
+//! let settings = RenderSettings {
+//!     width: 8,
+//!     height: 6,
+//!     spp: 4,
+//!     max_depth: 1,
+//!     seed: 0,
+//!     layers: Layers::default(),
+//! };
+//! let out = render(&scene, &camera, &settings, &|_| {});
+//! assert!(out.image.pixels.iter().all(|p| (*p - Vec3::splat(2.0)).abs().max_element() < 1e-6));
+//! # Ok::<(), streaks_render::scene::SceneError>(())
+//! ```
 #![deny(missing_docs)]
 
 pub mod accel;

@@ -19,13 +19,12 @@
 //!   `pdf = d^2 / (|cos theta_light| A)`.
 
 use super::{Light, LightSample, Visibility};
-use crate::geometry::Frame;
+use crate::geometry::{Frame, SurfaceHit};
 use crate::material::Material;
 use crate::sampling::{
     square_to_uniform_cone, square_to_uniform_cone_pdf, square_to_uniform_triangle,
     DiscreteDistribution,
 };
-use crate::scene::SurfaceHit;
 use crate::texture::Texture;
 use glam::{Vec2, Vec3};
 use std::collections::HashMap;

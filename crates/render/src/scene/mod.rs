@@ -51,7 +51,7 @@ pub use error::SceneError;
 
 use crate::accel::Accel;
 use crate::camera::Camera;
-use crate::geometry::Ray;
+use crate::geometry::{Ray, SurfaceHit};
 use crate::light::{Light, LightSampler, SurfaceMesh};
 use crate::material::Material;
 use crate::texture::Texture;
@@ -116,25 +116,6 @@ pub struct SceneParts {
     pub cameras: Vec<Camera>,
     /// Warnings to pass on.
     pub warnings: Vec<String>,
-}
-
-/// A ray's closest intersection with the scene.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SurfaceHit {
-    /// Ray parameter of the hit.
-    pub t: f32,
-    /// World position.
-    pub p: Vec3,
-    /// Unit geometric normal (from the winding, not flipped toward the ray).
-    pub ng: Vec3,
-    /// Unit interpolated shading normal (oriented to the same side as `ng`).
-    pub ns: Vec3,
-    /// Texture coordinates.
-    pub uv: Vec2,
-    /// Triangle index.
-    pub triangle: u32,
-    /// Material index.
-    pub material: u32,
 }
 
 impl Scene {
