@@ -51,7 +51,7 @@ impl TestDir {
     }
 
     /// Writes `scene.gltf` + `scene.bin`: a 10 m x 10 m diffuse floor at Y = 0 (front face up),
-    /// a point light of intensity 20 W/sr 2 m above its centre, a small emissive quad facing
+    /// a point light of intensity 20 W/sr (13660 cd) 2 m above its centre, a small emissive quad facing
     /// the camera, and a camera (aspect 1.5) at (0, 1, 4) tilted 0.1 rad down.
     pub fn write_tiny_gltf(&self) -> PathBuf {
         // Floor: 4 vertices; emitter quad at z = -3, y in [1.5, 2], facing +Z.
@@ -81,7 +81,7 @@ impl TestDir {
             r#"{{
   "asset": {{"version": "2.0"}},
   "extensionsUsed": ["KHR_lights_punctual", "KHR_materials_emissive_strength"],
-  "extensions": {{"KHR_lights_punctual": {{"lights": [{{"type": "point", "color": [1, 1, 1], "intensity": 20}}]}}}},
+  "extensions": {{"KHR_lights_punctual": {{"lights": [{{"type": "point", "color": [1, 1, 1], "intensity": 13660}}]}}}},
   "scene": 0,
   "scenes": [{{"nodes": [0, 1, 2, 3]}}],
   "nodes": [

@@ -208,7 +208,7 @@ fn write_scene(
     let mut gltf = serde_json::json!({
         "asset": {"version": "2.0"},
         "extensionsUsed": ["KHR_lights_punctual"],
-        "extensions": {"KHR_lights_punctual": {"lights": [{"type": "directional", "color": [1.0, 1.0, 1.0], "intensity": 3.0}]}},
+        "extensions": {"KHR_lights_punctual": {"lights": [{"type": "directional", "color": [1.0, 1.0, 1.0], "intensity": 2049.0}]}},
         "scene": 0,
         "scenes": [{"nodes": [0, 1, 2]}],
         "nodes": [

@@ -170,7 +170,13 @@ pub enum LightKind {
     },
 }
 
-/// A point or spot light: `color * intensity` is the radiant intensity (W/sr).
+/// Lumens per watt of the scene contract: a light of `I` W/sr is written as `683 I` candela
+/// (KHR_lights_punctual's unit), which the renderer reads back as `I` W/sr
+/// (`streaks_render::light::LUMINOUS_EFFICACY`; a test checks that they agree).
+pub const LUMENS_PER_WATT: f64 = 683.0;
+
+/// A point or spot light: `color * intensity` is the radiant intensity (W/sr); the file gets
+/// it in candela (times [`LUMENS_PER_WATT`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Light {
     /// Node and light name.
@@ -179,7 +185,7 @@ pub struct Light {
     pub kind: LightKind,
     /// Colour, max component 1.
     pub color: [f64; 3],
-    /// Intensity, W/sr.
+    /// Radiant intensity, W/sr.
     pub intensity: f64,
     /// Position in world space.
     pub position: Vec3,
@@ -457,7 +463,7 @@ impl Doc {
         let mut v = json!({
             "name": l.name,
             "color": l.color,
-            "intensity": l.intensity,
+            "intensity": l.intensity * LUMENS_PER_WATT,
         });
         let mut node = json!({
             "name": l.name,

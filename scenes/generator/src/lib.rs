@@ -168,6 +168,15 @@ mod tests {
     /// The committed scenes load with the project's renderer without warnings, with the named
     /// camera, the punctual and emissive lights, and (streets) a road whose alpha follows the
     /// dryness map between the wet and dry values.
+    /// The generator writes intensities in candela with the renderer's lumens per watt.
+    #[test]
+    fn lumens_per_watt_is_the_renderers() {
+        assert_eq!(
+            crate::doc::LUMENS_PER_WATT,
+            f64::from(streaks_render::light::LUMINOUS_EFFICACY)
+        );
+    }
+
     #[test]
     fn committed_scenes_load_in_the_renderer() {
         use streaks_render::bsdf::Bsdf;

@@ -28,7 +28,7 @@ pub mod tree;
 
 pub use choice::{LightSampler, Receiver};
 pub use emitter::{Emitter, Emitters, MeshEmitter, SurfaceMesh};
-pub use punctual::{range_window, spot_falloff, Light};
+pub use punctual::{range_window, spot_falloff, Light, LUMINOUS_EFFICACY};
 pub use tree::{LightTree, Node, BRANCHING};
 
 use glam::Vec3;

@@ -1,8 +1,8 @@
 //! Punctual lights (KHR_lights_punctual): point, spot and directional.
 //!
-//! Scene contract (DESIGN.md): for point and spot lights `color * intensity` is the radiant
-//! intensity in W/sr (linear RGB, no photometric conversion); for directional lights it is the
-//! irradiance in W/m^2.
+//! Units: a [`Light`] is radiometric, its intensity in W/sr (point, spot) and its irradiance in
+//! W/m^2 (directional), linear RGB. The glTF loader converts KHR_lights_punctual's photometric
+//! units (candela, lux) with [`LUMINOUS_EFFICACY`], as Blender's glTF importer does (DESIGN.md).
 //!
 //! `range` follows the specification's recommended window: the inverse-square law times
 //! `clamp(1 - (d / range)^4, 0, 1)`, so that light fades smoothly to exactly zero at
@@ -19,6 +19,12 @@ use super::{LightSample, Visibility};
 use glam::Vec3;
 use std::f32::consts::PI;
 use streaks_image::luminance;
+
+/// Lumens per watt between KHR_lights_punctual's photometric units and the renderer's
+/// radiometric ones: a point light of `I` candela has the radiant intensity `I / 683` W/sr, a
+/// directional light of `E` lux the irradiance `E / 683` W/m^2. Blender's glTF importer divides
+/// by the same number (`PBR_WATTS_TO_LUMENS`) and its exporter multiplies by it.
+pub const LUMINOUS_EFFICACY: f32 = 683.0;
 
 /// A punctual light source.
 #[derive(Clone, Copy, Debug, PartialEq)]

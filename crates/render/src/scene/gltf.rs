@@ -6,7 +6,7 @@
 
 use super::{Scene, SceneError, SceneParts};
 use crate::camera::Camera;
-use crate::light::Light;
+use crate::light::{Light, LUMINOUS_EFFICACY};
 use crate::material::{Material, PaperModel, Reflectance, Wetness};
 use crate::texture::{ColorSpace, Texture, TextureId};
 use glam::{Affine3A, Mat3, Mat4, Quat, Vec2, Vec3, Vec4};
@@ -68,6 +68,7 @@ pub(super) fn load(path: &Path) -> Result<Scene, SceneError> {
         },
         textures: HashMap::new(),
         default_material: None,
+        light_units: light_units(path, &document)?,
     };
     for (i, m) in document.materials().enumerate() {
         let material = loader.material(&m, i)?;
@@ -232,6 +233,46 @@ struct Loader<'a> {
     textures: HashMap<(usize, ColorSpace), TextureId>,
     /// Index of the glTF default material, once a primitive needs it.
     default_material: Option<u32>,
+    /// What KHR_lights_punctual's intensities are in.
+    light_units: LightUnits,
+}
+
+/// The units of a file's KHR_lights_punctual intensities: the specification's photometric ones
+/// (candela for point and spot lights, lux for directional lights), or, where the file says so
+/// with `asset.extras.streaks.light_units: "radiometric"`, W/sr and W/m^2 as they are.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+enum LightUnits {
+    Photometric,
+    Radiometric,
+}
+
+/// `asset.extras.streaks` (see the `scene` module documentation).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct AssetExtras {
+    light_units: LightUnits,
+}
+
+/// The light units `asset.extras.streaks.light_units` chooses (photometric when absent).
+fn light_units(path: &Path, document: &gltf::Document) -> Result<LightUnits, SceneError> {
+    let bad = |reason: String| SceneError::invalid(path, "asset.extras", reason);
+    // gltf 1.4 exposes the asset only through the JSON root.
+    let Some(raw) = document.clone().into_json().asset.extras else {
+        return Ok(LightUnits::Photometric);
+    };
+    let value: serde_json::Value =
+        serde_json::from_str(raw.get()).map_err(|e| bad(format!("not JSON: {e}")))?;
+    match value.get("streaks") {
+        None => Ok(LightUnits::Photometric),
+        Some(streaks) => serde_json::from_value::<AssetExtras>(streaks.clone())
+            .map(|x| x.light_units)
+            .map_err(|e| {
+                bad(format!(
+                    "streaks: {e} (expected {{\"light_units\": \"photometric\" | \"radiometric\"}})"
+                ))
+            }),
+    }
 }
 
 impl Loader<'_> {
@@ -317,7 +358,13 @@ impl Loader<'_> {
 
     fn light(&mut self, light: &gltf::khr_lights_punctual::Light, world: Mat4) {
         use gltf::khr_lights_punctual::Kind;
-        let power = Vec3::from(light.color()) * light.intensity();
+        // Photometric (candela, lux) to radiometric (W/sr, W/m^2) unless the file is radiometric.
+        let power = match self.light_units {
+            LightUnits::Photometric => {
+                Vec3::from(light.color()) * (light.intensity() / LUMINOUS_EFFICACY)
+            }
+            LightUnits::Radiometric => Vec3::from(light.color()) * light.intensity(),
+        };
         let position = world.transform_point3(Vec3::ZERO);
         let direction = world.transform_vector3(-Vec3::Z).normalize();
         let range = light.range().filter(|r| r.is_finite() && *r > 0.0);
@@ -899,10 +946,11 @@ mod tests {
                  "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 5}}}
             ],
             "cameras": [{"type": "perspective", "perspective": {"yfov": 0.7, "znear": 0.1, "aspectRatio": 1.5}}],
+            // Candela and lux: 10 W/sr, 3 W/sr and 2 W/m^2 at 683 lm/W.
             "extensions": {"KHR_lights_punctual": {"lights": [
-                {"type": "point", "color": [1, 0.5, 0.25], "intensity": 10, "range": 20},
-                {"type": "spot", "intensity": 3, "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.5}},
-                {"type": "directional", "intensity": 2}
+                {"type": "point", "color": [1, 0.5, 0.25], "intensity": 6830, "range": 20},
+                {"type": "spot", "intensity": 2049, "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.5}},
+                {"type": "directional", "intensity": 1366}
             ]}},
             "buffers": [{"byteLength": d.bin.len()}],
             "bufferViews": d.views,
@@ -1051,6 +1099,44 @@ mod tests {
         let emitters = scene.light_sampler.emitters();
         assert_eq!(emitters.len(), 4);
         assert_eq!(emitters.emitter_of(2), Some((3, 0)));
+    }
+
+    /// KHR_lights_punctual is photometric (candela, lux) unless `asset.extras.streaks` says
+    /// the file is radiometric; anything else there is an error naming it.
+    #[test]
+    fn light_units_are_photometric_unless_the_asset_says_radiometric() {
+        let dir = tempfile::tempdir().unwrap();
+        let (mut doc, bin) = test_doc();
+        let lights = |doc: &Value| -> Vec<Light> {
+            let path = write_embedded(dir.path(), doc.clone(), &bin);
+            Scene::load(&path).unwrap().lights
+        };
+        let photometric = lights(&doc);
+        doc["asset"]["extras"] = json!({"streaks": {"light_units": "radiometric"}});
+        doc["extensions"]["KHR_lights_punctual"]["lights"][0]["intensity"] = json!(10);
+        doc["extensions"]["KHR_lights_punctual"]["lights"][1]["intensity"] = json!(3);
+        doc["extensions"]["KHR_lights_punctual"]["lights"][2]["intensity"] = json!(2);
+        let radiometric = lights(&doc);
+        assert_eq!(photometric.len(), 3);
+        for (a, b) in photometric.iter().zip(&radiometric) {
+            let power = |l: &Light| match *l {
+                Light::Point { intensity, .. } | Light::Spot { intensity, .. } => intensity,
+                Light::Directional { irradiance, .. } => irradiance,
+            };
+            assert!(
+                (power(a) - power(b)).abs().max_element() < 1e-5,
+                "{a:?} {b:?}"
+            );
+        }
+        // Other extras of the asset are not ours; a wrong value of ours is an error.
+        doc["asset"]["extras"] = json!({"author": "someone"});
+        assert_eq!(lights(&doc).len(), 3);
+        doc["asset"]["extras"] = json!({"streaks": {"light_units": "watts"}});
+        let err = load_err(doc, &bin);
+        assert!(
+            err.contains("asset.extras") && err.contains("watts"),
+            "{err}"
+        );
     }
 
     #[test]

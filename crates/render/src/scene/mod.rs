@@ -12,7 +12,12 @@
 //!   specification says, so the geometric normal from the winding stays the front side.
 //! - Perspective cameras only; a camera's name is the camera's, else its node's, else
 //!   `camera<i>`; `world_from_camera` is the node's world transform with scale removed.
-//! - KHR_lights_punctual: `color * intensity` is W/sr (point, spot) or W/m^2 (directional).
+//! - KHR_lights_punctual: `color * intensity` is in candela (point, spot) or lux
+//!   (directional), as the specification says, and becomes W/sr or W/m^2 divided by 683 lm/W
+//!   ([`crate::light::LUMINOUS_EFFICACY`]), as Blender's importer does. A file written in
+//!   radiometric units says so with `"asset": {"extras": {"streaks": {"light_units":
+//!   "radiometric"}}}` (the default is `"photometric"`); its intensities are then used as
+//!   they are.
 //! - Materials: glTF metallic-roughness, unless `extras.streaks` chooses one of the paper's
 //!   models: `{"bsdf": "ggx" | "ward" | "blinn_phong", "kd": [r,g,b], "ks": [r,g,b],
 //!   "alpha": a, "shininess": s}` (`alpha` for ggx and ward, `shininess` for blinn_phong;
