@@ -50,6 +50,16 @@ pub enum SceneError {
         /// What is wrong with it.
         reason: String,
     },
+    /// The file requires a glTF extension the loader does not honour.
+    #[error("{path}: requires the glTF extension {extension}, which is not supported: {advice}")]
+    UnsupportedExtension {
+        /// The file.
+        path: PathBuf,
+        /// The extension, as named in `extensionsRequired`.
+        extension: String,
+        /// What it means and what to do instead.
+        advice: String,
+    },
     /// The scene has no camera at all.
     #[error("{path}: scene has no camera")]
     NoCamera {

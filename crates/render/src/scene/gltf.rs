@@ -4,7 +4,7 @@
 //! read, so malformed files give a [`SceneError`] naming the element instead of a panic.
 //! Sparse accessors are not supported (an error names them).
 
-use super::{Scene, SceneError, SceneParts};
+use super::{extensions, Scene, SceneError, SceneParts};
 use crate::camera::Camera;
 use crate::light::{Light, LUMINOUS_EFFICACY};
 use crate::material::{Material, PaperModel, Reflectance, Wetness};
@@ -45,17 +45,28 @@ enum StreaksBsdf {
 
 /// Loads a `.gltf` or `.glb` file.
 pub(super) fn load(path: &Path) -> Result<Scene, SceneError> {
-    let gltf::Gltf { document, blob } = gltf::Gltf::open(path).map_err(|e| match e {
-        gltf::Error::Io(source) => SceneError::Io {
-            path: path.to_path_buf(),
-            element: "the file".into(),
-            source,
-        },
-        source => SceneError::Gltf {
-            path: path.to_path_buf(),
-            source,
-        },
+    let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
+        path: path.to_path_buf(),
+        element: "the file".into(),
+        source,
     })?;
+    let gltf_err = |source| SceneError::Gltf {
+        path: path.to_path_buf(),
+        source,
+    };
+    // The JSON as written, for what the gltf crate does not keep: the extensions it does not
+    // know (checked before its validation, which would reject a required one less clearly)
+    // and the asset's extras.
+    let raw: serde_json::Value = if bytes.starts_with(b"glTF") {
+        let glb = gltf::binary::Glb::from_slice(&bytes).map_err(gltf_err)?;
+        serde_json::from_slice(&glb.json)
+    } else {
+        serde_json::from_slice(&bytes)
+    }
+    .map_err(|e| gltf_err(gltf::Error::Deserialize(e)))?;
+    let extension_warnings = extensions::check(path, &raw)?;
+    let light_units = light_units(path, &raw)?;
+    let gltf::Gltf { document, blob } = gltf::Gltf::from_slice(&bytes).map_err(gltf_err)?;
     let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
     let buffers = load_buffers(path, &base, &document, blob)?;
     let mut loader = Loader {
@@ -68,8 +79,11 @@ pub(super) fn load(path: &Path) -> Result<Scene, SceneError> {
         },
         textures: HashMap::new(),
         default_material: None,
-        light_units: light_units(path, &document)?,
+        light_units,
     };
+    for w in extension_warnings {
+        loader.warn(w);
+    }
     for (i, m) in document.materials().enumerate() {
         let material = loader.material(&m, i)?;
         loader.parts.materials.push(material);
@@ -254,16 +268,11 @@ struct AssetExtras {
     light_units: LightUnits,
 }
 
-/// The light units `asset.extras.streaks.light_units` chooses (photometric when absent).
-fn light_units(path: &Path, document: &gltf::Document) -> Result<LightUnits, SceneError> {
+/// The light units `asset.extras.streaks.light_units` of the file's JSON chooses (photometric
+/// when absent).
+fn light_units(path: &Path, json: &serde_json::Value) -> Result<LightUnits, SceneError> {
     let bad = |reason: String| SceneError::invalid(path, "asset.extras", reason);
-    // gltf 1.4 exposes the asset only through the JSON root.
-    let Some(raw) = document.clone().into_json().asset.extras else {
-        return Ok(LightUnits::Photometric);
-    };
-    let value: serde_json::Value =
-        serde_json::from_str(raw.get()).map_err(|e| bad(format!("not JSON: {e}")))?;
-    match value.get("streaks") {
+    match json.pointer("/asset/extras/streaks") {
         None => Ok(LightUnits::Photometric),
         Some(streaks) => serde_json::from_value::<AssetExtras>(streaks.clone())
             .map(|x| x.light_units)
@@ -1349,8 +1358,33 @@ mod tests {
         let (mut doc, bin) = test_doc();
         doc["extensionsRequired"] = json!(["KHR_draco_mesh_compression"]);
         doc["extensionsUsed"] = json!(["KHR_draco_mesh_compression"]);
-        let err = load_err(doc, &bin);
-        assert!(err.contains("invalid glTF"), "{err}");
+        let err = load_err(doc.clone(), &bin);
+        assert!(
+            err.contains("requires the glTF extension KHR_draco_mesh_compression")
+                && err.contains("export without compression"),
+            "{err}"
+        );
+        // The same file as a GLB.
+        let dir = tempfile::tempdir().unwrap();
+        let err = Scene::load(&write_glb(dir.path(), &doc, &bin)).unwrap_err();
+        assert!(
+            err.to_string().contains("KHR_draco_mesh_compression"),
+            "{err}"
+        );
+        // Used but not required: a warning naming the material, and the scene loads.
+        let (mut doc, bin) = test_doc();
+        doc["extensionsUsed"] = json!(["KHR_lights_punctual", "KHR_materials_clearcoat"]);
+        doc["materials"][0]["extensions"] =
+            json!({"KHR_materials_clearcoat": {"clearcoatFactor": 1}});
+        let scene = Scene::load(&write_embedded(dir.path(), doc, &bin)).unwrap();
+        assert!(
+            scene
+                .warnings
+                .iter()
+                .any(|w| w.contains("material \"asphalt\" (0) uses KHR_materials_clearcoat")),
+            "{:?}",
+            scene.warnings
+        );
         let err = Scene::load(Path::new("road.ply")).unwrap_err().to_string();
         assert!(
             err.contains("road.ply") && err.contains("unsupported"),

@@ -10,6 +10,10 @@
 //!   has none the shading normal is the face normal (stored as a zero vertex normal). A node
 //!   whose world transform has a negative determinant has its winding reversed, as the glTF
 //!   specification says, so the geometric normal from the winding stays the front side.
+//! - Extensions ([`extensions`]): the ones the loader honours are listed in
+//!   [`extensions::HONOURED`]; any other extension in `extensionsUsed` is a warning for each
+//!   element that uses it (naming the element and what is rendered without it), and in
+//!   `extensionsRequired` an error naming it.
 //! - Perspective cameras only; a camera's name is the camera's, else its node's, else
 //!   `camera<i>`; `world_from_camera` is the node's world transform with scale removed.
 //! - KHR_lights_punctual: `color * intensity` is in candela (point, spot) or lux
@@ -49,6 +53,7 @@
 //! [`crate::geometry::offset_ray_origin`].
 
 mod error;
+pub mod extensions;
 mod gltf;
 mod obj;
 
