@@ -2,9 +2,12 @@
 //!
 //! Every accessor is checked (type, bounds within its buffer view and buffer) before it is
 //! read, so malformed files give a [`SceneError`] naming the element instead of a panic.
-//! Sparse accessors are not supported (an error names them).
+//! Vertex attributes are read by the `accessor` module (every component type of the core
+//! specification and of KHR_mesh_quantization, sparse accessors); meshopt- and
+//! Draco-compressed geometry is decoded first by the `compression` module. Sparse index
+//! accessors are not supported (an error names them).
 
-use super::{extensions, Scene, SceneError, SceneParts};
+use super::{accessor, compression, extensions, Scene, SceneError, SceneParts};
 use crate::camera::Camera;
 use crate::light::{Light, LUMINOUS_EFFICACY};
 use crate::material::{Material, PaperModel, Reflectance, Wetness};
@@ -56,19 +59,44 @@ pub(super) fn load(path: &Path) -> Result<Scene, SceneError> {
     };
     // The JSON as written, for what the gltf crate does not keep: the extensions it does not
     // know (checked before its validation, which would reject a required one less clearly)
-    // and the asset's extras.
-    let raw: serde_json::Value = if bytes.starts_with(b"glTF") {
+    // and the asset's extras. Compressed geometry is decoded into it before it is read.
+    let (raw, blob) = if bytes.starts_with(b"glTF") {
         let glb = gltf::binary::Glb::from_slice(&bytes).map_err(gltf_err)?;
-        serde_json::from_slice(&glb.json)
+        let raw = serde_json::from_slice(&glb.json);
+        (raw, glb.bin.map(|b| b.into_owned()))
     } else {
-        serde_json::from_slice(&bytes)
-    }
-    .map_err(|e| gltf_err(gltf::Error::Deserialize(e)))?;
+        (serde_json::from_slice(&bytes), None)
+    };
+    let mut raw: serde_json::Value = raw.map_err(|e| gltf_err(gltf::Error::Deserialize(e)))?;
     let extension_warnings = extensions::check(path, &raw)?;
     let light_units = light_units(path, &raw)?;
-    let gltf::Gltf { document, blob } = gltf::Gltf::from_slice(&bytes).map_err(gltf_err)?;
+    // The extensions the loader honours have been checked; the gltf crate's validation would
+    // reject the required ones it does not implement itself.
+    if let Some(serde_json::Value::Array(required)) = raw.get_mut("extensionsRequired") {
+        required.retain(|e| {
+            !e.as_str()
+                .is_some_and(|e| extensions::HONOURED.contains(&e))
+        });
+    }
+    let read = |raw: serde_json::Value| {
+        serde_json::from_value(raw)
+            .map_err(gltf::Error::Deserialize)
+            .and_then(gltf::Document::from_json)
+            .map_err(gltf_err)
+    };
+    // The buffers are loaded first, from the file's buffer list alone: compressed geometry
+    // must be decoded before the whole document is valid (Draco's accessors have no
+    // bufferView until then).
+    let buffer_list = serde_json::json!({
+        "asset": raw.get("asset").cloned().unwrap_or_default(),
+        "buffers": raw.get("buffers").cloned().unwrap_or_default(),
+    });
     let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
-    let buffers = load_buffers(path, &base, &document, blob)?;
+    let fallbacks = compression::fallback_buffers(&raw);
+    let mut buffers = load_buffers(path, &base, &read(buffer_list)?, blob, &fallbacks)?;
+    compression::decode(path, &mut raw, &mut buffers)?;
+    let document = read(raw)?;
+    check_views(path, &document, &buffers, &fallbacks)?;
     let mut loader = Loader {
         path,
         base,
@@ -174,14 +202,21 @@ fn uri_label(base: &Path, uri: &str) -> String {
     }
 }
 
+/// Loads every buffer of `document` (external files, data URIs, the GLB binary chunk), except
+/// the meshopt fallback buffers `fallbacks`, which are placeholders without data (left empty).
 fn load_buffers(
     path: &Path,
     base: &Path,
     document: &gltf::Document,
     mut blob: Option<Vec<u8>>,
+    fallbacks: &[usize],
 ) -> Result<Vec<gltf::buffer::Data>, SceneError> {
     let mut buffers = Vec::new();
     for buffer in document.buffers() {
+        if fallbacks.contains(&buffer.index()) {
+            buffers.push(gltf::buffer::Data(Vec::new()));
+            continue;
+        }
         let element = match buffer.source() {
             gltf::buffer::Source::Bin => format!("buffer {} (GLB binary chunk)", buffer.index()),
             gltf::buffer::Source::Uri(uri) => {
@@ -219,7 +254,29 @@ fn load_buffers(
         }
         buffers.push(data);
     }
+    Ok(buffers)
+}
+
+/// Checks that every bufferView lies within its buffer, and that none (after decompression)
+/// reads a meshopt fallback buffer.
+fn check_views(
+    path: &Path,
+    document: &gltf::Document,
+    buffers: &[gltf::buffer::Data],
+    fallbacks: &[usize],
+) -> Result<(), SceneError> {
     for view in document.views() {
+        if fallbacks.contains(&view.buffer().index()) {
+            return Err(SceneError::invalid(
+                path,
+                format!("bufferView {}", view.index()),
+                format!(
+                    "reads buffer {}, a {} fallback without data, but is not compressed",
+                    view.buffer().index(),
+                    compression::MESHOPT
+                ),
+            ));
+        }
         let end = view.offset().checked_add(view.length());
         let have = buffers[view.buffer().index()].len();
         if end.is_none_or(|e| e > have) {
@@ -235,7 +292,7 @@ fn load_buffers(
             ));
         }
     }
-    Ok(buffers)
+    Ok(())
 }
 
 struct Loader<'a> {
@@ -402,6 +459,28 @@ impl Loader<'_> {
     }
 
     /// Checks that `accessor` has one of the `allowed` layouts and lies within its view.
+    /// The values of vertex attribute `name` of primitive `element` (`accessor`), of `N`
+    /// components of one of the types `allowed`, and `count` of them if given.
+    fn attribute<const N: usize>(
+        &self,
+        accessor: &gltf::Accessor,
+        element: &str,
+        name: &str,
+        allowed: &[accessor::Component],
+        count: Option<usize>,
+    ) -> Result<Vec<[f32; N]>, SceneError> {
+        let element = format!("{element}, {name} (accessor {})", accessor.index());
+        let values = accessor::read::<N>(accessor, &self.buffers, allowed)
+            .map_err(|r| self.bad(&element, r))?;
+        match count {
+            Some(n) if values.len() != n => Err(self.bad(
+                element,
+                format!("{} values for {n} positions", values.len()),
+            )),
+            _ => Ok(values),
+        }
+    }
+
     fn check_accessor(
         &self,
         accessor: &gltf::Accessor,
@@ -469,24 +548,6 @@ impl Loader<'_> {
             let Some(pos_acc) = prim.get(&gltf::Semantic::Positions) else {
                 return Err(self.bad(element, "has no POSITION attribute"));
             };
-            let f32x3 = [(Dimensions::Vec3, DataType::F32)];
-            self.check_accessor(&pos_acc, &format!("{element}, POSITION"), &f32x3)?;
-            let normal_acc = prim.get(&gltf::Semantic::Normals);
-            if let Some(a) = &normal_acc {
-                self.check_accessor(a, &format!("{element}, NORMAL"), &f32x3)?;
-            }
-            let uv_acc = prim.get(&gltf::Semantic::TexCoords(0));
-            if let Some(a) = &uv_acc {
-                self.check_accessor(
-                    a,
-                    &format!("{element}, TEXCOORD_0"),
-                    &[
-                        (Dimensions::Vec2, DataType::F32),
-                        (Dimensions::Vec2, DataType::U8),
-                        (Dimensions::Vec2, DataType::U16),
-                    ],
-                )?;
-            }
             if let Some(a) = prim.indices() {
                 self.check_accessor(
                     &a,
@@ -498,27 +559,17 @@ impl Loader<'_> {
                     ],
                 )?;
             }
-            let buffers = &self.buffers;
-            let reader = prim.reader(|b| buffers.get(b.index()).map(|d| d.0.as_slice()));
-            let short = |what: &str| self.bad(format!("{element}, {what}"), "cannot be read");
-            let positions: Vec<Vec3> = reader
-                .read_positions()
-                .ok_or_else(|| short("POSITION"))?
+            let positions: Vec<Vec3> = self
+                .attribute(&pos_acc, &element, "POSITION", accessor::POSITION, None)?
+                .into_iter()
                 .map(Vec3::from)
                 .collect();
             let n = positions.len();
-            if n != pos_acc.count() {
-                return Err(short("POSITION"));
-            }
-            if positions.iter().any(|p| !p.is_finite()) {
-                return Err(self.bad(
-                    format!("{element}, POSITION"),
-                    "contains a non-finite value",
-                ));
-            }
-            let normals: Vec<Vec3> = match reader.read_normals() {
-                Some(it) => it
-                    .map(|v| {
+            let normals: Vec<Vec3> = match prim.get(&gltf::Semantic::Normals) {
+                Some(a) => self
+                    .attribute(&a, &element, "NORMAL", accessor::DIRECTION, Some(n))?
+                    .into_iter()
+                    .map(|v: [f32; 3]| {
                         (normal_matrix * Vec3::from(v))
                             .try_normalize()
                             .unwrap_or(Vec3::ZERO)
@@ -526,16 +577,16 @@ impl Loader<'_> {
                     .collect(),
                 None => vec![Vec3::ZERO; n],
             };
-            let uvs: Vec<Vec2> = match reader.read_tex_coords(0) {
-                Some(it) => it.into_f32().map(Vec2::from).collect(),
+            let uvs: Vec<Vec2> = match prim.get(&gltf::Semantic::TexCoords(0)) {
+                Some(a) => self
+                    .attribute(&a, &element, "TEXCOORD_0", accessor::TEXCOORD, Some(n))?
+                    .into_iter()
+                    .map(Vec2::from)
+                    .collect(),
                 None => vec![Vec2::ZERO; n],
             };
-            if normals.len() != n || uvs.len() != n {
-                return Err(self.bad(
-                    element,
-                    "NORMAL or TEXCOORD_0 count differs from POSITION count",
-                ));
-            }
+            let buffers = &self.buffers;
+            let reader = prim.reader(|b| buffers.get(b.index()).map(|d| d.0.as_slice()));
             let indices: Vec<u32> = match reader.read_indices() {
                 Some(it) => it.into_u32().collect(),
                 None => (0..n as u32).collect(),
@@ -1356,21 +1407,18 @@ mod tests {
     #[test]
     fn unsupported_inputs_are_errors() {
         let (mut doc, bin) = test_doc();
-        doc["extensionsRequired"] = json!(["KHR_draco_mesh_compression"]);
-        doc["extensionsUsed"] = json!(["KHR_draco_mesh_compression"]);
+        doc["extensionsRequired"] = json!(["KHR_texture_basisu"]);
+        doc["extensionsUsed"] = json!(["KHR_texture_basisu"]);
         let err = load_err(doc.clone(), &bin);
         assert!(
-            err.contains("requires the glTF extension KHR_draco_mesh_compression")
-                && err.contains("export without compression"),
+            err.contains("requires the glTF extension KHR_texture_basisu")
+                && err.contains("export PNG or JPEG"),
             "{err}"
         );
         // The same file as a GLB.
         let dir = tempfile::tempdir().unwrap();
         let err = Scene::load(&write_glb(dir.path(), &doc, &bin)).unwrap_err();
-        assert!(
-            err.to_string().contains("KHR_draco_mesh_compression"),
-            "{err}"
-        );
+        assert!(err.to_string().contains("KHR_texture_basisu"), "{err}");
         // Used but not required: a warning naming the material, and the scene loads.
         let (mut doc, bin) = test_doc();
         doc["extensionsUsed"] = json!(["KHR_lights_punctual", "KHR_materials_clearcoat"]);

@@ -52,6 +52,8 @@
 //! self-intersection, on top of the origin offset callers apply with
 //! [`crate::geometry::offset_ray_origin`].
 
+mod accessor;
+mod compression;
 mod error;
 pub mod extensions;
 mod gltf;
