@@ -14,6 +14,9 @@
 //!   [`extensions::HONOURED`]; any other extension in `extensionsUsed` is a warning for each
 //!   element that uses it (naming the element and what is rendered without it), and in
 //!   `extensionsRequired` an error naming it.
+//! - Geometry may be quantized (KHR_mesh_quantization: 8- and 16-bit attributes, normalized
+//!   or not), sparse, or compressed (EXT_meshopt_compression, KHR_draco_mesh_compression,
+//!   decoded when the file is loaded).
 //! - Perspective cameras only; a camera's name is the camera's, else its node's, else
 //!   `camera<i>`; `world_from_camera` is the node's world transform with scale removed.
 //! - KHR_lights_punctual: `color * intensity` is in candela (point, spot) or lux
