@@ -51,6 +51,7 @@ fn street() -> Scene {
         },
         emission: Vec3::ZERO,
         emission_texture: None,
+        normal_map: None,
         double_sided: false,
     };
     let mut window = Material::diffuse("window", Vec3::ZERO);

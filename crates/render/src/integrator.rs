@@ -721,6 +721,7 @@ mod tests {
             },
             emission: Vec3::ZERO,
             emission_texture: None,
+            normal_map: None,
             double_sided: false,
         };
         let mut parts = SceneParts {

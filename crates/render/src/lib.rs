@@ -11,7 +11,8 @@
 //! - [`bsdf`]: the closed set of reflectance models ([`bsdf::Bsdf`]): diffuse, the paper's
 //!   `ggx`, `ward` and `blinn_phong`, and the glTF metallic-roughness BRDF.
 //! - [`material`] and [`texture`]: what a scene stores; a material turns into a [`bsdf::Bsdf`]
-//!   at a surface point.
+//!   at a surface point. [`normal_map`]: tangent-space normal maps and the rule that keeps a
+//!   perturbed shading normal valid.
 //! - [`light`]: one file per concept: the punctual lights ([`light::Light`]), the emitters
 //!   ([`light::Emitters`]: punctual lights and meshes of emissive triangles, built once with the
 //!   scene), the light tree ([`light::LightTree`]) and the light choice ([`light::LightSampler`]).
@@ -79,6 +80,7 @@ pub mod integrator;
 pub mod light;
 pub mod material;
 pub mod mitsuba;
+pub mod normal_map;
 pub mod output;
 pub mod regression;
 pub mod sampling;

@@ -8,8 +8,12 @@
 //!   wet and the dry values.
 //! - [`Reflectance::GltfPbr`]: RGB multiplies the base colour; the metallic-roughness texture's
 //!   blue channel multiplies `metallic` and its green channel `roughness` (glTF 2.0).
+//!
+//! A normal map ([`Material::normal_map`]) changes the shading normal, not the BSDF: the scene
+//! applies it at the hit ([`crate::normal_map`]).
 
 use crate::bsdf::{self, Bsdf};
+use crate::normal_map::NormalMap;
 use crate::texture::{Texture, TextureId};
 use glam::{Vec2, Vec3, Vec4};
 
@@ -89,6 +93,9 @@ pub struct Material {
     pub emission: Vec3,
     /// Optional texture multiplying `emission`.
     pub emission_texture: Option<TextureId>,
+    /// Optional tangent-space normal map (glTF `normalTexture`), applied to the shading normal
+    /// where the scene has vertex tangents ([`crate::normal_map`]).
+    pub normal_map: Option<NormalMap>,
     /// Emits (and is shaded) on both faces.
     pub double_sided: bool,
 }
@@ -113,6 +120,7 @@ impl Material {
             },
             emission: Vec3::ZERO,
             emission_texture: None,
+            normal_map: None,
             double_sided: false,
         }
     }
@@ -132,7 +140,9 @@ impl Material {
                 ..
             } => [*base_color_texture, *metallic_roughness_texture],
         };
-        r.into_iter().chain([self.emission_texture]).flatten()
+        r.into_iter()
+            .chain([self.emission_texture, self.normal_map.map(|n| n.texture)])
+            .flatten()
     }
 
     /// The BSDF at texture coordinate `uv`.
@@ -242,6 +252,7 @@ mod tests {
             },
             emission: Vec3::ZERO,
             emission_texture: None,
+            normal_map: None,
             double_sided: false,
         };
         let textures = [dry_map, kd_map];

@@ -701,6 +701,7 @@ mod tests {
             reflectance,
             emission,
             emission_texture: None,
+            normal_map: None,
             double_sided: false,
         }
     }

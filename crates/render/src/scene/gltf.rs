@@ -7,10 +7,11 @@
 //! Draco-compressed geometry is decoded first by the `compression` module. Sparse index
 //! accessors are not supported (an error names them).
 
-use super::{accessor, compression, extensions, Scene, SceneError, SceneParts};
+use super::{accessor, compression, extensions, tangents, Scene, SceneError, SceneParts};
 use crate::camera::Camera;
 use crate::light::{Light, LUMINOUS_EFFICACY};
 use crate::material::{Material, PaperModel, Reflectance, Wetness};
+use crate::normal_map::NormalMap;
 use crate::texture::{ColorSpace, Texture, TextureId};
 use glam::{Affine3A, Mat3, Mat4, Quat, Vec2, Vec3, Vec4};
 use gltf::accessor::{DataType, Dimensions};
@@ -145,6 +146,10 @@ pub(super) fn load(path: &Path) -> Result<Scene, SceneError> {
             .parts
             .warnings
             .push(format!("{}: the file has no scene", path.display())),
+    }
+    if !loader.parts.tangents.is_empty() {
+        let n = loader.parts.positions.len();
+        loader.parts.tangents.resize(n, Vec4::ZERO);
     }
     Scene::from_parts(loader.parts)
 }
@@ -585,6 +590,21 @@ impl Loader<'_> {
                     .collect(),
                 None => vec![Vec2::ZERO; n],
             };
+            // A normal-mapped primitive's tangents: the file's if it has TANGENT and NORMAL.
+            let normal_mapped = prim
+                .material()
+                .index()
+                .is_some_and(|i| self.parts.materials[i].normal_map.is_some());
+            let has_normals = prim.get(&gltf::Semantic::Normals).is_some();
+            let tangent_acc = prim
+                .get(&gltf::Semantic::Tangents)
+                .filter(|_| normal_mapped);
+            let file_tangents: Option<Vec<[f32; 4]>> = match &tangent_acc {
+                Some(a) if has_normals => {
+                    Some(self.attribute(a, &element, "TANGENT", accessor::DIRECTION, Some(n))?)
+                }
+                _ => None,
+            };
             let buffers = &self.buffers;
             let reader = prim.reader(|b| buffers.get(b.index()).map(|d| d.0.as_slice()));
             let indices: Vec<u32> = match reader.read_indices() {
@@ -608,20 +628,45 @@ impl Loader<'_> {
                 Some(i) => i as u32,
                 None => self.default_material(),
             };
+            if flip {
+                tris.iter_mut().for_each(|t| t.swap(1, 2));
+            }
+            let mut positions: Vec<Vec3> = positions
+                .iter()
+                .map(|&p| world.transform_point3(p))
+                .collect();
+            let (mut normals, mut uvs) = (normals, uvs);
+            let tangents = if normal_mapped {
+                let (t, copies) = match file_tangents {
+                    Some(t) => (tangents::to_world(t.into_iter(), world), Vec::new()),
+                    None => {
+                        let has = (
+                            tangent_acc.is_some(),
+                            prim.get(&gltf::Semantic::TexCoords(0)).is_some(),
+                        );
+                        self.tangents(&element, has, &positions, &normals, &uvs, &mut tris)
+                    }
+                };
+                tangents::extend_copies(&mut positions, &copies);
+                tangents::extend_copies(&mut normals, &copies);
+                tangents::extend_copies(&mut uvs, &copies);
+                Some(t)
+            } else {
+                None
+            };
             let first = self.parts.positions.len();
-            if first + n > u32::MAX as usize {
+            if first + positions.len() > u32::MAX as usize {
                 return Err(self.bad(element, "the scene has more than 2^32 - 1 vertices"));
+            }
+            if let Some(t) = tangents {
+                self.parts.tangents.resize(first, Vec4::ZERO);
+                self.parts.tangents.extend(t);
             }
             let first = first as u32;
             for t in &mut tris {
-                if flip {
-                    t.swap(1, 2);
-                }
                 *t = t.map(|i| i + first);
             }
-            self.parts
-                .positions
-                .extend(positions.iter().map(|&p| world.transform_point3(p)));
+            self.parts.positions.extend(positions);
             self.parts.normals.extend(normals);
             self.parts.uvs.extend(uvs);
             self.parts
@@ -630,6 +675,38 @@ impl Loader<'_> {
             self.parts.triangles.extend(tris);
         }
         Ok(())
+    }
+
+    /// The generated tangents of a normal-mapped primitive without usable TANGENT (see
+    /// [`tangents`]): MikkTSpace's from the world-space `positions`, `normals` (zero: the face
+    /// normal) and `uvs`, which may renumber `tris` to duplicated vertices (the second value
+    /// lists the vertex each duplicate copies). `has` says whether the primitive has TANGENT
+    /// (then ignored: it has no NORMAL) and TEXCOORD_0 (without it there is nothing to map:
+    /// zero tangents). Both cases are warned about.
+    fn tangents(
+        &mut self,
+        element: &str,
+        has: (bool, bool),
+        positions: &[Vec3],
+        normals: &[Vec3],
+        uvs: &[Vec2],
+        tris: &mut [[u32; 3]],
+    ) -> (Vec<Vec4>, Vec<u32>) {
+        let (has_tangents, has_uvs) = has;
+        if !has_uvs {
+            self.warn(format!(
+                "{element}: its material has a normal texture but the primitive has no \
+                 TEXCOORD_0; rendered without the normal map"
+            ));
+            return (vec![Vec4::ZERO; positions.len()], Vec::new());
+        }
+        if has_tangents {
+            self.warn(format!(
+                "{element}: has TANGENT but no NORMAL; the tangents are ignored and generated \
+                 from flat normals, as the glTF specification says"
+            ));
+        }
+        tangents::generate(positions, normals, uvs, tris)
     }
 
     /// The glTF default material (white, metallic 1, roughness 1), added once when needed.
@@ -646,6 +723,7 @@ impl Loader<'_> {
                 },
                 emission: Vec3::ZERO,
                 emission_texture: None,
+                normal_map: None,
                 double_sided: false,
             });
             (self.parts.materials.len() - 1) as u32
@@ -670,6 +748,26 @@ impl Loader<'_> {
             Some(info) => Some(self.texture(&info, ColorSpace::Srgb, &element)?),
             None => None,
         };
+        let normal_map = match m.normal_texture() {
+            Some(info) => {
+                let scale = info.scale();
+                if !scale.is_finite() {
+                    return Err(
+                        self.bad(element, format!("normalTexture.scale {scale} is invalid"))
+                    );
+                }
+                Some(NormalMap {
+                    texture: self.texture_of(
+                        &info.texture(),
+                        info.tex_coord(),
+                        ColorSpace::Linear,
+                        &element,
+                    )?,
+                    scale,
+                })
+            }
+            None => None,
+        };
         let emission = Vec3::from(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0);
         if !emission.is_finite() || emission.min_element() < 0.0 {
             return Err(self.bad(element, format!("emission {emission} is invalid")));
@@ -690,6 +788,7 @@ impl Loader<'_> {
             reflectance,
             emission,
             emission_texture,
+            normal_map,
             double_sided: m.double_sided(),
         })
     }
@@ -786,23 +885,33 @@ impl Loader<'_> {
         space: ColorSpace,
         material: &str,
     ) -> Result<TextureId, SceneError> {
-        if info.tex_coord() != 0 {
+        self.texture_of(&info.texture(), info.tex_coord(), space, material)
+    }
+
+    /// The decoded texture `texture` (read through the uv set `tex_coord`) in `space`.
+    fn texture_of(
+        &mut self,
+        texture: &gltf::Texture,
+        tex_coord: u32,
+        space: ColorSpace,
+        material: &str,
+    ) -> Result<TextureId, SceneError> {
+        if tex_coord != 0 {
             self.warn(format!(
-                "{material}: texture uses TEXCOORD_{}; TEXCOORD_0 is used instead",
-                info.tex_coord()
+                "{material}: texture uses TEXCOORD_{tex_coord}; TEXCOORD_0 is used instead"
             ));
         }
-        let sampler = info.texture().sampler();
+        let sampler = texture.sampler();
         let repeat = gltf::texture::WrappingMode::Repeat;
         if sampler.wrap_s() != repeat || sampler.wrap_t() != repeat {
             self.warn(format!(
                 "{material}: texture {} asks for {:?}/{:?} wrapping; repeat is used",
-                info.texture().index(),
+                texture.index(),
                 sampler.wrap_s(),
                 sampler.wrap_t()
             ));
         }
-        let image = info.texture().source();
+        let image = texture.source();
         let key = (image.index(), space);
         if let Some(&id) = self.textures.get(&key) {
             return Ok(id);

@@ -61,6 +61,7 @@ mod error;
 pub mod extensions;
 mod gltf;
 mod obj;
+mod tangents;
 
 pub use error::SceneError;
 
@@ -69,8 +70,9 @@ use crate::camera::Camera;
 use crate::geometry::{Ray, SurfaceHit};
 use crate::light::{Light, LightSampler, SurfaceMesh};
 use crate::material::Material;
+use crate::normal_map;
 use crate::texture::Texture;
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 use std::path::{Path, PathBuf};
 
 /// A loaded scene, shared read-only by all render threads (never copied per thread).
@@ -85,6 +87,10 @@ pub struct Scene {
     pub normals: Vec<Vec3>,
     /// Texture coordinates, one per vertex (zero where the file had none).
     pub uvs: Vec<Vec2>,
+    /// World-space vertex tangents for normal maps (xyz: unit tangent, w: handedness +-1),
+    /// one per vertex, or empty when no material has a normal map; a zero tangent means "not
+    /// normal mapped here" (see [`crate::normal_map`]).
+    pub tangents: Vec<Vec4>,
     /// Vertex indices of each triangle.
     pub triangles: Vec<[u32; 3]>,
     /// Material index of each triangle.
@@ -117,6 +123,8 @@ pub struct SceneParts {
     pub normals: Vec<Vec3>,
     /// One uv per vertex, or empty for zeros.
     pub uvs: Vec<Vec2>,
+    /// One tangent per vertex (xyz, w = handedness; zero = none), or empty for none.
+    pub tangents: Vec<Vec4>,
     /// Vertex indices of each triangle.
     pub triangles: Vec<[u32; 3]>,
     /// Material index of each triangle.
@@ -159,6 +167,7 @@ impl Scene {
             positions,
             mut normals,
             mut uvs,
+            tangents,
             triangles,
             triangle_materials,
             materials,
@@ -190,6 +199,15 @@ impl Scene {
                 "uvs".into(),
                 format!("{} uvs for {nv} vertices", uvs.len()),
             ));
+        }
+        if !tangents.is_empty() && tangents.len() != nv {
+            return Err(bad(
+                "tangents".into(),
+                format!("{} tangents for {nv} vertices", tangents.len()),
+            ));
+        }
+        if let Some(i) = tangents.iter().position(|t| !t.is_finite()) {
+            return Err(bad(format!("vertex {i}"), "tangent is not finite".into()));
         }
         if triangle_materials.len() != triangles.len() {
             return Err(bad(
@@ -247,6 +265,7 @@ impl Scene {
             positions,
             normals,
             uvs,
+            tangents,
             triangles,
             triangle_materials,
             materials,
@@ -300,7 +319,11 @@ impl Scene {
         material.emission_at(hit.uv, &self.textures)
     }
 
-    /// Closest hit along `ray` within `(t_min, ray.t_max)` (see [`Accel::t_min`]).
+    /// Closest hit along `ray` within `(t_min, ray.t_max)` (see [`Accel::t_min`]). The shading
+    /// normal is the interpolated vertex normal (the face normal where there is none), through
+    /// the material's normal map where it has one and the vertices have tangents (made valid
+    /// for the viewer `-ray.direction` by [`normal_map::valid_reflection_normal`]), and
+    /// oriented to the side of the geometric normal.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<SurfaceHit> {
         let hit = self.accel.intersect(ray)?;
@@ -312,21 +335,54 @@ impl Scene {
         let ng = (p1 - p0).cross(p2 - p0).normalize_or_zero();
         let p = p0 * b0 + p1 * b.x + p2 * b.y;
         let ns = self.normals[i0] * b0 + self.normals[i1] * b.x + self.normals[i2] * b.y;
-        let ns = match ns.try_normalize() {
-            Some(n) if n.dot(ng) < 0.0 => -n,
-            Some(n) => n,
-            None => ng,
-        };
+        let ns = ns.try_normalize().unwrap_or(ng);
         let uv = self.uvs[i0] * b0 + self.uvs[i1] * b.x + self.uvs[i2] * b.y;
+        let material = self.triangle_materials[hit.triangle as usize];
+        let ns = if self.tangents.is_empty() {
+            ns
+        } else {
+            self.normal_mapped(ns, ng, [i0, i1, i2], [b0, b.x, b.y], uv, material, ray)
+        };
         Some(SurfaceHit {
             t: hit.t,
             p,
             ng,
-            ns,
+            ns: if ns.dot(ng) < 0.0 { -ns } else { ns },
             uv,
             triangle: hit.triangle,
-            material: self.triangle_materials[hit.triangle as usize],
+            material,
         })
+    }
+
+    /// The unit shading normal `ns` through the normal map of `material`, if it has one and
+    /// the triangle's vertices `v` (barycentric weights `b`) have tangents; made valid for the
+    /// viewer of `ray` (see [`Scene::intersect`]).
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    fn normal_mapped(
+        &self,
+        ns: Vec3,
+        ng: Vec3,
+        v: [usize; 3],
+        b: [f32; 3],
+        uv: Vec2,
+        material: u32,
+        ray: &Ray,
+    ) -> Vec3 {
+        let Some(map) = self.materials[material as usize].normal_map else {
+            return ns;
+        };
+        let t = v.map(|i| self.tangents[i]);
+        let tangent = t[0] * b[0] + t[1] * b[1] + t[2] * b[2];
+        if tangent.truncate() == Vec3::ZERO {
+            return ns;
+        }
+        let n = map.perturb(ns, tangent, uv, &self.textures);
+        // On the viewer's side of the surface, as the integrator shades it.
+        let wo = -ray.direction;
+        let side = if ng.dot(wo) < 0.0 { -1.0 } else { 1.0 };
+        let (ng, n) = (ng * side, n * side);
+        normal_map::valid_reflection_normal(ng, wo, n) * side
     }
 
     /// Whether anything blocks `ray` within `(t_min, ray.t_max)` (shadow query).

@@ -177,6 +177,7 @@ fn convert_material(
         reflectance,
         emission,
         emission_texture: None,
+        normal_map: None,
         double_sided: false,
     })
 }

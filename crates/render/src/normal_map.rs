@@ -1,0 +1,242 @@
+//! Tangent-space normal maps (glTF `normalTexture`): the shading normal at a hit from the
+//! interpolated normal, the vertex tangent and a texel, and the rule that keeps a perturbed
+//! normal from making a lit surface black.
+//!
+//! # The perturbation (glTF 2.0, section 3.9.3 and `material.normalTexture`)
+//!
+//! The texture is linear (not sRGB). A texel `c` encodes the tangent-space normal
+//! `n_t = normalize((2 c.rgb - 1) * (scale, scale, 1))`: +X along the tangent (increasing u),
+//! +Y along the bitangent (up in the image, that is decreasing glTF v), +Z along the normal.
+//! The frame at a hit is the interpolated normal `N`, the interpolated tangent made orthogonal
+//! to it (Gram-Schmidt, as pbrt-v4's `NormalMap`) `T`, and `B = w * cross(N, T)` with the
+//! tangent's handedness `w` (glTF's `bitangent = cross(normal, tangent.xyz) * tangent.w`). The
+//! shading normal is `n_t.x T + n_t.y B + n_t.z N`. The frame is orthonormal, so the angle
+//! between the shading normal and `N` is exactly the angle that `n_t` encodes. (Bakers that
+//! follow MikkTSpace to the letter use the unnormalised interpolated frame; the two differ by
+//! second-order terms in the interpolation across a triangle.)
+//!
+//! A vertex without a tangent (a zero tangent: the primitive had no texture coordinates, or
+//! MikkTSpace found no tangent space for a degenerate triangle) is not normal mapped.
+//!
+//! # Keeping light where it belongs
+//!
+//! The integrator uses the shading normal's frame for the BSDF and cosines, and accepts a
+//! direction only if it lies on the viewer's side of the *geometric* normal as well (so no
+//! light comes through a surface from behind, whatever the shading normal). A tilted normal
+//! can still face away from the viewer at grazing angles, which would leave the surface black
+//! there (the integrator ends a path whose `wo` is below the shading hemisphere). So the
+//! perturbed normal goes through [`valid_reflection_normal`], Blender Cycles' rule
+//! (`ensure_valid_specular_reflection`; Schüssler et al., "Microfacet-based normal mapping for
+//! robust Monte Carlo path tracing", 2017, describe the artefact and a costlier fix): if the mirror reflection of `wo` about the shading normal would go below the surface, the
+//! normal is tilted back toward the geometric normal, in the plane of the two, just far enough
+//! that the reflection lies slightly above the surface. Then `wo` is always above the shading
+//! hemisphere and the shading normal is unchanged wherever it was already valid. The rule is
+//! applied to normal-mapped hits only: interpolated vertex normals are left as they are, so
+//! scenes without normal maps render exactly as before.
+
+use crate::texture::{Texture, TextureId};
+use glam::{Vec2, Vec3, Vec4};
+
+/// A material's tangent-space normal map (glTF `normalTexture`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NormalMap {
+    /// The linear RGB texture.
+    pub texture: TextureId,
+    /// `normalTexture.scale`: multiplies the X and Y of the decoded normal.
+    pub scale: f32,
+}
+
+impl NormalMap {
+    /// The unit tangent-space normal a texel encodes, `normalize((2 c - 1) * (scale, scale,
+    /// 1))` (glTF 2.0); +Z where that is zero.
+    #[inline]
+    pub fn tangent_space_normal(&self, texel: Vec4) -> Vec3 {
+        let n = (texel.truncate() * 2.0 - Vec3::ONE) * Vec3::new(self.scale, self.scale, 1.0);
+        n.try_normalize().unwrap_or(Vec3::Z)
+    }
+
+    /// The shading normal at `uv`: the tangent-space normal of the texel there in the frame of
+    /// the unit normal `n` and the tangent `tangent` (xyz: direction, need not be unit or
+    /// orthogonal to `n`; w: handedness, negative for a mirrored frame). `n` itself where the
+    /// tangent is zero or parallel to `n`.
+    #[inline]
+    pub fn perturb(&self, n: Vec3, tangent: Vec4, uv: Vec2, textures: &[Texture]) -> Vec3 {
+        let t = tangent.truncate();
+        let Some(t) = (t - n * n.dot(t)).try_normalize() else {
+            return n;
+        };
+        let Some(texture) = textures.get(self.texture as usize) else {
+            return n;
+        };
+        let b = n.cross(t) * if tangent.w < 0.0 { -1.0 } else { 1.0 };
+        let nt = self.tangent_space_normal(texture.sample(uv));
+        (t * nt.x + b * nt.y + n * nt.z)
+            .try_normalize()
+            .unwrap_or(n)
+    }
+}
+
+/// The shading normal `n` (unit; it may even point below the surface), tilted toward the
+/// geometric normal `ng` (unit, on the side of `wo`) just enough that the mirror reflection of `wo` (unit, pointing away from the surface)
+/// about it lies at least `min(0.9 wo.ng, 0.01)` above the surface; `n` itself when it already
+/// does. Cycles' `ensure_valid_specular_reflection` (see the module documentation): in the
+/// frame with `ng` as Z and `n` in the X-Z plane, the new normal `(sqrt(1 - z^2), 0, z)`
+/// solves `2 (n'.wo) z - wo.z = threshold`, a quadratic in `z^2`; of its roots the one whose
+/// reflection is valid and shallower is taken, and `ng` when neither is.
+pub fn valid_reflection_normal(ng: Vec3, wo: Vec3, n: Vec3) -> Vec3 {
+    let iz = wo.dot(ng);
+    let threshold = (0.9 * iz).min(0.01);
+    let r = 2.0 * n.dot(wo) * n - wo;
+    // Above the surface, with a valid reflection (then `n.wo > 0` too: were it not, the
+    // reflection would be at most `-wo.ng` high).
+    if n.dot(ng) > 0.0 && r.dot(ng) >= threshold {
+        return n;
+    }
+    let Some(x) = (n - n.dot(ng) * ng).try_normalize() else {
+        return ng;
+    };
+    let ix = wo.dot(x);
+    let (ix2, iz2) = (ix * ix, iz * iz);
+    let a = ix2 + iz2;
+    if a <= 0.0 {
+        return ng;
+    }
+    let b = (ix2 * (a - threshold * threshold)).max(0.0).sqrt();
+    let c = iz * threshold + a;
+    let fac = 0.5 / a;
+    let (z2_1, z2_2) = (fac * (b + c), fac * (c - b));
+    let valid = |z2: f32| z2 > 1e-5 && z2 <= 1.0 + 1e-5;
+    let normal = |z2: f32| Vec2::new((1.0 - z2).max(0.0).sqrt(), z2.max(0.0).sqrt());
+    // The reflection's height above the surface for the local normal `m`.
+    let height = |m: Vec2| 2.0 * (m.x * ix + m.y * iz) * m.y - iz;
+    let m = match (valid(z2_1), valid(z2_2)) {
+        (true, true) => {
+            let (m1, m2) = (normal(z2_1), normal(z2_2));
+            let (r1, r2) = (height(m1), height(m2));
+            if r1 >= 1e-5 && r2 >= 1e-5 {
+                if r1 < r2 {
+                    m1
+                } else {
+                    m2
+                }
+            } else if r1 > r2 {
+                m1
+            } else {
+                m2
+            }
+        }
+        (true, false) => normal(z2_1),
+        (false, true) => normal(z2_2),
+        (false, false) => return ng,
+    };
+    (x * m.x + ng * m.y).normalize()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::texture::ColorSpace;
+
+    fn constant(c: Vec4) -> Texture {
+        Texture::from_rgba(1, 1, vec![c], ColorSpace::Linear).unwrap()
+    }
+
+    #[test]
+    fn flat_texel_leaves_the_normal_and_scale_scales_xy() {
+        let map = NormalMap {
+            texture: 0,
+            scale: 1.0,
+        };
+        assert_eq!(
+            map.tangent_space_normal(Vec4::new(0.5, 0.5, 1.0, 1.0)),
+            Vec3::Z
+        );
+        let n = Vec3::new(0.0, 0.6, 0.8);
+        let flat = [constant(Vec4::new(0.5, 0.5, 1.0, 1.0))];
+        let t = Vec4::new(1.0, 0.0, 0.0, 1.0);
+        assert!((map.perturb(n, t, Vec2::ZERO, &flat) - n).length() < 1e-7);
+        // scale multiplies x and y before normalisation: (2c - 1) = (0.5, -0.25, 1).
+        let c = Vec4::new(0.75, 0.375, 1.0, 1.0);
+        for scale in [0.0f32, 0.5, 1.0, 2.0] {
+            let m = NormalMap { texture: 0, scale };
+            let got = m.tangent_space_normal(c);
+            let want = Vec3::new(0.5 * scale, -0.25 * scale, 1.0).normalize();
+            assert!(
+                (got - want).length() < 1e-6,
+                "scale {scale}: {got} vs {want}"
+            );
+        }
+        // A texel of exactly (0.5, 0.5, 0.5) has no direction: the normal stays.
+        assert_eq!(
+            map.tangent_space_normal(Vec4::new(0.5, 0.5, 0.5, 1.0)),
+            Vec3::Z
+        );
+    }
+
+    /// A texel encoding a normal tilted by `theta` toward +X (or +Y) tilts the shading normal by
+    /// `theta` toward the tangent (or the bitangent, which the handedness flips).
+    #[test]
+    fn tilted_texel_tilts_the_shading_normal_by_its_angle() {
+        let map = NormalMap {
+            texture: 0,
+            scale: 1.0,
+        };
+        let n = Vec3::Y;
+        // Tangent along +X but not orthogonal to n: Gram-Schmidt keeps only its +X part.
+        let tangent = Vec4::new(2.0, 0.7, 0.0, 1.0);
+        for theta in [0.1f32, 0.5, 1.0] {
+            let enc = |v: Vec3| (v + Vec3::ONE) * 0.5;
+            let tex = [constant(
+                enc(Vec3::new(theta.sin(), 0.0, theta.cos())).extend(1.0),
+            )];
+            let got = map.perturb(n, tangent, Vec2::ZERO, &tex);
+            assert!((got.dot(n).acos() - theta).abs() < 1e-5, "{theta}: {got}");
+            assert!(got.x > 0.0 && got.z.abs() < 1e-6);
+            // Along the bitangent B = w cross(N, T): cross(Y, X) = -Z.
+            let tex = [constant(
+                enc(Vec3::new(0.0, theta.sin(), theta.cos())).extend(1.0),
+            )];
+            for w in [1.0f32, -1.0] {
+                let got = map.perturb(n, tangent.truncate().extend(w), Vec2::ZERO, &tex);
+                assert!((got.dot(n).acos() - theta).abs() < 1e-5);
+                assert!((got.z + w * theta.sin()).abs() < 1e-5, "w {w}: {got}");
+            }
+        }
+        // No tangent, no perturbation.
+        let tex = [constant(Vec4::new(1.0, 0.5, 0.5, 1.0))];
+        assert_eq!(map.perturb(n, Vec4::ZERO, Vec2::ZERO, &tex), n);
+    }
+
+    #[test]
+    fn valid_reflection_normal_lifts_the_reflection_above_the_surface() {
+        let ng = Vec3::Z;
+        let mut lifted = 0;
+        for i in 0..40 {
+            for j in 0..40 {
+                // Viewer from nearly straight down to grazing; normals tilted up to 80 degrees.
+                let a = 0.02 + 1.5 * i as f32 / 40.0;
+                let wo = Vec3::new(a.sin(), 0.0, a.cos());
+                let (b, phi) = (1.4 * j as f32 / 40.0, 0.37 * j as f32);
+                let n = Vec3::new(b.sin() * phi.cos(), b.sin() * phi.sin(), b.cos());
+                let m = valid_reflection_normal(ng, wo, n);
+                assert!((m.length() - 1.0).abs() < 1e-5);
+                let r = 2.0 * m.dot(wo) * m - wo;
+                let threshold = (0.9 * wo.z).min(0.01);
+                assert!(r.z >= threshold - 1e-4, "wo {wo} n {n}: m {m}, r {r}");
+                assert!(m.dot(wo) > 0.0, "wo below the shading hemisphere");
+                let reflects = (2.0 * n.dot(wo) * n - wo).z >= threshold;
+                if reflects {
+                    assert_eq!(m, n, "a valid normal is unchanged");
+                } else {
+                    lifted += 1;
+                    // Tilted back in the plane of n and ng.
+                    assert!(m.cross(n).dot(ng).abs() < 1e-4 || n.cross(ng).length() < 1e-6);
+                }
+            }
+        }
+        assert!(lifted > 100, "{lifted}");
+        // The geometric normal itself is always valid.
+        let wo = Vec3::new(0.99, 0.0, 0.141).normalize();
+        assert_eq!(valid_reflection_normal(ng, wo, ng), ng);
+    }
+}
