@@ -239,4 +239,194 @@ mod tests {
         let wo = Vec3::new(0.99, 0.0, 0.141).normalize();
         assert_eq!(valid_reflection_normal(ng, wo, ng), ng);
     }
+    /// Render-level checks: a normal-mapped floor (material 0, a constant normal map of
+    /// `texel`, tangent +X) of albedo `kd`, with `extra` materials, lights and quads.
+    mod render {
+        use super::*;
+        use crate::camera::Camera;
+        use crate::integrator::{render, Layers, RenderSettings};
+        use crate::light::Light;
+        use crate::material::Material;
+        use crate::scene::{Scene, SceneParts};
+        use glam::{Affine3A, Quat};
+
+        fn camera(position: Vec3, pitch: f32) -> Camera {
+            Camera {
+                name: "cam".into(),
+                world_from_camera: Affine3A::from_rotation_translation(
+                    Quat::from_rotation_x(pitch),
+                    position,
+                ),
+                yfov: 0.6,
+                aspect_ratio: Some(1.5),
+            }
+        }
+
+        fn settings(spp: u32, max_depth: u32) -> RenderSettings {
+            RenderSettings {
+                width: 12,
+                height: 8,
+                spp,
+                max_depth,
+                seed: 3,
+                layers: Layers::default(),
+            }
+        }
+
+        fn quad(parts: &mut SceneParts, corners: [Vec3; 4], material: u32) {
+            let base = parts.positions.len() as u32;
+            parts.positions.extend_from_slice(&corners);
+            parts.triangles.push([base, base + 1, base + 2]);
+            parts.triangles.push([base, base + 2, base + 3]);
+            parts.triangle_materials.extend([material, material]);
+        }
+
+        /// The floor (200 m at y = 0, facing up) with or without the normal map, and
+        /// whatever `add` puts in.
+        fn scene(texel: Option<Vec4>, kd: Vec3, add: impl Fn(&mut SceneParts)) -> Scene {
+            let mut floor = Material::diffuse("floor", kd);
+            let mut parts = SceneParts::default();
+            if let Some(c) = texel {
+                floor.normal_map = Some(NormalMap {
+                    texture: 0,
+                    scale: 1.0,
+                });
+                parts.textures.push(constant(c));
+            }
+            parts.materials.push(floor);
+            let s = 100.0;
+            quad(
+                &mut parts,
+                [
+                    Vec3::new(-s, 0.0, -s),
+                    Vec3::new(-s, 0.0, s),
+                    Vec3::new(s, 0.0, s),
+                    Vec3::new(s, 0.0, -s),
+                ],
+                0,
+            );
+            add(&mut parts);
+            if texel.is_some() {
+                // A tangent not orthogonal to the normal: only its +X part counts.
+                parts.tangents = vec![Vec4::new(1.0, 0.3, 0.0, 1.0); parts.positions.len()];
+            }
+            Scene::from_parts(parts).unwrap()
+        }
+
+        /// A one-sided emitting ceiling of radiance `le`, 1 m up, 2 km wide, facing down.
+        fn ceiling(parts: &mut SceneParts, le: Vec3) {
+            let mut sky = Material::diffuse("sky", Vec3::ZERO);
+            sky.emission = le;
+            parts.materials.push(sky);
+            let s = 1000.0;
+            let m = parts.materials.len() as u32 - 1;
+            quad(
+                parts,
+                [
+                    Vec3::new(-s, 1.0, -s),
+                    Vec3::new(s, 1.0, -s),
+                    Vec3::new(s, 1.0, s),
+                    Vec3::new(-s, 1.0, s),
+                ],
+                m,
+            );
+        }
+
+        fn encode(n: Vec3) -> Vec4 {
+            ((n + Vec3::ONE) * 0.5).extend(1.0)
+        }
+
+        /// A flat map (exactly (0.5, 0.5, 1), a float texture) changes nothing, bit for bit, on
+        /// this floor: `2 * 0.5 - 1 = 0` exactly, the normal is `0 T + 0 B + 1 N` with N = +Y,
+        /// whose normalisation is exact. (An 8-bit "flat" texel, 128/255, is 0.0039 off and
+        /// tilts the normal by 0.3 degrees; a normal that is not axis-aligned may move by an
+        /// ulp in the normalisation.)
+        #[test]
+        fn flat_normal_map_leaves_the_image_unchanged() {
+            let add = |p: &mut SceneParts| {
+                p.lights.push(Light::Point {
+                    position: Vec3::new(0.5, 2.0, -3.0),
+                    intensity: Vec3::splat(10.0),
+                    range: None,
+                });
+                ceiling(p, Vec3::splat(0.2));
+            };
+            let kd = Vec3::new(0.5, 0.4, 0.3);
+            let plain = scene(None, kd, add);
+            let flat = scene(Some(Vec4::new(0.5, 0.5, 1.0, 1.0)), kd, add);
+            let cam = camera(Vec3::new(0.0, 0.8, 1.0), -0.5);
+            let a = render(&plain, &cam, &settings(8, 4), &|_| {});
+            let b = render(&flat, &cam, &settings(8, 4), &|_| {});
+            assert!(a.image.pixels.iter().all(|p| p.max_element() > 0.0));
+            assert_eq!(a.image, b.image);
+        }
+
+        /// White furnace style: a white floor under a uniform sky of radiance L reflects
+        /// `L (1 + cos theta) / 2` when its shading normal is tilted by theta (the sky's part
+        /// of the tilted cosine lobe: directions below the geometric surface are never taken,
+        /// so no energy is created and none comes from below).
+        #[test]
+        fn tilted_white_floor_under_a_uniform_sky_conserves_energy() {
+            let le = Vec3::new(1.0, 0.5, 0.25);
+            let theta = 0.6f32;
+            let texel = encode(Vec3::new(theta.sin(), 0.0, theta.cos()));
+            let s = scene(Some(texel), Vec3::ONE, |p| ceiling(p, le));
+            // Looking straight down: the mirror direction of wo is valid, the normal stays.
+            let down = camera(Vec3::new(0.0, 0.5, 0.0), -std::f32::consts::FRAC_PI_2);
+            let out = render(&s, &down, &settings(256, 2), &|_| {});
+            let want = le * (1.0 + theta.cos()) / 2.0;
+            let n = out.image.pixels.len() as f32;
+            let mean = out.image.pixels.iter().fold(Vec3::ZERO, |a, p| a + *p / n);
+            let err = ((mean - want) / want).abs().max_element();
+            assert!(err < 0.01, "{mean} vs {want}");
+            // From any angle the floor never reflects more than the sky gives.
+            for pitch in [-1.2f32, -0.6, -0.2] {
+                let cam = camera(Vec3::new(0.0, 0.5, 0.0), pitch);
+                let out = render(&s, &cam, &settings(64, 2), &|_| {});
+                let mean = out.image.pixels.iter().fold(Vec3::ZERO, |a, p| a + *p / n);
+                assert!(
+                    mean.cmple(le * 1.01).all() && mean.cmpgt(le * 0.3).all(),
+                    "pitch {pitch}: {mean} vs {le}"
+                );
+            }
+        }
+
+        /// A light below the floor never reaches its top, however the normal map tilts the
+        /// shading normal toward it; and a normal tilted away from a grazing viewer does not
+        /// leave the lit floor black.
+        #[test]
+        fn no_light_leaks_through_and_grazing_views_stay_lit() {
+            // Tilted by 1.2 rad toward +X, where the light sits just below the floor.
+            let texel = encode(Vec3::new(1.2f32.sin(), 0.0, 1.2f32.cos()));
+            let below = |p: &mut SceneParts| {
+                p.lights.push(Light::Point {
+                    position: Vec3::new(3.0, -0.05, -2.0),
+                    intensity: Vec3::splat(100.0),
+                    range: None,
+                });
+            };
+            let s = scene(Some(texel), Vec3::ONE, below);
+            let cam = camera(Vec3::new(0.0, 1.0, 0.0), -0.6);
+            let out = render(&s, &cam, &settings(8, 4), &|_| {});
+            assert!(out.image.pixels.iter().all(|p| *p == Vec3::ZERO));
+            // The camera looks along -Z at a grazing angle and the normals lean away from it
+            // (toward -Z): most of wo is below the tilted hemisphere, yet every pixel is lit.
+            // (Tangent-space +Y is the bitangent cross(N, T) = cross(+Y, +X) = -Z.)
+            let texel = encode(Vec3::new(0.0, 1.0f32.sin(), 1.0f32.cos()));
+            let s = scene(Some(texel), Vec3::splat(0.5), |p| ceiling(p, Vec3::ONE));
+            let cam = camera(Vec3::new(0.0, 0.2, 0.0), -0.35);
+            let mut set = settings(16, 2);
+            set.layers.normal = true;
+            let out = render(&s, &cam, &set, &|_| {});
+            assert!(
+                out.image.pixels.iter().all(|p| p.min_element() > 0.05),
+                "a black pixel"
+            );
+            // Where the viewer was below the tilted hemisphere (the upper rows), the shading
+            // normal was bent back toward the geometric normal; nowhere is it tilted further.
+            let normals = out.normal.unwrap();
+            assert!(normals.pixels.iter().all(|n| n.y > 1.0f32.cos() - 1e-3));
+            assert!(normals.pixels[..12].iter().all(|n| n.y > 1.0f32.cos() + 0.1));
+        }
+    }
 }

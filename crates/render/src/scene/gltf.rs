@@ -1591,4 +1591,133 @@ mod tests {
             "{err}"
         );
     }
+    /// A 1x1 PNG of `rgb` as a data URI (a tiny embedded texture).
+    fn png_uri(rgb: [u8; 3]) -> String {
+        let mut png = Vec::new();
+        image::RgbaImage::from_raw(1, 1, vec![rgb[0], rgb[1], rgb[2], 255])
+            .unwrap()
+            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+            .unwrap();
+        format!("data:image/png;base64,{}", base64::encode(png))
+    }
+
+    /// The test document with a normal texture on the quad's material ("asphalt") that tilts
+    /// the normal by `theta` toward +X of tangent space; the quad's tangent space is: tangent
+    /// +X (u), bitangent -Z (up the image: glTF's v grows along +Z), normal +Y.
+    fn normal_mapped_doc(theta: f32, scale: f32) -> (Value, Vec<u8>) {
+        let (mut doc, bin) = test_doc();
+        let texel = |x: f32| (255.0 * (x + 1.0) / 2.0).round() as u8;
+        doc["images"] = json!([{"uri": png_uri([texel(theta.sin()), 128, texel(theta.cos())])}]);
+        doc["textures"] = json!([{"source": 0}]);
+        doc["materials"][0]["normalTexture"] = json!({"index": 0, "scale": scale});
+        (doc, bin)
+    }
+
+    fn load(doc: Value, bin: &[u8]) -> Scene {
+        let dir = tempfile::tempdir().unwrap();
+        Scene::load(&write_embedded(dir.path(), doc, bin)).unwrap()
+    }
+
+    /// The shading normal of a ray straight down onto the quad.
+    fn quad_normal(scene: &Scene) -> Vec3 {
+        let ray = crate::geometry::Ray::new(Vec3::new(21.0, 5.0, 0.5), -Vec3::Y);
+        scene.intersect(&ray).unwrap().ns
+    }
+
+    #[test]
+    fn normal_texture_without_tangent_gets_mikktspace_tangents() {
+        // No normal map: no tangents stored at all.
+        assert!(load(test_doc().0, &test_doc().1).tangents.is_empty());
+        let theta = 0.4f32;
+        let (doc, bin) = normal_mapped_doc(theta, 1.0);
+        let scene = load(doc, &bin);
+        assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+        let m = scene.materials[0].normal_map.unwrap();
+        assert_eq!((m.texture, m.scale), (0, 1.0));
+        // One tangent per vertex; the quad's are +X with w = +1, the unmapped triangle's zero.
+        assert_eq!(scene.tangents.len(), scene.positions.len());
+        for t in &scene.tangents[..4] {
+            assert!((*t - Vec4::new(1.0, 0.0, 0.0, 1.0)).length() < 1e-5, "{t}");
+        }
+        assert!(scene.tangents[4..].iter().all(|t| *t == Vec4::ZERO));
+        // The texel (8-bit) tilts the normal by theta toward the tangent.
+        let ns = quad_normal(&scene);
+        assert!((ns.dot(Vec3::Y).acos() - theta).abs() < 0.01, "{ns}");
+        assert!(ns.x > 0.0 && ns.z.abs() < 0.01, "{ns}");
+        // scale 0 flattens the map: (2c - 1) * (0, 0, 1).
+        let (doc, bin) = normal_mapped_doc(theta, 0.0);
+        assert!((quad_normal(&load(doc, &bin)) - Vec3::Y).length() < 1e-6);
+    }
+
+    /// Gives the quad a TANGENT attribute of `t` at every vertex.
+    fn add_tangent(doc: &mut Value, bin: &mut Vec<u8>, t: [f32; 4]) {
+        let offset = bin.len();
+        bin.extend(t.repeat(4).iter().flat_map(|f| f.to_le_bytes()));
+        let views = doc["bufferViews"].as_array_mut().unwrap();
+        views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": 64}));
+        let view = views.len() - 1;
+        let accessors = doc["accessors"].as_array_mut().unwrap();
+        accessors.push(json!({"bufferView": view, "componentType": 5126, "count": 4,
+            "type": "VEC4"}));
+        doc["meshes"][0]["primitives"][0]["attributes"]["TANGENT"] = json!(accessors.len() - 1);
+        doc["buffers"][0]["byteLength"] = json!(bin.len());
+    }
+
+    #[test]
+    fn tangent_attribute_is_read_and_mirrored_nodes_flip_its_handedness() {
+        let (mut doc, mut bin) = normal_mapped_doc(0.0, 1.0);
+        // TANGENT along -X with w = -1: the same bitangent (-Z) as the generated one.
+        add_tangent(&mut doc, &mut bin, [-1.0, 0.0, 0.0, -1.0]);
+        // A texel tilting toward +Y of tangent space, i.e. the bitangent.
+        let theta = 0.5f32;
+        let texel = |x: f32| (255.0 * (x + 1.0) / 2.0).round() as u8;
+        doc["images"][0]["uri"] = json!(png_uri([128, texel(theta.sin()), texel(theta.cos())]));
+        let scene = load(doc.clone(), &bin);
+        for t in &scene.tangents[..4] {
+            assert!((*t - Vec4::new(-1.0, 0.0, 0.0, -1.0)).length() < 1e-5, "{t}");
+        }
+        let ns = quad_normal(&scene);
+        assert!((ns.dot(Vec3::Y).acos() - theta).abs() < 0.01, "{ns}");
+        assert!(ns.z < 0.0 && ns.x.abs() < 0.01, "tilted up the image (-Z): {ns}");
+        // Mirrored in x: the tangent is mirrored, w flips, and the bitangent -Z stays, so the
+        // shading normal tilts the same way.
+        doc["nodes"][0]["scale"] = json!([-2, 2, 2]);
+        let scene = load(doc, &bin);
+        for t in &scene.tangents[..4] {
+            assert!((*t - Vec4::new(1.0, 0.0, 0.0, 1.0)).length() < 1e-5, "{t}");
+        }
+        let ray = crate::geometry::Ray::new(Vec3::new(-21.0, 5.0, 0.5), -Vec3::Y);
+        let ns = scene.intersect(&ray).unwrap().ns;
+        assert!((ns.dot(Vec3::Y).acos() - theta).abs() < 0.01 && ns.z < 0.0, "{ns}");
+    }
+
+    #[test]
+    fn flat_or_uv_less_primitives_with_a_normal_texture_are_handled_and_warned() {
+        // The quad without NORMAL but with TANGENT: the tangents are ignored (and generated
+        // from the flat normal), with a warning.
+        let (mut doc, mut bin) = normal_mapped_doc(0.3, 1.0);
+        add_tangent(&mut doc, &mut bin, [0.0, 0.0, 1.0, 1.0]);
+        let attributes = &mut doc["meshes"][0]["primitives"][0]["attributes"];
+        attributes.as_object_mut().unwrap().remove("NORMAL");
+        let scene = load(doc.clone(), &bin);
+        assert!(
+            scene.warnings.iter().any(|w| w.contains("TANGENT but no NORMAL")),
+            "{:?}",
+            scene.warnings
+        );
+        let t = scene.tangents[0];
+        assert!((t - Vec4::new(1.0, 0.0, 0.0, 1.0)).length() < 1e-5, "{t}");
+        assert!((quad_normal(&scene).dot(Vec3::Y).acos() - 0.3).abs() < 0.01);
+        // Without TEXCOORD_0 there is nothing to map: a warning, and the plain normal.
+        let attributes = &mut doc["meshes"][0]["primitives"][0]["attributes"];
+        attributes.as_object_mut().unwrap().remove("TEXCOORD_0");
+        attributes.as_object_mut().unwrap().remove("TANGENT");
+        let scene = load(doc, &bin);
+        assert!(
+            scene.warnings.iter().any(|w| w.contains("no TEXCOORD_0")),
+            "{:?}",
+            scene.warnings
+        );
+        assert!((quad_normal(&scene) - Vec3::Y).length() < 1e-6);
+    }
 }
