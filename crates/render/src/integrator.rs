@@ -18,9 +18,10 @@
 //! `q = min(max component of the throughput, 0.95)` and its throughput is divided by `q`,
 //! which keeps the estimate unbiased while ending paths whose contribution has become small.
 //!
-//! Shading uses the interpolated shading normal's frame; a direction must also lie on the
-//! outgoing side of the *geometric* normal (for both light samples and BSDF samples), so that
-//! interpolated normals never let light leak through a surface. Surfaces reflect on both
+//! Shading uses the interpolated shading normal's frame (through the material's normal map, if
+//! any: [`crate::normal_map`]); a direction must also lie on the outgoing side of the
+//! *geometric* normal (for both light samples and BSDF samples), so that interpolated or
+//! perturbed normals never let light leak through a surface. Surfaces reflect on both
 //! faces (the frame is flipped toward the viewer); emission is one-sided unless the material
 //! is double-sided.
 //!

@@ -22,6 +22,7 @@
 //! | kd / base colour / emission texture | `bitmap` (an EXR of texture x factor, so the factor is baked in) | yes (bilinear, repeat) |
 //! | wet/dry map ([`Wetness`](crate::material::Wetness)) | `alpha` and `specular_reflectance` as `bitmap`s baked per texel of the dryness map (`mix(wet, dry, w)`) | yes for `ggx` and `ward`'s alpha (linear in `w`, so bilinear filtering commutes); blinn_phong's alpha is not linear in the shininess (approximation already) |
 //! | double-sided material | BSDF wrapped in `twosided` | yes |
+//! | normal map ([`NormalMap`](crate::normal_map::NormalMap)) | not exported | no (warning) |
 //! | camera | `perspective`, `fov_axis` y, `fov` in degrees, `to_world` as a `lookat` | yes |
 //! | film, filter | `hdrfilm` (rgb, float32) with a `box` filter | yes |
 //! | integrator | `path` with the same `max_depth` | yes (Russian roulette differs: unbiased either way) |
@@ -467,6 +468,13 @@ impl<'a> MaterialWriter<'a> {
                      <float name=\"roughness\" value=\"{roughness:?}\"/></bsdf>"
                 );
             }
+        }
+        if m.normal_map.is_some() {
+            self.warnings.push(format!(
+                "material {:?}: its normal map is not exported; Mitsuba shades it with the \
+                 interpolated normals",
+                m.name
+            ));
         }
         if m.double_sided {
             out = format!("<bsdf type=\"twosided\">{out}</bsdf>");

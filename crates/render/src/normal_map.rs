@@ -426,7 +426,9 @@ mod tests {
             // normal was bent back toward the geometric normal; nowhere is it tilted further.
             let normals = out.normal.unwrap();
             assert!(normals.pixels.iter().all(|n| n.y > 1.0f32.cos() - 1e-3));
-            assert!(normals.pixels[..12].iter().all(|n| n.y > 1.0f32.cos() + 0.1));
+            assert!(normals.pixels[..12]
+                .iter()
+                .all(|n| n.y > 1.0f32.cos() + 0.1));
         }
     }
 }

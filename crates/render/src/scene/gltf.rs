@@ -1657,8 +1657,10 @@ mod tests {
         views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": 64}));
         let view = views.len() - 1;
         let accessors = doc["accessors"].as_array_mut().unwrap();
-        accessors.push(json!({"bufferView": view, "componentType": 5126, "count": 4,
-            "type": "VEC4"}));
+        accessors.push(
+            json!({"bufferView": view, "componentType": 5126, "count": 4,
+            "type": "VEC4"}),
+        );
         doc["meshes"][0]["primitives"][0]["attributes"]["TANGENT"] = json!(accessors.len() - 1);
         doc["buffers"][0]["byteLength"] = json!(bin.len());
     }
@@ -1674,11 +1676,17 @@ mod tests {
         doc["images"][0]["uri"] = json!(png_uri([128, texel(theta.sin()), texel(theta.cos())]));
         let scene = load(doc.clone(), &bin);
         for t in &scene.tangents[..4] {
-            assert!((*t - Vec4::new(-1.0, 0.0, 0.0, -1.0)).length() < 1e-5, "{t}");
+            assert!(
+                (*t - Vec4::new(-1.0, 0.0, 0.0, -1.0)).length() < 1e-5,
+                "{t}"
+            );
         }
         let ns = quad_normal(&scene);
         assert!((ns.dot(Vec3::Y).acos() - theta).abs() < 0.01, "{ns}");
-        assert!(ns.z < 0.0 && ns.x.abs() < 0.01, "tilted up the image (-Z): {ns}");
+        assert!(
+            ns.z < 0.0 && ns.x.abs() < 0.01,
+            "tilted up the image (-Z): {ns}"
+        );
         // Mirrored in x: the tangent is mirrored, w flips, and the bitangent -Z stays, so the
         // shading normal tilts the same way.
         doc["nodes"][0]["scale"] = json!([-2, 2, 2]);
@@ -1688,7 +1696,10 @@ mod tests {
         }
         let ray = crate::geometry::Ray::new(Vec3::new(-21.0, 5.0, 0.5), -Vec3::Y);
         let ns = scene.intersect(&ray).unwrap().ns;
-        assert!((ns.dot(Vec3::Y).acos() - theta).abs() < 0.01 && ns.z < 0.0, "{ns}");
+        assert!(
+            (ns.dot(Vec3::Y).acos() - theta).abs() < 0.01 && ns.z < 0.0,
+            "{ns}"
+        );
     }
 
     #[test]
@@ -1701,7 +1712,10 @@ mod tests {
         attributes.as_object_mut().unwrap().remove("NORMAL");
         let scene = load(doc.clone(), &bin);
         assert!(
-            scene.warnings.iter().any(|w| w.contains("TANGENT but no NORMAL")),
+            scene
+                .warnings
+                .iter()
+                .any(|w| w.contains("TANGENT but no NORMAL")),
             "{:?}",
             scene.warnings
         );

@@ -29,6 +29,18 @@
 //!   models: `{"bsdf": "ggx" | "ward" | "blinn_phong", "kd": [r,g,b], "ks": [r,g,b],
 //!   "alpha": a, "shininess": s}` (`alpha` for ggx and ward, `shininess` for blinn_phong;
 //!   `kd` and `ks` default to black). The baseColorTexture, if any, multiplies `kd`.
+//! - Normal maps ([`crate::normal_map`]): a material's `normalTexture` (linear RGB, `scale`
+//!   multiplying X and Y) perturbs the shading normal in tangent space. Tangents are stored
+//!   per vertex ([`Scene::tangents`], empty when no material has a normal map; zero for the
+//!   vertices of primitives without one): a primitive's TANGENT (xyz by the model matrix, not
+//!   the inverse transpose; w, the handedness, flipped by a mirroring transform), or, where it
+//!   has none or has no NORMAL (then TANGENT is ignored, as the specification says),
+//!   MikkTSpace tangents generated from the world-space positions, the normals (the face
+//!   normals for flat primitives) and the uvs (vertices whose triangles disagree, as on a uv
+//!   mirror seam, are duplicated). A normal-mapped primitive without TEXCOORD_0 is rendered
+//!   without the map (a warning). A perturbed normal is tilted back toward the geometric
+//!   normal where the viewer's mirror direction would go below the surface
+//!   ([`crate::normal_map::valid_reflection_normal`]).
 //! - Emission `emissiveFactor * KHR_materials_emissive_strength` (times the emissive texture)
 //!   is radiance; the triangles of an emissive material are area lights, grouped into the
 //!   scene's emitters ([`crate::light::Emitters`]) when it is built. Emission is one-sided (the
@@ -46,7 +58,7 @@
 //! - OBJ/MTL (via tobj, triangulated): `Kd` with a non-zero `Ks` (and `illum` not 0 or 1) is
 //!   blinn_phong with shininess `Ns`; otherwise Lambertian `Kd` (times `map_Kd`); `Ke` is
 //!   emission. A missing MTL file is a warning (every material becomes grey diffuse). OBJ has no
-//!   cameras or punctual lights.
+//!   cameras or punctual lights, and no normal maps (`map_Bump` is a warning).
 //!
 //! # Ray queries
 //!

@@ -5,7 +5,8 @@
 //! `map_Kd` (sRGB) multiplying it. `Ke` is emitted radiance. A missing or unreadable MTL file is
 //! a warning: every material becomes the default grey diffuse (albedo 0.5), as do faces without
 //! a material. OBJ texture coordinates have v pointing up; they are stored as `(u, 1 - v)` to
-//! match the glTF convention of [`crate::texture::Texture`].
+//! match the glTF convention of [`crate::texture::Texture`]. Bump and normal maps (`map_Bump`,
+//! `bump`) are not read: a warning names the material.
 
 use super::{Scene, SceneError, SceneParts};
 use crate::material::{Material, PaperModel, Reflectance};
@@ -50,6 +51,14 @@ pub(super) fn load(path: &Path) -> Result<Scene, SceneError> {
         }
     };
     for m in &mtl {
+        if let Some(map) = &m.normal_texture {
+            parts.warnings.push(format!(
+                "{}: material {:?}: bump/normal map {map:?} (map_Bump, bump) is not supported; \
+                 rendered with the mesh's normals",
+                path.display(),
+                m.name
+            ));
+        }
         let material = convert_material(path, base, m, &mut parts.textures)?;
         parts.materials.push(material);
     }
