@@ -395,7 +395,7 @@ fn trace_path(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::light::Light;
     use crate::material::Material;
@@ -403,7 +403,7 @@ mod tests {
     use glam::{Affine3A, Quat};
     use std::f32::consts::PI;
 
-    fn camera(position: Vec3, pitch: f32, yfov: f32) -> Camera {
+    pub(crate) fn camera(position: Vec3, pitch: f32, yfov: f32) -> Camera {
         Camera {
             name: "cam".into(),
             world_from_camera: Affine3A::from_rotation_translation(
@@ -416,7 +416,7 @@ mod tests {
     }
 
     /// A quad (two triangles) with the given corners, counter-clockwise seen from its front.
-    fn quad(parts: &mut SceneParts, corners: [Vec3; 4], material: u32) {
+    pub(crate) fn quad(parts: &mut SceneParts, corners: [Vec3; 4], material: u32) {
         let base = parts.positions.len() as u32;
         parts.positions.extend_from_slice(&corners);
         parts.triangles.push([base, base + 1, base + 2]);
@@ -425,7 +425,7 @@ mod tests {
     }
 
     /// A 200 m floor at Y = 0 facing up, made of material 0.
-    fn floor(parts: &mut SceneParts) {
+    pub(crate) fn floor(parts: &mut SceneParts) {
         let s = 100.0;
         quad(
             parts,

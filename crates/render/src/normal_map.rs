@@ -244,23 +244,16 @@ mod tests {
     mod render {
         use super::*;
         use crate::camera::Camera;
-        use crate::integrator::{render, Layers, RenderSettings};
+        use crate::integrator::{self, render, Layers, RenderSettings};
+        use integrator::tests::quad;
+
+        fn camera(position: Vec3, pitch: f32) -> Camera {
+            integrator::tests::camera(position, pitch, 0.6)
+        }
+
         use crate::light::Light;
         use crate::material::Material;
         use crate::scene::{Scene, SceneParts};
-        use glam::{Affine3A, Quat};
-
-        fn camera(position: Vec3, pitch: f32) -> Camera {
-            Camera {
-                name: "cam".into(),
-                world_from_camera: Affine3A::from_rotation_translation(
-                    Quat::from_rotation_x(pitch),
-                    position,
-                ),
-                yfov: 0.6,
-                aspect_ratio: Some(1.5),
-            }
-        }
 
         fn settings(spp: u32, max_depth: u32) -> RenderSettings {
             RenderSettings {
@@ -271,14 +264,6 @@ mod tests {
                 seed: 3,
                 layers: Layers::default(),
             }
-        }
-
-        fn quad(parts: &mut SceneParts, corners: [Vec3; 4], material: u32) {
-            let base = parts.positions.len() as u32;
-            parts.positions.extend_from_slice(&corners);
-            parts.triangles.push([base, base + 1, base + 2]);
-            parts.triangles.push([base, base + 2, base + 3]);
-            parts.triangle_materials.extend([material, material]);
         }
 
         /// The floor (200 m at y = 0, facing up) with or without the normal map, and
@@ -294,17 +279,7 @@ mod tests {
                 parts.textures.push(constant(c));
             }
             parts.materials.push(floor);
-            let s = 100.0;
-            quad(
-                &mut parts,
-                [
-                    Vec3::new(-s, 0.0, -s),
-                    Vec3::new(-s, 0.0, s),
-                    Vec3::new(s, 0.0, s),
-                    Vec3::new(s, 0.0, -s),
-                ],
-                0,
-            );
+            integrator::tests::floor(&mut parts);
             add(&mut parts);
             if texel.is_some() {
                 // A tangent not orthogonal to the normal: only its +X part counts.
