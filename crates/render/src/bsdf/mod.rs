@@ -8,7 +8,11 @@
 //! (pbrt's convention; Mitsuba's `eval` includes the cosine and swaps the names).
 //!
 //! No paper model has a Fresnel term: `ks` is the specular reflectance. Only [`GltfPbr`] has one
-//! (Schlick's, as the glTF specification says).
+//! (Schlick's, as the glTF specification says), and only it has a third part, the
+//! KHR_materials_clearcoat coat, which counts as glossy (in [`LobeValues::glossy`] and
+//! [`Lobe::Glossy`]): its glossy lobe is the base's microfacet lobe and the coat's, sampled as
+//! a mixture (see [`GltfPbr`]). A coated [`GltfPbr`] is not reciprocal: the extension takes
+//! the coat's Fresnel at `n.wo`.
 //!
 //! Sampling: every model with both lobes picks the glossy lobe with a probability that depends
 //! only on `wo`: proportional to an estimate of the two lobes' directional albedos for this `wo`
@@ -34,8 +38,9 @@
 //! - `lanes.rs`: the number types every lobe is written in, a scalar or four SIMD lanes
 //!   (`Lanes`) and a reflectance as RGB or as its luminance (`Spectrum`);
 //! - `diffuse.rs`: the Lambertian lobe and [`Diffuse`];
-//! - `ggx.rs`: the GGX microfacet lobe (masking, visible-normal density and sampling), shared
-//!   by [`Ggx`] and [`GltfPbr`], and the paper's [`Ggx`];
+//! - `ggx.rs`: the GGX microfacet lobe (masking, the separable and the height-correlated
+//!   visibility, visible-normal density and sampling), shared by [`Ggx`] and [`GltfPbr`], and
+//!   the paper's [`Ggx`];
 //! - `ward.rs`: [`Ward`]; `blinn_phong.rs`: [`BlinnPhong`]; `gltf.rs`: [`GltfPbr`];
 //! - `luminance.rs`: [`LuminanceEval`], the light choice's `luminance(f(wo, wi))`: the
 //!   luminances of a model's reflectances and its `Model::AtWo`, taken once per `wo`, and
@@ -133,7 +138,8 @@ pub const MIN_ALPHA: f32 = 1e-4;
 // What a model provides
 
 /// A model's two reflectances, the colours its lobes scale: the diffuse lobe's and the glossy
-/// lobe's (`kd` and `ks` for the paper models; `(1 - F0) c_diff` and `F0` for glTF), as RGB
+/// lobe's (`kd` and `ks` for the paper models; `c_diff` and the glossy colour at normal
+/// incidence for glTF), as RGB
 /// or as luminances. [`LuminanceEval`] takes their luminances once per `wo`.
 #[derive(Clone, Copy, Debug)]
 struct Reflectances<S> {
