@@ -66,6 +66,7 @@ fn models() -> Vec<(&'static str, Bsdf)> {
                 base_color: Vec3::new(0.3, 0.3, 0.35),
                 metallic: 0.0,
                 roughness: 0.3,
+                ..GltfPbr::default()
             }),
         ),
     ]

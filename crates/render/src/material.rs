@@ -7,7 +7,11 @@
 //!   interpolates `alpha` (or, for blinn_phong, the shininess) and `ks` linearly between the
 //!   wet and the dry values.
 //! - [`Reflectance::GltfPbr`]: RGB multiplies the base colour; the metallic-roughness texture's
-//!   blue channel multiplies `metallic` and its green channel `roughness` (glTF 2.0).
+//!   blue channel multiplies `metallic` and its green channel `roughness` (glTF 2.0); the
+//!   specular texture's alpha multiplies `specular` and the specular colour texture's RGB
+//!   `specular_color` (KHR_materials_specular); the clearcoat texture's red channel multiplies
+//!   `clearcoat` and the clearcoat roughness texture's green channel `clearcoat_roughness`
+//!   (KHR_materials_clearcoat).
 //!
 //! A normal map ([`Material::normal_map`]) changes the shading normal, not the BSDF: the scene
 //! applies it at the hit ([`crate::normal_map`]).
@@ -67,6 +71,24 @@ pub enum Reflectance {
         roughness: f32,
         /// metallicRoughnessTexture (B = metal, G = roughness).
         metallic_roughness_texture: Option<TextureId>,
+        /// KHR_materials_specular specularFactor (1 without the extension).
+        specular: f32,
+        /// KHR_materials_specular specularTexture (A = specular).
+        specular_texture: Option<TextureId>,
+        /// KHR_materials_specular specularColorFactor, linear RGB (1 without the extension).
+        specular_color: Vec3,
+        /// KHR_materials_specular specularColorTexture (RGB, sRGB-encoded).
+        specular_color_texture: Option<TextureId>,
+        /// KHR_materials_ior ior (1.5 without the extension; 0 or at least 1).
+        ior: f32,
+        /// KHR_materials_clearcoat clearcoatFactor (0: no coat).
+        clearcoat: f32,
+        /// KHR_materials_clearcoat clearcoatTexture (R = clearcoat).
+        clearcoat_texture: Option<TextureId>,
+        /// KHR_materials_clearcoat clearcoatRoughnessFactor.
+        clearcoat_roughness: f32,
+        /// KHR_materials_clearcoat clearcoatRoughnessTexture (G = clearcoat roughness).
+        clearcoat_roughness_texture: Option<TextureId>,
     },
 }
 
@@ -128,17 +150,35 @@ impl Material {
     /// Every texture the material refers to.
     pub fn texture_ids(&self) -> impl Iterator<Item = TextureId> + '_ {
         let r = match &self.reflectance {
-            Reflectance::Diffuse { kd_texture, .. } => [*kd_texture, None],
+            Reflectance::Diffuse { kd_texture, .. } => [*kd_texture, None, None, None, None, None],
             Reflectance::Paper {
                 kd_texture,
                 wetness,
                 ..
-            } => [*kd_texture, wetness.as_ref().map(|w| w.texture)],
+            } => [
+                *kd_texture,
+                wetness.as_ref().map(|w| w.texture),
+                None,
+                None,
+                None,
+                None,
+            ],
             Reflectance::GltfPbr {
                 base_color_texture,
                 metallic_roughness_texture,
+                specular_texture,
+                specular_color_texture,
+                clearcoat_texture,
+                clearcoat_roughness_texture,
                 ..
-            } => [*base_color_texture, *metallic_roughness_texture],
+            } => [
+                *base_color_texture,
+                *metallic_roughness_texture,
+                *specular_texture,
+                *specular_color_texture,
+                *clearcoat_texture,
+                *clearcoat_roughness_texture,
+            ],
         };
         r.into_iter()
             .chain([self.emission_texture, self.normal_map.map(|n| n.texture)])
@@ -186,13 +226,30 @@ impl Material {
                 metallic,
                 roughness,
                 metallic_roughness_texture,
+                specular,
+                specular_texture,
+                specular_color,
+                specular_color_texture,
+                ior,
+                clearcoat,
+                clearcoat_texture,
+                clearcoat_roughness,
+                clearcoat_roughness_texture,
             } => {
                 let mr = sample_or_one(*metallic_roughness_texture, uv, textures);
+                let sample = |t: &Option<TextureId>| sample_or_one(*t, uv, textures);
                 Bsdf::GltfPbr(bsdf::GltfPbr {
-                    base_color: *base_color
-                        * sample_or_one(*base_color_texture, uv, textures).truncate(),
+                    base_color: *base_color * sample(base_color_texture).truncate(),
                     metallic: (*metallic * mr.z).clamp(0.0, 1.0),
                     roughness: (*roughness * mr.y).clamp(0.0, 1.0),
+                    specular: (*specular * sample(specular_texture).w).clamp(0.0, 1.0),
+                    specular_color: (*specular_color * sample(specular_color_texture).truncate())
+                        .max(Vec3::ZERO),
+                    ior: *ior,
+                    clearcoat: (*clearcoat * sample(clearcoat_texture).x).clamp(0.0, 1.0),
+                    clearcoat_roughness: (*clearcoat_roughness
+                        * sample(clearcoat_roughness_texture).y)
+                        .clamp(0.0, 1.0),
                 })
             }
         }
@@ -288,6 +345,15 @@ mod tests {
             metallic: 1.0,
             roughness: 0.8,
             metallic_roughness_texture: Some(0),
+            specular: 0.5,
+            specular_texture: Some(0),
+            specular_color: Vec3::new(2.0, 1.0, 0.5),
+            specular_color_texture: Some(0),
+            ior: 1.33,
+            clearcoat: 0.8,
+            clearcoat_texture: Some(0),
+            clearcoat_roughness: 0.6,
+            clearcoat_roughness_texture: Some(0),
         };
         m.emission = Vec3::new(2.0, 0.0, 1.0);
         m.emission_texture = Some(0);
@@ -295,6 +361,11 @@ mod tests {
             panic!("not pbr")
         };
         assert!((b.metallic - 0.25).abs() < 1e-6 && (b.roughness - 0.4).abs() < 1e-6);
+        // Texel (0, 0.5, 0.25, 1): specular x A, colour x RGB, clearcoat x R, its roughness x G.
+        assert_eq!(b.specular, 0.5);
+        assert_eq!(b.specular_color, Vec3::new(0.0, 0.5, 0.125));
+        assert_eq!(b.ior, 1.33);
+        assert_eq!((b.clearcoat, b.clearcoat_roughness), (0.0, 0.3));
         assert_eq!(m.emission_at(Vec2::ZERO, &[mr]), Vec3::new(0.0, 0.0, 0.25));
         assert!(m.is_emissive());
     }

@@ -32,6 +32,7 @@
 //! camera's origin, a target along its -Z and its +Y as up gives the same picture as ours
 //! (checked by rendering: see tools/mitsuba/README.md).
 
+use crate::bsdf;
 use crate::camera::Camera;
 use crate::light::Light;
 use crate::material::{Material, PaperModel, Reflectance};
@@ -447,25 +448,71 @@ impl<'a> MaterialWriter<'a> {
                 metallic,
                 roughness,
                 metallic_roughness_texture,
+                specular,
+                specular_texture,
+                specular_color,
+                specular_color_texture,
+                ior,
+                clearcoat,
+                clearcoat_texture,
+                clearcoat_roughness,
+                clearcoat_roughness_texture,
             } => {
                 self.warnings.push(format!(
                     "material {:?}: glTF metallic-roughness exported as Mitsuba's principled BSDF \
                      (different Fresnel, diffuse and multiple-scattering terms: approximation)",
                     m.name
                 ));
-                if metallic_roughness_texture.is_some() {
+                let unexported = [
+                    ("metallicRoughnessTexture", metallic_roughness_texture),
+                    ("specularTexture", specular_texture),
+                    ("specularColorTexture", specular_color_texture),
+                    ("clearcoatTexture", clearcoat_texture),
+                    ("clearcoatRoughnessTexture", clearcoat_roughness_texture),
+                ];
+                for (name, texture) in unexported {
+                    if texture.is_some() {
+                        self.warnings.push(format!(
+                            "material {:?}: {name} is not exported; its factor is used everywhere",
+                            m.name
+                        ));
+                    }
+                }
+                let base = self.colour(m, &stem, "base_color", *base_color, *base_color_texture)?;
+                let dielectric = principled_dielectric(*specular, *specular_color, *ior);
+                if !dielectric.exact {
                     self.warnings.push(format!(
-                        "material {:?}: metallicRoughnessTexture is not exported; the factors \
-                         metallic = {metallic}, roughness = {roughness} are used everywhere",
+                        "material {:?}: KHR_materials_specular's strength {specular} and colour \
+                         {specular_color} become principled specular (F0 = 0.08 specular, \
+                         grey, Fresnel 1 at grazing): approximation",
                         m.name
                     ));
                 }
-                let base = self.colour(m, &stem, "base_color", *base_color, *base_color_texture)?;
+                let coat = if *clearcoat > 0.0 {
+                    let alpha = clearcoat_roughness * clearcoat_roughness;
+                    let gloss = ((0.1 - alpha) / 0.099).clamp(0.0, 1.0);
+                    self.warnings.push(format!(
+                        "material {:?}: KHR_materials_clearcoat exported as principled clearcoat \
+                         {:?} (Disney's coat, GTR1 of alpha 0.1 to 0.001, a quarter of the \
+                         weight, over an unattenuated base) with clearcoat_gloss {gloss:?}: \
+                         approximation",
+                        m.name,
+                        4.0 * clearcoat
+                    ));
+                    format!(
+                        "<float name=\"clearcoat\" value=\"{:?}\"/>\
+                         <float name=\"clearcoat_gloss\" value=\"{gloss:?}\"/>",
+                        4.0 * clearcoat
+                    )
+                } else {
+                    String::new()
+                };
                 let _ = write!(
                     out,
                     "<bsdf type=\"principled\">{base}\
                      <float name=\"metallic\" value=\"{metallic:?}\"/>\
-                     <float name=\"roughness\" value=\"{roughness:?}\"/></bsdf>"
+                     <float name=\"roughness\" value=\"{roughness:?}\"/>{}{coat}</bsdf>",
+                    dielectric.xml
                 );
             }
         }
@@ -480,6 +527,40 @@ impl<'a> MaterialWriter<'a> {
             out = format!("<bsdf type=\"twosided\">{out}</bsdf>");
         }
         Ok(out)
+    }
+}
+
+/// How a glTF dielectric's reflectance is written for Mitsuba's principled BSDF, and whether
+/// that is exact up to the principled model's own Fresnel.
+struct PrincipledDielectric {
+    /// Nothing (the principled default, eta 1.5, glTF's default), `eta` or `specular`.
+    xml: String,
+    exact: bool,
+}
+
+/// The principled BSDF's `eta` or `specular` (F0 = 0.08 specular; the two cannot both be
+/// given) for KHR_materials_specular's strength and colour and KHR_materials_ior's index: the
+/// glTF default writes nothing, a white specular colour at full strength the `eta`, and any
+/// other combination the `specular` of the largest channel of glTF's F0 (exact only at
+/// strength 0, a pure diffuse dielectric in both).
+fn principled_dielectric(specular: f32, specular_color: Vec3, ior: f32) -> PrincipledDielectric {
+    if specular == 1.0 && specular_color == Vec3::ONE && ior >= 1.0 {
+        let xml = if ior == 1.5 {
+            String::new()
+        } else {
+            format!("<float name=\"eta\" value=\"{ior:?}\"/>")
+        };
+        return PrincipledDielectric { xml, exact: true };
+    }
+    let f0 = specular
+        * (bsdf::ior_f0(ior) * specular_color)
+            .min(Vec3::ONE)
+            .max_element();
+    // Mitsuba's eta from specular, 2 / (1 - sqrt(0.08 specular)) - 1, needs F0 below 1.
+    let principled = (f0 / 0.08).min(12.4);
+    PrincipledDielectric {
+        xml: format!("<float name=\"specular\" value=\"{principled:?}\"/>"),
+        exact: specular == 0.0,
     }
 }
 

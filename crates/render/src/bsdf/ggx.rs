@@ -1,6 +1,9 @@
-//! GGX: the microfacet lobe that [`Ggx`] and [`super::GltfPbr`] share (the separable Smith
-//! masking, the microfacet BRDF with its visible-normal density, visible-normal sampling, and
-//! the albedo estimate of the lobe choice), and the paper's `ggx` model [`Ggx`].
+//! GGX: the microfacet lobe that [`Ggx`] and [`super::GltfPbr`] share (the Smith masking, the
+//! microfacet BRDF with its visible-normal density, visible-normal sampling, and the albedo
+//! estimate of the lobe choice), and the paper's `ggx` model [`Ggx`]. The paper's model uses
+//! the separable Smith visibility `G1(wo) G1(wi)` ([`microfacet`], as Mitsuba does), the glTF
+//! model the height-correlated one ([`microfacet_correlated`], as the glTF specification's
+//! appendix B does); both sample the same visible normals.
 
 use super::lanes::{Lanes, Spectrum};
 use super::{glossy_probability, reflect, Lobes, Model, Reflectances, MIN_ALPHA};
@@ -77,8 +80,16 @@ impl Model for Ggx {
 /// which never happens for the half vector of two directions above the surface.)
 #[inline(always)]
 fn g1_denominator<L: Lanes>(v: [L; 3], a2: f32) -> L {
+    v[2] + masking_root(v, a2)
+}
+
+/// `sqrt(v.z^2 + alpha^2 (v.x^2 + v.y^2))` for a unit `v` above the surface, i.e.
+/// `sqrt(alpha^2 + (1 - alpha^2) cos^2(theta_v))`: `v.z` times `1 + 2 Lambda(v)`, with
+/// `Lambda` GGX's Smith masking exponent.
+#[inline(always)]
+fn masking_root<L: Lanes>(v: [L; 3], a2: f32) -> L {
     let [x, y, z] = v;
-    z + (z * z + (x * x + y * y) * a2).sqrt()
+    (z * z + (x * x + y * y) * a2).sqrt()
 }
 
 /// A GGX lobe's terms that depend on its alpha and `wo` alone.
@@ -88,6 +99,8 @@ pub(super) struct GgxAtWo {
     a2: f32,
     /// [`g1_denominator`] of `wo`.
     go: f32,
+    /// [`masking_root`] of `wo`.
+    ro: f32,
 }
 
 impl GgxAtWo {
@@ -95,9 +108,11 @@ impl GgxAtWo {
     #[inline]
     pub(super) fn new(alpha: f32, wo: Vec3) -> Self {
         let a2 = alpha * alpha;
+        let ro = masking_root(wo.to_array(), a2);
         GgxAtWo {
             a2,
-            go: g1_denominator(wo.to_array(), a2),
+            go: wo.z + ro,
+            ro,
         }
     }
 }
@@ -115,13 +130,42 @@ impl GgxAtWo {
 /// `1 / (4 wo.h)` cancels `wo.h`) is the lobe times `wi.z / G1(wi)`, i.e. times `gi / 2`.
 #[inline(always)]
 pub(super) fn microfacet<L: Lanes>(at: &GgxAtWo, wo: Vec3, wi: [L; 3]) -> (L, L) {
-    let GgxAtWo { a2, go } = *at;
-    let [hx, hy, hz] = [wi[0] + wo.x, wi[1] + wo.y, wi[2] + wo.z];
-    let h2 = hx * hx + hy * hy + hz * hz;
-    let q = hx * hx + hy * hy + hz * a2 * hz;
+    let GgxAtWo { a2, go, .. } = *at;
+    let (h2, q) = half_vector_terms(wo, wi, a2);
     let gi = g1_denominator(wi, a2);
     let spec = h2 * a2 * h2 / (q * PI * q * go * gi);
     (spec, spec * 0.5 * gi)
+}
+
+/// `|h|^2` and `q = h.x^2 + h.y^2 + alpha^2 h.z^2` of the unnormalised half vector
+/// `h = wo + wi` (see [`microfacet`]): `D(h) = alpha^2 |h|^4 / (pi q^2)`.
+#[inline(always)]
+fn half_vector_terms<L: Lanes>(wo: Vec3, wi: [L; 3], a2: f32) -> (L, L) {
+    let [hx, hy, hz] = [wi[0] + wo.x, wi[1] + wo.y, wi[2] + wo.z];
+    let h2 = hx * hx + hy * hy + hz * hz;
+    let q = hx * hx + hy * hy + hz * a2 * hz;
+    (h2, q)
+}
+
+/// The GGX microfacet lobe with the height-correlated Smith visibility, `D(h) V(wo, wi)`, and
+/// the same visible-normal density as [`microfacet`], for `wo` and `wi` above the surface and
+/// `at` the lobe's [`GgxAtWo`] for `wo`.
+///
+/// The glTF 2.0 specification, appendix B (and Heitz 2014, "Understanding the
+/// Masking-Shadowing Function in Microfacet-Based BRDFs", eq. 99):
+/// `V = G2 / (4 cos_o cos_i) = 0.5 / (cos_i sqrt(alpha^2 + (1 - alpha^2) cos_o^2) +
+/// cos_o sqrt(alpha^2 + (1 - alpha^2) cos_i^2))`, with `G2 = 1 / (1 + Lambda(wo) +
+/// Lambda(wi))`, written with the [`masking_root`]s `ro`, `ri`. The density of sampled
+/// visible normals, `D G1(wo) / (4 cos_o) = D / (2 go)`, depends on the masking of `wo` alone,
+/// so it is [`microfacet`]'s.
+#[inline(always)]
+pub(super) fn microfacet_correlated<L: Lanes>(at: &GgxAtWo, wo: Vec3, wi: [L; 3]) -> (L, L) {
+    let GgxAtWo { a2, go, ro } = *at;
+    let (h2, q) = half_vector_terms(wo, wi, a2);
+    let d = h2 * a2 * h2 / (q * PI * q);
+    let ri = masking_root(wi, a2);
+    let spec = d * 0.5 / (wi[2] * ro + ri * wo.z);
+    (spec, d * (0.5 / go))
 }
 
 /// Samples a GGX visible normal for `wo` (density `D(h) G1(wo, h) max(0, wo.h) / wo.z`) by

@@ -115,14 +115,17 @@ impl Lanes for Vec4 {
 }
 
 /// A reflectance while a lobe is evaluated in lanes `L`: linear RGB (`Vec3`, for `L = f32`), or
-/// its luminance (`L` itself). A lobe only adds reflectances, scales them by lane terms and
-/// takes `1 -` them, so evaluated on luminances it gives the luminance of its RGB value
-/// (luminance is linear, and `1 - luminance(c) = luminance(1 - c)` as the weights sum to 1).
+/// its luminance (`L` itself). A lobe only adds reflectances and greys, scales them by lane
+/// terms and takes `1 -` them, so evaluated on luminances it gives the luminance of its RGB
+/// value (luminance is linear, and `1 - luminance(c) = luminance(1 - c)` and
+/// `luminance(grey(x)) = x` as the weights sum to 1).
 pub(crate) trait Spectrum<L: Lanes>:
     Copy + Add<Output = Self> + Mul<L, Output = Self> + Mul<f32, Output = Self>
 {
     /// `1 - self`, per channel.
     fn one_minus(self) -> Self;
+    /// The grey reflectance `x` in every channel (whose luminance is `x`).
+    fn grey(x: L) -> Self;
 }
 
 impl Spectrum<f32> for Vec3 {
@@ -130,11 +133,19 @@ impl Spectrum<f32> for Vec3 {
     fn one_minus(self) -> Self {
         Vec3::ONE - self
     }
+    #[inline(always)]
+    fn grey(x: f32) -> Self {
+        Vec3::splat(x)
+    }
 }
 
 impl<L: Lanes> Spectrum<L> for L {
     #[inline(always)]
     fn one_minus(self) -> Self {
         L::splat(1.0) - self
+    }
+    #[inline(always)]
+    fn grey(x: L) -> Self {
+        x
     }
 }

@@ -8,7 +8,11 @@
 //! (pbrt's convention; Mitsuba's `eval` includes the cosine and swaps the names).
 //!
 //! No paper model has a Fresnel term: `ks` is the specular reflectance. Only [`GltfPbr`] has one
-//! (Schlick's, as the glTF specification says).
+//! (Schlick's, as the glTF specification says), and only it has a third part, the
+//! KHR_materials_clearcoat coat, which counts as glossy (in [`LobeValues::glossy`] and
+//! [`Lobe::Glossy`]): its glossy lobe is the base's microfacet lobe and the coat's, sampled as
+//! a mixture (see [`GltfPbr`]). A coated [`GltfPbr`] is not reciprocal: the extension takes
+//! the coat's Fresnel at `n.wo`.
 //!
 //! Sampling: every model with both lobes picks the glossy lobe with a probability that depends
 //! only on `wo`: proportional to an estimate of the two lobes' directional albedos for this `wo`
@@ -34,8 +38,9 @@
 //! - `lanes.rs`: the number types every lobe is written in, a scalar or four SIMD lanes
 //!   (`Lanes`) and a reflectance as RGB or as its luminance (`Spectrum`);
 //! - `diffuse.rs`: the Lambertian lobe and [`Diffuse`];
-//! - `ggx.rs`: the GGX microfacet lobe (masking, visible-normal density and sampling), shared
-//!   by [`Ggx`] and [`GltfPbr`], and the paper's [`Ggx`];
+//! - `ggx.rs`: the GGX microfacet lobe (masking, the separable and the height-correlated
+//!   visibility, visible-normal density and sampling), shared by [`Ggx`] and [`GltfPbr`], and
+//!   the paper's [`Ggx`];
 //! - `ward.rs`: [`Ward`]; `blinn_phong.rs`: [`BlinnPhong`]; `gltf.rs`: [`GltfPbr`];
 //! - `luminance.rs`: [`LuminanceEval`], the light choice's `luminance(f(wo, wi))`: the
 //!   luminances of a model's reflectances and its `Model::AtWo`, taken once per `wo`, and
@@ -61,7 +66,7 @@ mod ward;
 pub use blinn_phong::BlinnPhong;
 pub use diffuse::Diffuse;
 pub use ggx::Ggx;
-pub use gltf::GltfPbr;
+pub use gltf::{ior_f0, GltfPbr};
 pub use luminance::LuminanceEval;
 pub use ward::Ward;
 
@@ -133,7 +138,8 @@ pub const MIN_ALPHA: f32 = 1e-4;
 // What a model provides
 
 /// A model's two reflectances, the colours its lobes scale: the diffuse lobe's and the glossy
-/// lobe's (`kd` and `ks` for the paper models; `(1 - F0) c_diff` and `F0` for glTF), as RGB
+/// lobe's (`kd` and `ks` for the paper models; `c_diff` and the glossy colour at normal
+/// incidence for glTF), as RGB
 /// or as luminances. [`LuminanceEval`] takes their luminances once per `wo`.
 #[derive(Clone, Copy, Debug)]
 struct Reflectances<S> {
@@ -435,12 +441,62 @@ mod tests {
     pub(super) const SHININESS: [f32; 3] = [10.0, 100.0, 1000.0];
     pub(super) const MIXED_ANGLES: [f32; 3] = [0.0, 75.0, 88.0];
     pub(super) const GLTF_ROUGHNESS: [f32; 3] = [0.15, 0.5, 1.0];
-    pub(super) const GLTF_ANGLES: [f32; 3] = [0.0, 45.0, 85.0];
+    pub(super) const GLTF_ANGLES: [f32; 4] = [0.0, 45.0, 85.0, 88.0];
+    pub(super) const GLTF_VARIANT_ANGLES: [f32; 4] = [0.0, 60.0, 85.0, 88.0];
+    const GLTF_VARIANTS: usize = 5;
     /// Every chi-square test in the module, for the Sidak correction.
     const NUM_TESTS: usize = 2 * ALPHAS.len() * (ANGLES.len() + MIXED_ANGLES.len())
         + SHININESS.len() * (ANGLES.len() + MIXED_ANGLES.len())
         + 2 * GLTF_ROUGHNESS.len() * GLTF_ANGLES.len()
+        + GLTF_VARIANTS * GLTF_VARIANT_ANGLES.len()
         + 2;
+
+    /// glTF materials with the extensions' parameters: KHR_materials_specular with a coloured
+    /// F0 and KHR_materials_ior (1.33, and 0 as the specular-glossiness conversion uses), and
+    /// KHR_materials_clearcoat over a dark dielectric, a metal and a pure diffuse base.
+    pub(super) fn gltf_variants() -> [GltfPbr; GLTF_VARIANTS] {
+        let base = GltfPbr {
+            base_color: Vec3::new(0.8, 0.5, 0.2),
+            metallic: 0.0,
+            ..GltfPbr::default()
+        };
+        [
+            GltfPbr {
+                roughness: 0.3,
+                specular: 0.5,
+                specular_color: Vec3::new(1.0, 0.5, 2.0),
+                ior: 1.33,
+                ..base
+            },
+            GltfPbr {
+                roughness: 0.5,
+                specular_color: Vec3::new(0.3, 0.6, 0.9),
+                ior: 0.0,
+                ..base
+            },
+            GltfPbr {
+                base_color: Vec3::new(0.05, 0.04, 0.03),
+                roughness: 0.6,
+                clearcoat: 1.0,
+                clearcoat_roughness: 0.1,
+                ..base
+            },
+            GltfPbr {
+                metallic: 1.0,
+                roughness: 0.4,
+                clearcoat: 0.7,
+                clearcoat_roughness: 0.3,
+                ..base
+            },
+            GltfPbr {
+                roughness: 0.5,
+                specular: 0.0,
+                clearcoat: 1.0,
+                clearcoat_roughness: 0.05,
+                ..base
+            },
+        ]
+    }
 
     /// Direction at `theta` degrees from the normal, at an azimuth off the axes.
     fn wo_at(theta_deg: f32) -> Vec3 {
@@ -501,8 +557,10 @@ mod tests {
                 base_color: ks,
                 metallic: alpha,
                 roughness: alpha,
+                ..GltfPbr::default()
             }));
         }
+        v.extend(gltf_variants().map(Bsdf::GltfPbr));
         for shininess in [5.0, 200.0] {
             v.push(Bsdf::BlinnPhong(BlinnPhong { kd, ks, shininess }));
         }
@@ -525,10 +583,13 @@ mod tests {
         (mean, ((sum2 / n as f64 - mean * mean) / n as f64).sqrt())
     }
 
+    /// Every model but a clear-coated glTF one, whose coat weight KHR_materials_clearcoat
+    /// takes at `n.wo` alone.
     #[test]
     fn reciprocity() {
         let mut rng = Pcg32::new(12, 0);
-        for b in all_models() {
+        let coated = |b: &Bsdf| matches!(b, Bsdf::GltfPbr(g) if g.clearcoat > 0.0);
+        for b in all_models().into_iter().filter(|b| !coated(b)) {
             for _ in 0..2000 {
                 let (a, c) = (random_dir(&mut rng), random_dir(&mut rng));
                 let (f1, f2) = (b.eval(a, c), b.eval(c, a));
@@ -619,6 +680,7 @@ mod tests {
             base_color: kd,
             metallic: 0.5,
             roughness: 0.5,
+            ..GltfPbr::default()
         };
         assert_eq!(Bsdf::GltfPbr(g).albedo(), kd);
     }

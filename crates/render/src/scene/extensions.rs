@@ -22,17 +22,14 @@ pub const HONOURED: &[&str] = &[
     "KHR_mesh_quantization",
     "EXT_meshopt_compression",
     "KHR_draco_mesh_compression",
+    "KHR_materials_specular",
+    "KHR_materials_ior",
+    "KHR_materials_clearcoat",
 ];
 
 /// How an element that uses `extension` is rendered when the extension is not honoured.
 fn without(extension: &str) -> &'static str {
     match extension {
-        "KHR_materials_specular" => {
-            "its specular strength and colour are ignored (the glTF default, 4% Fresnel at normal \
-             incidence)"
-        }
-        "KHR_materials_ior" => "its index of refraction is taken as 1.5",
-        "KHR_materials_clearcoat" => "rendered without its clear-coat layer",
         "KHR_materials_transmission" => "rendered as an opaque surface, without transmission",
         "KHR_materials_volume" => "rendered without its volume (thickness, attenuation)",
         "KHR_materials_sheen" => "rendered without sheen",

@@ -47,6 +47,41 @@ enum StreaksBsdf {
     BlinnPhong,
 }
 
+/// A material's KHR_materials_specular and KHR_materials_ior parameters.
+struct Specular {
+    factor: f32,
+    texture: Option<TextureId>,
+    color: Vec3,
+    color_texture: Option<TextureId>,
+    ior: f32,
+}
+
+/// A material's KHR_materials_clearcoat object, as the JSON has it, and its decoded textures.
+#[derive(Debug, Default, Deserialize)]
+#[serde(rename_all = "camelCase")]
+struct Clearcoat {
+    #[serde(default)]
+    clearcoat_factor: f32,
+    clearcoat_texture: Option<TextureRef>,
+    #[serde(default)]
+    clearcoat_roughness_factor: f32,
+    clearcoat_roughness_texture: Option<TextureRef>,
+    clearcoat_normal_texture: Option<serde_json::Value>,
+    #[serde(skip)]
+    texture: Option<TextureId>,
+    #[serde(skip)]
+    roughness_texture: Option<TextureId>,
+}
+
+/// A textureInfo read from the JSON: the texture's index and its texCoord set.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(rename_all = "camelCase")]
+struct TextureRef {
+    index: usize,
+    #[serde(default)]
+    tex_coord: u32,
+}
+
 /// Loads a `.gltf` or `.glb` file.
 pub(super) fn load(path: &Path) -> Result<Scene, SceneError> {
     let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
@@ -114,7 +149,7 @@ pub(super) fn load(path: &Path) -> Result<Scene, SceneError> {
         loader.warn(w);
     }
     for (i, m) in document.materials().enumerate() {
-        let material = loader.material(&m, i)?;
+        let material = loader.material(&m, i, &document)?;
         loader.parts.materials.push(material);
     }
     let scene = document
@@ -720,6 +755,15 @@ impl Loader<'_> {
                     metallic: 1.0,
                     roughness: 1.0,
                     metallic_roughness_texture: None,
+                    specular: 1.0,
+                    specular_texture: None,
+                    specular_color: Vec3::ONE,
+                    specular_color_texture: None,
+                    ior: 1.5,
+                    clearcoat: 0.0,
+                    clearcoat_texture: None,
+                    clearcoat_roughness: 0.0,
+                    clearcoat_roughness_texture: None,
                 },
                 emission: Vec3::ZERO,
                 emission_texture: None,
@@ -730,7 +774,12 @@ impl Loader<'_> {
         })
     }
 
-    fn material(&mut self, m: &gltf::Material, index: usize) -> Result<Material, SceneError> {
+    fn material(
+        &mut self,
+        m: &gltf::Material,
+        index: usize,
+        document: &gltf::Document,
+    ) -> Result<Material, SceneError> {
         let name = m
             .name()
             .map_or_else(|| format!("material{index}"), str::to_string);
@@ -775,13 +824,26 @@ impl Loader<'_> {
         let base = Vec4::from(pbr.base_color_factor());
         let reflectance = match self.streaks_extras(m, &element)? {
             Some(x) => self.paper(x, base_color_texture, mr_texture, &element)?,
-            None => Reflectance::GltfPbr {
-                base_color: base.truncate(),
-                base_color_texture,
-                metallic: pbr.metallic_factor(),
-                roughness: pbr.roughness_factor(),
-                metallic_roughness_texture: mr_texture,
-            },
+            None => {
+                let specular = self.specular(m, &element)?;
+                let clearcoat = self.clearcoat(m, document, &element)?;
+                Reflectance::GltfPbr {
+                    base_color: base.truncate(),
+                    base_color_texture,
+                    metallic: pbr.metallic_factor(),
+                    roughness: pbr.roughness_factor(),
+                    metallic_roughness_texture: mr_texture,
+                    specular: specular.factor,
+                    specular_texture: specular.texture,
+                    specular_color: specular.color,
+                    specular_color_texture: specular.color_texture,
+                    ior: specular.ior,
+                    clearcoat: clearcoat.clearcoat_factor,
+                    clearcoat_texture: clearcoat.texture,
+                    clearcoat_roughness: clearcoat.clearcoat_roughness_factor,
+                    clearcoat_roughness_texture: clearcoat.roughness_texture,
+                }
+            }
         };
         Ok(Material {
             name,
@@ -791,6 +853,106 @@ impl Loader<'_> {
             normal_map,
             double_sided: m.double_sided(),
         })
+    }
+
+    /// KHR_materials_specular and KHR_materials_ior of a glTF material, with their defaults
+    /// where absent (specular 1, specular colour 1, ior 1.5); out-of-range values are errors.
+    fn specular(&mut self, m: &gltf::Material, element: &str) -> Result<Specular, SceneError> {
+        let ior = m.ior().unwrap_or(1.5);
+        if !(ior == 0.0 || (ior.is_finite() && ior >= 1.0)) {
+            return Err(self.bad(
+                element,
+                format!("KHR_materials_ior: ior {ior} must be 0 or at least 1"),
+            ));
+        }
+        let Some(sp) = m.specular() else {
+            return Ok(Specular {
+                factor: 1.0,
+                texture: None,
+                color: Vec3::ONE,
+                color_texture: None,
+                ior,
+            });
+        };
+        let (factor, color) = (sp.specular_factor(), Vec3::from(sp.specular_color_factor()));
+        if !(0.0..=1.0).contains(&factor) {
+            return Err(self.bad(
+                element,
+                format!("KHR_materials_specular: specularFactor {factor} is not in [0, 1]"),
+            ));
+        }
+        if !(color.is_finite() && color.min_element() >= 0.0) {
+            return Err(self.bad(
+                element,
+                format!("KHR_materials_specular: specularColorFactor {color} is invalid"),
+            ));
+        }
+        let texture = match sp.specular_texture() {
+            Some(info) => Some(self.texture(&info, ColorSpace::Linear, element)?),
+            None => None,
+        };
+        let color_texture = match sp.specular_color_texture() {
+            Some(info) => Some(self.texture(&info, ColorSpace::Srgb, element)?),
+            None => None,
+        };
+        Ok(Specular {
+            factor,
+            texture,
+            color,
+            color_texture,
+            ior,
+        })
+    }
+
+    /// KHR_materials_clearcoat of a glTF material (no coat where absent), read from the JSON
+    /// (the gltf crate does not know the extension); its textures are decoded, and a
+    /// clearcoatNormalTexture is a warning, as the coat is shaded with the base's normal.
+    fn clearcoat(
+        &mut self,
+        m: &gltf::Material,
+        document: &gltf::Document,
+        element: &str,
+    ) -> Result<Clearcoat, SceneError> {
+        let Some(value) = m.extension_value("KHR_materials_clearcoat") else {
+            return Ok(Clearcoat::default());
+        };
+        let reason = |r: String| format!("KHR_materials_clearcoat: {r}");
+        let mut c: Clearcoat = serde_json::from_value(value.clone())
+            .map_err(|e| self.bad(element, reason(e.to_string())))?;
+        for (key, v) in [
+            ("clearcoatFactor", c.clearcoat_factor),
+            ("clearcoatRoughnessFactor", c.clearcoat_roughness_factor),
+        ] {
+            if !(0.0..=1.0).contains(&v) {
+                return Err(self.bad(element, reason(format!("{key} {v} is not in [0, 1]"))));
+            }
+        }
+        if c.clearcoat_normal_texture.is_some() {
+            self.warn(format!(
+                "{element}: KHR_materials_clearcoat clearcoatNormalTexture is not used; the \
+                 clear coat is shaded with the base's normal"
+            ));
+        }
+        for (key, info, space) in [
+            ("clearcoatTexture", c.clearcoat_texture, ColorSpace::Linear),
+            (
+                "clearcoatRoughnessTexture",
+                c.clearcoat_roughness_texture,
+                ColorSpace::Linear,
+            ),
+        ] {
+            let Some(info) = info else { continue };
+            let Some(texture) = document.textures().nth(info.index) else {
+                let why = format!("{key}: texture {} does not exist", info.index);
+                return Err(self.bad(element, reason(why)));
+            };
+            let id = self.texture_of(&texture, info.tex_coord, space, element)?;
+            match key {
+                "clearcoatTexture" => c.texture = Some(id),
+                _ => c.roughness_texture = Some(id),
+            }
+        }
+        Ok(c)
     }
 
     fn streaks_extras(
@@ -1076,7 +1238,7 @@ mod tests {
 
     /// The test scene: a quad (indexed, normals, uvs) under a TRS parent and a matrix child, a
     /// non-indexed emissive triangle without normals, a camera, and three punctual lights.
-    fn test_doc() -> (Value, Vec<u8>) {
+    pub(super) fn test_doc() -> (Value, Vec<u8>) {
         let mut d = Doc::default();
         let quad_pos = d.floats(&[0., 0., 0., 0., 0., 1., 1., 0., 1., 1., 0., 0.], "VEC3", 3);
         let quad_nrm = d.floats(&[0., 1., 0.].repeat(4), "VEC3", 3);
@@ -1128,7 +1290,7 @@ mod tests {
         (doc, d.bin)
     }
 
-    fn write_embedded(dir: &Path, mut doc: Value, bin: &[u8]) -> PathBuf {
+    pub(super) fn write_embedded(dir: &Path, mut doc: Value, bin: &[u8]) -> PathBuf {
         doc["buffers"][0]["uri"] = json!(format!(
             "data:application/octet-stream;base64,{}",
             base64::encode(bin)
@@ -1530,15 +1692,15 @@ mod tests {
         assert!(err.to_string().contains("KHR_texture_basisu"), "{err}");
         // Used but not required: a warning naming the material, and the scene loads.
         let (mut doc, bin) = test_doc();
-        doc["extensionsUsed"] = json!(["KHR_lights_punctual", "KHR_materials_clearcoat"]);
+        doc["extensionsUsed"] = json!(["KHR_lights_punctual", "KHR_materials_sheen"]);
         doc["materials"][0]["extensions"] =
-            json!({"KHR_materials_clearcoat": {"clearcoatFactor": 1}});
+            json!({"KHR_materials_sheen": {"sheenColorFactor": [1, 1, 1]}});
         let scene = Scene::load(&write_embedded(dir.path(), doc, &bin)).unwrap();
         assert!(
             scene
                 .warnings
                 .iter()
-                .any(|w| w.contains("material \"asphalt\" (0) uses KHR_materials_clearcoat")),
+                .any(|w| w.contains("material \"asphalt\" (0) uses KHR_materials_sheen")),
             "{:?}",
             scene.warnings
         );
@@ -1733,5 +1895,141 @@ mod tests {
             scene.warnings
         );
         assert!((quad_normal(&scene) - Vec3::Y).length() < 1e-6);
+    }
+}
+
+#[cfg(test)]
+mod material_extension_tests {
+    //! KHR_materials_specular, KHR_materials_ior and KHR_materials_clearcoat: their parsing,
+    //! their defaults, their textures' channels and colour spaces, and their errors.
+    use super::tests::{test_doc, write_embedded};
+    use crate::bsdf::Bsdf;
+    use crate::material::Reflectance;
+    use crate::scene::Scene;
+    use glam::{Vec2, Vec3};
+    use serde_json::json;
+
+    #[test]
+    fn plain_material_has_the_extensions_defaults() {
+        let (doc, bin) = test_doc();
+        let dir = tempfile::tempdir().unwrap();
+        let scene = Scene::load(&write_embedded(dir.path(), doc, &bin)).unwrap();
+        let Reflectance::GltfPbr {
+            specular,
+            specular_texture,
+            specular_color,
+            specular_color_texture,
+            ior,
+            clearcoat,
+            clearcoat_texture,
+            clearcoat_roughness,
+            clearcoat_roughness_texture,
+            ..
+        } = &scene.materials[1].reflectance
+        else {
+            panic!("glow is not a glTF material")
+        };
+        assert_eq!((*specular, *specular_color, *ior), (1.0, Vec3::ONE, 1.5));
+        assert_eq!((*clearcoat, *clearcoat_roughness), (0.0, 0.0));
+        assert!(specular_texture.is_none() && specular_color_texture.is_none());
+        assert!(clearcoat_texture.is_none() && clearcoat_roughness_texture.is_none());
+    }
+
+    #[test]
+    fn specular_ior_and_clearcoat_are_read_with_their_textures() {
+        // One texel: R 255, G 128, B 0, A 64.
+        let mut png = Vec::new();
+        image::RgbaImage::from_raw(1, 1, vec![255, 128, 0, 64])
+            .unwrap()
+            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+            .unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("t.png"), &png).unwrap();
+        let (mut doc, bin) = test_doc();
+        doc["extensionsUsed"] = json!([
+            "KHR_lights_punctual",
+            "KHR_materials_emissive_strength",
+            "KHR_materials_specular",
+            "KHR_materials_ior",
+            "KHR_materials_clearcoat"
+        ]);
+        doc["images"] = json!([{"uri": "t.png"}]);
+        doc["textures"] = json!([{"source": 0}]);
+        doc["materials"][1]["extensions"]["KHR_materials_specular"] = json!({
+            "specularFactor": 0.5, "specularTexture": {"index": 0},
+            "specularColorFactor": [2, 1, 0.5], "specularColorTexture": {"index": 0}});
+        doc["materials"][1]["extensions"]["KHR_materials_ior"] = json!({"ior": 1.33});
+        doc["materials"][1]["extensions"]["KHR_materials_clearcoat"] = json!({
+            "clearcoatFactor": 0.8, "clearcoatTexture": {"index": 0},
+            "clearcoatRoughnessFactor": 0.2, "clearcoatRoughnessTexture": {"index": 0},
+            "clearcoatNormalTexture": {"index": 0}});
+        let scene = Scene::load(&write_embedded(dir.path(), doc.clone(), &bin)).unwrap();
+        // Honoured: no "uses KHR_materials_..." warning; the coat's normal map is named.
+        assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+        assert!(
+            scene.warnings[0].contains("material \"glow\" (1)")
+                && scene.warnings[0].contains("clearcoatNormalTexture is not used"),
+            "{:?}",
+            scene.warnings
+        );
+        // The image decoded twice: linear (specular, clearcoat) and sRGB (specular colour).
+        assert_eq!(scene.textures.len(), 2);
+        let Bsdf::GltfPbr(g) = scene.materials[1].bsdf_at(Vec2::ZERO, &scene.textures) else {
+            panic!("not a glTF material")
+        };
+        let close = |a: f32, b: f32| (a - b).abs() < 1e-4;
+        assert!(close(g.specular, 0.5 * 64.0 / 255.0), "{g:?}");
+        // sRGB 128/255 is linear 0.2158.
+        assert!(
+            (g.specular_color - Vec3::new(2.0, 0.2158, 0.0))
+                .abs()
+                .max_element()
+                < 1e-3,
+            "{g:?}"
+        );
+        assert_eq!(g.ior, 1.33);
+        assert!(close(g.clearcoat, 0.8), "{g:?}");
+        assert!(close(g.clearcoat_roughness, 0.2 * 128.0 / 255.0), "{g:?}");
+        // Defaults inside the extensions: an empty clear coat is no coat, an empty specular
+        // is the default strength and colour; ior 0 is allowed.
+        let mut d = doc.clone();
+        d["materials"][1]["extensions"] = json!({
+            "KHR_materials_specular": {}, "KHR_materials_clearcoat": {},
+            "KHR_materials_ior": {"ior": 0}});
+        let scene = Scene::load(&write_embedded(dir.path(), d, &bin)).unwrap();
+        let Bsdf::GltfPbr(g) = scene.materials[1].bsdf_at(Vec2::ZERO, &scene.textures) else {
+            panic!("not a glTF material")
+        };
+        assert_eq!((g.specular, g.specular_color, g.ior), (1.0, Vec3::ONE, 0.0));
+        assert_eq!((g.clearcoat, g.clearcoat_roughness), (0.0, 0.0));
+        // Out of range: errors naming the material and the extension.
+        for (ext, value, what) in [
+            ("KHR_materials_ior", json!({"ior": 0.5}), "ior 0.5"),
+            (
+                "KHR_materials_clearcoat",
+                json!({"clearcoatFactor": 2}),
+                "clearcoatFactor 2",
+            ),
+            (
+                "KHR_materials_clearcoat",
+                json!({"clearcoatTexture": {"index": 7}}),
+                "texture 7",
+            ),
+            (
+                "KHR_materials_specular",
+                json!({"specularColorFactor": [1, -1, 1]}),
+                "specularColorFactor",
+            ),
+        ] {
+            let mut d = doc.clone();
+            d["materials"][1]["extensions"] = json!({ ext: value });
+            let err = Scene::load(&write_embedded(dir.path(), d, &bin))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                err.contains("material \"glow\" (1)") && err.contains(what),
+                "{ext}: {err}"
+            );
+        }
     }
 }

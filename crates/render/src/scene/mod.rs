@@ -25,8 +25,16 @@
 //!   radiometric units says so with `"asset": {"extras": {"streaks": {"light_units":
 //!   "radiometric"}}}` (the default is `"photometric"`); its intensities are then used as
 //!   they are.
-//! - Materials: glTF metallic-roughness, unless `extras.streaks` chooses one of the paper's
-//!   models: `{"bsdf": "ggx" | "ward" | "blinn_phong", "kd": [r,g,b], "ks": [r,g,b],
+//! - Materials: glTF metallic-roughness ([`crate::bsdf::GltfPbr`]: the specification's
+//!   appendix B with the height-correlated Smith visibility), with KHR_materials_specular
+//!   (specularFactor and specularTexture's alpha, specularColorFactor and the sRGB
+//!   specularColorTexture), KHR_materials_ior (ior, 1.5 by default, 0 or at least 1) and
+//!   KHR_materials_clearcoat (clearcoatFactor and clearcoatTexture's red channel,
+//!   clearcoatRoughnessFactor and clearcoatRoughnessTexture's green channel; a
+//!   clearcoatNormalTexture is a warning, the coat uses the base's normal), with those
+//!   extensions' formulas; values outside the schemas' ranges are errors naming the material.
+//!   A specularFactor of 0 (Blender's Specular IOR Level 0) is exactly Lambertian. Unless
+//!   `extras.streaks` chooses one of the paper's models: `{"bsdf": "ggx" | "ward" | "blinn_phong", "kd": [r,g,b], "ks": [r,g,b],
 //!   "alpha": a, "shininess": s}` (`alpha` for ggx and ward, `shininess` for blinn_phong;
 //!   `kd` and `ks` default to black). The baseColorTexture, if any, multiplies `kd`.
 //! - Normal maps ([`crate::normal_map`]): a material's `normalTexture` (linear RGB, `scale`
