@@ -236,12 +236,17 @@ def _spot_ring(radius: float, width: float) -> tuple[Vec3, ...]:
     return quad_xy(x + radius - width / 2, y - 0.15, x + radius + width / 2, y + 0.15, 0.0)
 
 
-def _diffuse(name: str, spot_blend: float, description: str) -> SceneSpec:
+def _diffuse(
+    name: str,
+    spot_blend: float,
+    description: str,
+    surfaces: tuple[Material, Material] = (_FLOOR, _WALL),
+) -> SceneSpec:
     return SceneSpec(
         name=name,
         description=description,
         camera=Camera(location=(0.0, -7.0, 2.6), target=(0.0, 1.5, 0.9), yfov_deg=45.0),
-        materials=(_FLOOR, _WALL, _PANEL),
+        materials=(*surfaces, _PANEL),
         meshes=(
             Mesh("floor", "quad", quad_xy(-6.0, -4.0, 6.0, 4.0, 0.0), "floor"),
             Mesh("wall", "quad", quad_xz(-6.0, 0.0, 6.0, 4.5, 4.0), "wall"),
@@ -309,6 +314,17 @@ SPOT_BLEND_SCENE = _diffuse(
     "light in Cycles' wider penumbra also reaches the other regions by interreflection.",
 )
 
+PRINCIPLED_SCENE = _diffuse(
+    "principled",
+    0.0,
+    "The diffuse scene with Blender's default Principled BSDF on the floor and the wall "
+    "(Specular IOR Level 0.5, roughness 0.5): measures Cycles' Principled BSDF against the "
+    "glTF BRDF the export asks for (no material extension involved).",
+    (
+        Material("floor", base_color=_FLOOR.base_color),
+        Material("wall", base_color=_WALL.base_color),
+    ),
+)
 
 # --- (b) wet street: the material features --------------------------------------------------
 
@@ -413,8 +429,9 @@ WET_STREET = SceneSpec(
         ),
         Region(
             "building",
-            ((4.0, 0.5, 0.5), (4.0, 5.0, 0.5), (4.0, 5.0, 3.0), (4.0, 0.5, 3.0)),
-            "building front, default Principled (Specular IOR Level 0.5)",
+            ((4.0, 6.0, 3.0), (4.0, 10.0, 3.0), (4.0, 10.0, 4.5), (4.0, 6.0, 4.5)),
+            "building front above the shelter, default Principled (Specular IOR Level 0.5), "
+            "seen at grazing angles",
         ),
     ),
     max_depth=8,
@@ -424,7 +441,9 @@ WET_STREET = SceneSpec(
     tolerance=0.10,
 )
 
-SCENES: dict[str, SceneSpec] = {s.name: s for s in (DIFFUSE, SPOT_BLEND_SCENE, WET_STREET)}
+SCENES: dict[str, SceneSpec] = {
+    s.name: s for s in (DIFFUSE, SPOT_BLEND_SCENE, PRINCIPLED_SCENE, WET_STREET)
+}
 
 
 def cycles_bounces(max_depth: int) -> int:
