@@ -212,13 +212,20 @@ def region_fractions(
 
 _FLOOR = Material("floor", base_color=(0.5, 0.5, 0.5), roughness=1.0, specular_ior_level=0.0)
 _WALL = Material("wall", base_color=(0.6, 0.55, 0.5), roughness=1.0, specular_ior_level=0.0)
-_PANEL = Material(
-    "panel",
-    base_color=(0.0, 0.0, 0.0),
-    specular_ior_level=0.0,
-    emission=(1.0, 0.85, 0.6),
-    emission_strength=6.0,
-)
+
+
+def emitter(name: str, colour: Rgb, strength: float) -> Material:
+    """A black, non-reflecting Principled BSDF that emits `colour * strength` (radiance)."""
+    return Material(
+        name,
+        base_color=(0.0, 0.0, 0.0),
+        specular_ior_level=0.0,
+        emission=colour,
+        emission_strength=strength,
+    )
+
+
+_PANEL = emitter("panel", (1.0, 0.85, 0.6), 6.0)
 
 POINT_AT: Vec3 = (-2.2, 0.5, 1.2)
 SPOT_AT: Vec3 = (2.0, 0.6, 2.8)
@@ -345,13 +352,7 @@ _PAINT = Material(
 )
 _GLASS = Material("glass", base_color=(1.0, 1.0, 1.0), roughness=0.0, transmission=1.0, ior=1.5)
 _FENCE = Material("fence", roughness=0.6, alpha_map=Texture("fence", size=64, repeat=4.0))
-_HEADLIGHT = Material(
-    "headlight",
-    base_color=(0.0, 0.0, 0.0),
-    specular_ior_level=0.0,
-    emission=(1.0, 0.95, 0.85),
-    emission_strength=40.0,
-)
+_HEADLIGHT = emitter("headlight", (1.0, 0.95, 0.85), 40.0)
 _BRICK = Material("building", base_color=(0.35, 0.3, 0.28), roughness=0.8)
 _TYRE = Material("tyre", base_color=(0.02, 0.02, 0.02), roughness=0.9)
 
