@@ -19,13 +19,21 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import shutil
-import subprocess
 import sys
 import time
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(REPO / "tools"))
+from region_compare import (  # noqa: E402  (tools/ is not a package)
+    all_passed,
+    compare,
+    find_streaks,
+    log,
+    parse_region,
+    print_table,
+    run,
+)
 
 # Regions of scenes/crosscheck.gltf as fractions of the image (x0, y0, x1, y1), y down: the
 # road below the wall's base, the streaks of the sphere lamp (left) and of the point light
@@ -44,22 +52,6 @@ LLVM_CANDIDATES = [
 ]
 
 
-def log(msg: str) -> None:
-    print(msg, file=sys.stderr, flush=True)
-
-
-def run(cmd: list[str]) -> str:
-    log("$ " + " ".join(str(c) for c in cmd))
-    res = subprocess.run([str(c) for c in cmd], capture_output=True, text=True)
-    if res.stderr.strip():
-        log(res.stderr.rstrip())
-    if res.returncode != 0:
-        if res.stdout.strip():
-            log(res.stdout.rstrip())
-        raise SystemExit(f"command failed with exit code {res.returncode}: {cmd[0]} {cmd[1]}")
-    return res.stdout
-
-
 def import_mitsuba(variant: str):
     """Imports mitsuba with `variant` ('auto': llvm_ad_rgb if libLLVM 19 is found)."""
     if variant in ("auto", "llvm_ad_rgb") and "DRJIT_LIBLLVM_PATH" not in os.environ:
@@ -72,7 +64,7 @@ def import_mitsuba(variant: str):
     except ImportError as e:
         raise SystemExit(
             f"cannot import mitsuba ({e}): pip install -r tools/mitsuba/requirements.txt"
-        )
+        ) from e
     choices = ["llvm_ad_rgb", "scalar_rgb"] if variant == "auto" else [variant]
     for v in choices:
         try:
@@ -83,52 +75,39 @@ def import_mitsuba(variant: str):
     raise SystemExit(f"no usable mitsuba variant among {choices}")
 
 
-def find_streaks(arg: str | None) -> str:
-    if arg:
-        return arg
-    for profile in ("release", "debug"):
-        cand = REPO / "target" / profile / "streaks"
-        if cand.exists():
-            return str(cand)
-    found = shutil.which("streaks")
-    if found:
-        return found
-    raise SystemExit("no streaks binary: build it (cargo build --release) or pass --streaks")
-
-
-def pixel_region(name: str, frac: tuple[float, ...], w: int, h: int) -> str:
-    x0, y0, x1, y1 = frac
-    px = [round(x0 * w), round(y0 * h), round(x1 * w), round(y1 * h)]
-    px[2] = max(px[2], px[0] + 1)
-    px[3] = max(px[3], px[1] + 1)
-    return f"{name}=" + ",".join(str(v) for v in px)
-
-
-def parse_region(text: str) -> tuple[str, tuple[float, ...]]:
-    name, _, coords = text.rpartition("=")
-    vals = tuple(float(v) for v in coords.split(","))
-    if len(vals) != 4 or not all(0.0 <= v <= 1.0 for v in vals):
-        raise argparse.ArgumentTypeError(f"region {text!r}: need name=x0,y0,x1,y1 in [0, 1]")
-    return (name or "region", vals)
-
-
 def main() -> int:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("scene", nargs="?", type=Path, help="glTF scene (default with --ci: scenes/crosscheck.gltf)")
-    p.add_argument("--out", type=Path, default=None, help="work folder (default: target/crosscheck/<scene>)")
-    p.add_argument("--streaks", default=None, help="streaks binary (default: target/release or target/debug)")
+    p = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    p.add_argument(
+        "scene", nargs="?", type=Path, help="glTF scene (default with --ci: scenes/crosscheck.gltf)"
+    )
+    p.add_argument(
+        "--out", type=Path, default=None, help="work folder (default: target/crosscheck/<scene>)"
+    )
+    p.add_argument(
+        "--streaks", default=None, help="streaks binary (default: target/release or target/debug)"
+    )
     p.add_argument("--width", type=int, default=160)
     p.add_argument("--height", type=int, default=120)
     p.add_argument("--spp", type=int, default=64)
     p.add_argument("--max-depth", type=int, default=4)
     p.add_argument("--camera", default=None)
     p.add_argument("--seeds", type=int, nargs=2, default=[1, 2], metavar=("S1", "S2"))
-    p.add_argument("--region", type=parse_region, action="append", default=[],
-                   help="name=x0,y0,x1,y1 as fractions of the image; repeatable")
+    p.add_argument(
+        "--region",
+        type=parse_region,
+        action="append",
+        default=[],
+        help="name=x0,y0,x1,y1 as fractions of the image; repeatable",
+    )
     p.add_argument("--k", type=float, default=4.0, help="fail when |bias| > k standard errors")
     p.add_argument("--variant", default="auto", choices=["auto", "llvm_ad_rgb", "scalar_rgb"])
-    p.add_argument("--ci", action="store_true",
-                   help="the CI check: crosscheck scene, its regions, camera cam; exit 1 on disagreement")
+    p.add_argument(
+        "--ci",
+        action="store_true",
+        help="the CI check: crosscheck scene, its regions, camera cam; exit 1 on disagreement",
+    )
     p.add_argument("--json", type=Path, default=None, help="also write the comparison JSON here")
     args = p.parse_args()
 
@@ -145,8 +124,16 @@ def main() -> int:
     out = args.out or REPO / "target" / "crosscheck" / args.scene.stem
     out.mkdir(parents=True, exist_ok=True)
 
-    common = ["--width", args.width, "--height", args.height, "--spp", args.spp,
-              "--max-depth", args.max_depth]
+    common = [
+        "--width",
+        args.width,
+        "--height",
+        args.height,
+        "--spp",
+        args.spp,
+        "--max-depth",
+        args.max_depth,
+    ]
     if args.camera:
         common += ["--camera", args.camera]
 
@@ -168,36 +155,28 @@ def main() -> int:
         timings[f"streaks seed {s}"] = time.time() - t
 
     s1, s2 = args.seeds
-    cmp_cmd = [streaks, "compare", out / f"streaks_s{s1}.exr", out / f"mitsuba_s{s1}.exr",
-               "--a2", out / f"streaks_s{s2}.exr", "--b2", out / f"mitsuba_s{s2}.exr",
-               "--k", args.k, "--json", "--diff-png", out / "diff.png"]
-    for name, frac in args.region:
-        cmp_cmd += ["--region", pixel_region(name, frac, args.width, args.height)]
-    log("$ " + " ".join(str(c) for c in cmp_cmd))
-    res = subprocess.run([str(c) for c in cmp_cmd], capture_output=True, text=True)
-    if not res.stdout.strip():
-        log(res.stderr)
-        raise SystemExit("streaks compare produced no result")
-    comparison = json.loads(res.stdout)
+    diff_png = out / "diff.png"
+    comparison = compare(
+        streaks,
+        (out / f"streaks_s{s1}.exr", out / f"streaks_s{s2}.exr"),
+        (out / f"mitsuba_s{s1}.exr", out / f"mitsuba_s{s2}.exr"),
+        args.region,
+        args.width,
+        args.height,
+        args.k,
+        diff_png,
+    )
     if args.json:
         args.json.write_text(json.dumps(comparison, indent=2))
 
-    print(f"scene {args.scene}, {args.width}x{args.height}, {args.spp} spp x 2 seeds, "
-          f"max depth {args.max_depth}, mitsuba {mi.__version__} {variant}")
+    print(
+        f"scene {args.scene}, {args.width}x{args.height}, {args.spp} spp x 2 seeds, "
+        f"max depth {args.max_depth}, mitsuba {mi.__version__} {variant}"
+    )
     for k, v in timings.items():
         print(f"  {k}: {v:.1f} s")
-    print(f"{'region':<8} {'pixels':>16} {'ours':>11} {'mitsuba':>11} {'rel bias':>9} "
-          f"{'std err':>8} {'z':>7} {'rel RMSE':>9}  result")
-    for r in [comparison["overall"], *comparison["regions"]]:
-        g = r["region"]
-        print(f"{g['name']:<8} {g['x0']:>3},{g['y0']:>3}-{g['x1']:>3},{g['y1']:>3}   "
-              f"{r['mean_a']:>11.4e} {r['mean_b']:>11.4e} {100 * r['rel_bias']:>+8.2f}% "
-              f"{100 * r['std_error'] / r['mean_b']:>7.2f}% {r['z']:>+7.2f} "
-              f"{100 * r['rel_rmse']:>8.2f}%  {'ok' if r['passed'] else 'FAIL'}")
-    b = comparison["largest_block"]
-    print(f"largest {b['size']}x{b['size']} block difference: {100 * b['rel_diff']:+.2f}% of the "
-          f"image mean at ({b['x0']}, {b['y0']}); difference image {out / 'diff.png'}")
-    passed = all(r["passed"] for r in [comparison["overall"], *comparison["regions"]])
+    print_table(comparison, "mitsuba", diff_png)
+    passed = all_passed(comparison)
     print("agreement within noise" if passed else f"DISAGREEMENT beyond {args.k} standard errors")
     return 0 if passed or not args.ci else 1
 

@@ -99,13 +99,20 @@ def find_streaks(arg: str | None) -> str:
 def parse_region(text: str) -> tuple[str, tuple[float, ...]]:
     name, _, coords = text.rpartition("=")
     vals = tuple(float(v) for v in coords.split(","))
-    if len(vals) != 4 or not all(0.0 <= v <= 1.0 for v in vals) or vals[0] >= vals[2] or vals[1] >= vals[3]:
+    if (
+        len(vals) != 4
+        or not all(0.0 <= v <= 1.0 for v in vals)
+        or vals[0] >= vals[2]
+        or vals[1] >= vals[3]
+    ):
         raise argparse.ArgumentTypeError(f"region {text!r}: need name=x0,y0,x1,y1 in [0, 1]")
     return (name or "region", vals)
 
 
 def main() -> int:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     p.add_argument("scene", type=Path, nargs="?", help="glTF or OBJ scene")
     p.add_argument("--camera", default=None)
     p.add_argument("--width", type=int, default=320)
@@ -115,16 +122,31 @@ def main() -> int:
     p.add_argument("--runs", type=int, default=3, help="runs per renderer (seeds 1..runs)")
     p.add_argument("--ref-spp", type=int, default=4096)
     p.add_argument("--ref-renderer", choices=["streaks", "mitsuba"], default="streaks")
-    p.add_argument("--region", type=parse_region, default=("road", (0.0, 0.6, 1.0, 1.0)),
-                   help="name=x0,y0,x1,y1 in image fractions (default road=0,0.6,1,1)")
+    p.add_argument(
+        "--region",
+        type=parse_region,
+        default=("road", (0.0, 0.6, 1.0, 1.0)),
+        help="name=x0,y0,x1,y1 in image fractions (default road=0,0.6,1,1)",
+    )
     p.add_argument("--variant", default="llvm_ad_rgb")
-    p.add_argument("--streaks", default=None, help="streaks binary (default target/release/streaks)")
-    p.add_argument("--exporter", default=None,
-                   help="streaks binary that runs export-mitsuba (default: the --streaks one)")
-    p.add_argument("--out", type=Path, default=None, help="work folder (default target/race/<scene>)")
+    p.add_argument(
+        "--streaks", default=None, help="streaks binary (default target/release/streaks)"
+    )
+    p.add_argument(
+        "--exporter",
+        default=None,
+        help="streaks binary that runs export-mitsuba (default: the --streaks one)",
+    )
+    p.add_argument(
+        "--out", type=Path, default=None, help="work folder (default target/race/<scene>)"
+    )
     p.add_argument("--json", type=Path, default=None, help="also write the results here")
-    p.add_argument("--mitsuba-worker", nargs=5, metavar=("XML", "OUT", "SPP", "SEED", "VARIANT"),
-                   help=argparse.SUPPRESS)
+    p.add_argument(
+        "--mitsuba-worker",
+        nargs=5,
+        metavar=("XML", "OUT", "SPP", "SEED", "VARIANT"),
+        help=argparse.SUPPRESS,
+    )
     args = p.parse_args()
     if args.mitsuba_worker:
         xml, out, spp, seed, variant = args.mitsuba_worker
@@ -136,8 +158,8 @@ def main() -> int:
         raise SystemExit("--runs must be at least 2 (the bias's standard error needs a spread)")
 
     set_llvm_path()
-    import numpy as np
     import mitsuba as mi
+    import numpy as np
 
     mi.set_variant("scalar_rgb")  # only to read EXRs here; the runs use --variant
 
@@ -149,11 +171,35 @@ def main() -> int:
     xml_dir = out / "mitsuba"
     if xml_dir.exists():
         shutil.rmtree(xml_dir)
-    timed([args.exporter or streaks, "export-mitsuba", args.scene, "-o", xml_dir, "--spp", args.spp, *common, *cam])
+    timed(
+        [
+            args.exporter or streaks,
+            "export-mitsuba",
+            args.scene,
+            "-o",
+            xml_dir,
+            "--spp",
+            args.spp,
+            *common,
+            *cam,
+        ]
+    )
     xml = xml_dir / "scene.xml"
 
     def ours(spp: int, seed: int, path: Path) -> list:
-        return [streaks, "render", args.scene, "-o", path, "--spp", spp, "--seed", seed, *common, *cam]
+        return [
+            streaks,
+            "render",
+            args.scene,
+            "-o",
+            path,
+            "--spp",
+            spp,
+            "--seed",
+            seed,
+            *common,
+            *cam,
+        ]
 
     def theirs(spp: int, seed: int, path: Path) -> list:
         return [sys.executable, __file__, "--mitsuba-worker", xml, path, spp, seed, args.variant]
@@ -167,7 +213,7 @@ def main() -> int:
     half = max(args.ref_spp // 2, 1)
     ref_paths = [out / f"ref_{args.ref_renderer}_{half}spp_seed{seed}.exr" for seed in (1000, 1001)]
     make = ours if args.ref_renderer == "streaks" else theirs
-    for seed, path in zip((1000, 1001), ref_paths):
+    for seed, path in zip((1000, 1001), ref_paths, strict=True):
         if not path.exists():
             log(f"reference: {args.ref_renderer}, {half} spp, seed {seed} ...")
             t = timed(make(half, seed, path))
@@ -189,7 +235,10 @@ def main() -> int:
     ref_noise_mse = float(diff2.mean()) / 4.0 / ref_mean**2
     ref_se = float(np.sqrt(diff2.sum())) / (2.0 * diff2.size) / ref_mean
 
-    results = {"ours": {"times": [], "mse": [], "means": []}, "mitsuba": {"times": [], "mse": [], "means": []}}
+    results = {
+        "ours": {"times": [], "mse": [], "means": []},
+        "mitsuba": {"times": [], "mse": [], "means": []},
+    }
     for run in range(args.runs):
         seed = run + 1
         order = ["ours", "mitsuba"] if run % 2 == 0 else ["mitsuba", "ours"]
@@ -224,32 +273,51 @@ def main() -> int:
     so, sm = summary["ours"], summary["mitsuba"]
     report = {
         "scene": str(args.scene),
-        "width": args.width, "height": args.height, "spp": args.spp, "max_depth": args.max_depth,
-        "mitsuba_variant": args.variant, "mitsuba_version": mi.__version__,
-        "reference": {"renderer": args.ref_renderer, "spp": args.ref_spp,
-                      "paths": [str(p) for p in ref_paths], "noise_mse_relative": ref_noise_mse,
-                      "mean_standard_error": ref_se},
+        "width": args.width,
+        "height": args.height,
+        "spp": args.spp,
+        "max_depth": args.max_depth,
+        "mitsuba_variant": args.variant,
+        "mitsuba_version": mi.__version__,
+        "reference": {
+            "renderer": args.ref_renderer,
+            "spp": args.ref_spp,
+            "paths": [str(p) for p in ref_paths],
+            "noise_mse_relative": ref_noise_mse,
+            "mean_standard_error": ref_se,
+        },
         "region": {"name": args.region[0], "fractions": args.region[1]},
         "time_ratio_equal_spp": so["median_seconds"] / sm["median_seconds"],
         "equal_error_time_ratio": (so["median_seconds"] * so["mse_relative"])
         / (sm["median_seconds"] * sm["mse_relative"]),
         "equal_error_time_ratio_raw": (so["median_seconds"] * so["mse_relative_raw"])
         / (sm["median_seconds"] * sm["mse_relative_raw"]),
-        "ours": so, "mitsuba": sm,
+        "ours": so,
+        "mitsuba": sm,
     }
-    print(f"{args.scene.name} {args.width}x{args.height}, {args.spp} spp, max depth {args.max_depth}, "
-          f"{args.runs} runs each; mitsuba {mi.__version__} {args.variant}; reference "
-          f"{args.ref_renderer} {args.ref_spp} spp; region {args.region[0]}")
-    print(f"reference noise: relative RMSE {ref_noise_mse ** 0.5:.4f}, mean standard error {ref_se:.5f}"
-          " (subtracted from the MSEs below; included in z)")
+    print(
+        f"{args.scene.name} {args.width}x{args.height}, {args.spp} spp, "
+        f"max depth {args.max_depth}, {args.runs} runs each; "
+        f"mitsuba {mi.__version__} {args.variant}; reference "
+        f"{args.ref_renderer} {args.ref_spp} spp; region {args.region[0]}"
+    )
+    print(
+        f"reference noise: relative RMSE {ref_noise_mse**0.5:.4f}, mean standard error {ref_se:.5f}"
+        " (subtracted from the MSEs below; included in z)"
+    )
     print(f"{'':8} {'median s':>9} {'rel RMSE':>9} {'raw RMSE':>9} {'rel bias':>9} {'z':>6}")
     for who in ("ours", "mitsuba"):
         s = summary[who]
-        print(f"{who:8} {s['median_seconds']:9.3f} {s['rmse_relative']:9.4f} "
-              f"{s['mse_relative_raw'] ** 0.5:9.4f} {s['bias_relative']:+9.4f} {s['bias_z']:6.2f}")
+        print(
+            f"{who:8} {s['median_seconds']:9.3f} {s['rmse_relative']:9.4f} "
+            f"{s['mse_relative_raw'] ** 0.5:9.4f} {s['bias_relative']:+9.4f} {s['bias_z']:6.2f}"
+        )
     print(f"time ratio at equal spp (ours/mitsuba): {report['time_ratio_equal_spp']:.3f}")
-    print(f"equal-error time ratio (t*MSE ours / t*MSE mitsuba): {report['equal_error_time_ratio']:.3f}"
-          f" (raw, reference noise not subtracted: {report['equal_error_time_ratio_raw']:.3f})")
+    print(
+        "equal-error time ratio (t*MSE ours / t*MSE mitsuba): "
+        f"{report['equal_error_time_ratio']:.3f}"
+        f" (raw, reference noise not subtracted: {report['equal_error_time_ratio_raw']:.3f})"
+    )
     if args.json:
         args.json.write_text(json.dumps(report, indent=2))
     return 0
