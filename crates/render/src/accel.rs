@@ -13,6 +13,13 @@
 //! scene)` (about two millionths of the scene's extent, e.g. 0.2 mm for a scene spanning
 //! 100 m). Rays are assumed to have unit directions, so `t` is a distance.
 //!
+//! Alpha testing: triangles built as alpha-tested (those of materials with an alpha mode other
+//! than opaque) are marked in a bit set by BVH slot; [`Accel::intersect_filtered`] and
+//! [`Accel::occluded_filtered`] ask a caller's test about a hit on a marked triangle inside
+//! the traversal, and skip it when the test says so, so the traversal goes on to what lies
+//! behind. A scene without alpha-tested triangles has no bit set, and the filtered queries are
+//! the plain ones.
+//!
 //! Queries allocate nothing: traversal uses obvhs' fixed-size stack.
 
 use crate::geometry::Ray;
@@ -36,6 +43,9 @@ pub struct Accel {
     tris: Vec<RtTriangle>,
     /// Scene triangle index of each slot.
     ids: Vec<u32>,
+    /// Bit `i % 64` of word `i / 64` is set when slot `i` is alpha-tested; empty when no
+    /// triangle is.
+    alpha_tested: Vec<u64>,
     /// Hits at `t <= t_min` are ignored (see the module documentation).
     t_min: f32,
 }
@@ -64,8 +74,18 @@ impl std::fmt::Debug for Accel {
 
 impl Accel {
     /// Builds the BVH over `triangles` (vertex indices into `positions`; all indices must be in
-    /// range, which [`crate::scene::Scene::from_parts`] checks).
+    /// range, which [`crate::scene::Scene::from_parts`] checks), none alpha-tested.
     pub fn build(positions: &[Vec3], triangles: &[[u32; 3]]) -> Self {
+        Self::build_alpha_tested(positions, triangles, |_| false)
+    }
+
+    /// [`Accel::build`], with the triangles for which `alpha_tested(index)` is true marked
+    /// for the filtered queries' test.
+    pub fn build_alpha_tested(
+        positions: &[Vec3],
+        triangles: &[[u32; 3]],
+        alpha_tested: impl Fn(usize) -> bool,
+    ) -> Self {
         let max_coord = positions
             .iter()
             .fold(1.0f32, |m, p| m.max(p.abs().max_element()));
@@ -75,6 +95,7 @@ impl Accel {
                 bvh: None,
                 tris: Vec::new(),
                 ids: Vec::new(),
+                alpha_tested: Vec::new(),
                 t_min,
             };
         }
@@ -92,10 +113,19 @@ impl Accel {
             })
             .collect();
         let ids = bvh.primitive_indices.clone();
+        let mut bits = vec![0u64; ids.len().div_ceil(64)];
+        let mut any = false;
+        for (slot, &t) in ids.iter().enumerate() {
+            if alpha_tested(t as usize) {
+                bits[slot / 64] |= 1 << (slot % 64);
+                any = true;
+            }
+        }
         Self {
             bvh: Some(bvh),
             tris,
             ids,
+            alpha_tested: if any { bits } else { Vec::new() },
             t_min,
         }
     }
@@ -118,6 +148,13 @@ impl Accel {
         });
         bvh + std::mem::size_of_val(self.tris.as_slice())
             + std::mem::size_of_val(self.ids.as_slice())
+            + std::mem::size_of_val(self.alpha_tested.as_slice())
+    }
+
+    /// Whether BVH slot `slot` holds an alpha-tested triangle (only called when some is).
+    #[inline]
+    fn is_alpha_tested(&self, slot: usize) -> bool {
+        self.alpha_tested[slot / 64] & (1 << (slot % 64)) != 0
     }
 
     fn bvh_ray(&self, ray: &Ray) -> Option<(&CwBvh, BvhRay)> {
@@ -140,6 +177,59 @@ impl Accel {
 
     /// Closest hit with `t_min < t < ray.t_max`.
     pub fn intersect(&self, ray: &Ray) -> Option<AccelHit> {
+        self.closest::<false>(ray, |_, _| true)
+    }
+
+    /// Whether any triangle is hit with `t_min < t < ray.t_max` (any-hit query).
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        self.any::<false>(ray, |_, _| true)
+    }
+
+    /// [`Accel::intersect`], where a hit on an alpha-tested triangle counts only if
+    /// `stops(triangle, barycentrics)` says so (the closest hit that does is returned).
+    #[inline]
+    pub fn intersect_filtered(
+        &self,
+        ray: &Ray,
+        stops: impl FnMut(u32, Vec2) -> bool,
+    ) -> Option<AccelHit> {
+        if self.alpha_tested.is_empty() {
+            self.intersect(ray)
+        } else {
+            self.closest::<true>(ray, stops)
+        }
+    }
+
+    /// [`Accel::occluded`], where a hit on an alpha-tested triangle counts only if
+    /// `stops(triangle, barycentrics)` says so.
+    #[inline]
+    pub fn occluded_filtered(&self, ray: &Ray, stops: impl FnMut(u32, Vec2) -> bool) -> bool {
+        if self.alpha_tested.is_empty() {
+            self.occluded(ray)
+        } else {
+            self.any::<true>(ray, stops)
+        }
+    }
+
+    /// Whether a hit on slot `id` counts: always without `FILTER`; with it, unless the slot
+    /// is alpha-tested and `stops` rejects it.
+    #[inline(always)]
+    fn counts<const FILTER: bool>(
+        &self,
+        id: usize,
+        b: Vec2,
+        stops: &mut impl FnMut(u32, Vec2) -> bool,
+    ) -> bool {
+        !FILTER || !self.is_alpha_tested(id) || stops(self.ids[id], b)
+    }
+
+    /// The closest hit that [`Accel::counts`].
+    #[inline(always)]
+    fn closest<const FILTER: bool>(
+        &self,
+        ray: &Ray,
+        mut stops: impl FnMut(u32, Vec2) -> bool,
+    ) -> Option<AccelHit> {
         let (bvh, r) = self.bvh_ray(ray)?;
         let mut hit = RayHit::none();
         let mut barycentrics = Vec2::ZERO;
@@ -149,6 +239,9 @@ impl Accel {
             let (t, b) = intersect_triangle(&tris[id], r, t_min);
             // obvhs keeps a hit exactly when it is nearer than the ray's current end.
             if t < r.tmax {
+                if !self.counts::<FILTER>(id, b, &mut stops) {
+                    return f32::INFINITY;
+                }
                 barycentrics = b;
             }
             t
@@ -162,14 +255,21 @@ impl Accel {
         })
     }
 
-    /// Whether any triangle is hit with `t_min < t < ray.t_max` (any-hit query).
-    pub fn occluded(&self, ray: &Ray) -> bool {
+    /// Whether any hit [`Accel::counts`].
+    #[inline(always)]
+    fn any<const FILTER: bool>(&self, ray: &Ray, mut stops: impl FnMut(u32, Vec2) -> bool) -> bool {
         let Some((bvh, r)) = self.bvh_ray(ray) else {
             return false;
         };
         let tris = &self.tris;
         let t_min = self.t_min;
-        !bvh.ray_traverse_miss(r, |r, id| intersect_triangle(&tris[id], r, t_min).0)
+        !bvh.ray_traverse_miss(r, |r, id| {
+            let (t, b) = intersect_triangle(&tris[id], r, t_min);
+            if t < r.tmax && !self.counts::<FILTER>(id, b, &mut stops) {
+                return f32::INFINITY;
+            }
+            t
+        })
     }
 }
 

@@ -1,6 +1,6 @@
 //! Rays, shading frames and robust ray offsets.
 
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 
 /// A ray `origin + t * direction` for `t` in `[0, t_max)`; `direction` is unit length.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -31,6 +31,29 @@ impl Ray {
     }
 }
 
+/// The vertex attributes materials read, interpolated at a surface point: the two texture
+/// coordinate sets (`TEXCOORD_1` is `TEXCOORD_0` where the scene has no second set) and the
+/// vertex colour `COLOR_0` (linear RGBA, white where the scene has none).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VertexAttributes {
+    /// `TEXCOORD_0` and `TEXCOORD_1`.
+    pub uv: [Vec2; 2],
+    /// `COLOR_0`, linear RGBA.
+    pub color: Vec4,
+}
+
+impl VertexAttributes {
+    /// The attributes of a point with texture coordinates `uv` (both sets) and no vertex
+    /// colour (white).
+    #[inline]
+    pub fn from_uv(uv: Vec2) -> Self {
+        Self {
+            uv: [uv; 2],
+            color: Vec4::ONE,
+        }
+    }
+}
+
 /// A ray's closest intersection with a scene's triangles (what [`crate::scene::Scene::intersect`]
 /// returns).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -43,8 +66,8 @@ pub struct SurfaceHit {
     pub ng: Vec3,
     /// Unit interpolated shading normal (oriented to the same side as `ng`).
     pub ns: Vec3,
-    /// Texture coordinates.
-    pub uv: Vec2,
+    /// Texture coordinates and vertex colour.
+    pub attributes: VertexAttributes,
     /// Triangle index.
     pub triangle: u32,
     /// Material index.

@@ -211,7 +211,7 @@ fn first_hit_layers(scene: &Scene, ray: &Ray, origin: Vec3, forward: Vec3, pixel
             hit.ns
         };
         let material = &scene.materials[hit.material as usize];
-        pixel.albedo = material.bsdf_at(hit.uv, &scene.textures).albedo();
+        pixel.albedo = material.bsdf_at(&hit.attributes, &scene.textures).albedo();
     }
 }
 
@@ -263,7 +263,7 @@ fn trace_path(
 
         // Shading frame, flipped toward the viewer; geometric normal on the same side.
         let material = &scene.materials[hit.material as usize];
-        let bsdf = material.bsdf_at(hit.uv, &scene.textures);
+        let bsdf = material.bsdf_at(&hit.attributes, &scene.textures);
         let ng = if hit.ng.dot(wo) < 0.0 {
             -hit.ng
         } else {
@@ -724,6 +724,7 @@ pub(crate) mod tests {
             emission_texture: None,
             normal_map: None,
             double_sided: false,
+            alpha: crate::material::Alpha::OPAQUE,
         };
         let mut parts = SceneParts {
             materials: vec![road, sign],

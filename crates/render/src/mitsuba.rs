@@ -37,7 +37,7 @@ use crate::camera::Camera;
 use crate::light::Light;
 use crate::material::{Material, PaperModel, Reflectance};
 use crate::scene::{Scene, SceneError};
-use crate::texture::{Texture, TextureId};
+use crate::texture::{Sampler, Texture, TextureId, TextureRef};
 use glam::{Vec2, Vec3};
 use std::collections::HashMap;
 use std::fmt::Write as _;
@@ -297,8 +297,18 @@ impl<'a> MaterialWriter<'a> {
         )
     }
 
-    /// The scene texture `id` of `material`, or a [`MitsubaError::MissingTexture`].
-    fn texture(&self, material: &Material, id: TextureId) -> Result<&'a Texture, MitsubaError> {
+    /// The scene texture `r` refers to in `material`, or a [`MitsubaError::MissingTexture`];
+    /// a warning when the reference reads it other than as exported (TEXCOORD_0, repeat,
+    /// bilinear, untransformed).
+    fn texture(&mut self, material: &Material, r: TextureRef) -> Result<&'a Texture, MitsubaError> {
+        if r.texcoord != 0 || r.sampler != Sampler::default() || r.transform.is_some() {
+            self.warnings.push(format!(
+                "material {:?}: texture {} is exported at TEXCOORD_0 with repeat wrapping and \
+                 bilinear filtering, without its uv transform",
+                material.name, r.texture
+            ));
+        }
+        let id = r.texture;
         self.parts
             .textures
             .get(id as usize)
@@ -316,7 +326,7 @@ impl<'a> MaterialWriter<'a> {
         material: &Material,
         stem: &str,
         name: &str,
-        map: TextureId,
+        map: TextureRef,
         value: impl Fn(f32) -> Vec3,
     ) -> Result<String, MitsubaError> {
         let tex = self.texture(material, map)?;
@@ -331,7 +341,7 @@ impl<'a> MaterialWriter<'a> {
         stem: &str,
         name: &str,
         factor: Vec3,
-        texture: Option<TextureId>,
+        texture: Option<TextureRef>,
     ) -> Result<String, MitsubaError> {
         let Some(id) = texture else {
             return Ok(rgb(name, factor));
@@ -344,6 +354,12 @@ impl<'a> MaterialWriter<'a> {
     /// The `<bsdf>` element of a material.
     fn bsdf(&mut self, index: usize, m: &Material) -> Result<String, MitsubaError> {
         let stem = file_stem(index, &m.name);
+        if !m.alpha.is_opaque() {
+            self.warnings.push(format!(
+                "material {:?}: alphaMode {:?} is not exported (rendered opaque)",
+                m.name, m.alpha.mode
+            ));
+        }
         let mut out = String::new();
         match &m.reflectance {
             Reflectance::Diffuse { kd, kd_texture } => {
@@ -792,6 +808,7 @@ mod tests {
             emission_texture: None,
             normal_map: None,
             double_sided: false,
+            alpha: crate::material::Alpha::OPAQUE,
         }
     }
 
@@ -829,9 +846,9 @@ mod tests {
                 ks: Vec3::splat(0.04),
                 alpha: 0.1,
                 shininess: 0.0,
-                kd_texture: Some(0),
+                kd_texture: Some(TextureRef::new(0)),
                 wetness: Some(Wetness {
-                    texture: 0,
+                    texture: TextureRef::new(0),
                     alpha_dry: 0.5,
                     ks_dry: Vec3::splat(0.02),
                 }),

@@ -34,14 +34,14 @@
 //! applied to normal-mapped hits only: interpolated vertex normals are left as they are, so
 //! scenes without normal maps render exactly as before.
 
-use crate::texture::{Texture, TextureId};
+use crate::texture::{Texture, TextureRef};
 use glam::{Vec2, Vec3, Vec4};
 
 /// A material's tangent-space normal map (glTF `normalTexture`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NormalMap {
-    /// The linear RGB texture.
-    pub texture: TextureId,
+    /// The linear RGB texture, with its coordinate set, sampler and transform.
+    pub texture: TextureRef,
     /// `normalTexture.scale`: multiplies the X and Y of the decoded normal.
     pub scale: f32,
 }
@@ -55,21 +55,21 @@ impl NormalMap {
         n.try_normalize().unwrap_or(Vec3::Z)
     }
 
-    /// The shading normal at `uv`: the tangent-space normal of the texel there in the frame of
+    /// The shading normal at the texture coordinates `uv` (both sets): the tangent-space normal of the texel there in the frame of
     /// the unit normal `n` and the tangent `tangent` (xyz: direction, need not be unit or
     /// orthogonal to `n`; w: handedness, negative for a mirrored frame). `n` itself where the
     /// tangent is zero or parallel to `n`.
     #[inline]
-    pub fn perturb(&self, n: Vec3, tangent: Vec4, uv: Vec2, textures: &[Texture]) -> Vec3 {
+    pub fn perturb(&self, n: Vec3, tangent: Vec4, uv: [Vec2; 2], textures: &[Texture]) -> Vec3 {
         let t = tangent.truncate();
         let Some(t) = (t - n * n.dot(t)).try_normalize() else {
             return n;
         };
-        let Some(texture) = textures.get(self.texture as usize) else {
+        if textures.get(self.texture.texture as usize).is_none() {
             return n;
-        };
+        }
         let b = n.cross(t) * if tangent.w < 0.0 { -1.0 } else { 1.0 };
-        let nt = self.tangent_space_normal(texture.sample(uv));
+        let nt = self.tangent_space_normal(self.texture.sample(uv, textures));
         (t * nt.x + b * nt.y + n * nt.z)
             .try_normalize()
             .unwrap_or(n)
@@ -144,7 +144,7 @@ mod tests {
     #[test]
     fn flat_texel_leaves_the_normal_and_scale_scales_xy() {
         let map = NormalMap {
-            texture: 0,
+            texture: TextureRef::new(0),
             scale: 1.0,
         };
         assert_eq!(
@@ -154,11 +154,14 @@ mod tests {
         let n = Vec3::new(0.0, 0.6, 0.8);
         let flat = [constant(Vec4::new(0.5, 0.5, 1.0, 1.0))];
         let t = Vec4::new(1.0, 0.0, 0.0, 1.0);
-        assert!((map.perturb(n, t, Vec2::ZERO, &flat) - n).length() < 1e-7);
+        assert!((map.perturb(n, t, [Vec2::ZERO; 2], &flat) - n).length() < 1e-7);
         // scale multiplies x and y before normalisation: (2c - 1) = (0.5, -0.25, 1).
         let c = Vec4::new(0.75, 0.375, 1.0, 1.0);
         for scale in [0.0f32, 0.5, 1.0, 2.0] {
-            let m = NormalMap { texture: 0, scale };
+            let m = NormalMap {
+                texture: TextureRef::new(0),
+                scale,
+            };
             let got = m.tangent_space_normal(c);
             let want = Vec3::new(0.5 * scale, -0.25 * scale, 1.0).normalize();
             assert!(
@@ -178,7 +181,7 @@ mod tests {
     #[test]
     fn tilted_texel_tilts_the_shading_normal_by_its_angle() {
         let map = NormalMap {
-            texture: 0,
+            texture: TextureRef::new(0),
             scale: 1.0,
         };
         let n = Vec3::Y;
@@ -189,7 +192,7 @@ mod tests {
             let tex = [constant(
                 enc(Vec3::new(theta.sin(), 0.0, theta.cos())).extend(1.0),
             )];
-            let got = map.perturb(n, tangent, Vec2::ZERO, &tex);
+            let got = map.perturb(n, tangent, [Vec2::ZERO; 2], &tex);
             assert!((got.dot(n).acos() - theta).abs() < 1e-5, "{theta}: {got}");
             assert!(got.x > 0.0 && got.z.abs() < 1e-6);
             // Along the bitangent B = w cross(N, T): cross(Y, X) = -Z.
@@ -197,14 +200,14 @@ mod tests {
                 enc(Vec3::new(0.0, theta.sin(), theta.cos())).extend(1.0),
             )];
             for w in [1.0f32, -1.0] {
-                let got = map.perturb(n, tangent.truncate().extend(w), Vec2::ZERO, &tex);
+                let got = map.perturb(n, tangent.truncate().extend(w), [Vec2::ZERO; 2], &tex);
                 assert!((got.dot(n).acos() - theta).abs() < 1e-5);
                 assert!((got.z + w * theta.sin()).abs() < 1e-5, "w {w}: {got}");
             }
         }
         // No tangent, no perturbation.
         let tex = [constant(Vec4::new(1.0, 0.5, 0.5, 1.0))];
-        assert_eq!(map.perturb(n, Vec4::ZERO, Vec2::ZERO, &tex), n);
+        assert_eq!(map.perturb(n, Vec4::ZERO, [Vec2::ZERO; 2], &tex), n);
     }
 
     #[test]
@@ -273,7 +276,7 @@ mod tests {
             let mut parts = SceneParts::default();
             if let Some(c) = texel {
                 floor.normal_map = Some(NormalMap {
-                    texture: 0,
+                    texture: TextureRef::new(0),
                     scale: 1.0,
                 });
                 parts.textures.push(constant(c));

@@ -1,13 +1,125 @@
-//! Textures: decoded RGBA images in linear values, sampled with bilinear filtering and repeat
-//! wrapping (glTF's default sampler). Colour textures (base colour, emissive) are sRGB-decoded
-//! once, when they are loaded; data textures (metallic-roughness, dryness) are kept linear.
+//! Textures: decoded RGBA images in linear values, and the references materials hold to them.
+//!
+//! Colour textures (base colour, emissive) are sRGB-decoded once, when they are loaded; data
+//! textures (metallic-roughness, dryness) are kept linear.
+//!
+//! A material refers to a texture through a [`TextureRef`]: the image, which texture
+//! coordinate set it reads (`TEXCOORD_0` or `TEXCOORD_1`), the glTF sampler's wrap modes and
+//! magnification filter ([`Sampler`]), and a KHR_texture_transform ([`uv_transform`]). The
+//! image is stored once however many samplers read it.
+//!
+//! # Filtering in a path tracer
+//!
+//! Each texture lookup is a point sample (bilinear, or nearest for `magFilter: NEAREST`) at the
+//! ray's hit point, and every pixel is supersampled over its footprint, so the average over a
+//! pixel's samples converges to the texture filtered by the pixel footprint (better than a
+//! mipmap's approximation of it). The glTF `minFilter` (mipmapped or not) therefore changes
+//! only the noise at low sample counts, not the converged image: it is ignored, without a
+//! warning. `magFilter: NEAREST` is honoured (it shows as blocky texels however many samples
+//! a pixel takes).
 
-use glam::{Vec2, Vec4};
+use glam::{Affine2, Vec2, Vec4};
 use std::sync::LazyLock;
 use streaks_image::color::srgb_to_linear;
 
 /// Index of a texture in [`crate::scene::Scene::textures`].
 pub type TextureId = u32;
+
+/// How texture coordinates outside `[0, 1]` map to texels on one axis (glTF sampler `wrapS`,
+/// `wrapT`; OpenGL semantics).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Wrap {
+    /// `REPEAT` (10497, the glTF default): the image tiles.
+    #[default]
+    Repeat,
+    /// `CLAMP_TO_EDGE` (33071): coordinates are clamped to the edge texels.
+    ClampToEdge,
+    /// `MIRRORED_REPEAT` (33648): the image tiles, every other tile mirrored.
+    MirroredRepeat,
+}
+
+/// How a texture is filtered between texel centres (glTF `magFilter`; see the module
+/// documentation for `minFilter`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Filter {
+    /// `LINEAR` (the default here, as glTF leaves it to the implementation): bilinear.
+    #[default]
+    Linear,
+    /// `NEAREST`: the texel the point lies in.
+    Nearest,
+}
+
+/// A glTF sampler as far as it changes the converged image: wrap modes per axis and the
+/// magnification filter.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Sampler {
+    /// Wrapping along u (`wrapS`).
+    pub wrap_s: Wrap,
+    /// Wrapping along v (`wrapT`).
+    pub wrap_t: Wrap,
+    /// Filter between texels.
+    pub filter: Filter,
+}
+
+/// The KHR_texture_transform matrix `T * R * S` applied to `(u, v, 1)`, with
+/// `T = [1 0 ox; 0 1 oy]`, `R = [cos r, sin r; -sin r, cos r]` and `S = diag(sx, sy)` (the
+/// extension's specification, in its row-major notation): `rotation` turns the uvs
+/// counter-clockwise as seen in the image (whose v points down).
+pub fn uv_transform(offset: Vec2, rotation: f32, scale: Vec2) -> Affine2 {
+    let (sin, cos) = rotation.sin_cos();
+    // Columns of R * S: R's columns are (cos, -sin) and (sin, cos).
+    Affine2::from_cols(
+        Vec2::new(cos, -sin) * scale.x,
+        Vec2::new(sin, cos) * scale.y,
+        offset,
+    )
+}
+
+/// A material's reference to a texture: which image, read at which texture coordinate set,
+/// through which sampler and uv transform.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TextureRef {
+    /// The image.
+    pub texture: TextureId,
+    /// The texture coordinate set (0 for `TEXCOORD_0`, 1 for `TEXCOORD_1`).
+    pub texcoord: u8,
+    /// Wrapping and filtering.
+    pub sampler: Sampler,
+    /// KHR_texture_transform's matrix ([`uv_transform`]); `None` is the identity.
+    pub transform: Option<Affine2>,
+}
+
+impl TextureRef {
+    /// A reference to `texture` at `TEXCOORD_0` with the default sampler and no transform.
+    pub fn new(texture: TextureId) -> Self {
+        Self {
+            texture,
+            texcoord: 0,
+            sampler: Sampler::default(),
+            transform: None,
+        }
+    }
+
+    /// The texture coordinates this reference samples at, from the point's coordinate sets:
+    /// the chosen set, transformed.
+    #[inline]
+    pub fn uv(&self, uvs: [Vec2; 2]) -> Vec2 {
+        let uv = uvs[usize::from(self.texcoord & 1)];
+        match &self.transform {
+            Some(m) => m.transform_point2(uv),
+            None => uv,
+        }
+    }
+
+    /// The filtered texel value at the point with coordinate sets `uvs`; one where the id is
+    /// out of range (which [`crate::scene::Scene::from_parts`] rules out).
+    #[inline]
+    pub fn sample(&self, uvs: [Vec2; 2], textures: &[Texture]) -> Vec4 {
+        textures
+            .get(self.texture as usize)
+            .map_or(Vec4::ONE, |t| t.sample_with(self.uv(uvs), self.sampler))
+    }
+}
 
 /// How a texture's texels are stored once decoded.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -38,8 +150,9 @@ enum Texels {
     Rgba32F(Vec<Vec4>),
 }
 
-/// A decoded RGBA image in linear values, sampled with bilinear filtering and repeat wrapping
-/// (glTF's default sampler). 8-bit images keep their bytes (see [`Texture::from_rgba8`]).
+/// A decoded RGBA image in linear values, sampled through a [`Sampler`] (bilinear filtering
+/// and repeat wrapping by default, glTF's default sampler). 8-bit images keep their bytes (see
+/// [`Texture::from_rgba8`]).
 #[derive(Clone, Debug)]
 pub struct Texture {
     /// Width in texels.
@@ -130,23 +243,30 @@ impl Texture {
         (0..self.texel_count()).map(|i| self.texel(i))
     }
 
-    /// The filtered value at `uv`: bilinear between texel centres (texel `(i, j)` has its
-    /// centre at `((i + 0.5) / width, (j + 0.5) / height)`), repeat wrapping.
+    /// The filtered value at `uv` with the default sampler: bilinear between texel centres
+    /// (texel `(i, j)` has its centre at `((i + 0.5) / width, (j + 0.5) / height)`), repeat
+    /// wrapping.
     #[inline]
     pub fn sample(&self, uv: Vec2) -> Vec4 {
+        self.sample_with(uv, Sampler::default())
+    }
+
+    /// The value at `uv` through `sampler`: bilinear between texel centres, or the texel `uv`
+    /// lies in for [`Filter::Nearest`], with each axis wrapped as its [`Wrap`] says. A
+    /// non-finite `uv` reads texel 0.
+    #[inline]
+    pub fn sample_with(&self, uv: Vec2, sampler: Sampler) -> Vec4 {
         if !uv.is_finite() {
             return self.texel(0);
         }
-        // Reduce to one period first so that huge uvs keep their precision.
-        let u = uv.x - uv.x.floor();
-        let v = uv.y - uv.y.floor();
-        let x = u * self.width as f32 - 0.5;
-        let y = v * self.height as f32 - 0.5;
-        let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = (x - x0, y - y0);
-        let (xa, xb) = wrap_pair(x0, self.width);
-        let (ya, yb) = wrap_pair(y0, self.height);
         let row = self.width as usize;
+        if sampler.filter == Filter::Nearest {
+            let x = nearest(uv.x, self.width, sampler.wrap_s);
+            let y = nearest(uv.y, self.height, sampler.wrap_t);
+            return self.texel(y * row + x);
+        }
+        let (xa, xb, fx) = linear_pair(uv.x, self.width, sampler.wrap_s);
+        let (ya, yb, fy) = linear_pair(uv.y, self.height, sampler.wrap_t);
         let [i00, i10, i01, i11] = [ya * row + xa, ya * row + xb, yb * row + xa, yb * row + xb];
         let [c00, c10, c01, c11] = match &self.texels {
             Texels::Rgba8 { texels, srgb } => {
@@ -160,6 +280,64 @@ impl Texture {
         };
         c00.lerp(c10, fx).lerp(c01.lerp(c11, fx), fy)
     }
+}
+
+/// The two texels bilinear filtering blends on an axis of `n` texels at coordinate `u`, and
+/// the weight of the second: texel `i` has its centre at `(i + 0.5) / n`, and the texel
+/// indices outside `[0, n)` are wrapped as `wrap` says.
+#[inline]
+fn linear_pair(u: f32, n: u32, wrap: Wrap) -> (usize, usize, f32) {
+    match wrap {
+        Wrap::Repeat => {
+            // Reduce to one period first so that huge uvs keep their precision.
+            let x = (u - u.floor()) * n as f32 - 0.5;
+            let x0 = x.floor();
+            let (a, b) = wrap_pair(x0, n);
+            (a, b, x - x0)
+        }
+        Wrap::ClampToEdge => {
+            // Clamping u first changes nothing: beyond the outer texel centres both texels
+            // clamp to the edge one.
+            let x = u.clamp(0.0, 1.0) * n as f32 - 0.5;
+            let x0 = x.floor();
+            let last = n as i64 - 1;
+            let a = (x0 as i64).clamp(0, last) as usize;
+            let b = (x0 as i64 + 1).clamp(0, last) as usize;
+            (a, b, x - x0)
+        }
+        Wrap::MirroredRepeat => {
+            // Period 2 (a tile and its mirror image), texel index period 2n.
+            let x = (u - 2.0 * (0.5 * u).floor()) * n as f32 - 0.5;
+            let x0 = x.floor();
+            let a = mirror(x0 as i64, n);
+            let b = mirror(x0 as i64 + 1, n);
+            (a, b, x - x0)
+        }
+    }
+}
+
+/// The texel index on an axis of `n` texels that coordinate `u` lies in (nearest filtering),
+/// wrapped as `wrap` says.
+#[inline]
+fn nearest(u: f32, n: u32, wrap: Wrap) -> usize {
+    let last = n as i64 - 1;
+    match wrap {
+        Wrap::Repeat => (((u - u.floor()) * n as f32) as i64).min(last) as usize,
+        Wrap::ClampToEdge => ((u.clamp(0.0, 1.0) * n as f32) as i64).min(last) as usize,
+        Wrap::MirroredRepeat => {
+            let i = ((u - 2.0 * (0.5 * u).floor()) * n as f32) as i64;
+            mirror(i.min(2 * last + 1), n)
+        }
+    }
+}
+
+/// Texel index `i` (any integer) of an axis of `n` texels, mirrored-repeated: `0..n` as they
+/// are, `n..2n` backwards, and so on with period `2n`.
+#[inline]
+fn mirror(i: i64, n: u32) -> usize {
+    let n = i64::from(n);
+    let k = i.rem_euclid(2 * n);
+    (if k < n { k } else { 2 * n - 1 - k }) as usize
 }
 
 /// The texel indices of `x0` and `x0 + 1` on an axis of `n` texels, repeated: `x0` is the
@@ -234,6 +412,128 @@ mod tests {
         // Repeat wrapping: u = 0 blends the last and first columns.
         assert!((t.sample(Vec2::new(0.0, 0.25)).x - 0.5).abs() < 1e-6);
         assert_eq!(t.sample(Vec2::new(-1.25, 3.25)).x, 1.0);
+    }
+
+    /// A 4x1 ramp whose texel `i` has the value `i` (linear, any value allowed in floats).
+    fn ramp() -> Texture {
+        let texels = (0..4).map(|i| Vec4::splat(i as f32)).collect();
+        Texture::from_rgba(4, 1, texels, ColorSpace::Linear).unwrap()
+    }
+
+    fn with(wrap_s: Wrap, filter: Filter) -> Sampler {
+        Sampler {
+            wrap_s,
+            wrap_t: Wrap::Repeat,
+            filter,
+        }
+    }
+
+    /// Bilinear values at analytic points: texel `i` has its centre at `(i + 0.5) / 4`.
+    #[test]
+    fn wrap_modes_bilinear() {
+        let t = ramp();
+        let at = |u: f32, wrap| {
+            t.sample_with(Vec2::new(u, 0.5), with(wrap, Filter::Linear))
+                .x
+        };
+        let close = |a: f32, b: f32| (a - b).abs() < 1e-5;
+        // Centres are exact in every mode.
+        for wrap in [Wrap::Repeat, Wrap::ClampToEdge, Wrap::MirroredRepeat] {
+            for i in 0..4 {
+                assert!(
+                    close(at((i as f32 + 0.5) / 4.0, wrap), i as f32),
+                    "{wrap:?} {i}"
+                );
+            }
+            assert!(close(at(0.5, wrap), 1.5));
+        }
+        // Repeat: u = 0 blends the last and the first texel; the default sampler is repeat.
+        assert!(close(at(0.0, Wrap::Repeat), 1.5) && close(at(2.125, Wrap::Repeat), 0.0));
+        assert_eq!(
+            t.sample(Vec2::new(0.3, 0.5)),
+            t.sample_with(Vec2::new(0.3, 0.5), with(Wrap::Repeat, Filter::Linear))
+        );
+        // Clamp: the edge texels beyond the outer centres, however far.
+        for (u, want) in [(0.0, 0.0), (0.1, 0.0), (-7.0, 0.0), (1.0, 3.0), (1e9, 3.0)] {
+            assert!(close(at(u, Wrap::ClampToEdge), want), "clamp {u}");
+        }
+        // Mirrored repeat: u and -u, 2 - u, 2 + u read the same; the edge texel is doubled.
+        for (u, want) in [
+            (0.0, 0.0),
+            (-0.125, 0.0),
+            (1.0, 3.0),
+            (1.125, 3.0),
+            (1.25, 2.5),
+            (-0.75, 2.5),
+            (2.75, 2.5),
+            (-3.25, 2.5),
+        ] {
+            assert!(
+                close(at(u, Wrap::MirroredRepeat), want),
+                "mirror {u}: {}",
+                at(u, Wrap::MirroredRepeat)
+            );
+        }
+    }
+
+    #[test]
+    fn wrap_modes_nearest_and_per_axis() {
+        let t = ramp();
+        let at = |u: f32, wrap| {
+            t.sample_with(Vec2::new(u, 0.5), with(wrap, Filter::Nearest))
+                .x
+        };
+        for (u, repeat, clamp, mirror) in [
+            (0.3, 1.0, 1.0, 1.0),
+            (0.49, 1.0, 1.0, 1.0),
+            (0.51, 2.0, 2.0, 2.0),
+            (-0.1, 3.0, 0.0, 0.0),
+            (1.1, 0.0, 3.0, 3.0),
+            (1.0, 0.0, 3.0, 3.0),
+            (1.6, 2.0, 3.0, 1.0),
+            (-1.6, 1.0, 0.0, 1.0),
+        ] {
+            assert_eq!(at(u, Wrap::Repeat), repeat, "repeat {u}");
+            assert_eq!(at(u, Wrap::ClampToEdge), clamp, "clamp {u}");
+            assert_eq!(at(u, Wrap::MirroredRepeat), mirror, "mirror {u}");
+        }
+        // Per axis: a 1x4 column clamps along v while u repeats.
+        let texels = (0..4).map(|i| Vec4::splat(i as f32)).collect();
+        let column = Texture::from_rgba(1, 4, texels, ColorSpace::Linear).unwrap();
+        let s = Sampler {
+            wrap_s: Wrap::Repeat,
+            wrap_t: Wrap::ClampToEdge,
+            filter: Filter::Nearest,
+        };
+        assert_eq!(column.sample_with(Vec2::new(-3.3, 1.7), s).x, 3.0);
+        assert_eq!(column.sample_with(Vec2::new(5.5, -1.0), s).x, 0.0);
+        assert_eq!(column.sample_with(Vec2::new(0.5, 0.6), s).x, 2.0);
+    }
+
+    /// KHR_texture_transform is `T * R * S`: scale first, then rotate, then offset.
+    #[test]
+    fn uv_transform_is_translation_rotation_scale() {
+        let m = uv_transform(
+            Vec2::new(0.5, 0.0),
+            std::f32::consts::FRAC_PI_2,
+            Vec2::splat(2.0),
+        );
+        // (0.25, 0.1) -> S (0.5, 0.2) -> R [0 1; -1 0] (0.2, -0.5) -> T (0.7, -0.5).
+        let q = m.transform_point2(Vec2::new(0.25, 0.1));
+        assert!((q - Vec2::new(0.7, -0.5)).length() < 1e-6, "{q}");
+        assert_eq!(uv_transform(Vec2::ZERO, 0.0, Vec2::ONE), Affine2::IDENTITY);
+        // A 4x4 texture of texel (i, j) = i + 4 j, read through an offset of one texel in u
+        // and at TEXCOORD_1: uv (0.125, 0.375) lands in texel (1, 1).
+        let texels = (0..16).map(|k| Vec4::splat(k as f32)).collect();
+        let textures = [Texture::from_rgba(4, 4, texels, ColorSpace::Linear).unwrap()];
+        let r = TextureRef {
+            texcoord: 1,
+            transform: Some(uv_transform(Vec2::new(0.25, 0.0), 0.0, Vec2::ONE)),
+            ..TextureRef::new(0)
+        };
+        let uvs = [Vec2::new(0.875, 0.875), Vec2::new(0.125, 0.375)];
+        assert!((r.sample(uvs, &textures).x - 5.0).abs() < 1e-5);
+        assert!((TextureRef::new(0).sample(uvs, &textures).x - 15.0).abs() < 1e-5);
     }
 
     /// Bytes kept as bytes sample to exactly the values of decoding them at load time.

@@ -214,7 +214,10 @@ mod tests {
                 let (mut lo, mut hi) = (f32::INFINITY, 0.0f32);
                 for k in 0..400 {
                     let uv = glam::Vec2::new((k % 20) as f32 / 20.0, (k / 20) as f32 / 20.0);
-                    let Bsdf::Ggx(g) = road.bsdf_at(uv, &scene.textures) else {
+                    let Bsdf::Ggx(g) = road.bsdf_at(
+                        &streaks_render::geometry::VertexAttributes::from_uv(uv),
+                        &scene.textures,
+                    ) else {
                         panic!("{name}: the road is not ggx");
                     };
                     lo = lo.min(g.alpha);

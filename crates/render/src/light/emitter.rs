@@ -7,7 +7,11 @@
 //! analysis.
 //!
 //! An emissive triangle is an area light of radiance `emission` (times its texture), one-sided
-//! (the front face, by the triangle's winding) unless its material is double-sided. An emitter
+//! (the front face, by the triangle's winding) unless its material is double-sided. A
+//! triangle of a material that is not opaque emits where rays stop on it: light samples carry
+//! `emission x stop probability` (zero in a masked-out hole, alpha on a `BLEND` surface,
+//! [`crate::material::Alpha::stop_probability`]), which is what the rays that hit it find on
+//! average. The power that chooses between triangles ignores alpha. An emitter
 //! mesh is sampled one of two ways:
 //!
 //! - a compact mesh (area at least [`COMPACT_AREA_RATIO`]` pi r^2` for bounding radius `r`, a
@@ -19,14 +23,14 @@
 //!   `pdf = d^2 / (|cos theta_light| A)`.
 
 use super::{Light, LightSample, Visibility};
-use crate::geometry::{Frame, SurfaceHit};
+use crate::geometry::{Frame, SurfaceHit, VertexAttributes};
 use crate::material::Material;
 use crate::sampling::{
     square_to_uniform_cone, square_to_uniform_cone_pdf, square_to_uniform_triangle,
     DiscreteDistribution,
 };
 use crate::texture::Texture;
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 use std::collections::HashMap;
 use std::f32::consts::PI;
 use streaks_image::luminance;
@@ -43,6 +47,10 @@ pub struct SurfaceMesh<'a> {
     pub positions: &'a [Vec3],
     /// Texture coordinates, one per vertex.
     pub uvs: &'a [Vec2],
+    /// The second texture coordinate set, one per vertex, or empty (`uvs` is read instead).
+    pub uvs1: &'a [Vec2],
+    /// Vertex colours, one per vertex, or empty (white).
+    pub colors: &'a [Vec4],
     /// Vertex indices of each triangle.
     pub triangles: &'a [[u32; 3]],
     /// Material index of each triangle.
@@ -57,6 +65,39 @@ impl SurfaceMesh<'_> {
     fn vertices(&self, t: usize) -> [Vec3; 3] {
         self.triangles[t].map(|v| self.positions[v as usize])
     }
+
+    /// The attributes of vertex `v`.
+    #[inline]
+    pub fn vertex_attributes(&self, v: usize) -> VertexAttributes {
+        let uv = self.uvs[v];
+        VertexAttributes {
+            uv: [uv, self.uvs1.get(v).copied().unwrap_or(uv)],
+            color: self.colors.get(v).copied().unwrap_or(Vec4::ONE),
+        }
+    }
+
+    /// The attributes of triangle `t` at barycentrics `b` (the weights of its second and
+    /// third vertices), interpolated linearly.
+    #[inline]
+    pub fn attributes_at(&self, t: usize, b: Vec2) -> VertexAttributes {
+        let [i0, i1, i2] = self.triangles[t].map(|v| v as usize);
+        let b0 = 1.0 - b.x - b.y;
+        let uv0 = self.uvs[i0] * b0 + self.uvs[i1] * b.x + self.uvs[i2] * b.y;
+        let uv1 = if self.uvs1.is_empty() {
+            uv0
+        } else {
+            self.uvs1[i0] * b0 + self.uvs1[i1] * b.x + self.uvs1[i2] * b.y
+        };
+        let color = if self.colors.is_empty() {
+            Vec4::ONE
+        } else {
+            self.colors[i0] * b0 + self.colors[i1] * b.x + self.colors[i2] * b.y
+        };
+        VertexAttributes {
+            uv: [uv0, uv1],
+            color,
+        }
+    }
 }
 
 /// One emissive triangle of an emitter mesh, with what sampling it needs.
@@ -64,8 +105,8 @@ impl SurfaceMesh<'_> {
 struct EmitterTriangle {
     /// Vertex positions.
     v: [Vec3; 3],
-    /// Vertex texture coordinates.
-    uv: [Vec2; 3],
+    /// Vertex attributes (texture coordinates, colour).
+    attributes: [VertexAttributes; 3],
     /// Unit geometric normal from the winding.
     n: Vec3,
     /// Area.
@@ -73,12 +114,12 @@ struct EmitterTriangle {
 }
 
 impl EmitterTriangle {
-    fn new(v: [Vec3; 3], uv: [Vec2; 3]) -> Self {
+    fn new(v: [Vec3; 3], attributes: [VertexAttributes; 3]) -> Self {
         let cross = (v[1] - v[0]).cross(v[2] - v[0]);
         let len = cross.length();
         Self {
             v,
-            uv,
+            attributes,
             n: cross / len,
             area: 0.5 * len,
         }
@@ -108,8 +149,15 @@ impl EmitterTriangle {
         if cos_light.abs() < 1e-7 || (!material.double_sided && cos_light <= 0.0) {
             return None;
         }
-        let uv = b0 * self.uv[0] + b.x * self.uv[1] + b.y * self.uv[2];
-        let li = material.emission_at(uv, textures);
+        let [a0, a1, a2] = &self.attributes;
+        let at = VertexAttributes {
+            uv: [0, 1].map(|k| b0 * a0.uv[k] + b.x * a1.uv[k] + b.y * a2.uv[k]),
+            color: b0 * a0.color + b.x * a1.color + b.y * a2.color,
+        };
+        let mut li = material.emission_at(&at, textures);
+        if !material.alpha.is_opaque() {
+            li *= material.alpha.stop_probability(&at, textures);
+        }
         let pdf = dist2 / (cos_light.abs() * self.area);
         (pdf.is_finite() && li.max_element() > 0.0).then_some(LightSample {
             wi,
@@ -333,8 +381,9 @@ impl MeshEmitter {
         let triangles: Vec<EmitterTriangle> = group
             .iter()
             .map(|&t| {
-                let uv = mesh.triangles[t as usize].map(|v| mesh.uvs[v as usize]);
-                EmitterTriangle::new(mesh.vertices(t as usize), uv)
+                let attributes =
+                    mesh.triangles[t as usize].map(|v| mesh.vertex_attributes(v as usize));
+                EmitterTriangle::new(mesh.vertices(t as usize), attributes)
             })
             .collect();
         let powers: Vec<f32> = triangles
@@ -510,6 +559,40 @@ mod tests {
         }
     }
 
+    /// A BLEND emitter's light samples carry emission x alpha (what the rays that hit it see
+    /// on average), a MASK one's nothing in its holes and all of it elsewhere.
+    #[test]
+    fn light_samples_of_transparent_emitters_carry_their_coverage() {
+        use crate::material::{Alpha, AlphaMode};
+        let s = triangle_scene(false);
+        for (mode, factor, want) in [
+            (AlphaMode::Opaque, 0.3, 1.0),
+            (AlphaMode::Blend, 0.3, 0.3),
+            (AlphaMode::Mask { cutoff: 0.5 }, 0.3, 0.0),
+            (AlphaMode::Mask { cutoff: 0.5 }, 0.6, 1.0),
+        ] {
+            let mut materials = s.materials.clone();
+            materials[0].alpha = Alpha {
+                mode,
+                factor,
+                texture: None,
+            };
+            let ls = mesh(&s, 0).sample_li(
+                &materials,
+                &s.textures,
+                0,
+                Vec3::ZERO,
+                0.5,
+                Vec2::splat(0.4),
+            );
+            let li = ls.map_or(Vec3::ZERO, |ls| ls.li);
+            assert!(
+                (li - Vec3::new(2.0, 1.0, 0.5) * want).length() < 1e-6,
+                "{mode:?} {factor}: {li}"
+            );
+        }
+    }
+
     #[test]
     fn triangle_sampling_density_matches_solid_angle_and_pdf_li() {
         let s = triangle_scene(false);
@@ -540,7 +623,7 @@ mod tests {
                     p: q,
                     ng: -Vec3::Z,
                     ns: -Vec3::Z,
-                    uv: Vec2::ZERO,
+                    attributes: VertexAttributes::from_uv(Vec2::ZERO),
                     triangle: 0,
                     material: 0,
                 };

@@ -41,6 +41,9 @@ pub(super) const DIRECTION: &[Component] = &[FLOAT, (DataType::I8, true), (DataT
 /// KHR_mesh_quantization adds the signed ones and the unnormalized ones).
 pub(super) const TEXCOORD: &[Component] = POSITION;
 
+/// Component types of COLOR_0 (core: float, normalized unsigned 8- and 16-bit integers).
+pub(super) const COLOR: &[Component] = &[FLOAT, (DataType::U8, true), (DataType::U16, true)];
+
 /// The number of components of an accessor type.
 fn components(d: Dimensions) -> usize {
     match d {

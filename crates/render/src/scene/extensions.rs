@@ -25,6 +25,7 @@ pub const HONOURED: &[&str] = &[
     "KHR_materials_specular",
     "KHR_materials_ior",
     "KHR_materials_clearcoat",
+    "KHR_texture_transform",
 ];
 
 /// How an element that uses `extension` is rendered when the extension is not honoured.
@@ -40,7 +41,6 @@ fn without(extension: &str) -> &'static str {
         "KHR_materials_pbrSpecularGlossiness" => {
             "its specular-glossiness parameters are ignored (metallic-roughness defaults)"
         }
-        "KHR_texture_transform" => "its textures are read without their offset, scale or rotation",
         "EXT_mesh_gpu_instancing" => "drawn once, without its instances",
         "KHR_texture_basisu" | "EXT_texture_webp" | "EXT_texture_avif" | "MSFT_texture_dds" => {
             "its textures in that format are not decoded"
@@ -185,12 +185,11 @@ mod tests {
     #[test]
     fn used_and_unsupported_warns_for_every_user_by_name() {
         let doc = json!({
-            "extensionsUsed": ["KHR_materials_transmission", "KHR_texture_transform",
+            "extensionsUsed": ["KHR_materials_transmission", "KHR_materials_sheen",
                                "KHR_materials_emissive_strength", "EXT_unknown"],
             "materials": [
                 {"name": "glass", "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1}}},
-                {"name": "road", "pbrMetallicRoughness": {"baseColorTexture":
-                    {"index": 0, "extensions": {"KHR_texture_transform": {"scale": [4, 4]}}}}},
+                {"name": "road", "extensions": {"KHR_materials_sheen": {"sheenColorFactor": [1, 1, 1]}}},
                 {"extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 5}}}
             ]
         });
@@ -202,7 +201,7 @@ mod tests {
         );
         assert!(w[0].contains("opaque"), "{w:?}");
         assert!(
-            w[1].contains("material \"road\" (1) uses KHR_texture_transform"),
+            w[1].contains("material \"road\" (1) uses KHR_materials_sheen"),
             "{w:?}"
         );
         assert!(

@@ -10,10 +10,12 @@
 use super::{accessor, compression, extensions, tangents, Scene, SceneError, SceneParts};
 use crate::camera::Camera;
 use crate::light::{Light, LUMINOUS_EFFICACY};
-use crate::material::{Material, PaperModel, Reflectance, Wetness};
+use crate::material::{Alpha, AlphaMode, Material, PaperModel, Reflectance, Wetness};
 use crate::normal_map::NormalMap;
-use crate::texture::{ColorSpace, Texture, TextureId};
-use glam::{Affine3A, Mat3, Mat4, Quat, Vec2, Vec3, Vec4};
+use crate::texture::{
+    uv_transform, ColorSpace, Filter, Sampler, Texture, TextureId, TextureRef, Wrap,
+};
+use glam::{Affine2, Affine3A, Mat3, Mat4, Quat, Vec2, Vec3, Vec4};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 use serde::Deserialize;
@@ -50,9 +52,9 @@ enum StreaksBsdf {
 /// A material's KHR_materials_specular and KHR_materials_ior parameters.
 struct Specular {
     factor: f32,
-    texture: Option<TextureId>,
+    texture: Option<TextureRef>,
     color: Vec3,
-    color_texture: Option<TextureId>,
+    color_texture: Option<TextureRef>,
     ior: f32,
 }
 
@@ -62,21 +64,21 @@ struct Specular {
 struct Clearcoat {
     #[serde(default)]
     clearcoat_factor: f32,
-    clearcoat_texture: Option<TextureRef>,
+    clearcoat_texture: Option<JsonTextureInfo>,
     #[serde(default)]
     clearcoat_roughness_factor: f32,
-    clearcoat_roughness_texture: Option<TextureRef>,
+    clearcoat_roughness_texture: Option<JsonTextureInfo>,
     clearcoat_normal_texture: Option<serde_json::Value>,
     #[serde(skip)]
-    texture: Option<TextureId>,
+    texture: Option<TextureRef>,
     #[serde(skip)]
-    roughness_texture: Option<TextureId>,
+    roughness_texture: Option<TextureRef>,
 }
 
 /// A textureInfo read from the JSON: the texture's index and its texCoord set.
 #[derive(Clone, Copy, Debug, Deserialize)]
 #[serde(rename_all = "camelCase")]
-struct TextureRef {
+struct JsonTextureInfo {
     index: usize,
     #[serde(default)]
     tex_coord: u32,
@@ -642,6 +644,36 @@ impl Loader<'_> {
             };
             let buffers = &self.buffers;
             let reader = prim.reader(|b| buffers.get(b.index()).map(|d| d.0.as_slice()));
+            let uvs1: Option<Vec<Vec2>> = match prim.get(&gltf::Semantic::TexCoords(1)) {
+                Some(a) => Some(
+                    self.attribute(&a, &element, "TEXCOORD_1", accessor::TEXCOORD, Some(n))?
+                        .into_iter()
+                        .map(Vec2::from)
+                        .collect(),
+                ),
+                None => None,
+            };
+            let colors: Option<Vec<Vec4>> = match prim.get(&gltf::Semantic::Colors(0)) {
+                Some(a) if a.dimensions() == Dimensions::Vec3 => Some(
+                    self.attribute::<3>(&a, &element, "COLOR_0", accessor::COLOR, Some(n))?
+                        .into_iter()
+                        .map(|c| Vec3::from(c).extend(1.0))
+                        .collect(),
+                ),
+                Some(a) => Some(
+                    self.attribute::<4>(&a, &element, "COLOR_0", accessor::COLOR, Some(n))?
+                        .into_iter()
+                        .map(Vec4::from)
+                        .collect(),
+                ),
+                None => None,
+            };
+            if colors
+                .as_ref()
+                .is_some_and(|c| c.iter().any(|c| !c.is_finite()))
+            {
+                return Err(self.bad(format!("{element}, COLOR_0"), "contains a non-finite value"));
+            }
             let indices: Vec<u32> = match reader.read_indices() {
                 Some(it) => it.into_u32().collect(),
                 None => (0..n as u32).collect(),
@@ -671,6 +703,7 @@ impl Loader<'_> {
                 .map(|&p| world.transform_point3(p))
                 .collect();
             let (mut normals, mut uvs) = (normals, uvs);
+            let (mut uvs1, mut colors) = (uvs1, colors);
             let tangents = if normal_mapped {
                 let (t, copies) = match file_tangents {
                     Some(t) => (tangents::to_world(t.into_iter(), world), Vec::new()),
@@ -685,10 +718,26 @@ impl Loader<'_> {
                 tangents::extend_copies(&mut positions, &copies);
                 tangents::extend_copies(&mut normals, &copies);
                 tangents::extend_copies(&mut uvs, &copies);
+                if let Some(uvs1) = &mut uvs1 {
+                    tangents::extend_copies(uvs1, &copies);
+                }
+                if let Some(colors) = &mut colors {
+                    tangents::extend_copies(colors, &copies);
+                }
                 Some(t)
             } else {
                 None
             };
+            if uvs1.is_none()
+                && self.parts.materials[material as usize]
+                    .texture_refs()
+                    .any(|t| t.texcoord == 1)
+            {
+                self.warn(format!(
+                    "{element}: its material reads TEXCOORD_1, which the primitive does not \
+                     have; TEXCOORD_0 is read instead"
+                ));
+            }
             let first = self.parts.positions.len();
             if first + positions.len() > u32::MAX as usize {
                 return Err(self.bad(element, "the scene has more than 2^32 - 1 vertices"));
@@ -703,6 +752,33 @@ impl Loader<'_> {
             }
             self.parts.positions.extend(positions);
             self.parts.normals.extend(normals);
+            // The second uv set and the colours are stored only once some primitive has them:
+            // earlier vertices get TEXCOORD_0 and white, as do later primitives without them.
+            let parts = &mut self.parts;
+            match uvs1 {
+                Some(uvs1) => {
+                    if parts.uvs1.is_empty() {
+                        parts.uvs1 = parts.uvs.clone();
+                    }
+                    parts.uvs1.extend(uvs1);
+                }
+                None if !parts.uvs1.is_empty() => parts.uvs1.extend_from_slice(&uvs),
+                None => {}
+            }
+            match colors {
+                Some(colors) => {
+                    if parts.colors.is_empty() {
+                        parts.colors = vec![Vec4::ONE; parts.uvs.len()];
+                    }
+                    parts.colors.extend(colors);
+                }
+                None if !parts.colors.is_empty() => {
+                    parts
+                        .colors
+                        .extend(std::iter::repeat_n(Vec4::ONE, uvs.len()));
+                }
+                None => {}
+            }
             self.parts.uvs.extend(uvs);
             self.parts
                 .triangle_materials
@@ -769,6 +845,7 @@ impl Loader<'_> {
                 emission_texture: None,
                 normal_map: None,
                 double_sided: false,
+                alpha: Alpha::OPAQUE,
             });
             (self.parts.materials.len() - 1) as u32
         })
@@ -809,6 +886,7 @@ impl Loader<'_> {
                     texture: self.texture_of(
                         &info.texture(),
                         info.tex_coord(),
+                        None,
                         ColorSpace::Linear,
                         &element,
                     )?,
@@ -822,6 +900,25 @@ impl Loader<'_> {
             return Err(self.bad(element, format!("emission {emission} is invalid")));
         }
         let base = Vec4::from(pbr.base_color_factor());
+        let mode = match m.alpha_mode() {
+            gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+            gltf::material::AlphaMode::Mask => {
+                let cutoff = m.alpha_cutoff().unwrap_or(0.5);
+                if !cutoff.is_finite() {
+                    return Err(self.bad(element, format!("alphaCutoff {cutoff} is invalid")));
+                }
+                AlphaMode::Mask { cutoff }
+            }
+            gltf::material::AlphaMode::Blend => AlphaMode::Blend,
+        };
+        let alpha = match mode {
+            AlphaMode::Opaque => Alpha::OPAQUE,
+            mode => Alpha {
+                mode,
+                factor: base.w,
+                texture: base_color_texture,
+            },
+        };
         let reflectance = match self.streaks_extras(m, &element)? {
             Some(x) => self.paper(x, base_color_texture, mr_texture, &element)?,
             None => {
@@ -852,6 +949,7 @@ impl Loader<'_> {
             emission_texture,
             normal_map,
             double_sided: m.double_sided(),
+            alpha,
         })
     }
 
@@ -946,7 +1044,7 @@ impl Loader<'_> {
                 let why = format!("{key}: texture {} does not exist", info.index);
                 return Err(self.bad(element, reason(why)));
             };
-            let id = self.texture_of(&texture, info.tex_coord, space, element)?;
+            let id = self.texture_of(&texture, info.tex_coord, None, space, element)?;
             match key {
                 "clearcoatTexture" => c.texture = Some(id),
                 _ => c.roughness_texture = Some(id),
@@ -976,8 +1074,8 @@ impl Loader<'_> {
     fn paper(
         &self,
         x: StreaksExtras,
-        kd_texture: Option<TextureId>,
-        mr_texture: Option<TextureId>,
+        kd_texture: Option<TextureRef>,
+        mr_texture: Option<TextureRef>,
         element: &str,
     ) -> Result<Reflectance, SceneError> {
         let bad = |reason: String| self.bad(element, format!("extras.streaks: {reason}"));
@@ -1041,38 +1139,83 @@ impl Loader<'_> {
         })
     }
 
+    /// The reference a material's texture info makes: its image (decoded once per colour
+    /// space), texture coordinate set, sampler and KHR_texture_transform.
     fn texture(
         &mut self,
         info: &gltf::texture::Info,
         space: ColorSpace,
         material: &str,
-    ) -> Result<TextureId, SceneError> {
-        self.texture_of(&info.texture(), info.tex_coord(), space, material)
+    ) -> Result<TextureRef, SceneError> {
+        let transform = info.texture_transform();
+        self.texture_of(
+            &info.texture(),
+            info.tex_coord(),
+            transform,
+            space,
+            material,
+        )
     }
 
-    /// The decoded texture `texture` (read through the uv set `tex_coord`) in `space`.
+    /// The reference to `texture` read at TEXCOORD_`tex_coord` through `transform` (for the
+    /// texture infos the gltf crate has no KHR_texture_transform accessor for, `None`): its
+    /// image (decoded once per colour space), texture coordinate set, sampler and transform.
     fn texture_of(
         &mut self,
         texture: &gltf::Texture,
         tex_coord: u32,
+        transform: Option<gltf::texture::TextureTransform>,
+        space: ColorSpace,
+        material: &str,
+    ) -> Result<TextureRef, SceneError> {
+        let element = format!("{material}, texture {}", texture.index());
+        // KHR_texture_transform's texCoord overrides the texture info's.
+        let set = transform
+            .as_ref()
+            .and_then(|t| t.tex_coord())
+            .unwrap_or(tex_coord);
+        let texcoord = match set {
+            0 | 1 => set as u8,
+            _ => {
+                self.warn(format!(
+                    "{element} uses TEXCOORD_{set}; only TEXCOORD_0 and TEXCOORD_1 are read, \
+                     TEXCOORD_0 is used instead"
+                ));
+                0
+            }
+        };
+        let transform = match transform {
+            None => None,
+            Some(t) => {
+                let (offset, rotation, scale) =
+                    (Vec2::from(t.offset()), t.rotation(), Vec2::from(t.scale()));
+                if !(offset.is_finite() && rotation.is_finite() && scale.is_finite()) {
+                    return Err(self.bad(
+                        element,
+                        "KHR_texture_transform has a non-finite offset, rotation or scale",
+                    ));
+                }
+                let m = uv_transform(offset, rotation, scale);
+                (m != Affine2::IDENTITY).then_some(m)
+            }
+        };
+        let sampler = sampler(&texture.sampler());
+        let image = self.image(texture, space, material)?;
+        Ok(TextureRef {
+            texture: image,
+            texcoord,
+            sampler,
+            transform,
+        })
+    }
+
+    /// The decoded image of `texture` in colour space `space`, decoded once.
+    fn image(
+        &mut self,
+        texture: &gltf::Texture,
         space: ColorSpace,
         material: &str,
     ) -> Result<TextureId, SceneError> {
-        if tex_coord != 0 {
-            self.warn(format!(
-                "{material}: texture uses TEXCOORD_{tex_coord}; TEXCOORD_0 is used instead"
-            ));
-        }
-        let sampler = texture.sampler();
-        let repeat = gltf::texture::WrappingMode::Repeat;
-        if sampler.wrap_s() != repeat || sampler.wrap_t() != repeat {
-            self.warn(format!(
-                "{material}: texture {} asks for {:?}/{:?} wrapping; repeat is used",
-                texture.index(),
-                sampler.wrap_s(),
-                sampler.wrap_t()
-            ));
-        }
         let image = texture.source();
         let key = (image.index(), space);
         if let Some(&id) = self.textures.get(&key) {
@@ -1110,6 +1253,25 @@ impl Loader<'_> {
         self.parts.textures.push(texture);
         self.textures.insert(key, id);
         Ok(id)
+    }
+}
+
+/// What of a glTF sampler the renderer honours: the wrap modes and the magnification filter
+/// (see [`crate::texture`] for why `minFilter` does not change the converged image).
+fn sampler(s: &gltf::texture::Sampler) -> Sampler {
+    use gltf::texture::{MagFilter, WrappingMode};
+    let wrap = |w| match w {
+        WrappingMode::Repeat => Wrap::Repeat,
+        WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+        WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+    };
+    Sampler {
+        wrap_s: wrap(s.wrap_s()),
+        wrap_t: wrap(s.wrap_t()),
+        filter: match s.mag_filter() {
+            Some(MagFilter::Nearest) => Filter::Nearest,
+            Some(MagFilter::Linear) | None => Filter::Linear,
+        },
     }
 }
 
@@ -1187,6 +1349,7 @@ fn decode_image(data: &gltf::image::Data, space: ColorSpace) -> Option<Texture> 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::VertexAttributes;
     use serde_json::{json, Value};
     use std::f32::consts::FRAC_1_SQRT_2;
 
@@ -1357,9 +1520,9 @@ mod tests {
             .expect("hits the quad");
         assert!((hit.t - 4.0).abs() < 1e-5 && approx(hit.ng, Vec3::Y) && approx(hit.ns, Vec3::Y));
         assert!(
-            (hit.uv - Vec2::new(0.5, 0.25)).length() < 1e-5,
+            (hit.attributes.uv[0] - Vec2::new(0.5, 0.25)).length() < 1e-5,
             "{}",
-            hit.uv
+            hit.attributes.uv[0]
         );
         assert_eq!(scene.materials[hit.material as usize].name, "asphalt");
         // The triangle: ng = +Z from its winding, ns falls back to ng.
@@ -1715,6 +1878,113 @@ mod tests {
         assert!(err.contains("road.glb"), "{err}");
     }
 
+    /// TEXCOORD_1, COLOR_0 (normalized bytes), KHR_texture_transform with its texCoord
+    /// override, a sampler, alphaMode MASK and an emissive texture sharing the image.
+    #[test]
+    fn second_uvs_vertex_colours_transforms_samplers_and_masks() {
+        // 2x2 white PNG, alpha: top row opaque, transparent; bottom row the other way round.
+        let mut png = Vec::new();
+        let texels = [255, 255, 255, 255, 255, 255, 255, 0]
+            .into_iter()
+            .chain([255, 255, 255, 0, 255, 255, 255, 255])
+            .collect();
+        image::RgbaImage::from_raw(2, 2, texels)
+            .unwrap()
+            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+            .unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("leaf.png"), &png).unwrap();
+        let mut d = Doc::default();
+        // A unit quad in z = 0 facing +Z; uv1 = uv0 / 2; red opaque at y = 0, blue 0.2 at y = 1.
+        let pos = d.floats(&[0., 0., 0., 1., 0., 0., 1., 1., 0., 0., 1., 0.], "VEC3", 3);
+        let uv0 = d.floats(&[0., 0., 1., 0., 1., 1., 0., 1.], "VEC2", 2);
+        let uv1 = d.floats(&[0., 0., 0.5, 0., 0.5, 0.5, 0., 0.5], "VEC2", 2);
+        let colours = d.view(&[255, 0, 0, 255, 255, 0, 0, 255, 0, 0, 255, 51, 0, 0, 255, 51]);
+        d.accessors
+            .push(json!({"bufferView": colours, "componentType": 5121,
+            "normalized": true, "count": 4, "type": "VEC4"}));
+        let col = d.accessors.len() - 1;
+        let idx = d.indices(&[0, 1, 2, 0, 2, 3]);
+        // Behind it, an emissive triangle in z = -1 without uvs or colours.
+        let tri = d.floats(&[0., 0., -1., 1., 0., -1., 0., 1., -1.], "VEC3", 3);
+        let doc = json!({
+            "asset": {"version": "2.0"},
+            "extensionsUsed": ["KHR_texture_transform"],
+            "scenes": [{"nodes": [0]}],
+            "nodes": [{"mesh": 0}],
+            "meshes": [{"primitives": [
+                {"attributes": {"POSITION": pos, "TEXCOORD_0": uv0, "TEXCOORD_1": uv1,
+                    "COLOR_0": col}, "indices": idx, "material": 0},
+                {"attributes": {"POSITION": tri}, "material": 1}]}],
+            "materials": [
+                {"name": "leaf", "alphaMode": "MASK", "pbrMetallicRoughness": {
+                    "baseColorTexture": {"index": 0, "extensions": {"KHR_texture_transform":
+                        {"offset": [0.25, 0], "texCoord": 1}}}}},
+                {"name": "glow", "emissiveFactor": [1, 1, 1], "emissiveTexture": {"index": 1}}
+            ],
+            "images": [{"uri": "leaf.png"}],
+            "samplers": [{"magFilter": 9728, "wrapS": 33071, "wrapT": 33648}],
+            "textures": [{"source": 0, "sampler": 0}, {"source": 0}],
+            "buffers": [{"byteLength": d.bin.len()}],
+            "bufferViews": d.views,
+            "accessors": d.accessors
+        });
+        let scene = Scene::load(&write_embedded(dir.path(), doc, &d.bin)).unwrap();
+        assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+        // One image for both textures (same colour space); the second uv set and the colours
+        // are stored for every vertex, TEXCOORD_0 and white where a primitive has none.
+        assert_eq!(scene.textures.len(), 1);
+        assert_eq!(scene.uvs1.len(), 7);
+        assert_eq!(scene.uvs1[2], Vec2::new(0.5, 0.5));
+        assert_eq!(scene.uvs1[4..], scene.uvs[4..]);
+        assert!((scene.colors[2] - Vec4::new(0.0, 0.0, 1.0, 0.2)).length() < 1e-6);
+        assert_eq!(scene.colors[5], Vec4::ONE);
+        let Reflectance::GltfPbr {
+            base_color_texture: Some(base),
+            ..
+        } = scene.materials[0].reflectance
+        else {
+            panic!("no base colour texture")
+        };
+        assert_eq!(
+            base,
+            TextureRef {
+                texture: 0,
+                texcoord: 1,
+                sampler: Sampler {
+                    wrap_s: Wrap::ClampToEdge,
+                    wrap_t: Wrap::MirroredRepeat,
+                    filter: Filter::Nearest,
+                },
+                transform: Some(uv_transform(Vec2::new(0.25, 0.0), 0.0, Vec2::ONE)),
+            }
+        );
+        let leaf = &scene.materials[0];
+        assert_eq!(leaf.alpha.mode, AlphaMode::Mask { cutoff: 0.5 });
+        // At x = 0.4 the transformed TEXCOORD_1 (0.45, 0.1) is in the opaque texel (TEXCOORD_0
+        // would be in the transparent one); at x = 0.7 (0.6, 0.1) is in the transparent one,
+        // so the ray goes on to the triangle behind.
+        let down = |x: f32, y: f32| {
+            scene
+                .intersect(&crate::geometry::Ray::new(Vec3::new(x, y, 1.0), -Vec3::Z))
+                .unwrap()
+        };
+        let hit = down(0.4, 0.2);
+        assert!((hit.t - 1.0).abs() < 1e-5 && hit.material == 0);
+        assert!((hit.attributes.uv[1] - Vec2::new(0.2, 0.1)).length() < 1e-6);
+        let c = hit.attributes.color;
+        assert!((c - Vec4::new(0.8, 0.0, 0.2, 0.84)).length() < 1e-5, "{c}");
+        let crate::bsdf::Bsdf::GltfPbr(b) = leaf.bsdf_at(&hit.attributes, &scene.textures) else {
+            panic!("not pbr")
+        };
+        assert!((b.base_color - Vec3::new(0.8, 0.0, 0.2)).length() < 1e-5);
+        let hit = down(0.7, 0.2);
+        assert!((hit.t - 2.0).abs() < 1e-5 && hit.material == 1, "{hit:?}");
+        // The emissive texture is read (white: the emission is the factor).
+        assert!(scene.materials[1].emission_texture.is_some());
+        assert!(approx(scene.emitted_radiance(&hit, Vec3::Z), Vec3::ONE));
+    }
+
     #[test]
     fn wet_dry_material_reads_the_dryness_map() {
         // A 2x1 PNG: left texel G = 0 (wet), right texel G = 255 (dry).
@@ -1735,10 +2005,16 @@ mod tests {
         let scene = Scene::load(&write_embedded(dir.path(), doc.clone(), &bin)).unwrap();
         assert_eq!(scene.textures.len(), 1);
         let m = &scene.materials[0];
-        let crate::bsdf::Bsdf::Ggx(wet) = m.bsdf_at(Vec2::new(0.25, 0.5), &scene.textures) else {
+        let crate::bsdf::Bsdf::Ggx(wet) = m.bsdf_at(
+            &VertexAttributes::from_uv(Vec2::new(0.25, 0.5)),
+            &scene.textures,
+        ) else {
             panic!("not ggx")
         };
-        let crate::bsdf::Bsdf::Ggx(dry) = m.bsdf_at(Vec2::new(0.75, 0.5), &scene.textures) else {
+        let crate::bsdf::Bsdf::Ggx(dry) = m.bsdf_at(
+            &VertexAttributes::from_uv(Vec2::new(0.75, 0.5)),
+            &scene.textures,
+        ) else {
             panic!("not ggx")
         };
         assert!((wet.alpha - 0.05).abs() < 1e-6 && (dry.alpha - 0.45).abs() < 1e-6);
@@ -1795,7 +2071,7 @@ mod tests {
         let scene = load(doc, &bin);
         assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
         let m = scene.materials[0].normal_map.unwrap();
-        assert_eq!((m.texture, m.scale), (0, 1.0));
+        assert_eq!((m.texture.texture, m.scale), (0, 1.0));
         // One tangent per vertex; the quad's are +X with w = +1, the unmapped triangle's zero.
         assert_eq!(scene.tangents.len(), scene.positions.len());
         for t in &scene.tangents[..4] {
@@ -1974,7 +2250,10 @@ mod material_extension_tests {
         );
         // The image decoded twice: linear (specular, clearcoat) and sRGB (specular colour).
         assert_eq!(scene.textures.len(), 2);
-        let Bsdf::GltfPbr(g) = scene.materials[1].bsdf_at(Vec2::ZERO, &scene.textures) else {
+        let Bsdf::GltfPbr(g) = scene.materials[1].bsdf_at(
+            &crate::geometry::VertexAttributes::from_uv(Vec2::ZERO),
+            &scene.textures,
+        ) else {
             panic!("not a glTF material")
         };
         let close = |a: f32, b: f32| (a - b).abs() < 1e-4;
@@ -1997,7 +2276,10 @@ mod material_extension_tests {
             "KHR_materials_specular": {}, "KHR_materials_clearcoat": {},
             "KHR_materials_ior": {"ior": 0}});
         let scene = Scene::load(&write_embedded(dir.path(), d, &bin)).unwrap();
-        let Bsdf::GltfPbr(g) = scene.materials[1].bsdf_at(Vec2::ZERO, &scene.textures) else {
+        let Bsdf::GltfPbr(g) = scene.materials[1].bsdf_at(
+            &crate::geometry::VertexAttributes::from_uv(Vec2::ZERO),
+            &scene.textures,
+        ) else {
             panic!("not a glTF material")
         };
         assert_eq!((g.specular, g.specular_color, g.ior), (1.0, Vec3::ONE, 0.0));

@@ -49,6 +49,27 @@
 //!   without the map (a warning). A perturbed normal is tilted back toward the geometric
 //!   normal where the viewer's mirror direction would go below the surface
 //!   ([`crate::normal_map::valid_reflection_normal`]).
+//! - Textures ([`crate::texture`]): every material texture reads its `texCoord` set
+//!   (`TEXCOORD_0` or `TEXCOORD_1`; a higher set is a warning and reads `TEXCOORD_0`, and so
+//!   does a primitive without the set its material reads, with a warning), through its
+//!   KHR_texture_transform (`offset`, `rotation`, `scale`, and its `texCoord` override) and
+//!   its sampler's `wrapS`/`wrapT` (repeat, clamp to edge, mirrored repeat) and `magFilter`
+//!   (nearest or linear). `minFilter` is ignored: each pixel is supersampled, which filters
+//!   the texture over the pixel footprint as a mipmap approximates (see [`crate::texture`]).
+//!   An image is decoded once per colour space, whatever samplers read it.
+//! - Vertex colours `COLOR_0` (RGB or RGBA; float, or normalized unsigned byte or short)
+//!   multiply the base colour (`kd` for the paper's models) and its alpha. The second uv set
+//!   and the colours are stored only when some primitive has them ([`Scene::uvs1`],
+//!   [`Scene::colors`]).
+//! - `alphaMode`: alpha is `baseColorFactor.a x baseColorTexture.a x COLOR_0.a`. `MASK`
+//!   (`alphaCutoff`, default 0.5) cuts the surface away where alpha is below the cutoff;
+//!   `BLEND` is stochastic transparency: a ray stops at the surface with probability alpha
+//!   and passes through it otherwise, decided by a hash of the ray and the triangle, so an
+//!   image is the same for the same seed whatever the thread count. Both hold for every ray
+//!   ([`Scene::intersect`] and [`Scene::occluded`] alike). An emissive triangle that is not
+//!   opaque emits `emission x` the probability that a ray stops there (nothing in a hole,
+//!   alpha on a `BLEND` surface) in light samples; a ray that hits it sees its full emission,
+//!   which is the same on average.
 //! - Emission `emissiveFactor * KHR_materials_emissive_strength` (times the emissive texture)
 //!   is radiance; the triangles of an emissive material are area lights, grouped into the
 //!   scene's emitters ([`crate::light::Emitters`]) when it is built. Emission is one-sided (the
@@ -91,6 +112,7 @@ use crate::geometry::{Ray, SurfaceHit};
 use crate::light::{Light, LightSampler, SurfaceMesh};
 use crate::material::Material;
 use crate::normal_map;
+use crate::sampling::{pcg_hash, u32_to_unit_f32};
 use crate::texture::Texture;
 use glam::{Vec2, Vec3, Vec4};
 use std::path::{Path, PathBuf};
@@ -111,6 +133,12 @@ pub struct Scene {
     /// one per vertex, or empty when no material has a normal map; a zero tangent means "not
     /// normal mapped here" (see [`crate::normal_map`]).
     pub tangents: Vec<Vec4>,
+    /// The second texture coordinate set (`TEXCOORD_1`), one per vertex, or empty when no
+    /// primitive has one (the first set is read instead).
+    pub uvs1: Vec<Vec2>,
+    /// Vertex colours (`COLOR_0`, linear RGBA), one per vertex, or empty when no primitive
+    /// has them (white).
+    pub colors: Vec<Vec4>,
     /// Vertex indices of each triangle.
     pub triangles: Vec<[u32; 3]>,
     /// Material index of each triangle.
@@ -145,6 +173,10 @@ pub struct SceneParts {
     pub uvs: Vec<Vec2>,
     /// One tangent per vertex (xyz, w = handedness; zero = none), or empty for none.
     pub tangents: Vec<Vec4>,
+    /// One `TEXCOORD_1` per vertex, or empty for none (`uvs` is read instead).
+    pub uvs1: Vec<Vec2>,
+    /// One vertex colour per vertex, or empty for none (white).
+    pub colors: Vec<Vec4>,
     /// Vertex indices of each triangle.
     pub triangles: Vec<[u32; 3]>,
     /// Material index of each triangle.
@@ -188,6 +220,8 @@ impl Scene {
             mut normals,
             mut uvs,
             tangents,
+            uvs1,
+            colors,
             triangles,
             triangle_materials,
             materials,
@@ -228,6 +262,18 @@ impl Scene {
         }
         if let Some(i) = tangents.iter().position(|t| !t.is_finite()) {
             return Err(bad(format!("vertex {i}"), "tangent is not finite".into()));
+        }
+        if !uvs1.is_empty() && uvs1.len() != nv {
+            return Err(bad(
+                "TEXCOORD_1".into(),
+                format!("{} uvs for {nv} vertices", uvs1.len()),
+            ));
+        }
+        if !colors.is_empty() && colors.len() != nv {
+            return Err(bad(
+                "vertex colours".into(),
+                format!("{} colours for {nv} vertices", colors.len()),
+            ));
         }
         if triangle_materials.len() != triangles.len() {
             return Err(bad(
@@ -271,10 +317,14 @@ impl Scene {
                 ));
             }
         }
-        let accel = Accel::build(&positions, &triangles);
+        let accel = Accel::build_alpha_tested(&positions, &triangles, |t| {
+            !materials[triangle_materials[t] as usize].alpha.is_opaque()
+        });
         let mesh = SurfaceMesh {
             positions: &positions,
             uvs: &uvs,
+            uvs1: &uvs1,
+            colors: &colors,
             triangles: &triangles,
             triangle_materials: &triangle_materials,
             materials: &materials,
@@ -286,6 +336,8 @@ impl Scene {
             normals,
             uvs,
             tangents,
+            uvs1,
+            colors,
             triangles,
             triangle_materials,
             materials,
@@ -336,17 +388,48 @@ impl Scene {
         if !material.is_emissive() || (!material.double_sided && hit.ng.dot(wo) <= 0.0) {
             return Vec3::ZERO;
         }
-        material.emission_at(hit.uv, &self.textures)
+        material.emission_at(&hit.attributes, &self.textures)
     }
 
-    /// Closest hit along `ray` within `(t_min, ray.t_max)` (see [`Accel::t_min`]). The shading
-    /// normal is the interpolated vertex normal (the face normal where there is none), through
-    /// the material's normal map where it has one and the vertices have tangents (made valid
-    /// for the viewer `-ray.direction` by [`normal_map::valid_reflection_normal`]), and
-    /// oriented to the side of the geometric normal.
+    /// The scene's triangles with their vertex attributes and materials.
+    #[inline]
+    pub fn mesh(&self) -> SurfaceMesh<'_> {
+        SurfaceMesh {
+            positions: &self.positions,
+            uvs: &self.uvs,
+            uvs1: &self.uvs1,
+            colors: &self.colors,
+            triangles: &self.triangles,
+            triangle_materials: &self.triangle_materials,
+            materials: &self.materials,
+        }
+    }
+
+    /// Whether `ray` stops at its hit on `triangle` (barycentrics `b`), a triangle of a
+    /// material that is not opaque: by [`crate::material::Alpha::stop_probability`], for
+    /// `BLEND` against a hash of the ray and the triangle ([`transparency_hash`]), so the
+    /// same ray always gets the same answer.
+    #[inline]
+    fn stops(&self, ray: &Ray, triangle: u32, b: Vec2) -> bool {
+        let material = &self.materials[self.triangle_materials[triangle as usize] as usize];
+        let at = self.mesh().attributes_at(triangle as usize, b);
+        let p = material.alpha.stop_probability(&at, &self.textures);
+        p >= 1.0 || (p > 0.0 && transparency_hash(ray, triangle) < p)
+    }
+
+    /// Closest hit along `ray` within `(t_min, ray.t_max)` (see [`Accel::t_min`]) where the
+    /// ray stops: hits on alpha-masked-out points are skipped, and `BLEND` surfaces stop the
+    /// ray with probability alpha (stochastic transparency, decided by a hash of the ray and
+    /// the triangle). The shading normal is the interpolated vertex normal (the face normal
+    /// where there is none), through the material's normal map where it has one and the
+    /// vertices have tangents (made valid for the viewer `-ray.direction` by
+    /// [`normal_map::valid_reflection_normal`]), and oriented to the side of the geometric
+    /// normal.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<SurfaceHit> {
-        let hit = self.accel.intersect(ray)?;
+        let hit = self
+            .accel
+            .intersect_filtered(ray, |t, b| self.stops(ray, t, b))?;
         let tri = self.triangles[hit.triangle as usize];
         let [i0, i1, i2] = tri.map(|v| v as usize);
         let b = hit.barycentrics;
@@ -356,26 +439,35 @@ impl Scene {
         let p = p0 * b0 + p1 * b.x + p2 * b.y;
         let ns = self.normals[i0] * b0 + self.normals[i1] * b.x + self.normals[i2] * b.y;
         let ns = ns.try_normalize().unwrap_or(ng);
-        let uv = self.uvs[i0] * b0 + self.uvs[i1] * b.x + self.uvs[i2] * b.y;
+        let attributes = self.mesh().attributes_at(hit.triangle as usize, b);
         let material = self.triangle_materials[hit.triangle as usize];
         let ns = if self.tangents.is_empty() {
             ns
         } else {
-            self.normal_mapped(ns, ng, [i0, i1, i2], [b0, b.x, b.y], uv, material, ray)
+            self.normal_mapped(
+                ns,
+                ng,
+                [i0, i1, i2],
+                [b0, b.x, b.y],
+                attributes.uv,
+                material,
+                ray,
+            )
         };
         Some(SurfaceHit {
             t: hit.t,
             p,
             ng,
             ns: if ns.dot(ng) < 0.0 { -ns } else { ns },
-            uv,
+            attributes,
             triangle: hit.triangle,
             material,
         })
     }
 
     /// The unit shading normal `ns` through the normal map of `material`, if it has one and
-    /// the triangle's vertices `v` (barycentric weights `b`) have tangents; made valid for the
+    /// the triangle's vertices `v` (barycentric weights `b`, texture coordinates `uv`) have
+    /// tangents; made valid for the
     /// viewer of `ray` (see [`Scene::intersect`]).
     #[inline]
     #[allow(clippy::too_many_arguments)]
@@ -385,7 +477,7 @@ impl Scene {
         ng: Vec3,
         v: [usize; 3],
         b: [f32; 3],
-        uv: Vec2,
+        uv: [Vec2; 2],
         material: u32,
         ray: &Ray,
     ) -> Vec3 {
@@ -405,11 +497,32 @@ impl Scene {
         normal_map::valid_reflection_normal(ng, wo, n) * side
     }
 
-    /// Whether anything blocks `ray` within `(t_min, ray.t_max)` (shadow query).
+    /// Whether anything blocks `ray` within `(t_min, ray.t_max)` (shadow query), with the
+    /// same alpha test as [`Scene::intersect`].
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
-        self.accel.occluded(ray)
+        self.accel
+            .occluded_filtered(ray, |t, b| self.stops(ray, t, b))
     }
+}
+
+/// A number in `[0, 1)` that depends only on `ray` (origin and direction) and
+/// `triangle`: the uniform variate of a `BLEND` surface's stochastic transparency, the same
+/// for a ray whichever thread traces it.
+#[inline]
+fn transparency_hash(ray: &Ray, triangle: u32) -> f32 {
+    let words = [
+        ray.origin.x,
+        ray.origin.y,
+        ray.origin.z,
+        ray.direction.x,
+        ray.direction.y,
+        ray.direction.z,
+    ];
+    let h = words
+        .iter()
+        .fold(pcg_hash(triangle), |h, w| pcg_hash(h ^ w.to_bits()));
+    u32_to_unit_f32(h)
 }
 
 /// Centre and radius of a sphere enclosing `positions` (see [`Scene::bounding_sphere`]).
@@ -427,6 +540,9 @@ fn bounding_sphere(positions: &[Vec3]) -> (Vec3, f32) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::material::{Alpha, AlphaMode};
+    use crate::texture::{Filter, Sampler, TextureRef};
+    use glam::Vec4;
 
     /// SplitMix64: a tiny fixed-seed generator for test data.
     struct Rng(u64);
@@ -601,6 +717,111 @@ mod tests {
         }
     }
 
+    /// A unit quad in the plane `z` (x, y in [0, 1], uv = (x, y)) of material `material`.
+    fn quad(parts: &mut SceneParts, z: f32, material: u32) {
+        let k = parts.positions.len() as u32;
+        for (x, y) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)] {
+            parts.positions.push(Vec3::new(x, y, z));
+            parts.uvs.push(Vec2::new(x, y));
+        }
+        parts
+            .triangles
+            .extend([[k, k + 1, k + 2], [k, k + 2, k + 3]]);
+        parts.triangle_materials.extend([material; 2]);
+    }
+
+    /// A material whose alpha is `mode` with factor `factor` and `texture` (an alpha map).
+    fn alpha_material(mode: AlphaMode, factor: f32, texture: Option<TextureRef>) -> Material {
+        let mut m = Material::diffuse("leaf", Vec3::splat(0.5));
+        m.alpha = Alpha {
+            mode,
+            factor,
+            texture,
+        };
+        m
+    }
+
+    /// A ray through a masked-out hole hits what lies behind it, and a shadow ray passes; a
+    /// ray through the solid part stops there.
+    #[test]
+    fn alpha_mask_cuts_holes_for_camera_and_shadow_rays() {
+        // Alpha map: left half 0 (hole), right half 1 (solid), nearest filtering.
+        let map = Texture::from_rgba(
+            2,
+            1,
+            vec![Vec4::new(1.0, 1.0, 1.0, 0.0), Vec4::ONE],
+            crate::texture::ColorSpace::Linear,
+        )
+        .unwrap();
+        let texture = TextureRef {
+            sampler: Sampler {
+                filter: Filter::Nearest,
+                ..Sampler::default()
+            },
+            ..TextureRef::new(0)
+        };
+        let mut parts = SceneParts {
+            source: "mask".into(),
+            materials: vec![
+                alpha_material(AlphaMode::Mask { cutoff: 0.5 }, 1.0, Some(texture)),
+                Material::diffuse("wall", Vec3::ONE),
+            ],
+            textures: vec![map],
+            ..SceneParts::default()
+        };
+        quad(&mut parts, 1.0, 0);
+        quad(&mut parts, 2.0, 1);
+        let scene = Scene::from_parts(parts).unwrap();
+        let hole = Ray::new(Vec3::new(0.25, 0.5, 0.0), Vec3::Z);
+        let solid = Ray::new(Vec3::new(0.75, 0.5, 0.0), Vec3::Z);
+        let h = scene.intersect(&hole).unwrap();
+        assert!((h.t - 2.0).abs() < 1e-5 && h.material == 1, "{h:?}");
+        let h = scene.intersect(&solid).unwrap();
+        assert!((h.t - 1.0).abs() < 1e-5 && h.material == 0, "{h:?}");
+        let shadow = |mut r: Ray| {
+            r.t_max = 1.5;
+            scene.occluded(&r)
+        };
+        assert!(!shadow(hole) && shadow(solid));
+        // The factor scales the alpha: at 0.4 everything is below the cutoff.
+        let mut parts = SceneParts {
+            source: "mask".into(),
+            materials: vec![alpha_material(AlphaMode::Mask { cutoff: 0.5 }, 0.4, None)],
+            ..SceneParts::default()
+        };
+        quad(&mut parts, 1.0, 0);
+        let scene = Scene::from_parts(parts).unwrap();
+        assert!(scene.intersect(&solid).is_none() && !scene.occluded(&solid));
+    }
+
+    /// A BLEND surface of alpha 0.3 stops 30% of the rays (within a binomial bound), and the
+    /// same ray always gets the same answer, from both queries.
+    #[test]
+    fn alpha_blend_is_stochastic_and_deterministic() {
+        let mut parts = SceneParts {
+            source: "blend".into(),
+            materials: vec![alpha_material(AlphaMode::Blend, 0.3, None)],
+            ..SceneParts::default()
+        };
+        quad(&mut parts, 1.0, 0);
+        let scene = Scene::from_parts(parts).unwrap();
+        let mut rng = Rng(11);
+        let n = 20_000;
+        let mut passed = 0;
+        for _ in 0..n {
+            let target = Vec3::new(0.05 + 0.9 * rng.next(), 0.05 + 0.9 * rng.next(), 1.0);
+            let origin = Vec3::new(rng.next(), rng.next(), -rng.next());
+            let ray = Ray::new(origin, (target - origin).normalize());
+            let hit = scene.intersect(&ray);
+            assert_eq!(scene.intersect(&ray), hit);
+            assert_eq!(scene.occluded(&ray), hit.is_some());
+            passed += usize::from(hit.is_none());
+        }
+        let fraction = passed as f64 / n as f64;
+        let sigma = (0.7 * 0.3 / n as f64).sqrt();
+        assert!((fraction - 0.7).abs() < 4.0 * sigma, "{fraction}");
+    }
+
     #[test]
     fn shading_normal_is_interpolated_and_flipped_to_the_geometric_side() {
         let parts = SceneParts {
@@ -621,6 +842,6 @@ mod tests {
         assert_eq!(h.ng, Vec3::Z);
         let expected = -(Vec3::new(0.3, 0.0, -0.4) - 0.5 * Vec3::Z).normalize();
         assert!((h.ns - expected).length() < 1e-5, "{}", h.ns);
-        assert!((h.uv - Vec2::new(0.5, 0.25)).length() < 1e-6);
+        assert!((h.attributes.uv[0] - Vec2::new(0.5, 0.25)).length() < 1e-6);
     }
 }

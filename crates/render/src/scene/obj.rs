@@ -9,8 +9,8 @@
 //! `bump`) are not read: a warning names the material.
 
 use super::{Scene, SceneError, SceneParts};
-use crate::material::{Material, PaperModel, Reflectance};
-use crate::texture::{ColorSpace, Texture, TextureId};
+use crate::material::{Alpha, Material, PaperModel, Reflectance};
+use crate::texture::{ColorSpace, Texture, TextureId, TextureRef};
 use glam::{Vec2, Vec3};
 use std::path::Path;
 
@@ -156,7 +156,9 @@ fn convert_material(
     let ks = colour(m.specular, "Ks")?;
     let emission = colour(m.emissive, "Ke")?;
     let kd_texture = match &m.diffuse_texture {
-        Some(file) => Some(load_texture(path, base, file, &element, textures)?),
+        Some(file) => Some(TextureRef::new(load_texture(
+            path, base, file, &element, textures,
+        )?)),
         None => None,
     };
     let specular = ks.max_element() > 0.0 && !matches!(m.illumination_model, Some(0 | 1));
@@ -187,6 +189,7 @@ fn convert_material(
         emission,
         emission_texture: None,
         normal_map: None,
+        alpha: Alpha::OPAQUE,
         double_sided: false,
     })
 }
@@ -290,7 +293,11 @@ illum 1
             ))
             .unwrap();
         assert_eq!((h.ng, h.ns), (Vec3::Y, Vec3::Y));
-        assert!((h.uv - Vec2::new(0.75, 0.5)).length() < 1e-5, "{}", h.uv);
+        assert!(
+            (h.attributes.uv[0] - Vec2::new(0.75, 0.5)).length() < 1e-5,
+            "{}",
+            h.attributes.uv[0]
+        );
     }
 
     #[test]
