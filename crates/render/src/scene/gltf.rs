@@ -82,6 +82,61 @@ struct JsonTextureInfo {
     index: usize,
     #[serde(default)]
     tex_coord: u32,
+    /// Its KHR_texture_transform, read from its `extensions`.
+    #[serde(
+        default,
+        rename = "extensions",
+        deserialize_with = "transform_in_extensions"
+    )]
+    transform: Option<UvTransform>,
+}
+
+/// The KHR_texture_transform of a texture info's `extensions` object, if it has one.
+fn transform_in_extensions<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> Result<Option<UvTransform>, D::Error> {
+    let extensions = serde_json::Map::<String, serde_json::Value>::deserialize(d)?;
+    extensions
+        .get("KHR_texture_transform")
+        .map(UvTransform::from_json)
+        .transpose()
+        .map_err(serde::de::Error::custom)
+}
+
+/// A texture info's KHR_texture_transform, from the gltf crate's accessor or, for the texture
+/// infos it has none for (normalTexture), from the extension's JSON.
+#[derive(Clone, Copy, Debug)]
+struct UvTransform {
+    offset: [f32; 2],
+    rotation: f32,
+    scale: [f32; 2],
+    tex_coord: Option<u32>,
+}
+
+impl From<gltf::texture::TextureTransform<'_>> for UvTransform {
+    fn from(t: gltf::texture::TextureTransform<'_>) -> Self {
+        Self {
+            offset: t.offset(),
+            rotation: t.rotation(),
+            scale: t.scale(),
+            tex_coord: t.tex_coord(),
+        }
+    }
+}
+
+impl UvTransform {
+    /// The transform in an `"extensions": {"KHR_texture_transform": ...}` value.
+    fn from_json(value: &serde_json::Value) -> Result<Self, String> {
+        let t: gltf::json::extensions::texture::TextureTransform =
+            serde_json::from_value(value.clone())
+                .map_err(|e| format!("KHR_texture_transform: {e}"))?;
+        Ok(Self {
+            offset: t.offset.0,
+            rotation: t.rotation.0,
+            scale: t.scale.0,
+            tex_coord: t.tex_coord,
+        })
+    }
 }
 
 /// Loads a `.gltf` or `.glb` file.
@@ -883,13 +938,20 @@ impl Loader<'_> {
                     );
                 }
                 Some(NormalMap {
-                    texture: self.texture_of(
-                        &info.texture(),
-                        info.tex_coord(),
-                        None,
-                        ColorSpace::Linear,
-                        &element,
-                    )?,
+                    texture: {
+                        let transform = info
+                            .extension_value("KHR_texture_transform")
+                            .map(UvTransform::from_json)
+                            .transpose()
+                            .map_err(|e| self.bad(format!("{element}, normalTexture"), e))?;
+                        self.texture_of(
+                            &info.texture(),
+                            info.tex_coord(),
+                            transform,
+                            ColorSpace::Linear,
+                            &element,
+                        )?
+                    },
                     scale,
                 })
             }
@@ -1044,7 +1106,7 @@ impl Loader<'_> {
                 let why = format!("{key}: texture {} does not exist", info.index);
                 return Err(self.bad(element, reason(why)));
             };
-            let id = self.texture_of(&texture, info.tex_coord, None, space, element)?;
+            let id = self.texture_of(&texture, info.tex_coord, info.transform, space, element)?;
             match key {
                 "clearcoatTexture" => c.texture = Some(id),
                 _ => c.roughness_texture = Some(id),
@@ -1147,7 +1209,7 @@ impl Loader<'_> {
         space: ColorSpace,
         material: &str,
     ) -> Result<TextureRef, SceneError> {
-        let transform = info.texture_transform();
+        let transform = info.texture_transform().map(UvTransform::from);
         self.texture_of(
             &info.texture(),
             info.tex_coord(),
@@ -1157,14 +1219,14 @@ impl Loader<'_> {
         )
     }
 
-    /// The reference to `texture` read at TEXCOORD_`tex_coord` through `transform` (for the
-    /// texture infos the gltf crate has no KHR_texture_transform accessor for, `None`): its
-    /// image (decoded once per colour space), texture coordinate set, sampler and transform.
+    /// The reference to `texture` read at TEXCOORD_`tex_coord` through its KHR_texture_transform
+    /// `transform`: its image (decoded once per colour space), texture coordinate set, sampler
+    /// and transform.
     fn texture_of(
         &mut self,
         texture: &gltf::Texture,
         tex_coord: u32,
-        transform: Option<gltf::texture::TextureTransform>,
+        transform: Option<UvTransform>,
         space: ColorSpace,
         material: &str,
     ) -> Result<TextureRef, SceneError> {
@@ -1172,7 +1234,7 @@ impl Loader<'_> {
         // KHR_texture_transform's texCoord overrides the texture info's.
         let set = transform
             .as_ref()
-            .and_then(|t| t.tex_coord())
+            .and_then(|t| t.tex_coord)
             .unwrap_or(tex_coord);
         let texcoord = match set {
             0 | 1 => set as u8,
@@ -1188,7 +1250,7 @@ impl Loader<'_> {
             None => None,
             Some(t) => {
                 let (offset, rotation, scale) =
-                    (Vec2::from(t.offset()), t.rotation(), Vec2::from(t.scale()));
+                    (Vec2::from(t.offset), t.rotation, Vec2::from(t.scale));
                 if !(offset.is_finite() && rotation.is_finite() && scale.is_finite()) {
                     return Err(self.bad(
                         element,
@@ -2060,6 +2122,46 @@ mod tests {
     fn quad_normal(scene: &Scene) -> Vec3 {
         let ray = crate::geometry::Ray::new(Vec3::new(21.0, 5.0, 0.5), -Vec3::Y);
         scene.intersect(&ray).unwrap().ns
+    }
+
+    #[test]
+    fn normal_and_clearcoat_textures_read_their_texture_transform() {
+        let (mut doc, bin) = normal_mapped_doc(0.4, 1.0);
+        // glTF's own material model (the clear coat is one of its layers).
+        doc["materials"][0]
+            .as_object_mut()
+            .unwrap()
+            .remove("extras");
+        doc["extensionsUsed"] = json!(["KHR_texture_transform", "KHR_materials_clearcoat"]);
+        doc["materials"][0]["normalTexture"]["extensions"] =
+            json!({"KHR_texture_transform": {"scale": [2, 2], "texCoord": 1}});
+        doc["materials"][0]["extensions"] = json!({"KHR_materials_clearcoat": {
+            "clearcoatFactor": 1,
+            "clearcoatTexture": {"index": 0, "extensions":
+                {"KHR_texture_transform": {"offset": [0.5, 0]}}}}});
+        let scene = load(doc, &bin);
+        let t = scene.materials[0].normal_map.unwrap().texture;
+        assert_eq!(t.texcoord, 1);
+        let m = t.transform.expect("a transform");
+        assert!((m.transform_point2(Vec2::ONE) - Vec2::splat(2.0)).length() < 1e-6);
+        let Reflectance::GltfPbr {
+            clearcoat_texture: Some(c),
+            ..
+        } = scene.materials[0].reflectance
+        else {
+            panic!("no clearcoat texture")
+        };
+        let m = c.transform.expect("a transform");
+        assert!((m.transform_point2(Vec2::ZERO) - Vec2::new(0.5, 0.0)).length() < 1e-6);
+        // A malformed transform names the material's normal texture.
+        let (mut doc, bin) = normal_mapped_doc(0.4, 1.0);
+        doc["materials"][0]["normalTexture"]["extensions"] =
+            json!({"KHR_texture_transform": {"scale": "big"}});
+        let err = load_err(doc, &bin);
+        assert!(
+            err.contains("normalTexture") && err.contains("KHR_texture_transform"),
+            "{err}"
+        );
     }
 
     #[test]
