@@ -767,7 +767,19 @@ impl Loader<'_> {
                             tangent_acc.is_some(),
                             prim.get(&gltf::Semantic::TexCoords(0)).is_some(),
                         );
-                        self.tangents(&element, has, &positions, &normals, &uvs, &mut tris)
+                        // MikkTSpace works in the normal map's own texture space: its uv set
+                        // through its KHR_texture_transform (a rotation turns the frame).
+                        let map_uvs: Vec<Vec2> =
+                            match self.parts.materials[material as usize].normal_map {
+                                Some(map) => (0..uvs.len())
+                                    .map(|i| {
+                                        let uv1 = uvs1.as_ref().map_or(uvs[i], |u| u[i]);
+                                        map.texture.uv([uvs[i], uv1])
+                                    })
+                                    .collect(),
+                                None => uvs.clone(),
+                            };
+                        self.tangents(&element, has, &positions, &normals, &map_uvs, &mut tris)
                     }
                 };
                 tangents::extend_copies(&mut positions, &copies);
@@ -2153,6 +2165,15 @@ mod tests {
         };
         let m = c.transform.expect("a transform");
         assert!((m.transform_point2(Vec2::ZERO) - Vec2::new(0.5, 0.0)).length() < 1e-6);
+        // Tangents follow the normal map's texture space: a quarter turn of its uvs turns the
+        // quad's generated tangents from +X to the Z axis.
+        let (mut doc, bin) = normal_mapped_doc(0.4, 1.0);
+        doc["materials"][0]["normalTexture"]["extensions"] =
+            json!({"KHR_texture_transform": {"rotation": std::f32::consts::FRAC_PI_2}});
+        let scene = load(doc, &bin);
+        for t in &scene.tangents[..4] {
+            assert!(t.x.abs() < 1e-4 && (t.z.abs() - 1.0).abs() < 1e-4, "{t}");
+        }
         // A malformed transform names the material's normal texture.
         let (mut doc, bin) = normal_mapped_doc(0.4, 1.0);
         doc["materials"][0]["normalTexture"]["extensions"] =
