@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
-# CI check: streaks render against Blender's Cycles on the diffuse scene of
-# tools/blender/scenes.py, as exported and as its Lambert variant (tools/blender/README.md).
+# CI check: streaks render against Blender's Cycles on two scenes of tools/blender/scenes.py
+# (tools/blender/README.md): `diffuse`, as exported and as its Lambert variant (light units,
+# emission, light transport), and `road_lambert` (a normal map through a Mapping node:
+# KHR_texture_transform, MikkTSpace tangents, the normal map's orientation and Cycles'
+# shading-normal rules).
 # Exits 0 on agreement, 1 on disagreement, 2 when it cannot run (no bpy).
 # Environment: BLENDER_PYTHON (a Python with bpy; default target/blender-venv/bin/python),
 # STREAKS (the binary; default target/debug/streaks, built with cargo build),
@@ -20,7 +23,13 @@ if [ -z "${STREAKS:-}" ]; then
     cargo build --bin streaks >&2
 fi
 streaks="${STREAKS:-$repo/target/debug/streaks}"
-exec "$python" "$here/crosscheck.py" diffuse --lambert --streaks "$streaks" \
+status=0
+"$python" "$here/crosscheck.py" diffuse --lambert --streaks "$streaks" \
     --spp "${BLENDER_SPP:-256}" --width "${BLENDER_WIDTH:-160}" \
     --height "${BLENDER_HEIGHT:-120}" --k "${BLENDER_K:-4}" \
-    --out "$repo/target/blender/ci" "$@"
+    --out "$repo/target/blender/ci" "$@" || status=$?
+"$python" "$here/crosscheck.py" road_lambert --streaks "$streaks" \
+    --spp "${BLENDER_SPP:-256}" --width "${BLENDER_WIDTH:-160}" \
+    --height "${BLENDER_HEIGHT:-120}" --k "${BLENDER_K:-4}" \
+    --out "$repo/target/blender/ci_road" "$@" || status=$?
+exit "$status"

@@ -442,8 +442,54 @@ WET_STREET = SceneSpec(
     tolerance=0.10,
 )
 
+# --- (c) the wet street's road alone: the normal map and the road's BRDF -----------------------
+
+
+def _road_only(name: str, road: Material, description: str, tolerance: float) -> SceneSpec:
+    """The wet street's road, camera and lamps, nothing else: no interreflection with the car,
+    the shelter or the walls, so the road's regions measure the road's material alone."""
+    return SceneSpec(
+        name=name,
+        description=description,
+        camera=WET_STREET.camera,
+        materials=(road,),
+        meshes=(Mesh("road", "quad", quad_xy(-4.0, -3.0, 4.0, 14.0, 0.0), road.name),),
+        lights=WET_STREET.lights,
+        regions=tuple(r for r in WET_STREET.regions if r.name.startswith("road")),
+        max_depth=WET_STREET.max_depth,
+        width=WET_STREET.width,
+        height=WET_STREET.height,
+        spp=WET_STREET.spp,
+        tolerance=tolerance,
+    )
+
+
+ROAD_LAMBERT = _road_only(
+    "road_lambert",
+    Material(
+        "road",
+        base_color=(0.5, 0.5, 0.5),
+        roughness=1.0,
+        specular_ior_level=0.0,
+        normal_map=_ROAD.normal_map,
+    ),
+    "The wet street's road alone, a Lambertian grey (Specular IOR Level 0) with the road's "
+    "normal map of round bumps: checks the tangent frame, the normal map's orientation and the "
+    "shading-normal rules against Cycles', with no model difference in the BRDF.",
+    0.02,
+)
+ROAD_ONLY = _road_only(
+    "road_only",
+    _ROAD,
+    "The wet street's road alone, its material as in the street (normal map, roughness map, "
+    "Specular IOR Level 0.5): measures Cycles' Principled BSDF against the glTF BRDF on a "
+    "dark, bumpy, partly glossy road seen at grazing angles.",
+    0.10,
+)
+
 SCENES: dict[str, SceneSpec] = {
-    s.name: s for s in (DIFFUSE, SPOT_BLEND_SCENE, PRINCIPLED_SCENE, WET_STREET)
+    s.name: s
+    for s in (DIFFUSE, SPOT_BLEND_SCENE, PRINCIPLED_SCENE, WET_STREET, ROAD_LAMBERT, ROAD_ONLY)
 }
 
 

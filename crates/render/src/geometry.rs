@@ -1,5 +1,6 @@
 //! Rays, shading frames and robust ray offsets.
 
+use crate::normal_map::MappedNormal;
 use glam::{Vec2, Vec3, Vec4};
 
 /// A ray `origin + t * direction` for `t` in `[0, t_max)`; `direction` is unit length.
@@ -66,6 +67,9 @@ pub struct SurfaceHit {
     pub ng: Vec3,
     /// Unit interpolated shading normal (oriented to the same side as `ng`).
     pub ns: Vec3,
+    /// Where a normal map set `ns`: the smooth and the mapped normal, for the diffuse lobe
+    /// ([`crate::normal_map::MappedNormal`]); `None` elsewhere.
+    pub mapped: Option<MappedNormal>,
     /// Texture coordinates and vertex colour.
     pub attributes: VertexAttributes,
     /// Triangle index.

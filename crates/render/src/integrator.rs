@@ -21,7 +21,10 @@
 //! Shading uses the interpolated shading normal's frame (through the material's normal map, if
 //! any: [`crate::normal_map`]); a direction must also lie on the outgoing side of the
 //! *geometric* normal (for both light samples and BSDF samples), so that interpolated or
-//! perturbed normals never let light leak through a surface. Surfaces reflect on both
+//! perturbed normals never let light leak through a surface. On a normal-mapped hit the
+//! diffuse part of the BSDF takes its cosine about the map's own normal, softened by Cycles'
+//! bump shadowing, and the glossy part the corrected normal's
+//! ([`crate::normal_map::MappedNormal`]). Surfaces reflect on both
 //! faces (the frame is flipped toward the viewer); emission is one-sided unless the material
 //! is double-sided.
 //!
@@ -274,6 +277,10 @@ fn trace_path(
         } else {
             hit.ns
         };
+        // A normal-mapped hit's diffuse lobe follows the mapped normal (crate::normal_map).
+        let mapped = hit
+            .mapped
+            .map(|m| if hit.ng.dot(wo) < 0.0 { m.flipped() } else { m });
         let frame = Frame::from_normal(ns);
         let wo_local = frame.to_local(wo);
         if wo_local.z <= 0.0 {
@@ -303,7 +310,10 @@ fn trace_path(
                 } else {
                     bsdf.eval_pdf(wo_local, wi_local)
                 };
-                let total = f.total();
+                let total = match mapped {
+                    None => f.total(),
+                    Some(m) => m.reweigh(f, ns, ls.wi, wi_local.z),
+                };
                 if total.max_element() > 0.0 {
                     let origin = offset_ray_origin(hit.p, ng, ls.wi);
                     out.rays += 1;
@@ -370,7 +380,11 @@ fn trace_path(
         if bs.pdf <= 0.0 || bs.wi.z <= 0.0 || ng.dot(wi) <= 0.0 {
             break;
         }
-        throughput *= bs.f * (bs.wi.z / bs.pdf);
+        let f = match mapped {
+            None => bs.f,
+            Some(m) => m.reweigh(bsdf.eval_lobes(wo_local, bs.wi), ns, wi, bs.wi.z),
+        };
+        throughput *= f * (bs.wi.z / bs.pdf);
         if depth == 0 && want_specular {
             first_bsdf = Some((bsdf, frame, wo_local));
         }

@@ -623,6 +623,7 @@ mod tests {
                     p: q,
                     ng: -Vec3::Z,
                     ns: -Vec3::Z,
+                    mapped: None,
                     attributes: VertexAttributes::from_uv(Vec2::ZERO),
                     triangle: 0,
                     material: 0,

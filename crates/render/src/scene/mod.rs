@@ -111,7 +111,7 @@ use crate::camera::Camera;
 use crate::geometry::{Ray, SurfaceHit};
 use crate::light::{Light, LightSampler, SurfaceMesh};
 use crate::material::Material;
-use crate::normal_map;
+use crate::normal_map::{self, MappedNormal};
 use crate::sampling::{pcg_hash, u32_to_unit_f32};
 use crate::texture::Texture;
 use glam::{Vec2, Vec3, Vec4};
@@ -441,8 +441,8 @@ impl Scene {
         let ns = ns.try_normalize().unwrap_or(ng);
         let attributes = self.mesh().attributes_at(hit.triangle as usize, b);
         let material = self.triangle_materials[hit.triangle as usize];
-        let ns = if self.tangents.is_empty() {
-            ns
+        let (ns, mapped) = if self.tangents.is_empty() {
+            (ns, None)
         } else {
             self.normal_mapped(
                 ns,
@@ -459,6 +459,14 @@ impl Scene {
             p,
             ng,
             ns: if ns.dot(ng) < 0.0 { -ns } else { ns },
+            // Both turned by the smooth normal's side (the mapped one may point below).
+            mapped: mapped.map(|m| {
+                let side = if m.smooth.dot(ng) < 0.0 { -1.0 } else { 1.0 };
+                MappedNormal {
+                    smooth: m.smooth * side,
+                    mapped: m.mapped * side,
+                }
+            }),
             attributes,
             triangle: hit.triangle,
             material,
@@ -468,7 +476,8 @@ impl Scene {
     /// The unit shading normal `ns` through the normal map of `material`, if it has one and
     /// the triangle's vertices `v` (barycentric weights `b`, texture coordinates `uv`) have
     /// tangents; made valid for the
-    /// viewer of `ray` (see [`Scene::intersect`]).
+    /// viewer of `ray` (see [`Scene::intersect`]); with the smooth and the mapped normal for
+    /// the diffuse lobe where the map applied (not yet oriented).
     #[inline]
     #[allow(clippy::too_many_arguments)]
     fn normal_mapped(
@@ -480,21 +489,27 @@ impl Scene {
         uv: [Vec2; 2],
         material: u32,
         ray: &Ray,
-    ) -> Vec3 {
+    ) -> (Vec3, Option<MappedNormal>) {
         let Some(map) = self.materials[material as usize].normal_map else {
-            return ns;
+            return (ns, None);
         };
         let t = v.map(|i| self.tangents[i]);
         let tangent = t[0] * b[0] + t[1] * b[1] + t[2] * b[2];
         if tangent.truncate() == Vec3::ZERO {
-            return ns;
+            return (ns, None);
         }
         let n = map.perturb(ns, tangent, uv, &self.textures);
         // On the viewer's side of the surface, as the integrator shades it.
         let wo = -ray.direction;
         let side = if ng.dot(wo) < 0.0 { -1.0 } else { 1.0 };
-        let (ng, n) = (ng * side, n * side);
-        normal_map::valid_reflection_normal(ng, wo, n) * side
+        let valid = normal_map::valid_reflection_normal(ng * side, wo, n * side) * side;
+        (
+            valid,
+            Some(MappedNormal {
+                smooth: ns,
+                mapped: n,
+            }),
+        )
     }
 
     /// Whether anything blocks `ray` within `(t_min, ray.t_max)` (shadow query), with the
