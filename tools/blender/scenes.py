@@ -13,7 +13,7 @@ which the glTF exporter writes as `yfov`.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 Vec3 = tuple[float, float, float]
 Rgb = tuple[float, float, float]
@@ -487,9 +487,47 @@ ROAD_ONLY = _road_only(
     0.10,
 )
 
+# --- (d) the wet street's car paint on the diffuse scene's floor and wall ---------------------
+
+
+def _paint(name: str, paint: Material, description: str) -> SceneSpec:
+    """The diffuse scene with `paint` on the floor (seen at 70-75 degrees) and the wall (seen
+    nearly head-on): the car paint's parts, one at a time, against Cycles' Principled BSDF."""
+    return _diffuse(
+        name,
+        0.0,
+        description,
+        (replace(paint, name="floor"), replace(paint, name="wall")),
+    )
+
+
+PAINT_SCENES = (
+    _paint("paint", _PAINT, "The wet street's car paint (metallic 0.5, clear coat 1)."),
+    _paint(
+        "paint_base",
+        replace(_PAINT, metallic=0.0, coat_weight=0.0),
+        "The car paint's dielectric base alone (metallic 0, no coat): the layering of the "
+        "glTF BRDF (diffuse times 1 - F(v.h)) against Cycles' (times 1 - E(mu_o)).",
+    ),
+    _paint(
+        "paint_metal",
+        replace(_PAINT, metallic=1.0, coat_weight=0.0),
+        "The car paint's metal alone (metallic 1, no coat): Schlick's conductor Fresnel "
+        "against Cycles' F82 tint.",
+    ),
+)
+
 SCENES: dict[str, SceneSpec] = {
     s.name: s
-    for s in (DIFFUSE, SPOT_BLEND_SCENE, PRINCIPLED_SCENE, WET_STREET, ROAD_LAMBERT, ROAD_ONLY)
+    for s in (
+        DIFFUSE,
+        SPOT_BLEND_SCENE,
+        PRINCIPLED_SCENE,
+        WET_STREET,
+        ROAD_LAMBERT,
+        ROAD_ONLY,
+        *PAINT_SCENES,
+    )
 }
 
 
