@@ -19,14 +19,32 @@
 //! which keeps the estimate unbiased while ending paths whose contribution has become small.
 //!
 //! Shading uses the interpolated shading normal's frame (through the material's normal map, if
-//! any: [`crate::normal_map`]); a direction must also lie on the outgoing side of the
-//! *geometric* normal (for both light samples and BSDF samples), so that interpolated or
-//! perturbed normals never let light leak through a surface. On a normal-mapped hit the
-//! diffuse part of the BSDF takes its cosine about the map's own normal, softened by Cycles'
-//! bump shadowing, and the glossy part the corrected normal's
-//! ([`crate::normal_map::MappedNormal`]). Surfaces reflect on both
-//! faces (the frame is flipped toward the viewer); emission is one-sided unless the material
-//! is double-sided.
+//! any: [`crate::normal_map`]); a direction must also lie on the same side of the *geometric*
+//! normal as of the shading normal (for both light samples and BSDF samples): above both for
+//! reflection, below both for transmission, so that interpolated or perturbed normals never
+//! let light leak through a surface (such samples are dropped, as Mitsuba drops them). On a
+//! normal-mapped hit the diffuse part of the BSDF takes its cosine about the map's own normal,
+//! softened by Cycles' bump shadowing, and the glossy and transmitted parts the corrected
+//! normal's ([`crate::normal_map::MappedNormal`]). Surfaces reflect on both faces (the frame is flipped toward the viewer); emission is
+//! one-sided unless the material is double-sided.
+//!
+//! Transmission (a transmissive glTF material, [`crate::bsdf::GltfPbr`]): a sampled direction
+//! below the surface continues the path through it, from an origin offset to the side it
+//! leaves from; next-event estimation evaluates the rough transmission toward lights behind a
+//! thin-walled surface like any lobe (the light choice weighs them by irradiance alone, its
+//! BSDF-aware share looking at reflection only). A smooth surface's transmission is a delta
+//! lobe: light sampling cannot produce it, so an emitter hit after it counts in full (no MIS),
+//! and shadow rays are not transmitted through glass (as in Cycles and Mitsuba: no
+//! transparent shadows through a dielectric).
+//!
+//! Volumes (KHR_materials_volume, [`crate::material::Volume`]): each path carries the medium
+//! it is in, none at the camera. Crossing the boundary of a material with a volume from its
+//! front face (the side its winding's normal points to) enters the medium; crossing any such
+//! boundary from its back face leaves it; along every segment inside, the throughput (and a
+//! shadow ray's light) is multiplied by the Beer-Lambert transmittance of the segment's length.
+//! Limits: one medium at a time (nested or overlapping volumes are not tracked: leaving an
+//! inner volume puts the path in air), a camera inside a volume starts in air, and the
+//! boundary must be closed and consistently wound.
 //!
 //! Determinism: each pixel sample draws its random numbers from the [`Sampler`] positioned by
 //! `(pixel, sample index)` and the seed, never by thread; rows are rendered in parallel with
@@ -54,6 +72,7 @@ use crate::camera::Camera;
 use crate::film::{Film, Pixel};
 use crate::geometry::{offset_ray_origin, Frame, Ray};
 use crate::light::{LightSampler, Receiver, Visibility};
+use crate::material::Volume;
 use crate::sampling::{power_heuristic, Sampler};
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
@@ -234,6 +253,11 @@ fn trace_path(
     // The previous vertex and the BSDF-sampling density of the current direction, for MIS.
     let mut prev: Option<Receiver> = None;
     let mut prev_bsdf_pdf = 0.0f32;
+    // Whether the current direction came from a delta lobe (no MIS: light sampling cannot
+    // produce it).
+    let mut prev_delta = false;
+    // The medium the current segment travels in (KHR_materials_volume), if any.
+    let mut medium: Option<Volume> = None;
     // At the first hit: the BSDF and frame, for the specular layer of a hit emitter.
     let mut first_bsdf: Option<(Bsdf, Frame, Vec3)> = None;
 
@@ -243,11 +267,14 @@ fn trace_path(
             break;
         };
         let wo = -ray.direction;
+        if let Some(v) = medium {
+            throughput *= v.transmittance(hit.t);
+        }
 
         // 1. Emission of the surface hit.
         let le = scene.emitted_radiance(&hit, wo);
         if le.max_element() > 0.0 {
-            if depth == 0 {
+            if depth == 0 || prev_delta {
                 out.radiance += throughput * le;
             } else {
                 let light_pdf = prev.map_or(0.0, |rx| lights.pdf_li(&rx, &hit));
@@ -266,21 +293,26 @@ fn trace_path(
 
         // Shading frame, flipped toward the viewer; geometric normal on the same side.
         let material = &scene.materials[hit.material as usize];
-        let bsdf = material.bsdf_at(&hit.attributes, &scene.textures);
-        let ng = if hit.ng.dot(wo) < 0.0 {
-            -hit.ng
-        } else {
-            hit.ng
+        let front = hit.ng.dot(wo) >= 0.0;
+        let mut bsdf = material.bsdf_at(&hit.attributes, &scene.textures);
+        if !front {
+            bsdf = bsdf.seen_from_back();
+        }
+        let ng = if front { hit.ng } else { -hit.ng };
+        // The medium beyond the surface: entered through a volume's front face, left through
+        // its back face; a transmitted direction travels in it, a reflected one in `medium`.
+        let beyond = match material.volume() {
+            Some(v) if bsdf.transmits() => front.then_some(v),
+            _ => medium,
         };
+        let medium_along = |wi_local_z: f32| if wi_local_z < 0.0 { beyond } else { medium };
         let ns = if hit.ns.dot(ng) < 0.0 {
             -hit.ns
         } else {
             hit.ns
         };
         // A normal-mapped hit's diffuse lobe follows the mapped normal (crate::normal_map).
-        let mapped = hit
-            .mapped
-            .map(|m| if hit.ng.dot(wo) < 0.0 { m.flipped() } else { m });
+        let mapped = hit.mapped.map(|m| if front { m } else { m.flipped() });
         let frame = Frame::from_normal(ns);
         let wo_local = frame.to_local(wo);
         if wo_local.z <= 0.0 {
@@ -303,7 +335,7 @@ fn trace_path(
         if let Some(ls) = lights.sample_li(&scene.materials, &scene.textures, &rx, u_light, u_point)
         {
             let wi_local = frame.to_local(ls.wi);
-            if wi_local.z > 0.0 && ng.dot(ls.wi) > 0.0 {
+            if wi_local.z * ng.dot(ls.wi) > 0.0 {
                 // The BSDF's density of wi matters only for MIS against an area light.
                 let (f, bsdf_pdf) = if ls.delta {
                     (bsdf.eval_lobes(wo_local, wi_local), 0.0)
@@ -354,13 +386,17 @@ fn trace_path(
                             }
                         }
                     };
+                    let li = match medium_along(wi_local.z) {
+                        Some(v) if ls.dist.is_finite() => li * v.transmittance(ls.dist),
+                        _ => li,
+                    };
                     if li.max_element() > 0.0 {
                         let weight = if ls.delta {
                             1.0
                         } else {
                             power_heuristic(1.0, ls.pdf, 1.0, bsdf_pdf)
                         };
-                        let scale = li * (wi_local.z * weight / ls.pdf);
+                        let scale = li * (wi_local.z.abs() * weight / ls.pdf);
                         out.radiance += throughput * total * scale;
                         if depth == 0 && want_specular {
                             out.specular += f.glossy * scale;
@@ -377,19 +413,21 @@ fn trace_path(
             break;
         };
         let wi = frame.to_world(bs.wi);
-        if bs.pdf <= 0.0 || bs.wi.z <= 0.0 || ng.dot(wi) <= 0.0 {
+        if !(bs.pdf > 0.0 && bs.wi.z * ng.dot(wi) > 0.0) {
             break;
         }
         let f = match mapped {
-            None => bs.f,
-            Some(m) => m.reweigh(bsdf.eval_lobes(wo_local, bs.wi), ns, wi, bs.wi.z),
+            Some(m) if !bs.delta => m.reweigh(bsdf.eval_lobes(wo_local, bs.wi), ns, wi, bs.wi.z),
+            _ => bs.f,
         };
-        throughput *= f * (bs.wi.z / bs.pdf);
+        throughput *= f * (bs.wi.z.abs() / bs.pdf);
         if depth == 0 && want_specular {
             first_bsdf = Some((bsdf, frame, wo_local));
         }
         prev = Some(rx);
         prev_bsdf_pdf = bs.pdf;
+        prev_delta = bs.delta;
+        medium = medium_along(bs.wi.z);
         ray = Ray::new(offset_ray_origin(hit.p, ng, wi), wi);
         depth += 1;
 

@@ -11,7 +11,8 @@
 //!   specular texture's alpha multiplies `specular` and the specular colour texture's RGB
 //!   `specular_color` (KHR_materials_specular); the clearcoat texture's red channel multiplies
 //!   `clearcoat` and the clearcoat roughness texture's green channel `clearcoat_roughness`
-//!   (KHR_materials_clearcoat).
+//!   (KHR_materials_clearcoat); the transmission texture's red channel multiplies
+//!   `transmission` (KHR_materials_transmission).
 //! - The vertex colour `COLOR_0` (RGB) multiplies the base colour, as glTF says, and so `kd`
 //!   of the other models too (white where a scene has none).
 //!
@@ -38,7 +39,7 @@ pub enum PaperModel {
 }
 
 /// How a material reflects light.
-// The glTF variant holds ten texture references; a scene has few materials and `bsdf_at`
+// The glTF variant holds seven texture references; a scene has few materials and `bsdf_at`
 // reads them by reference, so boxing it would only add an indirection per hit.
 #[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug, PartialEq)]
@@ -67,37 +68,115 @@ pub enum Reflectance {
         /// Optional wet/dry modulation (see [`Wetness`] and the `scene` module documentation).
         wetness: Option<Wetness>,
     },
-    /// glTF metallic-roughness.
-    GltfPbr {
-        /// baseColorFactor (linear RGB).
-        base_color: Vec3,
-        /// baseColorTexture.
-        base_color_texture: Option<TextureRef>,
-        /// metallicFactor.
-        metallic: f32,
-        /// roughnessFactor.
-        roughness: f32,
-        /// metallicRoughnessTexture (B = metal, G = roughness).
-        metallic_roughness_texture: Option<TextureRef>,
-        /// KHR_materials_specular specularFactor (1 without the extension).
-        specular: f32,
-        /// KHR_materials_specular specularTexture (A = specular).
-        specular_texture: Option<TextureRef>,
-        /// KHR_materials_specular specularColorFactor, linear RGB (1 without the extension).
-        specular_color: Vec3,
-        /// KHR_materials_specular specularColorTexture (RGB, sRGB-encoded).
-        specular_color_texture: Option<TextureRef>,
-        /// KHR_materials_ior ior (1.5 without the extension; 0 or at least 1).
-        ior: f32,
-        /// KHR_materials_clearcoat clearcoatFactor (0: no coat).
-        clearcoat: f32,
-        /// KHR_materials_clearcoat clearcoatTexture (R = clearcoat).
-        clearcoat_texture: Option<TextureRef>,
-        /// KHR_materials_clearcoat clearcoatRoughnessFactor.
-        clearcoat_roughness: f32,
-        /// KHR_materials_clearcoat clearcoatRoughnessTexture (G = clearcoat roughness).
-        clearcoat_roughness_texture: Option<TextureRef>,
-    },
+    /// glTF metallic-roughness with its extensions' parameters.
+    GltfPbr(GltfPbrParams),
+}
+
+/// The parameters of a glTF metallic-roughness material and of the material extensions the
+/// loader honours, each factor with its optional texture. [`Default`] gives the glTF defaults
+/// (white, metallic 1, roughness 1, and every extension absent).
+#[derive(Clone, Debug, PartialEq)]
+pub struct GltfPbrParams {
+    /// baseColorFactor (linear RGB).
+    pub base_color: Vec3,
+    /// baseColorTexture.
+    pub base_color_texture: Option<TextureRef>,
+    /// metallicFactor.
+    pub metallic: f32,
+    /// roughnessFactor.
+    pub roughness: f32,
+    /// metallicRoughnessTexture (B = metal, G = roughness).
+    pub metallic_roughness_texture: Option<TextureRef>,
+    /// KHR_materials_specular specularFactor (1 without the extension).
+    pub specular: f32,
+    /// KHR_materials_specular specularTexture (A = specular).
+    pub specular_texture: Option<TextureRef>,
+    /// KHR_materials_specular specularColorFactor, linear RGB (1 without the extension).
+    pub specular_color: Vec3,
+    /// KHR_materials_specular specularColorTexture (RGB, sRGB-encoded).
+    pub specular_color_texture: Option<TextureRef>,
+    /// KHR_materials_ior ior (1.5 without the extension; 0 or at least 1).
+    pub ior: f32,
+    /// KHR_materials_clearcoat clearcoatFactor (0: no coat).
+    pub clearcoat: f32,
+    /// KHR_materials_clearcoat clearcoatTexture (R = clearcoat).
+    pub clearcoat_texture: Option<TextureRef>,
+    /// KHR_materials_clearcoat clearcoatRoughnessFactor.
+    pub clearcoat_roughness: f32,
+    /// KHR_materials_clearcoat clearcoatRoughnessTexture (G = clearcoat roughness).
+    pub clearcoat_roughness_texture: Option<TextureRef>,
+    /// KHR_materials_transmission transmissionFactor in [0, 1] (0: opaque).
+    pub transmission: f32,
+    /// KHR_materials_transmission transmissionTexture (R = transmission).
+    pub transmission_texture: Option<TextureRef>,
+    /// KHR_materials_volume with a thickness above 0: the surface bounds a closed volume
+    /// (refraction and absorption inside); `None` is a thin-walled surface.
+    pub volume: Option<Volume>,
+}
+
+/// The glTF defaults.
+impl Default for GltfPbrParams {
+    fn default() -> Self {
+        GltfPbrParams {
+            base_color: Vec3::ONE,
+            base_color_texture: None,
+            metallic: 1.0,
+            roughness: 1.0,
+            metallic_roughness_texture: None,
+            specular: 1.0,
+            specular_texture: None,
+            specular_color: Vec3::ONE,
+            specular_color_texture: None,
+            ior: 1.5,
+            clearcoat: 0.0,
+            clearcoat_texture: None,
+            clearcoat_roughness: 0.0,
+            clearcoat_roughness_texture: None,
+            transmission: 0.0,
+            transmission_texture: None,
+            volume: None,
+        }
+    }
+}
+
+/// KHR_materials_volume: the medium inside a closed surface, which absorbs by Beer-Lambert's
+/// law. Light that travels a distance `d` inside keeps `exp(-sigma_a d)` of its radiance, with
+/// `sigma_a = -ln(attenuationColor) / attenuationDistance` per channel, so that at
+/// `attenuationDistance` the transmitted colour is `attenuationColor` (the extension's
+/// definition).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Volume {
+    /// thicknessFactor (> 0; the thickness texture is not used: the path tracer measures the
+    /// distance travelled inside instead).
+    pub thickness: f32,
+    /// The absorption coefficient `sigma_a` per channel, 1/m (0: clear).
+    pub sigma_a: Vec3,
+}
+
+impl Volume {
+    /// The medium of attenuationColor `color` and attenuationDistance `distance` (infinite:
+    /// no absorption).
+    pub fn new(thickness: f32, color: Vec3, distance: f32) -> Self {
+        let sigma_a = if distance.is_finite() && distance > 0.0 {
+            Vec3::from_array(color.to_array().map(|c| -c.max(1e-30).ln() / distance))
+        } else {
+            Vec3::ZERO
+        };
+        Volume {
+            thickness,
+            sigma_a: sigma_a.max(Vec3::ZERO),
+        }
+    }
+
+    /// Beer-Lambert transmittance over `distance` inside the medium.
+    #[inline]
+    pub fn transmittance(&self, distance: f32) -> Vec3 {
+        if self.sigma_a == Vec3::ZERO {
+            Vec3::ONE
+        } else {
+            (-self.sigma_a * distance).exp()
+        }
+    }
 }
 
 /// Wet and dry patches: a texture channel gives dryness `w` in [0, 1] (0 = the material's wet
@@ -223,7 +302,9 @@ impl Material {
     /// Every texture reference the material holds.
     pub fn texture_refs(&self) -> impl Iterator<Item = TextureRef> + '_ {
         let r = match &self.reflectance {
-            Reflectance::Diffuse { kd_texture, .. } => [*kd_texture, None, None, None, None, None],
+            Reflectance::Diffuse { kd_texture, .. } => {
+                [*kd_texture, None, None, None, None, None, None]
+            }
             Reflectance::Paper {
                 kd_texture,
                 wetness,
@@ -235,22 +316,16 @@ impl Material {
                 None,
                 None,
                 None,
+                None,
             ],
-            Reflectance::GltfPbr {
-                base_color_texture,
-                metallic_roughness_texture,
-                specular_texture,
-                specular_color_texture,
-                clearcoat_texture,
-                clearcoat_roughness_texture,
-                ..
-            } => [
-                *base_color_texture,
-                *metallic_roughness_texture,
-                *specular_texture,
-                *specular_color_texture,
-                *clearcoat_texture,
-                *clearcoat_roughness_texture,
+            Reflectance::GltfPbr(g) => [
+                g.base_color_texture,
+                g.metallic_roughness_texture,
+                g.specular_texture,
+                g.specular_color_texture,
+                g.clearcoat_texture,
+                g.clearcoat_roughness_texture,
+                g.transmission_texture,
             ],
         };
         r.into_iter()
@@ -298,36 +373,31 @@ impl Material {
                     }
                 }
             }
-            Reflectance::GltfPbr {
-                base_color,
-                base_color_texture,
-                metallic,
-                roughness,
-                metallic_roughness_texture,
-                specular,
-                specular_texture,
-                specular_color,
-                specular_color_texture,
-                ior,
-                clearcoat,
-                clearcoat_texture,
-                clearcoat_roughness,
-                clearcoat_roughness_texture,
-            } => {
-                let mr = sample_or_one(*metallic_roughness_texture, at, textures);
-                let sample = |t: &Option<TextureRef>| sample_or_one(*t, at, textures);
+            Reflectance::GltfPbr(g) => {
+                let sample = |t: Option<TextureRef>| sample_or_one(t, at, textures);
+                let mr = sample(g.metallic_roughness_texture);
                 Bsdf::GltfPbr(bsdf::GltfPbr {
-                    base_color: *base_color * sample(base_color_texture).truncate() * vertex_color,
-                    metallic: (*metallic * mr.z).clamp(0.0, 1.0),
-                    roughness: (*roughness * mr.y).clamp(0.0, 1.0),
-                    specular: (*specular * sample(specular_texture).w).clamp(0.0, 1.0),
-                    specular_color: (*specular_color * sample(specular_color_texture).truncate())
-                        .max(Vec3::ZERO),
-                    ior: *ior,
-                    clearcoat: (*clearcoat * sample(clearcoat_texture).x).clamp(0.0, 1.0),
-                    clearcoat_roughness: (*clearcoat_roughness
-                        * sample(clearcoat_roughness_texture).y)
+                    base_color: g.base_color
+                        * sample(g.base_color_texture).truncate()
+                        * vertex_color,
+                    metallic: (g.metallic * mr.z).clamp(0.0, 1.0),
+                    roughness: (g.roughness * mr.y).clamp(0.0, 1.0),
+                    specular: (g.specular * sample(g.specular_texture).w).clamp(0.0, 1.0),
+                    specular_color: (g.specular_color
+                        * sample(g.specular_color_texture).truncate())
+                    .max(Vec3::ZERO),
+                    ior: g.ior,
+                    clearcoat: (g.clearcoat * sample(g.clearcoat_texture).x).clamp(0.0, 1.0),
+                    clearcoat_roughness: (g.clearcoat_roughness
+                        * sample(g.clearcoat_roughness_texture).y)
                         .clamp(0.0, 1.0),
+                    transmission: if g.transmission > 0.0 {
+                        (g.transmission * sample(g.transmission_texture).x).clamp(0.0, 1.0)
+                    } else {
+                        0.0
+                    },
+                    thin_walled: g.volume.is_none(),
+                    inside: false,
                 })
             }
         }
@@ -341,6 +411,15 @@ impl Material {
             return self.emission;
         }
         self.emission * sample_or_one(self.emission_texture, at, textures).truncate()
+    }
+
+    /// The medium inside the material's surface (KHR_materials_volume), if it bounds one.
+    #[inline]
+    pub fn volume(&self) -> Option<Volume> {
+        match &self.reflectance {
+            Reflectance::GltfPbr(g) => g.volume,
+            _ => None,
+        }
     }
 
     /// Whether the material emits at all.
@@ -424,9 +503,8 @@ mod tests {
         )
         .unwrap();
         let mut m = Material::diffuse("m", Vec3::ONE);
-        m.reflectance = Reflectance::GltfPbr {
+        m.reflectance = Reflectance::GltfPbr(GltfPbrParams {
             base_color: Vec3::splat(0.5),
-            base_color_texture: None,
             metallic: 1.0,
             roughness: 0.8,
             metallic_roughness_texture: Some(TextureRef::new(0)),
@@ -439,7 +517,10 @@ mod tests {
             clearcoat_texture: Some(TextureRef::new(0)),
             clearcoat_roughness: 0.6,
             clearcoat_roughness_texture: Some(TextureRef::new(0)),
-        };
+            transmission: 0.5,
+            transmission_texture: Some(TextureRef::new(0)),
+            ..GltfPbrParams::default()
+        });
         m.emission = Vec3::new(2.0, 0.0, 1.0);
         m.emission_texture = Some(TextureRef::new(0));
         let Bsdf::GltfPbr(b) = m.bsdf_at(&at(0.0, 0.0), std::slice::from_ref(&mr)) else {
@@ -451,6 +532,8 @@ mod tests {
         assert_eq!(b.specular_color, Vec3::new(0.0, 0.5, 0.125));
         assert_eq!(b.ior, 1.33);
         assert_eq!((b.clearcoat, b.clearcoat_roughness), (0.0, 0.3));
+        // Transmission x R.
+        assert_eq!((b.transmission, b.thin_walled), (0.0, true));
         assert_eq!(
             m.emission_at(&at(0.0, 0.0), &[mr]),
             Vec3::new(0.0, 0.0, 0.25)

@@ -35,7 +35,7 @@
 use crate::bsdf;
 use crate::camera::Camera;
 use crate::light::Light;
-use crate::material::{Material, PaperModel, Reflectance};
+use crate::material::{GltfPbrParams, Material, PaperModel, Reflectance};
 use crate::scene::{Scene, SceneError};
 use crate::texture::{Sampler, Texture, TextureId, TextureRef};
 use glam::{Vec2, Vec3};
@@ -351,6 +351,163 @@ impl<'a> MaterialWriter<'a> {
         Ok(self.bitmap(stem, name, tex, texels))
     }
 
+    /// An opaque glTF material as Mitsuba's `principled` BSDF (an approximation, warned about).
+    fn principled(
+        &mut self,
+        m: &Material,
+        stem: &str,
+        g: &GltfPbrParams,
+    ) -> Result<String, MitsubaError> {
+        self.warnings.push(format!(
+            "material {:?}: glTF metallic-roughness exported as Mitsuba's principled BSDF \
+             (different Fresnel, diffuse and multiple-scattering terms: approximation)",
+            m.name
+        ));
+        let unexported = [
+            ("metallicRoughnessTexture", g.metallic_roughness_texture),
+            ("specularTexture", g.specular_texture),
+            ("specularColorTexture", g.specular_color_texture),
+            ("clearcoatTexture", g.clearcoat_texture),
+            ("clearcoatRoughnessTexture", g.clearcoat_roughness_texture),
+        ];
+        for (name, texture) in unexported {
+            if texture.is_some() {
+                self.warnings.push(format!(
+                    "material {:?}: {name} is not exported; its factor is used everywhere",
+                    m.name
+                ));
+            }
+        }
+        let base = self.colour(m, stem, "base_color", g.base_color, g.base_color_texture)?;
+        let (specular, specular_color) = (g.specular, g.specular_color);
+        let dielectric = principled_dielectric(specular, specular_color, g.ior);
+        if !dielectric.exact {
+            self.warnings.push(format!(
+                "material {:?}: KHR_materials_specular's strength {specular} and colour \
+                 {specular_color} become principled specular (F0 = 0.08 specular, \
+                 grey, Fresnel 1 at grazing): approximation",
+                m.name
+            ));
+        }
+        let coat = if g.clearcoat > 0.0 {
+            let alpha = g.clearcoat_roughness * g.clearcoat_roughness;
+            let gloss = ((0.1 - alpha) / 0.099).clamp(0.0, 1.0);
+            self.warnings.push(format!(
+                "material {:?}: KHR_materials_clearcoat exported as principled clearcoat \
+                 {:?} (Disney's coat, GTR1 of alpha 0.1 to 0.001, a quarter of the \
+                 weight, over an unattenuated base) with clearcoat_gloss {gloss:?}: \
+                 approximation",
+                m.name,
+                4.0 * g.clearcoat
+            ));
+            format!(
+                "<float name=\"clearcoat\" value=\"{:?}\"/>\
+                 <float name=\"clearcoat_gloss\" value=\"{gloss:?}\"/>",
+                4.0 * g.clearcoat
+            )
+        } else {
+            String::new()
+        };
+        Ok(format!(
+            "<bsdf type=\"principled\">{base}\
+             <float name=\"metallic\" value=\"{:?}\"/>\
+             <float name=\"roughness\" value=\"{:?}\"/>{}{coat}</bsdf>",
+            g.metallic, g.roughness, dielectric.xml
+        ))
+    }
+
+    /// A glTF material with KHR_materials_transmission. A fully transmissive dielectric
+    /// (transmission 1, metallic 0) becomes `dielectric` (smooth) or `roughdielectric` (GGX,
+    /// `alpha = roughness^2`) when it has a volume, `thindielectric` when it is thin-walled and
+    /// smooth, with `int_ior` the glTF ior and `specular_transmittance` the base colour; any
+    /// other transmissive material becomes `principled` (a volume) or `principledthin`
+    /// (thin-walled) with `spec_trans` the transmission. Each approximation is warned about:
+    /// Mitsuba's dielectrics use the exact Fresnel equations (glTF: Schlick's), its
+    /// `thindielectric` is a slab with two interfaces and its inter-reflections (ours: one
+    /// interface, light going straight through), `principledthin` scales the transmission's
+    /// roughness, and the volume's absorption needs an interior medium on the shape, which is
+    /// not exported.
+    fn transmissive(
+        &mut self,
+        m: &Material,
+        stem: &str,
+        g: &GltfPbrParams,
+    ) -> Result<String, MitsubaError> {
+        let name = &m.name;
+        let smooth = g.roughness * g.roughness <= bsdf::MIN_ALPHA;
+        let eta = if g.ior >= 1.0 { g.ior } else { 1.5 };
+        if g.transmission_texture.is_some() {
+            self.warnings.push(format!(
+                "material {name:?}: transmissionTexture is not exported; its factor is used \
+                 everywhere"
+            ));
+        }
+        if let Some(v) = g.volume {
+            if v.sigma_a != Vec3::ZERO {
+                self.warnings.push(format!(
+                    "material {name:?}: KHR_materials_volume's attenuation is not exported \
+                     (Mitsuba needs an interior medium on the shape); rendered clear"
+                ));
+            }
+        }
+        let full = g.transmission >= 1.0 && g.metallic <= 0.0;
+        if !full || (g.volume.is_none() && !smooth) {
+            let kind = if g.volume.is_some() {
+                "principled"
+            } else {
+                "principledthin"
+            };
+            self.warnings.push(format!(
+                "material {name:?}: KHR_materials_transmission {} exported as Mitsuba's {kind} \
+                 BSDF with spec_trans (its own Fresnel, diffuse and transmission roughness): \
+                 approximation",
+                g.transmission
+            ));
+            let base = self.colour(m, stem, "base_color", g.base_color, g.base_color_texture)?;
+            let metallic = if kind == "principled" {
+                format!("<float name=\"metallic\" value=\"{:?}\"/>", g.metallic)
+            } else {
+                String::new()
+            };
+            return Ok(format!(
+                "<bsdf type=\"{kind}\">{base}{metallic}\
+                 <float name=\"roughness\" value=\"{:?}\"/>\
+                 <float name=\"spec_trans\" value=\"{:?}\"/>\
+                 <float name=\"eta\" value=\"{eta:?}\"/></bsdf>",
+                g.roughness, g.transmission
+            ));
+        }
+        let tint = self.colour(
+            m,
+            stem,
+            "specular_transmittance",
+            g.base_color,
+            g.base_color_texture,
+        )?;
+        let ior = format!("<float name=\"int_ior\" value=\"{eta:?}\"/>");
+        self.warnings.push(format!(
+            "material {name:?}: KHR_materials_transmission exported as a Mitsuba dielectric \
+             (exact Fresnel instead of glTF's Schlick approximation)"
+        ));
+        Ok(match (g.volume.is_some(), smooth) {
+            (true, true) => format!("<bsdf type=\"dielectric\">{ior}{tint}</bsdf>"),
+            (true, false) => format!(
+                "<bsdf type=\"roughdielectric\">\
+                 <string name=\"distribution\" value=\"ggx\"/>\
+                 <float name=\"alpha\" value=\"{:?}\"/>{ior}{tint}</bsdf>",
+                g.roughness * g.roughness
+            ),
+            _ => {
+                self.warnings.push(format!(
+                    "material {name:?}: thin-walled transmission exported as Mitsuba's \
+                     thindielectric, a slab with two interfaces and its inter-reflections \
+                     (streaks: one interface): approximation"
+                ));
+                format!("<bsdf type=\"thindielectric\">{ior}{tint}</bsdf>")
+            }
+        })
+    }
+
     /// The `<bsdf>` element of a material.
     fn bsdf(&mut self, index: usize, m: &Material) -> Result<String, MitsubaError> {
         let stem = file_stem(index, &m.name);
@@ -458,78 +615,12 @@ impl<'a> MaterialWriter<'a> {
                      {alpha_xml}{specular}</bsdf></bsdf>"
                 );
             }
-            Reflectance::GltfPbr {
-                base_color,
-                base_color_texture,
-                metallic,
-                roughness,
-                metallic_roughness_texture,
-                specular,
-                specular_texture,
-                specular_color,
-                specular_color_texture,
-                ior,
-                clearcoat,
-                clearcoat_texture,
-                clearcoat_roughness,
-                clearcoat_roughness_texture,
-            } => {
-                self.warnings.push(format!(
-                    "material {:?}: glTF metallic-roughness exported as Mitsuba's principled BSDF \
-                     (different Fresnel, diffuse and multiple-scattering terms: approximation)",
-                    m.name
-                ));
-                let unexported = [
-                    ("metallicRoughnessTexture", metallic_roughness_texture),
-                    ("specularTexture", specular_texture),
-                    ("specularColorTexture", specular_color_texture),
-                    ("clearcoatTexture", clearcoat_texture),
-                    ("clearcoatRoughnessTexture", clearcoat_roughness_texture),
-                ];
-                for (name, texture) in unexported {
-                    if texture.is_some() {
-                        self.warnings.push(format!(
-                            "material {:?}: {name} is not exported; its factor is used everywhere",
-                            m.name
-                        ));
-                    }
-                }
-                let base = self.colour(m, &stem, "base_color", *base_color, *base_color_texture)?;
-                let dielectric = principled_dielectric(*specular, *specular_color, *ior);
-                if !dielectric.exact {
-                    self.warnings.push(format!(
-                        "material {:?}: KHR_materials_specular's strength {specular} and colour \
-                         {specular_color} become principled specular (F0 = 0.08 specular, \
-                         grey, Fresnel 1 at grazing): approximation",
-                        m.name
-                    ));
-                }
-                let coat = if *clearcoat > 0.0 {
-                    let alpha = clearcoat_roughness * clearcoat_roughness;
-                    let gloss = ((0.1 - alpha) / 0.099).clamp(0.0, 1.0);
-                    self.warnings.push(format!(
-                        "material {:?}: KHR_materials_clearcoat exported as principled clearcoat \
-                         {:?} (Disney's coat, GTR1 of alpha 0.1 to 0.001, a quarter of the \
-                         weight, over an unattenuated base) with clearcoat_gloss {gloss:?}: \
-                         approximation",
-                        m.name,
-                        4.0 * clearcoat
-                    ));
-                    format!(
-                        "<float name=\"clearcoat\" value=\"{:?}\"/>\
-                         <float name=\"clearcoat_gloss\" value=\"{gloss:?}\"/>",
-                        4.0 * clearcoat
-                    )
+            Reflectance::GltfPbr(g) => {
+                if g.transmission > 0.0 {
+                    out = self.transmissive(m, &stem, g)?;
                 } else {
-                    String::new()
-                };
-                let _ = write!(
-                    out,
-                    "<bsdf type=\"principled\">{base}\
-                     <float name=\"metallic\" value=\"{metallic:?}\"/>\
-                     <float name=\"roughness\" value=\"{roughness:?}\"/>{}{coat}</bsdf>",
-                    dielectric.xml
-                );
+                    out = self.principled(m, &stem, g)?;
+                }
             }
         }
         if m.normal_map.is_some() {

@@ -141,8 +141,10 @@ impl MappedNormal {
 
     /// The BRDF value `f` (its lobes, evaluated in the frame of the corrected shading normal
     /// `n`) reweighted so that `result * (n . wi)` is Cycles' contribution toward `wi`: the
-    /// glossy part where [`MappedNormal::glossy_visible`], plus the diffuse part times
-    /// [`MappedNormal::diffuse_cosine`] `/ (n . wi)`. `cos_n = n . wi > 0`.
+    /// glossy part where [`MappedNormal::glossy_visible`], plus the transmitted part (below
+    /// the surface, about the corrected normal too; the integrator checks its side), plus the
+    /// diffuse part times [`MappedNormal::diffuse_cosine`] `/ (n . wi)`. `cos_n = n . wi`, not
+    /// 0 (negative for a transmitted `wi`, where the diffuse part is 0).
     #[inline]
     pub fn reweigh(&self, f: LobeValues, n: Vec3, wi: Vec3, cos_n: f32) -> Vec3 {
         let glossy = if self.glossy_visible(n, wi) {
@@ -150,7 +152,7 @@ impl MappedNormal {
         } else {
             Vec3::ZERO
         };
-        glossy + f.diffuse * (self.diffuse_cosine(wi) / cos_n)
+        glossy + f.transmission + f.diffuse * (self.diffuse_cosine(wi) / cos_n)
     }
 
     /// The same normals seen from the other face (both negated).

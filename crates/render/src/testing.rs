@@ -12,8 +12,12 @@
 //! The p-value comes from the chi-square distribution (`statrs`); the test passes when it is
 //! at least the Sidak-corrected significance `1 - (1 - significance)^(1 / num_tests)`.
 //!
-//! [`check_bsdf`] runs the test on a [`Bsdf`] for one `wo`, and also checks every sample
-//! against `eval` and `pdf`: adding a model to the [`Bsdf`] enum is enough for it to apply.
+//! [`check_bsdf`] runs the test on a [`Bsdf`] for one `wo` over the whole sphere of `wi`
+//! (transmitted directions below the surface included), and also checks every sample against
+//! `eval` and `pdf`: adding a model to the [`Bsdf`] enum is enough for it to apply. A delta
+//! lobe's samples (a smooth dielectric's transmission) have no density: they are counted with
+//! the failed samples, against the mass the density leaves uncovered, so the probability of
+//! choosing the delta lobe is tested too.
 //!
 //! ```
 //! use streaks_render::sampling::{square_to_cosine_hemisphere, square_to_cosine_hemisphere_pdf};
@@ -371,16 +375,31 @@ pub fn check_bsdf(name: &str, bsdf: &Bsdf, wo: Vec3, config: &ChiSquareConfig) -
             let u = rng.next_2d();
             let s = bsdf.sample(wo, u_lobe, u)?;
             let (f, pdf) = (bsdf.eval(wo, s.wi), bsdf.pdf(wo, s.wi));
+            let side_ok = s.wi.z > 0.0 || (s.wi.z < 0.0 && bsdf.transmits());
             if !(s.pdf.is_finite() && s.pdf > 0.0 && s.f.is_finite() && s.f.min_element() >= 0.0) {
                 note(
                     format!("bad sample {s:?} for u = {u_lobe}, {u}"),
                     &mut problems,
                 );
-            } else if (s.wi.length() - 1.0).abs() > 1e-4 || s.wi.z <= 0.0 {
+            } else if (s.wi.length() - 1.0).abs() > 1e-4 || !side_ok {
                 note(
-                    format!("sampled wi {} not a unit vector above the surface", s.wi),
+                    format!(
+                        "sampled wi {} not a unit vector above the surface (or below it, \
+                         for a transmitting BSDF)",
+                        s.wi
+                    ),
                     &mut problems,
                 );
+            } else if s.delta {
+                // A delta lobe has no density: its samples count with the mass `pdf` does not
+                // cover, and `eval` and `pdf` must not see them.
+                if f != Vec3::ZERO || pdf != 0.0 || s.pdf > 1.0 {
+                    note(
+                        format!("delta sample {s:?} but eval() = {f}, pdf() = {pdf}"),
+                        &mut problems,
+                    );
+                }
+                return None;
             } else if !close(s.pdf, pdf) {
                 note(
                     format!(

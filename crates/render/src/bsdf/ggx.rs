@@ -87,7 +87,7 @@ fn g1_denominator<L: Lanes>(v: [L; 3], a2: f32) -> L {
 /// `sqrt(alpha^2 + (1 - alpha^2) cos^2(theta_v))`: `v.z` times `1 + 2 Lambda(v)`, with
 /// `Lambda` GGX's Smith masking exponent.
 #[inline(always)]
-fn masking_root<L: Lanes>(v: [L; 3], a2: f32) -> L {
+pub(super) fn masking_root<L: Lanes>(v: [L; 3], a2: f32) -> L {
     let [x, y, z] = v;
     (z * z + (x * x + y * y) * a2).sqrt()
 }
@@ -96,11 +96,11 @@ fn masking_root<L: Lanes>(v: [L; 3], a2: f32) -> L {
 #[derive(Clone, Copy, Debug)]
 pub(super) struct GgxAtWo {
     /// `alpha^2`.
-    a2: f32,
+    pub(super) a2: f32,
     /// [`g1_denominator`] of `wo`.
-    go: f32,
+    pub(super) go: f32,
     /// [`masking_root`] of `wo`.
-    ro: f32,
+    pub(super) ro: f32,
 }
 
 impl GgxAtWo {

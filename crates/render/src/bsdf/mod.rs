@@ -5,7 +5,13 @@
 //! the surface point. `wo` points toward the viewer (where the path came from), `wi` toward the
 //! light (where the path goes next). Both are in the local shading frame, normal = +Z, so
 //! `cos(theta) = w.z`. `eval` returns the BRDF value `f(wo, wi)` WITHOUT the cosine factor
-//! (pbrt's convention; Mitsuba's `eval` includes the cosine and swaps the names).
+//! (pbrt's convention; Mitsuba's `eval` includes the cosine and swaps the names). `wo` is
+//! always above the surface (the integrator turns the frame toward the viewer); `wi` is above
+//! it for reflection and below it (`wi.z < 0`, the cosine `|wi.z|`) for the transmission of a
+//! transmissive [`GltfPbr`] (KHR_materials_transmission), the only model with a lobe there
+//! ([`Lobe::Transmission`], [`LobeValues::transmission`], [`Bsdf::transmits`]). Its smooth
+//! transmission is a delta lobe: [`BsdfSample::delta`] marks its samples, and `eval` and `pdf`
+//! are zero at its direction.
 //!
 //! No paper model has a Fresnel term: `ks` is the specular reflectance. Only [`GltfPbr`] has one
 //! (Schlick's, as the glTF specification says), and only it has a third part, the
@@ -41,7 +47,9 @@
 //! - `ggx.rs`: the GGX microfacet lobe (masking, the separable and the height-correlated
 //!   visibility, visible-normal density and sampling), shared by [`Ggx`] and [`GltfPbr`], and
 //!   the paper's [`Ggx`];
-//! - `ward.rs`: [`Ward`]; `blinn_phong.rs`: [`BlinnPhong`]; `gltf.rs`: [`GltfPbr`];
+//! - `ward.rs`: [`Ward`]; `blinn_phong.rs`: [`BlinnPhong`]; `gltf.rs`: [`GltfPbr`], with
+//!   its transmission; `dielectric.rs`: refraction and the GGX microfacet transmission (Walter
+//!   et al. 2007) it uses for a volume's boundary;
 //! - `luminance.rs`: [`LuminanceEval`], the light choice's `luminance(f(wo, wi))`: the
 //!   luminances of a model's reflectances and its `Model::AtWo`, taken once per `wo`, and
 //!   its lobes.
@@ -56,6 +64,7 @@
 //! each model's file and of this one; [`crate::testing::check_bsdf`] checks a model for one `wo`.
 
 mod blinn_phong;
+mod dielectric;
 mod diffuse;
 mod ggx;
 mod gltf;
@@ -83,6 +92,8 @@ pub enum Lobe {
     Diffuse,
     /// The glossy (microfacet or Phong-like) part; streaks come from it.
     Glossy,
+    /// The specular transmission (KHR_materials_transmission): `wi` below the surface.
+    Transmission,
 }
 
 /// BRDF values split by lobe, so the integrator can attribute glossy light to the specular layer.
@@ -92,13 +103,16 @@ pub struct LobeValues {
     pub diffuse: Vec3,
     /// Glossy part of `f(wo, wi)`.
     pub glossy: Vec3,
+    /// Transmitted part of `f(wo, wi)` (`wi` below the surface; zero for every model but a
+    /// transmissive [`GltfPbr`]).
+    pub transmission: Vec3,
 }
 
 impl LobeValues {
-    /// `diffuse + glossy`.
+    /// `diffuse + glossy + transmission`.
     #[inline]
     pub fn total(&self) -> Vec3 {
-        self.diffuse + self.glossy
+        self.diffuse + self.glossy + self.transmission
     }
 }
 
@@ -113,6 +127,10 @@ pub struct BsdfSample {
     pub pdf: f32,
     /// The lobe that was chosen to generate `wi`.
     pub lobe: Lobe,
+    /// Whether `wi` came from a delta lobe (a smooth dielectric's transmission): then `pdf` is
+    /// the discrete probability of choosing that lobe, `f |wi.z| / pdf` is the sample's weight,
+    /// and no other strategy (light sampling) can produce `wi`.
+    pub delta: bool,
 }
 
 /// The closed set of reflectance models; hot calls `match` on it (no trait objects).
@@ -226,6 +244,7 @@ fn rgb_lobes<M: Model>(m: &M, wo: Vec3, wi: Vec3) -> (LobeValues, f32) {
     let f = LobeValues {
         diffuse: lobes.diffuse,
         glossy: lobes.glossy,
+        transmission: Vec3::ZERO,
     };
     (f, lobes.glossy_pdf)
 }
@@ -361,16 +380,23 @@ impl Bsdf {
         }
     }
 
-    /// `f(wo, wi)` split by lobe; zero when either direction is below the surface.
+    /// `f(wo, wi)` split by lobe; zero when `wo` is below the surface, and when `wi` is,
+    /// except for a transmissive [`GltfPbr`]'s transmission (whose delta part, for a smooth
+    /// surface, is never evaluated: only [`Bsdf::sample`] returns it).
     #[inline]
     pub fn eval_lobes(&self, wo: Vec3, wi: Vec3) -> LobeValues {
-        self.eval_glossy_pdf(wo, wi).0
+        self.eval_pdf(wo, wi).0
     }
 
     /// `f(wo, wi)` split by lobe and [`Bsdf::pdf`] together, for the price of one: both share
     /// the half vector and the microfacet terms (next-event estimation with MIS needs both).
     #[inline]
     pub fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (LobeValues, f32) {
+        if let Bsdf::GltfPbr(m) = self {
+            if m.transmission > 0.0 {
+                return m.eval_pdf_transmissive(wo, wi);
+            }
+        }
         let (f, glossy_pdf) = self.eval_glossy_pdf(wo, wi);
         if !above(wo, wi) {
             return (f, 0.0);
@@ -393,7 +419,8 @@ impl Bsdf {
     }
 
     /// Samples `wi` given `wo`: `u_lobe` chooses the lobe, `u` samples within it.
-    /// `None` when no valid direction results (a failed sample is not an error).
+    /// `None` when no valid direction results (a failed sample is not an error). `wi` is
+    /// above the surface except for a transmissive [`GltfPbr`]'s transmission.
     #[inline]
     pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
         debug_assert!(
@@ -402,6 +429,11 @@ impl Bsdf {
         );
         if wo.z <= 0.0 {
             return None;
+        }
+        if let Bsdf::GltfPbr(m) = self {
+            if m.transmission > 0.0 {
+                return m.sample_transmissive(wo, u_lobe, u);
+            }
         }
         let p_glossy = self.glossy_probability(wo);
         let (wi, lobe) = if u_lobe < p_glossy {
@@ -422,7 +454,28 @@ impl Bsdf {
             f: f.total(),
             pdf,
             lobe,
+            delta: false,
         })
+    }
+
+    /// Whether any lobe sends light through the surface (`wi` below it).
+    #[inline]
+    pub fn transmits(&self) -> bool {
+        matches!(self, Bsdf::GltfPbr(m) if m.transmission > 0.0)
+    }
+
+    /// The BSDF seen from the back face of its surface (`wo` on the side opposite the
+    /// geometric normal of the triangle's winding): a [`GltfPbr`] bounding a volume
+    /// (KHR_materials_volume) then refracts from inside (relative index `1 / ior`); every
+    /// other model is the same on both faces.
+    #[inline]
+    pub fn seen_from_back(self) -> Self {
+        match self {
+            Bsdf::GltfPbr(m) if !m.thin_walled && m.transmission > 0.0 => {
+                Bsdf::GltfPbr(GltfPbr { inside: true, ..m })
+            }
+            b => b,
+        }
     }
 }
 

@@ -10,7 +10,9 @@
 use super::{accessor, compression, extensions, tangents, Scene, SceneError, SceneParts};
 use crate::camera::Camera;
 use crate::light::{Light, LUMINOUS_EFFICACY};
-use crate::material::{Alpha, AlphaMode, Material, PaperModel, Reflectance, Wetness};
+use crate::material::{
+    Alpha, AlphaMode, GltfPbrParams, Material, PaperModel, Reflectance, Volume, Wetness,
+};
 use crate::normal_map::NormalMap;
 use crate::texture::{
     uv_transform, ColorSpace, Filter, Sampler, Texture, TextureId, TextureRef, Wrap,
@@ -73,6 +75,40 @@ struct Clearcoat {
     texture: Option<TextureRef>,
     #[serde(skip)]
     roughness_texture: Option<TextureRef>,
+}
+
+/// A material's KHR_materials_transmission object, as the JSON has it, and its decoded texture.
+#[derive(Debug, Default, Deserialize)]
+#[serde(rename_all = "camelCase")]
+struct Transmission {
+    #[serde(default)]
+    transmission_factor: f32,
+    transmission_texture: Option<JsonTextureInfo>,
+    #[serde(skip)]
+    texture: Option<TextureRef>,
+}
+
+/// A material's KHR_materials_volume object, as the JSON has it.
+#[derive(Debug, Deserialize)]
+#[serde(rename_all = "camelCase")]
+struct JsonVolume {
+    #[serde(default)]
+    thickness_factor: f32,
+    thickness_texture: Option<serde_json::Value>,
+    #[serde(default = "infinite")]
+    attenuation_distance: f32,
+    #[serde(default = "white")]
+    attenuation_color: [f32; 3],
+}
+
+/// KHR_materials_volume's default attenuationDistance: no attenuation.
+fn infinite() -> f32 {
+    f32::INFINITY
+}
+
+/// KHR_materials_volume's default attenuationColor.
+fn white() -> [f32; 3] {
+    [1.0; 3]
 }
 
 /// A textureInfo read from the JSON: the texture's index and its texCoord set.
@@ -892,22 +928,7 @@ impl Loader<'_> {
         *self.default_material.get_or_insert_with(|| {
             self.parts.materials.push(Material {
                 name: "default".into(),
-                reflectance: Reflectance::GltfPbr {
-                    base_color: Vec3::ONE,
-                    base_color_texture: None,
-                    metallic: 1.0,
-                    roughness: 1.0,
-                    metallic_roughness_texture: None,
-                    specular: 1.0,
-                    specular_texture: None,
-                    specular_color: Vec3::ONE,
-                    specular_color_texture: None,
-                    ior: 1.5,
-                    clearcoat: 0.0,
-                    clearcoat_texture: None,
-                    clearcoat_roughness: 0.0,
-                    clearcoat_roughness_texture: None,
-                },
+                reflectance: Reflectance::GltfPbr(GltfPbrParams::default()),
                 emission: Vec3::ZERO,
                 emission_texture: None,
                 normal_map: None,
@@ -998,7 +1019,9 @@ impl Loader<'_> {
             None => {
                 let specular = self.specular(m, &element)?;
                 let clearcoat = self.clearcoat(m, document, &element)?;
-                Reflectance::GltfPbr {
+                let transmission = self.transmission(m, document, &element)?;
+                let volume = self.volume(m, &element)?;
+                Reflectance::GltfPbr(GltfPbrParams {
                     base_color: base.truncate(),
                     base_color_texture,
                     metallic: pbr.metallic_factor(),
@@ -1013,7 +1036,10 @@ impl Loader<'_> {
                     clearcoat_texture: clearcoat.texture,
                     clearcoat_roughness: clearcoat.clearcoat_roughness_factor,
                     clearcoat_roughness_texture: clearcoat.roughness_texture,
-                }
+                    transmission: transmission.transmission_factor,
+                    transmission_texture: transmission.texture,
+                    volume,
+                })
             }
         };
         Ok(Material {
@@ -1125,6 +1151,84 @@ impl Loader<'_> {
             }
         }
         Ok(c)
+    }
+
+    /// KHR_materials_transmission of a glTF material (none: transmission 0), with its texture;
+    /// a factor outside [0, 1] is an error.
+    fn transmission(
+        &mut self,
+        m: &gltf::Material,
+        document: &gltf::Document,
+        element: &str,
+    ) -> Result<Transmission, SceneError> {
+        let Some(value) = m.extension_value("KHR_materials_transmission") else {
+            return Ok(Transmission::default());
+        };
+        let reason = |r: String| format!("KHR_materials_transmission: {r}");
+        let mut t: Transmission = serde_json::from_value(value.clone())
+            .map_err(|e| self.bad(element, reason(e.to_string())))?;
+        let factor = t.transmission_factor;
+        if !(0.0..=1.0).contains(&factor) {
+            let why = format!("transmissionFactor {factor} is not in [0, 1]");
+            return Err(self.bad(element, reason(why)));
+        }
+        if let Some(info) = t.transmission_texture {
+            let Some(texture) = document.textures().nth(info.index) else {
+                let why = format!("transmissionTexture: texture {} does not exist", info.index);
+                return Err(self.bad(element, reason(why)));
+            };
+            t.texture = Some(self.texture_of(
+                &texture,
+                info.tex_coord,
+                info.transform,
+                ColorSpace::Linear,
+                element,
+            )?);
+        }
+        Ok(t)
+    }
+
+    /// KHR_materials_volume of a glTF material: `None` (thin-walled, as the extension says)
+    /// without it or with thicknessFactor 0; out-of-range values are errors, and a
+    /// thicknessTexture is a warning (the path tracer measures the distance travelled inside
+    /// instead of reading it).
+    fn volume(&mut self, m: &gltf::Material, element: &str) -> Result<Option<Volume>, SceneError> {
+        let Some(value) = m.extension_value("KHR_materials_volume") else {
+            return Ok(None);
+        };
+        let reason = |r: String| format!("KHR_materials_volume: {r}");
+        let v: JsonVolume = serde_json::from_value(value.clone())
+            .map_err(|e| self.bad(element, reason(e.to_string())))?;
+        let colour = Vec3::from(v.attenuation_color);
+        if !(v.thickness_factor.is_finite() && v.thickness_factor >= 0.0) {
+            let why = format!("thicknessFactor {} is invalid", v.thickness_factor);
+            return Err(self.bad(element, reason(why)));
+        }
+        if !(v.attenuation_distance > 0.0) {
+            let why = format!(
+                "attenuationDistance {} must be positive",
+                v.attenuation_distance
+            );
+            return Err(self.bad(element, reason(why)));
+        }
+        if !(colour.is_finite() && colour.min_element() >= 0.0 && colour.max_element() <= 1.0) {
+            let why = format!("attenuationColor {colour} is not in [0, 1]");
+            return Err(self.bad(element, reason(why)));
+        }
+        if v.thickness_factor == 0.0 {
+            return Ok(None);
+        }
+        if v.thickness_texture.is_some() {
+            self.warn(format!(
+                "{element}: KHR_materials_volume thicknessTexture is not used; the volume's \
+                 thickness is the distance the path travels inside the closed mesh"
+            ));
+        }
+        Ok(Some(Volume::new(
+            v.thickness_factor,
+            colour,
+            v.attenuation_distance,
+        )))
     }
 
     fn streaks_extras(
@@ -1620,7 +1724,7 @@ mod tests {
         assert!(approx(glow.emission, Vec3::new(5.0, 2.5, 0.0)) && glow.double_sided);
         assert!(matches!(
             glow.reflectance,
-            Reflectance::GltfPbr { metallic: 1.0, .. }
+            Reflectance::GltfPbr(GltfPbrParams { metallic: 1.0, .. })
         ));
         // Camera: named after the node, scale removed, looking along world -X.
         let cam = scene.camera(None).unwrap();
@@ -2013,10 +2117,10 @@ mod tests {
         assert_eq!(scene.uvs1[4..], scene.uvs[4..]);
         assert!((scene.colors[2] - Vec4::new(0.0, 0.0, 1.0, 0.2)).length() < 1e-6);
         assert_eq!(scene.colors[5], Vec4::ONE);
-        let Reflectance::GltfPbr {
+        let Reflectance::GltfPbr(GltfPbrParams {
             base_color_texture: Some(base),
             ..
-        } = scene.materials[0].reflectance
+        }) = scene.materials[0].reflectance
         else {
             panic!("no base colour texture")
         };
@@ -2156,10 +2260,10 @@ mod tests {
         assert_eq!(t.texcoord, 1);
         let m = t.transform.expect("a transform");
         assert!((m.transform_point2(Vec2::ONE) - Vec2::splat(2.0)).length() < 1e-6);
-        let Reflectance::GltfPbr {
+        let Reflectance::GltfPbr(GltfPbrParams {
             clearcoat_texture: Some(c),
             ..
-        } = scene.materials[0].reflectance
+        }) = scene.materials[0].reflectance
         else {
             panic!("no clearcoat texture")
         };
@@ -2303,7 +2407,7 @@ mod material_extension_tests {
     //! their defaults, their textures' channels and colour spaces, and their errors.
     use super::tests::{test_doc, write_embedded};
     use crate::bsdf::Bsdf;
-    use crate::material::Reflectance;
+    use crate::material::{GltfPbrParams, Reflectance};
     use crate::scene::Scene;
     use glam::{Vec2, Vec3};
     use serde_json::json;
@@ -2313,25 +2417,14 @@ mod material_extension_tests {
         let (doc, bin) = test_doc();
         let dir = tempfile::tempdir().unwrap();
         let scene = Scene::load(&write_embedded(dir.path(), doc, &bin)).unwrap();
-        let Reflectance::GltfPbr {
-            specular,
-            specular_texture,
-            specular_color,
-            specular_color_texture,
-            ior,
-            clearcoat,
-            clearcoat_texture,
-            clearcoat_roughness,
-            clearcoat_roughness_texture,
-            ..
-        } = &scene.materials[1].reflectance
-        else {
+        let Reflectance::GltfPbr(g) = &scene.materials[1].reflectance else {
             panic!("glow is not a glTF material")
         };
-        assert_eq!((*specular, *specular_color, *ior), (1.0, Vec3::ONE, 1.5));
-        assert_eq!((*clearcoat, *clearcoat_roughness), (0.0, 0.0));
-        assert!(specular_texture.is_none() && specular_color_texture.is_none());
-        assert!(clearcoat_texture.is_none() && clearcoat_roughness_texture.is_none());
+        let defaults = GltfPbrParams {
+            base_color: g.base_color,
+            ..GltfPbrParams::default()
+        };
+        assert_eq!(*g, defaults);
     }
 
     #[test]
