@@ -874,4 +874,96 @@ pub(crate) mod tests {
             .iter()
             .all(|s| *s == Vec3::ZERO));
     }
+
+    /// A glass box between the camera (on +Z, looking down -Z through a narrow field of view)
+    /// and an emitting wall of radiance 1 at z = -3: 20 m wide, from z = -`thickness` to 0,
+    /// its faces wound outward, smooth (roughness 0), white, transmission 1, with a volume of
+    /// attenuation colour `attenuation` at 1 m if `volume`.
+    fn glass_slab(thickness: f32, volume: Option<Vec3>) -> Scene {
+        use crate::material::{GltfPbrParams, Reflectance, Volume};
+        let mut wall = Material::diffuse("wall", Vec3::ZERO);
+        wall.emission = Vec3::ONE;
+        let mut glass = Material::diffuse("glass", Vec3::ONE);
+        glass.reflectance = Reflectance::GltfPbr(GltfPbrParams {
+            metallic: 0.0,
+            roughness: 0.0,
+            transmission: 1.0,
+            volume: volume.map(|c| Volume::new(thickness, c, 1.0)),
+            ..GltfPbrParams::default()
+        });
+        let mut parts = SceneParts {
+            materials: vec![wall, glass],
+            ..Default::default()
+        };
+        let (s, z0) = (10.0, -thickness);
+        quad(
+            &mut parts,
+            [
+                Vec3::new(-50.0, -50.0, -3.0),
+                Vec3::new(50.0, -50.0, -3.0),
+                Vec3::new(50.0, 50.0, -3.0),
+                Vec3::new(-50.0, 50.0, -3.0),
+            ],
+            0,
+        );
+        // The box: every face counter-clockwise seen from outside.
+        let c = |x: f32, y: f32, z: f32| Vec3::new(x * s, y * s, z);
+        let faces = [
+            [c(-1.0, -1.0, 0.0), c(1.0, -1.0, 0.0), c(1.0, 1.0, 0.0), c(-1.0, 1.0, 0.0)],
+            [c(-1.0, -1.0, z0), c(-1.0, 1.0, z0), c(1.0, 1.0, z0), c(1.0, -1.0, z0)],
+            [c(-1.0, -1.0, z0), c(1.0, -1.0, z0), c(1.0, -1.0, 0.0), c(-1.0, -1.0, 0.0)],
+            [c(-1.0, 1.0, z0), c(-1.0, 1.0, 0.0), c(1.0, 1.0, 0.0), c(1.0, 1.0, z0)],
+            [c(-1.0, -1.0, z0), c(-1.0, -1.0, 0.0), c(-1.0, 1.0, 0.0), c(-1.0, 1.0, z0)],
+            [c(1.0, -1.0, z0), c(1.0, 1.0, z0), c(1.0, 1.0, 0.0), c(1.0, -1.0, 0.0)],
+        ];
+        for f in faces {
+            quad(&mut parts, f, 1);
+        }
+        Scene::from_parts(parts).unwrap()
+    }
+
+    /// The mean radiance of a render of `scene` from z = 2 looking at -Z (normal incidence
+    /// within 0.01 rad), and its standard error.
+    fn slab_mean(scene: &Scene) -> (Vec3, f64) {
+        let cam = camera(Vec3::new(0.0, 0.0, 2.0), 0.0, 0.02);
+        let out = render(scene, &cam, &settings(12, 8, 256, u32::MAX), &|_| {});
+        let n = out.image.pixels.len() as f64;
+        let mean = out.image.pixels.iter().sum::<Vec3>() / n as f32;
+        let var = out
+            .image
+            .pixels
+            .iter()
+            .map(|p| ((p.x - mean.x) as f64).powi(2))
+            .sum::<f64>()
+            / (n - 1.0);
+        (mean, (var / n).sqrt())
+    }
+
+    /// Through a smooth pane of two faces, with all inter-reflections between them, a pane
+    /// transmits `(1 - F)^2 / (1 - F^2) = (1 - F) / (1 + F)` at normal incidence, F = 0.04: the
+    /// same thin-walled (each face an interface without bending) and as a volume (refracting in
+    /// and out; the radiance factors `1 / ior^2` and `ior^2` cancel). With absorption
+    /// `tau = exp(-sigma_a d)` across the thickness d, Beer-Lambert inside:
+    /// `T = (1 - F)^2 tau / (1 - F^2 tau^2)`.
+    #[test]
+    fn glass_slab_transmits_the_analytic_fraction() {
+        let f = crate::bsdf::ior_f0(1.5);
+        let clear = (1.0 - f) / (1.0 + f);
+        for volume in [None, Some(Vec3::ONE)] {
+            let (mean, err) = slab_mean(&glass_slab(0.05, volume));
+            assert!(
+                (mean - Vec3::splat(clear)).abs().max_element() < (4.0 * err as f32).max(2e-3),
+                "volume {volume:?}: {mean} vs {clear} (standard error {err})"
+            );
+        }
+        // attenuationColor (0.5, 0.8, 1) at 1 m, through 0.4 m.
+        let colour = Vec3::new(0.5, 0.8, 1.0);
+        let (mean, err) = slab_mean(&glass_slab(0.4, Some(colour)));
+        let tau = colour.powf(0.4);
+        let want = (1.0 - f) * (1.0 - f) * tau / (Vec3::ONE - f * f * tau * tau);
+        assert!(
+            (mean - want).abs().max_element() < (4.0 * err as f32).max(2e-3),
+            "{mean} vs {want} (standard error {err})"
+        );
+    }
 }

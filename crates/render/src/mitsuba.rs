@@ -18,6 +18,9 @@
 //! | `ward` | the same blend with `beckmann` and the same alpha | no (warning) |
 //! | `blinn_phong` | the same blend with `beckmann`, alpha = sqrt(2 / (s + 2)) | no (warning) |
 //! | glTF metallic-roughness | `principled` (base_color, metallic, roughness) | no: different Fresnel and diffuse models (warning); metallicRoughnessTexture ignored (warning) |
+//! | KHR_materials_transmission 1, metallic 0, with KHR_materials_volume | `dielectric` (roughness 0) or `roughdielectric` (ggx, alpha = roughness^2), `int_ior` = ior, `specular_transmittance` = base colour | no: exact Fresnel instead of Schlick's (warning); the volume's attenuation needs an interior medium, not exported (warning) |
+//! | the same, thin-walled and smooth | `thindielectric` | no: a slab with two interfaces and its inter-reflections, ours one interface (warning) |
+//! | other transmissive materials | `principled` (a volume) or `principledthin` (thin-walled) with `spec_trans` = transmission | no (warning) |
 //! | diffuse | `diffuse` | yes |
 //! | kd / base colour / emission texture | `bitmap` (an EXR of texture x factor, so the factor is baked in) | yes (bilinear, repeat) |
 //! | wet/dry map ([`Wetness`](crate::material::Wetness)) | `alpha` and `specular_reflectance` as `bitmap`s baked per texel of the dryness map (`mix(wet, dry, w)`) | yes for `ggx` and `ward`'s alpha (linear in `w`, so bilinear filtering commutes); blinn_phong's alpha is not linear in the shininess (approximation already) |
@@ -1257,5 +1260,70 @@ mod tests {
         assert_eq!(blend_weight(0.8, 0.0), (0.0, true));
         assert_eq!(blend_weight(0.0, 0.9), (1.0, true));
         assert!(!blend_weight(0.9, 0.4).1);
+    }
+
+    #[test]
+    fn transmission_maps_to_mitsuba_dielectrics() {
+        use crate::material::{GltfPbrParams, Volume};
+        let glass = |roughness: f32, transmission: f32, volume: Option<Volume>| {
+            Reflectance::GltfPbr(GltfPbrParams {
+                base_color: Vec3::new(0.9, 0.95, 1.0),
+                metallic: 0.0,
+                roughness,
+                ior: 1.45,
+                transmission,
+                volume,
+                ..GltfPbrParams::default()
+            })
+        };
+        let clear = Some(Volume::new(0.02, Vec3::ONE, f32::INFINITY));
+        let tinted = Some(Volume::new(0.02, Vec3::splat(0.5), 1.0));
+        for (reflectance, ty, needles) in [
+            (glass(0.0, 1.0, clear), "dielectric", vec!["exact Fresnel"]),
+            (
+                glass(0.3, 1.0, tinted),
+                "roughdielectric",
+                vec!["exact Fresnel", "attenuation is not exported"],
+            ),
+            (glass(0.0, 1.0, None), "thindielectric", vec!["two interfaces"]),
+            (glass(0.3, 1.0, None), "principledthin", vec!["principledthin"]),
+            (glass(0.3, 0.5, clear), "principled", vec!["spec_trans"]),
+        ] {
+            let mut fx = Fixture::new();
+            fx.materials[2].reflectance = reflectance;
+            let ex = export_parts(&fx.parts(), &fx.cameras[0], &opts()).unwrap();
+            let doc = roxmltree::Document::parse(&ex.xml).unwrap();
+            let bsdf = doc
+                .descendants()
+                .find(|n| n.has_tag_name("bsdf") && n.attribute("type") == Some(ty))
+                .unwrap_or_else(|| panic!("no {ty} in {}", ex.xml));
+            let value = |name: &str| {
+                bsdf.children()
+                    .find(|c| c.attribute("name") == Some(name))
+                    .and_then(|c| c.attribute("value"))
+                    .map(str::to_owned)
+            };
+            match ty {
+                "dielectric" | "thindielectric" => {
+                    assert_eq!(value("int_ior").as_deref(), Some("1.45"));
+                    assert_eq!(
+                        floats(&value("specular_transmittance").unwrap()),
+                        [0.9, 0.95, 1.0]
+                    );
+                }
+                "roughdielectric" => {
+                    let alpha: f32 = value("alpha").unwrap().parse().unwrap();
+                    assert!((alpha - 0.09).abs() < 1e-6);
+                }
+                _ => assert!(value("spec_trans").is_some()),
+            }
+            for needle in needles {
+                assert!(
+                    ex.warnings.iter().any(|w| w.contains("\"wall\"") && w.contains(needle)),
+                    "{ty}: no warning about {needle}: {:?}",
+                    ex.warnings
+                );
+            }
+        }
     }
 }

@@ -2530,4 +2530,105 @@ mod material_extension_tests {
             );
         }
     }
+
+    #[test]
+    fn transmission_and_volume_are_read() {
+        // One texel: R 128 (transmission x 0.502), linear.
+        let mut png = Vec::new();
+        image::RgbaImage::from_raw(1, 1, vec![128, 0, 0, 255])
+            .unwrap()
+            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+            .unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("t.png"), &png).unwrap();
+        let (mut doc, bin) = test_doc();
+        doc["extensionsUsed"] = json!([
+            "KHR_lights_punctual",
+            "KHR_materials_emissive_strength",
+            "KHR_materials_transmission",
+            "KHR_materials_volume"
+        ]);
+        doc["images"] = json!([{"uri": "t.png"}]);
+        doc["textures"] = json!([{"source": 0}]);
+        doc["materials"][1]["extensions"] = json!({
+            "KHR_materials_transmission": {
+                "transmissionFactor": 0.8, "transmissionTexture": {"index": 0}}});
+        let at = crate::geometry::VertexAttributes::from_uv(Vec2::ZERO);
+        // Thin-walled without KHR_materials_volume; no warning.
+        let scene = Scene::load(&write_embedded(dir.path(), doc.clone(), &bin)).unwrap();
+        assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+        let Bsdf::GltfPbr(g) = scene.materials[1].bsdf_at(&at, &scene.textures) else {
+            panic!("not a glTF material")
+        };
+        assert!((g.transmission - 0.8 * 128.0 / 255.0).abs() < 1e-4, "{g:?}");
+        assert!(g.thin_walled && scene.materials[1].volume().is_none());
+        // A volume: attenuation colour and distance give sigma_a; thicknessTexture warns.
+        let mut d = doc.clone();
+        d["materials"][1]["extensions"]["KHR_materials_volume"] = json!({
+            "thicknessFactor": 0.02, "thicknessTexture": {"index": 0},
+            "attenuationDistance": 0.5, "attenuationColor": [0.5, 1.0, 0.25]});
+        let scene = Scene::load(&write_embedded(dir.path(), d, &bin)).unwrap();
+        assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+        assert!(
+            scene.warnings[0].contains("material \"glow\" (1)")
+                && scene.warnings[0].contains("thicknessTexture is not used"),
+            "{:?}",
+            scene.warnings
+        );
+        let v = scene.materials[1].volume().expect("a volume");
+        let want = Vec3::new(0.5f32.ln(), 0.0, 0.25f32.ln()) / -0.5;
+        assert!((v.sigma_a - want).abs().max_element() < 1e-5, "{v:?}");
+        assert!((v.transmittance(0.5) - Vec3::new(0.5, 1.0, 0.25)).abs().max_element() < 1e-5);
+        let Bsdf::GltfPbr(g) = scene.materials[1].bsdf_at(&at, &scene.textures) else {
+            panic!("not a glTF material")
+        };
+        assert!(!g.thin_walled);
+        // Thickness 0 is thin-walled, as the extension says; no attenuation by default.
+        let mut d = doc.clone();
+        d["materials"][1]["extensions"]["KHR_materials_volume"] = json!({});
+        let scene = Scene::load(&write_embedded(dir.path(), d, &bin)).unwrap();
+        assert!(scene.materials[1].volume().is_none() && scene.warnings.is_empty());
+        let mut d = doc.clone();
+        d["materials"][1]["extensions"]["KHR_materials_volume"] = json!({"thicknessFactor": 1});
+        let scene = Scene::load(&write_embedded(dir.path(), d, &bin)).unwrap();
+        assert_eq!(scene.materials[1].volume().unwrap().sigma_a, Vec3::ZERO);
+        // Out of range: errors naming the material and the value.
+        for (ext, value, what) in [
+            (
+                "KHR_materials_transmission",
+                json!({"transmissionFactor": 1.5}),
+                "transmissionFactor 1.5",
+            ),
+            (
+                "KHR_materials_transmission",
+                json!({"transmissionTexture": {"index": 9}}),
+                "texture 9",
+            ),
+            (
+                "KHR_materials_volume",
+                json!({"thicknessFactor": -1}),
+                "thicknessFactor -1",
+            ),
+            (
+                "KHR_materials_volume",
+                json!({"thicknessFactor": 1, "attenuationDistance": 0}),
+                "attenuationDistance 0",
+            ),
+            (
+                "KHR_materials_volume",
+                json!({"attenuationColor": [2, 0, 0]}),
+                "attenuationColor",
+            ),
+        ] {
+            let mut d = doc.clone();
+            d["materials"][1]["extensions"] = json!({ ext: value });
+            let err = Scene::load(&write_embedded(dir.path(), d, &bin))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                err.contains("material \"glow\" (1)") && err.contains(what),
+                "{ext}: {err}"
+            );
+        }
+    }
 }
