@@ -33,6 +33,17 @@
 //!   clearcoatRoughnessFactor and clearcoatRoughnessTexture's green channel; a
 //!   clearcoatNormalTexture is a warning, the coat uses the base's normal), with those
 //!   extensions' formulas; values outside the schemas' ranges are errors naming the material.
+//!   KHR_materials_transmission (transmissionFactor and transmissionTexture's red channel)
+//!   makes that share of the dielectric's diffuse part a specular transmission tinted by the
+//!   base colour, with the surface's roughness (0: a smooth, delta dielectric). Without
+//!   KHR_materials_volume, or with thicknessFactor 0, the surface is thin-walled, as the
+//!   extension says: light goes through it without bending, and a closed mesh (a glass box)
+//!   is two such interfaces, its faces each transmitting without refraction. With a
+//!   thicknessFactor above 0 the mesh bounds a volume: it refracts by its ior entering
+//!   through the front faces and leaving through the back faces, and absorbs inside by
+//!   Beer-Lambert's law from attenuationColor and attenuationDistance over the distance the
+//!   path travels inside ([`crate::material::Volume`]); a thicknessTexture is a warning (the
+//!   travelled distance replaces it).
 //!   A specularFactor of 0 (Blender's Specular IOR Level 0) is exactly Lambertian. Unless
 //!   `extras.streaks` chooses one of the paper's models: `{"bsdf": "ggx" | "ward" | "blinn_phong", "kd": [r,g,b], "ks": [r,g,b],
 //!   "alpha": a, "shininess": s}` (`alpha` for ggx and ward, `shininess` for blinn_phong;
