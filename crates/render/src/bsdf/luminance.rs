@@ -14,7 +14,9 @@ use streaks_image::luminance;
 /// `luminance(f(wo, wi))` for one `wo` and any `wi` (see [`Bsdf::luminance_at`]):
 /// [`LuminanceEval::eval`] evaluates one direction and [`LuminanceEval::eval4`] four at once
 /// in SIMD lanes, each lane exactly the scalar value. Equal to `luminance(bsdf.eval(wo, wi))`
-/// up to rounding (tested).
+/// up to rounding (tested), except below the surface for a transmissive [`GltfPbr`]: its
+/// transmission is not evaluated here (zero), so the light choice's BSDF-aware share looks at
+/// reflection only.
 #[derive(Clone, Copy, Debug)]
 pub struct LuminanceEval {
     wo: Vec3,

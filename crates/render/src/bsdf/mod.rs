@@ -322,7 +322,9 @@ fn mixture_pdf(wi: Vec3, glossy_pdf: f32, p_glossy: f32) -> f32 {
 // Dispatch
 
 impl Bsdf {
-    /// Probability that [`Bsdf::sample`] picks the glossy lobe for this `wo` (0 for diffuse).
+    /// Probability that [`Bsdf::sample`] picks the glossy lobe for this `wo` (0 for diffuse;
+    /// for a transmissive [`GltfPbr`], whose sampling chooses among three lobes, the opaque
+    /// model's two-lobe probability).
     #[inline]
     pub fn glossy_probability(&self, wo: Vec3) -> f32 {
         if wo.z <= 0.0 {
@@ -385,7 +387,10 @@ impl Bsdf {
     /// surface, is never evaluated: only [`Bsdf::sample`] returns it).
     #[inline]
     pub fn eval_lobes(&self, wo: Vec3, wi: Vec3) -> LobeValues {
-        self.eval_pdf(wo, wi).0
+        match self {
+            Bsdf::GltfPbr(m) if m.transmission > 0.0 => m.eval_pdf_transmissive(wo, wi).0,
+            _ => self.eval_glossy_pdf(wo, wi).0,
+        }
     }
 
     /// `f(wo, wi)` split by lobe and [`Bsdf::pdf`] together, for the price of one: both share
