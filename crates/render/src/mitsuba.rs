@@ -1285,8 +1285,16 @@ mod tests {
                 "roughdielectric",
                 vec!["exact Fresnel", "attenuation is not exported"],
             ),
-            (glass(0.0, 1.0, None), "thindielectric", vec!["two interfaces"]),
-            (glass(0.3, 1.0, None), "principledthin", vec!["principledthin"]),
+            (
+                glass(0.0, 1.0, None),
+                "thindielectric",
+                vec!["two interfaces"],
+            ),
+            (
+                glass(0.3, 1.0, None),
+                "principledthin",
+                vec!["principledthin"],
+            ),
             (glass(0.3, 0.5, clear), "principled", vec!["spec_trans"]),
         ] {
             let mut fx = Fixture::new();
@@ -1319,7 +1327,9 @@ mod tests {
             }
             for needle in needles {
                 assert!(
-                    ex.warnings.iter().any(|w| w.contains("\"wall\"") && w.contains(needle)),
+                    ex.warnings
+                        .iter()
+                        .any(|w| w.contains("\"wall\"") && w.contains(needle)),
                     "{ty}: no warning about {needle}: {:?}",
                     ex.warnings
                 );

@@ -367,16 +367,7 @@ impl GltfPbr {
             return None;
         }
         let (f, pdf) = self.eval_pdf_transmissive(wo, wi);
-        if !(pdf > 0.0 && pdf.is_finite()) {
-            return None;
-        }
-        Some(BsdfSample {
-            wi,
-            f: f.total(),
-            pdf,
-            lobe,
-            delta: false,
-        })
+        BsdfSample::continuous(wi, f.total(), pdf, lobe)
     }
 
     /// The smooth transmission's delta sample, chosen with probability `p`: `-wo`

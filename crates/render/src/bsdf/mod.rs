@@ -133,6 +133,21 @@ pub struct BsdfSample {
     pub delta: bool,
 }
 
+impl BsdfSample {
+    /// The sample of `wi` from a lobe with a density, `f` and `pdf` being `eval` and `pdf` at
+    /// `wi`; `None` unless `pdf` is positive and finite.
+    #[inline]
+    fn continuous(wi: Vec3, f: Vec3, pdf: f32, lobe: Lobe) -> Option<Self> {
+        (pdf > 0.0 && pdf.is_finite()).then_some(BsdfSample {
+            wi,
+            f,
+            pdf,
+            lobe,
+            delta: false,
+        })
+    }
+}
+
 /// The closed set of reflectance models; hot calls `match` on it (no trait objects).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Bsdf {
@@ -450,17 +465,7 @@ impl Bsdf {
             return None;
         }
         let (f, glossy_pdf) = self.eval_glossy_pdf(wo, wi);
-        let pdf = mixture_pdf(wi, glossy_pdf, p_glossy);
-        if !(pdf > 0.0 && pdf.is_finite()) {
-            return None;
-        }
-        Some(BsdfSample {
-            wi,
-            f: f.total(),
-            pdf,
-            lobe,
-            delta: false,
-        })
+        BsdfSample::continuous(wi, f.total(), mixture_pdf(wi, glossy_pdf, p_glossy), lobe)
     }
 
     /// Whether any lobe sends light through the surface (`wi` below it).

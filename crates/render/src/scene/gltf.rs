@@ -2578,7 +2578,12 @@ mod material_extension_tests {
         let v = scene.materials[1].volume().expect("a volume");
         let want = Vec3::new(0.5f32.ln(), 0.0, 0.25f32.ln()) / -0.5;
         assert!((v.sigma_a - want).abs().max_element() < 1e-5, "{v:?}");
-        assert!((v.transmittance(0.5) - Vec3::new(0.5, 1.0, 0.25)).abs().max_element() < 1e-5);
+        assert!(
+            (v.transmittance(0.5) - Vec3::new(0.5, 1.0, 0.25))
+                .abs()
+                .max_element()
+                < 1e-5
+        );
         let Bsdf::GltfPbr(g) = scene.materials[1].bsdf_at(&at, &scene.textures) else {
             panic!("not a glTF material")
         };
