@@ -1204,7 +1204,7 @@ impl Loader<'_> {
             let why = format!("thicknessFactor {} is invalid", v.thickness_factor);
             return Err(self.bad(element, reason(why)));
         }
-        if !(v.attenuation_distance > 0.0) {
+        if v.attenuation_distance.is_nan() || v.attenuation_distance <= 0.0 {
             let why = format!(
                 "attenuationDistance {} must be positive",
                 v.attenuation_distance
