@@ -20,6 +20,14 @@
 //! behind. A scene without alpha-tested triangles has no bit set, and the filtered queries are
 //! the plain ones.
 //!
+//! Instancing: an instanced mesh has its own [`Accel`] in object space, queried with a ray
+//! taken into that space ([`Accel::intersect_object`], [`Accel::occluded_object`]): the
+//! direction is transformed but not renormalised, so `t` stays the world ray's parameter and
+//! the scene's `t_min` applies unchanged. A [`Tlas`] over the instances' world boxes finds the
+//! instances a ray may hit; each box's query runs the instance's BLAS traversal nested in the
+//! TLAS traversal (obvhs' `ray_traverse_tlas_blas` shares one stack but cannot transform the
+//! ray).
+//!
 //! Queries allocate nothing: traversal uses obvhs' fixed-size stack.
 
 use crate::geometry::Ray;
@@ -157,32 +165,58 @@ impl Accel {
         self.alpha_tested[slot / 64] & (1 << (slot % 64)) != 0
     }
 
-    fn bvh_ray(&self, ray: &Ray) -> Option<(&CwBvh, BvhRay)> {
-        let bvh = self.bvh.as_ref()?;
-        if !(ray.origin.is_finite() && ray.direction.is_finite()) || ray.t_max.is_nan() {
-            return None;
-        }
-        if ray.t_max <= self.t_min {
-            return None;
-        }
-        // obvhs 0.4 takes the traversal octant from `d < 0` but the inverse direction from the
-        // sign bit, so a -0.0 component makes them disagree and the ray misses everything:
-        // adding +0.0 turns -0.0 into +0.0.
-        let direction = Vec3A::from(ray.direction) + Vec3A::ZERO;
-        Some((
-            bvh,
-            BvhRay::new(ray.origin.into(), direction, self.t_min, ray.t_max),
-        ))
+    fn bvh_ray(&self, ray: &Ray, t_min: f32) -> Option<(&CwBvh, BvhRay)> {
+        Some((self.bvh.as_ref()?, bvh_ray(ray, t_min)?))
+    }
+
+    /// Raises [`Accel::t_min`] to `t_min` if that is larger: a scene whose instances reach
+    /// farther than its own triangles guards all its hits with one distance.
+    pub(crate) fn raise_t_min(&mut self, t_min: f32) {
+        self.t_min = self.t_min.max(t_min);
     }
 
     /// Closest hit with `t_min < t < ray.t_max`.
     pub fn intersect(&self, ray: &Ray) -> Option<AccelHit> {
-        self.closest::<false>(ray, |_, _| true)
+        self.closest::<false>(ray, self.t_min, |_, _| true)
     }
 
     /// Whether any triangle is hit with `t_min < t < ray.t_max` (any-hit query).
     pub fn occluded(&self, ray: &Ray) -> bool {
-        self.any::<false>(ray, |_, _| true)
+        self.any::<false>(ray, self.t_min, |_, _| true)
+    }
+
+    /// [`Accel::intersect_filtered`] for a ray in this BVH's object space (an instanced
+    /// mesh's): `ray.direction` need not be unit (it is the world direction through the
+    /// inverse transform, so `t` is the world ray's), and hits at `t <= t_min` (the scene's)
+    /// are ignored.
+    #[inline]
+    pub(crate) fn intersect_object(
+        &self,
+        ray: &Ray,
+        t_min: f32,
+        stops: impl FnMut(u32, Vec2) -> bool,
+    ) -> Option<AccelHit> {
+        if self.alpha_tested.is_empty() {
+            self.closest::<false>(ray, t_min, stops)
+        } else {
+            self.closest::<true>(ray, t_min, stops)
+        }
+    }
+
+    /// [`Accel::occluded_filtered`] for a ray in object space (see
+    /// [`Accel::intersect_object`]).
+    #[inline]
+    pub(crate) fn occluded_object(
+        &self,
+        ray: &Ray,
+        t_min: f32,
+        stops: impl FnMut(u32, Vec2) -> bool,
+    ) -> bool {
+        if self.alpha_tested.is_empty() {
+            self.any::<false>(ray, t_min, stops)
+        } else {
+            self.any::<true>(ray, t_min, stops)
+        }
     }
 
     /// [`Accel::intersect`], where a hit on an alpha-tested triangle counts only if
@@ -196,7 +230,7 @@ impl Accel {
         if self.alpha_tested.is_empty() {
             self.intersect(ray)
         } else {
-            self.closest::<true>(ray, stops)
+            self.closest::<true>(ray, self.t_min, stops)
         }
     }
 
@@ -207,7 +241,7 @@ impl Accel {
         if self.alpha_tested.is_empty() {
             self.occluded(ray)
         } else {
-            self.any::<true>(ray, stops)
+            self.any::<true>(ray, self.t_min, stops)
         }
     }
 
@@ -228,13 +262,13 @@ impl Accel {
     fn closest<const FILTER: bool>(
         &self,
         ray: &Ray,
+        t_min: f32,
         mut stops: impl FnMut(u32, Vec2) -> bool,
     ) -> Option<AccelHit> {
-        let (bvh, r) = self.bvh_ray(ray)?;
+        let (bvh, r) = self.bvh_ray(ray, t_min)?;
         let mut hit = RayHit::none();
         let mut barycentrics = Vec2::ZERO;
         let tris = &self.tris;
-        let t_min = self.t_min;
         if !bvh.ray_traverse(r, &mut hit, |r, id| {
             let (t, b) = intersect_triangle(&tris[id], r, t_min);
             // obvhs keeps a hit exactly when it is nearer than the ray's current end.
@@ -257,18 +291,108 @@ impl Accel {
 
     /// Whether any hit [`Accel::counts`].
     #[inline(always)]
-    fn any<const FILTER: bool>(&self, ray: &Ray, mut stops: impl FnMut(u32, Vec2) -> bool) -> bool {
-        let Some((bvh, r)) = self.bvh_ray(ray) else {
+    fn any<const FILTER: bool>(
+        &self,
+        ray: &Ray,
+        t_min: f32,
+        mut stops: impl FnMut(u32, Vec2) -> bool,
+    ) -> bool {
+        let Some((bvh, r)) = self.bvh_ray(ray, t_min) else {
             return false;
         };
         let tris = &self.tris;
-        let t_min = self.t_min;
         !bvh.ray_traverse_miss(r, |r, id| {
             let (t, b) = intersect_triangle(&tris[id], r, t_min);
             if t < r.tmax && !self.counts::<FILTER>(id, b, &mut stops) {
                 return f32::INFINITY;
             }
             t
+        })
+    }
+}
+
+/// The obvhs ray for `ray` with hits at `t <= t_min` ignored; `None` for a ray that cannot
+/// hit anything (not finite, or ending before `t_min`).
+#[inline(always)]
+fn bvh_ray(ray: &Ray, t_min: f32) -> Option<BvhRay> {
+    if !(ray.origin.is_finite() && ray.direction.is_finite()) || ray.t_max.is_nan() {
+        return None;
+    }
+    if ray.t_max <= t_min {
+        return None;
+    }
+    // obvhs 0.4 takes the traversal octant from `d < 0` but the inverse direction from the
+    // sign bit, so a -0.0 component makes them disagree and the ray misses everything:
+    // adding +0.0 turns -0.0 into +0.0.
+    let direction = Vec3A::from(ray.direction) + Vec3A::ZERO;
+    Some(BvhRay::new(ray.origin.into(), direction, t_min, ray.t_max))
+}
+
+/// A top-level BVH: an obvhs CWBVH over boxes (the world bounds of a scene's instances),
+/// whose queries call a closure for each box the ray enters, with the ray's current end.
+pub struct Tlas {
+    bvh: CwBvh,
+}
+
+impl std::fmt::Debug for Tlas {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Tlas")
+            .field("boxes", &self.bvh.primitive_indices.len())
+            .field("nodes", &self.bvh.nodes.len())
+            .finish()
+    }
+}
+
+impl Tlas {
+    /// The BVH over `boxes` (`[min, max]` corners); `None` when there are none.
+    pub fn build(boxes: &[[Vec3; 2]]) -> Option<Self> {
+        if boxes.is_empty() {
+            return None;
+        }
+        let bvh = build_cwbvh(
+            boxes
+                .iter()
+                .map(|[lo, hi]| Aabb::new(Vec3A::from(*lo), Vec3A::from(*hi))),
+            reinsertion_ratio(boxes.len()),
+        );
+        Some(Self { bvh })
+    }
+
+    /// Approximate heap memory of the BVH, in bytes.
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of_val(self.bvh.nodes.as_slice())
+            + std::mem::size_of_val(self.bvh.primitive_indices.as_slice())
+    }
+
+    /// Visits the boxes `ray` enters before its end, nearest first where the traversal order
+    /// allows: `visit(box, t_max)` returns the parameter of the closest hit inside box `box`
+    /// before `t_max` (infinity for none), which then becomes the ray's end. Whether any box
+    /// reported a hit.
+    #[inline]
+    pub fn closest(&self, ray: &Ray, t_min: f32, mut visit: impl FnMut(u32, f32) -> f32) -> bool {
+        let Some(r) = bvh_ray(ray, t_min) else {
+            return false;
+        };
+        let ids = &self.bvh.primitive_indices;
+        let mut hit = RayHit::none();
+        self.bvh
+            .ray_traverse(r, &mut hit, |r, slot| visit(ids[slot], r.tmax))
+    }
+
+    /// Whether `visit(box)` says true for some box `ray` enters before its end (stopping at
+    /// the first that does).
+    #[inline]
+    pub fn any(&self, ray: &Ray, t_min: f32, mut visit: impl FnMut(u32) -> bool) -> bool {
+        let Some(r) = bvh_ray(ray, t_min) else {
+            return false;
+        };
+        let ids = &self.bvh.primitive_indices;
+        !self.bvh.ray_traverse_miss(r, |_, slot| {
+            if visit(ids[slot]) {
+                0.0
+            } else {
+                f32::INFINITY
+            }
         })
     }
 }

@@ -6,8 +6,18 @@
 //! specification and of KHR_mesh_quantization, sparse accessors); meshopt- and
 //! Draco-compressed geometry is decoded first by the `compression` module. Sparse index
 //! accessors are not supported (an error names them).
+//!
+//! Instancing: the scene's nodes are walked first and every placement of a mesh recorded (a
+//! node with a mesh, or each instance of a node's EXT_mesh_gpu_instancing, whose TRANSLATION,
+//! ROTATION and SCALE attributes give `node world * T * R * S`). A mesh placed more than once
+//! and without an emissive material is loaded once in object space (its MikkTSpace tangents,
+//! if generated, from the object-space positions) and becomes instances
+//! ([`super::Instances`]); every other placement is flattened into world triangles, in the
+//! order of the walk.
 
-use super::{accessor, compression, extensions, tangents, Scene, SceneError, SceneParts};
+use super::{
+    accessor, compression, extensions, tangents, Instance, MeshParts, Scene, SceneError, SceneParts,
+};
 use crate::camera::Camera;
 use crate::light::{Light, LUMINOUS_EFFICACY};
 use crate::material::{
@@ -237,6 +247,7 @@ pub(super) fn load(path: &Path) -> Result<Scene, SceneError> {
         textures: HashMap::new(),
         default_material: None,
         light_units,
+        placements: Vec::new(),
     };
     for w in extension_warnings {
         loader.warn(w);
@@ -264,7 +275,7 @@ pub(super) fn load(path: &Path) -> Result<Scene, SceneError> {
                         "the node hierarchy has a cycle",
                     ));
                 }
-                let world = loader.node(&node, parent)?;
+                let world = loader.node(&node, parent, &document)?;
                 let first_child = stack.len();
                 stack.extend(node.children().map(|c| (c, world, depth + 1)));
                 stack[first_child..].reverse();
@@ -275,11 +286,24 @@ pub(super) fn load(path: &Path) -> Result<Scene, SceneError> {
             .warnings
             .push(format!("{}: the file has no scene", path.display())),
     }
+    loader.place_meshes(&document)?;
     if !loader.parts.tangents.is_empty() {
         let n = loader.parts.positions.len();
         loader.parts.tangents.resize(n, Vec4::ZERO);
     }
     Scene::from_parts(loader.parts)
+}
+
+/// Swaps the vertex arrays and triangles of `parts` with those of `mesh`.
+fn swap_geometry(parts: &mut SceneParts, mesh: &mut MeshParts) {
+    std::mem::swap(&mut parts.positions, &mut mesh.positions);
+    std::mem::swap(&mut parts.normals, &mut mesh.normals);
+    std::mem::swap(&mut parts.uvs, &mut mesh.uvs);
+    std::mem::swap(&mut parts.tangents, &mut mesh.tangents);
+    std::mem::swap(&mut parts.uvs1, &mut mesh.uvs1);
+    std::mem::swap(&mut parts.colors, &mut mesh.colors);
+    std::mem::swap(&mut parts.triangles, &mut mesh.triangles);
+    std::mem::swap(&mut parts.triangle_materials, &mut mesh.triangle_materials);
 }
 
 fn node_label(node: &gltf::Node) -> String {
@@ -439,6 +463,8 @@ struct Loader<'a> {
     default_material: Option<u32>,
     /// What KHR_lights_punctual's intensities are in.
     light_units: LightUnits,
+    /// Every placement of a mesh in the walk's order: mesh index and world transform.
+    placements: Vec<(usize, Mat4)>,
 }
 
 /// The units of a file's KHR_lights_punctual intensities: the specification's photometric ones
@@ -485,8 +511,14 @@ impl Loader<'_> {
             .push(format!("{}: {msg}", self.path.display()));
     }
 
-    /// Adds what `node` carries (mesh, camera, light); returns its world transform.
-    fn node(&mut self, node: &gltf::Node, parent: Mat4) -> Result<Mat4, SceneError> {
+    /// Adds what `node` carries (camera, light; its mesh's placements are recorded for
+    /// [`Loader::place_meshes`]); returns its world transform.
+    fn node(
+        &mut self,
+        node: &gltf::Node,
+        parent: Mat4,
+        document: &gltf::Document,
+    ) -> Result<Mat4, SceneError> {
         let local = match node.transform() {
             gltf::scene::Transform::Matrix { matrix } => Mat4::from_cols_array_2d(&matrix),
             gltf::scene::Transform::Decomposed {
@@ -509,7 +541,21 @@ impl Loader<'_> {
             ));
         }
         if let Some(mesh) = node.mesh() {
-            self.mesh(&mesh, world)?;
+            match node.extension_value("EXT_mesh_gpu_instancing") {
+                Some(ext) => {
+                    for (i, local) in self.gpu_instances(node, ext, document)?.iter().enumerate() {
+                        let w = world * *local;
+                        if Instance::new(0, w).is_none() {
+                            return Err(self.bad(
+                                format!("{}, EXT_mesh_gpu_instancing instance {i}", node_label(node)),
+                                format!("world transform is not invertible or not finite: {w:?}"),
+                            ));
+                        }
+                        self.placements.push((mesh.index(), w));
+                    }
+                }
+                None => self.placements.push((mesh.index(), world)),
+            }
         }
         if let Some(camera) = node.camera() {
             self.camera(node, &camera, world)?;
@@ -518,6 +564,134 @@ impl Loader<'_> {
             self.light(&light, world);
         }
         Ok(world)
+    }
+
+    /// The local transforms `T * R * S` of the instances of `node`'s EXT_mesh_gpu_instancing
+    /// `ext` (its TRANSLATION, ROTATION and SCALE accessors, each optional, of one count;
+    /// quantized as KHR_mesh_quantization allows).
+    fn gpu_instances(
+        &self,
+        node: &gltf::Node,
+        ext: &serde_json::Value,
+        document: &gltf::Document,
+    ) -> Result<Vec<Mat4>, SceneError> {
+        let element = format!("{}, EXT_mesh_gpu_instancing", node_label(node));
+        let attributes = ext.get("attributes").and_then(|a| a.as_object());
+        let Some(attributes) = attributes else {
+            return Err(self.bad(element, "has no attributes object"));
+        };
+        let accessor = |name: &str| -> Result<Option<gltf::Accessor>, SceneError> {
+            match attributes.get(name) {
+                None => Ok(None),
+                Some(v) => v
+                    .as_u64()
+                    .and_then(|i| document.accessors().nth(i as usize))
+                    .map(Some)
+                    .ok_or_else(|| {
+                        self.bad(format!("{element}, {name}"), format!("no accessor {v}"))
+                    }),
+            }
+        };
+        let read3 = |name: &str| -> Result<Option<Vec<Vec3>>, SceneError> {
+            accessor(name)?
+                .map(|a| {
+                    self.attribute::<3>(&a, &element, name, accessor::POSITION, None)
+                        .map(|v| v.into_iter().map(Vec3::from).collect())
+                })
+                .transpose()
+        };
+        let translation = read3("TRANSLATION")?;
+        let scale = read3("SCALE")?;
+        let rotation: Option<Vec<Quat>> = accessor("ROTATION")?
+            .map(|a| {
+                self.attribute::<4>(&a, &element, "ROTATION", accessor::DIRECTION, None)
+                    .map(|v| v.into_iter().map(|q| Quat::from_array(q).normalize()).collect())
+            })
+            .transpose()?;
+        let counts = [
+            translation.as_ref().map(Vec::len),
+            rotation.as_ref().map(Vec::len),
+            scale.as_ref().map(Vec::len),
+        ];
+        let mut known = counts.iter().flatten();
+        let Some(&count) = known.next() else {
+            return Err(self.bad(
+                element,
+                "has none of the attributes TRANSLATION, ROTATION, SCALE",
+            ));
+        };
+        if known.any(|&c| c != count) {
+            return Err(self.bad(
+                element,
+                format!("attribute counts differ (TRANSLATION, ROTATION, SCALE: {counts:?})"),
+            ));
+        }
+        Ok((0..count)
+            .map(|i| {
+                Mat4::from_scale_rotation_translation(
+                    scale.as_ref().map_or(Vec3::ONE, |s| s[i]),
+                    // A zero quaternion becomes NaN here and fails the caller's check.
+                    rotation.as_ref().map_or(Quat::IDENTITY, |r| r[i]),
+                    translation.as_ref().map_or(Vec3::ZERO, |t| t[i]),
+                )
+            })
+            .collect())
+    }
+
+    /// Turns the recorded placements into geometry: a mesh placed more than once and without
+    /// an emissive material is loaded once in object space and placed by instances, every
+    /// other placement is flattened into world triangles (see the module documentation).
+    fn place_meshes(&mut self, document: &gltf::Document) -> Result<(), SceneError> {
+        let meshes: Vec<gltf::Mesh> = document.meshes().collect();
+        let mut count = vec![0usize; meshes.len()];
+        for &(m, _) in &self.placements {
+            count[m] += 1;
+        }
+        let mut instanced: Vec<Option<u32>> = vec![None; meshes.len()];
+        for (m, world) in std::mem::take(&mut self.placements) {
+            let mesh = &meshes[m];
+            let emissive = mesh.primitives().any(|p| {
+                p.material()
+                    .index()
+                    .is_some_and(|i| self.parts.materials[i].is_emissive())
+            });
+            if count[m] < 2 || emissive {
+                self.mesh(mesh, world)?;
+                continue;
+            }
+            let index = match instanced[m] {
+                Some(i) => i,
+                None => {
+                    let object = self.object_mesh(mesh)?;
+                    let i = self.parts.instanced_meshes.len() as u32;
+                    self.parts.instanced_meshes.push(object);
+                    instanced[m] = Some(i);
+                    i
+                }
+            };
+            // The walk checked that the transform is invertible.
+            if let Some(instance) = Instance::new(index, world) {
+                self.parts.instances.push(instance);
+            }
+        }
+        Ok(())
+    }
+
+    /// `mesh` loaded in its own (object) space, as [`Loader::mesh`] loads it with the identity
+    /// transform, into its own arrays.
+    fn object_mesh(&mut self, mesh: &gltf::Mesh) -> Result<MeshParts, SceneError> {
+        let mut world = MeshParts::default();
+        swap_geometry(&mut self.parts, &mut world);
+        let loaded = self.mesh(mesh, Mat4::IDENTITY);
+        let mut object = MeshParts::default();
+        swap_geometry(&mut self.parts, &mut object);
+        swap_geometry(&mut self.parts, &mut world);
+        loaded?;
+        if !object.tangents.is_empty() {
+            object.tangents.resize(object.positions.len(), Vec4::ZERO);
+        }
+        object.name = mesh_label(mesh);
+        Ok(object)
     }
 
     fn camera(

@@ -112,10 +112,14 @@ mod compression;
 mod error;
 pub mod extensions;
 mod gltf;
+mod instances;
+mod mesh;
 mod obj;
 mod tangents;
 
 pub use error::SceneError;
+pub use instances::{Instance, InstancedMesh, Instances};
+pub use mesh::MeshParts;
 
 use crate::accel::Accel;
 use crate::camera::Camera;
@@ -126,7 +130,12 @@ use crate::normal_map::{self, MappedNormal};
 use crate::sampling::{pcg_hash, u32_to_unit_f32};
 use crate::texture::Texture;
 use glam::{Vec2, Vec3, Vec4};
+use mesh::{Geometry, LocalSurface};
 use std::path::{Path, PathBuf};
+
+/// [`SurfaceHit::triangle`] of a hit on an instanced mesh: no triangle of the flat soup (and
+/// never an emitter's; see [`Instances`]).
+pub const INSTANCED_TRIANGLE: u32 = u32::MAX;
 
 /// A loaded scene, shared read-only by all render threads (never copied per thread).
 #[derive(Debug)]
@@ -164,6 +173,9 @@ pub struct Scene {
     pub cameras: Vec<Camera>,
     /// The BVH over `triangles`.
     pub accel: Accel,
+    /// The instanced meshes (in object space, each stored once), their instances and the
+    /// top-level BVH over them; empty for most scenes (see [`Instances`]).
+    pub instances: Instances,
     /// The emitters (`lights` and the emissive triangles) and the light tree over them, built
     /// with the scene from its triangles, materials and lights.
     pub light_sampler: LightSampler,
@@ -200,6 +212,11 @@ pub struct SceneParts {
     pub lights: Vec<Light>,
     /// Cameras.
     pub cameras: Vec<Camera>,
+    /// Meshes stored once in object space and placed by `instances` (none may have an
+    /// emissive material: emitters are world triangles).
+    pub instanced_meshes: Vec<MeshParts>,
+    /// Placements of `instanced_meshes`.
+    pub instances: Vec<Instance>,
     /// Warnings to pass on.
     pub warnings: Vec<String>,
 }
@@ -228,8 +245,8 @@ impl Scene {
         let SceneParts {
             source,
             positions,
-            mut normals,
-            mut uvs,
+            normals,
+            uvs,
             tangents,
             uvs1,
             colors,
@@ -239,87 +256,34 @@ impl Scene {
             textures,
             lights,
             cameras,
+            instanced_meshes,
+            instances,
             warnings,
         } = parts;
         let bad = |element: String, reason: String| SceneError::invalid(&source, element, reason);
-        let nv = positions.len();
-        if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
-            return Err(bad(format!("vertex {i}"), "position is not finite".into()));
-        }
-        if normals.is_empty() {
-            normals = vec![Vec3::ZERO; nv];
-        } else if normals.len() != nv {
-            return Err(bad(
-                "normals".into(),
-                format!("{} normals for {nv} vertices", normals.len()),
-            ));
-        }
-        for n in &mut normals {
-            *n = n.normalize_or_zero();
-        }
-        if uvs.is_empty() {
-            uvs = vec![Vec2::ZERO; nv];
-        } else if uvs.len() != nv {
-            return Err(bad(
-                "uvs".into(),
-                format!("{} uvs for {nv} vertices", uvs.len()),
-            ));
-        }
-        if !tangents.is_empty() && tangents.len() != nv {
-            return Err(bad(
-                "tangents".into(),
-                format!("{} tangents for {nv} vertices", tangents.len()),
-            ));
-        }
-        if let Some(i) = tangents.iter().position(|t| !t.is_finite()) {
-            return Err(bad(format!("vertex {i}"), "tangent is not finite".into()));
-        }
-        if !uvs1.is_empty() && uvs1.len() != nv {
-            return Err(bad(
-                "TEXCOORD_1".into(),
-                format!("{} uvs for {nv} vertices", uvs1.len()),
-            ));
-        }
-        if !colors.is_empty() && colors.len() != nv {
-            return Err(bad(
-                "vertex colours".into(),
-                format!("{} colours for {nv} vertices", colors.len()),
-            ));
-        }
-        if triangle_materials.len() != triangles.len() {
-            return Err(bad(
-                "triangle materials".into(),
-                format!(
-                    "{} material indices for {} triangles",
-                    triangle_materials.len(),
-                    triangles.len()
-                ),
-            ));
-        }
-        if nv > u32::MAX as usize {
-            return Err(bad("vertices".into(), "more than 2^32 - 1 vertices".into()));
-        }
-        for (i, t) in triangles.iter().enumerate() {
-            if t.iter().any(|&v| v as usize >= nv) {
-                return Err(bad(
-                    format!("triangle {i}"),
-                    format!("vertex index {t:?} out of range ({nv} vertices)"),
-                ));
-            }
-        }
-        if let Some(i) = triangle_materials
-            .iter()
-            .position(|&m| m as usize >= materials.len())
-        {
-            return Err(bad(
-                format!("triangle {i}"),
-                format!(
-                    "material {} out of range ({} materials)",
-                    triangle_materials[i],
-                    materials.len()
-                ),
-            ));
-        }
+        let mut flat = MeshParts {
+            name: String::new(),
+            positions,
+            normals,
+            uvs,
+            tangents,
+            uvs1,
+            colors,
+            triangles,
+            triangle_materials,
+        };
+        flat.check(&source, materials.len())?;
+        let MeshParts {
+            positions,
+            normals,
+            uvs,
+            tangents,
+            uvs1,
+            colors,
+            triangles,
+            triangle_materials,
+            ..
+        } = flat;
         for m in &materials {
             if let Some(t) = m.texture_ids().find(|&t| t as usize >= textures.len()) {
                 return Err(bad(
@@ -328,9 +292,52 @@ impl Scene {
                 ));
             }
         }
-        let accel = Accel::build_alpha_tested(&positions, &triangles, |t| {
-            !materials[triangle_materials[t] as usize].alpha.is_opaque()
+        let alpha_tested = |m: u32| !materials[m as usize].alpha.is_opaque();
+        let mut meshes = Vec::with_capacity(instanced_meshes.len());
+        for mut m in instanced_meshes {
+            m.check(&source, materials.len())?;
+            if let Some(&e) = m
+                .triangle_materials
+                .iter()
+                .find(|&&t| materials[t as usize].is_emissive())
+            {
+                return Err(bad(
+                    m.name.clone(),
+                    format!(
+                        "is instanced but its material {:?} is emissive (emitters must be \
+                         world triangles)",
+                        materials[e as usize].name
+                    ),
+                ));
+            }
+            let accel = Accel::build_alpha_tested(&m.positions, &m.triangles, |t| {
+                alpha_tested(m.triangle_materials[t])
+            });
+            meshes.push(InstancedMesh { parts: m, accel });
+        }
+        if let Some((i, inst)) = instances
+            .iter()
+            .enumerate()
+            .find(|(_, inst)| inst.mesh as usize >= meshes.len())
+        {
+            return Err(bad(
+                format!("instance {i}"),
+                format!(
+                    "mesh {} out of range ({} instanced meshes)",
+                    inst.mesh,
+                    meshes.len()
+                ),
+            ));
+        }
+        let instances = Instances::build(meshes, instances);
+        let mut accel = Accel::build_alpha_tested(&positions, &triangles, |t| {
+            alpha_tested(triangle_materials[t])
         });
+        let bounds = bounding_box(&positions, &instances);
+        if let Some([lo, hi]) = bounds.filter(|_| !instances.is_empty()) {
+            // One self-intersection distance for all hits, from the extent of everything.
+            accel.raise_t_min(16.0 * f32::EPSILON * lo.abs().max(hi.abs()).max_element());
+        }
         let mesh = SurfaceMesh {
             positions: &positions,
             uvs: &uvs,
@@ -340,7 +347,7 @@ impl Scene {
             triangle_materials: &triangle_materials,
             materials: &materials,
         };
-        let light_sampler = LightSampler::new(&lights, mesh, bounding_sphere(&positions).1);
+        let light_sampler = LightSampler::new(&lights, mesh, bounding_sphere(bounds).1);
         Ok(Scene {
             source,
             positions,
@@ -356,6 +363,7 @@ impl Scene {
             lights,
             cameras,
             accel,
+            instances,
             light_sampler,
             warnings,
         })
@@ -384,10 +392,15 @@ impl Scene {
         })
     }
 
-    /// Centre and radius of a sphere enclosing all vertices (the centre of their bounding box
-    /// and its half diagonal); `(0, 0)` for an empty scene.
+    /// Centre and radius of a sphere enclosing all vertices, the instances' included (the
+    /// centre of their bounding box and its half diagonal); `(0, 0)` for an empty scene.
     pub fn bounding_sphere(&self) -> (Vec3, f32) {
-        bounding_sphere(&self.positions)
+        bounding_sphere(bounding_box(&self.positions, &self.instances))
+    }
+
+    /// The number of triangles in the world: the flat ones and every instance's.
+    pub fn world_triangle_count(&self) -> usize {
+        self.triangles.len() + self.instances.instanced_triangle_count()
     }
 
     /// Radiance emitted from `hit` toward `wo` (unit, pointing away from the surface): the
@@ -416,58 +429,127 @@ impl Scene {
         }
     }
 
-    /// Whether `ray` stops at its hit on `triangle` (barycentrics `b`), a triangle of a
-    /// material that is not opaque: by [`crate::material::Alpha::stop_probability`], for
-    /// `BLEND` against a hash of the ray and the triangle ([`transparency_hash`]), so the
-    /// same ray always gets the same answer.
+    /// The scene's own (flat, world-space) triangles as hit shading reads them.
     #[inline]
-    fn stops(&self, ray: &Ray, triangle: u32, b: Vec2) -> bool {
-        let material = &self.materials[self.triangle_materials[triangle as usize] as usize];
-        let at = self.mesh().attributes_at(triangle as usize, b);
+    fn geometry(&self) -> Geometry<'_> {
+        Geometry {
+            mesh: self.mesh(),
+            normals: &self.normals,
+            tangents: &self.tangents,
+        }
+    }
+
+    /// Whether `ray` stops at its hit at barycentrics `b` on triangle `triangle` of
+    /// `geometry`, a triangle of a material that is not opaque: by
+    /// [`crate::material::Alpha::stop_probability`], for `BLEND` against a hash of the ray
+    /// and `id` ([`transparency_hash`]; the triangle, made unique per instance for instanced
+    /// meshes), so the same ray always gets the same answer.
+    #[inline]
+    fn stops(&self, geometry: Geometry<'_>, ray: &Ray, triangle: u32, id: u32, b: Vec2) -> bool {
+        let mesh = geometry.mesh;
+        let material = &self.materials[mesh.triangle_materials[triangle as usize] as usize];
+        let at = mesh.attributes_at(triangle as usize, b);
         let p = material.alpha.stop_probability(&at, &self.textures);
-        p >= 1.0 || (p > 0.0 && transparency_hash(ray, triangle) < p)
+        p >= 1.0 || (p > 0.0 && transparency_hash(ray, id) < p)
+    }
+
+    /// [`Scene::stops`] for triangle `triangle` of instance `instance`.
+    #[inline]
+    fn instance_stops(&self, ray: &Ray, instance: u32, triangle: u32, b: Vec2) -> bool {
+        let mesh = self.instances.instances[instance as usize].mesh;
+        let geometry = self.instances.meshes[mesh as usize]
+            .parts
+            .geometry(&self.materials);
+        let id = triangle ^ pcg_hash(instance.wrapping_add(1));
+        self.stops(geometry, ray, triangle, id, b)
     }
 
     /// Closest hit along `ray` within `(t_min, ray.t_max)` (see [`Accel::t_min`]) where the
-    /// ray stops: hits on alpha-masked-out points are skipped, and `BLEND` surfaces stop the
-    /// ray with probability alpha (stochastic transparency, decided by a hash of the ray and
-    /// the triangle). The shading normal is the interpolated vertex normal (the face normal
-    /// where there is none), through the material's normal map where it has one and the
-    /// vertices have tangents (made valid for the viewer `-ray.direction` by
-    /// [`normal_map::valid_reflection_normal`]), and oriented to the side of the geometric
-    /// normal.
+    /// ray stops, on the flat triangles or an instance: hits on alpha-masked-out points are
+    /// skipped, and `BLEND` surfaces stop the ray with probability alpha (stochastic
+    /// transparency, decided by a hash of the ray and the triangle). The shading normal is the
+    /// interpolated vertex normal (the face normal where there is none), through the
+    /// material's normal map where it has one and the vertices have tangents (made valid for
+    /// the viewer `-ray.direction` by [`normal_map::valid_reflection_normal`]), and oriented to
+    /// the side of the geometric normal. A hit on an instance has
+    /// [`INSTANCED_TRIANGLE`] as its triangle.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<SurfaceHit> {
-        let hit = self
+        let flat = self
             .accel
-            .intersect_filtered(ray, |t, b| self.stops(ray, t, b))?;
-        let tri = self.triangles[hit.triangle as usize];
-        let [i0, i1, i2] = tri.map(|v| v as usize);
+            .intersect_filtered(ray, |t, b| self.stops(self.geometry(), ray, t, t, b));
+        if !self.instances.is_empty() {
+            let mut nearer = *ray;
+            if let Some(h) = &flat {
+                nearer.t_max = h.t;
+            }
+            let t_min = self.accel.t_min();
+            let instanced = self.instances.intersect(&nearer, t_min, |i, t, b| {
+                self.instance_stops(ray, i, t, b)
+            });
+            if let Some(h) = instanced {
+                let inst = &self.instances.instances[h.instance as usize];
+                let geometry = self.instances.meshes[inst.mesh as usize]
+                    .parts
+                    .geometry(&self.materials);
+                let b = h.hit.barycentrics;
+                let local = geometry.surface_at(h.hit.triangle, b);
+                let ng = inst.normal_to_world(local.ng);
+                let world = LocalSurface {
+                    p: inst.world_from_object.transform_point3(local.p),
+                    ng,
+                    ns: inst.normal_to_world(local.ns),
+                    ..local
+                };
+                let tangent = || inst.tangent_to_world(geometry.tangent_at(h.hit.triangle, b));
+                return Some(self.shade(ray, h.hit.t, INSTANCED_TRIANGLE, world, tangent));
+            }
+        }
+        let hit = flat?;
+        let geometry = self.geometry();
         let b = hit.barycentrics;
-        let b0 = 1.0 - b.x - b.y;
-        let (p0, p1, p2) = (self.positions[i0], self.positions[i1], self.positions[i2]);
-        let ng = (p1 - p0).cross(p2 - p0).normalize_or_zero();
-        let p = p0 * b0 + p1 * b.x + p2 * b.y;
-        let ns = self.normals[i0] * b0 + self.normals[i1] * b.x + self.normals[i2] * b.y;
-        let ns = ns.try_normalize().unwrap_or(ng);
-        let attributes = self.mesh().attributes_at(hit.triangle as usize, b);
-        let material = self.triangle_materials[hit.triangle as usize];
-        let (ns, mapped) = if self.tangents.is_empty() {
-            (ns, None)
-        } else {
-            self.normal_mapped(
-                ns,
-                ng,
-                [i0, i1, i2],
-                [b0, b.x, b.y],
-                attributes.uv,
-                material,
-                ray,
-            )
+        let surface = geometry.surface_at(hit.triangle, b);
+        let tangent = || geometry.tangent_at(hit.triangle, b);
+        Some(self.shade(ray, hit.t, hit.triangle, surface, tangent))
+    }
+
+    /// The [`SurfaceHit`] at parameter `t` of `ray` on the world-space point `s` of
+    /// triangle `triangle`, with the normal map applied (`tangent` gives the interpolated
+    /// world-space tangent, asked only for a normal-mapped material), with the smooth and the
+    /// mapped normal for the diffuse lobe where the map applied.
+    #[inline]
+    fn shade(
+        &self,
+        ray: &Ray,
+        t: f32,
+        triangle: u32,
+        s: LocalSurface,
+        tangent: impl FnOnce() -> Vec4,
+    ) -> SurfaceHit {
+        let ng = s.ng;
+        let (ns, mapped) = match self.materials[s.material as usize].normal_map {
+            Some(map) => {
+                let tangent = tangent();
+                if tangent.truncate() == Vec3::ZERO {
+                    (s.ns, None)
+                } else {
+                    let n = map.perturb(s.ns, tangent, s.attributes.uv, &self.textures);
+                    // On the viewer's side of the surface, as the integrator shades it.
+                    let wo = -ray.direction;
+                    let side = if ng.dot(wo) < 0.0 { -1.0 } else { 1.0 };
+                    let valid = normal_map::valid_reflection_normal(ng * side, wo, n * side) * side;
+                    let mapped = MappedNormal {
+                        smooth: s.ns,
+                        mapped: n,
+                    };
+                    (valid, Some(mapped))
+                }
+            }
+            _ => (s.ns, None),
         };
-        Some(SurfaceHit {
-            t: hit.t,
-            p,
+        SurfaceHit {
+            t,
+            p: s.p,
             ng,
             ns: if ns.dot(ng) < 0.0 { -ns } else { ns },
             // Both turned by the smooth normal's side (the mapped one may point below).
@@ -478,49 +560,10 @@ impl Scene {
                     mapped: m.mapped * side,
                 }
             }),
-            attributes,
-            triangle: hit.triangle,
-            material,
-        })
-    }
-
-    /// The unit shading normal `ns` through the normal map of `material`, if it has one and
-    /// the triangle's vertices `v` (barycentric weights `b`, texture coordinates `uv`) have
-    /// tangents; made valid for the
-    /// viewer of `ray` (see [`Scene::intersect`]); with the smooth and the mapped normal for
-    /// the diffuse lobe where the map applied (not yet oriented).
-    #[inline]
-    #[allow(clippy::too_many_arguments)]
-    fn normal_mapped(
-        &self,
-        ns: Vec3,
-        ng: Vec3,
-        v: [usize; 3],
-        b: [f32; 3],
-        uv: [Vec2; 2],
-        material: u32,
-        ray: &Ray,
-    ) -> (Vec3, Option<MappedNormal>) {
-        let Some(map) = self.materials[material as usize].normal_map else {
-            return (ns, None);
-        };
-        let t = v.map(|i| self.tangents[i]);
-        let tangent = t[0] * b[0] + t[1] * b[1] + t[2] * b[2];
-        if tangent.truncate() == Vec3::ZERO {
-            return (ns, None);
+            attributes: s.attributes,
+            triangle,
+            material: s.material,
         }
-        let n = map.perturb(ns, tangent, uv, &self.textures);
-        // On the viewer's side of the surface, as the integrator shades it.
-        let wo = -ray.direction;
-        let side = if ng.dot(wo) < 0.0 { -1.0 } else { 1.0 };
-        let valid = normal_map::valid_reflection_normal(ng * side, wo, n * side) * side;
-        (
-            valid,
-            Some(MappedNormal {
-                smooth: ns,
-                mapped: n,
-            }),
-        )
     }
 
     /// Whether anything blocks `ray` within `(t_min, ray.t_max)` (shadow query), with the
@@ -528,12 +571,18 @@ impl Scene {
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
         self.accel
-            .occluded_filtered(ray, |t, b| self.stops(ray, t, b))
+            .occluded_filtered(ray, |t, b| self.stops(self.geometry(), ray, t, t, b))
+            || (!self.instances.is_empty()
+                && self
+                    .instances
+                    .occluded(ray, self.accel.t_min(), |i, t, b| {
+                        self.instance_stops(ray, i, t, b)
+                    }))
     }
 }
 
 /// A number in `[0, 1)` that depends only on `ray` (origin and direction) and
-/// `triangle`: the uniform variate of a `BLEND` surface's stochastic transparency, the same
+/// `triangle` (an id of the triangle): the uniform variate of a `BLEND` surface's stochastic transparency, the same
 /// for a ray whichever thread traces it.
 #[inline]
 fn transparency_hash(ray: &Ray, triangle: u32) -> f32 {
@@ -551,16 +600,27 @@ fn transparency_hash(ray: &Ray, triangle: u32) -> f32 {
     u32_to_unit_f32(h)
 }
 
-/// Centre and radius of a sphere enclosing `positions` (see [`Scene::bounding_sphere`]).
-fn bounding_sphere(positions: &[Vec3]) -> (Vec3, f32) {
-    if positions.is_empty() {
-        return (Vec3::ZERO, 0.0);
+/// The bounding box `[min, max]` of `positions` and the instances; `None` when both are
+/// empty.
+fn bounding_box(positions: &[Vec3], instances: &Instances) -> Option<[Vec3; 2]> {
+    let flat = (!positions.is_empty()).then(|| {
+        positions.iter().fold(
+            [Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)],
+            |[lo, hi], &p| [lo.min(p), hi.max(p)],
+        )
+    });
+    match (flat, instances.bounds()) {
+        (Some([a, b]), Some([c, d])) => Some([a.min(c), b.max(d)]),
+        (flat, inst) => flat.or(inst),
     }
-    let (lo, hi) = positions.iter().fold(
-        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-        |(lo, hi), &p| (lo.min(p), hi.max(p)),
-    );
-    ((lo + hi) * 0.5, (hi - lo).length() * 0.5)
+}
+
+/// Centre and radius of a sphere enclosing the box `bounds` (see [`Scene::bounding_sphere`]).
+fn bounding_sphere(bounds: Option<[Vec3; 2]>) -> (Vec3, f32) {
+    match bounds {
+        None => (Vec3::ZERO, 0.0),
+        Some([lo, hi]) => ((lo + hi) * 0.5, (hi - lo).length() * 0.5),
+    }
 }
 
 #[cfg(test)]
