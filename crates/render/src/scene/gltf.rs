@@ -2573,6 +2573,297 @@ mod tests {
         );
         assert!((quad_normal(&scene) - Vec3::Y).length() < 1e-6);
     }
+    /// A box of 24 vertices (flat normals, uvs, one TANGENT per face) with a normal-mapped
+    /// material, and a quad in front of it whose COLOR_0 alpha runs from 0 to 1 along x under
+    /// an alphaMode MASK material: the primitives of the mesh the instancing tests place.
+    fn box_mesh(d: &mut Doc) -> Value {
+        let faces = [
+            (Vec3::X, Vec3::Z),
+            (-Vec3::X, Vec3::Y),
+            (Vec3::Y, Vec3::X),
+            (-Vec3::Y, Vec3::Z),
+            (Vec3::Z, Vec3::Y),
+            (-Vec3::Z, Vec3::X),
+        ];
+        let (mut pos, mut nrm, mut uv, mut tan, mut idx) = (vec![], vec![], vec![], vec![], vec![]);
+        for (f, (n, t)) in faces.into_iter().enumerate() {
+            let b = n.cross(t);
+            for (x, y) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+                pos.extend((0.5 * (n + x * t + y * b)).to_array());
+                nrm.extend(n.to_array());
+                uv.extend([(x + 1.0) / 2.0 + f as f32, (y + 1.0) / 2.0]);
+                tan.extend(t.extend(1.0).to_array());
+            }
+            let o = 4 * f as u16;
+            idx.extend([o, o + 1, o + 2, o, o + 2, o + 3]);
+        }
+        let pos = d.floats(&pos, "VEC3", 3);
+        let nrm = d.floats(&nrm, "VEC3", 3);
+        let uv = d.floats(&uv, "VEC2", 2);
+        let tan = d.floats(&tan, "VEC4", 4);
+        let idx = d.indices(&idx);
+        let quad = d.floats(
+            &[-0.5, -0.5, 0.8, 0.5, -0.5, 0.8, 0.5, 0.5, 0.8, -0.5, 0.5, 0.8],
+            "VEC3",
+            3,
+        );
+        let col = d.floats(
+            &[[1., 1., 1., 0.], [1.; 4], [1.; 4], [1., 1., 1., 0.]].concat(),
+            "VEC4",
+            4,
+        );
+        let quad_idx = d.indices(&[0, 1, 2, 0, 2, 3]);
+        json!([
+            {"attributes": {"POSITION": pos, "NORMAL": nrm, "TEXCOORD_0": uv, "TANGENT": tan},
+             "indices": idx, "material": 0},
+            {"attributes": {"POSITION": quad, "COLOR_0": col}, "indices": quad_idx, "material": 1}
+        ])
+    }
+
+    /// A document placing the box mesh ([`box_mesh`]) by `locals` (TRS node properties) under
+    /// a rotated, translated parent: with `share`, every node references the one mesh;
+    /// otherwise each has its own copy of it (the same primitives), so it is flattened.
+    fn placed_boxes(locals: &[Value], share: bool) -> (Value, Vec<u8>) {
+        let mut d = Doc::default();
+        let prims = box_mesh(&mut d);
+        let mut nodes = vec![json!({"name": "parent", "translation": [0.5, 1, -2],
+            "rotation": [0.2, 0.3, 0.1, 0.927], "scale": [1, 1.5, 1],
+            "children": (1..=locals.len()).collect::<Vec<_>>()})];
+        for (i, local) in locals.iter().enumerate() {
+            let mut n = local.clone();
+            n["mesh"] = json!(if share { 0 } else { i });
+            nodes.push(n);
+        }
+        let copies = if share { 1 } else { locals.len() };
+        let doc = json!({
+            "asset": {"version": "2.0"},
+            "scenes": [{"nodes": [0]}],
+            "nodes": nodes,
+            "meshes": vec![json!({"name": "box", "primitives": prims}); copies],
+            "materials": [
+                {"name": "painted", "normalTexture": {"index": 0, "scale": 0.8}},
+                {"name": "fence", "alphaMode": "MASK", "doubleSided": true}
+            ],
+            "images": [{"uri": png_uri([200, 100, 230])}],
+            "textures": [{"source": 0}],
+            "buffers": [{"byteLength": d.bin.len()}],
+            "bufferViews": d.views,
+            "accessors": d.accessors
+        });
+        (doc, d.bin)
+    }
+
+    /// Placements with rotations, non-uniform and negative (mirroring) scales.
+    fn box_placements() -> Vec<Value> {
+        vec![
+            json!({}),
+            json!({"translation": [2.5, 0, 0], "rotation": [0, 0.6, 0, 0.8]}),
+            json!({"translation": [-2.5, 0.5, 0], "scale": [1, 2, 0.5]}),
+            json!({"translation": [0, 2.5, 0.5], "scale": [-1, 1, 1],
+                   "rotation": [0.28, 0, 0.96, 0]}),
+            json!({"translation": [0, -2.5, 0], "scale": [1.5, -0.7, -1.2],
+                   "rotation": [0.5, 0.5, 0.5, 0.5]}),
+            json!({"matrix": [0.8, 0.3, 0, 0, -0.3, 1.2, 0.2, 0, 0.1, 0, -0.9, 0, 1, 1, 2, 1]}),
+        ]
+    }
+
+    /// Casts `n` random rays at both scenes and checks that they agree: the same hit or miss
+    /// (but for a few rays grazing an edge), with the same parameter, point, normals, uv,
+    /// colour and material up to float rounding, and the same shadow-ray answer. Returns the
+    /// number of hits.
+    fn assert_same_hits(a: &Scene, b: &Scene, n: usize) -> usize {
+        use crate::geometry::Ray;
+        let mut rng = crate::sampling::Pcg32::new(5, 3);
+        let mut v = |s: f32| {
+            Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 * s - Vec3::splat(s)
+        };
+        let (mut hits, mut mismatches) = (0, 0);
+        for k in 0..n {
+            let origin = v(9.0);
+            let target = v(3.5) + Vec3::new(0.5, 1.0, -2.0);
+            let mut ray = Ray::new(origin, (target - origin).normalize());
+            if k % 3 == 0 {
+                ray.t_max = (target - origin).length();
+            }
+            match (a.intersect(&ray), b.intersect(&ray)) {
+                (None, None) => {}
+                (Some(x), Some(y)) => {
+                    hits += 1;
+                    let close = |p: Vec3, q: Vec3, tol: f32| (p - q).length() <= tol;
+                    assert!((x.t - y.t).abs() <= 1e-4 * x.t.max(1.0), "ray {k}: {x:?} {y:?}");
+                    assert!(close(x.p, y.p, 1e-4), "ray {k}: {x:?} {y:?}");
+                    assert!(close(x.ng, y.ng, 1e-4), "ray {k}: {x:?} {y:?}");
+                    assert!(close(x.ns, y.ns, 1e-3), "ray {k}: {x:?} {y:?}");
+                    let [u, w] = [0, 1].map(|s| (x.attributes.uv[s] - y.attributes.uv[s]).length());
+                    assert!(u < 1e-4 && w < 1e-4, "ray {k}: {x:?} {y:?}");
+                    assert!((x.attributes.color - y.attributes.color).length() < 1e-4);
+                    assert_eq!(
+                        a.materials[x.material as usize].name,
+                        b.materials[y.material as usize].name
+                    );
+                }
+                _ => mismatches += 1,
+            }
+            if a.occluded(&ray) != b.occluded(&ray) {
+                mismatches += 1;
+            }
+        }
+        assert!(mismatches <= n / 500, "{mismatches} mismatches in {n} rays");
+        hits
+    }
+
+    /// One mesh referenced by many nodes (rotations, non-uniform and mirroring scales, a
+    /// parent) is stored once and placed by instances, and every ray hits it as it hits the
+    /// same scene with the triangles copied per node: same hits, normals (normal-mapped),
+    /// uvs, vertex colours and alpha-masked holes.
+    #[test]
+    fn nodes_sharing_a_mesh_are_instances_that_hit_like_copies() {
+        use crate::geometry::Ray;
+        let placements = box_placements();
+        let (doc, bin) = placed_boxes(&placements, true);
+        let instanced = load(doc, &bin);
+        let (doc, bin) = placed_boxes(&placements, false);
+        let flat = load(doc, &bin);
+        assert!(flat.instances.is_empty());
+        assert_eq!(flat.triangles.len(), placements.len() * 14);
+        assert!(instanced.triangles.is_empty() && instanced.positions.is_empty());
+        assert_eq!(instanced.instances.meshes.len(), 1);
+        assert_eq!(instanced.instances.instances.len(), placements.len());
+        assert_eq!(instanced.instances.stored_triangle_count(), 14);
+        assert_eq!(instanced.world_triangle_count(), flat.triangles.len());
+        assert!(instanced.instances.instances.iter().filter(|i| i.mirrored).count() == 2);
+        let (ca, ra) = instanced.bounding_sphere();
+        let (cb, rb) = flat.bounding_sphere();
+        assert!((ca - cb).length() < 1e-5 && (ra - rb).abs() < 1e-5);
+        assert!((instanced.accel.t_min() - flat.accel.t_min()).abs() < 1e-9);
+        let hits = assert_same_hits(&instanced, &flat, 6000);
+        assert!(hits > 1000, "{hits} hits");
+        // The mask cuts holes in the instances too: some rays through a fence quad's
+        // transparent half reach a box behind it or miss.
+        let fence = instanced
+            .materials
+            .iter()
+            .position(|m| m.name == "fence")
+            .unwrap() as u32;
+        let mut rng = crate::sampling::Pcg32::new(9, 1);
+        let fence_hits = (0..2000)
+            .filter(|_| {
+                let o = Vec3::new(rng.next_f32() - 0.5, rng.next_f32() - 0.5, 5.0);
+                let r = Ray::new(o, -Vec3::Z);
+                let inst = &instanced.instances.instances[0];
+                let world = Ray::new(
+                    inst.world_from_object.transform_point3(r.origin),
+                    inst.world_from_object.transform_vector3(r.direction).normalize(),
+                );
+                instanced
+                    .intersect(&world)
+                    .is_some_and(|h| h.material == fence)
+            })
+            .count();
+        assert!((700..1300).contains(&fence_hits), "{fence_hits}");
+    }
+
+    /// The triangles stored for a mesh do not grow with the number of nodes placing it.
+    #[test]
+    fn instanced_triangle_storage_does_not_grow_with_the_instances() {
+        let storage = |n: usize| {
+            let locals: Vec<Value> = (0..n)
+                .map(|i| json!({"translation": [i as f32 * 1.5, 0, 0]}))
+                .collect();
+            let (doc, bin) = placed_boxes(&locals, true);
+            let s = load(doc, &bin);
+            assert_eq!(s.world_triangle_count(), 14 * n);
+            let m = &s.instances.meshes[0];
+            (
+                s.triangles.len(),
+                m.parts.triangles.len(),
+                m.parts.positions.len(),
+                m.accel.memory_bytes(),
+            )
+        };
+        assert_eq!(storage(2), storage(300));
+        assert_eq!(storage(2).0, 0);
+    }
+
+    /// EXT_mesh_gpu_instancing, float and quantized: TRANSLATION as floats, ROTATION as
+    /// normalized shorts, SCALE as normalized bytes, under a parent; the instances hit as
+    /// nodes with the same (dequantized) transforms do. Mismatched counts are an error naming
+    /// the node.
+    #[test]
+    fn ext_mesh_gpu_instancing_with_float_and_quantized_attributes() {
+        let t = [[0.0f32, 0.0, 0.0], [2.5, 0.0, 0.0], [-1.0, 2.0, 0.5], [0.0, -2.0, 1.0]];
+        let q: [[i16; 4]; 4] = [
+            [0, 0, 0, 32767],
+            [0, 19660, 0, 26214],
+            [9830, 0, 31457, 0],
+            [16384, 16384, 16384, 16384],
+        ];
+        let s: [[i8; 3]; 4] = [[127, 127, 127], [64, 127, 100], [-127, 90, 127], [127, -80, -127]];
+        let mut d = Doc::default();
+        let prims = box_mesh(&mut d);
+        let translation = d.floats(&t.concat(), "VEC3", 3);
+        let rot_bytes: Vec<u8> = q.concat().iter().flat_map(|v| v.to_le_bytes()).collect();
+        let view = d.view(&rot_bytes);
+        d.accessors.push(json!({"bufferView": view, "componentType": 5122,
+            "normalized": true, "count": 4, "type": "VEC4"}));
+        let rotation = d.accessors.len() - 1;
+        // Each element padded to 4 bytes, as the specification requires of strides.
+        let scale_bytes: Vec<u8> = s
+            .iter()
+            .flat_map(|e| [e[0] as u8, e[1] as u8, e[2] as u8, 0])
+            .collect();
+        let view = d.view(&scale_bytes);
+        d.views[view]["byteStride"] = json!(4);
+        d.accessors.push(json!({"bufferView": view, "componentType": 5120,
+            "normalized": true, "count": 4, "type": "VEC3"}));
+        let scale = d.accessors.len() - 1;
+        let parent = json!({"name": "parent", "translation": [0.5, 1, -2],
+            "rotation": [0.2, 0.3, 0.1, 0.927], "scale": [1, 1.5, 1], "children": [1]});
+        let doc = json!({
+            "asset": {"version": "2.0"},
+            "extensionsUsed": ["EXT_mesh_gpu_instancing", "KHR_mesh_quantization"],
+            "extensionsRequired": ["EXT_mesh_gpu_instancing", "KHR_mesh_quantization"],
+            "scenes": [{"nodes": [0]}],
+            "nodes": [parent, {"name": "trees", "mesh": 0, "extensions": {"EXT_mesh_gpu_instancing":
+                {"attributes": {"TRANSLATION": translation, "ROTATION": rotation, "SCALE": scale}}}}],
+            "meshes": [{"name": "box", "primitives": prims}],
+            "materials": [
+                {"name": "painted", "normalTexture": {"index": 0, "scale": 0.8}},
+                {"name": "fence", "alphaMode": "MASK", "doubleSided": true}
+            ],
+            "images": [{"uri": png_uri([200, 100, 230])}],
+            "textures": [{"source": 0}],
+            "buffers": [{"byteLength": d.bin.len()}],
+            "bufferViews": d.views,
+            "accessors": d.accessors
+        });
+        let instanced = load(doc.clone(), &d.bin);
+        assert!(instanced.warnings.is_empty(), "{:?}", instanced.warnings);
+        assert_eq!(instanced.instances.instances.len(), 4);
+        assert!(instanced.triangles.is_empty());
+        // The same placements as nodes, with the values dequantized by the specification's
+        // rules (max(c / 32767, -1), max(c / 127, -1)).
+        let locals: Vec<Value> = (0..4)
+            .map(|i| {
+                let r: Vec<f32> = q[i].iter().map(|&c| (c as f32 / 32767.0).max(-1.0)).collect();
+                let sc: Vec<f32> = s[i].iter().map(|&c| (c as f32 / 127.0).max(-1.0)).collect();
+                json!({"translation": t[i], "rotation": r, "scale": sc})
+            })
+            .collect();
+        let (nodes, bin) = placed_boxes(&locals, false);
+        let flat = load(nodes, &bin);
+        assert!(flat.instances.is_empty());
+        let hits = assert_same_hits(&instanced, &flat, 4000);
+        assert!(hits > 500, "{hits} hits");
+
+        let mut bad = doc;
+        bad["accessors"][translation]["count"] = json!(3);
+        let err = load_err(bad, &d.bin);
+        assert!(
+            err.contains("node \"trees\" (1), EXT_mesh_gpu_instancing") && err.contains("counts"),
+            "{err}"
+        );
+    }
 }
 
 #[cfg(test)]
