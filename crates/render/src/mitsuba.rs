@@ -26,6 +26,7 @@
 //! | wet/dry map ([`Wetness`](crate::material::Wetness)) | `alpha` and `specular_reflectance` as `bitmap`s baked per texel of the dryness map (`mix(wet, dry, w)`) | yes for `ggx` and `ward`'s alpha (linear in `w`, so bilinear filtering commutes); blinn_phong's alpha is not linear in the shininess (approximation already) |
 //! | double-sided material | BSDF wrapped in `twosided` | yes |
 //! | normal map ([`NormalMap`](crate::normal_map::NormalMap)) | not exported | no (warning) |
+//! | instanced mesh ([`Instances`]) | a `shapegroup` of its object-space meshes (one PLY per material) and an `instance` with its `to_world` matrix per placement | yes |
 //! | camera | `perspective`, `fov_axis` y, `fov` in degrees, `to_world` as a `lookat` | yes |
 //! | film, filter | `hdrfilm` (rgb, float32) with a `box` filter | yes |
 //! | integrator | `path` with the same `max_depth` | yes (Russian roulette differs: unbiased either way) |
@@ -39,7 +40,7 @@ use crate::bsdf;
 use crate::camera::Camera;
 use crate::light::Light;
 use crate::material::{GltfPbrParams, Material, PaperModel, Reflectance};
-use crate::scene::{Scene, SceneError};
+use crate::scene::{Instances, Scene, SceneError};
 use crate::texture::{Sampler, Texture, TextureId, TextureRef};
 use glam::{Vec2, Vec3};
 use std::collections::HashMap;
@@ -158,7 +159,7 @@ pub struct BakedTexture {
 pub struct MitsubaExport {
     /// The scene XML (`scene.xml`).
     pub xml: String,
-    /// One mesh per material that has triangles.
+    /// One mesh per material that has triangles (and per instanced mesh and material).
     pub meshes: Vec<PlyMesh>,
     /// Textures referenced by `bitmap` elements.
     pub textures: Vec<BakedTexture>,
@@ -198,6 +199,7 @@ pub(crate) struct SceneParts<'a> {
     pub(crate) materials: &'a [Material],
     pub(crate) textures: &'a [Texture],
     pub(crate) lights: &'a [Light],
+    pub(crate) instances: &'a Instances,
 }
 
 /// Converts `scene` to Mitsuba 3 with the render settings `opts`.
@@ -213,6 +215,7 @@ pub fn export(scene: &Scene, opts: &ExportOptions) -> Result<MitsubaExport, Mits
             materials: &scene.materials,
             textures: &scene.textures,
             lights: &scene.lights,
+            instances: &scene.instances,
         },
         scene.camera(opts.camera.as_deref())?,
         opts,
@@ -845,15 +848,25 @@ pub(crate) fn export_parts(
     for light in parts.lights {
         let _ = writeln!(xml, "{}", light_xml(light, &mut warnings));
     }
-    let meshes = meshes_by_material(parts);
+    let mut meshes = meshes_by_material(parts);
     let mut mw = MaterialWriter {
         parts,
         warnings: &mut warnings,
         textures: &mut textures,
     };
+    // Each material's BSDF is made once (its textures baked once), whichever meshes use it.
+    let mut bsdfs: HashMap<usize, String> = HashMap::new();
+    let mut bsdf_of = |mw: &mut MaterialWriter, index: usize| -> Result<String, MitsubaError> {
+        if let Some(b) = bsdfs.get(&index) {
+            return Ok(b.clone());
+        }
+        let b = mw.bsdf(index, &parts.materials[index])?;
+        bsdfs.insert(index, b.clone());
+        Ok(b)
+    };
     for (index, mesh) in &meshes {
         let m = &parts.materials[*index];
-        let bsdf = mw.bsdf(*index, m)?;
+        let bsdf = bsdf_of(&mut mw, *index)?;
         let mut emitter = String::new();
         if m.is_emissive() {
             if m.double_sided {
@@ -876,6 +889,39 @@ pub(crate) fn export_parts(
             "<shape type=\"ply\"><string name=\"filename\" value=\"{}\"/>\
              <boolean name=\"face_normals\" value=\"{face_normals}\"/>{bsdf}{emitter}</shape>",
             esc(&mesh.file_name)
+        );
+    }
+    for (k, instanced) in parts.instances.meshes.iter().enumerate() {
+        let object = SceneParts {
+            positions: &instanced.parts.positions,
+            normals: &instanced.parts.normals,
+            uvs: &instanced.parts.uvs,
+            triangles: &instanced.parts.triangles,
+            triangle_materials: &instanced.parts.triangle_materials,
+            ..*parts
+        };
+        let _ = write!(xml, "<shape type=\"shapegroup\" id=\"instanced{k}\">");
+        for (index, mut mesh) in meshes_by_material(&object) {
+            mesh.file_name = mesh.file_name.replacen("meshes/", &format!("meshes/i{k}_"), 1);
+            let bsdf = bsdf_of(&mut mw, index)?;
+            let _ = write!(
+                xml,
+                "<shape type=\"ply\"><string name=\"filename\" value=\"{}\"/>{bsdf}</shape>",
+                esc(&mesh.file_name)
+            );
+            meshes.push((index, mesh));
+        }
+        let _ = writeln!(xml, "</shape>");
+    }
+    for inst in &parts.instances.instances {
+        let m = glam::Mat4::from(inst.world_from_object).transpose().to_cols_array();
+        let values: Vec<String> = m.iter().map(|v| format!("{v:?}")).collect();
+        let _ = writeln!(
+            xml,
+            "<shape type=\"instance\"><ref id=\"instanced{}\"/><transform name=\"to_world\">\
+             <matrix value=\"{}\"/></transform></shape>",
+            inst.mesh,
+            values.join(" ")
         );
     }
     xml.push_str("</scene>\n");
@@ -916,6 +962,7 @@ mod tests {
         textures: Vec<Texture>,
         lights: Vec<Light>,
         cameras: Vec<Camera>,
+        instances: Instances,
     }
 
     impl Fixture {
@@ -999,6 +1046,7 @@ mod tests {
                     yfov: 0.7,
                     aspect_ratio: None,
                 }],
+                instances: Instances::default(),
             }
         }
 
@@ -1013,6 +1061,7 @@ mod tests {
                 materials: &self.materials,
                 textures: &self.textures,
                 lights: &self.lights,
+                instances: &self.instances,
             }
         }
     }
@@ -1030,6 +1079,65 @@ mod tests {
 
     fn floats(s: &str) -> Vec<f32> {
         s.split(',').map(|x| x.trim().parse().unwrap()).collect()
+    }
+
+    /// An instanced mesh is written once, in object space, as a `shapegroup`, and each
+    /// placement as an `instance` with its `to_world` matrix (row-major).
+    #[test]
+    fn instanced_meshes_are_shapegroups_with_one_instance_per_placement() {
+        let fx = Fixture::new();
+        let tri = crate::scene::MeshParts {
+            name: "mesh \"tri\" (0)".into(),
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+            triangles: vec![[0, 1, 2]],
+            triangle_materials: vec![0],
+            ..Default::default()
+        };
+        let moves = [Vec3::new(0.0, 0.0, -3.0), Vec3::new(2.0, 0.0, -3.0)];
+        let scene = Scene::from_parts(crate::scene::SceneParts {
+            source: "inst.gltf".into(),
+            materials: fx.materials.clone(),
+            textures: fx.textures.clone(),
+            cameras: fx.cameras.clone(),
+            instanced_meshes: vec![tri],
+            instances: moves
+                .iter()
+                .map(|&t| {
+                    let m = glam::Mat4::from_translation(t) * glam::Mat4::from_scale(Vec3::splat(2.0));
+                    crate::scene::Instance::new(0, m).unwrap()
+                })
+                .collect(),
+            ..Default::default()
+        })
+        .unwrap();
+        let ex = export(&scene, &opts()).unwrap();
+        let doc = roxmltree::Document::parse(&ex.xml).unwrap();
+        let of_type = |ty: &str| {
+            doc.descendants()
+                .filter(|n| n.has_tag_name("shape") && n.attribute("type") == Some(ty))
+                .collect::<Vec<_>>()
+        };
+        let groups = of_type("shapegroup");
+        assert_eq!(groups.len(), 1);
+        assert_eq!(groups[0].attribute("id"), Some("instanced0"));
+        let ply: Vec<_> = groups[0].children().filter(|n| n.has_tag_name("shape")).collect();
+        assert_eq!(ply.len(), 1);
+        assert!(ply[0].children().any(|n| n.has_tag_name("bsdf")));
+        assert_eq!(ex.meshes.len(), 1);
+        assert!(ex.meshes[0].file_name.starts_with("meshes/i0_"), "{}", ex.meshes[0].file_name);
+        assert_eq!(ex.meshes[0].positions, vec![Vec3::ZERO, Vec3::X, Vec3::Y]);
+        let instances = of_type("instance");
+        assert_eq!(instances.len(), 2);
+        for (inst, t) in instances.iter().zip(moves) {
+            let matrix = inst
+                .descendants()
+                .find(|n| n.has_tag_name("matrix"))
+                .and_then(|n| n.attribute("value"))
+                .unwrap();
+            let v: Vec<f32> = matrix.split(' ').map(|x| x.parse().unwrap()).collect();
+            assert_eq!(v, [2., 0., 0., t.x, 0., 2., 0., t.y, 0., 0., 2., t.z, 0., 0., 0., 1.]);
+            assert!(inst.descendants().any(|n| n.attribute("id") == Some("instanced0")));
+        }
     }
 
     #[test]
