@@ -72,7 +72,8 @@ pub struct SurfaceHit {
     pub mapped: Option<MappedNormal>,
     /// Texture coordinates and vertex colour.
     pub attributes: VertexAttributes,
-    /// Triangle index.
+    /// Index of the scene's flat triangle, or [`crate::scene::INSTANCED_TRIANGLE`] for a
+    /// triangle of an instanced mesh.
     pub triangle: u32,
     /// Material index.
     pub material: u32,

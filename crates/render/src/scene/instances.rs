@@ -112,10 +112,12 @@ pub(super) struct InstanceHit {
 }
 
 impl Instances {
-    /// The meshes (checked) with their BVHs, the instances (whose mesh indices are in range),
-    /// their world boxes (the box of each instance's transformed vertices, so as tight as the
+    /// The meshes (checked) with their BVHs, the instances (whose mesh indices are in range;
+    /// those of meshes without triangles are dropped), their world boxes (the box of each instance's transformed vertices, so as tight as the
     /// flattened triangles' would be) and the TLAS over them.
-    pub(super) fn build(meshes: Vec<InstancedMesh>, instances: Vec<Instance>) -> Self {
+    pub(super) fn build(meshes: Vec<InstancedMesh>, mut instances: Vec<Instance>) -> Self {
+        // An instance of a mesh without triangles can be hit by nothing (and has no box).
+        instances.retain(|i| !meshes[i.mesh as usize].parts.triangles.is_empty());
         let boxes: Vec<[Vec3; 2]> = instances
             .iter()
             .map(|inst| {

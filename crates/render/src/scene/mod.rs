@@ -1,12 +1,18 @@
-//! Scenes: one flat triangle soup in world space with per-vertex attributes, materials,
-//! textures, lights, cameras and the BVH, loaded from glTF 2.0 (`.gltf`, `.glb`) or OBJ/MTL
+//! Scenes: one flat triangle soup in world space with per-vertex attributes, instanced meshes
+//! ([`Instances`]: stored once in object space, placed by transforms), materials, textures,
+//! lights, cameras and the BVH, loaded from glTF 2.0 (`.gltf`, `.glb`) or OBJ/MTL
 //! ([`Scene::load`]) or built from memory ([`Scene::from_parts`]).
 //!
 //! # The scene contract (see DESIGN.md)
 //!
 //! - glTF: the default scene (else scene 0) is flattened, `world = parent * local`. Triangle
 //!   primitives (strips and fans are converted) become world-space triangles; points and lines
-//!   are skipped with a warning. Normals go through the inverse transpose; where a primitive
+//!   are skipped with a warning. A mesh placed more than once (by several nodes, or by the
+//!   instances of EXT_mesh_gpu_instancing, `world = node world * T * R * S`) is instead stored
+//!   once in object space and placed by [`Instance`]s, unless it has an emissive material
+//!   (emitters are world triangles); hits on instances are shaded as the flattened triangles
+//!   would be (see [`Instances`]), and [`SurfaceHit::triangle`] is then
+//!   [`INSTANCED_TRIANGLE`]. Normals go through the inverse transpose; where a primitive
 //!   has none the shading normal is the face normal (stored as a zero vertex normal). A node
 //!   whose world transform has a negative determinant has its winding reversed, as the glTF
 //!   specification says, so the geometric normal from the winding stays the front side.
@@ -102,7 +108,8 @@
 //!
 //! # Ray queries
 //!
-//! [`Scene::intersect`] and [`Scene::occluded`] go through [`Accel`]; hits closer than
+//! [`Scene::intersect`] and [`Scene::occluded`] go through [`Accel`] (and, when the scene has
+//! instances, the top-level BVH over them and each instanced mesh's own BVH); hits closer than
 //! [`Accel::t_min`] (a tiny distance relative to the scene's size) are ignored to guard against
 //! self-intersection, on top of the origin offset callers apply with
 //! [`crate::geometry::offset_ray_origin`].
