@@ -22,7 +22,11 @@ fn sphere(rings: u32, segments: u32) -> (Vec<f32>, Vec<f32>, Vec<u32>) {
         let theta = std::f32::consts::PI * r as f32 / rings as f32;
         for s in 0..=segments {
             let phi = std::f32::consts::TAU * s as f32 / segments as f32;
-            let n = [theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin()];
+            let n = [
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                theta.sin() * phi.sin(),
+            ];
             pos.extend(n.map(|c| 0.5 * c));
             nrm.extend(n);
         }
@@ -49,7 +53,9 @@ fn write_field(dir: &Path, shared: bool, count: usize) -> std::path::PathBuf {
         views.len() - 1
     };
     let f = |v: &[f32]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
-    let ground = [-40.0f32, 0., -40., -40., 0., 40., 40., 0., 40., 40., 0., -40.];
+    let ground = [
+        -40.0f32, 0., -40., -40., 0., 40., 40., 0., 40., 40., 0., -40.,
+    ];
     let accessors = json!([
         {"bufferView": add(f(&pos)), "componentType": 5126, "count": pos.len() / 3,
          "type": "VEC3", "min": [-0.5, -0.5, -0.5], "max": [0.5, 0.5, 0.5]},
@@ -63,8 +69,10 @@ fn write_field(dir: &Path, shared: bool, count: usize) -> std::path::PathBuf {
     ]);
     let ball = json!({"name": "ball", "primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1},
         "indices": 2, "material": 1}]});
-    let mut meshes = vec![json!({"name": "ground", "primitives": [{"attributes": {"POSITION": 3},
-        "indices": 4, "material": 0}]})];
+    let mut meshes = vec![
+        json!({"name": "ground", "primitives": [{"attributes": {"POSITION": 3},
+        "indices": 4, "material": 0}]}),
+    ];
     let mut nodes = vec![json!({"mesh": 0})];
     let mut rng = Pcg32::new(1, 1);
     let side = (count as f32).sqrt().ceil() as usize;
@@ -104,7 +112,11 @@ fn write_field(dir: &Path, shared: bool, count: usize) -> std::path::PathBuf {
         "accessors": accessors
     });
     std::fs::write(dir.join("field.bin"), &bin).unwrap();
-    let path = dir.join(if shared { "instanced.gltf" } else { "flat.gltf" });
+    let path = dir.join(if shared {
+        "instanced.gltf"
+    } else {
+        "flat.gltf"
+    });
     std::fs::write(&path, serde_json::to_vec(&doc).unwrap()).unwrap();
     path
 }
@@ -172,6 +184,9 @@ fn main() {
         .zip(&b.pixels)
         .map(|(p, q)| f64::from((*p - *q).abs().element_sum()))
         .sum::<f64>()
-        / a.pixels.iter().map(|p| f64::from(p.element_sum())).sum::<f64>();
+        / a.pixels
+            .iter()
+            .map(|p| f64::from(p.element_sum()))
+            .sum::<f64>();
     println!("relative L1 difference of the two images: {diff:.2e}");
 }

@@ -387,13 +387,16 @@ impl Tlas {
             return false;
         };
         let ids = &self.bvh.primitive_indices;
-        !self.bvh.ray_traverse_miss(r, |_, slot| {
-            if visit(ids[slot]) {
-                0.0
-            } else {
-                f32::INFINITY
-            }
-        })
+        !self.bvh.ray_traverse_miss(
+            r,
+            |_, slot| {
+                if visit(ids[slot]) {
+                    0.0
+                } else {
+                    f32::INFINITY
+                }
+            },
+        )
     }
 }
 

@@ -902,7 +902,9 @@ pub(crate) fn export_parts(
         };
         let _ = write!(xml, "<shape type=\"shapegroup\" id=\"instanced{k}\">");
         for (index, mut mesh) in meshes_by_material(&object) {
-            mesh.file_name = mesh.file_name.replacen("meshes/", &format!("meshes/i{k}_"), 1);
+            mesh.file_name = mesh
+                .file_name
+                .replacen("meshes/", &format!("meshes/i{k}_"), 1);
             let bsdf = bsdf_of(&mut mw, index)?;
             let _ = write!(
                 xml,
@@ -914,7 +916,9 @@ pub(crate) fn export_parts(
         let _ = writeln!(xml, "</shape>");
     }
     for inst in &parts.instances.instances {
-        let m = glam::Mat4::from(inst.world_from_object).transpose().to_cols_array();
+        let m = glam::Mat4::from(inst.world_from_object)
+            .transpose()
+            .to_cols_array();
         let values: Vec<String> = m.iter().map(|v| format!("{v:?}")).collect();
         let _ = writeln!(
             xml,
@@ -1103,7 +1107,8 @@ mod tests {
             instances: moves
                 .iter()
                 .map(|&t| {
-                    let m = glam::Mat4::from_translation(t) * glam::Mat4::from_scale(Vec3::splat(2.0));
+                    let m =
+                        glam::Mat4::from_translation(t) * glam::Mat4::from_scale(Vec3::splat(2.0));
                     crate::scene::Instance::new(0, m).unwrap()
                 })
                 .collect(),
@@ -1120,11 +1125,18 @@ mod tests {
         let groups = of_type("shapegroup");
         assert_eq!(groups.len(), 1);
         assert_eq!(groups[0].attribute("id"), Some("instanced0"));
-        let ply: Vec<_> = groups[0].children().filter(|n| n.has_tag_name("shape")).collect();
+        let ply: Vec<_> = groups[0]
+            .children()
+            .filter(|n| n.has_tag_name("shape"))
+            .collect();
         assert_eq!(ply.len(), 1);
         assert!(ply[0].children().any(|n| n.has_tag_name("bsdf")));
         assert_eq!(ex.meshes.len(), 1);
-        assert!(ex.meshes[0].file_name.starts_with("meshes/i0_"), "{}", ex.meshes[0].file_name);
+        assert!(
+            ex.meshes[0].file_name.starts_with("meshes/i0_"),
+            "{}",
+            ex.meshes[0].file_name
+        );
         assert_eq!(ex.meshes[0].positions, vec![Vec3::ZERO, Vec3::X, Vec3::Y]);
         let instances = of_type("instance");
         assert_eq!(instances.len(), 2);
@@ -1135,8 +1147,13 @@ mod tests {
                 .and_then(|n| n.attribute("value"))
                 .unwrap();
             let v: Vec<f32> = matrix.split(' ').map(|x| x.parse().unwrap()).collect();
-            assert_eq!(v, [2., 0., 0., t.x, 0., 2., 0., t.y, 0., 0., 2., t.z, 0., 0., 0., 1.]);
-            assert!(inst.descendants().any(|n| n.attribute("id") == Some("instanced0")));
+            assert_eq!(
+                v,
+                [2., 0., 0., t.x, 0., 2., 0., t.y, 0., 0., 2., t.z, 0., 0., 0., 1.]
+            );
+            assert!(inst
+                .descendants()
+                .any(|n| n.attribute("id") == Some("instanced0")));
         }
     }
 

@@ -66,7 +66,10 @@ fn agree(a: &[Vec3], b: &[Vec3]) -> Result<(), String> {
         .filter(|(p, q)| (**p - **q).abs().max_element() > 0.05 * ma / 3.0)
         .count();
     if (ma - mb).abs() > 0.01 * ma || off * 50 > a.len() {
-        return Err(format!("means {ma} and {mb}, {off} of {} pixels differ", a.len()));
+        return Err(format!(
+            "means {ma} and {mb}, {off} of {} pixels differ",
+            a.len()
+        ));
     }
     Ok(())
 }

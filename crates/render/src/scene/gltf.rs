@@ -547,7 +547,10 @@ impl Loader<'_> {
                         let w = world * *local;
                         if Instance::new(0, w).is_none() {
                             return Err(self.bad(
-                                format!("{}, EXT_mesh_gpu_instancing instance {i}", node_label(node)),
+                                format!(
+                                    "{}, EXT_mesh_gpu_instancing instance {i}",
+                                    node_label(node)
+                                ),
                                 format!("world transform is not invertible or not finite: {w:?}"),
                             ));
                         }
@@ -605,7 +608,11 @@ impl Loader<'_> {
         let rotation: Option<Vec<Quat>> = accessor("ROTATION")?
             .map(|a| {
                 self.attribute::<4>(&a, &element, "ROTATION", accessor::DIRECTION, None)
-                    .map(|v| v.into_iter().map(|q| Quat::from_array(q).normalize()).collect())
+                    .map(|v| {
+                        v.into_iter()
+                            .map(|q| Quat::from_array(q).normalize())
+                            .collect()
+                    })
             })
             .transpose()?;
         let counts = [
@@ -2603,7 +2610,9 @@ mod tests {
         let tan = d.floats(&tan, "VEC4", 4);
         let idx = d.indices(&idx);
         let quad = d.floats(
-            &[-0.5, -0.5, 0.8, 0.5, -0.5, 0.8, 0.5, 0.5, 0.8, -0.5, 0.5, 0.8],
+            &[
+                -0.5, -0.5, 0.8, 0.5, -0.5, 0.8, 0.5, 0.5, 0.8, -0.5, 0.5, 0.8,
+            ],
             "VEC3",
             3,
         );
@@ -2690,7 +2699,10 @@ mod tests {
                 (Some(x), Some(y)) => {
                     hits += 1;
                     let close = |p: Vec3, q: Vec3, tol: f32| (p - q).length() <= tol;
-                    assert!((x.t - y.t).abs() <= 1e-4 * x.t.max(1.0), "ray {k}: {x:?} {y:?}");
+                    assert!(
+                        (x.t - y.t).abs() <= 1e-4 * x.t.max(1.0),
+                        "ray {k}: {x:?} {y:?}"
+                    );
                     assert!(close(x.p, y.p, 1e-4), "ray {k}: {x:?} {y:?}");
                     assert!(close(x.ng, y.ng, 1e-4), "ray {k}: {x:?} {y:?}");
                     assert!(close(x.ns, y.ns, 1e-3), "ray {k}: {x:?} {y:?}");
@@ -2731,7 +2743,15 @@ mod tests {
         assert_eq!(instanced.instances.instances.len(), placements.len());
         assert_eq!(instanced.instances.stored_triangle_count(), 14);
         assert_eq!(instanced.world_triangle_count(), flat.triangles.len());
-        assert!(instanced.instances.instances.iter().filter(|i| i.mirrored).count() == 2);
+        assert!(
+            instanced
+                .instances
+                .instances
+                .iter()
+                .filter(|i| i.mirrored)
+                .count()
+                == 2
+        );
         let (ca, ra) = instanced.bounding_sphere();
         let (cb, rb) = flat.bounding_sphere();
         assert!((ca - cb).length() < 1e-5 && (ra - rb).abs() < 1e-5);
@@ -2753,7 +2773,9 @@ mod tests {
                 let inst = &instanced.instances.instances[0];
                 let world = Ray::new(
                     inst.world_from_object.transform_point3(r.origin),
-                    inst.world_from_object.transform_vector3(r.direction).normalize(),
+                    inst.world_from_object
+                        .transform_vector3(r.direction)
+                        .normalize(),
                 );
                 instanced
                     .intersect(&world)
@@ -2791,20 +2813,31 @@ mod tests {
     /// the node.
     #[test]
     fn ext_mesh_gpu_instancing_with_float_and_quantized_attributes() {
-        let t = [[0.0f32, 0.0, 0.0], [2.5, 0.0, 0.0], [-1.0, 2.0, 0.5], [0.0, -2.0, 1.0]];
+        let t = [
+            [0.0f32, 0.0, 0.0],
+            [2.5, 0.0, 0.0],
+            [-1.0, 2.0, 0.5],
+            [0.0, -2.0, 1.0],
+        ];
         let q: [[i16; 4]; 4] = [
             [0, 0, 0, 32767],
             [0, 19660, 0, 26214],
             [9830, 0, 31457, 0],
             [16384, 16384, 16384, 16384],
         ];
-        let s: [[i8; 3]; 4] = [[127, 127, 127], [64, 127, 100], [-127, 90, 127], [127, -80, -127]];
+        let s: [[i8; 3]; 4] = [
+            [127, 127, 127],
+            [64, 127, 100],
+            [-127, 90, 127],
+            [127, -80, -127],
+        ];
         let mut d = Doc::default();
         let prims = box_mesh(&mut d);
         let translation = d.floats(&t.concat(), "VEC3", 3);
         let rot_bytes: Vec<u8> = q.concat().iter().flat_map(|v| v.to_le_bytes()).collect();
         let view = d.view(&rot_bytes);
-        d.accessors.push(json!({"bufferView": view, "componentType": 5122,
+        d.accessors
+            .push(json!({"bufferView": view, "componentType": 5122,
             "normalized": true, "count": 4, "type": "VEC4"}));
         let rotation = d.accessors.len() - 1;
         // Each element padded to 4 bytes, as the specification requires of strides.
@@ -2814,7 +2847,8 @@ mod tests {
             .collect();
         let view = d.view(&scale_bytes);
         d.views[view]["byteStride"] = json!(4);
-        d.accessors.push(json!({"bufferView": view, "componentType": 5120,
+        d.accessors
+            .push(json!({"bufferView": view, "componentType": 5120,
             "normalized": true, "count": 4, "type": "VEC3"}));
         let scale = d.accessors.len() - 1;
         let parent = json!({"name": "parent", "translation": [0.5, 1, -2],
@@ -2845,7 +2879,10 @@ mod tests {
         // rules (max(c / 32767, -1), max(c / 127, -1)).
         let locals: Vec<Value> = (0..4)
             .map(|i| {
-                let r: Vec<f32> = q[i].iter().map(|&c| (c as f32 / 32767.0).max(-1.0)).collect();
+                let r: Vec<f32> = q[i]
+                    .iter()
+                    .map(|&c| (c as f32 / 32767.0).max(-1.0))
+                    .collect();
                 let sc: Vec<f32> = s[i].iter().map(|&c| (c as f32 / 127.0).max(-1.0)).collect();
                 json!({"translation": t[i], "rotation": r, "scale": sc})
             })

@@ -76,7 +76,9 @@ impl Instance {
     #[inline]
     pub fn tangent_to_world(&self, t: Vec4) -> Vec4 {
         let w = if self.mirrored { -t.w } else { t.w };
-        self.world_from_object.transform_vector3(t.truncate()).extend(w)
+        self.world_from_object
+            .transform_vector3(t.truncate())
+            .extend(w)
     }
 }
 
@@ -131,12 +133,12 @@ impl Instances {
                 )
             })
             .collect();
-        let bounds = boxes
-            .iter()
-            .filter(|[lo, hi]| lo.cmple(*hi).all())
-            .fold(None, |acc: Option<[Vec3; 2]>, &[lo, hi]| {
+        let bounds = boxes.iter().filter(|[lo, hi]| lo.cmple(*hi).all()).fold(
+            None,
+            |acc: Option<[Vec3; 2]>, &[lo, hi]| {
                 Some(acc.map_or([lo, hi], |[a, b]| [a.min(lo), b.max(hi)]))
-            });
+            },
+        );
         Self {
             tlas: Tlas::build(&boxes),
             meshes,

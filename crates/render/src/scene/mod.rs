@@ -491,9 +491,9 @@ impl Scene {
                 nearer.t_max = h.t;
             }
             let t_min = self.accel.t_min();
-            let instanced = self.instances.intersect(&nearer, t_min, |i, t, b| {
-                self.instance_stops(ray, i, t, b)
-            });
+            let instanced = self
+                .instances
+                .intersect(&nearer, t_min, |i, t, b| self.instance_stops(ray, i, t, b));
             if let Some(h) = instanced {
                 let inst = &self.instances.instances[h.instance as usize];
                 let geometry = self.instances.meshes[inst.mesh as usize]
@@ -580,11 +580,9 @@ impl Scene {
         self.accel
             .occluded_filtered(ray, |t, b| self.stops(self.geometry(), ray, t, t, b))
             || (!self.instances.is_empty()
-                && self
-                    .instances
-                    .occluded(ray, self.accel.t_min(), |i, t, b| {
-                        self.instance_stops(ray, i, t, b)
-                    }))
+                && self.instances.occluded(ray, self.accel.t_min(), |i, t, b| {
+                    self.instance_stops(ray, i, t, b)
+                }))
     }
 }
 
