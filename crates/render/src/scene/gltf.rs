@@ -2635,20 +2635,35 @@ mod tests {
     fn placed_boxes(locals: &[Value], share: bool) -> (Value, Vec<u8>) {
         let mut d = Doc::default();
         let prims = box_mesh(&mut d);
-        let mut nodes = vec![json!({"name": "parent", "translation": [0.5, 1, -2],
-            "rotation": [0.2, 0.3, 0.1, 0.927], "scale": [1, 1.5, 1],
-            "children": (1..=locals.len()).collect::<Vec<_>>()})];
+        let children: Vec<usize> = (1..=locals.len()).collect();
+        let mut nodes = vec![boxes_parent(&children)];
         for (i, local) in locals.iter().enumerate() {
             let mut n = local.clone();
             n["mesh"] = json!(if share { 0 } else { i });
             nodes.push(n);
         }
         let copies = if share { 1 } else { locals.len() };
+        boxes_doc(
+            d,
+            json!(nodes),
+            json!(vec![json!({"name": "box", "primitives": prims}); copies]),
+        )
+    }
+
+    /// The parent node of the placed boxes, rotated, translated and scaled.
+    fn boxes_parent(children: &[usize]) -> Value {
+        json!({"name": "parent", "translation": [0.5, 1, -2],
+            "rotation": [0.2, 0.3, 0.1, 0.927], "scale": [1, 1.5, 1], "children": children})
+    }
+
+    /// The document of the box tests: scene 0 is node 0, the given nodes and meshes, the
+    /// box's materials and normal texture, and `d`'s buffer.
+    fn boxes_doc(d: Doc, nodes: Value, meshes: Value) -> (Value, Vec<u8>) {
         let doc = json!({
             "asset": {"version": "2.0"},
             "scenes": [{"nodes": [0]}],
             "nodes": nodes,
-            "meshes": vec![json!({"name": "box", "primitives": prims}); copies],
+            "meshes": meshes,
             "materials": [
                 {"name": "painted", "normalTexture": {"index": 0, "scale": 0.8}},
                 {"name": "fence", "alphaMode": "MASK", "doubleSided": true}
@@ -2851,27 +2866,14 @@ mod tests {
             .push(json!({"bufferView": view, "componentType": 5120,
             "normalized": true, "count": 4, "type": "VEC3"}));
         let scale = d.accessors.len() - 1;
-        let parent = json!({"name": "parent", "translation": [0.5, 1, -2],
-            "rotation": [0.2, 0.3, 0.1, 0.927], "scale": [1, 1.5, 1], "children": [1]});
-        let doc = json!({
-            "asset": {"version": "2.0"},
-            "extensionsUsed": ["EXT_mesh_gpu_instancing", "KHR_mesh_quantization"],
-            "extensionsRequired": ["EXT_mesh_gpu_instancing", "KHR_mesh_quantization"],
-            "scenes": [{"nodes": [0]}],
-            "nodes": [parent, {"name": "trees", "mesh": 0, "extensions": {"EXT_mesh_gpu_instancing":
-                {"attributes": {"TRANSLATION": translation, "ROTATION": rotation, "SCALE": scale}}}}],
-            "meshes": [{"name": "box", "primitives": prims}],
-            "materials": [
-                {"name": "painted", "normalTexture": {"index": 0, "scale": 0.8}},
-                {"name": "fence", "alphaMode": "MASK", "doubleSided": true}
-            ],
-            "images": [{"uri": png_uri([200, 100, 230])}],
-            "textures": [{"source": 0}],
-            "buffers": [{"byteLength": d.bin.len()}],
-            "bufferViews": d.views,
-            "accessors": d.accessors
-        });
-        let instanced = load(doc.clone(), &d.bin);
+        let nodes = json!([boxes_parent(&[1]), {"name": "trees", "mesh": 0, "extensions": {
+            "EXT_mesh_gpu_instancing": {"attributes":
+                {"TRANSLATION": translation, "ROTATION": rotation, "SCALE": scale}}}}]);
+        let (mut doc, bin) = boxes_doc(d, nodes, json!([{"name": "box", "primitives": prims}]));
+        let used = json!(["EXT_mesh_gpu_instancing", "KHR_mesh_quantization"]);
+        doc["extensionsUsed"] = used.clone();
+        doc["extensionsRequired"] = used;
+        let instanced = load(doc.clone(), &bin);
         assert!(instanced.warnings.is_empty(), "{:?}", instanced.warnings);
         assert_eq!(instanced.instances.instances.len(), 4);
         assert!(instanced.triangles.is_empty());
@@ -2887,15 +2889,15 @@ mod tests {
                 json!({"translation": t[i], "rotation": r, "scale": sc})
             })
             .collect();
-        let (nodes, bin) = placed_boxes(&locals, false);
-        let flat = load(nodes, &bin);
+        let (nodes, flat_bin) = placed_boxes(&locals, false);
+        let flat = load(nodes, &flat_bin);
         assert!(flat.instances.is_empty());
         let hits = assert_same_hits(&instanced, &flat, 4000);
         assert!(hits > 500, "{hits} hits");
 
         let mut bad = doc;
         bad["accessors"][translation]["count"] = json!(3);
-        let err = load_err(bad, &d.bin);
+        let err = load_err(bad, &bin);
         assert!(
             err.contains("node \"trees\" (1), EXT_mesh_gpu_instancing") && err.contains("counts"),
             "{err}"
