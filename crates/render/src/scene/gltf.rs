@@ -2242,17 +2242,11 @@ mod tests {
     #[test]
     fn second_uvs_vertex_colours_transforms_samplers_and_masks() {
         // 2x2 white PNG, alpha: top row opaque, transparent; bottom row the other way round.
-        let mut png = Vec::new();
         let texels = [255, 255, 255, 255, 255, 255, 255, 0]
             .into_iter()
             .chain([255, 255, 255, 0, 255, 255, 255, 255])
             .collect();
-        image::RgbaImage::from_raw(2, 2, texels)
-            .unwrap()
-            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
-            .unwrap();
-        let dir = tempfile::tempdir().unwrap();
-        std::fs::write(dir.path().join("leaf.png"), &png).unwrap();
+        let dir = png_file("leaf.png", 2, 2, texels);
         let mut d = Doc::default();
         // A unit quad in z = 0 facing +Z; uv1 = uv0 / 2; red opaque at y = 0, blue 0.2 at y = 1.
         let pos = d.floats(&[0., 0., 0., 1., 0., 0., 1., 1., 0., 0., 1., 0.], "VEC3", 3);
@@ -2347,13 +2341,7 @@ mod tests {
     #[test]
     fn wet_dry_material_reads_the_dryness_map() {
         // A 2x1 PNG: left texel G = 0 (wet), right texel G = 255 (dry).
-        let mut png = Vec::new();
-        image::RgbaImage::from_raw(2, 1, vec![0, 0, 0, 255, 0, 255, 0, 255])
-            .unwrap()
-            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
-            .unwrap();
-        let dir = tempfile::tempdir().unwrap();
-        std::fs::write(dir.path().join("dry.png"), &png).unwrap();
+        let dir = png_file("dry.png", 2, 1, vec![0, 0, 0, 255, 0, 255, 0, 255]);
         let (mut doc, bin) = test_doc();
         doc["images"] = json!([{"uri": "dry.png"}]);
         doc["textures"] = json!([{"source": 0}]);
@@ -2390,12 +2378,30 @@ mod tests {
     }
     /// A 1x1 PNG of `rgb` as a data URI (a tiny embedded texture).
     fn png_uri(rgb: [u8; 3]) -> String {
+        let png = png_bytes(1, 1, vec![rgb[0], rgb[1], rgb[2], 255]);
+        format!("data:image/png;base64,{}", base64::encode(png))
+    }
+
+    /// A `width` x `height` PNG of the RGBA bytes `texels`.
+    pub(super) fn png_bytes(width: u32, height: u32, texels: Vec<u8>) -> Vec<u8> {
         let mut png = Vec::new();
-        image::RgbaImage::from_raw(1, 1, vec![rgb[0], rgb[1], rgb[2], 255])
+        image::RgbaImage::from_raw(width, height, texels)
             .unwrap()
             .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
             .unwrap();
-        format!("data:image/png;base64,{}", base64::encode(png))
+        png
+    }
+
+    /// A temporary folder holding that PNG as `name`.
+    pub(super) fn png_file(
+        name: &str,
+        width: u32,
+        height: u32,
+        texels: Vec<u8>,
+    ) -> tempfile::TempDir {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join(name), png_bytes(width, height, texels)).unwrap();
+        dir
     }
 
     /// The test document with a normal texture on the quad's material ("asphalt") that tilts
@@ -2909,7 +2915,7 @@ mod tests {
 mod material_extension_tests {
     //! KHR_materials_specular, KHR_materials_ior and KHR_materials_clearcoat: their parsing,
     //! their defaults, their textures' channels and colour spaces, and their errors.
-    use super::tests::{test_doc, write_embedded};
+    use super::tests::{png_file, test_doc, write_embedded};
     use crate::bsdf::Bsdf;
     use crate::material::{GltfPbrParams, Reflectance};
     use crate::scene::Scene;
@@ -2934,13 +2940,7 @@ mod material_extension_tests {
     #[test]
     fn specular_ior_and_clearcoat_are_read_with_their_textures() {
         // One texel: R 255, G 128, B 0, A 64.
-        let mut png = Vec::new();
-        image::RgbaImage::from_raw(1, 1, vec![255, 128, 0, 64])
-            .unwrap()
-            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
-            .unwrap();
-        let dir = tempfile::tempdir().unwrap();
-        std::fs::write(dir.path().join("t.png"), &png).unwrap();
+        let dir = png_file("t.png", 1, 1, vec![255, 128, 0, 64]);
         let (mut doc, bin) = test_doc();
         doc["extensionsUsed"] = json!([
             "KHR_lights_punctual",
@@ -3038,13 +3038,7 @@ mod material_extension_tests {
     #[test]
     fn transmission_and_volume_are_read() {
         // One texel: R 128 (transmission x 0.502), linear.
-        let mut png = Vec::new();
-        image::RgbaImage::from_raw(1, 1, vec![128, 0, 0, 255])
-            .unwrap()
-            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
-            .unwrap();
-        let dir = tempfile::tempdir().unwrap();
-        std::fs::write(dir.path().join("t.png"), &png).unwrap();
+        let dir = png_file("t.png", 1, 1, vec![128, 0, 0, 255]);
         let (mut doc, bin) = test_doc();
         doc["extensionsUsed"] = json!([
             "KHR_lights_punctual",
