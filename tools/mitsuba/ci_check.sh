@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # CI check: streaks render against Mitsuba 3 on scenes/crosscheck.gltf, with the noise test of
-# tools/mitsuba/README.md. Exits 0 on agreement, 1 on disagreement, 2 when it cannot run.
+# tools/mitsuba/README.md, then on the same scene with the glass pane of glass_pane.py
+# (KHR_materials_transmission with a volume: Mitsuba's dielectric) at max depth 8.
+# Exits 0 on agreement, 1 on disagreement, 2 when it cannot run.
 # Environment: STREAKS (the binary; default target/debug/streaks, built with cargo build),
 # CROSSCHECK_SPP (default 64), CROSSCHECK_WIDTH/HEIGHT (default 160x120), CROSSCHECK_K (4).
-# Extra arguments go to crosscheck.py (e.g. another scene path).
+# Extra arguments go to the first crosscheck.py run (e.g. another scene path).
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 repo="$(cd "$here/../.." && pwd)"
@@ -16,7 +18,16 @@ if [ -z "${STREAKS:-}" ]; then
     cargo build --bin streaks >&2
 fi
 streaks="${STREAKS:-$repo/target/debug/streaks}"
-exec python3 "$here/crosscheck.py" --ci --streaks "$streaks" \
+status=0
+python3 "$here/crosscheck.py" --ci --streaks "$streaks" \
     --spp "${CROSSCHECK_SPP:-64}" --width "${CROSSCHECK_WIDTH:-160}" \
     --height "${CROSSCHECK_HEIGHT:-120}" --k "${CROSSCHECK_K:-4}" \
-    --out "$repo/target/crosscheck/ci" "$@"
+    --out "$repo/target/crosscheck/ci" "$@" || status=$?
+python3 "$here/glass_pane.py" "$repo/target/crosscheck/glass" >&2
+python3 "$here/crosscheck.py" "$repo/target/crosscheck/glass/glass_crosscheck.gltf" \
+    --camera cam --streaks "$streaks" --max-depth 8 \
+    --spp "${CROSSCHECK_SPP:-64}" --width "${CROSSCHECK_WIDTH:-160}" \
+    --height "${CROSSCHECK_HEIGHT:-120}" --k "${CROSSCHECK_K:-4}" \
+    --region pane=0.2,0.22,0.52,0.6 --region road=0,0.7,1,1 --region wall=0.6,0.1,0.95,0.5 \
+    --out "$repo/target/crosscheck/ci_glass" || status=$?
+exit "$status"
