@@ -81,10 +81,7 @@ mod tests {
     use super::*;
 
     fn committed_dir() -> PathBuf {
-        Path::new(env!("CARGO_MANIFEST_DIR"))
-            .parent()
-            .map(Path::to_path_buf)
-            .unwrap_or_default()
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
     }
 
     /// Regenerating gives exactly the committed files, and every committed scene file is

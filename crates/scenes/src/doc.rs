@@ -516,7 +516,7 @@ impl Doc {
         let mut root = json!({
             "asset": {
                 "version": "2.0",
-                "generator": "streaks-scenes (scenes/generator)",
+                "generator": "streaks-scenes (crates/scenes)",
             },
             "scene": 0,
             "scenes": [{

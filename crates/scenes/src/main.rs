@@ -10,7 +10,7 @@ use std::path::PathBuf;
 #[command(version, about)]
 struct Cli {
     /// Output directory (default: the repository's scenes/ directory).
-    #[arg(default_value = concat!(env!("CARGO_MANIFEST_DIR"), "/.."))]
+    #[arg(default_value = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes"))]
     dir: PathBuf,
 }
 
