@@ -70,6 +70,18 @@ pub struct Dryness {
     pub ks_dry: [f64; 3],
 }
 
+/// A tangent-space normal map on a paper material (glTF `normalTexture`), tiled over the
+/// mesh's texture coordinates by `KHR_texture_transform` when `tiles` is not 1.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NormalTexture {
+    /// Index of the image (from [`Doc::add_png`]).
+    pub image: usize,
+    /// `normalTexture.scale`: the strength of the map's X and Y.
+    pub scale: f64,
+    /// Repeats of the image across one unit of the texture coordinates (u, v).
+    pub tiles: [f64; 2],
+}
+
 /// How a material reflects.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Reflect {
@@ -86,6 +98,8 @@ pub enum Reflect {
         /// Optional albedo texture (image index from [`Doc::add_png`]), written as the
         /// baseColorTexture: its linear RGB multiplies `kd`.
         albedo: Option<usize>,
+        /// Optional normal map (rain ripples on the road).
+        normal: Option<NormalTexture>,
     },
     /// A black, non-reflecting surface (glTF metallic-roughness with base colour 0): used
     /// for emitters, whose look is their emission.
@@ -104,6 +118,9 @@ pub struct Material {
     pub emission: Option<[f64; 3]>,
     /// Whether both faces are shaded (and emit).
     pub double_sided: bool,
+    /// Whether this is the road surface (`extras.streaks.road`: the dataset's road mask is
+    /// the pixels whose first hit has such a material).
+    pub road: bool,
 }
 
 impl Material {
@@ -117,9 +134,11 @@ impl Material {
                 ks,
                 dryness: None,
                 albedo: None,
+                normal: None,
             },
             emission: None,
             double_sided: false,
+            road: false,
         }
     }
 
@@ -140,6 +159,20 @@ impl Material {
         self
     }
 
+    /// The same paper material with a normal map (no effect on other reflectances).
+    pub fn with_normal(mut self, n: NormalTexture) -> Self {
+        if let Reflect::Paper { normal, .. } = &mut self.reflect {
+            *normal = Some(n);
+        }
+        self
+    }
+
+    /// The same material, marked as the road surface.
+    pub fn as_road(mut self) -> Self {
+        self.road = true;
+        self
+    }
+
     /// A Mitsuba-style diffuse material: `ggx` with ks = 0.
     pub fn diffuse(name: &str, kd: [f64; 3]) -> Self {
         Self::paper(name, PaperBsdf::Ggx { alpha: 0.5 }, kd, [0.0; 3])
@@ -152,6 +185,7 @@ impl Material {
             reflect: Reflect::Black,
             emission: Some(radiance),
             double_sided: false,
+            road: false,
         }
     }
 }
@@ -208,6 +242,18 @@ pub struct Doc {
     textures_used: Vec<usize>,
     triangles: usize,
     description: String,
+}
+
+impl std::fmt::Debug for Doc {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Doc")
+            .field("name", &self.name)
+            .field("triangles", &self.triangles)
+            .field("lights", &self.lights.len())
+            .field("materials", &self.materials.len())
+            .field("images", &self.images.len())
+            .finish_non_exhaustive()
+    }
 }
 
 impl Doc {
@@ -314,7 +360,8 @@ impl Doc {
         let mut attributes = json!({ "POSITION": pos, "NORMAL": nor });
         let textured = matches!(
             &material.reflect,
-            Reflect::Paper { dryness, albedo, .. } if dryness.is_some() || albedo.is_some()
+            Reflect::Paper { dryness, albedo, normal, .. }
+                if dryness.is_some() || albedo.is_some() || normal.is_some()
         );
         if textured {
             let bytes: Vec<u8> = mesh
@@ -390,6 +437,7 @@ impl Doc {
                 ks,
                 dryness,
                 albedo,
+                normal,
             } => {
                 let mut s = json!({ "kd": kd, "ks": ks });
                 // glTF fallback for other viewers: roughness = sqrt(alpha).
@@ -428,6 +476,18 @@ impl Doc {
                     pbr["baseColorTexture"] = json!({ "index": tex });
                 }
                 v["pbrMetallicRoughness"] = pbr;
+                if let Some(n) = normal {
+                    let mut info =
+                        json!({ "index": self.texture_index(n.image), "scale": n.scale });
+                    if n.tiles != [1.0, 1.0] {
+                        info["extensions"] =
+                            json!({ "KHR_texture_transform": { "scale": n.tiles } });
+                    }
+                    v["normalTexture"] = info;
+                }
+                if m.road {
+                    s["road"] = json!(true);
+                }
                 v["extras"] = json!({ "streaks": s });
             }
         }
@@ -539,8 +599,17 @@ impl Doc {
             used.push("KHR_lights_punctual");
             root["extensions"] = json!({ "KHR_lights_punctual": { "lights": self.lights } });
         }
-        if self.materials.iter().any(|m| m.get("extensions").is_some()) {
+        if self.materials.iter().any(|m| {
+            m.pointer("/extensions/KHR_materials_emissive_strength")
+                .is_some()
+        }) {
             used.push("KHR_materials_emissive_strength");
+        }
+        if self.materials.iter().any(|m| {
+            m.pointer("/normalTexture/extensions/KHR_texture_transform")
+                .is_some()
+        }) {
+            used.push("KHR_texture_transform");
         }
         if !used.is_empty() {
             root["extensionsUsed"] = json!(used);

@@ -22,6 +22,7 @@ pub mod doc;
 pub mod estimate;
 pub mod mesh;
 pub mod paper;
+pub mod procedural;
 pub mod street;
 pub mod wetness;
 
@@ -52,6 +53,23 @@ pub enum Error {
     /// Encoding a texture failed.
     #[error("cannot encode texture: {0}")]
     Texture(String),
+    /// Reading a file failed.
+    #[error("cannot read {}: {source}", path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A generator config does not parse or has a bad value.
+    #[error("generator config {origin}: {reason}")]
+    Config {
+        /// The file (or other source) of the config.
+        origin: String,
+        /// What is wrong.
+        reason: String,
+    },
 }
 
 /// Builds every shipped scene (in memory).

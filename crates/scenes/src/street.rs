@@ -4,10 +4,12 @@
 //! [`Street::full`] is `rainy_street`; [`Street::small`] is `rainy_street_small` for tests.
 
 use crate::albedo::{albedo_png, Pattern};
-use crate::doc::{round7, Doc, Dryness, Light, LightKind, Material, PaperBsdf};
+use crate::doc::{
+    quantise, round7, Doc, Dryness, Light, LightKind, Material, NormalTexture, PaperBsdf,
+};
 use crate::estimate::Brdf;
 use crate::mesh::Mesh;
-use crate::wetness::dryness_png;
+use crate::wetness::{dryness_png, ripple_normal_png, Wetness, RIPPLE_TEXELS};
 use crate::Error;
 use glam::{Vec2, Vec3};
 
@@ -67,8 +69,140 @@ pub struct Car {
     pub oncoming: bool,
     /// Body colour.
     pub color: [f64; 3],
-    /// Whether its headlights are spot lights (lenses are always emissive).
+    /// Whether its headlights are spot lights (lenses are emissive unless parked).
     pub headlights: bool,
+    /// Parked with its lights off: no emissive lenses, no spot lights.
+    pub parked: bool,
+}
+
+/// What a traffic light shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Signal {
+    /// Red lit.
+    Red,
+    /// Amber lit.
+    Amber,
+    /// Green lit.
+    Green,
+}
+
+/// A traffic light on a sidewalk, facing the driver.
+#[derive(Clone, Copy, Debug)]
+pub struct TrafficLight {
+    /// Z along the road.
+    pub z: f32,
+    /// +1 for the right (+X) sidewalk, -1 for the left.
+    pub side: f32,
+    /// Which lens is lit (and has a spot light).
+    pub signal: Signal,
+}
+
+/// A road sign: a post on a sidewalk with a square plate facing the driver.
+#[derive(Clone, Copy, Debug)]
+pub struct Sign {
+    /// Z along the road.
+    pub z: f32,
+    /// +1 for the right (+X) sidewalk, -1 for the left.
+    pub side: f32,
+    /// Height of the plate's centre.
+    pub height: f32,
+    /// Half size of the plate.
+    pub half: f32,
+    /// Diffuse colour of the plate (linear).
+    pub color: [f64; 3],
+}
+
+/// Rain ripples on the road: a tiling normal map.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ripples {
+    /// `normalTexture.scale` (slope of the ripples).
+    pub strength: f64,
+    /// Metres covered by one tile of the map.
+    pub tile_m: f32,
+    /// Noise seed of the map.
+    pub seed: u32,
+}
+
+/// The continuous parameters of a street: sizes, lamps, wetness, windows and the driver's
+/// camera. [`StreetStyle::SHIPPED`] is the shipped scenes'; the procedural generator
+/// ([`crate::procedural`]) draws them from its config.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StreetStyle {
+    /// Half width of the carriageway.
+    pub road_half: f32,
+    /// Number of lanes (dashed lines between them; the outer edge lines are solid).
+    pub lanes: u32,
+    /// Kerb width and height.
+    pub kerb: f32,
+    /// X of the building facades (the far edge of the pavements).
+    pub facade_x: f32,
+    /// Height of the street lamps' light (the lamp head sits just above it).
+    pub lamp_height: f32,
+    /// Street lamp radiant intensity (W/sr) times [`StreetStyle::lamp_color`].
+    pub lamp_intensity: f64,
+    /// Street lamp colour (max component 1).
+    pub lamp_color: [f64; 3],
+    /// Half size of the lamp lens (along the road, across it).
+    pub lens_half: (f32, f32),
+    /// Radiance of the lamp lens.
+    pub lens_radiance: [f64; 3],
+    /// Headlight radiant intensity on axis (W/sr).
+    pub headlight_intensity: f64,
+    /// Traffic signal radiant intensity on axis (W/sr).
+    pub signal_intensity: f64,
+    /// Global wetness in [0, 1]: 0.5 is the shipped streets' balance of puddles, wet asphalt
+    /// and drier patches; 1 floods the road, 0 dries it.
+    pub wetness: f32,
+    /// Asphalt diffuse reflectance.
+    pub asphalt_kd: f64,
+    /// Specular reflectance and alpha of standing water (dryness 0).
+    pub wet: (f64, f64),
+    /// Specular reflectance and alpha of dry asphalt (dryness 1).
+    pub dry: (f64, f64),
+    /// Rain ripples on the road, if any.
+    pub ripples: Option<Ripples>,
+    /// Shares of the upper windows that are lit warm, and lit at all (warm or cool):
+    /// `(warm, lit)` with `warm <= lit`.
+    pub lit_windows: (f32, f32),
+    /// Share of the shop windows that are lit.
+    pub lit_shops: f32,
+    /// Mean diffuse colour of the three facade materials (brick, render, concrete).
+    pub facade_kd: [[f64; 3]; 3],
+    /// The driver's camera (the stereo rig's centre): eye position.
+    pub eye: Vec3,
+    /// Camera pitch: tangent of the angle below the horizon.
+    pub pitch_tan: f32,
+    /// Vertical field of view in degrees.
+    pub yfov_deg: f64,
+}
+
+impl StreetStyle {
+    /// The shipped streets' style.
+    pub const SHIPPED: Self = Self {
+        road_half: ROAD_HALF,
+        lanes: 2,
+        kerb: KERB,
+        facade_x: FACADE_X,
+        lamp_height: LAMP_H,
+        lamp_intensity: LAMP_INTENSITY,
+        lamp_color: [1.0, 0.78, 0.5],
+        lens_half: (0.12, 0.25),
+        lens_radiance: [40.0, 30.0, 18.0],
+        headlight_intensity: HEADLIGHT_INTENSITY,
+        signal_intensity: SIGNAL_INTENSITY,
+        wetness: 0.5,
+        asphalt_kd: ASPHALT_KD,
+        wet: (ASPHALT_KS_WET, ASPHALT_ALPHA_WET),
+        dry: (ASPHALT_KS_DRY, ASPHALT_ALPHA_DRY),
+        ripples: None,
+        lit_windows: (0.22, 0.3),
+        lit_shops: 0.5,
+        facade_kd: [[0.16, 0.09, 0.07], [0.3, 0.28, 0.24], [0.18, 0.18, 0.19]],
+        eye: EYE,
+        pitch_tan: 0.035,
+        yfov_deg: 45.0,
+    };
 }
 
 /// The layout of a street scene.
@@ -77,7 +211,7 @@ pub struct Street {
     /// Scene name.
     pub name: &'static str,
     /// Description written to the glTF.
-    pub description: &'static str,
+    pub description: String,
     /// Z of the road's near end (behind the driver).
     pub near: f32,
     /// Z of the road's far end.
@@ -90,8 +224,10 @@ pub struct Street {
     pub poles: Vec<f32>,
     /// Cars.
     pub cars: Vec<Car>,
-    /// Z of the traffic light (right sidewalk), if any.
-    pub traffic_light: Option<f32>,
+    /// Traffic lights.
+    pub traffic_lights: Vec<TrafficLight>,
+    /// Road signs.
+    pub signs: Vec<Sign>,
     /// Building blocks per side as (length along Z, height), from the near end.
     pub blocks: Vec<(f32, f32)>,
     /// Whether facades get windows.
@@ -101,6 +237,8 @@ pub struct Street {
     /// Dryness map size in pixels (across, along the road); powers of two. The road's
     /// albedo texture has [`ROAD_ALBEDO_ACROSS`] x twice as many.
     pub texture: (u32, u32),
+    /// Sizes, lamps, wetness, windows and the camera.
+    pub style: StreetStyle,
 }
 
 /// A tiling albedo image in a [`Doc`] and its mean linear value.
@@ -145,7 +283,8 @@ impl Street {
         Self {
             name: "rainy_street",
             description: "Rainy night street: wet two-lane road with puddles, street lamps, \
-                          cars, a traffic light, poles and facades",
+                          cars, a traffic light, poles and facades"
+                .into(),
             near: 10.0,
             far: -150.0,
             lamps_right: vec![-12.0, -40.0, -68.0, -96.0, -124.0],
@@ -158,6 +297,7 @@ impl Street {
                     oncoming: false,
                     color: [0.2, 0.02, 0.02],
                     headlights: true,
+                    parked: false,
                 },
                 Car {
                     x: -1.75,
@@ -165,9 +305,15 @@ impl Street {
                     oncoming: true,
                     color: [0.04, 0.06, 0.12],
                     headlights: true,
+                    parked: false,
                 },
             ],
-            traffic_light: Some(-60.0),
+            traffic_lights: vec![TrafficLight {
+                z: -60.0,
+                side: 1.0,
+                signal: Signal::Red,
+            }],
+            signs: Vec::new(),
             blocks: vec![
                 (14.0, 12.0),
                 (9.0, 9.0),
@@ -183,6 +329,7 @@ impl Street {
             windows: true,
             seed: 2024,
             texture: (64, 1024),
+            style: StreetStyle::SHIPPED,
         }
     }
 
@@ -191,7 +338,7 @@ impl Street {
     pub fn small() -> Self {
         Self {
             name: "rainy_street_small",
-            description: "Small rainy street for tests: two lamps, a traffic light, one car",
+            description: "Small rainy street for tests: two lamps, a traffic light, one car".into(),
             near: 5.0,
             far: -60.0,
             lamps_right: vec![-15.0],
@@ -203,18 +350,25 @@ impl Street {
                 oncoming: false,
                 color: [0.2, 0.02, 0.02],
                 headlights: false,
+                parked: false,
             }],
-            traffic_light: Some(-45.0),
+            traffic_lights: vec![TrafficLight {
+                z: -45.0,
+                side: 1.0,
+                signal: Signal::Red,
+            }],
+            signs: Vec::new(),
             blocks: vec![(25.0, 10.0), (20.0, 14.0), (20.0, 9.0)],
             windows: false,
             seed: 2024,
             texture: (64, 512),
+            style: StreetStyle::SHIPPED,
         }
     }
 
     /// Builds the scene.
     pub fn build(&self) -> Result<Doc, Error> {
-        let mut doc = Doc::new(self.name, self.description);
+        let mut doc = Doc::new(self.name, &self.description);
         let tile = (TILE_TEXELS, TILE_TEXELS);
         let tex = Albedos {
             stone: Albedo::new(&mut doc, "stone", Pattern::Stone, tile, self.seed + 11)?,
@@ -224,25 +378,41 @@ impl Street {
         self.road(&mut doc, &tex)?;
         self.lamps(&mut doc, &tex)?;
         self.poles(&mut doc, &tex)?;
+        let st = &self.style;
         for (k, car) in self.cars.iter().enumerate() {
-            add_car(&mut doc, k, car)?;
+            add_car(&mut doc, k, car, st)?;
         }
-        if let Some(z) = self.traffic_light {
-            add_traffic_light(&mut doc, z)?;
+        for (k, t) in self.traffic_lights.iter().enumerate() {
+            add_traffic_light(&mut doc, k, t, st)?;
+        }
+        if !self.signs.is_empty() {
+            add_signs(&mut doc, &self.signs, st)?;
         }
         self.buildings(&mut doc, &tex)?;
         doc.add_camera(
             "driver",
-            EYE,
-            EYE + Vec3::new(0.0, -0.035, -1.0),
-            45.0,
+            st.eye,
+            st.eye + Vec3::new(0.0, -st.pitch_tan, -1.0),
+            st.yfov_deg,
             16.0 / 9.0,
         );
         Ok(doc)
     }
 
     fn road(&self, doc: &mut Doc, tex: &Albedos) -> Result<(), Error> {
-        let (png, _, _) = dryness_png(ROAD_HALF, self.near, self.far, self.texture, self.seed)?;
+        let st = &self.style;
+        let wet = Wetness {
+            level: st.wetness,
+            lanes: st.lanes,
+        };
+        let (png, _, _) = dryness_png(
+            st.road_half,
+            self.near,
+            self.far,
+            self.texture,
+            self.seed,
+            wet,
+        )?;
         let image = doc.add_png("dryness", png);
         // The albedo shares the dryness map's texture coordinates (the whole carriageway).
         let grain = Albedo::new(
@@ -252,21 +422,34 @@ impl Street {
             (ROAD_ALBEDO_ACROSS, 2 * self.texture.1),
             self.seed + 10,
         )?;
-        let asphalt = grain
+        let mut asphalt = grain
             .paper(
                 "wet_asphalt",
-                PaperBsdf::Ggx {
-                    alpha: ASPHALT_ALPHA_WET,
-                },
-                [ASPHALT_KD; 3],
-                [ASPHALT_KS_WET; 3],
+                PaperBsdf::Ggx { alpha: st.wet.1 },
+                [st.asphalt_kd; 3],
+                [st.wet.0; 3],
             )
             .with_dryness(Dryness {
                 image,
-                alpha_dry: ASPHALT_ALPHA_DRY,
-                ks_dry: [ASPHALT_KS_DRY; 3],
+                alpha_dry: st.dry.1,
+                ks_dry: [st.dry.0; 3],
+            })
+            .as_road();
+        let (h, n, f) = (st.road_half, self.near, self.far);
+        if let Some(r) = st.ripples {
+            let png = ripple_normal_png(RIPPLE_TEXELS, r.seed)?;
+            let image = doc.add_png("ripples", png);
+            // The road's (u, v) spans the carriageway: repeat the tile to r.tile_m metres.
+            let tiles = [
+                f64::from(round7q(2.0 * h / r.tile_m)),
+                f64::from(round7q((n - f) / r.tile_m)),
+            ];
+            asphalt = asphalt.with_normal(NormalTexture {
+                image,
+                scale: r.strength,
+                tiles,
             });
-        let (h, n, f) = (ROAD_HALF, self.near, self.far);
+        }
         let mut road = Mesh::new();
         road.quad_uv(
             [
@@ -295,10 +478,13 @@ impl Street {
         );
         let mut marks = Mesh::new();
         let y = 0.002;
-        let mut z = n - 2.0;
-        while z - 3.0 > f {
-            marks.rect(Vec3::new(0.0, y, z - 1.5), Vec3::Z * 1.5, Vec3::X * 0.06);
-            z -= 12.0;
+        for k in 1..st.lanes.max(1) {
+            let x = -h + k as f32 * (2.0 * h / st.lanes as f32);
+            let mut z = n - 2.0;
+            while z - 3.0 > f {
+                marks.rect(Vec3::new(x, y, z - 1.5), Vec3::Z * 1.5, Vec3::X * 0.06);
+                z -= 12.0;
+            }
         }
         for side in [-1.0f32, 1.0] {
             marks.rect(
@@ -325,11 +511,11 @@ impl Street {
         let mut kerbs = Mesh::new();
         let mut walks = Mesh::new();
         for side in [-1.0f32, 1.0] {
-            let (a, b) = (side * h, side * (h + KERB));
-            kerbs.cuboid(Vec3::new(a.min(b), 0.0, f), Vec3::new(a.max(b), KERB, n));
-            let (c, d) = (side * (h + KERB), side * FACADE_X);
+            let (a, b) = (side * h, side * (h + st.kerb));
+            kerbs.cuboid(Vec3::new(a.min(b), 0.0, f), Vec3::new(a.max(b), st.kerb, n));
+            let (c, d) = (side * (h + st.kerb), side * st.facade_x);
             walks.rect(
-                Vec3::new((c + d) * 0.5, KERB, (n + f) * 0.5),
+                Vec3::new((c + d) * 0.5, st.kerb, (n + f) * 0.5),
                 Vec3::Z * (n - f) * 0.5,
                 Vec3::X * (d - c).abs() * 0.5,
             );
@@ -348,8 +534,12 @@ impl Street {
             [0.06; 3],
             [0.05; 3],
         );
-        // The visible lens is a marker (radiance 40); the light is the point light 5 cm below.
-        let lens = Material::emitter("lamp_lens", [40.0, 30.0, 18.0]);
+        let st = &self.style;
+        // The visible lens is a marker; the light is the point light 10 cm below it.
+        let lens = Material::emitter("lamp_lens", st.lens_radiance);
+        // Everything of the lamp head is placed relative to the light's height.
+        let up = st.lamp_height - LAMP_H;
+        let (kerb, half) = (st.kerb, st.road_half);
         let mut poles = Mesh::new();
         let mut lenses = Mesh::new();
         let sides = self
@@ -358,26 +548,37 @@ impl Street {
             .map(|&z| (1.0f32, z))
             .chain(self.lamps_left.iter().map(|&z| (-1.0f32, z)));
         for (k, (side, z)) in sides.enumerate() {
-            let pole_x = side * (ROAD_HALF + KERB + 0.5);
-            let head_x = side * (ROAD_HALF - 0.9);
-            poles.cylinder(Vec3::new(pole_x, KERB, z), 0.09, 6.5 - KERB, 12);
+            let pole_x = side * (half + kerb + 0.5);
+            let head_x = side * (half - 0.9);
+            poles.cylinder(Vec3::new(pole_x, kerb, z), 0.09, (6.5 + up) - kerb, 12);
             let (a, b) = (pole_x, head_x);
             poles.cuboid(
-                Vec3::new(a.min(b), 6.3, z - 0.05),
-                Vec3::new(a.max(b), 6.4, z + 0.05),
+                Vec3::new(a.min(b), 6.3 + up, z - 0.05),
+                Vec3::new(a.max(b), 6.4 + up, z + 0.05),
             );
-            let head_min = Vec3::new(head_x - 0.3, 6.0, z - 0.15);
-            let head_max = Vec3::new(head_x + 0.3, 6.3, z + 0.15);
+            // The head is at least 60 x 30 cm, and 5 cm (across) and 3 cm (along) wider than
+            // the lens on each side.
+            let lx = 0.3f32.max(st.lens_half.1 + 0.05);
+            let lz = 0.15f32.max(st.lens_half.0 + 0.03);
+            let head_min = Vec3::new(head_x - lx, 6.0 + up, z - lz);
+            let head_max = Vec3::new(head_x + lx, 6.3 + up, z + lz);
             poles.cuboid(head_min, head_max);
-            lenses.rect(Vec3::new(head_x, 5.999, z), Vec3::Z * 0.12, Vec3::X * 0.25);
+            lenses.rect(
+                Vec3::new(head_x, 5.999 + up, z),
+                Vec3::Z * st.lens_half.0,
+                Vec3::X * st.lens_half.1,
+            );
             doc.add_light(&Light {
                 name: format!("street_lamp_{k}"),
                 kind: LightKind::Point,
-                color: [1.0, 0.78, 0.5],
-                intensity: LAMP_INTENSITY,
-                position: Vec3::new(head_x, LAMP_H, z),
+                color: st.lamp_color,
+                intensity: st.lamp_intensity,
+                position: Vec3::new(head_x, st.lamp_height, z),
                 direction: Vec3::NEG_Y,
             });
+        }
+        if poles.indices.is_empty() {
+            return Ok(());
         }
         poles.scale_uvs(TILE_FINE);
         doc.add_mesh("lamp_posts", &poles, &metal)?;
@@ -395,9 +596,10 @@ impl Street {
             [0.03; 3],
         );
         let mut m = Mesh::new();
-        let x = -(ROAD_HALF + KERB + 0.9);
+        let st = &self.style;
+        let x = -(st.road_half + st.kerb + 0.9);
         for &z in &self.poles {
-            m.cylinder(Vec3::new(x, KERB, z), 0.13, 9.0, 12);
+            m.cylinder(Vec3::new(x, st.kerb, z), 0.13, 9.0, 12);
             m.cuboid(
                 Vec3::new(x - 0.9, 8.3, z - 0.06),
                 Vec3::new(x + 0.9, 8.42, z + 0.06),
@@ -411,26 +613,29 @@ impl Street {
     }
 
     fn buildings(&self, doc: &mut Doc, tex: &Albedos) -> Result<(), Error> {
+        let st = &self.style;
         let facades = [
             tex.brick.paper(
                 "facade_brick",
                 PaperBsdf::Ggx { alpha: 0.4 },
-                [0.16, 0.09, 0.07],
+                st.facade_kd[0],
                 [0.02; 3],
             ),
             tex.stone.paper(
                 "facade_render",
                 PaperBsdf::Ggx { alpha: 0.4 },
-                [0.3, 0.28, 0.24],
+                st.facade_kd[1],
                 [0.02; 3],
             ),
             tex.stone.paper(
                 "facade_concrete",
                 PaperBsdf::Ggx { alpha: 0.4 },
-                [0.18, 0.18, 0.19],
+                st.facade_kd[2],
                 [0.02; 3],
             ),
         ];
+        let facade_x = st.facade_x;
+        let (warm_share, lit_share) = st.lit_windows;
         let glass = Material::paper(
             "window_glass",
             PaperBsdf::Ggx { alpha: 0.02 },
@@ -452,7 +657,7 @@ impl Street {
                     len
                 };
                 let z1 = (z0 - len).max(self.far);
-                let (xa, xb) = (side * FACADE_X, side * (FACADE_X + 10.0));
+                let (xa, xb) = (side * facade_x, side * (facade_x + 10.0));
                 by_material[k % 3].cuboid(
                     Vec3::new(xa.min(xb), 0.0, z1),
                     Vec3::new(xa.max(xb), height, z0),
@@ -460,7 +665,7 @@ impl Street {
                 if self.windows {
                     // 1.2 x 1.5 m windows on a 3 m grid, 1 cm in front of the facade,
                     // facing the road; ground floors get wide shop windows.
-                    let x = side * (FACADE_X - 0.01);
+                    let x = side * (facade_x - 0.01);
                     let normal_u = Vec3::Z * side; // u x v = Z x Y * side = -X * side
                     let mut zc = z0 - 2.0;
                     while zc > z1 + 1.5 {
@@ -468,9 +673,9 @@ impl Street {
                         while yc + 1.5 < height {
                             counter += 1;
                             let h = hash01(counter, self.seed);
-                            let target = if h < 0.22 {
+                            let target = if h < warm_share {
                                 &mut lit_warm
-                            } else if h < 0.3 {
+                            } else if h < lit_share {
                                 &mut lit_cool
                             } else {
                                 &mut dark
@@ -483,7 +688,7 @@ impl Street {
                     let mut zc = z0 - 3.5;
                     while zc > z1 + 3.0 {
                         counter += 1;
-                        let target = if hash01(counter, self.seed) < 0.5 {
+                        let target = if hash01(counter, self.seed) < st.lit_shops {
                             &mut lit_warm
                         } else {
                             &mut dark
@@ -501,14 +706,14 @@ impl Street {
         // A block across the far end closes the street.
         let end = self.far;
         by_material[0].cuboid(
-            Vec3::new(-FACADE_X - 10.0, 0.0, end - 10.0),
-            Vec3::new(FACADE_X + 10.0, 16.0, end),
+            Vec3::new(-facade_x - 10.0, 0.0, end - 10.0),
+            Vec3::new(facade_x + 10.0, 16.0, end),
         );
         if self.windows {
             for ix in -4..=4 {
                 for iy in 0..4 {
                     counter += 1;
-                    let target = if hash01(counter, self.seed) < 0.3 {
+                    let target = if hash01(counter, self.seed) < lit_share {
                         &mut lit_warm
                     } else {
                         &mut dark
@@ -540,6 +745,11 @@ impl Street {
     }
 }
 
+/// `x` rounded to 2^-16 (for tiling factors written to the file).
+fn round7q(x: f32) -> f32 {
+    quantise(x, 16)
+}
+
 /// A deterministic pseudo-random number in [0, 1) for window `k`.
 fn hash01(k: u32, seed: u32) -> f32 {
     let mut x = k.wrapping_mul(0x9e37_79b9) ^ seed;
@@ -562,8 +772,8 @@ fn flip(m: &mut Mesh) {
 }
 
 /// A car: body, cabin and wheels as boxes; headlights (spot lights and emissive lenses) at
-/// the front, emissive red tail lights at the back.
-fn add_car(doc: &mut Doc, k: usize, car: &Car) -> Result<(), Error> {
+/// the front, emissive red tail lights at the back; a parked car's lenses are unlit.
+fn add_car(doc: &mut Doc, k: usize, car: &Car, st: &StreetStyle) -> Result<(), Error> {
     let dir = if car.oncoming { 1.0f32 } else { -1.0 }; // direction the car faces, along Z
     let (x, z) = (car.x, car.z);
     let paint = Material::paper(
@@ -612,7 +822,7 @@ fn add_car(doc: &mut Doc, k: usize, car: &Car) -> Result<(), Error> {
             Vec3::X * -dir * 0.1,
             Vec3::Y * 0.06,
         );
-        if !car.headlights {
+        if !car.headlights || car.parked {
             continue;
         }
         doc.add_light(&Light {
@@ -622,36 +832,61 @@ fn add_car(doc: &mut Doc, k: usize, car: &Car) -> Result<(), Error> {
                 outer: 0.4,
             },
             color: [1.0, 0.95, 0.85],
-            intensity: HEADLIGHT_INTENSITY,
+            intensity: st.headlight_intensity,
             position: Vec3::new(hx, 0.72, front + dir * 0.05),
             direction: Vec3::new(0.0, -0.03, dir),
         });
     }
-    doc.add_mesh(
-        &format!("car_{k}_headlamps"),
-        &heads,
-        &Material::emitter("headlamp_lens", [30.0, 28.5, 25.5]),
-    )?;
-    doc.add_mesh(
-        &format!("car_{k}_tail_lights"),
-        &tails,
-        &Material::emitter("tail_light", [6.0, 0.3, 0.15]),
-    )?;
+    let (head_lens, tail_lens) = if car.parked {
+        (
+            Material::paper(
+                "headlamp_glass",
+                PaperBsdf::Ggx { alpha: 0.02 },
+                [0.02; 3],
+                [0.3; 3],
+            ),
+            Material::paper(
+                "tail_light_off",
+                PaperBsdf::Ggx { alpha: 0.05 },
+                [0.12, 0.01, 0.01],
+                [0.1; 3],
+            ),
+        )
+    } else {
+        (
+            Material::emitter("headlamp_lens", [30.0, 28.5, 25.5]),
+            Material::emitter("tail_light", [6.0, 0.3, 0.15]),
+        )
+    };
+    doc.add_mesh(&format!("car_{k}_headlamps"), &heads, &head_lens)?;
+    doc.add_mesh(&format!("car_{k}_tail_lights"), &tails, &tail_lens)?;
     Ok(())
 }
 
-/// A traffic light on the right sidewalk at `z`, facing the driver: red lit (emissive lens
-/// plus a red spot light), amber and green dark.
-fn add_traffic_light(doc: &mut Doc, z: f32) -> Result<(), Error> {
-    let x = ROAD_HALF + KERB + 0.6;
+/// Traffic light `k` on a sidewalk, facing the driver: the lit signal has an emissive lens
+/// and a spot light, the other two lenses are dark. The first one keeps the shipped scenes'
+/// names (`traffic_light`, `signal_red`, ...); later ones get the index appended.
+fn add_traffic_light(
+    doc: &mut Doc,
+    k: usize,
+    t: &TrafficLight,
+    st: &StreetStyle,
+) -> Result<(), Error> {
+    let z = t.z;
+    let x = t.side * (st.road_half + st.kerb + 0.6);
+    let suffix = if k == 0 {
+        String::new()
+    } else {
+        format!("_{k}")
+    };
     let mut m = Mesh::new();
-    m.cylinder(Vec3::new(x, KERB, z), 0.07, 3.2, 12);
+    m.cylinder(Vec3::new(x, st.kerb, z), 0.07, 3.2, 12);
     m.cuboid(
         Vec3::new(x - 0.17, 3.2, z - 0.25),
         Vec3::new(x + 0.17, 4.2, z),
     );
     doc.add_mesh(
-        "traffic_light",
+        &format!("traffic_light{suffix}"),
         &m,
         &Material::paper(
             "traffic_light_housing",
@@ -660,28 +895,92 @@ fn add_traffic_light(doc: &mut Doc, z: f32) -> Result<(), Error> {
             [0.04; 3],
         ),
     )?;
+    // (signal, name, height, lit radiance, dark radiance, spot colour)
     let lenses = [
-        ("signal_red", 3.95, [40.0, 2.0, 0.8]),
-        ("signal_amber", 3.7, [0.15, 0.08, 0.0]),
-        ("signal_green", 3.45, [0.0, 0.12, 0.06]),
+        (
+            Signal::Red,
+            "red",
+            3.95,
+            [40.0, 2.0, 0.8],
+            [0.15, 0.0, 0.0],
+            [1.0, 0.05, 0.02],
+        ),
+        (
+            Signal::Amber,
+            "amber",
+            3.7,
+            [40.0, 16.0, 0.0],
+            [0.15, 0.08, 0.0],
+            [1.0, 0.4, 0.0],
+        ),
+        (
+            Signal::Green,
+            "green",
+            3.45,
+            [0.0, 30.0, 15.0],
+            [0.0, 0.12, 0.06],
+            [0.0, 1.0, 0.5],
+        ),
     ];
-    for (name, y, radiance) in lenses {
+    let mut lit_height = 3.95;
+    let mut spot_color = [1.0, 0.05, 0.02];
+    for (signal, name, y, lit, dark, color) in lenses {
+        let name = format!("signal_{name}{suffix}");
+        let radiance = if signal == t.signal {
+            lit_height = y;
+            spot_color = color;
+            lit
+        } else {
+            dark
+        };
         let mut q = Mesh::new();
         q.rect(Vec3::new(x, y, z + 0.002), Vec3::X * 0.1, Vec3::Y * 0.1);
-        doc.add_mesh(name, &q, &Material::emitter(name, radiance))?;
+        doc.add_mesh(&name, &q, &Material::emitter(&name, radiance))?;
     }
+    let light_name = match t.signal {
+        Signal::Red => "red",
+        Signal::Amber => "amber",
+        Signal::Green => "green",
+    };
     doc.add_light(&Light {
-        name: "signal_red_light".to_owned(),
+        name: format!("signal_{light_name}_light{suffix}"),
         kind: LightKind::Spot {
             inner: 0.3,
             outer: 0.7,
         },
-        color: [1.0, 0.05, 0.02],
-        intensity: SIGNAL_INTENSITY,
-        position: Vec3::new(x, 3.95, z + 0.06),
-        direction: Vec3::new(-0.05, -0.1, 1.0),
+        color: spot_color,
+        intensity: st.signal_intensity,
+        position: Vec3::new(x, lit_height, z + 0.06),
+        direction: Vec3::new(-0.05 * t.side, -0.1, 1.0),
     });
     Ok(())
+}
+
+/// Road signs: a grey post and a plate 2 cm in front of it, facing the driver (+Z).
+fn add_signs(doc: &mut Doc, signs: &[Sign], st: &StreetStyle) -> Result<(), Error> {
+    let mut posts = Mesh::new();
+    for (k, s) in signs.iter().enumerate() {
+        let x = s.side * (st.road_half + st.kerb + 0.4);
+        posts.cylinder(Vec3::new(x, st.kerb, s.z), 0.04, s.height + s.half, 8);
+        let mut plate = Mesh::new();
+        // rect(c, u, v) faces u x v = X x Y = +Z: towards the driver.
+        plate.rect(
+            Vec3::new(x, s.height, s.z + 0.06),
+            Vec3::X * s.half,
+            Vec3::Y * s.half,
+        );
+        let name = format!("sign_{k}");
+        let plate_material =
+            Material::paper(&name, PaperBsdf::Ggx { alpha: 0.25 }, s.color, [0.08; 3]);
+        doc.add_mesh(&name, &plate, &plate_material)?;
+    }
+    let metal = Material::paper(
+        "sign_post",
+        PaperBsdf::Ggx { alpha: 0.3 },
+        [0.15; 3],
+        [0.05; 3],
+    );
+    doc.add_mesh("sign_posts", &posts, &metal)
 }
 
 #[cfg(test)]

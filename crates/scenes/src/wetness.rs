@@ -68,22 +68,44 @@ fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
     t * t * (3.0 - 2.0 * t)
 }
 
+/// How wet a road is: the global wetness and the lanes whose wheel tracks are drier.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Wetness {
+    /// Global wetness in [0, 1]: 0.5 is the shipped streets' balance; 1 floods the road
+    /// (puddles everywhere but the wheel tracks), 0 leaves only the gutters wet.
+    pub level: f32,
+    /// Number of lanes across the road (equal widths).
+    pub lanes: u32,
+}
+
+impl Wetness {
+    /// The shipped streets' wetness: two lanes, level 0.5.
+    pub const SHIPPED: Self = Self {
+        level: 0.5,
+        lanes: 2,
+    };
+}
+
 /// Dryness w in [0, 1] at road position (x across, z along; metres) for a road of half
-/// width `half_width` with two lanes (centres at +-half_width/2).
-pub fn dryness(x: f32, z: f32, half_width: f32, seed: u32) -> f32 {
+/// width `half_width` with `wet.lanes` equal lanes.
+pub fn dryness(x: f32, z: f32, half_width: f32, seed: u32, wet: Wetness) -> f32 {
     let n = 0.6 * value_noise(x / 2.5, z / 4.0, seed)
         + 0.3 * value_noise(x / 1.0, z / 1.4, seed.wrapping_add(1))
         + 0.1 * value_noise(x / 0.35, z / 0.35, seed.wrapping_add(2));
     // Wheel tracks 0.8 m either side of each lane centre are drier.
-    let lane = half_width * 0.5;
-    let track_dist = [-lane - 0.8, -lane + 0.8, lane - 0.8, lane + 0.8]
-        .iter()
+    let lanes = wet.lanes.max(1);
+    let lane_width = 2.0 * half_width / lanes as f32;
+    let track_dist = (0..lanes)
+        .map(|k| -half_width + (k as f32 + 0.5) * lane_width)
+        .flat_map(|c| [c - 0.8, c + 0.8])
         .map(|t| (x - t).abs())
         .fold(f32::INFINITY, f32::min);
     let track = (-(track_dist / 0.35).powi(2)).exp();
     // Water collects in the gutters along the kerbs.
     let gutter = (-((half_width - x.abs()) / 0.6).powi(2)).exp();
-    let s = n + 0.22 * track - 0.3 * gutter;
+    // Wetness shifts the noise against the fixed thresholds below (no shift at 0.5).
+    let shift = 0.5 * (0.5 - wet.level.clamp(0.0, 1.0));
+    let s = n + 0.22 * track - 0.3 * gutter + shift;
     WET_ROAD_W * smoothstep(0.33, 0.37, s) + (1.0 - WET_ROAD_W) * smoothstep(0.56, 0.8, s)
 }
 
@@ -96,23 +118,79 @@ pub fn dryness_png(
     z_far: f32,
     (w, h): (u32, u32),
     seed: u32,
+    wet: Wetness,
 ) -> Result<(Vec<u8>, f32, f32), Error> {
     let mut img = RgbImage::new(w, h);
     let (mut puddle, mut dry) = (0usize, 0usize);
     for (i, j, p) in img.enumerate_pixels_mut() {
         let x = -half_width + (i as f32 + 0.5) / w as f32 * 2.0 * half_width;
         let z = z_near - (j as f32 + 0.5) / h as f32 * (z_near - z_far);
-        let d = dryness(x, z, half_width, seed);
+        let d = dryness(x, z, half_width, seed, wet);
         puddle += usize::from(d < 0.05);
         dry += usize::from(d > 0.6);
         p.0 = [0, (d * 255.0).round() as u8, 0];
     }
+    let n = (w * h) as f32;
+    Ok((encode_rgb_png(&img)?, puddle as f32 / n, dry as f32 / n))
+}
+
+fn encode_rgb_png(img: &RgbImage) -> Result<Vec<u8>, Error> {
     let mut png = Vec::new();
     image::codecs::png::PngEncoder::new(&mut png)
-        .write_image(img.as_raw(), w, h, image::ExtendedColorType::Rgb8)
+        .write_image(
+            img.as_raw(),
+            img.width(),
+            img.height(),
+            image::ExtendedColorType::Rgb8,
+        )
         .map_err(|e| Error::Texture(e.to_string()))?;
-    let n = (w * h) as f32;
-    Ok((png, puddle as f32 / n, dry as f32 / n))
+    Ok(png)
+}
+
+/// Texels across the square ripple normal map.
+pub const RIPPLE_TEXELS: u32 = 256;
+
+/// A tiling tangent-space normal map of rain ripples (`size` x `size` texels, glTF's
+/// convention: RGB = (n + 1) / 2 with +X along u, +Y along v and +Z out of the surface).
+/// The height field is three octaves of tiling value noise, from ripples a quarter of the
+/// tile across down to a sixteenth; its slopes are normalised so that the steepest texel
+/// has slope 1 before `normalTexture.scale` (the ripples' strength) scales X and Y.
+pub fn ripple_normal_png(size: u32, seed: u32) -> Result<Vec<u8>, Error> {
+    let n = size.max(8);
+    let height = |i: i64, j: i64| -> f32 {
+        let (x, y) = (
+            i.rem_euclid(i64::from(n)) as f32,
+            j.rem_euclid(i64::from(n)) as f32,
+        );
+        [(4, 0.6f32), (8, 0.3), (16, 0.1)]
+            .into_iter()
+            .enumerate()
+            .map(|(o, (cells, amp))| {
+                let s = cells as f32 / n as f32;
+                amp * tiling_noise(x * s, y * s, (cells, cells), seed.wrapping_add(o as u32))
+            })
+            .sum()
+    };
+    let mut slopes = Vec::with_capacity((n * n) as usize);
+    let mut steepest = 0.0f32;
+    for j in 0..i64::from(n) {
+        for i in 0..i64::from(n) {
+            let dx = 0.5 * (height(i + 1, j) - height(i - 1, j));
+            let dy = 0.5 * (height(i, j + 1) - height(i, j - 1));
+            steepest = steepest.max(dx.hypot(dy));
+            slopes.push((dx, dy));
+        }
+    }
+    let k = if steepest > 0.0 { 1.0 / steepest } else { 0.0 };
+    let img = RgbImage::from_fn(n, n, |i, j| {
+        let (dx, dy) = slopes[(j * n + i) as usize];
+        // Image rows run down while v runs up the texture in glTF's tangent frame only by
+        // convention of the map; the ripples are isotropic, so the sign does not matter.
+        let v = glam::Vec3::new(-dx * k, -dy * k, 1.0).normalize();
+        let enc = |c: f32| ((c * 0.5 + 0.5) * 255.0).round().clamp(0.0, 255.0) as u8;
+        image::Rgb([enc(v.x), enc(v.y), enc(v.z)])
+    });
+    encode_rgb_png(&img)
 }
 
 #[cfg(test)]
@@ -134,7 +212,8 @@ mod tests {
 
     #[test]
     fn road_has_puddles_wet_and_dry_patches() {
-        let (png, puddle, dry) = dryness_png(3.5, 10.0, -60.0, (64, 512), 4).unwrap();
+        let (png, puddle, dry) =
+            dryness_png(3.5, 10.0, -60.0, (64, 512), 4, Wetness::SHIPPED).unwrap();
         assert!(puddle > 0.03 && puddle < 0.4, "puddles {puddle}");
         assert!(dry > 0.03 && dry < 0.5, "dry {dry}");
         let img = image::load_from_memory(&png).unwrap().to_rgb8();
@@ -143,10 +222,59 @@ mod tests {
         // Gutters are wetter than wheel tracks on average.
         let mean_at = |x: f32| {
             (0..400)
-                .map(|k| dryness(x, -k as f32 * 0.15, 3.5, 4))
+                .map(|k| dryness(x, -k as f32 * 0.15, 3.5, 4, Wetness::SHIPPED))
                 .sum::<f32>()
                 / 400.0
         };
         assert!(mean_at(3.4) < mean_at(2.55));
+    }
+
+    #[test]
+    fn wetness_moves_puddles_and_dry_patches() {
+        let share = |level: f32| {
+            let wet = Wetness { level, lanes: 3 };
+            let (_, puddle, dry) = dryness_png(5.0, 10.0, -60.0, (64, 512), 9, wet).unwrap();
+            (puddle, dry)
+        };
+        let (soaked, damp, drying) = (share(0.9), share(0.5), share(0.1));
+        assert!(
+            soaked.0 > damp.0 && damp.0 > drying.0,
+            "{soaked:?} {damp:?} {drying:?}"
+        );
+        assert!(
+            soaked.1 < damp.1 && damp.1 < drying.1,
+            "{soaked:?} {damp:?} {drying:?}"
+        );
+    }
+
+    #[test]
+    fn ripple_map_tiles_and_is_unit_normals() {
+        let png = ripple_normal_png(64, 3).unwrap();
+        let img = image::load_from_memory(&png).unwrap().to_rgb8();
+        assert_eq!(img.dimensions(), (64, 64));
+        let dec = |p: &image::Rgb<u8>| p.0.map(|c| f32::from(c) / 255.0 * 2.0 - 1.0);
+        let mut tilted = 0;
+        for p in img.pixels() {
+            let [x, y, z] = dec(p);
+            assert!(
+                (x * x + y * y + z * z - 1.0).abs() < 0.03 && z > 0.5,
+                "{:?}",
+                p.0
+            );
+            tilted += usize::from(x.hypot(y) > 0.2);
+        }
+        assert!(tilted > 64, "only {tilted} tilted texels");
+        // The map wraps: the first and last columns differ as little as neighbours do.
+        let step = |a: (u32, u32), b: (u32, u32)| {
+            let (p, q) = (dec(img.get_pixel(a.0, a.1)), dec(img.get_pixel(b.0, b.1)));
+            (0..3).map(|c| (p[c] - q[c]).abs()).fold(0.0f32, f32::max)
+        };
+        let seam = (0..64)
+            .map(|j| step((63, j), (0, j)))
+            .fold(0.0f32, f32::max);
+        let inner = (0..64)
+            .map(|j| step((31, j), (32, j)))
+            .fold(0.0f32, f32::max);
+        assert!(seam < 2.0 * inner + 0.05, "seam {seam} inner {inner}");
     }
 }

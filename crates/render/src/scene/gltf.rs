@@ -51,6 +51,10 @@ struct StreaksExtras {
     alpha_dry: Option<f32>,
     #[serde(default)]
     ks_dry: Option<[f32; 3]>,
+    /// Marks the road surface (the dataset's road mask); no effect on shading.
+    #[serde(default)]
+    #[allow(dead_code)]
+    road: bool,
 }
 
 #[derive(Clone, Copy, Debug, Deserialize)]

@@ -1,0 +1,1075 @@
+//! The procedural night-street generator: varied rainy streets for stereo datasets, each
+//! reproducible from `(config, seed, index)` alone.
+//!
+//! A [`GeneratorConfig`] (TOML; [`GeneratorConfig::default`] is the documented default, and
+//! `config/default.toml` beside this crate is the same file with comments) gives a range for
+//! every parameter of a [`Street`]: the road's lanes and widths, kerbs and pavements, facades
+//! and their lit windows, street lamps (spacing, height, lens size, colour temperature,
+//! intensity), parked, leading and oncoming cars, traffic lights and signs, wetness (global
+//! level, the puddle map's wet and dry specular, ripples as a normal map), the stereo rig
+//! (height, lateral position, pitch, baseline, focal length) and the PNG exposure.
+//!
+//! [`sample`] turns `(config, seed, index)` into a [`SampleScene`]: a glTF document named
+//! `scene`, the camera to render, the baseline and exposure, the street it belongs to and its
+//! split. Samples `index` of one street share everything but the rig's position along the
+//! road when `pairs_per_street > 1`, so the train/val/test split is by street. Random numbers
+//! come from ChaCha8 streams seeded by a hash of `(seed, street)` for the street and of
+//! `(seed, index)` for the rig, so changing one sample never moves another.
+
+use crate::street::{Car, Ripples, Sign, Signal, Street, StreetStyle, TrafficLight};
+use crate::Error;
+use glam::Vec3;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+use serde_json::json;
+use std::path::Path;
+
+/// The generator's version, written into datasets: it changes whenever the same
+/// `(config, seed, index)` would give a different scene.
+pub const GENERATOR_VERSION: &str = concat!(
+    "streaks-scenes ",
+    env!("CARGO_PKG_VERSION"),
+    " procedural/1"
+);
+
+/// A closed range `[min, max]` of a real parameter, written `[min, max]` in TOML.
+pub type Range = [f64; 2];
+
+/// A closed range of a count, written `[min, max]` in TOML.
+pub type CountRange = [u32; 2];
+
+/// The road, pavements and buildings.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct StreetConfig {
+    /// Number of lanes (the driver is in the rightmost; lanes left of the centre carry
+    /// oncoming traffic).
+    pub lanes: CountRange,
+    /// Lane width, metres.
+    pub lane_width: Range,
+    /// Kerb width and height, metres.
+    pub kerb: Range,
+    /// Pavement width from the kerb to the facades, metres.
+    pub pavement: Range,
+    /// Length of street modelled ahead of the driver, metres.
+    pub length: Range,
+    /// Length of one building block along the street, metres.
+    pub block_length: Range,
+    /// Height of a building block, metres.
+    pub block_height: Range,
+    /// Factor on the shipped facades' mean diffuse colours (brick, render, concrete).
+    pub facade_brightness: Range,
+    /// Share of the upper windows that are lit.
+    pub lit_windows: Range,
+    /// Share of the lit windows that are cool (fluorescent, LED) rather than warm.
+    pub cool_windows: Range,
+    /// Share of the ground-floor shop windows that are lit.
+    pub lit_shops: Range,
+    /// Probability that the street has telephone poles.
+    pub poles: f64,
+}
+
+impl Default for StreetConfig {
+    fn default() -> Self {
+        Self {
+            lanes: [2, 4],
+            lane_width: [2.8, 3.7],
+            kerb: [0.1, 0.18],
+            pavement: [1.8, 4.5],
+            length: [90.0, 160.0],
+            block_length: [8.0, 25.0],
+            block_height: [6.0, 20.0],
+            facade_brightness: [0.6, 1.4],
+            lit_windows: [0.05, 0.45],
+            cool_windows: [0.0, 0.4],
+            lit_shops: [0.1, 0.8],
+            poles: 0.5,
+        }
+    }
+}
+
+/// The street lamps.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct LampConfig {
+    /// Distance between lamps on one side, metres.
+    pub spacing: Range,
+    /// Height of the light above the road, metres.
+    pub height: Range,
+    /// Half size of the lens across the road, metres (along the road it is half of that).
+    pub lens: Range,
+    /// Correlated colour temperature, kelvin (about 2000 for high-pressure sodium, 3000 to
+    /// 5000 for LED lamps).
+    pub temperature: Range,
+    /// Radiant intensity, W/sr (written to the glTF in candela).
+    pub intensity: Range,
+    /// Probability of lamps on both sides (staggered) rather than on the right only.
+    pub both_sides: f64,
+}
+
+impl Default for LampConfig {
+    fn default() -> Self {
+        Self {
+            spacing: [20.0, 40.0],
+            height: [5.0, 9.0],
+            lens: [0.12, 0.35],
+            temperature: [1900.0, 5000.0],
+            intensity: [120.0, 600.0],
+            both_sides: 0.6,
+        }
+    }
+}
+
+/// Cars and their lights.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct CarConfig {
+    /// Parked cars along the kerbs, lights off.
+    pub parked: CountRange,
+    /// Cars ahead in the driver's direction: tail lights on, headlights on.
+    pub ahead: CountRange,
+    /// Oncoming cars: headlights (spot lights) on.
+    pub oncoming: CountRange,
+    /// Headlight radiant intensity on axis, W/sr.
+    pub headlight_intensity: Range,
+}
+
+impl Default for CarConfig {
+    fn default() -> Self {
+        Self {
+            parked: [0, 6],
+            ahead: [0, 2],
+            oncoming: [0, 2],
+            headlight_intensity: [10.0, 40.0],
+        }
+    }
+}
+
+/// Traffic lights and road signs.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TrafficConfig {
+    /// Traffic lights (red, amber or green at random).
+    pub traffic_lights: CountRange,
+    /// Signal radiant intensity on axis, W/sr.
+    pub signal_intensity: Range,
+    /// Road signs on posts.
+    pub signs: CountRange,
+}
+
+impl Default for TrafficConfig {
+    fn default() -> Self {
+        Self {
+            traffic_lights: [0, 2],
+            signal_intensity: [30.0, 90.0],
+            signs: [0, 4],
+        }
+    }
+}
+
+/// Wetness of the road.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct WetnessConfig {
+    /// Global wetness in [0, 1]: 0.5 is the shipped streets' balance of puddles, wet
+    /// asphalt and drier patches; 1 floods the road.
+    pub level: Range,
+    /// Asphalt diffuse reflectance.
+    pub asphalt_kd: Range,
+    /// Specular reflectance of standing water (the puddle map's w = 0).
+    pub ks_wet: Range,
+    /// GGX alpha of standing water.
+    pub alpha_wet: Range,
+    /// Specular reflectance of dry asphalt (w = 1).
+    pub ks_dry: Range,
+    /// GGX alpha of dry asphalt.
+    pub alpha_dry: Range,
+    /// Probability that rain ripples the road (a normal map).
+    pub ripples: f64,
+    /// Ripple strength (`normalTexture.scale`: the steepest slope).
+    pub ripple_strength: Range,
+    /// Metres covered by one tile of the ripple map.
+    pub ripple_tile: Range,
+}
+
+impl Default for WetnessConfig {
+    fn default() -> Self {
+        Self {
+            level: [0.3, 0.9],
+            asphalt_kd: [0.03, 0.07],
+            ks_wet: [0.06, 0.12],
+            alpha_wet: [0.01, 0.04],
+            ks_dry: [0.03, 0.05],
+            alpha_dry: [0.25, 0.45],
+            ripples: 0.4,
+            ripple_strength: [0.05, 0.25],
+            ripple_tile: [0.6, 2.0],
+        }
+    }
+}
+
+/// The stereo rig (its centre is the glTF camera `driver`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RigConfig {
+    /// Height of the rig above the road, metres.
+    pub height: Range,
+    /// Offset from the driver's lane centre to the right, metres.
+    pub lateral: Range,
+    /// Pitch below the horizon, degrees.
+    pub pitch_deg: Range,
+    /// Stereo baseline, metres.
+    pub baseline: Range,
+    /// Focal length as a 35 mm-equivalent (24 mm image height), mm: the vertical field of
+    /// view is `2 atan(12 / f)`.
+    pub focal_mm35: Range,
+    /// Distance between the rigs of consecutive pairs of one street, metres.
+    pub pair_spacing: f64,
+}
+
+impl Default for RigConfig {
+    fn default() -> Self {
+        Self {
+            height: [1.1, 1.7],
+            lateral: [-0.5, 0.3],
+            pitch_deg: [0.0, 4.0],
+            baseline: [0.1, 0.4],
+            focal_mm35: [24.0, 45.0],
+            pair_spacing: 7.0,
+        }
+    }
+}
+
+/// The PNG exposure.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ExposureConfig {
+    /// Exposure of the 8-bit images, stops.
+    pub ev: Range,
+}
+
+impl Default for ExposureConfig {
+    fn default() -> Self {
+        Self { ev: [-0.5, 1.5] }
+    }
+}
+
+/// Shares of the streets in each split.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SplitConfig {
+    /// Training share.
+    pub train: f64,
+    /// Validation share.
+    pub val: f64,
+    /// Test share.
+    pub test: f64,
+}
+
+impl Default for SplitConfig {
+    fn default() -> Self {
+        Self {
+            train: 0.8,
+            val: 0.1,
+            test: 0.1,
+        }
+    }
+}
+
+/// How samples group into streets and splits.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct DatasetConfig {
+    /// Consecutive samples rendered from one street (the rig moves along the road).
+    pub pairs_per_street: u32,
+    /// Shares of the streets in the train, val and test splits.
+    pub split: SplitConfig,
+}
+
+impl Default for DatasetConfig {
+    fn default() -> Self {
+        Self {
+            pairs_per_street: 1,
+            split: SplitConfig::default(),
+        }
+    }
+}
+
+/// The generator's configuration: a range for every parameter. Every table and key is
+/// optional in the TOML file; what is left out keeps its default.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct GeneratorConfig {
+    /// Road, pavements and buildings.
+    pub street: StreetConfig,
+    /// Street lamps.
+    pub lamps: LampConfig,
+    /// Cars.
+    pub cars: CarConfig,
+    /// Traffic lights and signs.
+    pub traffic: TrafficConfig,
+    /// Wetness.
+    pub wetness: WetnessConfig,
+    /// The stereo rig.
+    pub rig: RigConfig,
+    /// PNG exposure.
+    pub exposure: ExposureConfig,
+    /// Streets and splits.
+    pub dataset: DatasetConfig,
+}
+
+/// The documented default config, with comments (the same values as
+/// [`GeneratorConfig::default`]; a test checks it).
+pub const DEFAULT_CONFIG_TOML: &str = include_str!("../config/default.toml");
+
+impl GeneratorConfig {
+    /// Parses a TOML config and checks its ranges; `origin` names the source in errors.
+    pub fn from_toml_str(text: &str, origin: &str) -> Result<Self, Error> {
+        let config: Self = toml::from_str(text).map_err(|e| Error::Config {
+            origin: origin.to_owned(),
+            reason: e.to_string(),
+        })?;
+        config.validate().map_err(|reason| Error::Config {
+            origin: origin.to_owned(),
+            reason,
+        })?;
+        Ok(config)
+    }
+
+    /// Reads and checks a TOML config file.
+    pub fn from_toml_file(path: &Path) -> Result<Self, Error> {
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::from_toml_str(&text, &path.display().to_string())
+    }
+
+    /// The config as TOML (every key, no comments).
+    pub fn to_toml(&self) -> String {
+        toml::to_string(self).unwrap_or_else(|e| format!("# cannot serialise the config: {e}\n"))
+    }
+
+    /// The config as JSON (for `dataset.json` and the samples' metadata).
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::to_value(self).unwrap_or(serde_json::Value::Null)
+    }
+
+    /// Checks every range (`min <= max`, finite, within physical bounds) and probability.
+    pub fn validate(&self) -> Result<(), String> {
+        let real = |name: &str, r: Range, lo: f64, hi: f64| -> Result<(), String> {
+            if !(r[0].is_finite() && r[1].is_finite() && r[0] <= r[1]) {
+                return Err(format!(
+                    "{name} = {r:?} is not a range [min, max] with min <= max"
+                ));
+            }
+            if r[0] < lo || r[1] > hi {
+                return Err(format!("{name} = {r:?} must lie within [{lo}, {hi}]"));
+            }
+            Ok(())
+        };
+        let count = |name: &str, r: CountRange, hi: u32| -> Result<(), String> {
+            if r[0] > r[1] || r[1] > hi {
+                return Err(format!(
+                    "{name} = {r:?} must be [min, max] with min <= max <= {hi}"
+                ));
+            }
+            Ok(())
+        };
+        let prob = |name: &str, p: f64| -> Result<(), String> {
+            if (0.0..=1.0).contains(&p) {
+                Ok(())
+            } else {
+                Err(format!("{name} = {p} must be a probability in [0, 1]"))
+            }
+        };
+        let s = &self.street;
+        count("street.lanes", s.lanes, 8)?;
+        if s.lanes[0] == 0 {
+            return Err("street.lanes must be at least 1".into());
+        }
+        real("street.lane_width", s.lane_width, 2.0, 6.0)?;
+        real("street.kerb", s.kerb, 0.02, 0.5)?;
+        real("street.pavement", s.pavement, 0.5, 20.0)?;
+        real("street.length", s.length, 30.0, 500.0)?;
+        real("street.block_length", s.block_length, 3.0, 200.0)?;
+        real("street.block_height", s.block_height, 2.5, 200.0)?;
+        real("street.facade_brightness", s.facade_brightness, 0.0, 3.0)?;
+        real("street.lit_windows", s.lit_windows, 0.0, 1.0)?;
+        real("street.cool_windows", s.cool_windows, 0.0, 1.0)?;
+        real("street.lit_shops", s.lit_shops, 0.0, 1.0)?;
+        prob("street.poles", s.poles)?;
+        let l = &self.lamps;
+        real("lamps.spacing", l.spacing, 5.0, 500.0)?;
+        real("lamps.height", l.height, 3.0, 20.0)?;
+        real("lamps.lens", l.lens, 0.02, 1.0)?;
+        real("lamps.temperature", l.temperature, 1000.0, 15000.0)?;
+        real("lamps.intensity", l.intensity, 0.0, 1e6)?;
+        prob("lamps.both_sides", l.both_sides)?;
+        let c = &self.cars;
+        count("cars.parked", c.parked, 40)?;
+        count("cars.ahead", c.ahead, 8)?;
+        count("cars.oncoming", c.oncoming, 8)?;
+        real("cars.headlight_intensity", c.headlight_intensity, 0.0, 1e5)?;
+        let t = &self.traffic;
+        count("traffic.traffic_lights", t.traffic_lights, 8)?;
+        real("traffic.signal_intensity", t.signal_intensity, 0.0, 1e5)?;
+        count("traffic.signs", t.signs, 20)?;
+        let w = &self.wetness;
+        real("wetness.level", w.level, 0.0, 1.0)?;
+        real("wetness.asphalt_kd", w.asphalt_kd, 0.0, 1.0)?;
+        real("wetness.ks_wet", w.ks_wet, 0.0, 1.0)?;
+        real("wetness.alpha_wet", w.alpha_wet, 0.001, 1.0)?;
+        real("wetness.ks_dry", w.ks_dry, 0.0, 1.0)?;
+        real("wetness.alpha_dry", w.alpha_dry, 0.001, 1.0)?;
+        prob("wetness.ripples", w.ripples)?;
+        real("wetness.ripple_strength", w.ripple_strength, 0.0, 2.0)?;
+        real("wetness.ripple_tile", w.ripple_tile, 0.05, 20.0)?;
+        let r = &self.rig;
+        real("rig.height", r.height, 0.2, 10.0)?;
+        real("rig.lateral", r.lateral, -3.0, 3.0)?;
+        real("rig.pitch_deg", r.pitch_deg, -30.0, 30.0)?;
+        real("rig.baseline", r.baseline, 0.001, 5.0)?;
+        real("rig.focal_mm35", r.focal_mm35, 8.0, 400.0)?;
+        if !(r.pair_spacing.is_finite() && (0.0..=50.0).contains(&r.pair_spacing)) {
+            return Err(format!(
+                "rig.pair_spacing = {} must be in [0, 50]",
+                r.pair_spacing
+            ));
+        }
+        real("exposure.ev", self.exposure.ev, -20.0, 20.0)?;
+        let d = &self.dataset;
+        if d.pairs_per_street == 0 || d.pairs_per_street > 100 {
+            return Err(format!(
+                "dataset.pairs_per_street = {} must be in 1..=100",
+                d.pairs_per_street
+            ));
+        }
+        let sp = &d.split;
+        for (name, v) in [("train", sp.train), ("val", sp.val), ("test", sp.test)] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(format!("dataset.split.{name} = {v} must be a share >= 0"));
+            }
+        }
+        let sum = sp.train + sp.val + sp.test;
+        if (sum - 1.0).abs() > 1e-6 {
+            return Err(format!(
+                "dataset.split shares add up to {sum}, not 1 (train {}, val {}, test {})",
+                sp.train, sp.val, sp.test
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// A dataset split.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Split {
+    /// Training.
+    Train,
+    /// Validation.
+    Val,
+    /// Test (held back).
+    Test,
+}
+
+impl Split {
+    /// All splits, in file order.
+    pub const ALL: [Split; 3] = [Split::Train, Split::Val, Split::Test];
+
+    /// `train`, `val` or `test` (the names of `splits/*.txt`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Split::Train => "train",
+            Split::Val => "val",
+            Split::Test => "test",
+        }
+    }
+}
+
+impl std::fmt::Display for Split {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// One dataset sample's scene, ready to write and render.
+#[derive(Debug)]
+pub struct SampleScene {
+    /// The glTF document, named `scene` (`doc.write(dir)` writes `scene.gltf`, `scene.bin`
+    /// and `scene_*.png`).
+    pub doc: crate::doc::Doc,
+    /// The camera node to render: the stereo rig's centre.
+    pub camera: String,
+    /// Stereo baseline, metres.
+    pub baseline: f32,
+    /// Exposure of the 8-bit images, stops.
+    pub exposure_ev: f32,
+    /// The street this sample belongs to (`index / pairs_per_street`).
+    pub street: u64,
+    /// The street's split.
+    pub split: Split,
+    /// Every drawn parameter, for `meta.json`.
+    pub params: serde_json::Value,
+}
+
+/// Camera node name of generated streets.
+pub const CAMERA: &str = "driver";
+
+/// A 64-bit mix (SplitMix64's finaliser) of a seed, a stream tag and a number.
+fn mix(seed: u64, tag: u64, n: u64) -> u64 {
+    let mut z = seed
+        .wrapping_add(tag.wrapping_mul(0x9e37_79b9_7f4a_7c15))
+        .wrapping_add(n.wrapping_mul(0xbf58_476d_1ce4_e5b9));
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+const STREET_STREAM: u64 = 1;
+const RIG_STREAM: u64 = 2;
+const SPLIT_STREAM: u64 = 3;
+
+fn uniform(rng: &mut ChaCha8Rng, r: Range) -> f64 {
+    if r[1] > r[0] {
+        rng.random_range(r[0]..=r[1])
+    } else {
+        r[0]
+    }
+}
+
+fn count(rng: &mut ChaCha8Rng, r: CountRange) -> u32 {
+    rng.random_range(r[0]..=r[1])
+}
+
+/// Linear sRGB colour (max component 1) of a blackbody at `kelvin`: Kim et al.'s cubic
+/// spline for the Planckian locus in CIE 1931 xy (valid 1667 K to 25000 K), then XYZ to
+/// linear sRGB.
+pub fn blackbody_rgb(kelvin: f64) -> [f64; 3] {
+    let t = kelvin.clamp(1667.0, 25000.0);
+    let (t1, t2, t3) = (1e3 / t, 1e6 / (t * t), 1e9 / (t * t * t));
+    let x = if t <= 4000.0 {
+        -0.2661239 * t3 - 0.2343589 * t2 + 0.8776956 * t1 + 0.179910
+    } else {
+        -3.0258469 * t3 + 2.1070379 * t2 + 0.2226347 * t1 + 0.240390
+    };
+    let y = if t <= 2222.0 {
+        -1.1063814 * x.powi(3) - 1.34811020 * x * x + 2.18555832 * x - 0.20219683
+    } else if t <= 4000.0 {
+        -0.9549476 * x.powi(3) - 1.37418593 * x * x + 2.09137015 * x - 0.16748867
+    } else {
+        3.0817580 * x.powi(3) - 5.87338670 * x * x + 3.75112997 * x - 0.37001483
+    };
+    let (cx, cy, cz) = (x / y, 1.0, (1.0 - x - y) / y);
+    let rgb = [
+        3.2404542 * cx - 1.5371385 * cy - 0.4985314 * cz,
+        -0.969_266 * cx + 1.8760108 * cy + 0.0415560 * cz,
+        0.0556434 * cx - 0.2040259 * cy + 1.0572252 * cz,
+    ]
+    .map(|c: f64| c.max(0.0));
+    let peak = rgb[0].max(rgb[1]).max(rgb[2]);
+    rgb.map(|c| crate::doc::round7(c / peak))
+}
+
+/// Positions along the road from `start` towards `far` every `spacing` metres (at least
+/// `start` itself).
+fn along(start: f32, spacing: f32, far: f32) -> Vec<f32> {
+    let mut z = start;
+    let mut out = vec![start];
+    z -= spacing;
+    while z > far + 3.0 {
+        out.push(z);
+        z -= spacing;
+    }
+    out
+}
+
+/// Picks `n` positions in `[lo, hi]` (lo < hi <= 0) at least `gap` apart, or fewer if they
+/// do not fit after a bounded number of tries.
+fn spaced(rng: &mut ChaCha8Rng, n: u32, lo: f32, hi: f32, gap: f32) -> Vec<f32> {
+    let mut out: Vec<f32> = Vec::new();
+    let mut tries = 0;
+    while (out.len() as u32) < n && tries < 50 * (n + 1) && hi > lo {
+        tries += 1;
+        let z = rng.random_range(lo..=hi);
+        if out.iter().all(|o| (o - z).abs() >= gap) {
+            out.push(z);
+        }
+    }
+    out.sort_by(|a, b| b.total_cmp(a));
+    out
+}
+
+/// Builds sample `index` of the dataset `(config, seed)`.
+pub fn sample(config: &GeneratorConfig, seed: u64, index: u64) -> Result<SampleScene, Error> {
+    config.validate().map_err(|reason| Error::Config {
+        origin: "the generator config".into(),
+        reason,
+    })?;
+    let per_street = u64::from(config.dataset.pairs_per_street.max(1));
+    let street_id = index / per_street;
+    let pair_in_street = index % per_street;
+    let mut rng = ChaCha8Rng::seed_from_u64(mix(seed, STREET_STREAM, street_id));
+    let (street, mut params) = random_street(config, &mut rng, seed, street_id)?;
+    let mut rig_rng = ChaCha8Rng::seed_from_u64(mix(seed, RIG_STREAM, index));
+    let rig = &config.rig;
+    let height = uniform(&mut rig_rng, rig.height) as f32;
+    let lateral = uniform(&mut rig_rng, rig.lateral) as f32;
+    let pitch_deg = uniform(&mut rig_rng, rig.pitch_deg);
+    let baseline = uniform(&mut rig_rng, rig.baseline) as f32;
+    let focal = uniform(&mut rig_rng, rig.focal_mm35);
+    let yfov_deg = (2.0 * (12.0 / focal).atan()).to_degrees();
+    let exposure_ev = uniform(&mut rig_rng, config.exposure.ev) as f32;
+    let lane_centre = params["street"]["driver_lane_x"].as_f64().unwrap_or(0.0) as f32;
+    let eye = Vec3::new(
+        lane_centre + lateral,
+        height,
+        -(pair_in_street as f32) * rig.pair_spacing as f32,
+    );
+    let mut street = street;
+    street.style.eye = eye;
+    street.style.pitch_tan = pitch_deg.to_radians().tan() as f32;
+    street.style.yfov_deg = yfov_deg;
+    let doc = street.build()?;
+    let split = split_of(config, seed, street_id);
+    params["rig"] = json!({
+        "eye": eye.to_array(),
+        "height": height,
+        "lateral": lateral,
+        "pitch_deg": pitch_deg,
+        "baseline": baseline,
+        "focal_mm35": focal,
+        "yfov_deg": yfov_deg,
+        "pair_in_street": pair_in_street,
+    });
+    params["exposure_ev"] = json!(exposure_ev);
+    Ok(SampleScene {
+        doc,
+        camera: CAMERA.to_owned(),
+        baseline,
+        exposure_ev,
+        street: street_id,
+        split,
+        params,
+    })
+}
+
+/// The split of street `street_id`: a uniform number from `(seed, street)` against the
+/// config's cumulative shares.
+fn split_of(config: &GeneratorConfig, seed: u64, street_id: u64) -> Split {
+    let u = (mix(seed, SPLIT_STREAM, street_id) >> 11) as f64 / (1u64 << 53) as f64;
+    let sp = &config.dataset.split;
+    if u < sp.train {
+        Split::Train
+    } else if u < sp.train + sp.val {
+        Split::Val
+    } else {
+        Split::Test
+    }
+}
+
+/// Draws a street (everything but the rig) and its parameters as JSON.
+fn random_street(
+    config: &GeneratorConfig,
+    rng: &mut ChaCha8Rng,
+    seed: u64,
+    street_id: u64,
+) -> Result<(Street, serde_json::Value), Error> {
+    let sc = &config.street;
+    let lanes = count(rng, sc.lanes);
+    let lane_width = uniform(rng, sc.lane_width) as f32;
+    let road_half = lanes as f32 * lane_width * 0.5;
+    let kerb = uniform(rng, sc.kerb) as f32;
+    let pavement = uniform(rng, sc.pavement) as f32;
+    let facade_x = road_half + kerb + pavement;
+    let length = uniform(rng, sc.length) as f32;
+    let (near, far) = (10.0f32, -length);
+    // The driver keeps to the rightmost lane.
+    let driver_lane_x = road_half - 0.5 * lane_width;
+
+    // Lamps.
+    let lc = &config.lamps;
+    let spacing = uniform(rng, lc.spacing) as f32;
+    let lamp_height = uniform(rng, lc.height) as f32;
+    let lens = uniform(rng, lc.lens) as f32;
+    let temperature = uniform(rng, lc.temperature);
+    let lamp_intensity = uniform(rng, lc.intensity);
+    let both_sides = rng.random_bool(lc.both_sides);
+    // The first lamp lies within one spacing ahead, and always on the modelled street.
+    let first = -rng.random_range(3.0..=spacing.min(length - 5.0).max(3.5));
+    let lamps_right = along(first, spacing, far);
+    let lamps_left = if both_sides {
+        along(first - 0.5 * spacing, spacing, far)
+    } else {
+        Vec::new()
+    };
+    let lamp_color = blackbody_rgb(temperature);
+    let marker = 40.0 * lamp_intensity / 250.0;
+    let lens_radiance = lamp_color.map(|c| crate::doc::round7(c * marker));
+
+    // Cars: parked ones in the outer lanes by the kerbs, leading ones in the driver's lane,
+    // oncoming ones in the lanes left of the centre.
+    let cc = &config.cars;
+    let headlight_intensity = uniform(rng, cc.headlight_intensity);
+    let paint = |rng: &mut ChaCha8Rng| -> [f64; 3] {
+        const PAINTS: [[f64; 3]; 8] = [
+            [0.2, 0.02, 0.02],
+            [0.04, 0.06, 0.12],
+            [0.5, 0.5, 0.5],
+            [0.02, 0.02, 0.02],
+            [0.6, 0.6, 0.62],
+            [0.05, 0.12, 0.05],
+            [0.3, 0.22, 0.05],
+            [0.12, 0.12, 0.14],
+        ];
+        PAINTS[rng.random_range(0..PAINTS.len())]
+    };
+    let mut cars = Vec::new();
+    let n_parked = count(rng, cc.parked);
+    for side in [1.0f32, -1.0] {
+        let n_side = if side > 0.0 {
+            n_parked.div_ceil(2)
+        } else {
+            n_parked / 2
+        };
+        for z in spaced(rng, n_side, far + 15.0, -6.0, 6.0) {
+            cars.push(Car {
+                x: side * (road_half - 1.1),
+                z,
+                oncoming: rng.random_bool(0.5),
+                color: paint(rng),
+                headlights: false,
+                parked: true,
+            });
+        }
+    }
+    // Leading cars keep to the driver's lane centre (parked ones are at its kerb edge).
+    let ahead_x = driver_lane_x;
+    let n_ahead = count(rng, cc.ahead);
+    for z in spaced(rng, n_ahead, -70.0f32.max(far + 20.0), -12.0, 15.0) {
+        cars.push(Car {
+            x: ahead_x,
+            z,
+            oncoming: false,
+            color: paint(rng),
+            headlights: true,
+            parked: false,
+        });
+    }
+    if lanes >= 2 {
+        let oncoming_x = -road_half + 0.5 * lane_width;
+        let n_oncoming = count(rng, cc.oncoming);
+        for z in spaced(rng, n_oncoming, -100.0f32.max(far + 20.0), -15.0, 15.0) {
+            cars.push(Car {
+                x: oncoming_x,
+                z,
+                oncoming: true,
+                color: paint(rng),
+                headlights: true,
+                parked: false,
+            });
+        }
+    }
+
+    // Traffic lights and signs.
+    let tc = &config.traffic;
+    let signal_intensity = uniform(rng, tc.signal_intensity);
+    let n_traffic_lights = count(rng, tc.traffic_lights);
+    let traffic_lights: Vec<TrafficLight> = spaced(rng, n_traffic_lights, far + 20.0, -20.0, 20.0)
+        .into_iter()
+        .map(|z| TrafficLight {
+            z,
+            side: if rng.random_bool(0.75) { 1.0 } else { -1.0 },
+            signal: [Signal::Red, Signal::Amber, Signal::Green][rng.random_range(0..3)],
+        })
+        .collect();
+    let n_signs = count(rng, tc.signs);
+    let signs: Vec<Sign> = spaced(rng, n_signs, far + 10.0, -8.0, 6.0)
+        .into_iter()
+        .map(|z| {
+            const PLATES: [[f64; 3]; 4] = [
+                [0.6, 0.05, 0.04],
+                [0.03, 0.12, 0.45],
+                [0.7, 0.7, 0.68],
+                [0.7, 0.55, 0.03],
+            ];
+            Sign {
+                z,
+                side: if rng.random_bool(0.5) { 1.0 } else { -1.0 },
+                height: rng.random_range(2.0..=2.6),
+                half: rng.random_range(0.25..=0.4),
+                color: PLATES[rng.random_range(0..PLATES.len())],
+            }
+        })
+        .collect();
+
+    // Poles and buildings.
+    let poles = if rng.random_bool(sc.poles) {
+        along(-rng.random_range(4.0..=20.0), 25.0, far)
+    } else {
+        Vec::new()
+    };
+    let mut blocks = Vec::new();
+    let mut covered = 0.0f32;
+    while covered < near - far + 20.0 {
+        let len = uniform(rng, sc.block_length) as f32;
+        let h = uniform(rng, sc.block_height) as f32;
+        blocks.push((len, h));
+        covered += len;
+    }
+    let brightness = uniform(rng, sc.facade_brightness);
+    let facade_kd = StreetStyle::SHIPPED
+        .facade_kd
+        .map(|c| c.map(|k| crate::doc::round7((k * brightness).min(0.9))));
+    let lit = uniform(rng, sc.lit_windows) as f32;
+    let cool = uniform(rng, sc.cool_windows) as f32;
+    let lit_shops = uniform(rng, sc.lit_shops) as f32;
+
+    // Wetness.
+    let wc = &config.wetness;
+    let wetness = uniform(rng, wc.level) as f32;
+    let asphalt_kd = uniform(rng, wc.asphalt_kd);
+    let wet = (uniform(rng, wc.ks_wet), uniform(rng, wc.alpha_wet));
+    let dry = (uniform(rng, wc.ks_dry), uniform(rng, wc.alpha_dry));
+    let ripples = rng.random_bool(wc.ripples).then(|| Ripples {
+        strength: crate::doc::round7(uniform(rng, wc.ripple_strength)),
+        tile_m: uniform(rng, wc.ripple_tile) as f32,
+        seed: rng.random(),
+    });
+    let texture_seed: u32 = rng.random();
+    let along_texels = ((near - far) * 6.4).max(64.0) as u32;
+
+    let style = StreetStyle {
+        road_half,
+        lanes,
+        kerb,
+        facade_x,
+        lamp_height,
+        lamp_intensity,
+        lamp_color,
+        lens_half: (0.5 * lens, lens),
+        lens_radiance,
+        headlight_intensity,
+        signal_intensity,
+        wetness,
+        asphalt_kd,
+        wet,
+        dry,
+        ripples,
+        lit_windows: (lit * (1.0 - cool), lit),
+        lit_shops,
+        facade_kd,
+        ..StreetStyle::SHIPPED
+    };
+    let street = Street {
+        name: "scene",
+        description: format!(
+            "Procedural rainy night street {street_id} of seed {seed} ({GENERATOR_VERSION})"
+        ),
+        near,
+        far,
+        lamps_right: lamps_right.clone(),
+        lamps_left: lamps_left.clone(),
+        poles: poles.clone(),
+        cars: cars.clone(),
+        traffic_lights: traffic_lights.clone(),
+        signs: signs.clone(),
+        blocks: blocks.clone(),
+        windows: true,
+        seed: texture_seed,
+        texture: (64, along_texels.next_power_of_two().min(2048)),
+        style,
+    };
+    let params = json!({
+        "generator": GENERATOR_VERSION,
+        "street_id": street_id,
+        "street": {
+            "lanes": lanes,
+            "lane_width": lane_width,
+            "road_half_width": road_half,
+            "kerb": kerb,
+            "pavement": pavement,
+            "length": length,
+            "driver_lane_x": driver_lane_x,
+            "blocks": blocks.iter().map(|b| [b.0, b.1]).collect::<Vec<_>>(),
+            "facade_brightness": brightness,
+            "lit_windows": lit,
+            "cool_windows": cool,
+            "lit_shops": lit_shops,
+            "poles": poles,
+        },
+        "lamps": {
+            "spacing": spacing,
+            "height": lamp_height,
+            "lens_half_size": lens,
+            "temperature_k": temperature,
+            "color": lamp_color,
+            "intensity_w_sr": lamp_intensity,
+            "right": lamps_right,
+            "left": lamps_left,
+        },
+        "cars": cars.iter().map(|c| json!({
+            "x": c.x,
+            "z": c.z,
+            "kind": if c.parked { "parked" } else if c.oncoming { "oncoming" } else { "ahead" },
+            "color": c.color,
+        })).collect::<Vec<_>>(),
+        "headlight_intensity_w_sr": headlight_intensity,
+        "traffic_lights": traffic_lights.iter().map(|t| json!({
+            "z": t.z, "side": t.side, "signal": t.signal,
+        })).collect::<Vec<_>>(),
+        "signal_intensity_w_sr": signal_intensity,
+        "signs": signs.iter().map(|s| json!({
+            "z": s.z, "side": s.side, "height": s.height, "half_size": s.half, "color": s.color,
+        })).collect::<Vec<_>>(),
+        "wetness": {
+            "level": wetness,
+            "asphalt_kd": asphalt_kd,
+            "ks_wet": wet.0,
+            "alpha_wet": wet.1,
+            "ks_dry": dry.0,
+            "alpha_dry": dry.1,
+            "ripples": ripples.map(|r| json!({"strength": r.strength, "tile_m": r.tile_m})),
+        },
+    });
+    Ok((street, params))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn default_toml_is_the_default_config() {
+        let parsed = GeneratorConfig::from_toml_str(DEFAULT_CONFIG_TOML, "default.toml").unwrap();
+        assert_eq!(parsed, GeneratorConfig::default());
+        // And the serialised form reads back.
+        let again = GeneratorConfig::from_toml_str(&parsed.to_toml(), "again").unwrap();
+        assert_eq!(again, parsed);
+    }
+
+    #[test]
+    fn partial_configs_keep_defaults_and_bad_ones_say_why() {
+        let c = GeneratorConfig::from_toml_str("[lamps]\nspacing = [30, 30]\n", "x.toml").unwrap();
+        assert_eq!(c.lamps.spacing, [30.0, 30.0]);
+        assert_eq!(c.street, StreetConfig::default());
+        for (text, needle) in [
+            ("[lamps]\nspacing = [40, 30]\n", "lamps.spacing"),
+            ("[lamps]\nspacng = [30, 40]\n", "spacng"),
+            ("[dataset.split]\ntrain = 0.5\n", "add up"),
+            ("[street]\nlanes = [0, 2]\n", "street.lanes"),
+            ("[wetness]\nripples = 1.5\n", "wetness.ripples"),
+            ("not toml at all", "x.toml"),
+        ] {
+            let e = GeneratorConfig::from_toml_str(text, "x.toml")
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(needle) && e.contains("x.toml"), "{text:?}: {e}");
+        }
+    }
+
+    #[test]
+    fn samples_are_reproducible_and_independent() {
+        let config = GeneratorConfig::default();
+        let gltf = |seed, index| {
+            let s = sample(&config, seed, index).unwrap();
+            let dir = tempfile::tempdir().unwrap();
+            let files = s.doc.write(dir.path()).unwrap();
+            files
+                .iter()
+                .map(|f| std::fs::read(f).unwrap())
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(gltf(7, 3), gltf(7, 3));
+        assert_ne!(gltf(7, 3), gltf(7, 4));
+        assert_ne!(gltf(7, 3), gltf(8, 3));
+    }
+
+    #[test]
+    fn streets_vary_over_the_documented_ranges() {
+        let config = GeneratorConfig::default();
+        let (mut lanes, mut ripples, mut parked, mut signals) = (
+            std::collections::BTreeSet::new(),
+            0,
+            0,
+            std::collections::BTreeSet::new(),
+        );
+        let mut baselines = Vec::new();
+        for i in 0..40 {
+            let mut rng = ChaCha8Rng::seed_from_u64(mix(1, STREET_STREAM, i));
+            let (street, p) = random_street(&config, &mut rng, 1, i).unwrap();
+            let lights = street.lamps_right.len()
+                + street.lamps_left.len()
+                + street.traffic_lights.len()
+                + 2 * street.cars.iter().filter(|c| !c.parked).count();
+            let mut rig_rng = ChaCha8Rng::seed_from_u64(mix(1, RIG_STREAM, i));
+            let baseline = uniform(&mut rig_rng, config.rig.baseline) as f32;
+            lanes.insert(p["street"]["lanes"].as_u64().unwrap());
+            ripples += usize::from(!p["wetness"]["ripples"].is_null());
+            parked += p["cars"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .filter(|c| c["kind"] == "parked")
+                .count();
+            for t in p["traffic_lights"].as_array().unwrap() {
+                signals.insert(t["signal"].as_str().unwrap().to_owned());
+            }
+            baselines.push(baseline);
+            assert!((0.1..=0.4).contains(&baseline));
+            let t = p["lamps"]["temperature_k"].as_f64().unwrap();
+            assert!((1900.0..=5000.0).contains(&t));
+            assert!(lights >= 2, "street {i}: {lights} lights");
+        }
+        assert_eq!(lanes.len(), 3, "{lanes:?}");
+        assert!(
+            ripples > 5 && ripples < 35,
+            "{ripples} rippled streets of 40"
+        );
+        assert!(parked > 20, "{parked} parked cars in 40 streets");
+        assert_eq!(signals.len(), 3, "{signals:?}");
+        let spread = baselines.iter().fold(0.0f32, |m, b| m.max(*b))
+            - baselines.iter().fold(1.0f32, |m, b| m.min(*b));
+        assert!(spread > 0.2, "baselines spread {spread}");
+    }
+
+    #[test]
+    fn pairs_of_a_street_share_it_and_its_split() {
+        let mut config = GeneratorConfig::default();
+        config.dataset.pairs_per_street = 3;
+        let a = sample(&config, 5, 3).unwrap();
+        let b = sample(&config, 5, 5).unwrap();
+        let c = sample(&config, 5, 6).unwrap();
+        assert_eq!((a.street, b.street, c.street), (1, 1, 2));
+        assert_eq!(a.split, b.split);
+        assert_eq!(a.params["street"], b.params["street"]);
+        assert_eq!(a.params["lamps"], b.params["lamps"]);
+        assert_ne!(a.params["rig"], b.params["rig"]);
+    }
+
+    #[test]
+    fn splits_follow_the_shares() {
+        let config = GeneratorConfig::default();
+        let mut n = [0usize; 3];
+        for index in 0..300u64 {
+            let split = split_of(&config, 9, index);
+            n[Split::ALL.iter().position(|s| *s == split).unwrap()] += 1;
+        }
+        // 80/10/10 of 300: binomial standard deviations about 7 and 5.
+        assert!(n[0] > 210 && n[0] < 270, "{n:?}");
+        assert!(n[1] > 12 && n[2] > 12, "{n:?}");
+    }
+
+    #[test]
+    fn blackbody_colours_run_from_orange_to_white() {
+        let sodium = blackbody_rgb(2000.0);
+        let led = blackbody_rgb(4000.0);
+        let d65 = blackbody_rgb(6500.0);
+        assert_eq!(sodium[0], 1.0);
+        assert!(sodium[2] < 0.15 && sodium[1] < 0.6, "{sodium:?}");
+        assert!(led[2] > sodium[2] && led[1] > sodium[1], "{led:?}");
+        assert!(d65.iter().all(|&c| c > 0.85), "{d65:?}");
+    }
+}
