@@ -1,12 +1,25 @@
 //! `streaks locus`: the locus of the virtual light `L_virtual` (Eq. 4) for ground points
 //! between a viewer and a point light (the `h_X = 0` family of the paper's proof), with the
-//! angular disparity a stereo rig at the viewer sees, as CSV or JSON on standard output.
+//! angular disparity a stereo rig at the viewer sees, as CSV or JSON on standard output; or,
+//! with `--model centre`, the streak-centre model at the same ground depths (each eye's
+//! brightest point of the row and their disparity, beside Eq. 4's).
 
 use anyhow::{Context, Result};
 use glam::DVec3;
 use serde::Serialize;
 use std::io::Write;
+use streaks_analysis::centre::CentreModel;
 use streaks_analysis::model::ColumnModel;
+use streaks_stereo::rig::RoadRig;
+
+/// Which model to print.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Model {
+    /// Eq. 4's virtual lights (the `h_X = 0` family).
+    Eq4,
+    /// The streak-centre model: the brightest point of each row in each eye.
+    Centre,
+}
 
 /// Output format.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -40,6 +53,11 @@ pub struct Args {
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Csv)]
     pub format: Format,
+    /// The model: `eq4` (columns ground_x, ground_z, virtual_x/y/z, tilt_deg, elevation_deg,
+    /// disparity_deg) or `centre` (ground_z, left_x, right_x, tilt_deg, elevation_deg,
+    /// disparity_deg, plane_offset, eq4_disparity_deg).
+    #[arg(long, value_enum, default_value_t = Model::Eq4)]
+    pub model: Model,
 }
 
 /// Parses "X,Y,Z" into a point.
@@ -75,9 +93,93 @@ struct Row {
     disparity_deg: f64,
 }
 
+/// One output line of `--model centre`.
+#[derive(Serialize, Debug)]
+struct CentreLine {
+    /// Ground depth Z of the row.
+    ground_z: f64,
+    /// The left eye's brightest point of the row, X.
+    left_x: f64,
+    /// The right eye's, X.
+    right_x: f64,
+    /// Angle of the left peak's h from vertical.
+    tilt_deg: f64,
+    /// Elevation below the horizon of the left peak seen from the viewer.
+    elevation_deg: f64,
+    /// Angular disparity of the streak centre (left azimuth of the left peak minus right
+    /// azimuth of the right peak).
+    disparity_deg: f64,
+    /// Distance of the left peak from the plane through the left eye and the light's
+    /// vertical line, metres.
+    plane_offset: f64,
+    /// Eq. 4's angular disparity at the same depth.
+    eq4_disparity_deg: f64,
+}
+
+/// Writes `rows` as JSON or as CSV with `header` and `fields` per row.
+fn write_rows<T: Serialize>(
+    format: Format,
+    rows: &[T],
+    header: &str,
+    fields: impl Fn(&T) -> Vec<f64>,
+) -> Result<()> {
+    let mut out = std::io::stdout().lock();
+    match format {
+        Format::Json => {
+            serde_json::to_writer_pretty(&mut out, rows).context("writing JSON")?;
+            writeln!(out)?;
+        }
+        Format::Csv => {
+            writeln!(out, "{header}")?;
+            for r in rows {
+                let line: Vec<String> = fields(r).iter().map(f64::to_string).collect();
+                writeln!(out, "{}", line.join(","))?;
+            }
+        }
+    }
+    out.flush().context("writing standard output")?;
+    Ok(())
+}
+
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
     let model = ColumnModel::new(args.light, args.viewer).context("invalid --light/--viewer")?;
+    if args.model == Model::Centre {
+        let rig = RoadRig::level(args.viewer, 1.0, args.baseline).context("invalid --baseline")?;
+        let centre = CentreModel::new(args.light, rig).context("invalid --light/--viewer")?;
+        let rows: Vec<CentreLine> = centre
+            .rows(args.max_tilt, args.samples)
+            .context("cannot compute the streak-centre model")?
+            .into_iter()
+            .map(|r| CentreLine {
+                ground_z: r.ground_z,
+                left_x: r.left_x,
+                right_x: r.right_x,
+                tilt_deg: r.tilt_deg,
+                elevation_deg: r.elevation_deg,
+                disparity_deg: r.disparity_deg,
+                plane_offset: r.plane_offset,
+                eq4_disparity_deg: r.eq4_disparity_deg,
+            })
+            .collect();
+        return write_rows(
+            args.format,
+            &rows,
+            "ground_z,left_x,right_x,tilt_deg,elevation_deg,disparity_deg,plane_offset,eq4_disparity_deg",
+            |r| {
+                vec![
+                    r.ground_z,
+                    r.left_x,
+                    r.right_x,
+                    r.tilt_deg,
+                    r.elevation_deg,
+                    r.disparity_deg,
+                    r.plane_offset,
+                    r.eq4_disparity_deg,
+                ]
+            },
+        );
+    }
     let points = model
         .locus_profile(args.max_tilt, args.samples, args.baseline)
         .context("cannot compute the locus")?;
@@ -97,35 +199,23 @@ pub fn run(args: Args) -> Result<()> {
             }
         })
         .collect();
-    let mut out = std::io::stdout().lock();
-    match args.format {
-        Format::Json => {
-            serde_json::to_writer_pretty(&mut out, &rows).context("writing JSON")?;
-            writeln!(out)?;
-        }
-        Format::Csv => {
-            writeln!(
-                out,
-                "ground_x,ground_z,virtual_x,virtual_y,virtual_z,tilt_deg,elevation_deg,disparity_deg"
-            )?;
-            for r in &rows {
-                writeln!(
-                    out,
-                    "{},{},{},{},{},{},{},{}",
-                    r.ground_x,
-                    r.ground_z,
-                    r.virtual_x,
-                    r.virtual_y,
-                    r.virtual_z,
-                    r.tilt_deg,
-                    r.elevation_deg,
-                    r.disparity_deg
-                )?;
-            }
-        }
-    }
-    out.flush().context("writing standard output")?;
-    Ok(())
+    write_rows(
+        args.format,
+        &rows,
+        "ground_x,ground_z,virtual_x,virtual_y,virtual_z,tilt_deg,elevation_deg,disparity_deg",
+        |r| {
+            vec![
+                r.ground_x,
+                r.ground_z,
+                r.virtual_x,
+                r.virtual_y,
+                r.virtual_z,
+                r.tilt_deg,
+                r.elevation_deg,
+                r.disparity_deg,
+            ]
+        },
+    )
 }
 
 #[cfg(test)]
@@ -225,6 +315,10 @@ mod tests {
             let err = run(parse(bad).unwrap()).unwrap_err();
             assert!(!format!("{err:#}").is_empty());
         }
+        let centre = parse(&[
+            "--light", "0,-1,15", "--viewer", "0,1.5,0", "--model", "centre",
+        ]);
+        assert!(run(centre.unwrap()).is_err());
         let err = run(parse(&["--light", "0,1.5,0", "--viewer", "0,1.5,0"]).unwrap()).unwrap_err();
         assert!(format!("{err:#}").contains("light's depth"), "{err:#}");
     }

@@ -3,15 +3,16 @@
 //!
 //! Fig. 2: the three `paper_fig2` scenes rendered (left eye of the default rig); Fig. 3: their
 //! ground-plane texture maps; Fig. 4 and Fig. 5: the column model; Fig. 6: a stereo render of
-//! `paper_fig6`, the 1D LK disparity along the streak against Eq. 4 (pixels and degrees against
-//! elevation), with the RMS difference and a line fit to each curve.
+//! `paper_fig6`, the 1D LK disparity along the streak against Eq. 4 and against the
+//! streak-centre model (pixels and degrees against elevation), with the RMS differences and a
+//! line fit to each curve.
 
 use anyhow::{Context, Result};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use streaks_analysis::figures;
-use streaks_analysis::plot::{Marker, Plot, Series, BLACK_RGB, BLUE, GREY};
+use streaks_analysis::plot::{Marker, Plot, Series, BLACK_RGB, BLUE, GREY, ORANGE};
 use streaks_analysis::report::{Comparison, Report, RowRecord, StreakReport};
 use streaks_image::png::write_png;
 use streaks_image::{write_bytes_atomically, GrayImage};
@@ -173,6 +174,11 @@ fn fig6_plots(out: &Path, streak: &StreakReport) -> Result<()> {
         "Eq. 4 + Eq. 5",
         BLUE,
         pts(&|r| r.predicted_deg),
+    ))
+    .with(Series::line(
+        "streak-centre model",
+        ORANGE,
+        pts(&|r| r.centre_deg),
     ));
     deg.write_png(&out.join("fig6_deg.png"))?;
     let px = Plot::new(
@@ -190,6 +196,11 @@ fn fig6_plots(out: &Path, streak: &StreakReport) -> Result<()> {
         "Eq. 4 + Eq. 5",
         BLUE,
         pts(&|r| r.predicted_px),
+    ))
+    .with(Series::line(
+        "streak-centre model",
+        ORANGE,
+        pts(&|r| r.centre_px),
     ))
     .with(Series::dashed(
         "road surface (matte road)",
@@ -236,8 +247,12 @@ fn fig6(args: &Args, out: &Path, index: &mut String) -> Result<Report> {
         .max_by_key(|s| s.rows.len())
         .context("no streak of paper_fig6 was matched to its light")?;
     let c = streak.comparison.context("no comparison")?;
+    let cc = streak
+        .centre_comparison
+        .context("no comparison with the streak-centre model")?;
     fig6_plots(out, streak)?;
     let (mfit, pfit) = fmt_fit(&c);
+    let (_, cfit) = fmt_fit(&cc);
     let span_deg = |f: &dyn Fn(&RowRecord) -> Option<f64>| {
         let v: Vec<f64> = streak
             .rows
@@ -265,15 +280,26 @@ fn fig6(args: &Args, out: &Path, index: &mut String) -> Result<Report> {
          degrees of elevation; the differences between the curves are very small.\n\n\
          Ours: {w} x {h} pixels (f = {:.1} px), {} spp per eye, streak rows {}..{} ({} rows \
          with both curves, {elev:.2} degrees of elevation).\n\n\
-         | quantity | measured (LK) | predicted (Eq. 4) |\n|---|---|---|\n\
-         | span along the streak | {:.4} px = {:.5} deg | {:.4} px = {:.5} deg |\n\
-         | line fit, disparity against row | {mfit} | {pfit} |\n\
-         | RMS difference | {:.4} px = {:.5} deg (mean {:+.4} px) | |\n\
-         | slope agrees (within 2 combined standard errors) | {} | |\n\
+         | quantity | measured (LK) | predicted (Eq. 4) | streak-centre model |\n|---|---|---|---|\n\
+         | span along the streak | {:.4} px = {:.5} deg | {:.4} px = {:.5} deg | {:.4} px = {:.5} deg |\n\
+         | line fit, disparity against row | {mfit} | {pfit} | {cfit} |\n\
+         | RMS difference from the measurement | | {:.4} px = {:.5} deg (mean {:+.4} px) | {:.4} px = {:.5} deg (mean {:+.4} px) |\n\
+         | slope agrees with the measurement's (within 2 combined standard errors) | | {} | {} |\n\
          | a matte road over the same rows would span | {} px | |\n\
          | median depth stereo assigns / median height of the implied points | {:.2} m / {:.2} m | light at Z = 15 m, mirror image at Y = -1.5 m |\n\
          | row where the fitted lines cross (paper: at the mirror image) | {} | mirror image at row {:.1} |\n\n\
-         ![](fig6_deg.png)\n\n![](fig6_px.png)\n\nThe whole analysis (report.json, plots, depth map, \
+         ![](fig6_deg.png)\n\n![](fig6_px.png)\n\n\
+         **Why the measurement is flatter than Eq. 4.** Each eye sees a row's streak brightest \
+         where the half vector is nearest the normal (the maximum of any isotropic microfacet \
+         distribution): the streak-centre model (`streaks locus --model centre`, \
+         `crates/analysis/src/centre.rs`). That point lies on (or within micrometres of) the \
+         vertical plane through the eye and the light's vertical line; the whole plane projects \
+         onto the light's own image column, so each eye sees the streak centre in the column \
+         where it sees the light, and the streak's disparity is the light's, f b / Z_L, on every \
+         row. Eq. 4 mirrors the light about the rig centre's microfacet at each ground point, \
+         whose slant moves the virtual light nearer at the near end and farther at the far end; \
+         the two agree at the mirror point only.\n\n\
+         The whole analysis (report.json, plots, depth map, \
          side view of the point cloud) is in [fig6/analysis](fig6/analysis/).\n",
         rig.focal_px(),
         args.fig6_spp,
@@ -284,10 +310,16 @@ fn fig6(args: &Args, out: &Path, index: &mut String) -> Result<Report> {
         span_deg(&|r| Some(r.measured_deg)),
         c.predicted_span_px,
         span_deg(&|r| r.predicted_deg),
+        cc.predicted_span_px,
+        span_deg(&|r| r.centre_deg),
         c.rms_px,
         c.rms_deg,
         c.bias_px,
+        cc.rms_px,
+        cc.rms_deg,
+        cc.bias_px,
         if c.slope_agrees { "yes" } else { "no" },
+        if cc.slope_agrees { "yes" } else { "no" },
         streak.road_span_px.map_or("-".into(), |v| format!("{v:.3}")),
         streak.median_depth_m,
         streak.median_road_y_m,

@@ -52,3 +52,52 @@ fn lk_measures_through_fireflies_unless_raw() {
     assert!(prepared < 0.25, "prepared pair: RMS {prepared} px");
     assert!(raw > 5.0 * prepared, "raw {raw} px, prepared {prepared} px");
 }
+
+/// `streaks locus --model centre` prints the streak-centre model beside Eq. 4: in the paper's
+/// Fig. 6 configuration its disparity is flat (the light's, 0.24828 deg) where Eq. 4's spans
+/// 0.0078 deg over the 4-degree tilt range.
+#[test]
+fn locus_centre_model_is_flat_where_eq4_is_not() {
+    let t = TestDir::new();
+    let run = t.streaks(&[
+        "locus",
+        "--light",
+        "0,1.5,15",
+        "--viewer",
+        "0,1.5,0",
+        "--max-tilt",
+        "4",
+        "--samples",
+        "9",
+        "--model",
+        "centre",
+    ]);
+    run.assert_success();
+    let text = String::from_utf8_lossy(&run.output.stdout).into_owned();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (d, e4, el) = (
+        col("disparity_deg"),
+        col("eq4_disparity_deg"),
+        col("elevation_deg"),
+    );
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 9);
+    let span = |c: usize| {
+        let v = rows.iter().map(|r| r[c]);
+        v.clone().fold(f64::MIN, f64::max) - v.fold(f64::MAX, f64::min)
+    };
+    assert!(span(d) < 0.0005, "centre span {} deg", span(d));
+    assert!(
+        (span(e4) - 0.00778).abs() < 1e-4,
+        "Eq. 4 span {} deg",
+        span(e4)
+    );
+    assert!((span(el) - 8.0).abs() < 1e-3, "elevation span {}", span(el));
+    for r in &rows {
+        assert!((r[d] - 0.248281).abs() < 0.0003, "{r:?}");
+    }
+}

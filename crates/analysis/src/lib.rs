@@ -9,6 +9,9 @@
 //!   per image row of a streak ([`model::streak_rows`]). Its cameras, their horizon, elevation
 //!   angles and disparities in pixels and degrees are the stereo crate's
 //!   ([`streaks_stereo::rig::RoadRig`], in `f64`), as are the report's: one camera model.
+//! - [`centre`]: the streak-centre model: the brightest point of each row in each eye (the
+//!   half vector nearest the normal) and its disparity, flat at the light's own disparity,
+//!   beside Eq. 4 ([`centre::CentreModel`]).
 //! - [`plot`]: line, scatter and arrow plots with labelled axes and legends, written
 //!   atomically to PNG (plotters, with a font bundled in the crate).
 //! - [`figures`]: the paper's figures made from the model (Fig. 4, Fig. 5).
@@ -44,6 +47,7 @@
 //! ```
 #![deny(missing_docs)]
 
+pub mod centre;
 pub mod detect;
 pub mod figures;
 pub mod lk;

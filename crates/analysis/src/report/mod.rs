@@ -143,6 +143,10 @@ pub struct RowRecord {
     pub predicted_px: Option<f64>,
     /// Predicted disparity, degrees.
     pub predicted_deg: Option<f64>,
+    /// For a streak: the streak-centre model's disparity ([`crate::centre`]), pixels.
+    pub centre_px: Option<f64>,
+    /// The streak-centre model's disparity, degrees.
+    pub centre_deg: Option<f64>,
     /// For a streak: the disparity of the road point seen through the pixel (what a matte
     /// road would give), pixels.
     pub road_px: Option<f64>,
@@ -173,6 +177,9 @@ pub struct StreakReport {
     pub rows: Vec<RowRecord>,
     /// Measured against Eq. 4.
     pub comparison: Option<Comparison>,
+    /// Measured against the streak-centre model ([`crate::centre`]) over the rows that have
+    /// both, if a light matched.
+    pub centre_comparison: Option<Comparison>,
     /// The road's disparity span over the same rows (what a matte road would give), pixels.
     pub road_span_px: Option<f64>,
     /// Median depth stereo assigns along the streak, metres.

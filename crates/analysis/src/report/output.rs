@@ -186,13 +186,13 @@ pub fn write_outputs(
 /// A short text table: one line per streak and region.
 pub fn summary_table(report: &Report) -> String {
     let mut s = String::from(
-        "what        rows  light  meas span  pred span  road span  RMS px   RMS deg   slope ok  median Z  median Y\n",
+        "what        rows  light  meas span  pred span  road span  RMS px   RMS deg   slope ok  median Z  median Y  centre RMS px\n",
     );
     let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
     for st in &report.streaks {
         let c = st.comparison.as_ref();
         s.push_str(&format!(
-            "streak{:<5} {:>4}  {:>5}  {:>9}  {:>9}  {:>9}  {:>7}  {:>8}  {:>8}  {:>7.2}m  {:>7.2}m\n",
+            "streak{:<5} {:>4}  {:>5}  {:>9}  {:>9}  {:>9}  {:>7}  {:>8}  {:>8}  {:>7.2}m  {:>7.2}m  {:>13}\n",
             st.index,
             st.rows.len(),
             st.light.as_ref().map_or("-".into(), |l| l.index.to_string()),
@@ -204,6 +204,7 @@ pub fn summary_table(report: &Report) -> String {
             c.map_or("-", |c| if c.slope_agrees { "yes" } else { "no" }),
             st.median_depth_m,
             st.median_road_y_m,
+            opt(st.centre_comparison.map(|c| c.rms_px)),
         ));
     }
     for r in &report.regions {

@@ -5,9 +5,10 @@
 use super::dense::{dense_accuracy, disparity_range, summarize_dense};
 use super::input::{RigView, StereoInput};
 use super::lights::match_light;
-use super::stats::{compare, median, span};
+use super::stats::{compare, compare_with, median, span};
 use super::targets::{find_objects, find_road};
 use super::{Analysis, RegionReport, Report, ReportError, RigSummary, RowRecord, StreakReport};
+use crate::centre::CentreModel;
 use crate::detect::{detect_streaks, score_mask, vertical_truth, DetectParams, Streak};
 use crate::lk::{lk_rows, prepare_pair, LkError, LkParams, RowDisparity};
 use crate::model::streak_rows;
@@ -92,6 +93,8 @@ fn record(
         measured_deg: cam.angular_disparity_deg_px(x, d),
         predicted_px,
         predicted_deg: predicted_px.map(|p| cam.angular_disparity_deg_px(x, p)),
+        centre_px: None,
+        centre_deg: None,
         road_px,
         depth_m: depth,
         road_y_m: p.y as f64,
@@ -144,16 +147,31 @@ fn analyze_streak(
             what: format!("Eq. 4 for streak {index}"),
             source,
         })?;
+        // The streak-centre model on the same rows: each eye's brightest point of the row's
+        // ground line (a roll-free rig sees one depth per row in both eyes).
+        let centre =
+            CentreModel::new(DVec3::from_array(l.road), view.camera).map_err(|source| {
+                ReportError::Model {
+                    what: format!("the streak-centre model for streak {index}"),
+                    source,
+                }
+            })?;
         for p in pred {
             let road_px = view.camera.disparity_px(p.point.reflection.ground);
-            predicted.insert(p.row as usize, (p.point.disparity_px, road_px));
+            let centre_px = centre.row(p.point.reflection.ground.z).disparity_px;
+            predicted.insert(p.row as usize, (p.point.disparity_px, road_px, centre_px));
         }
     }
     let mut rows: Vec<RowRecord> = measured
         .iter()
         .map(|r| {
             let p = predicted.get(&r.row);
-            record(view, r, p.map(|p| p.0), p.map(|p| p.1))
+            let mut rec = record(view, r, p.map(|p| p.0), p.map(|p| p.1));
+            rec.centre_px = p.map(|p| p.2).filter(|d| d.is_finite());
+            rec.centre_deg = rec
+                .centre_px
+                .map(|d| view.camera.angular_disparity_deg_px(f64::from(r.x), d));
+            rec
         })
         .collect();
     let off_road = median(
@@ -165,6 +183,7 @@ fn analyze_streak(
         light = None;
         for r in &mut rows {
             (r.predicted_px, r.predicted_deg, r.road_px) = (None, None, None);
+            (r.centre_px, r.centre_deg) = (None, None);
         }
     }
     let road: Vec<f64> = rows.iter().filter_map(|r| r.road_px).collect();
@@ -175,6 +194,7 @@ fn analyze_streak(
         peak: streak.peak,
         light,
         comparison: compare(&rows),
+        centre_comparison: compare_with(&rows, |r| r.centre_px.zip(r.centre_deg)),
         road_span_px: (!road.is_empty()).then(|| span(road.iter().copied())),
         median_depth_m: median(rows.iter().map(|r| r.depth_m).collect()),
         median_road_y_m: median(rows.iter().map(|r| r.road_y_m).collect()),

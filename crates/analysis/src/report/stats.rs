@@ -90,30 +90,39 @@ pub(super) fn median(mut v: Vec<f64>) -> f64 {
 
 /// Compares the measured and predicted disparities of `rows`.
 pub fn compare(rows: &[RowRecord]) -> Option<Comparison> {
-    let both: Vec<&RowRecord> = rows
+    compare_with(rows, |r| r.predicted_px.zip(r.predicted_deg))
+}
+
+/// Compares the measured disparities of `rows` with the prediction `model` gives a row (in
+/// pixels and degrees): [`compare`] for Eq. 4, the same statistics for the streak-centre
+/// model.
+pub fn compare_with(
+    rows: &[RowRecord],
+    model: impl Fn(&RowRecord) -> Option<(f64, f64)>,
+) -> Option<Comparison> {
+    let both: Vec<(&RowRecord, f64, f64)> = rows
         .iter()
-        .filter(|r| r.predicted_px.is_some() && r.measured_px.is_finite())
+        .filter(|r| r.measured_px.is_finite())
+        .filter_map(|r| model(r).map(|(px, deg)| (r, px, deg)))
         .collect();
     if both.is_empty() {
         return None;
     }
     let n = both.len() as f64;
-    let diff_px = both
-        .iter()
-        .map(|r| r.measured_px - r.predicted_px.unwrap_or(f64::NAN));
+    let diff_px = both.iter().map(|(r, px, _)| r.measured_px - px);
     let rms_px = (diff_px.clone().map(|d| d * d).sum::<f64>() / n).sqrt();
     let bias_px = diff_px.sum::<f64>() / n;
     let rms_deg = (both
         .iter()
-        .map(|r| (r.measured_deg - r.predicted_deg.unwrap_or(f64::NAN)).powi(2))
+        .map(|(r, _, deg)| (r.measured_deg - deg).powi(2))
         .sum::<f64>()
         / n)
         .sqrt();
-    let measured: Vec<(f64, f64)> = both.iter().map(|r| (r.row as f64, r.measured_px)).collect();
-    let predicted: Vec<(f64, f64)> = both
+    let measured: Vec<(f64, f64)> = both
         .iter()
-        .map(|r| (r.row as f64, r.predicted_px.unwrap_or(f64::NAN)))
+        .map(|(r, _, _)| (r.row as f64, r.measured_px))
         .collect();
+    let predicted: Vec<(f64, f64)> = both.iter().map(|(r, px, _)| (r.row as f64, *px)).collect();
     let (mf, pf) = (fit_line(&measured), fit_line(&predicted));
     let slope_agrees = match (mf, pf) {
         (Some(m), Some(p)) => {
