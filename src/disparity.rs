@@ -1,11 +1,15 @@
 //! `streaks disparity`: dense disparity of the left image by semi-global matching, written as
 //! a PFM (inf where the left-right check fails), with an optional colour preview and an
-//! optional comparison against ground truth.
+//! optional comparison against ground truth. `--streaks mask|repair` makes it streak-robust
+//! ([`streaks_analysis::repair`]): the pixels streaks and reflections put beneath the road
+//! plane (fitted from the pair itself) are made invalid or given the road's disparity, and a
+//! confidence map is written beside the output.
 
 use anyhow::{bail, Context};
 use std::path::PathBuf;
+use streaks_analysis::repair::{robust_disparity, RepairParams, StreakHandling};
 use streaks_analysis::sgm::{
-    compare_disparity, sgm, write_disparity_png, Census, Paths, SgmParams,
+    compare_disparity, compare_disparity_where, sgm, write_disparity_png, Census, Paths, SgmParams,
 };
 use streaks_image::pfm::{read_pfm, write_pfm};
 use streaks_image::GrayImage;
@@ -53,6 +57,27 @@ pub struct Args {
     /// Ground-truth disparity (PFM): print bad-2.0, mean error and density as JSON.
     #[arg(long)]
     pub truth: Option<PathBuf>,
+    /// With --truth: a road mask (PNG, non-zero = road) to also score the road pixels
+    /// (with their phantom-hole rate, `below_1px`) and the others separately.
+    #[arg(long, requires = "truth")]
+    pub road: Option<PathBuf>,
+    /// Streak-robust output: `mask` marks detected streak and below-the-road (reflection)
+    /// pixels invalid; `repair` gives them the road plane's disparity.
+    #[arg(long, value_enum)]
+    pub streaks: Option<Handling>,
+    /// Where the confidence map goes with --streaks (PFM: 1 measured, 0.5 repaired, 0 no
+    /// value); default: OUTPUT with `_confidence` added to its stem.
+    #[arg(long, requires = "streaks")]
+    pub confidence: Option<PathBuf>,
+}
+
+/// `--streaks`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Handling {
+    /// Mark streak and reflection pixels invalid.
+    Mask,
+    /// Replace them with the road plane's disparity.
+    Repair,
 }
 
 /// Runs the command.
@@ -92,6 +117,43 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         params.disparities(),
         start.elapsed().as_secs_f64()
     );
+    let disp = match args.streaks {
+        None => disp,
+        Some(h) => {
+            let handling = match h {
+                Handling::Mask => StreakHandling::Mask,
+                Handling::Repair => StreakHandling::Repair,
+            };
+            let r = robust_disparity(&left, &disp, handling, &RepairParams::default())
+                .context("streak-robust disparity")?;
+            match r.plane {
+                Some(p) => eprintln!(
+                    "road plane: d = {:.4} (y - {:.1}), {} inliers ({:.0} %), RMS {:.2} px",
+                    p.slope,
+                    p.horizon,
+                    p.inliers,
+                    100.0 * p.inlier_share,
+                    p.rms_px
+                ),
+                None => eprintln!("no road plane found: streak pixels are masked, not repaired"),
+            }
+            eprintln!(
+                "streaks: {} detected pixels, {} below the road; {} repaired, {} masked",
+                r.streak_pixels, r.below_road_pixels, r.repaired_pixels, r.masked_pixels
+            );
+            let conf_path = args.confidence.clone().unwrap_or_else(|| {
+                let stem = args
+                    .output
+                    .file_stem()
+                    .map(|s| s.to_string_lossy().into_owned())
+                    .unwrap_or_else(|| "disparity".into());
+                args.output.with_file_name(format!("{stem}_confidence.pfm"))
+            });
+            write_pfm(&conf_path, &r.confidence)
+                .with_context(|| format!("writing the confidence map {}", conf_path.display()))?;
+            r.disparity
+        }
+    };
     write_pfm(&args.output, &disp).context("writing the disparity map")?;
     if let Some(png) = &args.png {
         write_disparity_png(png, &disp, None).context("writing the preview")?;
@@ -99,7 +161,33 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if let Some(truth) = &args.truth {
         let truth = read_pfm(truth).context("reading the ground truth")?;
         let errors = compare_disparity(&disp, &truth, 2.0).context("comparing with the truth")?;
-        println!("{}", serde_json::to_string_pretty(&errors)?);
+        match &args.road {
+            None => println!("{}", serde_json::to_string_pretty(&errors)?),
+            Some(road) => {
+                let mask = GrayImage::load(road)
+                    .with_context(|| format!("reading the road mask {}", road.display()))?;
+                if (mask.width, mask.height) != (truth.width, truth.height) {
+                    bail!(
+                        "the road mask {} is {}x{}, the truth {}x{}",
+                        road.display(),
+                        mask.width,
+                        mask.height,
+                        truth.width,
+                        truth.height
+                    );
+                }
+                let on = |i: usize| mask.data[i] > 0.0;
+                let road_err = compare_disparity_where(&disp, &truth, 2.0, on)?;
+                let off_err = compare_disparity_where(&disp, &truth, 2.0, |i| !on(i))?;
+                let all = serde_json::json!({
+                    "all": errors,
+                    "road": road_err,
+                    "off_road": off_err,
+                    "phantom_hole_rate": road_err.below_1px,
+                });
+                println!("{}", serde_json::to_string_pretty(&all)?);
+            }
+        }
     }
     Ok(())
 }

@@ -101,3 +101,84 @@ fn locus_centre_model_is_flat_where_eq4_is_not() {
         assert!((r[d] - 0.248281).abs() < 0.0003, "{r:?}");
     }
 }
+
+/// `streaks disparity --streaks repair` on a rendered pair writes the repaired map and its
+/// confidence map (values 0, 0.5 and 1 only), and `--truth --road` scores the road's
+/// phantom-hole rate; `--road` without `--truth` and a bad `--streaks` are errors.
+#[test]
+fn disparity_streak_repair_writes_confidence_and_scores_phantom_holes() {
+    let t = TestDir::new();
+    t.write_tiny_gltf();
+    t.streaks(&[
+        "stereo",
+        "scene.gltf",
+        "-o",
+        "pair",
+        "--spp",
+        "4",
+        "--height",
+        "48",
+        "--baseline",
+        "0.1",
+    ])
+    .assert_success();
+    // The floor is the road: a road mask of the pixels with a ground truth below the horizon.
+    let truth = streaks_image::pfm::read_pfm(&t.join("pair/disparity_left.pfm")).unwrap();
+    let road = image::GrayImage::from_fn(truth.width as u32, truth.height as u32, |x, y| {
+        let d = truth.get(x as usize, y as usize);
+        image::Luma([if d.is_finite() && y as usize > truth.height / 2 {
+            255
+        } else {
+            0
+        }])
+    });
+    road.save(t.join("road.png")).unwrap();
+    let run = t.streaks(&[
+        "disparity",
+        "pair/left.png",
+        "pair/right.png",
+        "-o",
+        "d.pfm",
+        "--max-disp",
+        "31",
+        "--streaks",
+        "repair",
+        "--truth",
+        "pair/disparity_left.pfm",
+        "--road",
+        "road.png",
+    ]);
+    run.assert_success();
+    let json: serde_json::Value = serde_json::from_slice(&run.output.stdout).unwrap();
+    let phantom = json["phantom_hole_rate"].as_f64().unwrap();
+    assert!((0.0..=1.0).contains(&phantom), "{json}");
+    assert!(
+        json["off_road"]["truth_pixels"].as_u64().is_some(),
+        "{json}"
+    );
+    assert!(run.stderr().contains("streaks:"), "{}", run.stderr());
+    let conf = streaks_image::pfm::read_pfm(&t.join("d_confidence.pfm")).unwrap();
+    assert_eq!((conf.width, conf.height), (truth.width, truth.height));
+    assert!(conf.data.iter().all(|&c| c == 0.0 || c == 0.5 || c == 1.0));
+    assert!(conf.data.iter().any(|&c| c == 1.0));
+    t.streaks(&[
+        "disparity",
+        "pair/left.png",
+        "pair/right.png",
+        "-o",
+        "e.pfm",
+        "--road",
+        "road.png",
+    ])
+    .assert_failure_mentioning("--truth");
+    t.streaks(&[
+        "disparity",
+        "pair/left.png",
+        "pair/right.png",
+        "-o",
+        "e.pfm",
+        "--streaks",
+        "fix",
+    ])
+    .assert_failure_mentioning("fix");
+}

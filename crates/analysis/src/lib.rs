@@ -18,6 +18,8 @@
 //! - [`lk`]: the paper's per-row 1D Lucas-Kanade estimator, and the preparation of a rendered
 //!   pair for it (fireflies removed, range log-compressed).
 //! - [`detect`]: streaks, glows and lamps in the left image; masks scored against the truth.
+//! - [`repair`]: streak-robust stereo: the road plane from the pair's own v-disparity, and
+//!   the masking or repair of the pixels streaks and reflections put beneath the road.
 //! - [`sgm`]: dense semi-global matching, and its errors against a ground truth (bad-2.0).
 //! - [`report`]: the per-streak analysis of a rendered or photographed pair (Fig. 6, Fig. 8):
 //!   measured against predicted disparity per row, poles and road against their ground truth,
@@ -53,6 +55,7 @@ pub mod figures;
 pub mod lk;
 pub mod model;
 pub mod plot;
+pub mod repair;
 pub mod report;
 pub mod sgm;
 pub mod synth;

@@ -548,6 +548,10 @@ pub struct DisparityErrors {
     pub rms: f64,
     /// The threshold in pixels.
     pub threshold: f32,
+    /// Fraction of all ground-truth pixels whose estimate is more than 1 px *below* the truth
+    /// (farther away). Over road pixels this is the phantom-hole rate: the share of the road
+    /// that stereo puts beneath the road.
+    pub below_1px: f64,
 }
 
 /// Compares an estimate with ground truth (both `inf` where there is no value).
@@ -576,6 +580,7 @@ pub fn compare_disparity_where(
         });
     }
     let (mut n, mut m, mut bad, mut sa, mut ss) = (0usize, 0usize, 0usize, 0.0f64, 0.0f64);
+    let mut below = 0usize;
     for (i, (&e, &t)) in estimate.data.iter().zip(&truth.data).enumerate() {
         if !t.is_finite() || !select(i) {
             continue;
@@ -589,6 +594,7 @@ pub fn compare_disparity_where(
         if err > threshold as f64 {
             bad += 1;
         }
+        below += usize::from(e < t - 1.0);
         sa += err;
         ss += err * err;
     }
@@ -601,6 +607,7 @@ pub fn compare_disparity_where(
         mean_abs: if m > 0 { sa / m as f64 } else { 0.0 },
         rms: if m > 0 { (ss / m as f64).sqrt() } else { 0.0 },
         threshold,
+        below_1px: frac(below, n),
     })
 }
 
