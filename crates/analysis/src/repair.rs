@@ -258,7 +258,7 @@ pub fn robust_disparity(
     let (w, h) = (disp.width, disp.height);
     // The plane from all valid pixels first (streaks are few), for the detector's horizon.
     let first = fit_road_plane(disp, None, params.lower_share);
-    let mut detect = params.detect.clone();
+    let mut detect = params.detect;
     if detect.horizon.is_none() {
         if let Some(p) = first {
             if p.horizon.is_finite() && p.horizon > 0.0 && p.horizon < h as f64 {
