@@ -27,6 +27,8 @@ from streaks_ray.task import RunResult, run_renderer
 
 POLL_SECONDS = 0.5
 """How often the progress bar counts the published samples."""
+SHOWN_FAILURES = 5
+"""How many failed chunks the final report shows with the renderer's output."""
 CONNECT_TIMEOUT_SECONDS = 10.0
 """How long the check that something listens at the Ray address waits."""
 
@@ -324,10 +326,15 @@ def generate(job: Job) -> int:
         f"{wall:.1f} s wall, {pairs_per_hour:.0f} pairs/hour"
     )
     if failed:
-        for chunk, reason, stderr_tail in failed:
+        for chunk, reason, stderr_tail in failed[:SHOWN_FAILURES]:
             print(f"streaks-ray: {chunk.describe()}: {reason}", file=sys.stderr)
             for line in stderr_tail.splitlines():
                 print(f"    {line}", file=sys.stderr)
+        if len(failed) > SHOWN_FAILURES:
+            print(
+                f"streaks-ray: and {len(failed) - SHOWN_FAILURES} more failed chunk(s)",
+                file=sys.stderr,
+            )
         print(f"streaks-ray: {summary}", file=sys.stderr)
         raise DriverError(
             f"{len(failed)} chunk(s) failed {job.max_retries + 1} times; the samples published so "
