@@ -10,6 +10,7 @@ the temporary folder the failed run left.
 from __future__ import annotations
 
 import ipaddress
+import logging
 import os
 import shutil
 import socket
@@ -192,7 +193,7 @@ def connect(address: str) -> None:
     import ray
 
     try:
-        ray.init(address=address, logging_level="WARNING", log_to_driver=False)
+        ray.init(address=address, logging_level=logging.WARNING, log_to_driver=False)
     except (ConnectionError, RuntimeError, ValueError) as err:
         raise DriverError(f"cannot connect to the Ray cluster at {address}: {err}") from None
 
