@@ -251,7 +251,10 @@ def _run_chunks(
     failed: list[tuple[Chunk, str, str]] = []
     try:
         while pending:
-            ready, _ = ray.wait(list(pending), num_returns=1, timeout=POLL_SECONDS)
+            # Every task that is done within the poll interval (one at a time would make a
+            # dataset of n tasks cost n^2).
+            refs = list(pending)
+            ready, _ = ray.wait(refs, num_returns=len(refs), timeout=POLL_SECONDS)
             progress.update()
             for ref in ready:
                 attempt = pending.pop(ref)
