@@ -59,9 +59,10 @@ def _renderers(streaks_bin: str, out: Path) -> list[int]:
     return found
 
 
-def _rendering(out: Path) -> bool:
-    """A sample is being rendered: a temporary sample folder exists."""
-    return any(out.rglob(".tmp-*"))
+def _rendering(out: Path, pid: int) -> bool:
+    """Renderer `pid` is in the middle of a sample: its temporary sample folder exists
+    (`samples/.tmp-NNNNNN-PID/`, published by a rename when the sample is complete)."""
+    return any((out / "samples").glob(f".tmp-*-{pid}"))
 
 
 def test_a_killed_renderer_is_retried(ray_cluster, streaks_bin, reference, tmp_path):
@@ -78,9 +79,9 @@ def test_a_killed_renderer_is_retried(ray_cluster, streaks_bin, reference, tmp_p
         deadline = time.monotonic() + 60
         victim = None
         while victim is None and time.monotonic() < deadline and driver.poll() is None:
-            pids = _renderers(streaks_bin, out)
-            if pids and _rendering(out):
-                victim = pids[0]
+            busy = [pid for pid in _renderers(streaks_bin, out) if _rendering(out, pid)]
+            if busy:
+                victim = busy[0]
             else:
                 time.sleep(0.01)
         assert victim is not None, "saw no renderer in the middle of a sample"
