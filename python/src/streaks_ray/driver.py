@@ -117,7 +117,7 @@ def resolve_binary(name: str) -> str:
         except (OSError, subprocess.TimeoutExpired) as err:
             raise DriverError(f"cannot run the streaks binary {path}: {err}") from None
         if proc.returncode != 0:
-            said = (proc.stderr.strip().splitlines() or [""])[-1]
+            said = (proc.stderr.strip().splitlines() or [""])[0]
             raise DriverError(
                 f"{path} {what} exited with status {proc.returncode}"
                 + (f": {said}" if said else "")
