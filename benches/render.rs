@@ -54,6 +54,7 @@ fn street() -> Scene {
         normal_map: None,
         double_sided: false,
         alpha: streaks_render::material::Alpha::OPAQUE,
+        road: true,
     };
     let mut window = Material::diffuse("window", Vec3::ZERO);
     window.emission = Vec3::new(2.0, 1.8, 1.2);

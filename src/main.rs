@@ -5,6 +5,7 @@
 
 mod analyze;
 mod compare;
+mod dataset;
 mod disparity;
 mod export_mitsuba;
 mod figure;
@@ -53,6 +54,8 @@ enum Command {
     ExportMitsuba(export_mitsuba::Args),
     /// Compare a render with a reference: relative RMSE and bias per region, noise test.
     Compare(compare::Args),
+    /// Generate stereo datasets of procedural rainy streets (generate), and index them (index).
+    Dataset(dataset::Args),
 }
 
 fn main() -> ExitCode {
@@ -70,6 +73,7 @@ fn main() -> ExitCode {
         Command::Compare(args) => compare::run(args),
         Command::Lk(args) => lk::run(args),
         Command::Disparity(args) => disparity::run(args),
+        Command::Dataset(args) => dataset::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

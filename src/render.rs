@@ -240,6 +240,7 @@ pub fn run(args: Args) -> Result<()> {
         normal: args.layers.contains(&Layer::Normal),
         albedo: args.layers.contains(&Layer::Albedo),
         specular: args.layers.contains(&Layer::Specular),
+        material: false,
     };
     if format == Format::Png && !args.layers.is_empty() {
         eprintln!(

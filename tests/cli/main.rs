@@ -4,6 +4,7 @@
 
 mod analyze;
 mod common;
+mod dataset;
 mod measure;
 mod render;
 mod stereo;

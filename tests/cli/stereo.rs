@@ -483,3 +483,39 @@ fn rig_json_lists_the_renderers_emitters() {
     }
     assert!(lamps > 0, "rainy_street_small has emissive lamps");
 }
+
+#[test]
+fn the_road_surface_mask_is_the_first_hit_of_road_materials() {
+    use streaks_stereo::render::scene_has_road;
+    let t = TestDir::new();
+    let path = t.write_tiny_gltf();
+    let scene = Scene::load(&path).unwrap();
+    let rig = rig_from_camera(scene.camera(None).unwrap(), 30, 20, 0.1).unwrap();
+    let plain = render_pair(&scene, &rig, &settings(1), &|_| {}).unwrap();
+    assert!(!scene_has_road(&scene));
+    assert!(plain.iter().all(|v| v.road_surface.iter().all(|&r| !r)));
+    // Flag the floor's material as the road surface.
+    let mut gltf: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    gltf["materials"][0]["extras"]["streaks"]["road"] = serde_json::json!(true);
+    std::fs::write(&path, gltf.to_string()).unwrap();
+    let scene = Scene::load(&path).unwrap();
+    assert!(scene_has_road(&scene));
+    let flagged = render_pair(&scene, &rig, &settings(1), &|_| {}).unwrap();
+    for (a, b) in plain.iter().zip(&flagged) {
+        // The floor is flat: its pixels are exactly the upward-facing ones; the sign and the
+        // sky are not road.
+        assert_eq!(b.road_surface, a.road);
+        assert!(b.road_surface.iter().any(|&r| r) && b.road_surface.iter().any(|&r| !r));
+        let sign = b
+            .road_surface
+            .iter()
+            .zip(&b.depth.data)
+            .filter(|(r, z)| !**r && z.is_finite())
+            .count();
+        assert!(sign > 0, "the sign is in view and is not road");
+        // The flag changes no pixel of the images or masks.
+        assert_eq!(a.output.image, b.output.image);
+        assert_eq!(a.streak_mask, b.streak_mask);
+    }
+}

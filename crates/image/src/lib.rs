@@ -13,6 +13,7 @@
 //!   (a uniquely named temporary file, then a rename);
 //! - [`exr`], [`png`], [`pfm`]: reading and writing the three formats (EXR with named float
 //!   channels; PNG as 8-bit sRGB or any 8/16-bit buffer; PFM in the Middlebury convention);
+//! - [`kitti`]: disparity maps in the KITTI 2015 encoding (16-bit PNG, disparity x 256);
 //! - [`compare`]: statistics of the difference between two images (relative RMSE, bias, the
 //!   noise test), per region;
 //! - [`error`]: [`ImageError`], which names the file or the region.
@@ -39,6 +40,7 @@ pub mod compare;
 pub mod error;
 pub mod exr;
 pub mod gray;
+pub mod kitti;
 pub mod pfm;
 pub mod png;
 pub mod region;

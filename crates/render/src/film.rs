@@ -29,7 +29,13 @@ pub struct Pixel {
     pub normal: Vec3,
     /// First-hit BSDF albedo (zero on a miss).
     pub albedo: Vec3,
+    /// Index into the scene's materials of the pixel-centre ray's first hit ([`NO_MATERIAL`]
+    /// on a miss).
+    pub material: u32,
 }
+
+/// [`Pixel::material`] of a pixel whose centre ray hits nothing.
+pub const NO_MATERIAL: u32 = u32::MAX;
 
 impl Default for Pixel {
     fn default() -> Self {
@@ -41,6 +47,7 @@ impl Default for Pixel {
             depth: f32::INFINITY,
             normal: Vec3::ZERO,
             albedo: Vec3::ZERO,
+            material: NO_MATERIAL,
         }
     }
 }
@@ -141,6 +148,11 @@ impl Film {
         self.pixels.iter().map(|p| p.depth).collect()
     }
 
+    /// The first-hit material layer ([`NO_MATERIAL`] on a miss).
+    pub fn material(&self) -> Vec<u32> {
+        self.pixels.iter().map(|p| p.material).collect()
+    }
+
     /// Total number of dropped samples.
     pub fn dropped(&self) -> u64 {
         self.pixels.iter().map(|p| p.dropped as u64).sum()
@@ -176,5 +188,6 @@ mod tests {
         assert_eq!(film.dropped(), 3);
         assert!(img.pixels.iter().all(|p| p.is_finite()));
         assert_eq!(film.depth()[0], f32::INFINITY);
+        assert_eq!(film.material(), vec![NO_MATERIAL; 6]);
     }
 }

@@ -57,6 +57,9 @@
 //! - `normal`: the first hit's shading normal for the pixel-centre ray, world space, flipped
 //!   to face the camera; zero on a miss.
 //! - `albedo`: the first hit's [`crate::bsdf::Bsdf::albedo`] for the pixel-centre ray.
+//! - `material`: the index into [`Scene::materials`] of the pixel-centre ray's first hit
+//!   ([`crate::film::NO_MATERIAL`] on a miss); with [`crate::material::Material::road`] it tells
+//!   which pixels see the road surface first.
 //! - `specular`: the part of the pixel's radiance that reached the camera by exactly one
 //!   reflection of an emitter off the glossy lobe at the first surface hit: the glossy part
 //!   (`eval_lobes(..).glossy`) of the next-event estimate at the first hit, plus, for the BSDF
@@ -99,6 +102,8 @@ pub struct Layers {
     pub albedo: bool,
     /// Single-glossy-bounce emitter light (streaks).
     pub specular: bool,
+    /// First-hit material index of the pixel-centre ray.
+    pub material: bool,
 }
 
 /// What to render.
@@ -144,6 +149,9 @@ pub struct RenderOutput {
     pub albedo: Option<RgbImage>,
     /// Specular part (if requested).
     pub specular: Option<RgbImage>,
+    /// First-hit material index per pixel, row-major (if requested; see the module
+    /// documentation).
+    pub material: Option<Vec<u32>>,
     /// Counters.
     pub stats: RenderStats,
 }
@@ -174,7 +182,8 @@ pub fn render(
         .world_from_camera
         .transform_vector3(-Vec3::Z)
         .normalize();
-    let need_centre = settings.layers.depth || settings.layers.normal || settings.layers.albedo;
+    let l = settings.layers;
+    let need_centre = l.depth || l.normal || l.albedo || l.material;
 
     film.par_rows_mut().enumerate().for_each(|(y, row)| {
         let y = y as u32;
@@ -214,6 +223,7 @@ pub fn render(
         normal: layers.normal.then(|| film.normal()),
         albedo: layers.albedo.then(|| film.albedo()),
         specular: layers.specular.then(|| film.specular()),
+        material: layers.material.then(|| film.material()),
         stats: RenderStats {
             seconds: start.elapsed().as_secs_f64(),
             samples: width as u64 * height as u64 * settings.spp as u64,
@@ -223,10 +233,11 @@ pub fn render(
     }
 }
 
-/// Fills the depth, normal and albedo of `pixel` from the pixel-centre ray.
+/// Fills the depth, normal, albedo and material of `pixel` from the pixel-centre ray.
 fn first_hit_layers(scene: &Scene, ray: &Ray, origin: Vec3, forward: Vec3, pixel: &mut Pixel) {
     if let Some(hit) = scene.intersect(ray) {
         pixel.depth = (hit.p - origin).dot(forward);
+        pixel.material = hit.material;
         pixel.normal = if hit.ns.dot(ray.direction) > 0.0 {
             -hit.ns
         } else {
@@ -777,6 +788,7 @@ pub(crate) mod tests {
             normal_map: None,
             double_sided: false,
             alpha: crate::material::Alpha::OPAQUE,
+            road: true,
         };
         let mut parts = SceneParts {
             materials: vec![road, sign],
@@ -821,6 +833,7 @@ pub(crate) mod tests {
             normal: true,
             albedo: true,
             specular: true,
+            material: true,
         };
         let run = |threads| {
             rayon::ThreadPoolBuilder::new()
@@ -833,7 +846,27 @@ pub(crate) mod tests {
         assert_eq!(one.image, two.image);
         assert_eq!(one.specular, two.specular);
         assert_eq!(one.depth, two.depth);
+        assert_eq!(one.material, two.material);
         assert!(one.image.pixels.iter().any(|p| p.max_element() > 0.0));
+        // The material layer: the floor (material 0, the road) where the depth is finite
+        // below the horizon, nothing where the centre ray misses.
+        let material = one.material.as_ref().unwrap();
+        let depth = one.depth.as_ref().unwrap();
+        for (m, z) in material.iter().zip(depth) {
+            assert_eq!(*m == crate::film::NO_MATERIAL, z.is_infinite(), "{m} {z}");
+        }
+        assert!(material.contains(&0));
+        assert!(material.contains(&crate::film::NO_MATERIAL));
+        assert!(scene.materials[0].road && !scene.materials[1].road);
+        // Asking for the layers does not change the image.
+        set.layers = Layers::default();
+        let plain = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap()
+            .install(|| render(&scene, &cam, &set, &|_| {}));
+        assert_eq!(plain.image, one.image);
+        assert!(plain.material.is_none());
         // Another seed gives another image.
         set.seed = 2;
         let other = rayon::ThreadPoolBuilder::new()

@@ -209,6 +209,9 @@ pub struct Material {
     pub double_sided: bool,
     /// How much of the surface is there (glTF `alphaMode`).
     pub alpha: Alpha,
+    /// The road surface of the scene contract (`extras.streaks.road: true`): datasets mark
+    /// the pixels whose first hit has such a material.
+    pub road: bool,
 }
 
 /// glTF `alphaMode`.
@@ -291,6 +294,7 @@ impl Material {
             normal_map: None,
             double_sided: false,
             alpha: Alpha::OPAQUE,
+            road: false,
         }
     }
 
@@ -475,6 +479,7 @@ mod tests {
             normal_map: None,
             double_sided: false,
             alpha: Alpha::OPAQUE,
+            road: false,
         };
         let textures = [dry_map, kd_map];
         let Bsdf::Ggx(wet) = m.bsdf_at(&at(0.25, 0.5), &textures) else {

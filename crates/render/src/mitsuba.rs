@@ -953,6 +953,7 @@ mod tests {
             normal_map: None,
             double_sided: false,
             alpha: crate::material::Alpha::OPAQUE,
+            road: false,
         }
     }
 

@@ -94,6 +94,7 @@ mod tests {
             }),
             albedo: None,
             specular: Some(gradient(w, h)),
+            material: None,
             stats: RenderStats::default(),
         }
     }

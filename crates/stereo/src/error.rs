@@ -26,6 +26,14 @@ pub enum StereoError {
         /// Why.
         reason: String,
     },
+    /// A Middlebury calib.txt could not be read or parsed.
+    #[error("calibration file {path}: {reason}")]
+    CalibFile {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        reason: String,
+    },
     /// The scene has no camera to build the rig from, or not the one asked for.
     #[error("no camera for the rig: {0}")]
     Camera(String),

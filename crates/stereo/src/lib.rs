@@ -10,6 +10,7 @@
 //!   frame; and the same rig in `f64` road coordinates ([`rig::RoadRig`]: projection, ground
 //!   points, horizon, elevation, disparity in pixels and the one definition of angular
 //!   disparity), which the analysis crate uses for all its angles.
+//! - [`calib`]: `calib.txt` in the Middlebury 2014 format ([`calib::MiddleburyCalib`]).
 //! - [`rigfile`]: `rig.json` ([`rigfile::RigFile`]), with the scene's lights in world and road
 //!   coordinates.
 //! - [`pair`]: side-by-side and anaglyph views; the paper's Fig. 7 treatment of photographs.
@@ -36,6 +37,7 @@
 //! ```
 #![deny(missing_docs)]
 
+pub mod calib;
 pub mod error;
 pub mod font;
 pub mod pair;

@@ -5,7 +5,9 @@
 //! pixel's centre ray (`inf` on a miss): the disparity of that pixel is `d = f b / Z` pixels
 //! (`inf` on a miss). For the right view this is the Middlebury `disp1` convention: the pixel's
 //! match in the left view is at `x + d`. The streak masks use the `specular` layer (see
-//! [`crate::streak_mask`]) with road pixels from the `normal` layer.
+//! [`crate::streak_mask`]) with road pixels from the `normal` layer. The road-surface mask
+//! ([`EyeView::road_surface`]) is from the `material` layer: the pixels whose centre ray hits a
+//! material of the scene contract's road (`extras.streaks.road: true`) first.
 //!
 //! The left eye is rendered with the given seed and the right eye with `seed + 1`, so that
 //! the two views' sampling noise is independent and cannot pull a matcher toward zero disparity.
@@ -91,8 +93,12 @@ pub struct EyeView {
     pub depth: GrayImage,
     /// Ground-truth disparity `f b / Z` in pixels (`inf` on a miss).
     pub disparity: GrayImage,
-    /// Which pixels see an upward-facing surface (the road).
+    /// Which pixels see an upward-facing surface (the road for the streak mask).
     pub road: Vec<bool>,
+    /// Which pixels' centre ray hits a road material
+    /// ([`streaks_render::material::Material::road`]) first; all `false` when the scene flags
+    /// none ([`scene_has_road`]).
+    pub road_surface: Vec<bool>,
     /// The streak mask (1 = streak).
     pub streak_mask: GrayImage,
     /// The specular-luminance threshold the mask used.
@@ -129,6 +135,7 @@ pub fn render_eye(
             normal: true,
             albedo: false,
             specular: true,
+            material: true,
         },
     };
     let output = render(scene, &eye_camera(rig, eye), &render_settings, progress);
@@ -140,6 +147,14 @@ pub fn render_eye(
         .specular
         .as_ref()
         .ok_or_else(|| missing("specular"))?;
+    let materials = output
+        .material
+        .as_ref()
+        .ok_or_else(|| missing("material"))?;
+    let road_surface: Vec<bool> = materials
+        .iter()
+        .map(|&m| scene.materials.get(m as usize).is_some_and(|m| m.road))
+        .collect();
     let (wu, hu) = (w as usize, h as usize);
     let disparity: Vec<f32> = z
         .iter()
@@ -167,10 +182,17 @@ pub fn render_eye(
         depth: GrayImage::from_vec(wu, hu, z)?,
         disparity: GrayImage::from_vec(wu, hu, disparity)?,
         road,
+        road_surface,
         streak_mask,
         streak_threshold,
         output,
     })
+}
+
+/// Whether any material of `scene` is the road surface of the scene contract
+/// (`extras.streaks.road: true`); without one, [`EyeView::road_surface`] is empty of road.
+pub fn scene_has_road(scene: &Scene) -> bool {
+    scene.materials.iter().any(|m| m.road)
 }
 
 /// Renders both eyes (left first) with one `progress` over both: it receives increments of

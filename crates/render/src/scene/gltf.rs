@@ -38,7 +38,14 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct StreaksExtras {
-    bsdf: StreaksBsdf,
+    /// The paper model; absent, the material is glTF metallic-roughness and `extras.streaks`
+    /// may only carry `road`.
+    #[serde(default)]
+    bsdf: Option<StreaksBsdf>,
+    /// Marks the road surface (datasets mask the pixels whose first hit has such a
+    /// material); no effect on shading.
+    #[serde(default)]
+    road: bool,
     #[serde(default)]
     kd: Option<[f32; 3]>,
     #[serde(default)]
@@ -51,10 +58,6 @@ struct StreaksExtras {
     alpha_dry: Option<f32>,
     #[serde(default)]
     ks_dry: Option<[f32; 3]>,
-    /// Marks the road surface (the dataset's road mask); no effect on shading.
-    #[serde(default)]
-    #[allow(dead_code)]
-    road: bool,
 }
 
 #[derive(Clone, Copy, Debug, Deserialize)]
@@ -1119,6 +1122,7 @@ impl Loader<'_> {
                 normal_map: None,
                 double_sided: false,
                 alpha: Alpha::OPAQUE,
+                road: false,
             });
             (self.parts.materials.len() - 1) as u32
         })
@@ -1199,7 +1203,9 @@ impl Loader<'_> {
                 texture: base_color_texture,
             },
         };
-        let reflectance = match self.streaks_extras(m, &element)? {
+        let extras = self.streaks_extras(m, &element)?;
+        let road = extras.as_ref().is_some_and(|x| x.road);
+        let reflectance = match extras.filter(|x| x.bsdf.is_some()) {
             Some(x) => self.paper(x, base_color_texture, mr_texture, &element)?,
             None => {
                 let specular = self.specular(m, &element)?;
@@ -1235,6 +1241,7 @@ impl Loader<'_> {
             normal_map,
             double_sided: m.double_sided(),
             alpha,
+            road,
         })
     }
 
@@ -1429,9 +1436,28 @@ impl Loader<'_> {
         let Some(streaks) = value.get("streaks") else {
             return Ok(None);
         };
-        serde_json::from_value(streaks.clone())
-            .map(Some)
-            .map_err(|e| self.bad(element, format!("extras.streaks: {e}")))
+        let x: StreaksExtras = serde_json::from_value(streaks.clone())
+            .map_err(|e| self.bad(element, format!("extras.streaks: {e}")))?;
+        let paper_keys = [
+            ("kd", x.kd.is_some()),
+            ("ks", x.ks.is_some()),
+            ("alpha", x.alpha.is_some()),
+            ("shininess", x.shininess.is_some()),
+            ("alpha_dry", x.alpha_dry.is_some()),
+            ("ks_dry", x.ks_dry.is_some()),
+        ];
+        if x.bsdf.is_none() {
+            if let Some((key, _)) = paper_keys.iter().find(|(_, given)| *given) {
+                return Err(self.bad(
+                    element,
+                    format!(
+                        "extras.streaks: {key:?} needs \"bsdf\" (\"ggx\", \"ward\" or \"blinn_phong\"); \
+                         without it only \"road\" may be given"
+                    ),
+                ));
+            }
+        }
+        Ok(Some(x))
     }
 
     fn paper(
@@ -1453,7 +1479,10 @@ impl Loader<'_> {
         let kd = colour(x.kd, "kd")?;
         let ks = colour(x.ks, "ks")?;
         let ks_dry = colour(x.ks_dry.or(x.ks), "ks_dry")?;
-        let model = match x.bsdf {
+        let Some(bsdf) = x.bsdf else {
+            return Err(bad("no \"bsdf\"".into()));
+        };
+        let model = match bsdf {
             StreaksBsdf::Ggx => PaperModel::Ggx,
             StreaksBsdf::Ward => PaperModel::Ward,
             StreaksBsdf::BlinnPhong => PaperModel::BlinnPhong,
@@ -2169,6 +2198,39 @@ mod tests {
             ))
             .unwrap();
         assert!(approx(hit.ng, Vec3::Z), "{}", hit.ng);
+    }
+
+    #[test]
+    fn road_materials_are_flagged_with_or_without_a_paper_model() {
+        let dir = tempfile::tempdir().unwrap();
+        let (doc, bin) = test_doc();
+        let scene = Scene::load(&write_embedded(dir.path(), doc, &bin)).unwrap();
+        assert!(scene.materials.iter().all(|m| !m.road));
+        let (mut doc, bin) = test_doc();
+        doc["materials"][0]["extras"]["streaks"]["road"] = json!(true);
+        // A glTF metallic-roughness material may carry the flag alone.
+        doc["materials"][1]["extras"] = json!({"streaks": {"road": true}});
+        let scene = Scene::load(&write_embedded(dir.path(), doc, &bin)).unwrap();
+        let asphalt = &scene.materials[0];
+        assert!(asphalt.road);
+        assert!(matches!(asphalt.reflectance, Reflectance::Paper { .. }));
+        assert!(scene.materials[1].road);
+        assert!(matches!(
+            scene.materials[1].reflectance,
+            Reflectance::GltfPbr(_)
+        ));
+        // Paper parameters without a model are an error that says what is missing.
+        let (mut doc, bin) = test_doc();
+        doc["materials"][1]["extras"] = json!({"streaks": {"road": true, "alpha": 0.1}});
+        let err = load_err(doc, &bin);
+        assert!(
+            err.contains("material \"glow\" (1)") && err.contains("needs \"bsdf\""),
+            "{err}"
+        );
+        let (mut doc, bin) = test_doc();
+        doc["materials"][0]["extras"]["streaks"]["road"] = json!("yes");
+        let err = load_err(doc, &bin);
+        assert!(err.contains("extras.streaks"), "{err}");
     }
 
     #[test]

@@ -54,6 +54,9 @@
 //!   `extras.streaks` chooses one of the paper's models: `{"bsdf": "ggx" | "ward" | "blinn_phong", "kd": [r,g,b], "ks": [r,g,b],
 //!   "alpha": a, "shininess": s}` (`alpha` for ggx and ward, `shininess` for blinn_phong;
 //!   `kd` and `ks` default to black). The baseColorTexture, if any, multiplies `kd`.
+//!   `extras.streaks.road: true` (with a paper model, or alone on a metallic-roughness
+//!   material) flags the road surface ([`crate::material::Material::road`]), which the
+//!   integrator's `material` layer lets datasets mask; it changes no pixel.
 //! - Normal maps ([`crate::normal_map`]): a material's `normalTexture` (linear RGB, `scale`
 //!   multiplying X and Y) perturbs the shading normal in tangent space. Tangents are stored
 //!   per vertex ([`Scene::tangents`], empty when no material has a normal map; zero for the

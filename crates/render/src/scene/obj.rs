@@ -191,6 +191,7 @@ fn convert_material(
         normal_map: None,
         alpha: Alpha::OPAQUE,
         double_sided: false,
+        road: false,
     })
 }
 

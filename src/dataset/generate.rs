@@ -1,0 +1,252 @@
+//! `streaks dataset generate`: render the samples of a dataset (or one shard of them).
+//!
+//! For each index `i` in `0..count` of the shard: if `samples/NNNNNN/` is complete it is
+//! skipped (and stale temporary folders of `i` removed); otherwise the sample is built with the
+//! procedural generator from `(config, seed, i)`, rendered into `samples/.tmp-NNNNNN-PID/`, its
+//! KITTI files written, and the folder renamed to `samples/NNNNNN/`. An incomplete published
+//! sample (files removed by hand) is rendered again. Without `--shard` the index is rebuilt at
+//! the end ([`super::index`]).
+
+use super::index::index_dir;
+use super::layout::{sample_id, Conventions, DatasetInfo, FileList, Layout, FORMAT, MAX_COUNT};
+use super::sample::{is_complete, remove_stale_tmp, render_sample, SampleSettings};
+use super::shard::Shard;
+use crate::render::{image_size, progress_bar};
+use anyhow::{bail, Context, Result};
+use sha2::{Digest, Sha256};
+use std::cell::Cell;
+use std::path::PathBuf;
+use std::time::Instant;
+use streaks_image::write_bytes_atomically;
+use streaks_scenes::procedural::{GeneratorConfig, GENERATOR_VERSION};
+
+/// Render the samples of a dataset (all, or one shard) into a folder; resumable.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// The dataset folder (created if missing; must be empty or hold the same dataset).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Number of samples in the dataset (indices 0..N, at most 1000000).
+    #[arg(long)]
+    pub count: u64,
+    /// Dataset seed: with the config and the index it determines each sample.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Generator config (TOML) [default: the documented default config].
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// Image width in pixels.
+    #[arg(long, default_value_t = 640)]
+    pub width: u32,
+    /// Image height in pixels.
+    #[arg(long, default_value_t = 384)]
+    pub height: u32,
+    /// Samples per pixel per eye.
+    #[arg(long, default_value_t = 64)]
+    pub spp: u32,
+    /// Render only the samples whose index is K modulo N (0 <= K < N); shards may run at the
+    /// same time into one folder; then run `streaks dataset index DIR`.
+    #[arg(long, value_name = "K/N")]
+    pub shard: Option<Shard>,
+    /// Worker threads [default: all cores].
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Longest path, Mitsuba's meaning: 1 = emitters only, 2 = direct light, 3 = one bounce...
+    #[arg(long, default_value_t = 8)]
+    pub max_depth: u32,
+}
+
+/// sha256 of bytes, lowercase hex.
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    format!("{:x}", Sha256::digest(bytes))
+}
+
+/// The nearest-rank quantile `p` of sorted values.
+fn quantile(sorted: &[f64], p: f64) -> f64 {
+    sorted[((p * (sorted.len() - 1) as f64).round() as usize).min(sorted.len() - 1)]
+}
+
+/// Runs the subcommand.
+pub fn run(args: Args) -> Result<()> {
+    // Phase 1: the flags and the config; nothing is written before they are all good.
+    if args.count == 0 {
+        bail!("--count must be at least 1");
+    }
+    if args.count > MAX_COUNT {
+        bail!(
+            "--count {} is too large: sample ids have six digits (at most {MAX_COUNT})",
+            args.count
+        );
+    }
+    image_size(Some(args.width), Some(args.height), None)?;
+    if args.spp == 0 {
+        bail!("--spp must be at least 1");
+    }
+    if args.max_depth == 0 {
+        bail!("--max-depth must be at least 1 (1 renders only emitters seen directly)");
+    }
+    let config = match &args.config {
+        Some(path) => GeneratorConfig::from_toml_file(path)
+            .with_context(|| format!("cannot use the config {}", path.display()))?,
+        None => GeneratorConfig::default(),
+    };
+    let config_hash = sha256_hex(config.to_toml().as_bytes());
+    let info = DatasetInfo {
+        format: FORMAT.to_owned(),
+        generator_version: GENERATOR_VERSION.to_owned(),
+        config: config.to_json(),
+        config_hash: config_hash.clone(),
+        count: args.count,
+        seed: args.seed,
+        width: args.width,
+        height: args.height,
+        spp: args.spp,
+        max_depth: args.max_depth,
+        files: FileList::current(),
+        conventions: Conventions::current(),
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads.unwrap_or(0))
+        .build()
+        .context("cannot start the worker threads")?;
+
+    // Phase 2: the folder: new, or the same dataset.
+    let layout = Layout::new(&args.output);
+    prepare_folder(&layout, &info)?;
+
+    // Phase 3: the samples of this shard.
+    let shard = args.shard.unwrap_or(Shard::ALL);
+    let indices: Vec<u64> = (0..args.count).filter(|&i| shard.contains(i)).collect();
+    let settings = SampleSettings {
+        config,
+        config_hash,
+        seed: args.seed,
+        width: args.width,
+        height: args.height,
+        spp: args.spp,
+        max_depth: args.max_depth,
+    };
+    let bar = progress_bar(indices.len() as u64);
+    let start = Instant::now();
+    let mut shares = Vec::new();
+    let mut skipped = 0usize;
+    let warned_no_road = Cell::new(false);
+    for &index in &indices {
+        let id = sample_id(index);
+        if is_complete(&layout, index) {
+            remove_stale_tmp(&layout, index)?;
+            skipped += 1;
+            bar.inc(1);
+            continue;
+        }
+        let dir = layout.sample_dir(index);
+        if dir.exists() {
+            bar.suspend(|| {
+                eprintln!(
+                    "sample {id}: {} is incomplete; rendering it again",
+                    dir.display()
+                )
+            });
+            std::fs::remove_dir_all(&dir).with_context(|| {
+                format!("cannot remove the incomplete sample {}", dir.display())
+            })?;
+        }
+        let rendered = pool.install(|| {
+            render_sample(&layout, &settings, index, &|w| {
+                bar.suspend(|| eprintln!("warning: {w}"))
+            })
+        })?;
+        if !rendered.road_mask && !warned_no_road.replace(true) {
+            bar.suspend(|| {
+                eprintln!(
+                    "warning: the scene of sample {id} flags no road material \
+                     (extras.streaks.road); road0.png is not written and meta.json says so \
+                     (road_mask: false); said once"
+                )
+            });
+        }
+        let share = rendered.stats.streak_share;
+        shares.push(share);
+        bar.suspend(|| {
+            eprintln!(
+                "sample {id}: {:.2} s, streak share {:.3} %",
+                rendered.seconds,
+                100.0 * share
+            )
+        });
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+
+    let seconds = start.elapsed().as_secs_f64();
+    let mut summary = format!(
+        "shard {shard}: {} samples rendered, {skipped} already done, in {seconds:.1} s",
+        shares.len()
+    );
+    if !shares.is_empty() {
+        shares.sort_by(f64::total_cmp);
+        summary += &format!(
+            " ({:.0} pairs per hour); streak share min {:.3} %, median {:.3} %, max {:.3} %",
+            shares.len() as f64 * 3600.0 / seconds.max(1e-9),
+            100.0 * shares[0],
+            100.0 * quantile(&shares, 0.5),
+            100.0 * shares[shares.len() - 1]
+        );
+    }
+    eprintln!("{summary}");
+
+    if args.shard.is_some() {
+        eprintln!(
+            "when all shards are done, run: streaks dataset index {}",
+            layout.root().display()
+        );
+        return Ok(());
+    }
+    index_dir(&layout)?.finish(&layout)
+}
+
+/// Fails unless the bytes of an existing `dataset.json` describe the dataset `info`.
+fn check_existing(info: &DatasetInfo, existing: &[u8], path: &std::path::Path) -> Result<()> {
+    let value: serde_json::Value = serde_json::from_slice(existing)
+        .with_context(|| format!("{} is not a dataset.json (not JSON)", path.display()))?;
+    info.check_same(&value, path)
+}
+
+/// Creates the dataset folder and its `dataset.json`, or checks that the folder holds the
+/// same dataset; a folder with other files and no `dataset.json` is refused.
+fn prepare_folder(layout: &Layout, info: &DatasetInfo) -> Result<()> {
+    let root = layout.root();
+    std::fs::create_dir_all(root)
+        .with_context(|| format!("cannot create the dataset folder {}", root.display()))?;
+    let json = layout.dataset_json();
+    match std::fs::read(&json) {
+        Ok(existing) => check_existing(info, &existing, &json)?,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            // Another shard may be writing dataset.json right now (its temporary file
+            // `.dataset.json.*.tmp`, then the file): those do not make the folder non-empty.
+            let entries = std::fs::read_dir(root)
+                .with_context(|| format!("cannot list {}", root.display()))?;
+            for entry in entries {
+                let name = entry?.file_name().to_string_lossy().into_owned();
+                if name != "dataset.json" && !name.starts_with(".dataset.json.") {
+                    bail!(
+                        "{} is not empty (it holds {name}) and has no dataset.json: it is not a \
+                         dataset; give an empty or new folder",
+                        root.display()
+                    );
+                }
+            }
+            write_bytes_atomically(&json, &info.to_bytes()?)
+                .with_context(|| format!("cannot write into {}", root.display()))?;
+            // A shard with other settings that wrote at the same time is caught here.
+            let written =
+                std::fs::read(&json).with_context(|| format!("cannot read {}", json.display()))?;
+            check_existing(info, &written, &json)?;
+        }
+        Err(e) => return Err(e).with_context(|| format!("cannot read {}", json.display())),
+    }
+    let samples = layout.samples_dir();
+    std::fs::create_dir_all(&samples)
+        .with_context(|| format!("cannot create the folder {}", samples.display()))?;
+    Ok(())
+}

@@ -1,0 +1,342 @@
+//! `streaks dataset index DIR`: check the samples on disk and rebuild `manifest.jsonl` and
+//! `splits/{train,val,test}.txt` from the good ones.
+//!
+//! A sample is good when its folder has every file (`dataset.json`'s list, `road0.png` when
+//! its meta says so, and the files its `scene.gltf` refers to), its images, EXRs and PFMs
+//! decode at the dataset's size, its `calib.txt` parses with that size, and its `meta.json`
+//! parses and names its index. Missing samples (indices in `0..count` without a folder), corrupt
+//! ones (with the reason), stale temporary folders of interrupted runs and folders that are no
+//! sample of the dataset are reported; the command then exits non-zero, after writing the
+//! manifest and the splits of the good samples. Missing KITTI files of good samples are written
+//! again from the sample.
+//!
+//! `manifest.jsonl`: one JSON object per line, in index order, with `id`, `index`, `street`,
+//! `split`, `seed`, `render_seed`, `files` (path relative to the dataset folder -> sha256 of
+//! every file of the sample folder and of its KITTI files) and `stats` (from `meta.json`).
+
+use super::generate::sha256_hex;
+use super::layout::{sample_id, DatasetInfo, Layout, ROAD_MASK, SAMPLE_FILES, SCENE_GLTF, SPLITS};
+use super::sample::{write_kitti, SampleMeta, SampleStats};
+use anyhow::{bail, Context, Result};
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use streaks_image::exr::read_exr_rgb;
+use streaks_image::kitti::read_kitti_disparity;
+use streaks_image::pfm::read_pfm;
+use streaks_image::{write_bytes_atomically, GrayImage};
+use streaks_stereo::calib::MiddleburyCalib;
+
+/// Check a dataset folder and rebuild manifest.jsonl and splits/ from what is on disk.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// The dataset folder (with its dataset.json).
+    pub dir: PathBuf,
+}
+
+/// One line of `manifest.jsonl`.
+#[derive(Clone, Debug, Serialize)]
+pub struct ManifestLine {
+    /// The sample id.
+    pub id: String,
+    /// The sample index.
+    pub index: u64,
+    /// The street it belongs to.
+    pub street: u64,
+    /// Its split.
+    pub split: String,
+    /// The dataset seed.
+    pub seed: u64,
+    /// The render seed of the left eye.
+    pub render_seed: u32,
+    /// sha256 of each file, by path relative to the dataset folder.
+    pub files: BTreeMap<String, String>,
+    /// The sample's statistics.
+    pub stats: SampleStats,
+}
+
+/// What indexing found.
+#[derive(Debug, Default)]
+pub struct IndexReport {
+    /// Good samples.
+    pub good: usize,
+    /// Indices in `0..count` without a folder.
+    pub missing: Vec<u64>,
+    /// Folders that are not good samples, with the reason.
+    pub corrupt: Vec<(String, String)>,
+    /// KITTI files written again.
+    pub kitti_repaired: usize,
+}
+
+impl IndexReport {
+    /// Prints the report on stderr and fails if any sample is missing or corrupt.
+    pub fn finish(self, layout: &Layout) -> Result<()> {
+        let root = layout.root().display();
+        if self.kitti_repaired > 0 {
+            eprintln!("wrote {} missing KITTI files again", self.kitti_repaired);
+        }
+        for (what, why) in &self.corrupt {
+            eprintln!("corrupt: {what}: {why}");
+        }
+        if !self.missing.is_empty() {
+            let ids: Vec<String> = self.missing.iter().map(|&i| sample_id(i)).collect();
+            eprintln!("missing samples ({}): {}", ids.len(), abbreviate(&ids));
+        }
+        eprintln!(
+            "indexed {root}: {} good samples in manifest.jsonl and splits/, {} missing, {} corrupt",
+            self.good,
+            self.missing.len(),
+            self.corrupt.len()
+        );
+        if !self.missing.is_empty() || !self.corrupt.is_empty() {
+            bail!(
+                "the dataset {root} is incomplete: {} missing, {} corrupt (see above); \
+                 rerun `streaks dataset generate` with the same arguments to render and repair them",
+                self.missing.len(),
+                self.corrupt.len()
+            );
+        }
+        Ok(())
+    }
+}
+
+/// At most 20 ids, then how many more.
+fn abbreviate(ids: &[String]) -> String {
+    if ids.len() <= 20 {
+        ids.join(", ")
+    } else {
+        format!("{}, ... ({} more)", ids[..20].join(", "), ids.len() - 20)
+    }
+}
+
+/// Runs the subcommand.
+pub fn run(args: Args) -> Result<()> {
+    let layout = Layout::new(&args.dir);
+    index_dir(&layout)?.finish(&layout)
+}
+
+/// Checks every sample of the dataset in `layout`, repairs missing KITTI files, and writes
+/// `manifest.jsonl` and `splits/` of the good samples (atomically, deterministic bytes).
+pub fn index_dir(layout: &Layout) -> Result<IndexReport> {
+    let info = DatasetInfo::load(&layout.dataset_json())?;
+    let mut report = IndexReport::default();
+    let mut manifest = String::new();
+    let mut splits: BTreeMap<&str, String> = SPLITS.iter().map(|&s| (s, String::new())).collect();
+
+    // Folders of samples/ that are no sample of the dataset.
+    let samples = layout.samples_dir();
+    let mut names: Vec<String> = match std::fs::read_dir(&samples) {
+        Ok(entries) => entries
+            .map(|e| e.map(|e| e.file_name().to_string_lossy().into_owned()))
+            .collect::<Result<_, _>>()
+            .with_context(|| format!("cannot list {}", samples.display()))?,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Vec::new(),
+        Err(e) => return Err(e).with_context(|| format!("cannot list {}", samples.display())),
+    };
+    names.sort();
+    for name in &names {
+        if name.starts_with(".tmp-") {
+            report.corrupt.push((
+                format!("samples/{name}"),
+                "stale temporary folder of an interrupted run (generate removes it when it \
+                 renders or skips that sample)"
+                    .into(),
+            ));
+        } else if !(name.len() == 6
+            && name.bytes().all(|b| b.is_ascii_digit())
+            && name.parse::<u64>().is_ok_and(|i| i < info.count))
+        {
+            report.corrupt.push((
+                format!("samples/{name}"),
+                format!(
+                    "not a sample of this dataset (ids 000000 to {})",
+                    sample_id(info.count - 1)
+                ),
+            ));
+        }
+    }
+
+    for index in 0..info.count {
+        let dir = layout.sample_dir(index);
+        if !dir.is_dir() {
+            report.missing.push(index);
+            continue;
+        }
+        match check_sample(layout, &info, index, &dir, &mut report.kitti_repaired) {
+            Ok((line, split)) => {
+                let Some(list) = splits.get_mut(split.as_str()) else {
+                    report.corrupt.push((
+                        sample_id(index),
+                        format!("meta.json names the split {split:?}, not train, val or test"),
+                    ));
+                    continue;
+                };
+                list.push_str(&line.id);
+                list.push('\n');
+                manifest.push_str(&serde_json::to_string(&line)?);
+                manifest.push('\n');
+                report.good += 1;
+            }
+            Err(reason) => report
+                .corrupt
+                .push((sample_id(index), format!("{reason:#}"))),
+        }
+    }
+
+    write_bytes_atomically(&layout.manifest(), manifest.as_bytes())?;
+    let dir = layout.splits_dir();
+    std::fs::create_dir_all(&dir)
+        .with_context(|| format!("cannot create the folder {}", dir.display()))?;
+    for (split, ids) in &splits {
+        write_bytes_atomically(&dir.join(format!("{split}.txt")), ids.as_bytes())?;
+    }
+    Ok(report)
+}
+
+/// The files a sample's `scene.gltf` refers to (buffers and images with a relative `uri`).
+fn scene_files(gltf: &Path) -> Result<Vec<String>> {
+    let text = std::fs::read_to_string(gltf).context("cannot read scene.gltf")?;
+    let json: serde_json::Value = serde_json::from_str(&text).context("scene.gltf is not JSON")?;
+    let mut files = Vec::new();
+    for key in ["buffers", "images"] {
+        for item in json[key].as_array().into_iter().flatten() {
+            if let Some(uri) = item["uri"].as_str().filter(|u| !u.starts_with("data:")) {
+                files.push(uri.to_owned());
+            }
+        }
+    }
+    Ok(files)
+}
+
+/// Checks that `path` is an image of `w` x `h` pixels.
+fn check_size(
+    path: &Path,
+    (w, h): (usize, usize),
+    img: Result<GrayImage, impl Into<anyhow::Error>>,
+) -> Result<()> {
+    let img = img.map_err(Into::into)?;
+    if (img.width, img.height) != (w, h) {
+        bail!(
+            "{} is {}x{}, the dataset's images are {w}x{h}",
+            path.file_name().unwrap_or_default().to_string_lossy(),
+            img.width,
+            img.height
+        );
+    }
+    Ok(())
+}
+
+/// Checks one sample folder; returns its manifest line and split.
+fn check_sample(
+    layout: &Layout,
+    info: &DatasetInfo,
+    index: u64,
+    dir: &Path,
+    kitti_repaired: &mut usize,
+) -> Result<(ManifestLine, String)> {
+    let meta = SampleMeta::load(&dir.join("meta.json"))
+        .map_err(|e| anyhow::anyhow!("meta.json: {e:#}"))?;
+    if meta.index != index || meta.seed != info.seed || meta.config_hash != info.config_hash {
+        bail!(
+            "meta.json is of another sample or dataset (index {}, seed {}, config {})",
+            meta.index,
+            meta.seed,
+            meta.config_hash
+        );
+    }
+    let mut expected: Vec<String> = SAMPLE_FILES.map(String::from).to_vec();
+    if meta.road_mask {
+        expected.push(ROAD_MASK.to_owned());
+    }
+    expected.push(SCENE_GLTF.to_owned());
+    if dir.join(SCENE_GLTF).is_file() {
+        expected.extend(scene_files(&dir.join(SCENE_GLTF))?);
+    }
+    let absent: Vec<&String> = expected.iter().filter(|f| !dir.join(f).is_file()).collect();
+    if !absent.is_empty() {
+        let list: Vec<&str> = absent.iter().map(|s| s.as_str()).collect();
+        bail!("missing files: {}", list.join(", "));
+    }
+    let size = (info.width as usize, info.height as usize);
+    let mut pngs = vec!["im0.png", "im1.png", "streaks0.png"];
+    if meta.road_mask {
+        pngs.push(ROAD_MASK);
+    }
+    for name in pngs {
+        let p = dir.join(name);
+        check_size(&p, size, GrayImage::load(&p))?;
+    }
+    for name in ["disp0.pfm", "disp1.pfm", "depth0.pfm"] {
+        let p = dir.join(name);
+        check_size(&p, size, read_pfm(&p))?;
+    }
+    for name in ["im0.exr", "im1.exr"] {
+        let p = dir.join(name);
+        let img = read_exr_rgb(&p)?;
+        if (img.width as usize, img.height as usize) != size {
+            bail!(
+                "{name} is {}x{}, the dataset's images are {}x{}",
+                img.width,
+                img.height,
+                size.0,
+                size.1
+            );
+        }
+    }
+    let calib = MiddleburyCalib::load(&dir.join("calib.txt"))?;
+    if (calib.width, calib.height) != (info.width, info.height) {
+        bail!(
+            "calib.txt is for {}x{}, the dataset's images are {}x{}",
+            calib.width,
+            calib.height,
+            info.width,
+            info.height
+        );
+    }
+
+    // The KITTI view: written again where missing.
+    let kitti = layout.kitti(index);
+    let named = kitti.named(layout);
+    if named.iter().any(|(_, p)| !p.is_file()) {
+        let missing = named.iter().filter(|(_, p)| !p.is_file()).count();
+        write_kitti(layout, index, dir, &read_pfm(&dir.join("disp0.pfm"))?)?;
+        *kitti_repaired += missing;
+    }
+    check_size(
+        &kitti.disp_occ_0,
+        size,
+        read_kitti_disparity(&kitti.disp_occ_0),
+    )?;
+
+    let mut files = BTreeMap::new();
+    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
+        .with_context(|| format!("cannot list {}", dir.display()))?
+        .map(|e| e.map(|e| e.path()))
+        .collect::<Result<_, _>>()?;
+    entries.sort();
+    for path in entries
+        .iter()
+        .map(PathBuf::as_path)
+        .chain(named.iter().map(|(_, p)| *p))
+    {
+        if !path.is_file() {
+            bail!("{} is not a file", layout.relative(path));
+        }
+        let bytes =
+            std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
+        files.insert(layout.relative(path), sha256_hex(&bytes));
+    }
+    Ok((
+        ManifestLine {
+            id: sample_id(index),
+            index,
+            street: meta.street,
+            split: meta.split.clone(),
+            seed: meta.seed,
+            render_seed: meta.render_seed,
+            files,
+            stats: meta.stats,
+        },
+        meta.split,
+    ))
+}

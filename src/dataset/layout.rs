@@ -1,0 +1,377 @@
+//! The dataset folder: where each file goes, `dataset.json` and the conventions it states.
+//!
+//! ```text
+//! DIR/dataset.json                      settings, generator version, config, conventions
+//! DIR/samples/NNNNNN/                   one sample (Middlebury style, see SAMPLE_FILES)
+//! DIR/samples/.tmp-NNNNNN-PID/          a sample being rendered (renamed when complete)
+//! DIR/kitti/training/image_2/NNNNNN_10.png       = im0.png
+//! DIR/kitti/training/image_3/NNNNNN_10.png       = im1.png
+//! DIR/kitti/training/disp_occ_0/NNNNNN_10.png    disp0 as uint16 x 256, 0 = no value
+//! DIR/manifest.jsonl                    one line per good sample (`streaks dataset index`)
+//! DIR/splits/{train,val,test}.txt       sample ids, split by street
+//! ```
+
+use anyhow::{bail, Context, Result};
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// The format of `dataset.json` and of the folder it describes.
+pub const FORMAT: &str = "streaks-dataset/1";
+
+/// Sample ids have six digits: at most this many samples.
+pub const MAX_COUNT: u64 = 1_000_000;
+
+/// The files of every sample folder besides the scene's, sorted.
+pub const SAMPLE_FILES: [&str; 10] = [
+    "calib.txt",
+    "depth0.pfm",
+    "disp0.pfm",
+    "disp1.pfm",
+    "im0.exr",
+    "im0.png",
+    "im1.exr",
+    "im1.png",
+    "meta.json",
+    "streaks0.png",
+];
+
+/// The road-surface mask, present when the scene flags a road material.
+pub const ROAD_MASK: &str = "road0.png";
+
+/// The scene's glTF in a sample folder (with `scene.bin` and its `scene_*.png` textures).
+pub const SCENE_GLTF: &str = "scene.gltf";
+
+/// The splits, in the order of `splits/`.
+pub const SPLITS: [&str; 3] = ["train", "val", "test"];
+
+/// The id (folder name) of sample `index`: six digits.
+pub fn sample_id(index: u64) -> String {
+    format!("{index:06}")
+}
+
+/// The three KITTI 2015 files of one sample.
+#[derive(Clone, Debug)]
+pub struct KittiFiles {
+    /// `image_2/NNNNNN_10.png`: the left image.
+    pub image_2: PathBuf,
+    /// `image_3/NNNNNN_10.png`: the right image.
+    pub image_3: PathBuf,
+    /// `disp_occ_0/NNNNNN_10.png`: the left disparity, uint16 x 256.
+    pub disp_occ_0: PathBuf,
+}
+
+impl KittiFiles {
+    /// The three paths with their names relative to the dataset folder.
+    pub fn named(&self, layout: &Layout) -> [(String, &Path); 3] {
+        [&self.image_2, &self.image_3, &self.disp_occ_0].map(|p| (layout.relative(p), p.as_path()))
+    }
+}
+
+/// The paths of a dataset folder.
+#[derive(Clone, Debug)]
+pub struct Layout {
+    root: PathBuf,
+}
+
+impl Layout {
+    /// The layout of the folder `root`.
+    pub fn new(root: &Path) -> Self {
+        Self {
+            root: root.to_path_buf(),
+        }
+    }
+
+    /// The dataset folder.
+    pub fn root(&self) -> &Path {
+        &self.root
+    }
+
+    /// `dataset.json`.
+    pub fn dataset_json(&self) -> PathBuf {
+        self.root.join("dataset.json")
+    }
+
+    /// `manifest.jsonl`.
+    pub fn manifest(&self) -> PathBuf {
+        self.root.join("manifest.jsonl")
+    }
+
+    /// `splits/`.
+    pub fn splits_dir(&self) -> PathBuf {
+        self.root.join("splits")
+    }
+
+    /// `samples/`.
+    pub fn samples_dir(&self) -> PathBuf {
+        self.root.join("samples")
+    }
+
+    /// `samples/NNNNNN/`.
+    pub fn sample_dir(&self, index: u64) -> PathBuf {
+        self.samples_dir().join(sample_id(index))
+    }
+
+    /// The name prefix of sample `index`'s temporary folders: `.tmp-NNNNNN-`.
+    pub fn tmp_prefix(index: u64) -> String {
+        format!(".tmp-{}-", sample_id(index))
+    }
+
+    /// This process's temporary folder for sample `index`: `samples/.tmp-NNNNNN-PID/`.
+    pub fn tmp_dir(&self, index: u64) -> PathBuf {
+        self.samples_dir()
+            .join(format!("{}{}", Self::tmp_prefix(index), std::process::id()))
+    }
+
+    /// The KITTI view's files of sample `index`.
+    pub fn kitti(&self, index: u64) -> KittiFiles {
+        let dir = self.root.join("kitti").join("training");
+        let name = format!("{}_10.png", sample_id(index));
+        KittiFiles {
+            image_2: dir.join("image_2").join(&name),
+            image_3: dir.join("image_3").join(&name),
+            disp_occ_0: dir.join("disp_occ_0").join(&name),
+        }
+    }
+
+    /// `path` relative to the dataset folder, with `/` separators (for the manifest).
+    pub fn relative(&self, path: &Path) -> String {
+        let rel = path.strip_prefix(&self.root).unwrap_or(path);
+        rel.components()
+            .map(|c| c.as_os_str().to_string_lossy())
+            .collect::<Vec<_>>()
+            .join("/")
+    }
+}
+
+/// The conventions of the files, stated in `dataset.json`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Conventions {
+    /// Coordinates of the world, the cameras and the pixels.
+    pub coordinates: String,
+    /// Disparity: sign, units, no value.
+    pub disparity: String,
+    /// Depth.
+    pub depth: String,
+    /// The PFM files.
+    pub pfm: String,
+    /// The images.
+    pub images: String,
+    /// The masks.
+    pub masks: String,
+    /// `calib.txt`.
+    pub calib: String,
+    /// The KITTI view.
+    pub kitti: String,
+    /// The splits.
+    pub splits: String,
+    /// Seeds.
+    pub seeds: String,
+}
+
+impl Conventions {
+    /// This version's conventions.
+    pub fn current() -> Self {
+        let s = |t: &str| t.to_owned();
+        Self {
+            coordinates: s("world: glTF's (right-handed, +Y up, metres, road at Y = 0); cameras look along local -Z with +Y up; \
+                 pixels: x right, y down, pixel (i, j) covers [i, i+1) x [j, j+1); the rig centre is the scene's camera, \
+                 left eye at -b/2 and right eye at +b/2 along its +X, same orientation and intrinsics (rectified)"),
+            disparity: s("pixels, d = x_left - x_right = f b / Z > 0 in front of the rig; disp0 is the left view's, \
+                 disp1 the right view's (its match in the left view is at x + d); inf = no value (the pixel-centre ray hits nothing)"),
+            depth: s("depth0.pfm: view-space depth Z in metres of the left view's pixel-centre first hit (along the camera's -Z), inf = none"),
+            pfm: s("Middlebury/SceneFlow: greyscale 'Pf', scale -1 (little-endian), rows stored bottom to top, inf = no value"),
+            images: s("im0/im1.png: 8-bit sRGB of the linear render times 2^exposure_ev (meta.json), clipped; \
+                 im0/im1.exr: linear float32 RGB with the layers depth.Z, normal.X/Y/Z and specular.R/G/B"),
+            masks: s("8-bit greyscale PNG, 0 or 255: streaks0.png the left view's streak pixels (specular layer threshold), \
+                 road0.png the left pixels whose first hit is a road material (extras.streaks.road), absent when the scene flags none"),
+            calib: s("Middlebury 2014 calib.txt: cam0/cam1 = [f 0 cx; 0 f cy; 0 0 1] with the top-left pixel centre at (0, 0), \
+                 doffs = 0, baseline in mm, ndisp a multiple of 16 above the largest disparity, vmin/vmax the finite disparity range"),
+            kitti: s("KITTI 2015: image_2 = im0.png, image_3 = im1.png, disp_occ_0 = disp0 as uint16 PNG of round(256 d), 0 = no value \
+                 (also disparities that do not fit in 1..65535)"),
+            splits: s("by street: every sample of one street is in the same split (splits/{train,val,test}.txt, sample ids)"),
+            seeds: s("each sample is reproducible from (config, seed, index); its render seed is derived from (seed, index), \
+                 the right eye uses render seed + 1"),
+        }
+    }
+}
+
+/// The files of a sample, as `dataset.json` lists them.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FileList {
+    /// In every sample folder.
+    pub sample: Vec<String>,
+    /// In a sample folder under a condition (file -> condition).
+    pub optional: BTreeMap<String, String>,
+    /// The scene's files in a sample folder.
+    pub scene: Vec<String>,
+    /// The sample's KITTI files (NNNNNN = the sample id).
+    pub kitti: Vec<String>,
+}
+
+impl FileList {
+    /// This version's files.
+    pub fn current() -> Self {
+        Self {
+            sample: SAMPLE_FILES.map(String::from).to_vec(),
+            optional: BTreeMap::from([(
+                ROAD_MASK.to_owned(),
+                "the scene flags a road material (meta.json road_mask)".to_owned(),
+            )]),
+            scene: vec![
+                SCENE_GLTF.to_owned(),
+                "scene.bin".to_owned(),
+                "scene_*.png (the textures scene.gltf refers to)".to_owned(),
+            ],
+            kitti: vec![
+                "kitti/training/image_2/NNNNNN_10.png".to_owned(),
+                "kitti/training/image_3/NNNNNN_10.png".to_owned(),
+                "kitti/training/disp_occ_0/NNNNNN_10.png".to_owned(),
+            ],
+        }
+    }
+}
+
+/// The contents of `dataset.json`: everything that makes two runs the same dataset (nothing
+/// that depends on the shard, the machine or the time, so every shard writes the same bytes).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DatasetInfo {
+    /// [`FORMAT`].
+    pub format: String,
+    /// The procedural generator's version.
+    pub generator_version: String,
+    /// The generator config.
+    pub config: Value,
+    /// sha256 of the config's TOML.
+    pub config_hash: String,
+    /// Number of samples (indices `0..count`).
+    pub count: u64,
+    /// The dataset seed.
+    pub seed: u64,
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Samples per pixel per eye.
+    pub spp: u32,
+    /// Longest path (Mitsuba's meaning).
+    pub max_depth: u32,
+    /// The files.
+    pub files: FileList,
+    /// The conventions.
+    pub conventions: Conventions,
+}
+
+impl DatasetInfo {
+    /// Reads `dataset.json`.
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read {}", path.display()))?;
+        serde_json::from_str(&text)
+            .with_context(|| format!("{} is not a dataset.json of {FORMAT}", path.display()))
+    }
+
+    /// The file's bytes (pretty JSON, a final newline).
+    pub fn to_bytes(&self) -> Result<Vec<u8>> {
+        let mut text = serde_json::to_string_pretty(self)?;
+        text.push('\n');
+        Ok(text.into_bytes())
+    }
+
+    /// Fails, naming the first field that differs, unless `existing` (the folder's
+    /// `dataset.json` as JSON) describes the same dataset as `self`.
+    pub fn check_same(&self, existing: &Value, path: &Path) -> Result<()> {
+        let new = serde_json::to_value(self)?;
+        if let Some((field, old, new)) = first_difference("", existing, &new) {
+            bail!(
+                "{} describes another dataset: its {field} is {old}, this run's is {new}; \
+                 datasets are not mixed: write into another folder (or remove this one)",
+                path.display()
+            );
+        }
+        Ok(())
+    }
+}
+
+/// The first path (`a.b.c`) at which two JSON values differ, with both values.
+fn first_difference(at: &str, old: &Value, new: &Value) -> Option<(String, String, String)> {
+    let join = |key: &str| {
+        if at.is_empty() {
+            key.to_owned()
+        } else {
+            format!("{at}.{key}")
+        }
+    };
+    match (old, new) {
+        (Value::Object(a), Value::Object(b)) => {
+            let mut keys: Vec<&String> = a.keys().chain(b.keys()).collect();
+            keys.sort();
+            keys.dedup();
+            let null = Value::Null;
+            keys.into_iter().find_map(|k| {
+                first_difference(
+                    &join(k),
+                    a.get(k).unwrap_or(&null),
+                    b.get(k).unwrap_or(&null),
+                )
+            })
+        }
+        (a, b) if a == b => None,
+        (a, b) => Some((
+            if at.is_empty() {
+                "content".into()
+            } else {
+                at.to_owned()
+            },
+            short(a),
+            short(b),
+        )),
+    }
+}
+
+/// A JSON value for a message, cut to 80 characters.
+fn short(v: &Value) -> String {
+    let s = v.to_string();
+    if s.chars().count() > 80 {
+        format!("{}...", s.chars().take(77).collect::<String>())
+    } else {
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    #[test]
+    fn differences_are_named_by_path() {
+        let a = json!({"count": 3, "config": {"street": {"lanes": [1, 2]}}, "seed": 0});
+        let b = json!({"count": 3, "config": {"street": {"lanes": [1, 3]}}, "seed": 0});
+        let (field, old, new) = first_difference("", &a, &b).unwrap();
+        assert_eq!(
+            (field.as_str(), old.as_str(), new.as_str()),
+            ("config.street.lanes", "[1,2]", "[1,3]")
+        );
+        assert!(first_difference("", &a, &a).is_none());
+        let c = json!({"count": 3, "config": {"street": {"lanes": [1, 2]}}});
+        assert_eq!(first_difference("", &a, &c).unwrap().0, "seed");
+    }
+
+    #[test]
+    fn paths_follow_the_layout() {
+        let l = Layout::new(Path::new("/d"));
+        assert_eq!(l.sample_dir(7), Path::new("/d/samples/000007"));
+        assert_eq!(Layout::tmp_prefix(12), ".tmp-000012-");
+        let k = l.kitti(3);
+        assert_eq!(
+            k.named(&l).map(|(n, _)| n),
+            [
+                "kitti/training/image_2/000003_10.png",
+                "kitti/training/image_3/000003_10.png",
+                "kitti/training/disp_occ_0/000003_10.png"
+            ]
+        );
+    }
+}

@@ -1,0 +1,42 @@
+//! `streaks dataset`: generate stereo datasets of procedural rainy streets, and index them.
+//!
+//! - [`generate`]: `streaks dataset generate -o DIR --count N ...` renders the samples (or one
+//!   shard of them) into `DIR/samples/NNNNNN/`, each published atomically, with its KITTI view;
+//! - [`index`]: `streaks dataset index DIR` checks what is on disk and rebuilds
+//!   `manifest.jsonl` and `splits/`;
+//! - [`layout`]: the folder layout, `dataset.json` and the conventions it states;
+//! - [`sample`]: rendering and writing one sample;
+//! - [`shard`]: `--shard K/N`.
+//!
+//! The README's "Datasets" section describes the layout and the conventions for users.
+
+pub mod generate;
+pub mod index;
+pub mod layout;
+pub mod sample;
+pub mod shard;
+
+use anyhow::Result;
+
+/// Generate stereo datasets of procedural rainy streets, and index them.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(clap::Subcommand, Debug)]
+enum Command {
+    /// Render samples (all, or one shard) into a dataset folder; resumable.
+    Generate(generate::Args),
+    /// Check a dataset folder and rebuild manifest.jsonl and splits/ from what is on disk.
+    Index(index::Args),
+}
+
+/// Runs the subcommand.
+pub fn run(args: Args) -> Result<()> {
+    match args.command {
+        Command::Generate(a) => generate::run(a),
+        Command::Index(a) => index::run(a),
+    }
+}

@@ -1,0 +1,318 @@
+//! End-to-end tests of `streaks dataset generate` and `streaks dataset index`: determinism
+//! (repeated, other thread counts, sharded), resuming and repair, the ground truth's formats,
+//! and bad input. Tiny images (64 x 40 at 2 spp) keep them fast in debug builds.
+
+use crate::common::TestDir;
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::process::Command;
+use streaks_image::kitti::read_kitti_disparity;
+use streaks_image::pfm::read_pfm;
+use streaks_stereo::calib::MiddleburyCalib;
+
+/// The image flags of the test datasets: 64 x 40 at 2 spp.
+const SMALL: [&str; 6] = ["--width", "64", "--height", "40", "--spp", "2"];
+
+/// `streaks dataset generate -o DIR --count 3` with the small flags and `extra`.
+fn generate(t: &TestDir, dir: &str, extra: &[&str]) -> crate::common::Run {
+    generate_n(t, dir, "3", extra)
+}
+
+/// `streaks dataset generate -o DIR --count N` with the small flags and `extra`.
+fn generate_n(t: &TestDir, dir: &str, count: &str, extra: &[&str]) -> crate::common::Run {
+    let mut args = vec!["dataset", "generate", "-o", dir, "--count", count];
+    args.extend(SMALL);
+    args.extend(extra);
+    t.streaks(&args)
+}
+
+/// Every file under `root` (relative path -> bytes).
+fn tree(root: &Path) -> BTreeMap<String, Vec<u8>> {
+    fn walk(root: &Path, dir: &Path, out: &mut BTreeMap<String, Vec<u8>>) {
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                walk(root, &path, out);
+            } else {
+                let rel = path
+                    .strip_prefix(root)
+                    .unwrap()
+                    .to_string_lossy()
+                    .into_owned();
+                out.insert(rel, std::fs::read(&path).unwrap());
+            }
+        }
+    }
+    let mut out = BTreeMap::new();
+    walk(root, root, &mut out);
+    out
+}
+
+/// Panics naming the first file that differs between two trees.
+fn assert_same_tree(a: &Path, b: &Path) {
+    let (ta, tb) = (tree(a), tree(b));
+    let names = |t: &BTreeMap<String, Vec<u8>>| t.keys().cloned().collect::<Vec<_>>();
+    assert_eq!(
+        names(&ta),
+        names(&tb),
+        "{} and {}",
+        a.display(),
+        b.display()
+    );
+    for (name, bytes) in &ta {
+        assert!(
+            bytes == &tb[name],
+            "{name} differs between {} and {}",
+            a.display(),
+            b.display()
+        );
+    }
+}
+
+#[test]
+fn datasets_are_byte_identical_across_runs_threads_and_shards() {
+    let t = TestDir::new();
+    generate(&t, "a", &["--threads", "1"]).assert_success();
+    generate(&t, "b", &["--threads", "1"]).assert_success();
+    assert_same_tree(&t.join("a"), &t.join("b"));
+    generate(&t, "c", &["--threads", "2"]).assert_success();
+    assert_same_tree(&t.join("a"), &t.join("c"));
+
+    // Two shards at the same time into one folder, then the index.
+    let shard = |k: &str| {
+        let mut args = vec!["dataset", "generate", "-o", "d", "--count", "3"];
+        args.extend(["--threads", "1", "--shard", k]);
+        args.extend(SMALL);
+        Command::new(env!("CARGO_BIN_EXE_streaks"))
+            .args(&args)
+            .current_dir(t.path())
+            .env("CI", "true")
+            .output()
+            .unwrap()
+    };
+    let (s0, s1) = std::thread::scope(|s| {
+        let h0 = s.spawn(|| shard("0/2"));
+        let h1 = s.spawn(|| shard("1/2"));
+        (h0.join().unwrap(), h1.join().unwrap())
+    });
+    for out in [&s0, &s1] {
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{err}");
+        assert!(err.contains("streaks dataset index"), "{err}");
+    }
+    assert!(!t.join("d/manifest.jsonl").exists());
+    t.streaks(&["dataset", "index", "d"]).assert_success();
+    assert_same_tree(&t.join("a"), &t.join("d"));
+
+    // The layout of a sample and of the dataset.
+    let files = t.files_in("a/samples/000001");
+    for f in [
+        "calib.txt",
+        "depth0.pfm",
+        "disp0.pfm",
+        "disp1.pfm",
+        "im0.exr",
+        "im0.png",
+        "im1.exr",
+        "im1.png",
+        "meta.json",
+        "road0.png",
+        "scene.bin",
+        "scene.gltf",
+        "streaks0.png",
+    ] {
+        assert!(files.contains(&f.to_owned()), "{f} missing from {files:?}");
+    }
+    let manifest = std::fs::read_to_string(t.join("a/manifest.jsonl")).unwrap();
+    let lines: Vec<serde_json::Value> = manifest
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(lines.len(), 3);
+    let mut in_splits = Vec::new();
+    for split in ["train", "val", "test"] {
+        let text = std::fs::read_to_string(t.join(&format!("a/splits/{split}.txt"))).unwrap();
+        in_splits.extend(text.lines().map(|id| (id.to_owned(), split.to_owned())));
+    }
+    in_splits.sort();
+    for (k, line) in lines.iter().enumerate() {
+        let id = format!("{k:06}");
+        assert_eq!(line["id"], id.as_str());
+        assert_eq!(
+            in_splits[k],
+            (id.clone(), line["split"].as_str().unwrap().to_owned())
+        );
+        let files = line["files"].as_object().unwrap();
+        let sha = files[&format!("samples/{id}/im0.png")].as_str().unwrap();
+        assert_eq!(sha.len(), 64);
+        assert_eq!(files[&format!("kitti/training/image_2/{id}_10.png")], sha);
+        assert!(files.contains_key(&format!("kitti/training/disp_occ_0/{id}_10.png")));
+    }
+    let info: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(t.join("a/dataset.json")).unwrap()).unwrap();
+    assert_eq!(
+        (info["count"].as_u64(), info["width"].as_u64()),
+        (Some(3), Some(64))
+    );
+    assert!(info["conventions"]["pfm"]
+        .as_str()
+        .unwrap()
+        .contains("bottom to top"));
+
+    // A rerun skips every sample and changes nothing.
+    let run = generate(&t, "a", &[]);
+    run.assert_success();
+    assert!(
+        run.stderr().contains("0 samples rendered, 3 already done"),
+        "{}",
+        run.stderr()
+    );
+    assert_same_tree(&t.join("a"), &t.join("b"));
+}
+
+#[test]
+fn ground_truth_reads_back_as_stereo_loaders_read_it() {
+    let t = TestDir::new();
+    generate_n(&t, "ds", "1", &[]).assert_success();
+    let dir = t.join("ds/samples/000000");
+    let disp = read_pfm(&dir.join("disp0.pfm")).unwrap();
+    let depth = read_pfm(&dir.join("depth0.pfm")).unwrap();
+    assert_eq!((disp.width, disp.height), (64, 40));
+    // KITTI: uint16 / 256 equals the PFM within 1/256 px; 0 where the PFM has no value.
+    let kitti =
+        read_kitti_disparity(&t.join("ds/kitti/training/disp_occ_0/000000_10.png")).unwrap();
+    let mut finite = 0;
+    for (k, d) in kitti.data.iter().zip(&disp.data) {
+        if d.is_finite() && *d * 256.0 >= 0.5 {
+            assert!((k - d).abs() <= 1.0 / 256.0, "{k} {d}");
+            finite += 1;
+        } else {
+            assert_eq!(*k, f32::INFINITY, "{d}");
+        }
+    }
+    assert!(finite > disp.data.len() / 4, "{finite} finite disparities");
+    // calib.txt: d = f b / Z with its f and baseline (mm), and vmin/vmax/ndisp bound it.
+    let calib = MiddleburyCalib::load(&dir.join("calib.txt")).unwrap();
+    assert_eq!((calib.width, calib.height, calib.doffs), (64, 40, 0.0));
+    let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+    for (d, z) in disp.data.iter().zip(&depth.data) {
+        assert_eq!(d.is_finite(), z.is_finite());
+        if d.is_finite() {
+            let expect = calib.focal_px * calib.baseline_mm / 1000.0 / *z as f64;
+            assert!(
+                (*d as f64 - expect).abs() <= 1e-4 * expect.max(1.0),
+                "{d} {expect}"
+            );
+            lo = lo.min(*d as f64);
+            hi = hi.max(*d as f64);
+        }
+    }
+    // vmin/vmax are the f32 disparities in their shortest decimal form.
+    assert_eq!(
+        (calib.vmin as f32, calib.vmax as f32),
+        (lo as f32, hi as f32)
+    );
+    assert!(calib.ndisp as f64 > hi && calib.ndisp % 16 == 0);
+    // image_2 is im0.png, image_3 is im1.png.
+    let bytes = |p: &str| std::fs::read(t.join(p)).unwrap();
+    assert_eq!(
+        bytes("ds/kitti/training/image_2/000000_10.png"),
+        bytes("ds/samples/000000/im0.png")
+    );
+    assert_eq!(
+        bytes("ds/kitti/training/image_3/000000_10.png"),
+        bytes("ds/samples/000000/im1.png")
+    );
+    // The streak mask is 0/255.
+    let mask = image::open(dir.join("streaks0.png")).unwrap().into_luma8();
+    assert!(mask.pixels().all(|p| p.0[0] == 0 || p.0[0] == 255));
+    let meta: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("meta.json")).unwrap()).unwrap();
+    assert_eq!(meta["index"], 0);
+    // The generator flags its road: road0.png marks the road's first hits, 0/255, and only
+    // pixels with a finite depth.
+    assert_eq!(meta["road_mask"], true);
+    let road = image::open(dir.join("road0.png")).unwrap().into_luma8();
+    let road_pixels = road.pixels().filter(|p| p.0[0] == 255).count();
+    assert!(road.pixels().all(|p| p.0[0] == 0 || p.0[0] == 255));
+    assert!(road_pixels > 0 && road_pixels < 64 * 40, "{road_pixels}");
+    for (p, z) in road.pixels().zip(&depth.data) {
+        assert!(p.0[0] == 0 || z.is_finite());
+    }
+    let share = meta["stats"]["road_share"].as_f64().unwrap();
+    assert_eq!(share, road_pixels as f64 / (64.0 * 40.0));
+    assert!(meta["rig"]["baseline_m"].as_f64().unwrap() > 0.0);
+    assert!(meta["stats"]["disparity_max"].as_f64().unwrap() > 0.0);
+    assert!(meta.get("seconds").is_none());
+}
+
+#[test]
+fn interrupted_and_damaged_datasets_are_reported_then_repaired() {
+    let t = TestDir::new();
+    generate(&t, "ds", &[]).assert_success();
+    let good = tree(&t.join("ds"));
+    // A sample with a file removed, a stale temporary folder, a missing sample and a missing
+    // KITTI file.
+    std::fs::remove_file(t.join("ds/samples/000001/disp0.pfm")).unwrap();
+    std::fs::create_dir(t.join("ds/samples/.tmp-000000-4242")).unwrap();
+    std::fs::write(t.join("ds/samples/.tmp-000000-4242/im0.png"), b"half").unwrap();
+    std::fs::remove_dir_all(t.join("ds/samples/000002")).unwrap();
+    std::fs::remove_file(t.join("ds/kitti/training/image_3/000000_10.png")).unwrap();
+    let run = t.streaks(&["dataset", "index", "ds"]);
+    run.assert_failure_mentioning("incomplete");
+    let err = run.stderr();
+    assert!(err.contains("000001: missing files: disp0.pfm"), "{err}");
+    assert!(
+        err.contains("samples/.tmp-000000-4242: stale temporary folder"),
+        "{err}"
+    );
+    assert!(err.contains("missing samples (1): 000002"), "{err}");
+    // The good sample's KITTI file is written again; the manifest lists the good sample only.
+    assert_eq!(
+        std::fs::read(t.join("ds/kitti/training/image_3/000000_10.png")).unwrap(),
+        good["kitti/training/image_3/000000_10.png"]
+    );
+    let manifest = std::fs::read_to_string(t.join("ds/manifest.jsonl")).unwrap();
+    assert_eq!(manifest.lines().count(), 1);
+    // A rerun renders what is missing, removes the stale folder, and the dataset is whole.
+    let run = generate(&t, "ds", &[]);
+    run.assert_success();
+    assert!(
+        run.stderr().contains("2 samples rendered, 1 already done"),
+        "{}",
+        run.stderr()
+    );
+    assert_eq!(tree(&t.join("ds")), good);
+}
+
+#[test]
+fn bad_dataset_arguments_are_refused() {
+    let t = TestDir::new();
+    generate(&t, "x", &["--shard", "2/2"]).assert_failure_mentioning("less than N = 2");
+    generate(&t, "x", &["--shard", "1"]).assert_failure_mentioning("K/N");
+    generate(&t, "x", &["--config", "none.toml"]).assert_failure_mentioning("none.toml");
+    std::fs::write(t.join("bad.toml"), "[street\nlanes = ").unwrap();
+    generate(&t, "x", &["--config", "bad.toml"]).assert_failure_mentioning("bad.toml");
+    std::fs::write(t.join("unknown.toml"), "[street]\nlanez = [1, 2]\n").unwrap();
+    generate(&t, "x", &["--config", "unknown.toml"]).assert_failure_mentioning("lanez");
+    std::fs::write(t.join("range.toml"), "[rig]\nbaseline = [0.4, 0.1]\n").unwrap();
+    generate(&t, "x", &["--config", "range.toml"]).assert_failure_mentioning("rig.baseline");
+    generate_n(&t, "x", "0", &[]).assert_failure_mentioning("--count");
+    // Nothing was written by the refused runs.
+    assert!(!t.join("x").exists());
+    // A folder with other files is not a dataset.
+    std::fs::create_dir(t.join("other")).unwrap();
+    std::fs::write(t.join("other/notes.txt"), "mine").unwrap();
+    generate(&t, "other", &[]).assert_failure_mentioning("not a dataset");
+    // A folder with another dataset: the differing setting is named.
+    generate_n(&t, "ds", "1", &[]).assert_success();
+    generate_n(&t, "ds", "1", &["--seed", "7"])
+        .assert_failure_mentioning("its seed is 0, this run's is 7");
+    let mut args = vec!["dataset", "generate", "-o", "ds", "--count", "1"];
+    args.extend(["--width", "64", "--height", "40", "--spp", "4"]);
+    t.streaks(&args)
+        .assert_failure_mentioning("its spp is 2, this run's is 4");
+    generate(&t, "ds", &[]).assert_failure_mentioning("count");
+    t.streaks(&["dataset", "index", "nowhere"])
+        .assert_failure_mentioning("nowhere");
+}
