@@ -532,17 +532,33 @@ pub fn sgm(left: &GrayImage, right: &GrayImage, params: &SgmParams) -> Result<Gr
 }
 
 /// Errors of an estimate against ground truth.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+///
+/// The shares of estimated pixels (`bad`, `bad_1`, `bad_2`, `bad_3`, `d1`) and the errors
+/// (`mean_abs`, `rms`) are over the pixels with both a finite truth and a finite estimate;
+/// `density`, `bad_all` and `below_1px` are over the pixels with a finite truth.
+/// [`DisparityErrors::pooled`] combines the errors of several images pixel-weighted.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct DisparityErrors {
     /// Pixels with a finite ground truth.
     pub truth_pixels: usize,
-    /// Fraction of those with a finite estimate (density).
+    /// Of those, the pixels with a finite estimate.
+    pub valid_pixels: usize,
+    /// Fraction of those with a finite estimate (density, the valid share).
     pub density: f64,
     /// Fraction of the estimated ones off by more than the threshold (bad-T).
     pub bad: f64,
     /// Fraction of all ground-truth pixels that are missing or off by more than the threshold.
     pub bad_all: f64,
-    /// Mean absolute error over estimated pixels.
+    /// Fraction of the estimated ones off by more than 1 px (bad-1).
+    pub bad_1: f64,
+    /// Fraction of the estimated ones off by more than 2 px (bad-2).
+    pub bad_2: f64,
+    /// Fraction of the estimated ones off by more than 3 px (bad-3).
+    pub bad_3: f64,
+    /// KITTI 2015's D1: fraction of the estimated ones off by more than 3 px *and* by more
+    /// than 5 % of the true disparity.
+    pub d1: f64,
+    /// Mean absolute error over estimated pixels (the end-point error, EPE).
     pub mean_abs: f64,
     /// Root-mean-square error over estimated pixels.
     pub rms: f64,
@@ -552,6 +568,53 @@ pub struct DisparityErrors {
     /// (farther away). Over road pixels this is the phantom-hole rate: the share of the road
     /// that stereo puts beneath the road.
     pub below_1px: f64,
+}
+
+impl DisparityErrors {
+    /// The errors of the union of disjoint pixel sets, from the errors of each (pixel-weighted:
+    /// every pixel counts once, the KITTI convention), all with the same threshold. `None`
+    /// for an empty list or differing thresholds.
+    pub fn pooled(parts: &[DisparityErrors]) -> Option<DisparityErrors> {
+        let threshold = parts.first()?.threshold;
+        if parts.iter().any(|p| p.threshold != threshold) {
+            return None;
+        }
+        let n: usize = parts.iter().map(|p| p.truth_pixels).sum();
+        let m: usize = parts.iter().map(|p| p.valid_pixels).sum();
+        // Each share times its own denominator is a count; their sums over the parts are the
+        // union's counts.
+        let over_valid = |f: fn(&DisparityErrors) -> f64| {
+            let c: f64 = parts.iter().map(|p| f(p) * p.valid_pixels as f64).sum();
+            if m > 0 {
+                c / m as f64
+            } else {
+                0.0
+            }
+        };
+        let over_truth = |f: fn(&DisparityErrors) -> f64| {
+            let c: f64 = parts.iter().map(|p| f(p) * p.truth_pixels as f64).sum();
+            if n > 0 {
+                c / n as f64
+            } else {
+                0.0
+            }
+        };
+        Some(DisparityErrors {
+            truth_pixels: n,
+            valid_pixels: m,
+            density: if n > 0 { m as f64 / n as f64 } else { 0.0 },
+            bad: over_valid(|p| p.bad),
+            bad_all: over_truth(|p| p.bad_all),
+            bad_1: over_valid(|p| p.bad_1),
+            bad_2: over_valid(|p| p.bad_2),
+            bad_3: over_valid(|p| p.bad_3),
+            d1: over_valid(|p| p.d1),
+            mean_abs: over_valid(|p| p.mean_abs),
+            rms: over_valid(|p| p.rms * p.rms).sqrt(),
+            threshold,
+            below_1px: over_truth(|p| p.below_1px),
+        })
+    }
 }
 
 /// Compares an estimate with ground truth (both `inf` where there is no value).
@@ -580,7 +643,8 @@ pub fn compare_disparity_where(
         });
     }
     let (mut n, mut m, mut bad, mut sa, mut ss) = (0usize, 0usize, 0usize, 0.0f64, 0.0f64);
-    let mut below = 0usize;
+    let (mut below, mut over) = (0usize, [0usize; 3]);
+    let mut d1 = 0usize;
     for (i, (&e, &t)) in estimate.data.iter().zip(&truth.data).enumerate() {
         if !t.is_finite() || !select(i) {
             continue;
@@ -595,15 +659,24 @@ pub fn compare_disparity_where(
             bad += 1;
         }
         below += usize::from(e < t - 1.0);
+        for (k, c) in over.iter_mut().enumerate() {
+            *c += usize::from(err > (k + 1) as f64);
+        }
+        d1 += usize::from(err > 3.0 && err > 0.05 * t.abs() as f64);
         sa += err;
         ss += err * err;
     }
     let frac = |a: usize, b: usize| if b > 0 { a as f64 / b as f64 } else { 0.0 };
     Ok(DisparityErrors {
         truth_pixels: n,
+        valid_pixels: m,
         density: frac(m, n),
         bad: frac(bad, m),
         bad_all: frac(bad + n - m, n),
+        bad_1: frac(over[0], m),
+        bad_2: frac(over[1], m),
+        bad_3: frac(over[2], m),
+        d1: frac(d1, m),
         mean_abs: if m > 0 { sa / m as f64 } else { 0.0 },
         rms: if m > 0 { (ss / m as f64).sqrt() } else { 0.0 },
         threshold,
@@ -773,6 +846,48 @@ mod tests {
         );
         let none = compare_disparity_where(&est, &truth, 2.0, |_| false).unwrap();
         assert_eq!((none.truth_pixels, none.density), (0, 0.0));
+    }
+
+    #[test]
+    fn bad_thresholds_d1_and_pooling_count_pixels() {
+        // Truth 10 everywhere but one 100 px pixel; errors 0, 1.5, 2.5, 4 (on 10: D1) and 4
+        // (on 100: under 5 %, not D1), one missing estimate, one pixel without truth.
+        let truth = GrayImage::from_vec(
+            7,
+            1,
+            vec![10.0, 10.0, 10.0, 10.0, 100.0, 10.0, f32::INFINITY],
+        )
+        .unwrap();
+        let est = GrayImage::from_vec(7, 1, vec![10.0, 11.5, 7.5, 6.0, 96.0, f32::INFINITY, 3.0])
+            .unwrap();
+        let e = compare_disparity(&est, &truth, 2.0).unwrap();
+        assert_eq!((e.truth_pixels, e.valid_pixels), (6, 5));
+        assert_eq!((e.bad_1, e.bad_2, e.bad_3), (0.8, 0.6, 0.4));
+        assert_eq!(e.bad, e.bad_2);
+        assert_eq!(e.d1, 0.2);
+        assert_eq!(e.mean_abs, (1.5 + 2.5 + 4.0 + 4.0) / 5.0);
+        // Below by more than 1 px: 7.5, 6 and 96, of 6 truth pixels.
+        assert_eq!(e.below_1px, 0.5);
+        // Pooling the two halves gives the whole.
+        let a = compare_disparity_where(&est, &truth, 2.0, |i| i < 3).unwrap();
+        let b = compare_disparity_where(&est, &truth, 2.0, |i| i >= 3).unwrap();
+        let p = DisparityErrors::pooled(&[a, b]).unwrap();
+        assert_eq!((p.truth_pixels, p.valid_pixels), (6, 5));
+        for (x, y) in [
+            (p.density, e.density),
+            (p.bad_1, e.bad_1),
+            (p.bad_3, e.bad_3),
+            (p.d1, e.d1),
+            (p.mean_abs, e.mean_abs),
+            (p.rms, e.rms),
+            (p.bad_all, e.bad_all),
+            (p.below_1px, e.below_1px),
+        ] {
+            assert!((x - y).abs() < 1e-12, "{p:?} against {e:?}");
+        }
+        assert!(DisparityErrors::pooled(&[]).is_none());
+        let other = compare_disparity(&est, &truth, 3.0).unwrap();
+        assert!(DisparityErrors::pooled(&[a, other]).is_none());
     }
 
     /// Timing of a megapixel pair: `cargo test --release -p streaks-analysis -- --ignored
