@@ -1,6 +1,6 @@
 //! PNG writing: 8-bit sRGB of a linear image with an exposure ([`write_png`]), and any 8- or
 //! 16-bit grey or colour buffer of the `image` crate ([`write_png_buffer`]), both atomically and
-//! through the one encoder call. Reading any image file is [`crate::GrayImage::load`] and
+//! through the one encoder call, which also gives the bytes in memory ([`png_bytes`]). Reading any image file is [`crate::GrayImage::load`] and
 //! [`crate::gray::load_rgb_channels`].
 
 use crate::atomic::{write_atomically, WriteFailure};
@@ -48,6 +48,23 @@ pub fn write_png(path: &Path, image: &RgbImage, exposure_ev: f32) -> Result<(), 
     write_png_buffer(path, &to_srgb8_image(image, exposure_ev).ok_or_else(bad)?)
 }
 
+/// Encodes any `image` crate buffer (8- or 16-bit grey or colour) as PNG into `w`: the one
+/// encoder call of this project.
+fn encode_png<P, C>(w: impl Write, img: &image::ImageBuffer<P, C>) -> Result<(), image::ImageError>
+where
+    P: image::PixelWithColorType,
+    C: std::ops::Deref<Target = [P::Subpixel]>,
+    [P::Subpixel]: image::EncodableLayout,
+{
+    use image::EncodableLayout;
+    image::codecs::png::PngEncoder::new(w).write_image(
+        img.as_raw().as_bytes(),
+        img.width(),
+        img.height(),
+        P::COLOR_TYPE,
+    )
+}
+
 /// Encodes any `image` crate buffer (8- or 16-bit grey or colour) as PNG and writes it
 /// atomically: the one way this project writes PNG files.
 pub fn write_png_buffer<P, C>(path: &Path, img: &image::ImageBuffer<P, C>) -> Result<(), ImageError>
@@ -56,7 +73,6 @@ where
     C: std::ops::Deref<Target = [P::Subpixel]>,
     [P::Subpixel]: image::EncodableLayout,
 {
-    use image::EncodableLayout;
     if img.width() == 0 || img.height() == 0 {
         return Err(ImageError::BadImage {
             path: path.to_path_buf(),
@@ -64,21 +80,36 @@ where
         });
     }
     write_atomically(path, |w| {
-        image::codecs::png::PngEncoder::new(w.by_ref())
-            .write_image(
-                img.as_raw().as_bytes(),
-                img.width(),
-                img.height(),
-                P::COLOR_TYPE,
-            )
-            .map_err(WriteFailure::Png)
+        encode_png(w.by_ref(), img).map_err(WriteFailure::Png)
     })
+}
+
+/// The PNG bytes of any `image` crate buffer, in memory (for pages that embed their images
+/// as data URIs); the same encoder as [`write_png_buffer`].
+pub fn png_bytes<P, C>(img: &image::ImageBuffer<P, C>) -> Result<Vec<u8>, image::ImageError>
+where
+    P: image::PixelWithColorType,
+    C: std::ops::Deref<Target = [P::Subpixel]>,
+    [P::Subpixel]: image::EncodableLayout,
+{
+    let mut bytes = Vec::new();
+    encode_png(&mut bytes, img)?;
+    Ok(bytes)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use glam::Vec3;
+
+    #[test]
+    fn png_bytes_decode_to_the_image() {
+        let img =
+            image::RgbImage::from_fn(3, 2, |x, y| image::Rgb([x as u8 * 80, y as u8 * 200, 7]));
+        let bytes = png_bytes(&img).unwrap();
+        let back = image::load_from_memory(&bytes).unwrap().to_rgb8();
+        assert_eq!(back, img);
+    }
 
     #[test]
     fn png_exposure_clip_and_srgb() {
