@@ -16,7 +16,7 @@ use streaks_render::scene::Scene;
 use streaks_scenes::procedural::{sample, GeneratorConfig, GENERATOR_VERSION};
 use streaks_stereo::calib::MiddleburyCalib;
 use streaks_stereo::render::{
-    light_records, render_pair, rig_from_camera, scene_has_road, EyeView, PairSettings,
+    light_records, render_pair, rig_from_camera, scene_has_road, PairSettings,
 };
 use streaks_stereo::rigfile::{LightRecord, PoseRecord};
 use streaks_stereo::streak_mask::StreakMaskParams;
@@ -194,16 +194,6 @@ pub fn remove_stale_tmp(layout: &Layout, index: u64) -> Result<()> {
     Ok(())
 }
 
-/// The left view's mask (true = 255) as an 8-bit image.
-fn mask_image(view: &EyeView, flags: &[bool]) -> Result<GrayImage> {
-    let data = flags.iter().map(|&b| if b { 1.0 } else { 0.0 }).collect();
-    Ok(GrayImage::from_vec(
-        view.disparity.width,
-        view.disparity.height,
-        data,
-    )?)
-}
-
 /// Writes the KITTI view of a sample from its folder `dir` (image_2 and image_3 are copies of
 /// im0.png and im1.png, disp_occ_0 is disp0 as uint16 x 256); each file atomically.
 pub fn write_kitti(layout: &Layout, index: u64, dir: &Path, disp0: &GrayImage) -> Result<()> {
@@ -312,7 +302,7 @@ fn write_sample(
     left.streak_mask.save_png(&dir.join("streaks0.png"))?;
     let has_road = scene_has_road(&scene);
     if has_road {
-        mask_image(left, &left.road_surface)?.save_png(&dir.join(ROAD_MASK))?;
+        left.road_surface_mask()?.save_png(&dir.join(ROAD_MASK))?;
     }
 
     let pixels = left.disparity.data.len().max(1) as f64;

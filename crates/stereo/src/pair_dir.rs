@@ -4,7 +4,8 @@
 //!
 //! Per eye (`left`, `right`): `EYE.exr` (linear, with the depth, normal and specular layers),
 //! `EYE.png` (8-bit sRGB), `disparity_EYE.pfm` and `depth_EYE.pfm` (ground truth, Middlebury
-//! PFM), `streak_mask_EYE.png` (0/255). For the pair: `side_by_side.png`, `anaglyph.png` and
+//! PFM), `streak_mask_EYE.png` (0/255), `road_mask_EYE.png` (0/255, when the scene flags a
+//! road material). For the pair: `side_by_side.png`, `anaglyph.png` and
 //! `rig.json`.
 
 use crate::rig::Eye;
@@ -62,6 +63,12 @@ impl<'a> PairDir<'a> {
         self.dir.join(format!("streak_mask_{}.png", eye.name()))
     }
 
+    /// `road_mask_EYE.png`: the pixels whose first hit is the road surface (0/255; written
+    /// only when the scene flags a road material).
+    pub fn road_mask(&self, eye: Eye) -> PathBuf {
+        self.dir.join(format!("road_mask_{}.png", eye.name()))
+    }
+
     /// `side_by_side.png`.
     pub fn side_by_side(&self) -> PathBuf {
         self.dir.join("side_by_side.png")
@@ -89,6 +96,7 @@ mod tests {
         let name = |q: PathBuf| q.file_name().unwrap().to_string_lossy().into_owned();
         assert_eq!(name(p.disparity(Eye::Left)), "disparity_left.pfm");
         assert_eq!(name(p.streak_mask(Eye::Right)), "streak_mask_right.png");
+        assert_eq!(name(p.road_mask(Eye::Left)), "road_mask_left.png");
         assert_eq!(name(p.rig()), "rig.json");
         // The image to measure: the EXR when there is one.
         assert_eq!(name(p.image(Eye::Left)), "left.png");

@@ -15,8 +15,9 @@
 //! Files written by [`write_pair`] into the output folder: `left.exr`, `right.exr` (linear,
 //! with `depth`, `normal` and `specular` layers), `left.png`, `right.png` (sRGB with the
 //! exposure), `side_by_side.png`, `anaglyph.png`, `disparity_left.pfm`, `depth_left.pfm`,
-//! `disparity_right.pfm`, `depth_right.pfm`, `streak_mask_left.png`, `streak_mask_right.png`
-//! and `rig.json`.
+//! `disparity_right.pfm`, `depth_right.pfm`, `streak_mask_left.png`, `streak_mask_right.png`,
+//! `road_mask_left.png`, `road_mask_right.png` (when the scene flags a road material:
+//! [`EyeView::road_surface`], 0/255) and `rig.json`.
 //!
 //! The rendered-scene tests (ground truth against an analytic road plane, and the disparity
 //! of a rendered textured plane measured with the project's Lucas-Kanade estimator) are in
@@ -103,6 +104,23 @@ pub struct EyeView {
     pub streak_mask: GrayImage,
     /// The specular-luminance threshold the mask used.
     pub streak_threshold: f32,
+}
+
+impl EyeView {
+    /// [`EyeView::road_surface`] as an image: 1 on road-surface pixels, 0 elsewhere (written
+    /// 0/255 by [`GrayImage::save_png`]).
+    pub fn road_surface_mask(&self) -> Result<GrayImage, StereoError> {
+        let data = self
+            .road_surface
+            .iter()
+            .map(|&b| f32::from(u8::from(b)))
+            .collect();
+        Ok(GrayImage::from_vec(
+            self.disparity.width,
+            self.disparity.height,
+            data,
+        )?)
+    }
 }
 
 /// Renders one eye and derives its ground truth and streak mask.
@@ -287,6 +305,9 @@ pub fn write_pair(
         write_pfm(&files.disparity(eye), &view.disparity)?;
         write_pfm(&files.depth(eye), &view.depth)?;
         view.streak_mask.save_png(&files.streak_mask(eye))?;
+        if scene_has_road(scene) {
+            view.road_surface_mask()?.save_png(&files.road_mask(eye))?;
+        }
     }
     write_pair_views(dir, &srgb[0], &srgb[1])?;
     let road = rig.road_frame().ok();
