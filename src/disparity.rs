@@ -7,7 +7,7 @@
 
 use anyhow::{bail, Context};
 use std::path::PathBuf;
-use streaks_analysis::repair::{robust_disparity, RepairParams, StreakHandling};
+use streaks_analysis::repair::{robust_disparity, RepairParams, RobustDisparity, StreakHandling};
 use streaks_analysis::sgm::{
     compare_disparity, compare_disparity_where, sgm, write_disparity_png, Census, Paths, SgmParams,
 };
@@ -80,6 +80,48 @@ pub enum Handling {
     Repair,
 }
 
+/// A dense disparity as `streaks disparity` computes it.
+pub struct Estimate {
+    /// The disparity of the left view (`inf`: no value): SGM's, or the streak-robust one.
+    pub disparity: GrayImage,
+    /// Wall time of the semi-global matching alone, seconds.
+    pub sgm_seconds: f64,
+    /// With a streak handling: what the streak-robust pass did (its `disparity` is
+    /// [`Estimate::disparity`]).
+    pub robust: Option<RobustDisparity>,
+}
+
+/// Semi-global matching of `left` and `right` with `params`, then, given a `handling`, the
+/// streak-robust pass with its default parameters ([`robust_disparity`]): exactly what
+/// `streaks disparity [--streaks mask|repair]` computes (and `streaks benchmark`'s `sgm` and
+/// `sgm-streaks` methods).
+pub fn estimate(
+    left: &GrayImage,
+    right: &GrayImage,
+    params: &SgmParams,
+    handling: Option<StreakHandling>,
+) -> anyhow::Result<Estimate> {
+    let start = std::time::Instant::now();
+    let disp = sgm(left, right, params).context("semi-global matching")?;
+    let sgm_seconds = start.elapsed().as_secs_f64();
+    Ok(match handling {
+        None => Estimate {
+            disparity: disp,
+            sgm_seconds,
+            robust: None,
+        },
+        Some(handling) => {
+            let r = robust_disparity(left, &disp, handling, &RepairParams::default())
+                .context("streak-robust disparity")?;
+            Estimate {
+                disparity: r.disparity.clone(),
+                sgm_seconds,
+                robust: Some(r),
+            }
+        }
+    })
+}
+
 /// Runs the command.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let left = GrayImage::load(&args.left).context("reading the left image")?;
@@ -108,52 +150,48 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         median: !args.no_median,
         ..defaults
     };
-    let start = std::time::Instant::now();
-    let disp = sgm(&left, &right, &params).context("semi-global matching")?;
+    let handling = args.streaks.map(|h| match h {
+        Handling::Mask => StreakHandling::Mask,
+        Handling::Repair => StreakHandling::Repair,
+    });
+    let Estimate {
+        disparity: disp,
+        sgm_seconds,
+        robust,
+    } = estimate(&left, &right, &params, handling)?;
     eprintln!(
-        "{}x{}, {} disparities: {:.2} s",
+        "{}x{}, {} disparities: {sgm_seconds:.2} s",
         left.width,
         left.height,
         params.disparities(),
-        start.elapsed().as_secs_f64()
     );
-    let disp = match args.streaks {
-        None => disp,
-        Some(h) => {
-            let handling = match h {
-                Handling::Mask => StreakHandling::Mask,
-                Handling::Repair => StreakHandling::Repair,
-            };
-            let r = robust_disparity(&left, &disp, handling, &RepairParams::default())
-                .context("streak-robust disparity")?;
-            match r.plane {
-                Some(p) => eprintln!(
-                    "road plane: d = {:.4} (y - {:.1}), {} inliers ({:.0} %), RMS {:.2} px",
-                    p.slope,
-                    p.horizon,
-                    p.inliers,
-                    100.0 * p.inlier_share,
-                    p.rms_px
-                ),
-                None => eprintln!("no road plane found: streak pixels are masked, not repaired"),
-            }
-            eprintln!(
-                "streaks: {} detected pixels, {} below the road; {} repaired, {} masked",
-                r.streak_pixels, r.below_road_pixels, r.repaired_pixels, r.masked_pixels
-            );
-            let conf_path = args.confidence.clone().unwrap_or_else(|| {
-                let stem = args
-                    .output
-                    .file_stem()
-                    .map(|s| s.to_string_lossy().into_owned())
-                    .unwrap_or_else(|| "disparity".into());
-                args.output.with_file_name(format!("{stem}_confidence.pfm"))
-            });
-            write_pfm(&conf_path, &r.confidence)
-                .with_context(|| format!("writing the confidence map {}", conf_path.display()))?;
-            r.disparity
+    if let Some(r) = &robust {
+        match r.plane {
+            Some(p) => eprintln!(
+                "road plane: d = {:.4} (y - {:.1}), {} inliers ({:.0} %), RMS {:.2} px",
+                p.slope,
+                p.horizon,
+                p.inliers,
+                100.0 * p.inlier_share,
+                p.rms_px
+            ),
+            None => eprintln!("no road plane found: streak pixels are masked, not repaired"),
         }
-    };
+        eprintln!(
+            "streaks: {} detected pixels, {} below the road; {} repaired, {} masked",
+            r.streak_pixels, r.below_road_pixels, r.repaired_pixels, r.masked_pixels
+        );
+        let conf_path = args.confidence.clone().unwrap_or_else(|| {
+            let stem = args
+                .output
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "disparity".into());
+            args.output.with_file_name(format!("{stem}_confidence.pfm"))
+        });
+        write_pfm(&conf_path, &r.confidence)
+            .with_context(|| format!("writing the confidence map {}", conf_path.display()))?;
+    }
     write_pfm(&args.output, &disp).context("writing the disparity map")?;
     if let Some(png) = &args.png {
         write_disparity_png(png, &disp, None).context("writing the preview")?;
