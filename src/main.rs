@@ -4,6 +4,7 @@
 //! Errors are printed with their whole chain and the process exits non-zero.
 
 mod analyze;
+mod benchmark;
 mod compare;
 mod dataset;
 mod disparity;
@@ -56,6 +57,8 @@ enum Command {
     Compare(compare::Args),
     /// Generate stereo datasets of procedural rainy streets (generate), and index them (index).
     Dataset(dataset::Args),
+    /// Score stereo methods (built-in and external) against a dataset's ground truth by region.
+    Benchmark(benchmark::Args),
 }
 
 fn main() -> ExitCode {
@@ -74,6 +77,7 @@ fn main() -> ExitCode {
         Command::Lk(args) => lk::run(args),
         Command::Disparity(args) => disparity::run(args),
         Command::Dataset(args) => dataset::run(args),
+        Command::Benchmark(args) => benchmark::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

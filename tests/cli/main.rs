@@ -3,6 +3,7 @@
 //! habit), one module per group of subcommands.
 
 mod analyze;
+mod benchmark;
 mod common;
 mod dataset;
 mod measure;

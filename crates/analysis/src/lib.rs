@@ -18,6 +18,8 @@
 //! - [`lk`]: the paper's per-row 1D Lucas-Kanade estimator, and the preparation of a rendered
 //!   pair for it (fireflies removed, range log-compressed).
 //! - [`detect`]: streaks, glows and lamps in the left image; masks scored against the truth.
+//! - [`benchmark`]: an estimate scored by region (streak, road, off-road; the phantom-hole
+//!   rate), pooled over samples; the LK streak disparity as a map; signed error maps.
 //! - [`repair`]: streak-robust stereo: the road plane from the pair's own v-disparity, and
 //!   the masking or repair of the pixels streaks and reflections put beneath the road.
 //! - [`sgm`]: dense semi-global matching, and its errors against a ground truth (bad-2.0).
@@ -49,6 +51,7 @@
 //! ```
 #![deny(missing_docs)]
 
+pub mod benchmark;
 pub mod centre;
 pub mod detect;
 pub mod figures;

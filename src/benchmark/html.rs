@@ -1,0 +1,471 @@
+//! `OUT/index.html` of `streaks benchmark`: one self-contained page (inline CSS, inline SVG
+//! bar charts, thumbnails as base64 PNG data URIs), readable offline.
+
+use super::report::{MethodScore, Report, REGIONS};
+use anyhow::Result;
+use std::fmt::Write;
+use streaks_analysis::benchmark::{
+    error_colour, ERROR_MAP_RANGE_PX, NO_ESTIMATE_RGB, NO_TRUTH_RGB,
+};
+use streaks_analysis::sgm::DisparityErrors;
+
+/// Widest thumbnail, pixels.
+const THUMB_WIDTH: u32 = 256;
+
+/// Bar colours of the methods, in order (Tableau 10).
+const PALETTE: [&str; 10] = [
+    "#4e79a7", "#f28e2b", "#59a14f", "#e15759", "#76b7b2", "#edc948", "#b07aa1", "#ff9da7",
+    "#9c755f", "#bab0ac",
+];
+
+/// The thumbnails of one sample: its left image and each method's error map, as data URIs.
+pub struct SampleThumbs {
+    id: String,
+    left: String,
+    maps: Vec<(String, String)>,
+}
+
+/// `img` scaled to at most [`THUMB_WIDTH`] wide, as a PNG data URI.
+fn thumb_uri(img: &image::RgbImage, filter: image::imageops::FilterType) -> Result<String> {
+    let (w, h) = img.dimensions();
+    let small = if w > THUMB_WIDTH {
+        let th = ((h as f64 * THUMB_WIDTH as f64 / w as f64).round() as u32).max(1);
+        image::imageops::resize(img, THUMB_WIDTH, th, filter)
+    } else {
+        img.clone()
+    };
+    let png = streaks_image::png::png_bytes(&small)?;
+    Ok(format!("data:image/png;base64,{}", base64::encode(png)))
+}
+
+impl SampleThumbs {
+    /// The thumbnails of sample `id`: its left image and `(method, error map)`s.
+    pub fn new(
+        id: &str,
+        left: &image::RgbImage,
+        maps: &[(String, image::RgbImage)],
+    ) -> Result<Self> {
+        use image::imageops::FilterType;
+        Ok(Self {
+            id: id.to_string(),
+            left: thumb_uri(left, FilterType::Triangle)?,
+            maps: maps
+                .iter()
+                .map(|(m, img)| Ok((m.clone(), thumb_uri(img, FilterType::Nearest)?)))
+                .collect::<Result<_>>()?,
+        })
+    }
+}
+
+/// `s` escaped for HTML text and attributes.
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+fn pct(v: f64) -> String {
+    format!("{:.1} %", 100.0 * v)
+}
+
+/// A cell of a figure over the pixels with a value: `–` when there are none.
+fn cell(e: &DisparityErrors, text: String) -> String {
+    if e.valid_pixels == 0 {
+        "<td class=\"none\" title=\"no values\">–</td>".to_string()
+    } else {
+        format!("<td>{text}</td>")
+    }
+}
+
+/// `s` escaped, with `code` spans in backticks shown as code.
+fn esc_code(s: &str) -> String {
+    esc(s)
+        .split('`')
+        .enumerate()
+        .map(|(i, part)| {
+            if i % 2 == 1 {
+                format!("<code>{part}</code>")
+            } else {
+                part.to_string()
+            }
+        })
+        .collect()
+}
+
+const CSS: &str = r#"
+:root { --ink: #1f2430; --muted: #5b6475; --line: #e3e6ec; --bg: #f6f7f9; --card: #fff; }
+* { box-sizing: border-box; }
+body { margin: 0; font: 15px/1.5 system-ui, -apple-system, "Segoe UI", Roboto, sans-serif;
+       color: var(--ink); background: var(--bg); }
+header { background: #1f2a44; color: #fff; padding: 28px 40px 22px; }
+header h1 { margin: 0 0 6px; font-size: 26px; font-weight: 650; letter-spacing: .2px; }
+header p { margin: 2px 0; color: #c9d1e4; }
+main { padding: 10px 40px 40px; max-width: 1400px; }
+section { background: var(--card); border: 1px solid var(--line); border-radius: 10px;
+          padding: 18px 22px; margin: 22px 0; box-shadow: 0 1px 2px rgba(0,0,0,.04); }
+h2 { margin: 0 0 12px; font-size: 19px; }
+h3 { margin: 18px 0 8px; font-size: 15px; color: var(--muted); font-weight: 600; }
+table { border-collapse: collapse; margin: 4px 0 10px; font-variant-numeric: tabular-nums; }
+th, td { padding: 5px 12px; text-align: right; border-bottom: 1px solid var(--line); }
+th { font-weight: 600; color: var(--muted); font-size: 13px; background: #fafbfc; }
+td:first-child, th:first-child, td.l, th.l { text-align: left; }
+td:first-child { white-space: nowrap; }
+tr:last-child td { border-bottom: none; }
+.swatch { display: inline-block; width: 11px; height: 11px; border-radius: 2px;
+          margin-right: 7px; vertical-align: -1px; }
+.grid { display: flex; flex-wrap: wrap; gap: 18px 26px; }
+.grid > div { flex: 0 1 auto; }
+.note { color: var(--muted); font-size: 13.5px; max-width: 1000px; }
+.methods td, .methods th { text-align: left; }
+td.none { color: #9aa1ad; }
+.sample { margin: 14px 0 22px; }
+.sample h3 { margin: 0 0 6px; color: var(--ink); }
+.thumbs { display: grid; grid-template-columns: repeat(auto-fill, minmax(220px, 1fr));
+          gap: 10px; max-width: 1300px; }
+figure { margin: 0; }
+figure img { display: block; width: 100%; height: auto; border-radius: 4px;
+             border: 1px solid var(--line); }
+figcaption { font-size: 12.5px; color: var(--muted); margin-top: 3px; }
+code { background: #eef1f5; padding: 1px 5px; border-radius: 4px; font-size: 13px; }
+"#;
+
+/// The columns of a region table.
+fn region_row(out: &mut String, method: &str, colour: &str, e: &DisparityErrors) {
+    let _ = writeln!(
+        out,
+        "<tr><td><span class=\"swatch\" style=\"background:{colour}\"></span>{}</td>\
+         {}{}{}{}{}<td>{}</td><td>{}</td><td>{}</td></tr>",
+        esc(method),
+        cell(e, format!("{:.3}", e.mean_abs)),
+        cell(e, pct(e.bad_1)),
+        cell(e, pct(e.bad_2)),
+        cell(e, pct(e.bad_3)),
+        cell(e, pct(e.d1)),
+        pct(e.density),
+        pct(e.below_1px),
+        e.truth_pixels
+    );
+}
+
+/// A horizontal bar chart (inline SVG) of `(label, colour, value)` bars, values formatted by
+/// `fmt`.
+fn bar_chart(title: &str, bars: &[Bar], fmt: &dyn Fn(f64) -> String) -> String {
+    let (label_w, bar_w, row_h) = (140.0, 300.0, 24.0);
+    let max = bars.iter().map(|b| b.2).fold(0.0f64, f64::max);
+    let scale = if max > 0.0 { bar_w / max } else { 0.0 };
+    let h = 30.0 + row_h * bars.len() as f64;
+    let mut s = format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" \
+         role=\"img\" aria-label=\"{t}\"><text x=\"0\" y=\"16\" font-size=\"13.5\" \
+         font-weight=\"600\" fill=\"#1f2430\">{t}</text>",
+        w = label_w + bar_w + 80.0,
+        t = esc(title)
+    );
+    for (i, (label, colour, v)) in bars.iter().enumerate() {
+        let y = 28.0 + row_h * i as f64;
+        let len = (v * scale).max(if *v > 0.0 { 1.0 } else { 0.0 });
+        let _ = write!(
+            s,
+            "<text x=\"{lx}\" y=\"{ty}\" font-size=\"12.5\" text-anchor=\"end\" \
+             fill=\"#5b6475\">{l}</text><rect x=\"{label_w}\" y=\"{y}\" width=\"{len:.1}\" \
+             height=\"{bh}\" rx=\"3\" fill=\"{colour}\"/><text x=\"{vx:.1}\" y=\"{ty}\" \
+             font-size=\"12\" fill=\"#1f2430\">{v}</text>",
+            lx = label_w - 8.0,
+            ty = y + 13.0,
+            l = esc(label),
+            bh = row_h - 7.0,
+            vx = label_w + len + 6.0,
+            v = esc(&fmt(*v)),
+        );
+    }
+    s.push_str("</svg>");
+    s
+}
+
+/// The legend of the error maps (inline SVG).
+fn legend() -> String {
+    let mut s = String::from(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"640\" height=\"46\" role=\"img\" \
+         aria-label=\"error map legend\"><defs><linearGradient id=\"err\">",
+    );
+    for k in 0..=20 {
+        let e = -ERROR_MAP_RANGE_PX + 2.0 * ERROR_MAP_RANGE_PX * k as f32 / 20.0;
+        let [r, g, b] = error_colour(e);
+        let _ = write!(
+            s,
+            "<stop offset=\"{}%\" stop-color=\"rgb({r},{g},{b})\"/>",
+            k * 5
+        );
+    }
+    s.push_str(
+        "</linearGradient></defs><rect x=\"0\" y=\"4\" width=\"360\" height=\"14\" rx=\"2\" \
+         fill=\"url(#err)\" stroke=\"#ccc\"/>",
+    );
+    let r = ERROR_MAP_RANGE_PX;
+    for (x, anchor, label) in [
+        (0.0, "start", format!("−{r} px or less: farther")),
+        (180.0, "middle", "0".to_string()),
+        (360.0, "end", format!("nearer: +{r} px or more")),
+    ] {
+        let _ = write!(
+            s,
+            "<text x=\"{x}\" y=\"34\" font-size=\"12\" text-anchor=\"{anchor}\" \
+             fill=\"#5b6475\">{}</text>",
+            esc(&label)
+        );
+    }
+    for (x, rgb, label) in [
+        (390.0, NO_ESTIMATE_RGB, "no estimate"),
+        (500.0, NO_TRUTH_RGB, "no ground truth"),
+    ] {
+        let _ = write!(
+            s,
+            "<rect x=\"{x}\" y=\"4\" width=\"14\" height=\"14\" rx=\"2\" \
+             fill=\"rgb({},{},{})\" stroke=\"#ccc\"/><text x=\"{tx}\" y=\"16\" font-size=\"12\" \
+             fill=\"#5b6475\">{label}</text>",
+            rgb[0],
+            rgb[1],
+            rgb[2],
+            tx = x + 20.0
+        );
+    }
+    s.push_str("</svg>");
+    s
+}
+
+/// The region's errors of a method's score.
+fn region_of<'a>(m: &'a MethodScore, region: &str) -> Option<&'a DisparityErrors> {
+    let e = &m.errors;
+    match region {
+        "all" => Some(&e.all),
+        "streak" => Some(&e.streak),
+        "non_streak" => Some(&e.non_streak),
+        "road" => e.road.as_ref(),
+        "off_road" => e.off_road.as_ref(),
+        "road_surface" => e.road_surface.as_ref(),
+        _ => None,
+    }
+}
+
+/// A bar of a chart: label, colour, value.
+type Bar = (String, String, f64);
+
+/// The page.
+pub fn page(report: &Report, thumbs: &[SampleThumbs]) -> String {
+    let colour = |i: usize| PALETTE[i % PALETTE.len()];
+    let mut o = String::new();
+    let _ = write!(
+        o,
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\
+         <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\
+         <title>streaks benchmark: {}</title><style>{CSS}</style></head><body>\n",
+        esc(&report.input.dir)
+    );
+    let _ = write!(
+        o,
+        "<header><h1>Stereo methods against specular streaks</h1><p><code style=\"background:\
+         #2c3a5c;color:#fff\">{}</code> &middot; {} &middot; {} samples{} &middot; {} methods</p>\
+         <p>{}</p></header><main>",
+        esc(&report.input.dir),
+        esc(&format!("{:?}", report.input.kind).to_lowercase()),
+        report.samples.len(),
+        report
+            .input
+            .split
+            .as_ref()
+            .map(|s| format!(" (split {})", esc(s)))
+            .unwrap_or_default(),
+        report.methods.len(),
+        esc(report.aggregation)
+    );
+    // Methods.
+    o.push_str("<section><h2>Methods</h2><table class=\"methods\" id=\"methods\"><tr><th>method</th><th>kind</th><th>what it is</th></tr>");
+    for (i, m) in report.methods.iter().enumerate() {
+        let _ = write!(
+            o,
+            "<tr><td><span class=\"swatch\" style=\"background:{}\"></span><b>{}</b></td>\
+             <td>{}</td><td>{}</td></tr>",
+            colour(i),
+            esc(&m.name),
+            m.kind,
+            esc_code(&m.description)
+        );
+    }
+    o.push_str(
+        "</table><p class=\"note\">Every method sees the same 8-bit left and right PNGs. A \
+         disparity that is not finite or not positive counts as no value. EPE and bad-N are \
+         over the pixels a method gives a value (its valid share is beside them), so a method \
+         with few values (<code>lk</code>, which measures only along detected streaks) is \
+         scored where it applies, not over the whole image; a dash means no values at all \
+         (for <code>lk</code>: no streak detected). Time is the method's wall time \
+         (built-ins: reading the PNGs and estimating; commands: the whole process), not the \
+         scoring.</p></section>\n",
+    );
+    // Headline: phantom holes and time, and the charts.
+    o.push_str("<section><h2>Summary</h2><table id=\"summary\"><tr><th>method</th><th>EPE px</th><th>bad-2</th><th>D1</th><th>valid</th><th>streak EPE px</th><th>phantom-hole rate</th><th>s / megapixel</th></tr>");
+    for (i, m) in report.summary.iter().enumerate() {
+        let e = &m.errors;
+        let _ = write!(
+            o,
+            "<tr><td><span class=\"swatch\" style=\"background:{}\"></span>{}</td>{}{}{}\
+             <td>{}</td>{}<td>{}</td><td>{:.2}</td></tr>",
+            colour(i),
+            esc(&m.method),
+            cell(&e.all, format!("{:.3}", e.all.mean_abs)),
+            cell(&e.all, pct(e.all.bad_2)),
+            cell(&e.all, pct(e.all.d1)),
+            pct(e.all.density),
+            cell(&e.streak, format!("{:.3}", e.streak.mean_abs)),
+            m.phantom_hole_rate.map(pct).unwrap_or_else(|| "–".into()),
+            m.seconds_per_megapixel
+        );
+    }
+    o.push_str("</table><p class=\"note\">The phantom-hole rate is the share of road pixels (streaks included) whose estimate is more than 1 px below the true disparity: stereo puts them beneath the road.</p><div class=\"grid\">");
+    let bars = |f: &dyn Fn(&MethodScore) -> Option<f64>| -> Vec<Bar> {
+        report
+            .summary
+            .iter()
+            .enumerate()
+            .filter_map(|(i, m)| f(m).map(|v| (m.method.clone(), colour(i).to_string(), v)))
+            .collect()
+    };
+    let charts: [(&str, Vec<Bar>, bool); 5] = [
+        (
+            "Phantom-hole rate (road)",
+            bars(&|m| m.phantom_hole_rate),
+            true,
+        ),
+        (
+            "bad-2, all pixels",
+            bars(&|m| Some(m.errors.all.bad_2)),
+            true,
+        ),
+        (
+            "EPE on streak pixels, px",
+            bars(&|m| Some(m.errors.streak.mean_abs)),
+            false,
+        ),
+        (
+            "bad-2, off-road pixels",
+            bars(&|m| m.errors.off_road.map(|e| e.bad_2)),
+            true,
+        ),
+        (
+            "Seconds per megapixel",
+            bars(&|m| Some(m.seconds_per_megapixel)),
+            false,
+        ),
+    ];
+    for (title, b, is_share) in charts {
+        if b.is_empty() {
+            continue;
+        }
+        let fmt: &dyn Fn(f64) -> String = if is_share {
+            &|v| pct(v)
+        } else {
+            &|v| format!("{v:.3}")
+        };
+        let _ = write!(o, "<div>{}</div>", bar_chart(title, &b, fmt));
+    }
+    o.push_str("</div></section>\n");
+    // Region tables.
+    o.push_str("<section><h2>By region</h2>");
+    for (region, meaning) in REGIONS {
+        if report
+            .summary
+            .iter()
+            .all(|m| region_of(m, region).is_none())
+        {
+            continue;
+        }
+        let _ = write!(
+            o,
+            "<h3>{} <span style=\"font-weight:400\">&mdash; {}</span></h3><table \
+             id=\"region-{}\"><tr><th>method</th><th>EPE px</th><th>bad-1</th><th>bad-2</th>\
+             <th>bad-3</th><th>D1</th><th>valid</th><th>&gt; 1 px below</th><th>pixels</th></tr>",
+            esc(region),
+            esc(meaning),
+            esc(region)
+        );
+        for (i, m) in report.summary.iter().enumerate() {
+            if let Some(e) = region_of(m, region) {
+                region_row(&mut o, &m.method, colour(i), e);
+            }
+        }
+        o.push_str("</table>");
+    }
+    o.push_str("<p class=\"note\">D1 is KITTI 2015's: off by more than 3 px and by more than 5 % of the true disparity. Without road masks (pair folders of scenes that flag no road) the road regions are left out.</p></section>\n");
+    // Per-sample table.
+    o.push_str("<section><h2>Per sample</h2><table id=\"samples\"><tr><th>sample</th><th class=\"l\">method</th><th>EPE px</th><th>bad-2</th><th>streak EPE px</th><th>valid</th><th>phantom-hole rate</th><th>seconds</th></tr>");
+    for s in &report.samples {
+        for (j, r) in s.results.iter().enumerate() {
+            let first = if j == 0 {
+                format!(
+                    "<td rowspan=\"{}\">{}<br><span class=\"note\">{}x{}</span></td>",
+                    s.results.len(),
+                    esc(&s.id),
+                    s.width,
+                    s.height
+                )
+            } else {
+                String::new()
+            };
+            let e = &r.errors;
+            let _ = write!(
+                o,
+                "<tr>{first}<td class=\"l\">{}</td>{}{}{}<td>{}</td><td>{}</td><td>{:.2}</td>\
+                 </tr>",
+                esc(&r.method),
+                cell(&e.all, format!("{:.3}", e.all.mean_abs)),
+                cell(&e.all, pct(e.all.bad_2)),
+                cell(&e.streak, format!("{:.3}", e.streak.mean_abs)),
+                pct(e.all.density),
+                r.phantom_hole_rate.map(pct).unwrap_or_else(|| "–".into()),
+                r.seconds
+            );
+        }
+    }
+    o.push_str("</table></section>\n");
+    // Thumbnails.
+    if !thumbs.is_empty() {
+        let _ = write!(
+            o,
+            "<section><h2>Error maps</h2><p class=\"note\">Estimate minus truth per pixel \
+             (first {} of {} samples).</p>{}",
+            thumbs.len(),
+            report.samples.len(),
+            legend()
+        );
+        for t in thumbs {
+            let _ = write!(
+                o,
+                "<div class=\"sample\"><h3>{}</h3><div class=\"thumbs\"><figure><img src=\"{}\" \
+                 alt=\"left image of {}\"><figcaption>left image</figcaption></figure>",
+                esc(&t.id),
+                t.left,
+                esc(&t.id)
+            );
+            for (m, uri) in &t.maps {
+                let _ = write!(
+                    o,
+                    "<figure><img src=\"{uri}\" alt=\"{} error map of {}\"><figcaption>{}\
+                     </figcaption></figure>",
+                    esc(m),
+                    esc(&t.id),
+                    esc(m)
+                );
+            }
+            o.push_str("</div></div>");
+        }
+        o.push_str("</section>\n");
+    }
+    let _ = write!(
+        o,
+        "<p class=\"note\">{} &middot; report.json beside this page has every figure.</p>\
+         </main></body></html>",
+        esc(report.format)
+    );
+    o.push('\n');
+    o
+}

@@ -1,0 +1,248 @@
+//! `streaks benchmark DIR --method NAME... [--method-cmd NAME=TEMPLATE]... -o OUT`: stereo
+//! methods scored against the ground truth of a dataset or of `streaks stereo` pair folders,
+//! by region (streak, road, off-road), with `OUT/report.json` ([`report`]) and a
+//! self-contained `OUT/index.html` ([`html`]).
+//!
+//! - [`input`]: the samples of DIR;
+//! - [`method`]: the built-in methods (`sgm`, `sgm-streaks`, `lk`) and external commands;
+//! - [`report`]: the report's schema;
+//! - [`html`]: the page.
+//!
+//! Scoring is [`streaks_analysis::benchmark`]. Every method runs on every sample (a progress
+//! bar over samples x methods); the first failure stops the run with an error naming the
+//! method and the sample (and a command's stderr), and nothing is written. Both outputs are
+//! written atomically at the end.
+
+pub mod html;
+pub mod input;
+pub mod method;
+pub mod report;
+
+use anyhow::{bail, Context, Result};
+use method::Method;
+use report::{Input, MethodInfo, MethodScore, Report, SampleReport};
+use std::path::PathBuf;
+use streaks_analysis::benchmark::{error_map, score_regions, BAD_THRESHOLD_PX};
+use streaks_image::pfm::read_pfm;
+use streaks_image::{write_bytes_atomically, GrayImage};
+
+/// Score stereo methods against a dataset's or pair folders' ground truth.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// A dataset (`streaks dataset generate`), a `streaks stereo` pair folder, or a folder of
+    /// pair folders.
+    pub dir: PathBuf,
+    /// Methods to run: built-in `sgm`, `sgm-streaks`, `lk`, or the name of a --method-cmd
+    /// (every --method-cmd runs, named here or not).
+    #[arg(long = "method", value_name = "NAME", num_args = 1..)]
+    pub methods: Vec<String>,
+    /// An external method: NAME=TEMPLATE, a shell command (run by `sh -c`) in which
+    /// `{left}`, `{right}` and `{out}` are replaced by the quoted paths of the left and right
+    /// PNGs and of the PFM disparity map it must write (inf, NaN or <= 0: no value).
+    #[arg(long = "method-cmd", value_name = "NAME=TEMPLATE")]
+    pub method_cmds: Vec<String>,
+    /// Only this split of a dataset (train, val, test).
+    #[arg(long)]
+    pub split: Option<String>,
+    /// Output folder: report.json and index.html.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// How many samples get thumbnails on the page (the first ones).
+    #[arg(long, default_value_t = 8)]
+    pub thumbnails: usize,
+}
+
+/// The methods of the arguments, in order: `--method` names, then the other `--method-cmd`s.
+fn methods(args: &Args) -> Result<Vec<Method>> {
+    let commands = args
+        .method_cmds
+        .iter()
+        .map(|s| Method::command(s))
+        .collect::<Result<Vec<_>>>()?;
+    let mut out: Vec<Method> = Vec::new();
+    for name in &args.methods {
+        let m = Method::built_in(name)
+            .or_else(|| commands.iter().find(|c| c.name() == name).cloned())
+            .with_context(|| {
+                format!(
+                    "unknown method {name:?}: the built-in methods are {}; an external one \
+                     needs --method-cmd {name}=TEMPLATE",
+                    method::BUILT_INS.map(|(n, _)| n).join(", ")
+                )
+            })?;
+        if out.iter().any(|o| o.name() == m.name()) {
+            bail!("method {name} is named twice");
+        }
+        out.push(m);
+    }
+    for c in commands {
+        if !args.methods.iter().any(|n| n == c.name()) {
+            if out.iter().any(|o| o.name() == c.name()) {
+                bail!("--method-cmd {} is given twice", c.name());
+            }
+            out.push(c);
+        }
+    }
+    if out.is_empty() {
+        bail!("no method: give --method sgm (or sgm-streaks, lk) or --method-cmd NAME=TEMPLATE");
+    }
+    Ok(out)
+}
+
+/// Reads a 0/255 mask of `size` (`what` names it in errors).
+fn load_mask(path: &std::path::Path, size: (usize, usize), what: &str) -> Result<GrayImage> {
+    let m =
+        GrayImage::load(path).with_context(|| format!("reading the {what} {}", path.display()))?;
+    if (m.width, m.height) != size {
+        bail!(
+            "the {what} {} is {}x{}, the ground truth {}x{}",
+            path.display(),
+            m.width,
+            m.height,
+            size.0,
+            size.1
+        );
+    }
+    Ok(m)
+}
+
+/// Runs the subcommand.
+pub fn run(args: Args) -> Result<()> {
+    let methods = methods(&args)?;
+    if args.output.is_file() {
+        bail!(
+            "the output {} is a file, not a folder",
+            args.output.display()
+        );
+    }
+    let (kind, samples) = input::samples(&args.dir, args.split.as_deref())?;
+    // Commands write their maps here; it goes away with the run.
+    let work = tempfile::Builder::new()
+        .prefix("streaks-benchmark-")
+        .tempdir()
+        .context("cannot create a temporary folder")?;
+    let bar = crate::render::progress_bar((samples.len() * methods.len()) as u64);
+    let mut sample_reports = Vec::new();
+    let mut thumbs = Vec::new();
+    for (k, sample) in samples.iter().enumerate() {
+        let truth = read_pfm(&sample.truth)
+            .with_context(|| format!("reading the ground truth {}", sample.truth.display()))?;
+        let size = (truth.width, truth.height);
+        let streaks = load_mask(&sample.streaks, size, "streak mask")?;
+        let road = match &sample.road {
+            Some(p) => Some(load_mask(p, size, "road mask")?),
+            None => None,
+        };
+        let megapixels = (size.0 * size.1) as f64 / 1e6;
+        let mut results = Vec::new();
+        let mut maps = Vec::new();
+        for m in &methods {
+            let what = || format!("method {} on sample {}", m.name(), sample.id);
+            let (disp, seconds) = m.run(sample, work.path()).with_context(what)?;
+            let errors =
+                score_regions(&disp, &truth, &streaks, road.as_ref()).with_context(what)?;
+            if k < args.thumbnails {
+                maps.push((m.name().to_string(), error_map(&disp, &truth)?));
+            }
+            results.push(MethodScore::new(m.name(), errors, seconds, megapixels));
+            bar.inc(1);
+        }
+        if k < args.thumbnails {
+            let left = image::open(&sample.left)
+                .with_context(|| format!("reading {}", sample.left.display()))?
+                .to_rgb8();
+            thumbs.push(html::SampleThumbs::new(&sample.id, &left, &maps)?);
+        }
+        sample_reports.push(SampleReport {
+            id: sample.id.clone(),
+            dir: sample.dir.display().to_string(),
+            width: size.0,
+            height: size.1,
+            road_mask: road.is_some(),
+            results,
+        });
+    }
+    bar.finish_and_clear();
+    let summary = methods
+        .iter()
+        .map(|m| {
+            let parts: Vec<&MethodScore> = sample_reports
+                .iter()
+                .flat_map(|s| s.results.iter().filter(|r| r.method == m.name()))
+                .collect();
+            MethodScore::pooled(m.name(), &parts).context("pooling the samples")
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let report = Report {
+        format: report::FORMAT,
+        input: Input {
+            dir: args.dir.display().to_string(),
+            kind,
+            split: args.split.clone(),
+        },
+        aggregation: report::AGGREGATION,
+        bad_threshold_px: BAD_THRESHOLD_PX,
+        regions: report::REGIONS
+            .iter()
+            .map(|(k, v)| (k.to_string(), serde_json::Value::from(*v)))
+            .collect(),
+        methods: methods
+            .iter()
+            .map(|m| MethodInfo {
+                name: m.name().to_string(),
+                kind: match m {
+                    Method::Command { .. } => "command",
+                    _ => "built-in",
+                },
+                description: m.description(),
+            })
+            .collect(),
+        summary,
+        samples: sample_reports,
+    };
+    let page = html::page(&report, &thumbs);
+    let mut json = serde_json::to_string_pretty(&report)?;
+    json.push('\n');
+    std::fs::create_dir_all(&args.output)
+        .with_context(|| format!("cannot create the folder {}", args.output.display()))?;
+    let (json_path, html_path) = (
+        args.output.join("report.json"),
+        args.output.join("index.html"),
+    );
+    write_bytes_atomically(&json_path, json.as_bytes())?;
+    write_bytes_atomically(&html_path, page.as_bytes())?;
+    eprint!("{}", summary_table(&report));
+    eprintln!(
+        "{} samples x {} methods; wrote {} and {}",
+        report.samples.len(),
+        report.methods.len(),
+        json_path.display(),
+        html_path.display()
+    );
+    Ok(())
+}
+
+/// The summary as a text table (EPE, bad-2, D1, valid share over all pixels; phantom holes;
+/// seconds per megapixel).
+fn summary_table(report: &Report) -> String {
+    let mut s = format!(
+        "{:<16} {:>8} {:>8} {:>8} {:>8} {:>10} {:>8} {:>8}\n",
+        "method", "EPE", "bad-2", "D1", "valid", "streak EPE", "phantom", "s/MP"
+    );
+    let pct = |v: f64| format!("{:.1}%", 100.0 * v);
+    for m in &report.summary {
+        let e = &m.errors;
+        s.push_str(&format!(
+            "{:<16} {:>8.3} {:>8} {:>8} {:>8} {:>10.3} {:>8} {:>8.2}\n",
+            m.method,
+            e.all.mean_abs,
+            pct(e.all.bad_2),
+            pct(e.all.d1),
+            pct(e.all.density),
+            e.streak.mean_abs,
+            m.phantom_hole_rate.map(pct).unwrap_or_else(|| "-".into()),
+            m.seconds_per_megapixel
+        ));
+    }
+    s
+}

@@ -1,0 +1,153 @@
+//! `OUT/report.json` of `streaks benchmark`: its schema (format `streaks-benchmark/1`).
+//!
+//! ```text
+//! format             "streaks-benchmark/1"
+//! input              the folder benchmarked, its kind (dataset, pair, pairs) and split
+//! aggregation        how the summary pools samples (pixel-weighted)
+//! bad_threshold_px   the threshold of `bad` (2.0; bad_1/2/3 are always given)
+//! regions            what each region means
+//! methods[]          name, kind (built-in, command), description
+//! summary[]          per method: pooled errors by region, phantom-hole rate, seconds,
+//!                    megapixels, seconds per megapixel
+//! samples[]          per sample: id, folder, size, whether it has a road mask, and per
+//!                    method the same figures for that sample alone
+//! ```
+//!
+//! Errors by region are [`RegionErrors`]: `all`, `streak`, `non_streak`, and with a road mask
+//! `road` (road surface off the streaks), `off_road` and `road_surface` (the whole road, whose
+//! `below_1px` is the phantom-hole rate); each is a [`streaks_analysis::sgm::DisparityErrors`]
+//! (`truth_pixels`, `valid_pixels`, `density` = the valid share, `mean_abs` = EPE, `rms`,
+//! `bad_1`, `bad_2`, `bad_3`, `d1` (KITTI), `bad` and `bad_all` at `threshold`, `below_1px`).
+
+use serde::Serialize;
+use streaks_analysis::benchmark::RegionErrors;
+
+/// The report's format.
+pub const FORMAT: &str = "streaks-benchmark/1";
+
+/// How the summary pools samples.
+pub const AGGREGATION: &str = "pixel-weighted: every pixel of every sample counts once (the \
+    KITTI convention); shares of valid pixels (EPE, bad-N, D1) over all samples' valid pixels, \
+    shares of truth pixels (valid share, phantom holes) over all samples' truth pixels";
+
+/// The regions, as the report states them.
+pub const REGIONS: [(&str, &str); 6] = [
+    ("all", "every pixel with a ground truth"),
+    ("streak", "the renderer's streak mask"),
+    ("non_streak", "every pixel off the streak mask"),
+    (
+        "road",
+        "the road surface (the renderer's road mask) off the streaks",
+    ),
+    ("off_road", "neither streak nor road"),
+    (
+        "road_surface",
+        "the whole road mask, streaks included; its below_1px is the phantom-hole rate",
+    ),
+];
+
+/// The whole report.
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    /// [`FORMAT`].
+    pub format: &'static str,
+    /// What was benchmarked.
+    pub input: Input,
+    /// [`AGGREGATION`].
+    pub aggregation: &'static str,
+    /// The threshold of `bad` and `bad_all`, pixels.
+    pub bad_threshold_px: f32,
+    /// [`REGIONS`] as a map.
+    pub regions: serde_json::Map<String, serde_json::Value>,
+    /// The methods, in the order run.
+    pub methods: Vec<MethodInfo>,
+    /// Per method, over all samples.
+    pub summary: Vec<MethodScore>,
+    /// Per sample.
+    pub samples: Vec<SampleReport>,
+}
+
+/// The input folder.
+#[derive(Clone, Debug, Serialize)]
+pub struct Input {
+    /// The folder as given.
+    pub dir: String,
+    /// What it is.
+    pub kind: super::input::InputKind,
+    /// The dataset split, if one was chosen.
+    pub split: Option<String>,
+}
+
+/// A method.
+#[derive(Clone, Debug, Serialize)]
+pub struct MethodInfo {
+    /// Its name.
+    pub name: String,
+    /// `built-in` or `command`.
+    pub kind: &'static str,
+    /// What it does (for a command: its template).
+    pub description: String,
+}
+
+/// One method's figures over some pixels (a sample, or all of them).
+#[derive(Clone, Debug, Serialize)]
+pub struct MethodScore {
+    /// The method.
+    pub method: String,
+    /// Errors by region.
+    pub errors: RegionErrors,
+    /// The phantom-hole rate (`errors.road_surface.below_1px`; `null` without road masks).
+    pub phantom_hole_rate: Option<f64>,
+    /// The method's wall time, seconds.
+    pub seconds: f64,
+    /// Megapixels estimated.
+    pub megapixels: f64,
+    /// `seconds / megapixels`.
+    pub seconds_per_megapixel: f64,
+}
+
+impl MethodScore {
+    /// The figures of `method` from its errors and time.
+    pub fn new(method: &str, errors: RegionErrors, seconds: f64, megapixels: f64) -> Self {
+        Self {
+            method: method.to_string(),
+            phantom_hole_rate: errors.phantom_hole_rate(),
+            errors,
+            seconds,
+            megapixels,
+            seconds_per_megapixel: if megapixels > 0.0 {
+                seconds / megapixels
+            } else {
+                0.0
+            },
+        }
+    }
+
+    /// The pooled figures of one method's per-sample figures.
+    pub fn pooled(method: &str, parts: &[&MethodScore]) -> Option<Self> {
+        let errors: Vec<RegionErrors> = parts.iter().map(|p| p.errors).collect();
+        Some(Self::new(
+            method,
+            RegionErrors::pooled(&errors)?,
+            parts.iter().map(|p| p.seconds).sum(),
+            parts.iter().map(|p| p.megapixels).sum(),
+        ))
+    }
+}
+
+/// One sample.
+#[derive(Clone, Debug, Serialize)]
+pub struct SampleReport {
+    /// Its id.
+    pub id: String,
+    /// Its folder.
+    pub dir: String,
+    /// Width in pixels.
+    pub width: usize,
+    /// Height in pixels.
+    pub height: usize,
+    /// Whether it has a road mask (else the road regions are `null`).
+    pub road_mask: bool,
+    /// Per method.
+    pub results: Vec<MethodScore>,
+}
