@@ -142,6 +142,7 @@ fn bench(c: &mut Criterion) {
         max_depth: 4,
         seed: 0,
         layers: Layers::default(),
+        regularize: false,
     };
     let mut group = c.benchmark_group("render");
     group.sample_size(10);

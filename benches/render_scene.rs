@@ -75,6 +75,7 @@ fn settings(spp: u32) -> RenderSettings {
         max_depth: 4,
         seed: 1,
         layers: Layers::default(),
+        regularize: false,
     }
 }
 

@@ -1,13 +1,13 @@
 //! `streaks compare`: relative RMSE and bias of one render against a reference, overall, per
-//! region and for the worst 8x8 block, optionally with the noise test (second renders with
-//! other seeds) and a false-colour difference PNG. See `streaks_image::compare` for the
-//! statistics.
+//! region (rectangles, or masks such as a dataset's `road0.png`) and for the worst 8x8 block,
+//! A's fireflies, optionally with the noise test (second renders with other seeds) and a
+//! false-colour difference PNG. See `streaks_image::compare` for the statistics.
 
 use anyhow::Context;
 use std::path::{Path, PathBuf};
-use streaks_image::compare::{compare, write_diff_png, Inputs};
+use streaks_image::compare::{compare_masked, write_diff_png, Inputs, MaskRegion};
 use streaks_image::exr::read_exr_rgb;
-use streaks_image::{NamedRegion, RgbImage};
+use streaks_image::{GrayImage, NamedRegion, RgbImage};
 
 /// Arguments of `streaks compare`.
 #[derive(clap::Args, Debug)]
@@ -19,6 +19,10 @@ pub struct Args {
     /// A region `[name=]x0,y0,x1,y1` (pixels, x1 and y1 exclusive); repeatable.
     #[arg(long = "region", value_name = "[NAME=]X0,Y0,X1,Y1")]
     pub regions: Vec<NamedRegion>,
+    /// A region given by a mask image `[name=]FILE` (non-zero pixels are in; the name defaults
+    /// to the file's stem), such as a dataset's road0.png; repeatable.
+    #[arg(long = "mask", value_name = "[NAME=]FILE")]
+    pub masks: Vec<String>,
     /// Print the comparison as JSON instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -46,10 +50,37 @@ fn read(path: &Path) -> anyhow::Result<RgbImage> {
     read_exr_rgb(path).with_context(|| format!("reading {}", path.display()))
 }
 
+/// Reads a `--mask [NAME=]FILE`.
+fn read_mask(spec: &str) -> anyhow::Result<MaskRegion> {
+    let (name, file) = match spec.split_once('=') {
+        Some((name, file)) => (name.to_owned(), PathBuf::from(file)),
+        None => {
+            let file = PathBuf::from(spec);
+            let stem = file
+                .file_stem()
+                .map_or_else(|| "mask".to_owned(), |s| s.to_string_lossy().into_owned());
+            (stem, file)
+        }
+    };
+    let img =
+        GrayImage::load(&file).with_context(|| format!("reading the mask {}", file.display()))?;
+    Ok(MaskRegion {
+        name,
+        width: img.width as u32,
+        height: img.height as u32,
+        mask: img.data.iter().map(|&v| v > 0.0).collect(),
+    })
+}
+
 /// Runs the command; fails (non-zero exit) when the noise test runs and a region fails.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let a = read(&args.a)?;
     let b = read(&args.b)?;
+    let masks = args
+        .masks
+        .iter()
+        .map(|m| read_mask(m))
+        .collect::<anyhow::Result<Vec<_>>>()?;
     let seconds = match (&args.a2, &args.b2) {
         (Some(a2), Some(b2)) => Some((read(a2)?, read(b2)?)),
         _ => None,
@@ -69,7 +100,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         b: &b,
         seconds: seconds.as_ref().map(|(a2, b2)| (a2, b2)),
     };
-    let c = compare(&inputs, &args.regions, args.block, args.k)
+    let c = compare_masked(&inputs, &args.regions, &masks, args.block, args.k)
         .with_context(|| format!("comparing {names}"))?;
     if let Some(path) = &args.diff_png {
         write_diff_png(path, &a, &b, args.diff_scale)

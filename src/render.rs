@@ -5,10 +5,12 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use streaks_image::png::write_png;
+use streaks_image::GrayImage;
 use streaks_render::camera::Camera;
 use streaks_render::integrator::{self, Layers, RenderOutput, RenderSettings};
 use streaks_render::output;
 use streaks_render::scene::Scene;
+use streaks_stereo::render::{road_surface, scene_has_road};
 
 /// Largest image accepted, in pixels (2^26, twice 8K UHD; the film keeps about 64 bytes per
 /// pixel, so 4 GiB).
@@ -58,6 +60,10 @@ pub struct RenderOpts {
     /// Exposure of the PNGs in stops (linear * 2^EV before the sRGB curve).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
+    /// Path regularisation (biased): roughen glossy lobes after a diffuse or rough bounce, as
+    /// Cycles' "Filter Glossy" does; far fewer fireflies, the first bounce (streaks) unchanged.
+    #[arg(long)]
+    pub regularize: bool,
 }
 
 /// A scene loaded for rendering, with the chosen camera and the image size.
@@ -141,6 +147,11 @@ pub struct Args {
     /// Extra EXR layers, comma-separated.
     #[arg(long, value_enum, value_delimiter = ',')]
     pub layers: Vec<Layer>,
+    /// Also write the road mask here: a 0/255 PNG of the pixels whose pixel-centre ray hits a
+    /// road material (extras.streaks.road) first, as a dataset's road0.png (for `streaks
+    /// compare --mask`).
+    #[arg(long, value_name = "MASK.png")]
+    pub road_mask: Option<PathBuf>,
 }
 
 /// The output format, from the file extension.
@@ -240,8 +251,13 @@ pub fn run(args: Args) -> Result<()> {
         normal: args.layers.contains(&Layer::Normal),
         albedo: args.layers.contains(&Layer::Albedo),
         specular: args.layers.contains(&Layer::Specular),
-        material: false,
+        material: args.road_mask.is_some(),
     };
+    if let Some(mask) = &args.road_mask {
+        if format_of(mask)? != Format::Png {
+            bail!("--road-mask {} must end in .png", mask.display());
+        }
+    }
     if format == Format::Png && !args.layers.is_empty() {
         eprintln!(
             "warning: --layers are written only to EXR outputs; {} is a PNG",
@@ -256,6 +272,12 @@ pub fn run(args: Args) -> Result<()> {
         width,
         height,
     } = opts.load(&args.scene)?;
+    if args.road_mask.is_some() && !scene_has_road(&scene) {
+        bail!(
+            "--road-mask: the scene {} flags no road material (extras.streaks.road)",
+            args.scene.display()
+        );
+    }
     let settings = RenderSettings {
         width,
         height,
@@ -263,10 +285,11 @@ pub fn run(args: Args) -> Result<()> {
         max_depth: opts.max_depth,
         seed: opts.seed,
         layers,
+        regularize: opts.regularize,
     };
     create_parent(&args.output)?;
-    if let Some(png) = &args.png {
-        create_parent(png)?;
+    for path in args.png.iter().chain(&args.road_mask) {
+        create_parent(path)?;
     }
 
     // Phase 3: render and write.
@@ -282,6 +305,15 @@ pub fn run(args: Args) -> Result<()> {
     }
     if let Some(png) = &args.png {
         write_png(png, &out.image, opts.exposure)?;
+    }
+    if let (Some(path), Some(material)) = (&args.road_mask, &out.material) {
+        let road = road_surface(&scene, material)
+            .into_iter()
+            .map(|r| if r { 1.0 } else { 0.0 })
+            .collect();
+        GrayImage::from_vec(width as usize, height as usize, road)?
+            .save_png(path)
+            .with_context(|| format!("cannot write the road mask {}", path.display()))?;
     }
     let s = &out.stats;
     let secs = s.seconds.max(1e-9);

@@ -54,6 +54,10 @@ pub struct Args {
     /// Longest path, Mitsuba's meaning: 1 = emitters only, 2 = direct light, 3 = one bounce...
     #[arg(long, default_value_t = 8)]
     pub max_depth: u32,
+    /// Render without path regularisation (on by default here: fewer fireflies, a small bias
+    /// in indirect light; see `streaks render --regularize`).
+    #[arg(long)]
+    pub no_regularize: bool,
 }
 
 /// sha256 of bytes, lowercase hex.
@@ -102,6 +106,7 @@ pub fn run(args: Args) -> Result<()> {
         height: args.height,
         spp: args.spp,
         max_depth: args.max_depth,
+        regularize: !args.no_regularize,
         files: FileList::current(),
         conventions: Conventions::current(),
     };
@@ -125,6 +130,7 @@ pub fn run(args: Args) -> Result<()> {
         height: args.height,
         spp: args.spp,
         max_depth: args.max_depth,
+        regularize: !args.no_regularize,
     };
     let bar = progress_bar(indices.len() as u64);
     let start = Instant::now();

@@ -257,6 +257,10 @@ pub struct DatasetInfo {
     pub spp: u32,
     /// Longest path (Mitsuba's meaning).
     pub max_depth: u32,
+    /// Path regularisation (`--no-regularize` turns it off). A `dataset.json` written before
+    /// the field existed has none and was rendered without it: it reads as `false`.
+    #[serde(default)]
+    pub regularize: bool,
     /// The files.
     pub files: FileList,
     /// The conventions.
@@ -280,12 +284,32 @@ impl DatasetInfo {
     }
 
     /// Fails, naming the first field that differs, unless `existing` (the folder's
-    /// `dataset.json` as JSON) describes the same dataset as `self`.
+    /// `dataset.json` as JSON) describes the same dataset as `self`. A `dataset.json` without
+    /// `regularize` (written before the field existed) describes a dataset rendered without
+    /// path regularisation: it matches a run with `--no-regularize`, and the message for any
+    /// other run says so.
     pub fn check_same(&self, existing: &Value, path: &Path) -> Result<()> {
+        let mut existing = existing.clone();
+        let unrecorded = match &mut existing {
+            Value::Object(map) if !map.contains_key("regularize") => {
+                map.insert("regularize".into(), Value::Bool(false));
+                true
+            }
+            _ => false,
+        };
         let new = serde_json::to_value(self)?;
-        if let Some((field, old, new)) = first_difference("", existing, &new) {
+        if let Some((field, old, new)) = first_difference("", &existing, &new) {
+            let hint = match field.as_str() {
+                "regularize" if unrecorded => {
+                    " (it predates the setting and was rendered without path regularisation: \
+                     add --no-regularize to continue it)"
+                }
+                "regularize" if self.regularize => " (add --no-regularize to continue it)",
+                "regularize" => " (drop --no-regularize to continue it)",
+                _ => "",
+            };
             bail!(
-                "{} describes another dataset: its {field} is {old}, this run's is {new}; \
+                "{} describes another dataset: its {field} is {old}, this run's is {new}{hint}; \
                  datasets are not mixed: write into another folder (or remove this one)",
                 path.display()
             );
@@ -357,6 +381,47 @@ mod tests {
         assert!(first_difference("", &a, &a).is_none());
         let c = json!({"count": 3, "config": {"street": {"lanes": [1, 2]}}});
         assert_eq!(first_difference("", &a, &c).unwrap().0, "seed");
+    }
+
+    fn info(regularize: bool) -> DatasetInfo {
+        DatasetInfo {
+            format: FORMAT.into(),
+            generator_version: "g".into(),
+            config: json!({"a": 1}),
+            config_hash: "h".into(),
+            count: 2,
+            seed: 0,
+            width: 64,
+            height: 40,
+            spp: 2,
+            max_depth: 8,
+            regularize,
+            files: FileList::current(),
+            conventions: Conventions::current(),
+        }
+    }
+
+    /// A dataset.json from before `regularize` existed reads as rendered without it: it is
+    /// continued with --no-regularize, and refused otherwise with a message that says so.
+    #[test]
+    fn datasets_without_the_regularize_field_are_unregularised() {
+        let path = Path::new("d/dataset.json");
+        let mut old = serde_json::to_value(info(false)).unwrap();
+        old.as_object_mut().unwrap().remove("regularize");
+        let back: DatasetInfo = serde_json::from_value(old.clone()).unwrap();
+        assert_eq!(back, info(false));
+        info(false).check_same(&old, path).unwrap();
+        let err = info(true).check_same(&old, path).unwrap_err().to_string();
+        assert!(
+            err.contains("its regularize is false, this run's is true")
+                && err.contains("predates the setting")
+                && err.contains("--no-regularize"),
+            "{err}"
+        );
+        let new = serde_json::to_value(info(true)).unwrap();
+        info(true).check_same(&new, path).unwrap();
+        let err = info(false).check_same(&new, path).unwrap_err().to_string();
+        assert!(err.contains("drop --no-regularize"), "{err}");
     }
 
     #[test]

@@ -38,6 +38,8 @@ pub struct SampleSettings {
     pub spp: u32,
     /// Longest path.
     pub max_depth: u32,
+    /// Path regularisation.
+    pub regularize: bool,
 }
 
 /// The render seed of sample `index` of a dataset of seed `seed` (SplitMix64 of the pair, high
@@ -103,6 +105,9 @@ pub struct RenderMeta {
     pub seed_left: u32,
     /// Seed of the right eye.
     pub seed_right: u32,
+    /// Path regularisation (absent, `false`, in samples written before the field existed).
+    #[serde(default)]
+    pub regularize: bool,
 }
 
 /// `meta.json` of a sample (no wall time: the file is the same on every run).
@@ -287,6 +292,7 @@ fn write_sample(
         seed,
         exposure_ev: s.exposure_ev,
         mask: StreakMaskParams::default(),
+        regularize: settings.regularize,
     };
     let views = render_pair(&scene, &rig, &pair, &|_| {})?;
     let [left, right] = &views;
@@ -363,6 +369,7 @@ fn write_sample(
             max_depth: settings.max_depth,
             seed_left: seed,
             seed_right: seed.wrapping_add(1),
+            regularize: settings.regularize,
         },
     };
     let mut text = serde_json::to_string_pretty(&meta)?;

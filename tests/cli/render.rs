@@ -229,3 +229,75 @@ fn every_shipped_scene_renders() {
         assert!(mean.is_finite() && mean > 0.0, "{stem}: mean {mean}");
     }
 }
+
+/// `--regularize` changes the image but not its specular layer (the first glossy bounce),
+/// `--road-mask` writes the road pixels, and `streaks compare` reports the regularised image's
+/// fireflies and the road's brightness through the mask.
+#[test]
+fn regularize_keeps_the_streaks_and_compare_measures_it() {
+    let scene =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/rainy_street_small.gltf");
+    let scene = scene.to_str().unwrap();
+    let t = TestDir::new();
+    for (out, extra) in [("plain.exr", None), ("reg.exr", Some("--regularize"))] {
+        let mut args = vec![
+            "render",
+            scene,
+            "-o",
+            out,
+            "--height",
+            "32",
+            "--spp",
+            "2",
+            "--layers",
+            "specular",
+            "--road-mask",
+            "road.png",
+        ];
+        args.extend(extra);
+        t.streaks(&args).assert_success();
+    }
+    let (plain, reg) = (t.join("plain.exr"), t.join("reg.exr"));
+    assert_ne!(read_exr_rgb(&plain).unwrap(), read_exr_rgb(&reg).unwrap());
+    assert_eq!(
+        read_exr_layer(&plain, "specular").unwrap(),
+        read_exr_layer(&reg, "specular").unwrap()
+    );
+    let road = streaks_image::GrayImage::load(&t.join("road.png")).unwrap();
+    let on = road.data.iter().filter(|&&v| v > 0.5).count();
+    assert!(on > 0 && on < road.data.len(), "{on} road pixels");
+
+    let run = t.streaks(&[
+        "compare",
+        "reg.exr",
+        "plain.exr",
+        "--mask",
+        "road.png",
+        "--json",
+    ]);
+    run.assert_success();
+    let c: serde_json::Value = serde_json::from_slice(&run.output.stdout).unwrap();
+    assert_eq!(c["regions"][0]["region"]["name"], "road");
+    assert_eq!(c["regions"][0]["pixels"].as_u64(), Some(on as u64));
+    let share = c["fireflies"]["share"].as_f64().unwrap();
+    assert!((0.0..1.0).contains(&share), "{share}");
+
+    // A scene without a road material has no road mask.
+    t.write_tiny_gltf();
+    t.streaks(&[
+        "render",
+        "scene.gltf",
+        "-o",
+        "x.exr",
+        "--spp",
+        "1",
+        "--height",
+        "8",
+        "--road-mask",
+        "r.png",
+    ])
+    .assert_failure_mentioning("flags no road material");
+    assert!(!t.join("r.png").exists() && !t.join("x.exr").exists());
+    t.streaks(&["compare", "reg.exr", "plain.exr", "--mask", "missing.png"])
+        .assert_failure_mentioning("missing.png");
+}

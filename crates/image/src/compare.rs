@@ -22,9 +22,27 @@
 //! `z = (mean_R(A) - mean_R(B)) / sqrt(SE_A^2 + SE_B^2)`; a region passes when `|z| <= k`
 //! (`k` = 4 by default: a false alarm rate of 6e-5 per region when the renderers agree).
 //! A bias that noise cannot explain is a real difference between the renderers.
+//!
+//! # Masked regions
+//!
+//! Besides rectangles, a region may be a mask ([`MaskRegion`]: the road pixels of a
+//! dataset's `road0.png`, say); its statistics are the same, over the pixels it marks.
+//!
+//! # Fireflies
+//!
+//! A firefly is an isolated pixel more than [`FIREFLY_RATIO`] = 10 times brighter than its
+//! neighbourhood: its luminance exceeds 10 times the median luminance of its 8 neighbours (5
+//! at an edge, 3 at a corner; the mean of the two middle values for an even count), or of
+//! 10^-3 times the reference's mean luminance where that is larger (so that specks in black
+//! areas too dim to see do not count) ([`isolated_bright`]). Emitters seen directly (a lamp
+//! of a pixel or two against the night sky) pass that test as well, so A's fireflies
+//! ([`Fireflies`]) leave out every pixel within one pixel of an isolated bright pixel of the
+//! reference B: those are features of the converged image (emitters, or B's own remaining
+//! fireflies), not noise of A. The share is over all pixels of the image. With second
+//! renders, fireflies are counted on the first render of each, not on the averages.
 
 use crate::png::write_png_buffer;
-use crate::{ImageError, NamedRegion, Region, RgbImage};
+use crate::{luminance, ImageError, NamedRegion, Region, RgbImage};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -50,6 +68,43 @@ pub struct RegionStats {
     pub z: Option<f64>,
     /// `|z| <= k` (noise test only).
     pub passed: Option<bool>,
+    /// Number of pixels in the region (a mask's marked pixels; its rectangle is the mask's
+    /// bounding box).
+    #[serde(default)]
+    pub pixels: u64,
+}
+
+/// A region given by a mask: the pixels where `mask` is true (row-major, the image's size).
+#[derive(Clone, Debug, PartialEq)]
+pub struct MaskRegion {
+    /// Its name.
+    pub name: String,
+    /// Width of the mask in pixels.
+    pub width: u32,
+    /// Height of the mask in pixels.
+    pub height: u32,
+    /// Which pixels belong to the region, row-major.
+    pub mask: Vec<bool>,
+}
+
+/// How much brighter than its neighbourhood a pixel must be to be a firefly.
+pub const FIREFLY_RATIO: f32 = 10.0;
+
+/// The fireflies of A against the reference B (see the module documentation).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Fireflies {
+    /// [`FIREFLY_RATIO`].
+    pub ratio: f32,
+    /// A's fireflies: its isolated bright pixels away from B's.
+    pub count: u64,
+    /// `count` over all pixels of the image.
+    pub share: f64,
+    /// Pixels left out: within one pixel of an isolated bright pixel of B.
+    pub excluded: u64,
+    /// Share of A's pixels that are isolated bright, none left out (emitters included).
+    pub share_a_all: f64,
+    /// Share of B's pixels that are isolated bright, none left out (emitters included).
+    pub share_b_all: f64,
 }
 
 /// The tile with the largest difference.
@@ -82,10 +137,12 @@ pub struct Comparison {
     pub k: f64,
     /// The whole image.
     pub overall: RegionStats,
-    /// The requested regions, in order.
+    /// The requested regions, in order, then the masked regions.
     pub regions: Vec<RegionStats>,
     /// The tile with the largest difference.
     pub largest_block: BlockDiff,
+    /// A's fireflies against B.
+    pub fireflies: Fireflies,
 }
 
 impl Comparison {
@@ -113,10 +170,16 @@ impl Comparison {
         s.push('\n');
         for r in std::iter::once(&self.overall).chain(&self.regions) {
             let g = &r.region.region;
+            let area = (g.x1 - g.x0) as u64 * (g.y1 - g.y0) as u64;
+            let pixels = if r.pixels == area {
+                format!("{},{}-{},{}", g.x0, g.y0, g.x1, g.y1)
+            } else {
+                format!("mask {} px", r.pixels)
+            };
             s.push_str(&format!(
                 "{:<12} {:>17} {:>12.5e} {:>12.5e} {:>+9.3}% {:>9.3}%",
                 r.region.name,
-                format!("{},{}-{},{}", g.x0, g.y0, g.x1, g.y1),
+                pixels,
                 r.mean_a,
                 r.mean_b,
                 100.0 * r.rel_bias,
@@ -143,6 +206,17 @@ impl Comparison {
             b.y0,
             b.mean_a,
             b.mean_b
+        ));
+        let f = &self.fireflies;
+        s.push_str(&format!(
+            "fireflies (> {}x the neighbourhood median, away from B's): A {:.4}% ({} px, {} px \
+             left out); all isolated bright pixels: A {:.4}%, B {:.4}%\n",
+            f.ratio,
+            100.0 * f.share,
+            f.count,
+            f.excluded,
+            100.0 * f.share_a_all,
+            100.0 * f.share_b_all
         ));
         s
     }
@@ -213,21 +287,29 @@ fn pixel(inputs: &Inputs<'_>, i: usize) -> (Vec3, Vec3, f64, f64) {
     }
 }
 
+impl Sums {
+    /// Adds pixel `i`.
+    #[inline]
+    fn add(&mut self, inputs: &Inputs<'_>, i: usize) {
+        let (a, b, da, db) = pixel(inputs, i);
+        self.n += 1;
+        for c in 0..3 {
+            self.a[c] += f64::from(a[c]);
+            self.b[c] += f64::from(b[c]);
+        }
+        let d = a - b;
+        self.sq += f64::from(d.x).powi(2) + f64::from(d.y).powi(2) + f64::from(d.z).powi(2);
+        self.noise_a += da * da;
+        self.noise_b += db * db;
+    }
+}
+
 fn region_sums(inputs: &Inputs<'_>, r: &Region) -> Sums {
     let mut s = Sums::default();
     let w = inputs.a.width as usize;
     for y in r.y0..r.y1 {
         for x in r.x0..r.x1 {
-            let (a, b, da, db) = pixel(inputs, y * w + x);
-            s.n += 1;
-            for c in 0..3 {
-                s.a[c] += f64::from(a[c]);
-                s.b[c] += f64::from(b[c]);
-            }
-            let d = a - b;
-            s.sq += f64::from(d.x).powi(2) + f64::from(d.y).powi(2) + f64::from(d.z).powi(2);
-            s.noise_a += da * da;
-            s.noise_b += db * db;
+            s.add(inputs, y * w + x);
         }
     }
     s
@@ -235,11 +317,55 @@ fn region_sums(inputs: &Inputs<'_>, r: &Region) -> Sums {
 
 fn region_stats(inputs: &Inputs<'_>, region: NamedRegion, k: f64) -> RegionStats {
     let s = region_sums(inputs, &region.region);
+    stats_of(s, region, k, inputs.seconds.is_some())
+}
+
+/// The statistics of a masked region: over its marked pixels, with its bounding box as the
+/// rectangle.
+fn mask_stats(inputs: &Inputs<'_>, m: &MaskRegion, k: f64) -> Result<RegionStats, ImageError> {
+    let (w, h) = (inputs.a.width, inputs.a.height);
+    if (m.width, m.height) != (w, h) || m.mask.len() != w as usize * h as usize {
+        return Err(ImageError::SizeMismatch {
+            first: "A",
+            w0: w as usize,
+            h0: h as usize,
+            second: "the mask",
+            w1: m.width as usize,
+            h1: m.height as usize,
+        });
+    }
+    let mut s = Sums::default();
+    let mut bbox: Option<Region> = None;
+    for (i, _) in m.mask.iter().enumerate().filter(|(_, &on)| on) {
+        s.add(inputs, i);
+        let (x, y) = (i % w as usize, i / w as usize);
+        let b = bbox.get_or_insert(Region {
+            x0: x,
+            y0: y,
+            x1: x + 1,
+            y1: y + 1,
+        });
+        (b.x0, b.y0) = (b.x0.min(x), b.y0.min(y));
+        (b.x1, b.y1) = (b.x1.max(x + 1), b.y1.max(y + 1));
+    }
+    let Some(region) = bbox else {
+        return Err(ImageError::EmptyMask {
+            name: m.name.clone(),
+        });
+    };
+    let region = NamedRegion {
+        name: m.name.clone(),
+        region,
+    };
+    Ok(stats_of(s, region, k, inputs.seconds.is_some()))
+}
+
+fn stats_of(s: Sums, region: NamedRegion, k: f64, noise_test: bool) -> RegionStats {
     let n = s.n as f64;
     let mean_a = s.a.iter().sum::<f64>() / (3.0 * n);
     let mean_b = s.b.iter().sum::<f64>() / (3.0 * n);
     let rel_bias_rgb = [0, 1, 2].map(|c| s.a[c] / s.b[c] - 1.0);
-    let (std_error, z, passed) = if inputs.seconds.is_some() {
+    let (std_error, z, passed) = if noise_test {
         let se = (s.noise_a + s.noise_b).sqrt() / (2.0 * n);
         let z = (mean_a - mean_b) / se;
         // A zero standard error (no noise at all) passes only on exact agreement.
@@ -262,15 +388,108 @@ fn region_stats(inputs: &Inputs<'_>, region: NamedRegion, k: f64) -> RegionStats
         std_error,
         z,
         passed,
+        pixels: s.n,
     }
 }
 
+/// Whether each pixel of `img` is isolated bright: its luminance above `ratio` times the
+/// larger of `floor` and the median luminance of its neighbours (see the module
+/// documentation). Row-major.
+pub fn isolated_bright(img: &RgbImage, ratio: f32, floor: f32) -> Vec<bool> {
+    let (w, h) = (img.width as usize, img.height as usize);
+    let lum: Vec<f32> = img.pixels.iter().map(|&p| luminance(p)).collect();
+    let mut out = vec![false; w * h];
+    let mut nb = [0f32; 8];
+    for y in 0..h {
+        for x in 0..w {
+            let mut n = 0;
+            for dy in -1i32..=1 {
+                for dx in -1i32..=1 {
+                    let (xx, yy) = (x as i32 + dx, y as i32 + dy);
+                    if (dx, dy) != (0, 0)
+                        && xx >= 0
+                        && yy >= 0
+                        && (xx as usize) < w
+                        && (yy as usize) < h
+                    {
+                        nb[n] = lum[yy as usize * w + xx as usize];
+                        n += 1;
+                    }
+                }
+            }
+            if n == 0 {
+                continue;
+            }
+            let v = &mut nb[..n];
+            v.sort_unstable_by(f32::total_cmp);
+            let median = if n % 2 == 1 {
+                v[n / 2]
+            } else {
+                0.5 * (v[n / 2 - 1] + v[n / 2])
+            };
+            out[y * w + x] = lum[y * w + x] > ratio * median.max(floor);
+        }
+    }
+    out
+}
+
+/// A's fireflies against the reference `b` (same size; see the module documentation).
+pub fn fireflies(a: &RgbImage, b: &RgbImage) -> Result<Fireflies, ImageError> {
+    check_size("A", a, "B", b)?;
+    let (w, h) = (a.width as usize, a.height as usize);
+    let n = (w * h).max(1) as f64;
+    let mean_b = b
+        .pixels
+        .iter()
+        .map(|&p| f64::from(luminance(p)))
+        .sum::<f64>()
+        / n;
+    let floor = (1e-3 * mean_b) as f32;
+    let in_a = isolated_bright(a, FIREFLY_RATIO, floor);
+    let in_b = isolated_bright(b, FIREFLY_RATIO, floor);
+    let near_b = |x: usize, y: usize| {
+        (y.saturating_sub(1)..(y + 2).min(h))
+            .any(|yy| (x.saturating_sub(1)..(x + 2).min(w)).any(|xx| in_b[yy * w + xx]))
+    };
+    let (mut count, mut excluded) = (0u64, 0u64);
+    for y in 0..h {
+        for x in 0..w {
+            if near_b(x, y) {
+                excluded += 1;
+            } else if in_a[y * w + x] {
+                count += 1;
+            }
+        }
+    }
+    let share = |m: &[bool]| m.iter().filter(|&&v| v).count() as f64 / n;
+    Ok(Fireflies {
+        ratio: FIREFLY_RATIO,
+        count,
+        share: count as f64 / n,
+        excluded,
+        share_a_all: share(&in_a),
+        share_b_all: share(&in_b),
+    })
+}
+
 /// Compares A with B over the whole image, the `regions` (unnamed ones are called
-/// `region<i>`), and `block x block` tiles; `k` is the noise test's threshold (used only with
-/// second renders).
+/// `region<i>`), and `block x block` tiles, and counts A's fireflies; `k` is the noise
+/// test's threshold (used only with second renders).
 pub fn compare(
     inputs: &Inputs<'_>,
     regions: &[NamedRegion],
+    block: u32,
+    k: f64,
+) -> Result<Comparison, ImageError> {
+    compare_masked(inputs, regions, &[], block, k)
+}
+
+/// [`compare`] with masked regions as well (after the rectangles in
+/// [`Comparison::regions`]).
+pub fn compare_masked(
+    inputs: &Inputs<'_>,
+    regions: &[NamedRegion],
+    masks: &[MaskRegion],
     block: u32,
     k: f64,
 ) -> Result<Comparison, ImageError> {
@@ -297,6 +516,9 @@ pub fn compare(
         r.region
             .check_fits(&r.name, width as usize, height as usize)?;
         stats.push(region_stats(inputs, r, k));
+    }
+    for m in masks {
+        stats.push(mask_stats(inputs, m, k)?);
     }
     let overall = region_stats(inputs, whole, k);
     let block = block.max(1);
@@ -344,6 +566,7 @@ pub fn compare(
             mean_b: 0.0,
             rel_diff: 0.0,
         }),
+        fireflies: fireflies(a, b)?,
     })
 }
 
@@ -575,6 +798,115 @@ mod tests {
         let c = compare(&biased, &[], 8, 4.0).unwrap();
         assert_eq!(c.passed(), Some(false), "{}", c.table());
         assert!(c.table().contains("FAIL"));
+    }
+
+    /// A smooth image with three spikes in A: one 20x its neighbours (a firefly), one 5x (not
+    /// one), and one where B has an emitter of one pixel (left out, with its neighbours).
+    #[test]
+    fn fireflies_are_isolated_pixels_away_from_the_references() {
+        let base = |x: u32, y: u32| Vec3::splat(1.0 + 0.01 * (x + y) as f32);
+        let lamp = (20, 5);
+        let b = img(32, 16, |x, y| {
+            if (x, y) == lamp {
+                Vec3::splat(500.0)
+            } else {
+                base(x, y)
+            }
+        });
+        let a = img(32, 16, |x, y| match (x, y) {
+            (4, 4) => Vec3::splat(20.0),
+            (10, 10) => Vec3::splat(5.0),
+            (21, 5) => Vec3::splat(30.0),
+            p if p == lamp => Vec3::splat(480.0),
+            _ => base(x, y),
+        });
+        let f = fireflies(&a, &b).unwrap();
+        assert_eq!((f.count, f.excluded), (1, 9), "{f:?}");
+        let n = 32.0 * 16.0;
+        assert_eq!(f.share, 1.0 / n);
+        // A's isolated bright pixels, none left out: the firefly and the lamp (its neighbour
+        // at 30 has the lamp among its neighbours, whose median stays about 1).
+        assert_eq!(f.share_a_all, 3.0 / n);
+        assert_eq!(f.share_b_all, 1.0 / n);
+        let c = compare(
+            &Inputs {
+                a: &a,
+                b: &b,
+                seconds: None,
+            },
+            &[],
+            8,
+            4.0,
+        )
+        .unwrap();
+        assert_eq!(c.fireflies, f);
+        assert!(c.table().contains("fireflies"), "{}", c.table());
+        // Specks in black far below the image's brightness are not fireflies; in a lit image
+        // of the same black area they are.
+        let dark = img(8, 8, |x, y| {
+            if (x, y) == (3, 3) {
+                Vec3::splat(1e-6)
+            } else if x >= 6 {
+                Vec3::splat(1.0)
+            } else {
+                Vec3::ZERO
+            }
+        });
+        assert_eq!(fireflies(&dark, &dark).unwrap().share_a_all, 0.0);
+        let speck = img(8, 8, |x, y| {
+            if (x, y) == (3, 3) {
+                Vec3::splat(0.1)
+            } else if x >= 6 {
+                Vec3::splat(1.0)
+            } else {
+                Vec3::ZERO
+            }
+        });
+        let f = fireflies(&speck, &dark).unwrap();
+        assert_eq!((f.count, f.share_a_all), (1, 1.0 / 64.0), "{f:?}");
+    }
+
+    #[test]
+    fn masked_regions_average_their_pixels() {
+        let b = img(8, 4, |_, _| Vec3::ONE);
+        let a = img(8, 4, |x, _| Vec3::splat(if x % 2 == 0 { 2.0 } else { 1.0 }));
+        let mask = MaskRegion {
+            name: "even".into(),
+            width: 8,
+            height: 4,
+            mask: (0..32).map(|i| i % 2 == 0 && i >= 8).collect(),
+        };
+        let inputs = Inputs {
+            a: &a,
+            b: &b,
+            seconds: None,
+        };
+        let c = compare_masked(&inputs, &[], std::slice::from_ref(&mask), 8, 4.0).unwrap();
+        let r = &c.regions[0];
+        assert_eq!((r.region.name.as_str(), r.pixels), ("even", 12));
+        assert_eq!(
+            (
+                r.region.region.x0,
+                r.region.region.y0,
+                r.region.region.x1,
+                r.region.region.y1
+            ),
+            (0, 1, 7, 4)
+        );
+        assert!((r.rel_bias - 1.0).abs() < 1e-12);
+        assert!(c.table().contains("mask 12 px"), "{}", c.table());
+        let empty = MaskRegion {
+            mask: vec![false; 32],
+            ..mask.clone()
+        };
+        let err = compare_masked(&inputs, &[], &[empty], 8, 4.0).unwrap_err();
+        assert_eq!(err.to_string(), "the mask even marks no pixel");
+        let small = MaskRegion {
+            width: 4,
+            mask: vec![true; 16],
+            ..mask
+        };
+        assert!(compare_masked(&inputs, &[], &[small], 8, 4.0).is_err());
     }
 
     #[test]

@@ -98,6 +98,12 @@ pub enum ImageError {
         /// The form expected: `x0,y0,x1,y1` or `[name=]x0,y0,x1,y1`.
         expected: &'static str,
     },
+    /// A masked region marks no pixel.
+    #[error("the mask {name} marks no pixel")]
+    EmptyMask {
+        /// The mask's name.
+        name: String,
+    },
     /// A region is empty or extends past the image.
     #[error(
         "region {}({x0},{y0})-({x1},{y1}) is empty or outside the {width}x{height} image",

@@ -146,6 +146,7 @@ fn main() {
         max_depth: 3,
         seed: 1,
         layers: Default::default(),
+        regularize: false,
     };
     let mut images = Vec::new();
     for shared in [true, false] {

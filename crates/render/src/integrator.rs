@@ -46,6 +46,26 @@
 //! inner volume puts the path in air), a camera inside a volume starts in air, and the
 //! boundary must be closed and consistently wound.
 //!
+//! Path regularisation ([`RenderSettings::regularize`], off by default; biased): a glossy
+//! lobe seen after a diffuse or rough bounce is roughened, so that the light a small lamp
+//! sends through the wet road to a facade or pavement is found by next-event estimation
+//! rather than by the rare BSDF sample that hits the lamp (a firefly). The rule is Cycles'
+//! "Filter Glossy" (`integrator/surface_shader.h`, `surface_shader_prepare_closures`; Kaplanyan
+//! and Dachsbacher 2013 regularise paths the same way): each path keeps the smallest
+//! density `min_ray_pdf` of the directions its BSDF samples chose (lobe choice included;
+//! infinite at the camera, delta samples leave it unchanged, as Cycles' singular closures
+//! report a density of 1e6), and at a vertex where `min_ray_pdf / filter_glossy < 1` every
+//! glossy lobe is clamped from below to the microfacet alpha
+//! `0.5 sqrt(1 - min_ray_pdf / filter_glossy)` ([`regularized_alpha`], [`FILTER_GLOSSY`] =
+//! Blender's default 1; [`Bsdf::roughened`]). A Lambertian bounce (density `cos / pi <=
+//! 1 / pi`) makes every later glossy lobe at least as rough as alpha 0.41; a sharp glossy
+//! bounce (density far above 1) changes nothing. The roughened lobe is the vertex's BSDF for
+//! everything at that vertex: next-event estimation, the light choice, BSDF sampling and both
+//! MIS weights, so the estimator is consistent for the roughened scene. The first vertex is
+//! never roughened, so the specular layer (camera, first glossy bounce, emitter) and every
+//! path of up to one bounce are bit-identical with and without it; the cost is a bias in
+//! indirect light (a blurred reflection of a lamp in the road seen from a facade).
+//!
 //! Determinism: each pixel sample draws its random numbers from the [`Sampler`] positioned by
 //! `(pixel, sample index)` and the seed, never by thread; rows are rendered in parallel with
 //! rayon, each pixel accumulated by one thread in sample order, so the image is bit-identical
@@ -121,6 +141,24 @@ pub struct RenderSettings {
     pub seed: u32,
     /// Extra layers.
     pub layers: Layers,
+    /// Path regularisation (Cycles' "Filter Glossy"; biased, see the module documentation).
+    pub regularize: bool,
+}
+
+/// Cycles' "Filter Glossy" value used by path regularisation: Blender's default
+/// (`cycles.blur_glossy = 1.0`; the kernel's `filter_glossy` is its inverse).
+pub const FILTER_GLOSSY: f32 = 1.0;
+
+/// The smallest microfacet alpha that path regularisation lets a glossy lobe have at a vertex
+/// whose path has so far chosen directions of smallest density `min_ray_pdf` (per steradian,
+/// infinite for a camera ray): Cycles' `0.5 sqrt(1 - min_ray_pdf / filter_glossy)` when
+/// `min_ray_pdf / filter_glossy < 1` (`surface_shader_prepare_closures` with
+/// `kernel_data.integrator.filter_glossy = 1 / blur_glossy`), else `None` (no change). At most
+/// 0.5.
+#[inline]
+pub fn regularized_alpha(min_ray_pdf: f32) -> Option<f32> {
+    let blur_pdf = min_ray_pdf / FILTER_GLOSSY;
+    (blur_pdf < 1.0).then(|| 0.5 * (1.0 - blur_pdf).sqrt())
 }
 
 /// Counters of one render.
@@ -201,13 +239,7 @@ pub fn render(
                 sampler.start_pixel_sample((x, y), s);
                 let film_pos = Vec2::new(x as f32, y as f32) + sampler.next_2d();
                 let ray = camera.generate_ray(film_pos, width, height);
-                let path = trace_path(
-                    scene,
-                    ray,
-                    &mut sampler,
-                    settings.max_depth,
-                    settings.layers.specular,
-                );
+                let path = trace_path(scene, ray, &mut sampler, settings);
                 row_rays += path.rays;
                 pixel.add_sample(path.radiance, path.specular);
             }
@@ -253,9 +285,9 @@ fn trace_path(
     scene: &Scene,
     mut ray: Ray,
     sampler: &mut Sampler,
-    max_depth: u32,
-    want_specular: bool,
+    settings: &RenderSettings,
 ) -> PathResult {
+    let (max_depth, want_specular) = (settings.max_depth, settings.layers.specular);
     let lights: &LightSampler = &scene.light_sampler;
     let mut out = PathResult::default();
     let mut throughput = Vec3::ONE;
@@ -271,6 +303,8 @@ fn trace_path(
     let mut medium: Option<Volume> = None;
     // At the first hit: the BSDF and frame, for the specular layer of a hit emitter.
     let mut first_bsdf: Option<(Bsdf, Frame, Vec3)> = None;
+    // The smallest density of the directions chosen so far (path regularisation).
+    let mut min_ray_pdf = f32::INFINITY;
 
     while depth < max_depth {
         out.rays += 1;
@@ -308,6 +342,11 @@ fn trace_path(
         let mut bsdf = material.bsdf_at(&hit.attributes, &scene.textures);
         if !front {
             bsdf = bsdf.seen_from_back();
+        }
+        if settings.regularize {
+            if let Some(alpha) = regularized_alpha(min_ray_pdf) {
+                bsdf = bsdf.roughened(alpha);
+            }
         }
         let ng = if front { hit.ng } else { -hit.ng };
         // The medium beyond the surface: entered through a volume's front face, left through
@@ -438,6 +477,9 @@ fn trace_path(
         prev = Some(rx);
         prev_bsdf_pdf = bs.pdf;
         prev_delta = bs.delta;
+        if !bs.delta {
+            min_ray_pdf = min_ray_pdf.min(bs.pdf);
+        }
         medium = medium_along(bs.wi.z);
         ray = Ray::new(offset_ray_origin(hit.p, ng, wi), wi);
         depth += 1;
@@ -510,6 +552,7 @@ pub(crate) mod tests {
             max_depth,
             seed: 1,
             layers: Layers::default(),
+            regularize: false,
         }
     }
 
@@ -906,6 +949,99 @@ pub(crate) mod tests {
             .pixels
             .iter()
             .all(|s| *s == Vec3::ZERO));
+    }
+
+    /// Path regularisation changes no path of the first bounce: with and without it, the
+    /// specular layer (camera, road, emitter) is bit-identical, and so is the whole image at
+    /// max depth 2 (direct light only); deeper paths (road, wall, road, lamp) change.
+    #[test]
+    fn regularisation_leaves_the_first_bounce_unchanged() {
+        // The street with a diffuse wall beside the road, so that paths reach the glossy
+        // road again after a diffuse bounce.
+        let mut sign = Material::diffuse("sign", Vec3::ZERO);
+        sign.emission = Vec3::new(40.0, 20.0, 10.0);
+        let mut road = Material::diffuse("road", Vec3::ZERO);
+        road.reflectance = crate::material::Reflectance::Paper {
+            model: crate::material::PaperModel::Ggx,
+            kd: Vec3::splat(0.1),
+            ks: Vec3::splat(0.5),
+            alpha: 0.02,
+            shininess: 0.0,
+            kd_texture: None,
+            wetness: None,
+        };
+        road.road = true;
+        let mut parts = SceneParts {
+            materials: vec![road, sign, Material::diffuse("wall", Vec3::splat(0.6))],
+            lights: vec![Light::Point {
+                position: Vec3::new(-1.0, 3.0, -6.0),
+                intensity: Vec3::splat(30.0),
+                range: None,
+            }],
+            ..Default::default()
+        };
+        floor(&mut parts);
+        quad(
+            &mut parts,
+            [
+                Vec3::new(-0.3, 0.2, -12.0),
+                Vec3::new(0.3, 0.2, -12.0),
+                Vec3::new(0.3, 0.5, -12.0),
+                Vec3::new(-0.3, 0.5, -12.0),
+            ],
+            1,
+        );
+        quad(
+            &mut parts,
+            [
+                Vec3::new(3.0, 0.0, 5.0),
+                Vec3::new(3.0, 0.0, -30.0),
+                Vec3::new(3.0, 8.0, -30.0),
+                Vec3::new(3.0, 8.0, 5.0),
+            ],
+            2,
+        );
+        let scene = Scene::from_parts(parts).unwrap();
+        let cam = camera(Vec3::new(0.0, 1.5, 0.0), -0.1, 0.7);
+        let mut set = settings(24, 16, 8, 6);
+        set.layers.specular = true;
+        let plain = render(&scene, &cam, &set, &|_| {});
+        set.regularize = true;
+        let reg = render(&scene, &cam, &set, &|_| {});
+        assert_eq!(plain.specular, reg.specular);
+        assert!(plain
+            .specular
+            .as_ref()
+            .unwrap()
+            .pixels
+            .iter()
+            .any(|p| p.max_element() > 0.0));
+        assert_ne!(plain.image, reg.image);
+        let mean =
+            |o: &RenderOutput| o.image.pixels.iter().sum::<Vec3>() / o.image.pixels.len() as f32;
+        let (a, b) = (mean(&plain), mean(&reg));
+        assert!(
+            ((a - b) / a).abs().max_element() < 0.2,
+            "mean radiance {a} plain, {b} regularised"
+        );
+        set.max_depth = 2;
+        let plain2 = render(&scene, &cam, &set, &|_| {});
+        set.regularize = false;
+        let reg2 = render(&scene, &cam, &set, &|_| {});
+        assert_eq!(plain2.image, reg2.image);
+        assert_eq!(plain2.specular, reg2.specular);
+    }
+
+    #[test]
+    fn regularized_alpha_follows_cycles() {
+        assert_eq!(regularized_alpha(f32::INFINITY), None);
+        assert_eq!(regularized_alpha(1.0), None);
+        assert_eq!(regularized_alpha(50.0), None);
+        assert_eq!(regularized_alpha(0.0), Some(0.5));
+        // After a Lambertian bounce at normal incidence (density 1 / pi).
+        let a = regularized_alpha(std::f32::consts::FRAC_1_PI).unwrap();
+        assert!((a - 0.5 * (1.0 - std::f32::consts::FRAC_1_PI).sqrt()).abs() < 1e-7);
+        assert!((0.41..0.42).contains(&a), "{a}");
     }
 
     /// A glass box between the camera (on +Z, looking down -Z through a narrow field of view)

@@ -64,6 +64,7 @@
 //!     max_depth: 1,
 //!     seed: 0,
 //!     layers: Layers::default(),
+//!     regularize: false,
 //! };
 //! let out = render(&scene, &camera, &settings, &|_| {});
 //! assert!(out.image.pixels.iter().all(|p| (*p - Vec3::splat(2.0)).abs().max_element() < 1e-6));

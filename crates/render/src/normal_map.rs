@@ -404,6 +404,7 @@ mod tests {
                 max_depth,
                 seed: 3,
                 layers: Layers::default(),
+                regularize: false,
             }
         }
 

@@ -123,6 +123,7 @@ impl RegressionCase {
             max_depth: self.max_depth,
             seed,
             layers: Layers::default(),
+            regularize: false,
         }
     }
 

@@ -49,6 +49,7 @@ fn image(scene: &Scene) -> Vec<Vec3> {
         max_depth: 4,
         seed: 3,
         layers: Default::default(),
+        regularize: false,
     };
     render(scene, scene.camera(None).unwrap(), &settings, &|_| {})
         .image

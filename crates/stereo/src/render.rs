@@ -83,6 +83,8 @@ pub struct PairSettings {
     pub exposure_ev: f32,
     /// The streak-mask definition.
     pub mask: StreakMaskParams,
+    /// Path regularisation (biased; [`streaks_render::integrator::RenderSettings::regularize`]).
+    pub regularize: bool,
 }
 
 /// One rendered eye with its ground truth.
@@ -155,6 +157,7 @@ pub fn render_eye(
             specular: true,
             material: true,
         },
+        regularize: settings.regularize,
     };
     let output = render(scene, &eye_camera(rig, eye), &render_settings, progress);
     let missing =
@@ -169,10 +172,7 @@ pub fn render_eye(
         .material
         .as_ref()
         .ok_or_else(|| missing("material"))?;
-    let road_surface: Vec<bool> = materials
-        .iter()
-        .map(|&m| scene.materials.get(m as usize).is_some_and(|m| m.road))
-        .collect();
+    let road_surface = road_surface(scene, materials);
     let (wu, hu) = (w as usize, h as usize);
     let disparity: Vec<f32> = z
         .iter()
@@ -205,6 +205,15 @@ pub fn render_eye(
         streak_threshold,
         output,
     })
+}
+
+/// Which pixels of a render's `material` layer ([`RenderOutput::material`]) see a road
+/// material ([`streaks_render::material::Material::road`]) first.
+pub fn road_surface(scene: &Scene, materials: &[u32]) -> Vec<bool> {
+    materials
+        .iter()
+        .map(|&m| scene.materials.get(m as usize).is_some_and(|m| m.road))
+        .collect()
 }
 
 /// Whether any material of `scene` is the road surface of the scene contract
