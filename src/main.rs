@@ -7,6 +7,7 @@ mod analyze;
 mod benchmark;
 mod compare;
 mod dataset;
+mod detect;
 mod disparity;
 mod export_mitsuba;
 mod figure;
@@ -55,6 +56,8 @@ enum Command {
     ExportMitsuba(export_mitsuba::Args),
     /// Compare a render with a reference: relative RMSE and bias per region, noise test.
     Compare(compare::Args),
+    /// Detect specular streaks in an image, or score the detector over a dataset.
+    Detect(detect::Args),
     /// Generate stereo datasets of procedural rainy streets (generate), and index them (index).
     Dataset(dataset::Args),
     /// Score stereo methods (built-in and external) against a dataset's ground truth by region.
@@ -78,6 +81,7 @@ fn main() -> ExitCode {
         Command::Disparity(args) => disparity::run(args),
         Command::Dataset(args) => dataset::run(args),
         Command::Benchmark(args) => benchmark::run(args),
+        Command::Detect(args) => detect::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -59,6 +59,10 @@ pub struct DetectParams {
     pub horizon: Option<f32>,
     /// Radius of the box filter applied before thresholding, pixels (0: none).
     pub smooth_radius: usize,
+    /// Width of the horizontal window whose median is a pixel's background, as a share of the
+    /// image width (0: the whole row). A streak narrower than half the window does not raise
+    /// its own background; facades and pavements beside the road do not raise the road's.
+    pub background_width: f32,
     /// High (seed) threshold in noise deviations above the row's background.
     pub high: f32,
     /// Low (growth) threshold, likewise.
@@ -88,9 +92,10 @@ impl Default for DetectParams {
         Self {
             horizon: None,
             smooth_radius: 1,
-            high: 12.0,
-            low: 4.0,
-            row_fraction: 0.25,
+            background_width: 0.25,
+            high: 6.0,
+            low: 3.0,
+            row_fraction: 0.6,
             noise_floor: 0.01,
             gap: 0.5,
             head_ratio: 2.0,
@@ -113,6 +118,9 @@ impl DetectParams {
         }
         if !(0.0..1.0).contains(&self.noise_floor) {
             return bad("noise_floor", "must be in [0, 1)");
+        }
+        if !(0.0..=1.0).contains(&self.background_width) {
+            return bad("background_width", "must be in [0, 1]");
         }
         if self.smooth_radius > 16 {
             return bad("smooth_radius", "must be at most 16");
@@ -236,11 +244,50 @@ fn box_blur(img: &GrayImage, r: usize) -> GrayImage {
     out
 }
 
-/// Per-row thresholds: background (median), and the low and high contrasts above it.
+/// Each pixel's contrast above its background, and per row the low and high thresholds.
 struct RowThresholds {
-    bg: Vec<f32>,
+    contrast: Vec<f32>,
     lo: Vec<f32>,
     hi: Vec<f32>,
+}
+
+/// Each pixel's value minus the median of its row's window of `share` times the image width
+/// (odd, at least 3 pixels; clipped at the image's sides; 0: the whole row), row-major.
+fn local_contrast(img: &GrayImage, share: f32, buf: &mut Vec<f32>) -> Vec<f32> {
+    let (w, h) = (img.width, img.height);
+    let mut out = vec![0.0f32; w * h];
+    if share <= 0.0 {
+        for (row, o) in img.data.chunks_exact(w).zip(out.chunks_exact_mut(w)) {
+            let b = quantile(row, 0.5, buf);
+            for (o, &v) in o.iter_mut().zip(row) {
+                *o = v - b;
+            }
+        }
+        return out;
+    }
+    let r = ((share * w as f32 / 2.0).round() as usize).max(1);
+    // A sorted sliding window per row: insertion and removal by binary search.
+    let mut window: Vec<f32> = Vec::with_capacity(2 * r + 1);
+    let pos = |win: &[f32], v: f32| win.partition_point(|&u| u.total_cmp(&v).is_lt());
+    for (row, o) in img.data.chunks_exact(w).zip(out.chunks_exact_mut(w)) {
+        window.clear();
+        let (mut lo, mut hi) = (0usize, 0usize); // the window is row[lo..hi]
+        for x in 0..w {
+            let (want_lo, want_hi) = (x.saturating_sub(r), (x + r + 1).min(w));
+            while hi < want_hi {
+                let v = row[hi];
+                window.insert(pos(&window, v), v);
+                hi += 1;
+            }
+            while lo < want_lo {
+                let k = pos(&window, row[lo]);
+                window.remove(k);
+                lo += 1;
+            }
+            o[x] = row[x] - window[window.len() / 2];
+        }
+    }
+    out
 }
 
 /// Finds streaks and lamps in `img`.
@@ -256,17 +303,17 @@ pub fn detect_streaks(img: &GrayImage, params: &DetectParams) -> Result<Detectio
     })?;
     let img = &box_blur(img, params.smooth_radius);
     let mut buf = Vec::with_capacity(w);
-    let mut dev = vec![0.0f32; w];
     let mut th = RowThresholds {
-        bg: vec![0.0; h],
+        contrast: local_contrast(img, params.background_width, &mut buf),
         lo: vec![f32::INFINITY; h],
         hi: vec![f32::INFINITY; h],
     };
     let mut noise = vec![0.0f32; h];
-    for ((row, b), n) in img.data.chunks_exact(w).zip(&mut th.bg).zip(&mut noise) {
-        *b = quantile(row, 0.5, &mut buf);
-        for (d, &v) in dev.iter_mut().zip(row) {
-            *d = (v - *b).abs();
+    let mut dev = vec![0.0f32; w];
+    for (row, n) in th.contrast.chunks_exact(w).zip(&mut noise) {
+        let m = quantile(row, 0.5, &mut buf);
+        for (d, &c) in dev.iter_mut().zip(row) {
+            *d = (c - m).abs();
         }
         *n = 1.4826 * quantile(&dev, 0.5, &mut buf);
     }
@@ -274,7 +321,7 @@ pub fn detect_streaks(img: &GrayImage, params: &DetectParams) -> Result<Detectio
     // bright, do not raise it).
     let contrasts: Vec<f32> = (0..w * h)
         .filter(|&i| below(i / w))
-        .map(|i| img.data[i] - th.bg[i / w])
+        .map(|i| th.contrast[i])
         .collect();
     let floor = params.noise_floor * quantile(&contrasts, 0.999, &mut buf).max(0.0);
     for ((n, lo), hi) in noise.iter().zip(&mut th.lo).zip(&mut th.hi) {
@@ -298,7 +345,7 @@ pub fn detect_streaks(img: &GrayImage, params: &DetectParams) -> Result<Detectio
         horizon,
         thresholds,
     };
-    let on = |i: usize| img.data[i] - th.bg[i / w] >= th.lo[i / w];
+    let on = |i: usize| th.contrast[i] >= th.lo[i / w];
     let mut label = vec![false; w * h];
     let mut stack = Vec::new();
     let mut region: Vec<usize> = Vec::new();
@@ -438,6 +485,31 @@ fn split_head<'a>(img: &GrayImage, region: &'a [usize], ratio: f32) -> (&'a [usi
     region.split_at(rows[head_rows].0)
 }
 
+/// The cross-section of a region's row (pixel indices of one row, by column): the run of
+/// pixels at least `keep` in contrast, without gaps wider than one pixel, that holds the row's
+/// brightest pixel. A lane marking or a second reflection that touches the streak in the same
+/// row is separated from it by darker road, and is left out.
+fn cross_section<'a>(
+    row: &'a [usize],
+    w: usize,
+    contrast: &impl Fn(usize) -> f32,
+    keep: f32,
+) -> &'a [usize] {
+    let Some(peak) = (0..row.len()).max_by(|&a, &b| contrast(row[a]).total_cmp(&contrast(row[b])))
+    else {
+        return row;
+    };
+    let joined = |a: usize, b: usize| row[b] % w - row[a] % w <= 2 && contrast(row[b]) >= keep;
+    let (mut lo, mut hi) = (peak, peak + 1);
+    while lo > 0 && joined(lo - 1, lo) && contrast(row[lo - 1]) >= keep {
+        lo -= 1;
+    }
+    while hi < row.len() && joined(hi - 1, hi) {
+        hi += 1;
+    }
+    &row[lo..hi]
+}
+
 /// Measures a region and records it as a streak (below the horizon, elongated) or a lamp.
 fn classify(
     img: &GrayImage,
@@ -448,7 +520,7 @@ fn classify(
     mask: &mut GrayImage,
 ) {
     let w = img.width;
-    let contrast = |i: usize| img.data[i] - th.bg[i / w];
+    let contrast = |i: usize| th.contrast[i];
     let peak = region.iter().map(|&i| img.data[i]).fold(f32::MIN, f32::max);
     if region.is_empty() || !region.iter().any(|&i| contrast(i) >= th.hi[i / w]) {
         return;
@@ -483,10 +555,8 @@ fn classify(
                 let row = &region[k..end];
                 let keep =
                     params.row_fraction * row.iter().map(|&i| contrast(i)).fold(0.0, f32::max);
-                for &i in row {
-                    if contrast(i) >= keep {
-                        mask.data[i] = 1.0;
-                    }
+                for &i in cross_section(row, w, &contrast, keep) {
+                    mask.data[i] = 1.0;
                 }
                 k = end;
             }
@@ -516,11 +586,8 @@ fn classify(
             .fold(0.0f32, f32::max);
         let keep = params.row_fraction * row_peak;
         let (mut rw, mut rx) = (0.0f64, 0.0f64);
-        for &i in &region[k..end] {
+        for &i in cross_section(&region[k..end], w, &contrast, keep) {
             let c = contrast(i);
-            if c < keep {
-                continue;
-            }
             let wgt = (c - keep) as f64 + 1e-12;
             rw += wgt;
             rx += wgt * ((i % w) as f64 + 0.5);
@@ -574,6 +641,50 @@ pub struct MaskScore {
     pub detected: usize,
     /// True pixels.
     pub truth: usize,
+    /// Pixels both detected and true.
+    pub true_positives: usize,
+}
+
+impl MaskScore {
+    /// The score of `true_positives` hits among `detected` detections of `truth` true pixels
+    /// (precision and recall are 0 when their denominator is).
+    pub fn from_counts(true_positives: usize, detected: usize, truth: usize) -> Self {
+        let precision = if detected > 0 {
+            true_positives as f64 / detected as f64
+        } else {
+            0.0
+        };
+        let recall = if truth > 0 {
+            true_positives as f64 / truth as f64
+        } else {
+            0.0
+        };
+        let f1 = if precision + recall > 0.0 {
+            2.0 * precision * recall / (precision + recall)
+        } else {
+            0.0
+        };
+        Self {
+            precision,
+            recall,
+            f1,
+            detected,
+            truth,
+            true_positives,
+        }
+    }
+
+    /// The pixel-pooled score of several images: their counts summed, so that each pixel
+    /// weighs the same (an image without streaks adds only its false detections).
+    pub fn pooled<'a>(scores: impl IntoIterator<Item = &'a MaskScore>) -> Self {
+        let (mut tp, mut nd, mut nt) = (0, 0, 0);
+        for s in scores {
+            tp += s.true_positives;
+            nd += s.detected;
+            nt += s.truth;
+        }
+        Self::from_counts(tp, nd, nt)
+    }
 }
 
 /// Scores `detected` against `truth` (a pixel is "on" when its value exceeds 0.5).
@@ -593,20 +704,7 @@ pub fn score_mask(detected: &GrayImage, truth: &GrayImage) -> Result<MaskScore, 
         nt += t as usize;
         tp += (d && t) as usize;
     }
-    let precision = if nd > 0 { tp as f64 / nd as f64 } else { 0.0 };
-    let recall = if nt > 0 { tp as f64 / nt as f64 } else { 0.0 };
-    let f1 = if precision + recall > 0.0 {
-        2.0 * precision * recall / (precision + recall)
-    } else {
-        0.0
-    };
-    Ok(MaskScore {
-        precision,
-        recall,
-        f1,
-        detected: nd,
-        truth: nt,
-    })
+    Ok(MaskScore::from_counts(tp, nd, nt))
 }
 
 /// The part of a ground-truth streak mask the detector is meant to find: "on" pixels (above
