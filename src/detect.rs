@@ -209,7 +209,8 @@ fn score_sample(dir: &Path, id: &str, kind: ImageKind, params: &ParamArgs) -> Re
         ImageKind::Png => "im0.png",
         ImageKind::Exr => "im0.exr",
     });
-    let img = GrayImage::load(&image).with_context(|| format!("cannot read {}", image.display()))?;
+    let img =
+        GrayImage::load(&image).with_context(|| format!("cannot read {}", image.display()))?;
     let horizon = sample_horizon(&meta);
     let det = detect_streaks(&img, &params.params(Some(horizon)))
         .with_context(|| format!("detecting streaks in {}", image.display()))?;
@@ -250,7 +251,9 @@ pub fn score_dataset(
         bail!(
             "{} has no samples{}",
             dir.display(),
-            split.map(|s| format!(" in the {s} split")).unwrap_or_default()
+            split
+                .map(|s| format!(" in the {s} split"))
+                .unwrap_or_default()
         );
     }
     params
@@ -285,7 +288,8 @@ pub fn score_dataset(
 
 /// The table `streaks detect DIR` prints.
 fn table(score: &DatasetScore) -> String {
-    let mut out = String::from("sample  split  horizon  streaks  all P/R (true px)    road P/R (true px)\n");
+    let mut out =
+        String::from("sample  split  horizon  streaks  all P/R (true px)    road P/R (true px)\n");
     let cell = |m: &MaskScore| format!("{:.2}/{:.2} ({:>6})", m.precision, m.recall, m.truth);
     for s in &score.samples {
         out.push_str(&format!(
@@ -295,7 +299,10 @@ fn table(score: &DatasetScore) -> String {
             s.horizon,
             s.streaks,
             cell(&s.all),
-            s.road.as_ref().map(cell).unwrap_or_else(|| "no road mask".into())
+            s.road
+                .as_ref()
+                .map(cell)
+                .unwrap_or_else(|| "no road mask".into())
         ));
     }
     out.push_str(&format!(
@@ -335,6 +342,11 @@ pub fn run(args: Args) -> Result<()> {
     }
     let img = GrayImage::load(&args.input)
         .with_context(|| format!("cannot read {}", args.input.display()))?;
+    // The truth is read first: a bad one stops the run before anything is written.
+    let truth = match &args.truth {
+        Some(t) => Some(load_mask(t, img.width, img.height)?),
+        None => None,
+    };
     let det = detect_streaks(&img, &args.params.params(args.horizon))
         .with_context(|| format!("detecting streaks in {}", args.input.display()))?;
     let out = args.output.clone().unwrap_or_else(|| {
@@ -359,9 +371,8 @@ pub fn run(args: Args) -> Result<()> {
         det.horizon,
         out.display()
     );
-    if let Some(truth) = &args.truth {
-        let t = load_mask(truth, img.width, img.height)?;
-        let s = score_mask(&det.mask, &t)?;
+    if let Some(t) = &truth {
+        let s = score_mask(&det.mask, t)?;
         println!("{}", serde_json::to_string_pretty(&s)?);
     }
     Ok(())

@@ -6,6 +6,7 @@ mod analyze;
 mod benchmark;
 mod common;
 mod dataset;
+mod detect;
 mod measure;
 mod render;
 mod stereo;

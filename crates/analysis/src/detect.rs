@@ -95,7 +95,7 @@ impl Default for DetectParams {
             background_width: 0.25,
             high: 6.0,
             low: 3.0,
-            row_fraction: 0.6,
+            row_fraction: 0.5,
             noise_floor: 0.01,
             gap: 0.5,
             head_ratio: 2.0,
@@ -758,7 +758,8 @@ pub(crate) mod tests {
 
     /// Streak axes (a, b, first y, last y, amplitude) below a horizon at y = 120, lamps above
     /// it, a low headlight with its own streak, and noise. Returns the image and the truth mask
-    /// (streak contribution above 0.1).
+    /// (a streak's contribution above half its peak: the half-maximum width, where the default
+    /// `row_fraction` puts a streak's edge).
     fn scene(exposure: f32) -> (GrayImage, GrayImage, Vec<(f32, f32)>) {
         scene_shifted(exposure, 0.0)
     }
@@ -788,10 +789,13 @@ pub(crate) mod tests {
             for x in 0..w {
                 let (xc, yc) = (x as f32 + 0.5 + disparity, y as f32 + 0.5);
                 let mut s = 0.0f32;
+                let mut core = false;
                 for &(a, b, y0, y1, amp) in &streaks {
                     if (y0..=y1).contains(&yc) {
                         let dx = xc - (a + b * yc);
-                        s += amp * (-dx * dx / (2.0 * 2.5 * 2.5)).exp();
+                        let v = amp * (-dx * dx / (2.0 * 2.5 * 2.5)).exp();
+                        core |= v > 0.5 * amp;
+                        s += v;
                     }
                 }
                 let mut l = 0.0f32;
@@ -801,7 +805,7 @@ pub(crate) mod tests {
                 }
                 let v = 0.03 + 0.01 * rng.gaussian() + s + l;
                 img.set(x, y, exposure * v);
-                truth.set(x, y, if s > 0.1 { 1.0 } else { 0.0 });
+                truth.set(x, y, if core { 1.0 } else { 0.0 });
             }
         }
         let axes = streaks.iter().map(|s| (s.0, s.1)).collect();
@@ -895,7 +899,7 @@ pub(crate) mod tests {
                     0.0
                 };
                 img.set(x, y, road + s + lamp + lane + 0.005 * rng.gaussian());
-                truth.set(x, y, if s > 0.25 * 0.15 { 1.0 } else { 0.0 });
+                truth.set(x, y, if s > 0.5 * 0.15 { 1.0 } else { 0.0 });
             }
         }
         let p = DetectParams {
