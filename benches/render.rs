@@ -139,6 +139,7 @@ fn bench(c: &mut Criterion) {
         width: 160,
         height: 120,
         spp: 1,
+        noise_target: None,
         max_depth: 4,
         seed: 0,
         layers: Layers::default(),

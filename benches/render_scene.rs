@@ -72,6 +72,7 @@ fn settings(spp: u32) -> RenderSettings {
         width: 320,
         height: 240,
         spp,
+        noise_target: None,
         max_depth: 4,
         seed: 1,
         layers: Layers::default(),

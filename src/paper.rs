@@ -70,6 +70,7 @@ fn fig2_and_3(args: &Args, out: &Path, index: &mut String) -> Result<()> {
         let rig = rig_from_camera(camera, w, h, Rig::DEFAULT_BASELINE)?;
         let settings = PairSettings {
             spp: args.fig2_spp,
+            noise_target: None,
             max_depth: 8,
             seed: 0,
             exposure_ev: 0.0,
@@ -225,6 +226,7 @@ fn fig6(args: &Args, out: &Path, index: &mut String) -> Result<Report> {
     let rig = rig_from_camera(camera, w, h, Rig::DEFAULT_BASELINE)?;
     let settings = PairSettings {
         spp: args.fig6_spp,
+        noise_target: None,
         max_depth: 8,
         seed: 0,
         exposure_ev: 0.0,

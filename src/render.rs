@@ -12,8 +12,8 @@ use streaks_render::output;
 use streaks_render::scene::Scene;
 use streaks_stereo::render::{road_surface, scene_has_road};
 
-/// Largest image accepted, in pixels (2^26, twice 8K UHD; the film keeps about 64 bytes per
-/// pixel, so 4 GiB).
+/// Largest image accepted, in pixels (2^26, twice 8K UHD; the film keeps about 72 bytes per
+/// pixel, so 4.5 GiB).
 const MAX_PIXELS: u64 = 1 << 26;
 
 /// Default image height when neither `--width` nor `--height` is given.
@@ -30,14 +30,21 @@ pub enum Layer {
     Albedo,
     /// Light reflected once by the glossy lobe at the first hit (streaks).
     Specular,
+    /// Samples taken per pixel (channel `spp.Y`; all `--spp` unless `--noise-target`).
+    Spp,
 }
 
 /// The rendering flags that `streaks render` and `streaks stereo` share.
 #[derive(clap::Args, Debug)]
 pub struct RenderOpts {
-    /// Samples per pixel (per eye for a stereo pair).
+    /// Samples per pixel (per eye for a stereo pair); the cap with --noise-target.
     #[arg(long, default_value_t = 64)]
     pub spp: u32,
+    /// Adaptive sampling: stop each pixel once the estimated relative standard error of its
+    /// mean luminance is below REL (e.g. 0.05), after at least 16 samples, --spp being the cap.
+    /// Deterministic: the same image for a seed on any number of threads.
+    #[arg(long, value_name = "REL", allow_negative_numbers = true)]
+    pub noise_target: Option<f32>,
     /// Image width in pixels [default: from the height and the camera's aspect ratio].
     #[arg(long)]
     pub width: Option<u32>,
@@ -86,6 +93,14 @@ impl RenderOpts {
         }
         if self.max_depth == 0 {
             bail!("--max-depth must be at least 1 (1 renders only emitters seen directly)");
+        }
+        if let Some(rel) = self.noise_target {
+            if !(rel.is_finite() && rel > 0.0) {
+                bail!(
+                    "--noise-target must be a positive, finite relative standard error (such as \
+                     0.05), got {rel}"
+                );
+            }
         }
         if !self.exposure.is_finite() {
             bail!("--exposure must be a finite number of stops");
@@ -252,6 +267,7 @@ pub fn run(args: Args) -> Result<()> {
         albedo: args.layers.contains(&Layer::Albedo),
         specular: args.layers.contains(&Layer::Specular),
         material: args.road_mask.is_some(),
+        spp: args.layers.contains(&Layer::Spp),
     };
     if let Some(mask) = &args.road_mask {
         if format_of(mask)? != Format::Png {
@@ -282,6 +298,7 @@ pub fn run(args: Args) -> Result<()> {
         width,
         height,
         spp: opts.spp,
+        noise_target: opts.noise_target,
         max_depth: opts.max_depth,
         seed: opts.seed,
         layers,
@@ -317,9 +334,17 @@ pub fn run(args: Args) -> Result<()> {
     }
     let s = &out.stats;
     let secs = s.seconds.max(1e-9);
+    let pixels = (width as u64 * height as u64).max(1);
+    let spp = match opts.noise_target {
+        None => format!("{} spp", opts.spp),
+        Some(rel) => format!(
+            "{:.1} spp on average (noise target {rel}, cap {})",
+            s.samples as f64 / pixels as f64,
+            opts.spp
+        ),
+    };
     eprintln!(
-        "rendered {width}x{height} at {} spp, max depth {} in {:.2} s: {:.3} M samples/s, {:.3} M rays/s, {} samples dropped (NaN/inf)",
-        opts.spp,
+        "rendered {width}x{height} at {spp}, max depth {} in {:.2} s: {:.3} M samples/s, {:.3} M rays/s, {} samples dropped (NaN/inf)",
         opts.max_depth,
         s.seconds,
         s.samples as f64 / secs / 1e6,

@@ -51,6 +51,7 @@ pub fn run(args: Args) -> Result<()> {
         .with_context(|| format!("cannot create the folder {}", args.output.display()))?;
     let settings = PairSettings {
         spp: opts.spp,
+        noise_target: opts.noise_target,
         max_depth: opts.max_depth,
         seed: opts.seed,
         exposure_ev: opts.exposure,

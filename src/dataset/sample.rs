@@ -288,6 +288,7 @@ fn write_sample(
     let seed = render_seed(settings.seed, index);
     let pair = PairSettings {
         spp: settings.spp,
+        noise_target: None,
         max_depth: settings.max_depth,
         seed,
         exposure_ev: s.exposure_ev,

@@ -140,6 +140,10 @@ fn bad_arguments_fail_clearly() {
     with(&["--spp=-3"]).assert_failure_mentioning("--spp");
     with(&["--spp", "many"]).assert_failure_mentioning("many");
     with(&["--camera", "nope"]).assert_failure_mentioning("nope");
+    for rel in ["0", "-0.1", "nan", "inf"] {
+        with(&["--noise-target", rel]).assert_failure_mentioning("--noise-target must be");
+    }
+    with(&["--noise-target", "low"]).assert_failure_mentioning("low");
     t.streaks(&["render", "scene.gltf", "-o", "x.jpg"])
         .assert_failure_mentioning("x.jpg");
     t.streaks(&["render", "missing.gltf", "-o", "x.exr"])
@@ -300,4 +304,50 @@ fn regularize_keeps_the_streaks_and_compare_measures_it() {
     assert!(!t.join("r.png").exists() && !t.join("x.exr").exists());
     t.streaks(&["compare", "reg.exr", "plain.exr", "--mask", "missing.png"])
         .assert_failure_mentioning("missing.png");
+}
+
+/// `--noise-target` with the `spp` layer: deterministic across thread counts, the layer holds
+/// the counts (the black sky at the minimum of 16, never above the cap), and the samples
+/// reported are the ones taken.
+#[test]
+fn noise_target_writes_the_spp_layer_and_is_deterministic() {
+    let t = TestDir::new();
+    t.write_tiny_gltf();
+    let mut stderr = Vec::new();
+    for (threads, out) in [("1", "one.exr"), ("2", "two.exr")] {
+        let run = t.streaks(&[
+            "render",
+            "scene.gltf",
+            "-o",
+            out,
+            "--spp",
+            "64",
+            "--noise-target",
+            "0.05",
+            "--height",
+            "12",
+            "--max-depth",
+            "3",
+            "--threads",
+            threads,
+            "--layers",
+            "spp",
+        ]);
+        run.assert_success();
+        stderr.push(run.stderr());
+    }
+    let one = read_exr_rgb(&t.join("one.exr")).unwrap();
+    let two = read_exr_rgb(&t.join("two.exr")).unwrap();
+    assert_eq!(one, two);
+    let spp = read_exr_layer(&t.join("one.exr"), "spp").unwrap();
+    assert_eq!(spp, read_exr_layer(&t.join("two.exr"), "spp").unwrap());
+    assert_eq!(spp.get(0, 0).x, 16.0, "the black sky stops at the minimum");
+    assert!(spp.pixels.iter().all(|n| (16.0..=64.0).contains(&n.x)));
+    assert!(
+        spp.pixels.iter().any(|n| n.x > 16.0),
+        "the lit floor takes more"
+    );
+    let mean = spp.pixels.iter().map(|n| n.x as f64).sum::<f64>() / spp.pixels.len() as f64;
+    let said = format!("{mean:.1} spp on average (noise target 0.05, cap 64)");
+    assert!(stderr[0].contains(&said), "{} (wanted {said})", stderr[0]);
 }

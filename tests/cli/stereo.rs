@@ -244,6 +244,7 @@ fn write_scene(
 fn settings(spp: u32) -> PairSettings {
     PairSettings {
         spp,
+        noise_target: None,
         max_depth: 2,
         seed: 7,
         exposure_ev: 0.0,

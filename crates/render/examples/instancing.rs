@@ -143,6 +143,7 @@ fn main() {
         width: 320,
         height: 240,
         spp: 4,
+        noise_target: None,
         max_depth: 3,
         seed: 1,
         layers: Default::default(),

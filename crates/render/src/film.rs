@@ -8,8 +8,16 @@
 //!
 //! A sample whose radiance (or specular part) is NaN or infinite is dropped and counted,
 //! never accumulated (DESIGN.md).
+//!
+//! For adaptive sampling ([`crate::integrator::RenderSettings::noise_target`]) each pixel also
+//! keeps the running mean and sum of squared deviations of its kept samples' luminance
+//! (Welford's update: two `f32`s, no allocation, stable where a running sum of squares would
+//! cancel), from which [`Pixel::relative_error`] estimates the relative standard error of the
+//! pixel's mean. These statistics never enter the image: the beauty and specular sums are
+//! accumulated exactly as without them.
 
 use glam::Vec3;
+use streaks_image::color::luminance;
 use streaks_image::RgbImage;
 
 /// One pixel's accumulators.
@@ -23,6 +31,11 @@ pub struct Pixel {
     pub kept: u32,
     /// Number of dropped (non-finite) samples.
     pub dropped: u32,
+    /// Running mean of the kept samples' luminance (Welford).
+    pub lum_mean: f32,
+    /// Running sum of the squared deviations of the kept samples' luminance from their mean
+    /// (Welford's `M2`; the sample variance is `M2 / (kept - 1)`).
+    pub lum_m2: f32,
     /// Camera-space depth of the pixel-centre ray's first hit (`inf` on a miss).
     pub depth: f32,
     /// First-hit shading normal (world space, facing the camera; zero on a miss).
@@ -44,6 +57,8 @@ impl Default for Pixel {
             specular: Vec3::ZERO,
             kept: 0,
             dropped: 0,
+            lum_mean: 0.0,
+            lum_m2: 0.0,
             depth: f32::INFINITY,
             normal: Vec3::ZERO,
             albedo: Vec3::ZERO,
@@ -60,6 +75,10 @@ impl Pixel {
             self.radiance += radiance;
             self.specular += specular;
             self.kept += 1;
+            let l = luminance(radiance);
+            let delta = l - self.lum_mean;
+            self.lum_mean += delta / self.kept as f32;
+            self.lum_m2 += delta * (l - self.lum_mean);
             true
         } else {
             self.dropped += 1;
@@ -75,6 +94,27 @@ impl Pixel {
         } else {
             self.radiance / self.kept as f32
         }
+    }
+
+    /// Samples taken: kept plus dropped (the samples-per-pixel layer).
+    #[inline]
+    pub fn taken(&self) -> u32 {
+        self.kept + self.dropped
+    }
+
+    /// Estimated relative standard error of the pixel's mean luminance,
+    /// `sqrt(s^2 / n) / max(mean, dark_floor)` over its `n` kept samples (`s^2` the sample
+    /// variance); infinite with fewer than two kept samples (no estimate yet). `dark_floor`
+    /// (a luminance) turns the criterion into an absolute one for dark pixels, so that a black
+    /// or nearly black pixel converges instead of chasing a relative error of a tiny mean.
+    #[inline]
+    pub fn relative_error(&self, dark_floor: f32) -> f32 {
+        if self.kept < 2 {
+            return f32::INFINITY;
+        }
+        let n = self.kept as f32;
+        let variance = (self.lum_m2 / (n - 1.0)).max(0.0);
+        (variance / n).sqrt() / self.lum_mean.max(dark_floor)
     }
 
     /// The box-filtered specular part.
@@ -153,6 +193,16 @@ impl Film {
         self.pixels.iter().map(|p| p.material).collect()
     }
 
+    /// The samples-per-pixel layer: samples taken per pixel (kept and dropped), row-major.
+    pub fn spp(&self) -> Vec<u32> {
+        self.pixels.iter().map(Pixel::taken).collect()
+    }
+
+    /// Total number of samples taken (kept and dropped).
+    pub fn samples(&self) -> u64 {
+        self.pixels.iter().map(|p| p.taken() as u64).sum()
+    }
+
     /// Total number of dropped samples.
     pub fn dropped(&self) -> u64 {
         self.pixels.iter().map(|p| p.dropped as u64).sum()
@@ -189,5 +239,31 @@ mod tests {
         assert!(img.pixels.iter().all(|p| p.is_finite()));
         assert_eq!(film.depth()[0], f32::INFINITY);
         assert_eq!(film.material(), vec![NO_MATERIAL; 6]);
+        assert_eq!(film.spp(), vec![0, 4, 0, 0, 0, 1]);
+        assert_eq!(film.samples(), 5);
+    }
+
+    #[test]
+    fn welford_statistics_give_the_relative_standard_error() {
+        let mut p = Pixel::default();
+        assert_eq!(p.relative_error(1e-3), f32::INFINITY);
+        // Luminances 1, 2, 3, 4 (grey samples): mean 2.5, sample variance 5/3.
+        for v in [1.0f32, 2.0, 3.0, 4.0] {
+            assert!(p.add_sample(Vec3::splat(v), Vec3::ZERO));
+        }
+        assert!(!p.add_sample(Vec3::splat(f32::NAN), Vec3::ZERO));
+        assert!((p.lum_mean - 2.5).abs() < 1e-6);
+        assert!((p.lum_m2 / 3.0 - 5.0 / 3.0).abs() < 1e-5);
+        let want = (5.0f32 / 3.0 / 4.0).sqrt() / 2.5;
+        assert!((p.relative_error(1e-3) - want).abs() < 1e-6);
+        // Below the floor the error is relative to the floor.
+        assert!((p.relative_error(10.0) - want * 2.5 / 10.0).abs() < 1e-6);
+        assert_eq!(p.taken(), 5);
+        // A black pixel has no error at all.
+        let mut black = Pixel::default();
+        for _ in 0..3 {
+            black.add_sample(Vec3::ZERO, Vec3::ZERO);
+        }
+        assert_eq!(black.relative_error(1e-3), 0.0);
     }
 }

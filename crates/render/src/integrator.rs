@@ -71,6 +71,32 @@
 //! rayon, each pixel accumulated by one thread in sample order, so the image is bit-identical
 //! whatever the thread count. The hot loop does not allocate.
 //!
+//! Adaptive sampling ([`RenderSettings::noise_target`], off by default): a pixel stops taking
+//! samples once the estimated relative standard error of its mean luminance is below the
+//! target, `spp` being the cap. The rule looks only at the pixel's own samples, in sample
+//! order ([`crate::film::Pixel::relative_error`]), so the image stays bit-identical whatever
+//! the thread count:
+//! - at least [`ADAPTIVE_MIN_SPP`] = 16 samples (or the cap, if smaller) before the first
+//!   check: the variance of fewer samples is too unreliable (a pixel whose bright paths come
+//!   one sample in 20 shows none of them in 16 samples 44% of the time, and would then stop
+//!   with a zero variance); 16 is also the fixed-spp count below which the images are too
+//!   noisy to be worth measuring;
+//! - then a check every [`ADAPTIVE_BATCH`] = 8 samples (so that the test, and a pixel that
+//!   just crossed the target by chance, cost little), stopping when
+//!   `sqrt(s^2 / n) / max(mean, ADAPTIVE_DARK_FLOOR) < noise_target` over the `n` kept samples'
+//!   luminance (sample variance `s^2`), or at the cap;
+//! - [`ADAPTIVE_DARK_FLOOR`] = 1e-3 (linear luminance): below it the error is measured against
+//!   the floor, i.e. an absolute standard error of `noise_target * 1e-3`, far under one 8-bit
+//!   sRGB step at exposure 0; a black pixel (zero variance) stops at the minimum instead of
+//!   running to the cap. The floor is absolute because the relative RMSE that `streaks
+//!   compare` reports is normalised by the region's mean, not per pixel: a dark pixel's
+//!   absolute error is what it adds to it.
+//!
+//! Stopping on an estimated variance makes the estimate slightly biased (a pixel that stops
+//! early is more likely one whose rare bright samples have not shown up yet); the bias
+//! shrinks with the minimum count and the target. With `noise_target = None` the loop is the
+//! fixed-spp loop, operation for operation.
+//!
 //! Layers (all optional, [`Layers`]):
 //! - `depth`: distance along the camera's -Z axis (view-space depth, the `Z` of Eq. 5) to the
 //!   first hit of the pixel-centre ray; `inf` on a miss.
@@ -89,6 +115,8 @@
 //!   unbiased estimate of the single-glossy-bounce direct light, the same quantity the
 //!   next-event part estimates. It is box-filtered like the beauty image; a streak mask is a
 //!   threshold on it.
+//! - `spp`: the number of samples the pixel took (kept and dropped), `spp` everywhere unless
+//!   adaptive sampling stopped it earlier.
 
 use crate::bsdf::Bsdf;
 use crate::camera::Camera;
@@ -124,17 +152,23 @@ pub struct Layers {
     pub specular: bool,
     /// First-hit material index of the pixel-centre ray.
     pub material: bool,
+    /// Samples taken per pixel (see adaptive sampling in the module documentation).
+    pub spp: bool,
 }
 
 /// What to render.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderSettings {
     /// Image width in pixels.
     pub width: u32,
     /// Image height in pixels.
     pub height: u32,
-    /// Samples per pixel.
+    /// Samples per pixel (the cap, with adaptive sampling).
     pub spp: u32,
+    /// Adaptive sampling: stop a pixel once the relative standard error of its mean
+    /// luminance is below this (a positive, finite fraction such as 0.05); `None` takes `spp`
+    /// samples everywhere. See the module documentation.
+    pub noise_target: Option<f32>,
     /// Longest path (Mitsuba's `max_depth`; see the module documentation).
     pub max_depth: u32,
     /// Seed of the sampler.
@@ -143,6 +177,29 @@ pub struct RenderSettings {
     pub layers: Layers,
     /// Path regularisation (Cycles' "Filter Glossy"; biased, see the module documentation).
     pub regularize: bool,
+}
+
+/// Adaptive sampling: samples every pixel takes before its error is first checked (or the
+/// cap, if smaller; see the module documentation).
+pub const ADAPTIVE_MIN_SPP: u32 = 16;
+
+/// Adaptive sampling: samples between two checks of a pixel's error.
+pub const ADAPTIVE_BATCH: u32 = 8;
+
+/// Adaptive sampling: the luminance below which a pixel's standard error is measured against
+/// this floor rather than its mean (so that black pixels stop; see the module documentation).
+pub const ADAPTIVE_DARK_FLOOR: f32 = 1e-3;
+
+/// Whether a pixel that has taken `taken` samples stops there, under adaptive sampling to
+/// `target` with a cap of `cap` samples: at the cap, or at a check (the minimum, then every
+/// batch) whose error estimate is below the target.
+#[inline]
+fn adaptive_stop(pixel: &Pixel, taken: u32, target: f32, cap: u32) -> bool {
+    let min = ADAPTIVE_MIN_SPP.min(cap);
+    taken >= cap
+        || (taken >= min
+            && (taken - min) % ADAPTIVE_BATCH == 0
+            && pixel.relative_error(ADAPTIVE_DARK_FLOOR) < target)
 }
 
 /// Cycles' "Filter Glossy" value used by path regularisation: Blender's default
@@ -166,7 +223,8 @@ pub fn regularized_alpha(min_ray_pdf: f32) -> Option<f32> {
 pub struct RenderStats {
     /// Wall-clock seconds of the render.
     pub seconds: f64,
-    /// Pixel samples traced (dropped ones included).
+    /// Pixel samples traced (dropped ones included; with adaptive sampling, those actually
+    /// taken).
     pub samples: u64,
     /// Rays traced (camera, continuation and shadow rays).
     pub rays: u64,
@@ -190,6 +248,8 @@ pub struct RenderOutput {
     /// First-hit material index per pixel, row-major (if requested; see the module
     /// documentation).
     pub material: Option<Vec<u32>>,
+    /// Samples taken per pixel, row-major (if requested).
+    pub spp: Option<Vec<u32>>,
     /// Counters.
     pub stats: RenderStats,
 }
@@ -205,7 +265,8 @@ struct PathResult {
 /// Renders `camera`'s view of `scene` on the current rayon thread pool.
 ///
 /// `progress` is called with increments of completed pixel samples (the total is
-/// `width * height * spp`).
+/// `width * height * spp`; under adaptive sampling a finished row reports the samples its
+/// pixels skipped as done too, so the total is reached).
 pub fn render(
     scene: &Scene,
     camera: &Camera,
@@ -242,6 +303,11 @@ pub fn render(
                 let path = trace_path(scene, ray, &mut sampler, settings);
                 row_rays += path.rays;
                 pixel.add_sample(path.radiance, path.specular);
+                if let Some(target) = settings.noise_target {
+                    if adaptive_stop(pixel, s + 1, target, settings.spp) {
+                        break;
+                    }
+                }
             }
         }
         rays.fetch_add(row_rays, Ordering::Relaxed);
@@ -256,9 +322,10 @@ pub fn render(
         albedo: layers.albedo.then(|| film.albedo()),
         specular: layers.specular.then(|| film.specular()),
         material: layers.material.then(|| film.material()),
+        spp: layers.spp.then(|| film.spp()),
         stats: RenderStats {
             seconds: start.elapsed().as_secs_f64(),
-            samples: width as u64 * height as u64 * settings.spp as u64,
+            samples: film.samples(),
             rays: rays.into_inner(),
             nonfinite_dropped: film.dropped(),
         },
@@ -507,6 +574,7 @@ pub(crate) mod tests {
     use crate::scene::SceneParts;
     use glam::{Affine3A, Quat};
     use std::f32::consts::PI;
+    use streaks_image::color::luminance;
 
     pub(crate) fn camera(position: Vec3, pitch: f32, yfov: f32) -> Camera {
         Camera {
@@ -549,6 +617,7 @@ pub(crate) mod tests {
             width,
             height,
             spp,
+            noise_target: None,
             max_depth,
             seed: 1,
             layers: Layers::default(),
@@ -877,6 +946,7 @@ pub(crate) mod tests {
             albedo: true,
             specular: true,
             material: true,
+            spp: true,
         };
         let run = |threads| {
             rayon::ThreadPoolBuilder::new()
@@ -918,6 +988,134 @@ pub(crate) mod tests {
             .unwrap()
             .install(|| render(&scene, &cam, &set, &|_| {}));
         assert_ne!(one.image, other.image);
+    }
+
+    /// Renders on a pool of `threads` workers.
+    fn render_on(
+        threads: usize,
+        scene: &Scene,
+        cam: &Camera,
+        set: &RenderSettings,
+    ) -> RenderOutput {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| render(scene, cam, set, &|_| {}))
+    }
+
+    #[test]
+    fn adaptive_sampling_is_deterministic_and_respects_the_cap() {
+        let scene = street(Vec3::splat(0.2), Vec3::splat(0.3));
+        let cam = camera(Vec3::new(0.0, 1.5, 0.0), -0.1, 0.7);
+        let cap = 96;
+        let mut set = settings(20, 12, cap, 4);
+        set.noise_target = Some(0.05);
+        set.layers.spp = true;
+        set.layers.specular = true;
+        let progress = AtomicU64::new(0);
+        let one = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap()
+            .install(|| {
+                render(&scene, &cam, &set, &|n| {
+                    progress.fetch_add(n, Ordering::Relaxed);
+                })
+            });
+        let two = render_on(2, &scene, &cam, &set);
+        assert_eq!(one.image, two.image);
+        assert_eq!(one.specular, two.specular);
+        assert_eq!(one.spp, two.spp);
+        // The progress bar reaches its total although pixels stopped early.
+        assert_eq!(progress.into_inner(), 20 * 12 * cap as u64);
+        let spp = one.spp.as_ref().unwrap();
+        // Every count is the minimum plus whole batches, or the cap.
+        for &n in spp {
+            assert!(
+                (ADAPTIVE_MIN_SPP..=cap).contains(&n)
+                    && ((n - ADAPTIVE_MIN_SPP) % ADAPTIVE_BATCH == 0 || n == cap),
+                "{n}"
+            );
+        }
+        // The sky (black) stops at the minimum; the lit road takes more samples.
+        assert!(spp.contains(&ADAPTIVE_MIN_SPP));
+        assert!(spp.iter().any(|&n| n > ADAPTIVE_MIN_SPP));
+        assert_eq!(
+            one.stats.samples,
+            spp.iter().map(|&n| n as u64).sum::<u64>()
+        );
+        assert!(one.stats.samples < 20 * 12 * cap as u64);
+        // Not the fixed-spp image, and the fixed-spp render's layer is the cap everywhere.
+        set.noise_target = None;
+        let fixed = render_on(2, &scene, &cam, &set);
+        assert_ne!(fixed.image, one.image);
+        assert!(fixed.spp.unwrap().iter().all(|&n| n == cap));
+        // A cap at or below the minimum is fixed-spp sampling, bit for bit.
+        set.spp = ADAPTIVE_MIN_SPP;
+        let fixed = render_on(2, &scene, &cam, &set);
+        set.noise_target = Some(0.05);
+        let capped = render_on(1, &scene, &cam, &set);
+        assert_eq!(fixed.image, capped.image);
+        assert_eq!(fixed.stats.samples, capped.stats.samples);
+        set.spp = 5;
+        let small = render_on(1, &scene, &cam, &set);
+        assert!(small.spp.unwrap().iter().all(|&n| n == 5));
+    }
+
+    #[test]
+    fn adaptive_sampling_stops_flat_pixels_and_runs_noisy_ones_to_the_cap() {
+        let le = Vec3::new(1.0, 0.5, 0.25);
+        let cam = camera(Vec3::new(0.1, -0.2, 0.3), 0.3, 1.2);
+        let (w, h, cap) = (12, 8, 64);
+        let mut set = settings(w, h, cap, u32::MAX);
+        set.layers.spp = true;
+        // Albedo 0: every sample is exactly the emission, zero variance: all stop at the
+        // minimum, however tight the target.
+        set.noise_target = Some(1e-6);
+        let flat = render(&furnace_box(Vec3::ZERO, le), &cam, &set, &|_| {});
+        assert!(flat
+            .spp
+            .as_ref()
+            .unwrap()
+            .iter()
+            .all(|&n| n == ADAPTIVE_MIN_SPP));
+        assert_eq!(flat.stats.samples, (w * h * ADAPTIVE_MIN_SPP) as u64);
+        assert!(flat
+            .image
+            .pixels
+            .iter()
+            .all(|p| (*p - le).abs().max_element() < 1e-6));
+        // Albedo 0.8: multiple bounces, a relative error of ~10% per pixel at 16 samples; a
+        // target of 1e-3 is out of reach, so every pixel takes the cap and no more.
+        let noisy_scene = furnace_box(Vec3::splat(0.8), le);
+        let noisy = render(&noisy_scene, &cam, &set, &|_| {});
+        assert!(noisy.spp.as_ref().unwrap().iter().all(|&n| n == cap));
+        assert_eq!(noisy.stats.samples, (w * h * cap) as u64);
+        // The pixels' spread at the cap is their relative standard error at 64 samples, `e`
+        // (about twice that at 16): a target of 1.5 e stops them in between (near 64 / 2.25
+        // samples on average), and the estimate stays close to Le / (1 - a).
+        let lum: Vec<f32> = noisy.image.pixels.iter().map(|p| luminance(*p)).collect();
+        let m = lum.iter().sum::<f32>() / lum.len() as f32;
+        let e =
+            (lum.iter().map(|l| (l - m).powi(2)).sum::<f32>() / (lum.len() - 1) as f32).sqrt() / m;
+        set.noise_target = Some(1.5 * e);
+        let mid = render(&noisy_scene, &cam, &set, &|_| {});
+        let spp = mid.spp.as_ref().unwrap();
+        let mean_spp = spp.iter().map(|&n| n as f64).sum::<f64>() / spp.len() as f64;
+        assert!(
+            mean_spp > ADAPTIVE_MIN_SPP as f64 && mean_spp < cap as f64,
+            "{mean_spp}"
+        );
+        let expected = luminance(le / 0.2);
+        let mean = mid.image.pixels.iter().map(|p| luminance(*p)).sum::<f32>()
+            / mid.image.pixels.len() as f32;
+        assert!((mean / expected - 1.0).abs() < 0.03, "{mean} vs {expected}");
+        // The same noisy furnace a million times dimmer, below the dark floor: the error is
+        // measured against the floor, and every pixel stops at the minimum.
+        let empty = furnace_box(Vec3::splat(0.8), le * 1e-6);
+        let dark = render(&empty, &cam, &set, &|_| {});
+        assert!(dark.spp.unwrap().iter().all(|&n| n == ADAPTIVE_MIN_SPP));
     }
 
     #[test]

@@ -61,6 +61,7 @@
 //!     width: 8,
 //!     height: 6,
 //!     spp: 4,
+//!     noise_target: None,
 //!     max_depth: 1,
 //!     seed: 0,
 //!     layers: Layers::default(),

@@ -401,6 +401,7 @@ mod tests {
                 width: 12,
                 height: 8,
                 spp,
+                noise_target: None,
                 max_depth,
                 seed: 3,
                 layers: Layers::default(),

@@ -1,8 +1,8 @@
 //! The renderer's EXR layout: a render and its layers in one float32 EXR part.
 //!
 //! Channels: `R`, `G`, `B` (the beauty image, linear) plus, when present, `depth.Z`,
-//! `normal.X`/`normal.Y`/`normal.Z`, `albedo.R`/`.G`/`.B` and `specular.R`/`.G`/`.B`
-//! (OpenEXR's `layer.channel` naming, which Blender, Nuke and `exrheader` show as layers).
+//! `normal.X`/`normal.Y`/`normal.Z`, `albedo.R`/`.G`/`.B`, `specular.R`/`.G`/`.B` and
+//! `spp.Y` (samples taken per pixel, as float32: exact up to 2^24) (OpenEXR's `layer.channel` naming, which Blender, Nuke and `exrheader` show as layers).
 //! [`write_exr`] writes them and [`read_exr_layer`] reads them back, from the names here; the
 //! file itself is written by [`streaks_image::exr`] (atomically).
 
@@ -21,6 +21,8 @@ pub const SPECULAR: [&str; 3] = ["specular.R", "specular.G", "specular.B"];
 pub const NORMAL: [&str; 3] = ["normal.X", "normal.Y", "normal.Z"];
 /// The depth layer's channel.
 pub const DEPTH: &str = "depth.Z";
+/// The samples-per-pixel layer's channel.
+pub const SPP: &str = "spp.Y";
 
 /// Writes the render as a float32 EXR: the beauty image and the layers present in `output`
 /// (see the module documentation), atomically.
@@ -44,24 +46,29 @@ pub fn write_exr(path: &Path, output: &RenderOutput) -> Result<(), ImageError> {
     if let Some(depth) = &output.depth {
         channels.push((DEPTH, depth.clone()));
     }
+    if let Some(spp) = &output.spp {
+        channels.push((SPP, spp.iter().map(|&n| n as f32).collect()));
+    }
     streaks_image::exr::write_exr(path, img.width, img.height, channels)
 }
 
 /// Reads a layer written by [`write_exr`]: `"albedo"`, `"specular"` (RGB), `"normal"` (XYZ
-/// into the RGB slots) or `"depth"` (Z, repeated into all three slots).
+/// into the RGB slots), `"depth"` (Z) or `"spp"` (samples per pixel; one channel, repeated
+/// into all three slots).
 pub fn read_exr_layer(path: &Path, name: &str) -> Result<RgbImage, ImageError> {
     match name {
         "albedo" => read_exr_rgb_channels(path, ALBEDO),
         "specular" => read_exr_rgb_channels(path, SPECULAR),
         "normal" => read_exr_rgb_channels(path, NORMAL),
-        "depth" => {
-            let (w, h, planes) = read_exr_channels(path, &[DEPTH])?;
+        "depth" | "spp" => {
+            let channel = if name == "depth" { DEPTH } else { SPP };
+            let (w, h, planes) = read_exr_channels(path, &[channel])?;
             let z = &planes[0];
             Ok(RgbImage::from_planes(w, h, [z, z, z]))
         }
         other => Err(ImageError::MissingChannels {
             path: path.to_path_buf(),
-            what: format!("layer {other:?} (the layers are albedo, specular, normal, depth)"),
+            what: format!("layer {other:?} (the layers are albedo, specular, normal, depth, spp)"),
         }),
     }
 }
@@ -95,6 +102,7 @@ mod tests {
             albedo: None,
             specular: Some(gradient(w, h)),
             material: None,
+            spp: Some((0..w * h).map(|i| 16 + 8 * i).collect()),
             stats: RenderStats::default(),
         }
     }
@@ -115,6 +123,8 @@ mod tests {
         let depth = read_exr_layer(&path, "depth").unwrap();
         assert_eq!(depth.get(1, 0).x, 1.25);
         assert_eq!(depth.get(4, 0).z, f32::INFINITY);
+        let spp = read_exr_layer(&path, "spp").unwrap();
+        assert_eq!(spp.get(2, 1).x, (16 + 8 * 7) as f32);
         let err = read_exr_layer(&path, "albedo").unwrap_err();
         assert!(err.to_string().contains("albedo.R"), "{err}");
         let err = read_exr_layer(&path, "beauty").unwrap_err();

@@ -120,6 +120,7 @@ impl RegressionCase {
             width: self.width,
             height: self.height,
             spp,
+            noise_target: None,
             max_depth: self.max_depth,
             seed,
             layers: Layers::default(),

@@ -46,6 +46,7 @@ fn image(scene: &Scene) -> Vec<Vec3> {
         width: 48,
         height: 32,
         spp: 16,
+        noise_target: None,
         max_depth: 4,
         seed: 3,
         layers: Default::default(),

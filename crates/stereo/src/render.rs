@@ -73,8 +73,11 @@ pub fn eye_camera(rig: &Rig, eye: Eye) -> Camera {
 /// How to render a pair.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PairSettings {
-    /// Samples per pixel.
+    /// Samples per pixel (the cap, with adaptive sampling).
     pub spp: u32,
+    /// Adaptive sampling's target relative standard error per pixel (`None`: `spp`
+    /// everywhere; [`streaks_render::integrator::RenderSettings::noise_target`]).
+    pub noise_target: Option<f32>,
     /// Longest path (Mitsuba's meaning).
     pub max_depth: u32,
     /// Seed of the left eye (the right eye uses `seed + 1`).
@@ -145,6 +148,7 @@ pub fn render_eye(
         width: w,
         height: h,
         spp: settings.spp,
+        noise_target: settings.noise_target,
         max_depth: settings.max_depth,
         seed: match eye {
             Eye::Left => settings.seed,
@@ -156,6 +160,7 @@ pub fn render_eye(
             albedo: false,
             specular: true,
             material: true,
+            spp: false,
         },
         regularize: settings.regularize,
     };
