@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 use streaks_analysis::detect::{detect_streaks, score_mask, DetectParams, MaskScore};
 use streaks_image::{write_bytes_atomically, GrayImage};
 
-use crate::dataset::layout::{Layout, SPLITS};
+use crate::dataset::layout::Layout;
 use crate::dataset::sample::SampleMeta;
 
 /// Detect specular streaks in an image, or score the detector over a dataset.
@@ -155,30 +155,6 @@ pub struct DatasetScore {
     pub samples: Vec<SampleScore>,
 }
 
-/// The samples of `layout` (their ids), all or one split's, from `splits/` as `streaks dataset
-/// index` wrote them.
-pub fn dataset_samples(layout: &Layout, split: Option<&str>) -> Result<Vec<String>> {
-    let names: Vec<&str> = match split {
-        Some(s) if SPLITS.contains(&s) => vec![s],
-        Some(s) => bail!("unknown split {s:?}: expected one of {}", SPLITS.join(", ")),
-        None => SPLITS.to_vec(),
-    };
-    let mut ids = Vec::new();
-    for name in names {
-        let path = layout.splits_dir().join(format!("{name}.txt"));
-        let text = std::fs::read_to_string(&path).with_context(|| {
-            format!(
-                "cannot read {} (run `streaks dataset index {}` first)",
-                path.display(),
-                layout.root().display()
-            )
-        })?;
-        ids.extend(text.lines().filter(|l| !l.is_empty()).map(str::to_owned));
-    }
-    ids.sort();
-    Ok(ids)
-}
-
 /// The horizon row (image y) of a sample's left camera: `c_y - f tan(pitch)`, with the pitch
 /// from the rig's pose (its -Z axis, the viewing direction, `asin(z_y)` below the horizontal).
 pub fn sample_horizon(meta: &SampleMeta) -> f32 {
@@ -246,16 +222,7 @@ pub fn score_dataset(
     params: &ParamArgs,
 ) -> Result<DatasetScore> {
     let layout = Layout::new(dir);
-    let ids = dataset_samples(&layout, split)?;
-    if ids.is_empty() {
-        bail!(
-            "{} has no samples{}",
-            dir.display(),
-            split
-                .map(|s| format!(" in the {s} split"))
-                .unwrap_or_default()
-        );
-    }
+    let ids = layout.sample_ids(split)?;
     params
         .params(None)
         .validate()

@@ -1,7 +1,7 @@
 //! The samples of `streaks benchmark DIR`: a dataset (`streaks dataset generate`), one
 //! `streaks stereo` pair folder, or a folder of pair folders.
 
-use crate::dataset::layout::{Layout, ROAD_MASK, SPLITS};
+use crate::dataset::layout::{Layout, ROAD_MASK};
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
 use streaks_stereo::pair_dir::PairDir;
@@ -98,50 +98,7 @@ pub fn samples(dir: &Path, split: Option<&str>) -> Result<(InputKind, Vec<Sample
     }
     let layout = Layout::new(dir);
     if layout.dataset_json().is_file() {
-        let ids: Vec<String> = match split {
-            Some(name) => {
-                if !SPLITS.contains(&name) {
-                    bail!(
-                        "--split {name}: a dataset's splits are {}",
-                        SPLITS.join(", ")
-                    );
-                }
-                let path = layout.splits_dir().join(format!("{name}.txt"));
-                let text = std::fs::read_to_string(&path).with_context(|| {
-                    format!(
-                        "cannot read the split {} (run `streaks dataset index {}`)",
-                        path.display(),
-                        dir.display()
-                    )
-                })?;
-                text.lines()
-                    .map(str::trim)
-                    .filter(|l| !l.is_empty())
-                    .map(String::from)
-                    .collect()
-            }
-            None => {
-                let samples = layout.samples_dir();
-                let mut ids: Vec<String> = std::fs::read_dir(&samples)
-                    .with_context(|| format!("cannot list {}", samples.display()))?
-                    .filter_map(|e| e.ok())
-                    .map(|e| e.file_name().to_string_lossy().into_owned())
-                    // Sample folders are six digits; `.tmp-` folders are samples in progress.
-                    .filter(|n| n.len() == 6 && n.bytes().all(|b| b.is_ascii_digit()))
-                    .collect();
-                ids.sort();
-                ids
-            }
-        };
-        if ids.is_empty() {
-            bail!(
-                "the dataset {} has no samples{}",
-                dir.display(),
-                split
-                    .map(|s| format!(" in its {s} split"))
-                    .unwrap_or_default()
-            );
-        }
+        let ids = layout.sample_ids(split)?;
         let samples = ids
             .iter()
             .map(|id| dataset_sample(id, layout.samples_dir().join(id)))

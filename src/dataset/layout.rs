@@ -135,6 +135,56 @@ impl Layout {
         }
     }
 
+    /// The ids of the dataset's samples, sorted: with `split`, those that `streaks dataset
+    /// index` listed in `splits/SPLIT.txt`; without, every complete sample folder (six digits;
+    /// the `.tmp-` folders of samples in progress are left out). Fails on an unknown split, a
+    /// missing split file, or no samples.
+    pub fn sample_ids(&self, split: Option<&str>) -> Result<Vec<String>> {
+        let mut ids: Vec<String> = match split {
+            Some(name) => {
+                if !SPLITS.contains(&name) {
+                    bail!(
+                        "--split {name}: a dataset's splits are {}",
+                        SPLITS.join(", ")
+                    );
+                }
+                let path = self.splits_dir().join(format!("{name}.txt"));
+                let text = std::fs::read_to_string(&path).with_context(|| {
+                    format!(
+                        "cannot read the split {} (run `streaks dataset index {}`)",
+                        path.display(),
+                        self.root.display()
+                    )
+                })?;
+                text.lines()
+                    .map(str::trim)
+                    .filter(|l| !l.is_empty())
+                    .map(String::from)
+                    .collect()
+            }
+            None => {
+                let samples = self.samples_dir();
+                std::fs::read_dir(&samples)
+                    .with_context(|| format!("cannot list {}", samples.display()))?
+                    .filter_map(|e| e.ok())
+                    .map(|e| e.file_name().to_string_lossy().into_owned())
+                    .filter(|n| n.len() == 6 && n.bytes().all(|b| b.is_ascii_digit()))
+                    .collect()
+            }
+        };
+        ids.sort();
+        if ids.is_empty() {
+            bail!(
+                "the dataset {} has no samples{}",
+                self.root.display(),
+                split
+                    .map(|s| format!(" in its {s} split"))
+                    .unwrap_or_default()
+            );
+        }
+        Ok(ids)
+    }
+
     /// `path` relative to the dataset folder, with `/` separators (for the manifest).
     pub fn relative(&self, path: &Path) -> String {
         let rel = path.strip_prefix(&self.root).unwrap_or(path);
