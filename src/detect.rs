@@ -1,10 +1,17 @@
 //! `streaks detect`: specular streak detection ([`streaks_analysis::detect`]) on one image, or
 //! scored over a dataset of `streaks dataset generate` against the renderer's masks.
 //!
+//! Two detectors: `learned`, the per-pixel classifier of
+//! [`streaks_analysis::streak_classifier`] on linear luminance (the one shipped with the crate,
+//! or `--model FILE` from `streaks train-detector`), the default on linear input (EXR, and
+//! datasets); and `hand`, the region-growing detector of [`streaks_analysis::detect`], the
+//! default on 8-bit images, where it does better than the classifier.
+//!
 //! On an image it writes the detector's mask (PNG, 0/255) and, with `--truth MASK`, prints
 //! precision and recall against it. On a dataset folder it runs the detector on each sample's
-//! left image (`im0.png`, as a photograph would be; `--image exr` for the linear one), with the
-//! horizon of the sample's own camera (`meta.json`), and scores it against two truths:
+//! left image (`im0.exr` for `learned`, `im0.png` for `hand`, as a photograph would be;
+//! `--image` picks), with the horizon of the sample's own camera (`meta.json`), and scores it
+//! against two truths:
 //!
 //! - **all**: the renderer's streak mask `streaks0.png` (every pixel whose light is mostly a
 //!   glossy reflection of an emitter: road streaks, but also glints on windows and car bodies);
@@ -19,6 +26,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use streaks_analysis::detect::{detect_streaks, score_mask, DetectParams, MaskScore};
+use streaks_analysis::streak_classifier::{operating_point, smooth_probability, StreakClassifier};
 use streaks_image::{write_bytes_atomically, GrayImage};
 
 use crate::dataset::layout::Layout;
@@ -43,12 +51,169 @@ pub struct Args {
     /// Dataset: only the samples of this split (train, val, test).
     #[arg(long)]
     pub split: Option<String>,
-    /// Dataset: which left image to run on.
-    #[arg(long, value_enum, default_value_t = ImageKind::Png)]
-    pub image: ImageKind,
-    /// Detector settings (see `streaks_analysis::detect::DetectParams`; defaults there).
+    /// Dataset: which left image to run on [default: exr for the learned detector, png for
+    /// the hand-built one].
+    #[arg(long, value_enum)]
+    pub image: Option<ImageKind>,
+    /// The detector [default: learned on linear input (an EXR image; a dataset, whose im0.exr
+    /// it reads), hand on 8-bit images (PNG, JPEG; a dataset with --image png), where the
+    /// learned one has lost what it needs; --model or --threshold ask for learned, the
+    /// hand-built detector's settings for hand].
+    #[arg(long, value_enum)]
+    pub detector: Option<DetectorKind>,
+    /// Learned detector: a classifier of `streaks train-detector` [default: the one shipped
+    /// with streaks, trained on procedural streets].
+    #[arg(long)]
+    pub model: Option<PathBuf>,
+    /// Learned detector: the probability threshold [default: the classifier's own, chosen at
+    /// training for its target precision].
+    #[arg(long)]
+    pub threshold: Option<f32>,
+    /// Hand-built detector settings (see `streaks_analysis::detect::DetectParams`; defaults
+    /// there).
     #[command(flatten)]
     pub params: ParamArgs,
+}
+
+/// The two detectors.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DetectorKind {
+    /// The per-pixel classifier on linear luminance (`streaks_analysis::streak_classifier`).
+    Learned,
+    /// The region-growing detector for 8-bit images (`streaks_analysis::detect`).
+    Hand,
+}
+
+/// A detector ready to run.
+pub enum Detector {
+    /// The learned classifier.
+    Learned(Box<StreakClassifier>),
+    /// The hand-built detector with these settings (the horizon is set per image).
+    Hand(ParamArgs),
+}
+
+/// What a detector found in one image.
+pub struct Found {
+    /// 1 on streak pixels, 0 elsewhere.
+    pub mask: GrayImage,
+    /// The learned detector's smoothed streak probability (the mask is where it reaches the
+    /// threshold).
+    pub probability: Option<GrayImage>,
+    /// The number of streaks (regions), for the hand-built detector.
+    pub streaks: Option<usize>,
+}
+
+/// The detector `args` ask for (see `--detector`), for a dataset (`dataset`) or an image.
+pub fn detector_kind(args: &Args, dataset: bool) -> DetectorKind {
+    if let Some(k) = args.detector {
+        return k;
+    }
+    if args.model.is_some() || args.threshold.is_some() {
+        return DetectorKind::Learned;
+    }
+    if args.params != ParamArgs::default() {
+        return DetectorKind::Hand;
+    }
+    let linear = if dataset {
+        args.image != Some(ImageKind::Png)
+    } else {
+        args.input
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+    };
+    if linear {
+        DetectorKind::Learned
+    } else {
+        DetectorKind::Hand
+    }
+}
+
+impl Detector {
+    /// The detector of kind `kind` with the arguments' settings: loads and checks `--model`.
+    pub fn from_args(args: &Args, kind: DetectorKind) -> Result<Self> {
+        match kind {
+            DetectorKind::Hand => {
+                if args.model.is_some() || args.threshold.is_some() {
+                    bail!("--model and --threshold apply to --detector learned");
+                }
+                args.params
+                    .params(None)
+                    .validate()
+                    .context("detector parameters")?;
+                Ok(Self::Hand(args.params.clone()))
+            }
+            DetectorKind::Learned => {
+                if args.params != ParamArgs::default() {
+                    bail!("the hand-built detector's settings need --detector hand");
+                }
+                let mut c = match &args.model {
+                    Some(p) => load_classifier(p)?,
+                    None => StreakClassifier::shipped(),
+                };
+                if let Some(t) = args.threshold {
+                    if !(0.0..=1.0).contains(&t) {
+                        bail!("--threshold {t} is not a probability in [0, 1]");
+                    }
+                    c.threshold = t;
+                }
+                Ok(Self::Learned(Box::new(c)))
+            }
+        }
+    }
+
+    /// The dataset image this detector reads by default.
+    pub fn default_image(&self) -> ImageKind {
+        match self {
+            Self::Learned(_) => ImageKind::Exr,
+            Self::Hand(_) => ImageKind::Png,
+        }
+    }
+
+    /// Runs on the image at `path` with the horizon at row `horizon` (`None`: the image
+    /// centre).
+    pub fn detect(&self, path: &Path, horizon: Option<f32>) -> Result<Found> {
+        let what = || format!("detecting streaks in {}", path.display());
+        match self {
+            Self::Learned(c) => {
+                let lum = GrayImage::load_linear(path)
+                    .with_context(|| format!("cannot read {}", path.display()))?;
+                let horizon = horizon.unwrap_or(0.5 * lum.height as f32);
+                let p = c.probability(&lum, horizon).with_context(what)?;
+                let p = smooth_probability(&p, c.smooth);
+                let mut mask = p.clone();
+                for v in &mut mask.data {
+                    *v = (*v >= c.threshold) as u8 as f32;
+                }
+                Ok(Found {
+                    mask,
+                    probability: Some(p),
+                    streaks: None,
+                })
+            }
+            Self::Hand(params) => {
+                let img = GrayImage::load(path)
+                    .with_context(|| format!("cannot read {}", path.display()))?;
+                let det = detect_streaks(&img, &params.params(horizon)).with_context(what)?;
+                let mut mask = det.mask;
+                for v in &mut mask.data {
+                    *v = if *v > 0.5 { 1.0 } else { 0.0 };
+                }
+                Ok(Found {
+                    mask,
+                    probability: None,
+                    streaks: Some(det.streaks.len()),
+                })
+            }
+        }
+    }
+}
+
+/// Loads and checks a classifier file.
+pub fn load_classifier(path: &Path) -> Result<StreakClassifier> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("cannot read the classifier {}", path.display()))?;
+    StreakClassifier::from_json(&text)
+        .with_context(|| format!("{} is not a usable streak classifier", path.display()))
 }
 
 /// Which image of a dataset sample the detector sees.
@@ -61,7 +226,7 @@ pub enum ImageKind {
 }
 
 /// Overrides of the detector's parameters.
-#[derive(clap::Args, Debug, Default, Clone)]
+#[derive(clap::Args, Debug, Default, Clone, PartialEq)]
 pub struct ParamArgs {
     /// Seed threshold, in noise deviations above the row's background.
     #[arg(long)]
@@ -129,8 +294,9 @@ pub struct SampleScore {
     pub split: String,
     /// The horizon row used.
     pub horizon: f32,
-    /// Streaks the detector found.
-    pub streaks: usize,
+    /// Streaks the detector found (the hand-built detector; the learned one classifies
+    /// pixels).
+    pub streaks: Option<usize>,
     /// Against `streaks0.png`.
     pub all: MaskScore,
     /// Against the part of `streaks0.png` on the road (`road0.png`); `None` without a road
@@ -151,8 +317,26 @@ pub struct DatasetScore {
     pub all: MaskScore,
     /// Pixel-pooled score against the road's streaks (samples with a road mask).
     pub road: MaskScore,
+    /// The learned detector: the threshold over these samples that gives the highest road
+    /// recall at [`AT_PRECISION`] (chosen on the scored samples themselves: a point of their
+    /// precision-recall curve, not an operating point); `None` for the hand-built detector or
+    /// when no threshold reaches that precision.
+    pub road_at_precision: Option<CurvePoint>,
     /// Per sample.
     pub samples: Vec<SampleScore>,
+}
+
+/// The precision at which [`DatasetScore::road_at_precision`] reads the curve (issue 18's
+/// target: recall 0.8 at precision 0.9).
+pub const AT_PRECISION: f64 = 0.9;
+
+/// A point of a precision-recall curve.
+#[derive(Clone, Debug, Serialize)]
+pub struct CurvePoint {
+    /// The probability threshold.
+    pub threshold: f32,
+    /// The pooled score at it.
+    pub score: MaskScore,
 }
 
 /// The horizon row (image y) of a sample's left camera: `c_y - f tan(pitch)`, with the pitch
@@ -178,40 +362,68 @@ fn load_mask(path: &Path, w: usize, h: usize) -> Result<GrayImage> {
     Ok(m)
 }
 
-/// Scores the detector on one sample folder.
-fn score_sample(dir: &Path, id: &str, kind: ImageKind, params: &ParamArgs) -> Result<SampleScore> {
-    let meta = SampleMeta::load(&dir.join("meta.json"))?;
-    let image = dir.join(match kind {
+/// Image file name of a dataset sample's left view.
+fn image_file(kind: ImageKind) -> &'static str {
+    match kind {
         ImageKind::Png => "im0.png",
         ImageKind::Exr => "im0.exr",
-    });
-    let img =
-        GrayImage::load(&image).with_context(|| format!("cannot read {}", image.display()))?;
-    let horizon = sample_horizon(&meta);
-    let det = detect_streaks(&img, &params.params(Some(horizon)))
-        .with_context(|| format!("detecting streaks in {}", image.display()))?;
-    let truth = load_mask(&dir.join("streaks0.png"), img.width, img.height)?;
-    let all = score_mask(&det.mask, &truth)?;
-    let road = if meta.road_mask {
-        let road = load_mask(&dir.join("road0.png"), img.width, img.height)?;
-        let mut on_road = truth.clone();
-        for (t, &r) in on_road.data.iter_mut().zip(&road.data) {
-            if r <= 0.5 {
-                *t = 0.0;
-            }
+    }
+}
+
+/// The truth masks of one dataset sample: `streaks0.png`, and its part on the road
+/// (`road0.png`), if the scene flags a road.
+pub fn sample_truths(dir: &Path, meta: &SampleMeta) -> Result<(GrayImage, Option<GrayImage>)> {
+    let (w, h) = (meta.rig.width as usize, meta.rig.height as usize);
+    let truth = load_mask(&dir.join("streaks0.png"), w, h)?;
+    if !meta.road_mask {
+        return Ok((truth, None));
+    }
+    let road = load_mask(&dir.join("road0.png"), w, h)?;
+    let mut on_road = truth.clone();
+    for (t, &r) in on_road.data.iter_mut().zip(&road.data) {
+        if r <= 0.5 {
+            *t = 0.0;
         }
-        Some(score_mask(&det.mask, &on_road)?)
-    } else {
-        None
+    }
+    Ok((truth, Some(on_road)))
+}
+
+/// Scores the detector on one sample folder.
+/// With the learned detector, also its (probability, road truth) per pixel.
+fn score_sample(
+    dir: &Path,
+    id: &str,
+    kind: ImageKind,
+    detector: &Detector,
+) -> Result<(SampleScore, Vec<(f32, bool)>)> {
+    let meta = SampleMeta::load(&dir.join("meta.json"))?;
+    let image = dir.join(image_file(kind));
+    let horizon = sample_horizon(&meta);
+    let found = detector.detect(&image, Some(horizon))?;
+    let (truth, on_road) = sample_truths(dir, &meta)?;
+    let all = score_mask(&found.mask, &truth)?;
+    let road = match &on_road {
+        Some(t) => Some(score_mask(&found.mask, t)?),
+        None => None,
     };
-    Ok(SampleScore {
+    let pairs = match (&found.probability, &on_road) {
+        (Some(p), Some(t)) => p
+            .data
+            .iter()
+            .zip(&t.data)
+            .map(|(&p, &t)| (p, t > 0.5))
+            .collect(),
+        _ => vec![],
+    };
+    let score = SampleScore {
         id: id.to_owned(),
         split: meta.split,
         horizon,
-        streaks: det.streaks.len(),
+        streaks: found.streaks,
         all,
         road,
-    })
+    };
+    Ok((score, pairs))
 }
 
 /// Scores the detector over the dataset in `dir`.
@@ -219,36 +431,37 @@ pub fn score_dataset(
     dir: &Path,
     split: Option<&str>,
     kind: ImageKind,
-    params: &ParamArgs,
+    detector: &Detector,
 ) -> Result<DatasetScore> {
     let layout = Layout::new(dir);
     let ids = layout.sample_ids(split)?;
-    params
-        .params(None)
-        .validate()
-        .context("detector parameters")?;
     let bar = crate::render::progress_bar(ids.len() as u64);
     let samples = ids
         .par_iter()
         .map(|id| {
             let sample = layout.samples_dir().join(id);
-            let s = score_sample(&sample, id, kind, params)
+            let s = score_sample(&sample, id, kind, detector)
                 .with_context(|| format!("sample {}", sample.display()));
             bar.inc(1);
             s
         })
         .collect::<Result<Vec<_>>>()?;
     bar.finish_and_clear();
+    let (samples, pairs): (Vec<SampleScore>, Vec<Vec<(f32, bool)>>) = samples.into_iter().unzip();
+    let pairs: Vec<(f32, bool)> = pairs.into_iter().flatten().collect();
+    let road_at_precision = if pairs.is_empty() {
+        None
+    } else {
+        operating_point(pairs, AT_PRECISION)
+            .map(|(threshold, score)| CurvePoint { threshold, score })
+    };
     Ok(DatasetScore {
         dataset: dir.to_path_buf(),
         split: split.map(str::to_owned),
-        image: match kind {
-            ImageKind::Png => "im0.png",
-            ImageKind::Exr => "im0.exr",
-        }
-        .into(),
+        image: image_file(kind).into(),
         all: MaskScore::pooled(samples.iter().map(|s| &s.all)),
         road: MaskScore::pooled(samples.iter().filter_map(|s| s.road.as_ref())),
+        road_at_precision,
         samples,
     })
 }
@@ -264,7 +477,7 @@ fn table(score: &DatasetScore) -> String {
             s.id,
             s.split,
             s.horizon,
-            s.streaks,
+            s.streaks.map_or("-".into(), |n| n.to_string()),
             cell(&s.all),
             s.road
                 .as_ref()
@@ -282,13 +495,23 @@ fn table(score: &DatasetScore) -> String {
         score.road.recall,
         score.road.f1
     ));
+    if let Some(c) = &score.road_at_precision {
+        out.push_str(&format!(
+            "road precision-recall curve: recall {:.3} at precision {:.3} (threshold {:.4}, \
+             chosen on these samples)\n",
+            c.score.recall, c.score.precision, c.threshold
+        ));
+    }
     out
 }
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<()> {
-    if args.input.join("dataset.json").is_file() {
-        let score = score_dataset(&args.input, args.split.as_deref(), args.image, &args.params)?;
+    let dataset = args.input.join("dataset.json").is_file();
+    let detector = Detector::from_args(&args, detector_kind(&args, dataset))?;
+    if dataset {
+        let kind = args.image.unwrap_or(detector.default_image());
+        let score = score_dataset(&args.input, args.split.as_deref(), kind, &detector)?;
         eprint!("{}", table(&score));
         if let Some(out) = &args.output {
             let json = serde_json::to_vec_pretty(&score)?;
@@ -304,18 +527,29 @@ pub fn run(args: Args) -> Result<()> {
             args.input.display()
         );
     }
-    if args.split.is_some() {
-        bail!("--split applies to a dataset folder, not to an image");
+    if args.split.is_some() || args.image.is_some() {
+        bail!("--split and --image apply to a dataset folder, not to an image");
     }
-    let img = GrayImage::load(&args.input)
-        .with_context(|| format!("cannot read {}", args.input.display()))?;
     // The truth is read first: a bad one stops the run before anything is written.
     let truth = match &args.truth {
-        Some(t) => Some(load_mask(t, img.width, img.height)?),
+        Some(t) => {
+            let m = GrayImage::load(t).with_context(|| format!("cannot read {}", t.display()))?;
+            Some((t, m))
+        }
         None => None,
     };
-    let det = detect_streaks(&img, &args.params.params(args.horizon))
-        .with_context(|| format!("detecting streaks in {}", args.input.display()))?;
+    let found = detector.detect(&args.input, args.horizon)?;
+    let (w, h) = (found.mask.width, found.mask.height);
+    if let Some((t, m)) = &truth {
+        if (m.width, m.height) != (w, h) {
+            bail!(
+                "{} is {}x{}, the image {w}x{h}",
+                t.display(),
+                m.width,
+                m.height
+            );
+        }
+    }
     let out = args.output.clone().unwrap_or_else(|| {
         let stem = args
             .input
@@ -324,22 +558,25 @@ pub fn run(args: Args) -> Result<()> {
             .unwrap_or_else(|| "image".into());
         args.input.with_file_name(format!("{stem}_streaks.png"))
     });
-    let mut mask = det.mask.clone();
-    for v in &mut mask.data {
-        *v = if *v > 0.5 { 1.0 } else { 0.0 };
-    }
-    mask.save_png(&out)
+    found
+        .mask
+        .save_png(&out)
         .with_context(|| format!("writing the mask {}", out.display()))?;
-    eprintln!(
-        "{} streaks, {} glows, {} lamps (horizon at row {:.1}); mask in {}",
-        det.streaks.len(),
-        det.glows.len(),
-        det.lamps.len(),
-        det.horizon,
-        out.display()
-    );
-    if let Some(t) = &truth {
-        let s = score_mask(&det.mask, t)?;
+    let pixels = found.mask.data.iter().filter(|&&v| v > 0.5).count();
+    let horizon = args.horizon.unwrap_or(0.5 * h as f32);
+    match found.streaks {
+        Some(n) => eprintln!(
+            "{n} streaks, {pixels} pixels (horizon at row {horizon:.1}); mask in {}",
+            out.display()
+        ),
+        None => eprintln!(
+            "{pixels} streak pixels ({:.2} %, horizon at row {horizon:.1}); mask in {}",
+            100.0 * pixels as f64 / (w * h) as f64,
+            out.display()
+        ),
+    }
+    if let Some((_, t)) = &truth {
+        let s = score_mask(&found.mask, t)?;
         println!("{}", serde_json::to_string_pretty(&s)?);
     }
     Ok(())

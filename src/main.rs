@@ -18,6 +18,7 @@ mod prepare;
 mod render;
 mod stereo;
 mod texture_map;
+mod train_detector;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -58,6 +59,8 @@ enum Command {
     Compare(compare::Args),
     /// Detect specular streaks in an image, or score the detector over a dataset.
     Detect(detect::Args),
+    /// Train the learned streak detector on datasets (for `streaks detect --model`).
+    TrainDetector(train_detector::Args),
     /// Generate stereo datasets of procedural rainy streets (generate), and index them (index).
     Dataset(dataset::Args),
     /// Score stereo methods (built-in and external) against a dataset's ground truth by region.
@@ -82,6 +85,7 @@ fn main() -> ExitCode {
         Command::Dataset(args) => dataset::run(args),
         Command::Benchmark(args) => benchmark::run(args),
         Command::Detect(args) => detect::run(args),
+        Command::TrainDetector(args) => train_detector::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,6 +1,7 @@
-//! End-to-end tests of `streaks detect`: on an image with a known streak (mask written and
-//! scored), on a tiny generated dataset (per-sample and pooled counts that agree with the
-//! dataset's own masks), and bad input that fails clearly without writing.
+//! End-to-end tests of `streaks detect` and `streaks train-detector`: the hand-built detector on
+//! an image with a known streak (mask written and scored), the learned one over a tiny
+//! generated dataset (per-sample and pooled counts that agree with the dataset's own masks), a
+//! classifier trained on a dataset and used, and bad input that fails clearly without writing.
 
 use crate::common::TestDir;
 use serde_json::Value;
@@ -50,6 +51,8 @@ fn an_image_streak_is_masked_and_scored() {
     let run = t.streaks(&[
         "detect",
         "road.png",
+        "--detector",
+        "hand",
         "--truth",
         "truth.png",
         "--horizon",
@@ -151,7 +154,128 @@ fn bad_detect_input_fails_without_writing() {
     t.streaks(&["detect", "empty"])
         .assert_failure_mentioning("without dataset.json");
     t.streaks(&["detect", "road.png", "--split", "test"])
-        .assert_failure_mentioning("--split applies to a dataset");
-    t.streaks(&["detect", "road.png", "--row-fraction", "2"])
-        .assert_failure_mentioning("row_fraction");
+        .assert_failure_mentioning("--split and --image apply to a dataset");
+    t.streaks(&[
+        "detect",
+        "road.png",
+        "--detector",
+        "hand",
+        "--row-fraction",
+        "2",
+    ])
+    .assert_failure_mentioning("row_fraction");
+    t.streaks(&[
+        "detect",
+        "road.png",
+        "--detector",
+        "learned",
+        "--row-fraction",
+        "0.3",
+    ])
+    .assert_failure_mentioning("need --detector hand");
+    std::fs::write(
+        t.join("model.json"),
+        "{\"format\": \"streaks-classifier/1\"}",
+    )
+    .unwrap();
+    t.streaks(&[
+        "detect",
+        "road.png",
+        "--model",
+        "model.json",
+        "-o",
+        "mask.png",
+    ])
+    .assert_failure_mentioning("model.json is not a usable streak classifier");
+    t.streaks(&["detect", "road.png", "--threshold", "1.5", "-o", "mask.png"])
+        .assert_failure_mentioning("not a probability");
+    assert!(!t.join("mask.png").exists());
+    t.streaks(&["train-detector", "empty", "-o", "m.json"])
+        .assert_failure_mentioning("not a dataset folder");
+    assert!(!t.join("m.json").exists());
+}
+
+#[test]
+fn a_classifier_trained_on_a_dataset_is_used_by_detect() {
+    let t = TestDir::new();
+    t.streaks(&[
+        "dataset", "generate", "-o", "ds", "--count", "6", "--width", "96", "--height", "64",
+        "--spp", "4",
+    ])
+    .assert_success();
+    // Splits are drawn per street; train on the split with most samples, choose the threshold
+    // on another non-empty one.
+    let mut splits: Vec<(usize, &str)> = ["train", "val", "test"]
+        .into_iter()
+        .map(|s| {
+            let text = std::fs::read_to_string(t.join("ds/splits").join(format!("{s}.txt")))
+                .unwrap_or_default();
+            (text.split_whitespace().count(), s)
+        })
+        .filter(|(n, _)| *n > 0)
+        .collect();
+    splits.sort();
+    let (train, val) = (splits.last().unwrap().1, splits[0].1);
+    assert_ne!(train, val, "{splits:?}");
+    let run = t.streaks(&[
+        "train-detector",
+        "ds",
+        "-o",
+        "model.json",
+        "--train-split",
+        train,
+        "--val-split",
+        val,
+        "--rounds",
+        "20",
+        "--min-leaf",
+        "20",
+        "--precision",
+        "0.5",
+    ]);
+    run.assert_success();
+    assert!(
+        run.stderr().contains("kept smoothing radius"),
+        "{}",
+        run.stderr()
+    );
+    let model: Value =
+        serde_json::from_str(&std::fs::read_to_string(t.join("model.json")).unwrap()).unwrap();
+    assert_eq!(model["format"], "streaks-classifier/1");
+    assert_eq!(model["model"]["trees"].as_array().unwrap().len(), 20);
+    assert_eq!(model["provenance"]["train_split"], train);
+    // The classifier scores its own training split well: it has learned the masks.
+    t.streaks(&[
+        "detect",
+        "ds",
+        "--model",
+        "model.json",
+        "--split",
+        train,
+        "-o",
+        "s.json",
+    ])
+    .assert_success();
+    let s: Value =
+        serde_json::from_str(&std::fs::read_to_string(t.join("s.json")).unwrap()).unwrap();
+    assert_eq!(s["image"], "im0.exr");
+    let road = &s["road"];
+    assert!(road["f1"].as_f64().unwrap() > 0.5, "{s}");
+    // The same on one image, with the sample's horizon: the mask is written and non-empty.
+    let id = s["samples"][0]["id"].as_str().unwrap();
+    let horizon = s["samples"][0]["horizon"].as_f64().unwrap().to_string();
+    let exr = format!("ds/samples/{id}/im0.exr");
+    t.streaks(&[
+        "detect",
+        &exr,
+        "--model",
+        "model.json",
+        "--horizon",
+        &horizon,
+        "-o",
+        "one.png",
+    ])
+    .assert_success();
+    let n = count(&t.join("one.png"), None);
+    assert_eq!(n, s["samples"][0]["all"]["detected"].as_u64().unwrap());
 }

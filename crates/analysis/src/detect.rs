@@ -25,6 +25,7 @@
 //! [`score_mask`] compares a detection mask with a ground-truth mask (precision and recall).
 //! Coordinates follow DESIGN.md: image x and y with pixel centres at `i + 0.5`; rows are indices.
 
+use crate::filter::{median, Axis};
 use streaks_image::GrayImage;
 
 /// Errors of streak detection.
@@ -197,8 +198,8 @@ pub struct Detection {
     pub thresholds: (f32, f32),
 }
 
-/// The `p`-quantile (0..1) of the finite values; `buf` is scratch space.
-fn quantile(values: &[f32], p: f32, buf: &mut Vec<f32>) -> f32 {
+/// The `p`-quantile (0..1) of the finite values (nearest rank); `buf` is scratch space.
+pub(crate) fn quantile(values: &[f32], p: f32, buf: &mut Vec<f32>) -> f32 {
     buf.clear();
     buf.extend(values.iter().copied().filter(|v| v.is_finite()));
     if buf.is_empty() {
@@ -266,26 +267,9 @@ fn local_contrast(img: &GrayImage, share: f32, buf: &mut Vec<f32>) -> Vec<f32> {
         return out;
     }
     let r = ((share * w as f32 / 2.0).round() as usize).max(1);
-    // A sorted sliding window per row: insertion and removal by binary search.
-    let mut window: Vec<f32> = Vec::with_capacity(2 * r + 1);
-    let pos = |win: &[f32], v: f32| win.partition_point(|&u| u.total_cmp(&v).is_lt());
-    for (row, o) in img.data.chunks_exact(w).zip(out.chunks_exact_mut(w)) {
-        window.clear();
-        let (mut lo, mut hi) = (0usize, 0usize); // the window is row[lo..hi]
-        for x in 0..w {
-            let (want_lo, want_hi) = (x.saturating_sub(r), (x + r + 1).min(w));
-            while hi < want_hi {
-                let v = row[hi];
-                window.insert(pos(&window, v), v);
-                hi += 1;
-            }
-            while lo < want_lo {
-                let k = pos(&window, row[lo]);
-                window.remove(k);
-                lo += 1;
-            }
-            o[x] = row[x] - window[window.len() / 2];
-        }
+    let background = median(img, Axis::Rows, r);
+    for ((o, &v), &b) in out.iter_mut().zip(&img.data).zip(&background.data) {
+        *o = v - b;
     }
     out
 }

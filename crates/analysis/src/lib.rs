@@ -17,7 +17,11 @@
 //! - [`figures`]: the paper's figures made from the model (Fig. 4, Fig. 5).
 //! - [`lk`]: the paper's per-row 1D Lucas-Kanade estimator, and the preparation of a rendered
 //!   pair for it (fireflies removed, range log-compressed).
-//! - [`detect`]: streaks, glows and lamps in the left image; masks scored against the truth.
+//! - [`detect`]: streaks, glows and lamps in the left image, by hand-built rules for 8-bit
+//!   images; masks scored against the truth.
+//! - [`streak_classifier`]: learned streak detection on linear luminance: per-pixel features
+//!   and a trained classifier (the shipped one in `models/`), on [`gbdt`]'s gradient-boosted
+//!   trees (training and inference) and [`filter`]'s sliding-window medians, means and maxima.
 //! - [`benchmark`]: an estimate scored by region (streak, road, off-road; the phantom-hole
 //!   rate), pooled over samples; the LK streak disparity as a map; signed error maps.
 //! - [`repair`]: streak-robust stereo: the road plane from the pair's own v-disparity, and
@@ -55,10 +59,13 @@ pub mod benchmark;
 pub mod centre;
 pub mod detect;
 pub mod figures;
+pub mod filter;
+pub mod gbdt;
 pub mod lk;
 pub mod model;
 pub mod plot;
 pub mod repair;
 pub mod report;
 pub mod sgm;
+pub mod streak_classifier;
 pub mod synth;

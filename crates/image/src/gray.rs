@@ -1,7 +1,7 @@
 //! [`GrayImage`]: a single-channel float image, the currency of the stereo and analysis code
 //! (grey levels, disparity and depth maps, masks).
 
-use crate::color::luminance;
+use crate::color::{luminance, srgb_to_linear};
 use crate::png::write_png_buffer;
 use crate::{ImageError, RgbImage};
 use glam::Vec3;
@@ -123,6 +123,30 @@ impl GrayImage {
     }
 }
 
+impl GrayImage {
+    /// Loads an image as the [`luminance`] of its *linear* RGB: float formats (EXR) as stored,
+    /// integer formats (PNG, JPEG: sRGB-encoded) decoded with [`srgb_to_linear`] first. The
+    /// input a detector working on radiance needs; an 8-bit image's clipped highlights stay
+    /// clipped.
+    pub fn load_linear(path: &Path) -> Result<Self, ImageError> {
+        let img = ::image::open(path).map_err(|e| ImageError::Read {
+            path: path.to_path_buf(),
+            reason: e.to_string(),
+        })?;
+        let float = matches!(
+            img,
+            ::image::DynamicImage::ImageRgb32F(_) | ::image::DynamicImage::ImageRgba32F(_)
+        );
+        let rgb = img.to_rgb32f();
+        let decode = |c: f32| if float { c } else { srgb_to_linear(c) };
+        let data = rgb
+            .pixels()
+            .map(|p| luminance(Vec3::new(decode(p[0]), decode(p[1]), decode(p[2]))))
+            .collect();
+        Self::from_vec(rgb.width() as usize, rgb.height() as usize, data)
+    }
+}
+
 /// Loads any image the `image` crate reads as its three channels R, G, B as stored (sRGB
 /// values in [0, 1] for PNG and JPEG, linear for EXR).
 pub fn load_rgb_channels(path: &Path) -> Result<[GrayImage; 3], ImageError> {
@@ -204,5 +228,33 @@ mod tests {
         assert!((back.data[1] - 128.0 / 255.0).abs() < 1e-6);
         assert_eq!(back.data[2], 1.0);
         assert!(g.save_png(&dir.path().join("no/such/dir.png")).is_err());
+    }
+
+    #[test]
+    fn load_linear_decodes_png_but_not_exr() {
+        let dir = tempfile::tempdir().unwrap();
+        let png = dir.path().join("g.png");
+        GrayImage::from_vec(2, 1, vec![0.5, 1.0])
+            .unwrap()
+            .save_png(&png)
+            .unwrap();
+        let lin = GrayImage::load_linear(&png).unwrap();
+        assert!(
+            (lin.data[0] - srgb_to_linear(128.0 / 255.0)).abs() < 1e-5,
+            "{}",
+            lin.data[0]
+        );
+        assert!((lin.data[1] - 1.0).abs() < 1e-5);
+        let exr = dir.path().join("g.exr");
+        let mut rgb = RgbImage::new(2, 1);
+        rgb.pixels = vec![Vec3::splat(0.25), Vec3::splat(7.0)];
+        crate::exr::write_exr_rgb(&exr, &rgb).unwrap();
+        let lin = GrayImage::load_linear(&exr).unwrap();
+        assert!(
+            (lin.data[0] - 0.25).abs() < 1e-5 && (lin.data[1] - 7.0).abs() < 1e-4,
+            "{:?}",
+            lin.data
+        );
+        assert!(GrayImage::load_linear(&dir.path().join("none.png")).is_err());
     }
 }
