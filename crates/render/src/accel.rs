@@ -29,6 +29,12 @@
 //! ray).
 //!
 //! Queries allocate nothing: traversal uses obvhs' fixed-size stack.
+//!
+//! SIMD: each node of the CWBVH has eight children, whose boxes obvhs tests four at a time in
+//! SSE lanes. Where the CPU has AVX2 (detected once per process at run time), the traversal
+//! tests all eight in one AVX2 pass ([`NodeTest`]); both do the same IEEE operations per lane
+//! (no fused multiply-add), so they find the same hits, bit for bit, and images do not depend
+//! on the CPU's SIMD width. `STREAKS_SIMD=sse` forces the SSE test.
 
 use crate::geometry::Ray;
 use glam::{Vec2, Vec3, Vec3A};
@@ -37,6 +43,7 @@ use obvhs::bvh2::node::Bvh2Node;
 use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
 use obvhs::bvh2::Bvh2;
 use obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh;
+use obvhs::cwbvh::node::CwBvhNode;
 use obvhs::cwbvh::CwBvh;
 use obvhs::ploc::PlocBuilder;
 use obvhs::ray::{Ray as BvhRay, RayHit};
@@ -269,7 +276,7 @@ impl Accel {
         let mut hit = RayHit::none();
         let mut barycentrics = Vec2::ZERO;
         let tris = &self.tris;
-        if !bvh.ray_traverse(r, &mut hit, |r, id| {
+        if !traverse_closest(node_test(), bvh, r, &mut hit, |r, id| {
             let (t, b) = intersect_triangle(&tris[id], r, t_min);
             // obvhs keeps a hit exactly when it is nearer than the ray's current end.
             if t < r.tmax {
@@ -301,7 +308,7 @@ impl Accel {
             return false;
         };
         let tris = &self.tris;
-        !bvh.ray_traverse_miss(r, |r, id| {
+        !traverse_miss(node_test(), bvh, r, |r, id| {
             let (t, b) = intersect_triangle(&tris[id], r, t_min);
             if t < r.tmax && !self.counts::<FILTER>(id, b, &mut stops) {
                 return f32::INFINITY;
@@ -375,8 +382,9 @@ impl Tlas {
         };
         let ids = &self.bvh.primitive_indices;
         let mut hit = RayHit::none();
-        self.bvh
-            .ray_traverse(r, &mut hit, |r, slot| visit(ids[slot], r.tmax))
+        traverse_closest(node_test(), &self.bvh, r, &mut hit, |r, slot| {
+            visit(ids[slot], r.tmax)
+        })
     }
 
     /// Whether `visit(box)` says true for some box `ray` enters before its end (stopping at
@@ -387,16 +395,224 @@ impl Tlas {
             return false;
         };
         let ids = &self.bvh.primitive_indices;
-        !self.bvh.ray_traverse_miss(
-            r,
-            |_, slot| {
-                if visit(ids[slot]) {
-                    0.0
-                } else {
-                    f32::INFINITY
+        !traverse_miss(node_test(), &self.bvh, r, |_, slot| {
+            if visit(ids[slot]) {
+                0.0
+            } else {
+                f32::INFINITY
+            }
+        })
+    }
+}
+
+/// How the traversal tests a node's eight child boxes against a ray.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NodeTest {
+    /// obvhs' own test: SSE, four boxes at a time.
+    Sse,
+    /// All eight boxes in one pass of AVX2 lanes.
+    Avx2,
+}
+
+impl NodeTest {
+    /// The best test this CPU runs, unless `STREAKS_SIMD=sse` asks for SSE.
+    fn detect() -> Self {
+        if std::env::var("STREAKS_SIMD").is_ok_and(|v| v.eq_ignore_ascii_case("sse")) {
+            return Self::Sse;
+        }
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            return Self::Avx2;
+        }
+        Self::Sse
+    }
+}
+
+/// The node test every traversal of this process uses ([`NodeTest::detect`], once).
+pub fn node_test() -> NodeTest {
+    static TEST: std::sync::OnceLock<NodeTest> = std::sync::OnceLock::new();
+    *TEST.get_or_init(NodeTest::detect)
+}
+
+/// obvhs' `CwBvh::ray_traverse` (closest hit: `intersect(ray, slot)` returns a primitive's
+/// hit parameter, which shortens the ray when nearer) with node test `test`; whether anything
+/// was hit. Falls back to SSE if `test` is AVX2 on a CPU without it.
+#[inline(always)]
+fn traverse_closest(
+    test: NodeTest,
+    bvh: &CwBvh,
+    ray: BvhRay,
+    hit: &mut RayHit,
+    intersect: impl FnMut(&BvhRay, usize) -> f32,
+) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    if test == NodeTest::Avx2 && std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2 (checked just above).
+        return unsafe { avx2::closest(bvh, ray, hit, intersect) };
+    }
+    let _ = test;
+    bvh.ray_traverse(ray, hit, intersect)
+}
+
+/// obvhs' `CwBvh::ray_traverse_miss` (stops at the first primitive whose parameter is before
+/// the ray's end) with node test `test`; whether the ray missed everything.
+#[inline(always)]
+fn traverse_miss(
+    test: NodeTest,
+    bvh: &CwBvh,
+    ray: BvhRay,
+    intersect: impl FnMut(&BvhRay, usize) -> f32,
+) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    if test == NodeTest::Avx2 && std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2 (checked just above).
+        return unsafe { avx2::miss(bvh, ray, intersect) };
+    }
+    let _ = test;
+    bvh.ray_traverse_miss(ray, intersect)
+}
+
+/// The AVX2 traversals: obvhs' traversal loop (its `traverse!` macro) with an eight-wide node
+/// test, compiled for AVX2 as a whole so that the test and the primitive callback inline.
+#[cfg(target_arch = "x86_64")]
+mod avx2 {
+    use super::{BvhRay, CwBvh, CwBvhNode, RayHit};
+    use glam::{UVec2, Vec3A};
+    use std::arch::x86_64::*;
+
+    /// obvhs' node epsilon (`cwbvh::node::EPSILON`, crate-private there): boxes are entered
+    /// no nearer than this.
+    const EPSILON: f32 = 0.0001;
+
+    /// obvhs' `CwBvhNode::intersect_ray_simd`, eight children in one pass: the same
+    /// dequantisation (bytes to `f32`, exact), the same products, sums, minima and maxima in
+    /// the same order per lane, so the same hit mask.
+    ///
+    /// # Safety
+    /// The CPU must have AVX2.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    unsafe fn intersect_node(node: &CwBvhNode, ray: &BvhRay, oct_inv4: u32) -> u32 {
+        let dir_inv = node.compute_extent() * ray.inv_direction;
+        let origin = (Vec3A::from(node.p) - ray.origin) * ray.inv_direction;
+        // The eight children's quantised bounds of one axis as f32 lanes.
+        // SAFETY (of every intrinsic below): the caller's CPU has AVX2; the load reads the 8
+        // bytes of `v`, unaligned.
+        let q = |v: &[u8; 8]| unsafe {
+            _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(
+                v.as_ptr().cast::<__m128i>(),
+            )))
+        };
+        let slab = |lo: &[u8; 8], hi: &[u8; 8], negative: bool, d: f32, o: f32| {
+            let (lo, hi) = (q(lo), q(hi));
+            let (near, far) = if negative { (hi, lo) } else { (lo, hi) };
+            let (d, o) = (_mm256_set1_ps(d), _mm256_set1_ps(o));
+            (
+                _mm256_add_ps(_mm256_mul_ps(near, d), o),
+                _mm256_add_ps(_mm256_mul_ps(far, d), o),
+            )
+        };
+        let (tmin_x, tmax_x) = slab(
+            &node.child_min_x,
+            &node.child_max_x,
+            ray.direction.x < 0.0,
+            dir_inv.x,
+            origin.x,
+        );
+        let (tmin_y, tmax_y) = slab(
+            &node.child_min_y,
+            &node.child_max_y,
+            ray.direction.y < 0.0,
+            dir_inv.y,
+            origin.y,
+        );
+        let (tmin_z, tmax_z) = slab(
+            &node.child_min_z,
+            &node.child_max_z,
+            ray.direction.z < 0.0,
+            dir_inv.z,
+            origin.z,
+        );
+        let tmin = _mm256_max_ps(tmin_x, _mm256_max_ps(tmin_y, tmin_z));
+        let tmax = _mm256_min_ps(tmax_x, _mm256_min_ps(tmax_y, tmax_z));
+        let tmin = _mm256_max_ps(tmin, _mm256_set1_ps(EPSILON));
+        let tmax = _mm256_min_ps(tmax, _mm256_set1_ps(ray.tmax));
+        // `_mm_cmple_ps` is the ordered, signalling less-or-equal.
+        let mut mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OS>(tmin, tmax)) as u32;
+        let (child_bits8, bit_index8) = node.get_child_and_index_bits(oct_inv4);
+        let mut hit_mask = 0u32;
+        while mask != 0 {
+            let offset = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            let child_bits = obvhs::cwbvh::node::extract_byte64(child_bits8, offset);
+            let bit_index = obvhs::cwbvh::node::extract_byte64(bit_index8, offset);
+            hit_mask |= child_bits << bit_index;
+        }
+        hit_mask
+    }
+
+    /// `CwBvh::ray_traverse` with [`intersect_node`].
+    ///
+    /// # Safety
+    /// The CPU must have AVX2.
+    #[target_feature(enable = "avx2")]
+    pub(super) unsafe fn closest(
+        bvh: &CwBvh,
+        ray: BvhRay,
+        hit: &mut RayHit,
+        mut intersect: impl FnMut(&BvhRay, usize) -> f32,
+    ) -> bool {
+        let mut traverse_ray = ray;
+        let mut state = bvh.new_traversal(ray.direction);
+        let mut node;
+        obvhs::traverse!(
+            bvh,
+            node,
+            state,
+            // SAFETY: the caller's CPU has AVX2.
+            unsafe { intersect_node(node, &traverse_ray, state.oct_inv4) },
+            {
+                let t = intersect(&traverse_ray, state.primitive_id as usize);
+                if t < traverse_ray.tmax {
+                    hit.primitive_id = state.primitive_id;
+                    hit.t = t;
+                    traverse_ray.tmax = t;
                 }
-            },
-        )
+            }
+        );
+        hit.t < ray.tmax
+    }
+
+    /// `CwBvh::ray_traverse_miss` with [`intersect_node`].
+    ///
+    /// # Safety
+    /// The CPU must have AVX2.
+    #[target_feature(enable = "avx2")]
+    pub(super) unsafe fn miss(
+        bvh: &CwBvh,
+        ray: BvhRay,
+        mut intersect: impl FnMut(&BvhRay, usize) -> f32,
+    ) -> bool {
+        let mut state = bvh.new_traversal(ray.direction);
+        let mut node;
+        let mut miss = true;
+        'outer: {
+            obvhs::traverse!(
+                bvh,
+                node,
+                state,
+                // SAFETY: the caller's CPU has AVX2.
+                unsafe { intersect_node(node, &ray, state.oct_inv4) },
+                {
+                    let t = intersect(&ray, state.primitive_id as usize);
+                    if t < ray.tmax {
+                        miss = false;
+                        break 'outer;
+                    }
+                }
+            );
+        }
+        miss
     }
 }
 
@@ -485,6 +701,79 @@ fn build_cwbvh(aabbs: impl ExactSizeIterator<Item = Aabb>, reinsertion_ratio: f3
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The AVX2 node test finds exactly the SSE test's hits (same `t` bits, same triangle),
+    /// for closest-hit and occlusion queries, on a soup of small random triangles crossed by
+    /// random rays (skipped on a CPU without AVX2).
+    #[test]
+    fn avx2_and_sse_node_tests_find_the_same_hits() {
+        #[cfg(target_arch = "x86_64")]
+        let avx2 = std::arch::is_x86_feature_detected!("avx2");
+        #[cfg(not(target_arch = "x86_64"))]
+        let avx2 = false;
+        if !avx2 {
+            eprintln!("no AVX2 on this CPU: nothing to compare");
+            return;
+        }
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut rnd = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let mut positions = vec![];
+        let mut triangles = vec![];
+        for i in 0..4000u32 {
+            let c = Vec3::new(rnd(), rnd(), rnd()) * 20.0 - 10.0;
+            for _ in 0..3 {
+                positions.push(c + Vec3::new(rnd(), rnd(), rnd()) - 0.5);
+            }
+            triangles.push([3 * i, 3 * i + 1, 3 * i + 2]);
+        }
+        let accel = Accel::build(&positions, &triangles);
+        let (mut hits, mut blocked) = (0, 0);
+        for k in 0..20_000 {
+            let origin = Vec3::new(rnd(), rnd(), rnd()) * 30.0 - 15.0;
+            let direction = (Vec3::new(rnd(), rnd(), rnd()) - 0.5).normalize();
+            let t_max = if k % 2 == 0 {
+                f32::INFINITY
+            } else {
+                8.0 * rnd()
+            };
+            let ray = Ray {
+                origin,
+                direction,
+                t_max,
+            };
+            let (bvh, r) = accel.bvh_ray(&ray, accel.t_min).unwrap();
+            let tris = &accel.tris;
+            let closest = |test| {
+                let mut hit = RayHit::none();
+                let found = traverse_closest(test, bvh, r, &mut hit, |r, id| {
+                    intersect_triangle(&tris[id], r, accel.t_min).0
+                });
+                (found, hit.t.to_bits(), found.then_some(hit.primitive_id))
+            };
+            let miss = |test| {
+                traverse_miss(test, bvh, r, |r, id| {
+                    intersect_triangle(&tris[id], r, accel.t_min).0
+                })
+            };
+            let sse = closest(NodeTest::Sse);
+            assert_eq!(sse, closest(NodeTest::Avx2), "ray {k}: {ray:?}");
+            assert_eq!(
+                miss(NodeTest::Sse),
+                miss(NodeTest::Avx2),
+                "ray {k}: {ray:?}"
+            );
+            hits += sse.0 as u32;
+            blocked += !miss(NodeTest::Sse) as u32;
+        }
+        // Both kinds of answer occur often.
+        assert!((1_000..19_000).contains(&hits), "{hits} hits");
+        assert!(blocked > 500, "{blocked} blocked");
+    }
 
     /// The step-by-step build makes exactly the BVH of obvhs' own `medium_build` path, on
     /// enough triangles for its parallel sort and cost passes. (From 500k triangles on, obvhs'
