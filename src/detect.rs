@@ -26,7 +26,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use streaks_analysis::detect::{detect_streaks, score_mask, DetectParams, MaskScore};
-use streaks_analysis::streak_classifier::{operating_point, smooth_probability, StreakClassifier};
+use streaks_analysis::streak_classifier::{operating_point, StreakClassifier};
 use streaks_image::{write_bytes_atomically, GrayImage};
 
 use crate::dataset::layout::Layout;
@@ -178,14 +178,9 @@ impl Detector {
                 let lum = GrayImage::load_linear(path)
                     .with_context(|| format!("cannot read {}", path.display()))?;
                 let horizon = horizon.unwrap_or(0.5 * lum.height as f32);
-                let p = c.probability(&lum, horizon).with_context(what)?;
-                let p = smooth_probability(&p, c.smooth);
-                let mut mask = p.clone();
-                for v in &mut mask.data {
-                    *v = (*v >= c.threshold) as u8 as f32;
-                }
+                let p = c.smoothed_probability(&lum, horizon).with_context(what)?;
                 Ok(Found {
-                    mask,
+                    mask: c.mask_of(&p),
                     probability: Some(p),
                     streaks: None,
                 })

@@ -273,13 +273,31 @@ impl StreakClassifier {
         })
     }
 
-    /// The streak mask (1 on streak pixels, 0 elsewhere) of the linear luminance `lum`.
-    pub fn mask(&self, lum: &GrayImage, horizon: f32) -> Result<GrayImage, ClassifierError> {
-        let mut p = smooth_probability(&self.probability(lum, horizon)?, self.smooth);
-        for v in &mut p.data {
+    /// [`Self::probability`] averaged over the classifier's `smooth` radius: the probability
+    /// that [`Self::mask_of`] thresholds.
+    pub fn smoothed_probability(
+        &self,
+        lum: &GrayImage,
+        horizon: f32,
+    ) -> Result<GrayImage, ClassifierError> {
+        Ok(smooth_probability(
+            &self.probability(lum, horizon)?,
+            self.smooth,
+        ))
+    }
+
+    /// The streak mask (1 where `p >= threshold`, 0 elsewhere) of a smoothed probability.
+    pub fn mask_of(&self, p: &GrayImage) -> GrayImage {
+        let mut mask = p.clone();
+        for v in &mut mask.data {
             *v = (*v >= self.threshold) as u8 as f32;
         }
-        Ok(p)
+        mask
+    }
+
+    /// The streak mask (1 on streak pixels, 0 elsewhere) of the linear luminance `lum`.
+    pub fn mask(&self, lum: &GrayImage, horizon: f32) -> Result<GrayImage, ClassifierError> {
+        Ok(self.mask_of(&self.smoothed_probability(lum, horizon)?))
     }
 }
 
