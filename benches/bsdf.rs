@@ -1,6 +1,6 @@
 //! BSDF benchmarks: each model's `sample`, `eval` and `pdf` on a batch of fixed random
-//! directions, its luminance evaluator as the light choice uses it (`luminance_at` once per
-//! vertex, then `eval4` toward 16 emitters), and the closed-enum dispatch of [`Bsdf`] against
+//! directions, the light choice that weighs emitters by each model's BSDF in SIMD lanes
+//! (`LightSampler::sample_li` on `rainy_street`'s road), and the closed-enum dispatch of [`Bsdf`] against
 //! a trait-object version of the same calls (DESIGN.md and STYLE.md choose the enum; this
 //! measures the choice).
 //!
@@ -9,10 +9,14 @@
 //! Run: `cargo bench --bench bsdf`. Throughput is reported in calls per second.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use glam::{Vec2, Vec3, Vec4};
+use glam::{Vec2, Vec3};
 use std::hint::black_box;
+use std::path::Path;
 use streaks_render::bsdf::{BlinnPhong, Bsdf, BsdfSample, Diffuse, Ggx, GltfPbr, Ward};
+use streaks_render::geometry::Frame;
+use streaks_render::light::Receiver;
 use streaks_render::sampling::{square_to_cosine_hemisphere, Pcg32, Sampler};
+use streaks_render::scene::Scene;
 
 /// Calls per iteration: large enough to hide the loop, small enough to stay in L1.
 const BATCH: usize = 1024;
@@ -110,38 +114,58 @@ fn bench_models(c: &mut Criterion) {
     group.finish();
 }
 
-/// Directions toward a light-tree node's children per vertex (four SIMD groups of four).
-const CHILDREN: usize = 16;
-
-/// The light choice's BSDF weights: per vertex, [`Bsdf::luminance_at`] once and
-/// `LuminanceEval::eval4` toward [`CHILDREN`] directions, some below the surface.
-fn bench_luminance(c: &mut Criterion) {
-    let input = inputs(3);
+/// The light choice as the integrator makes it (`LightSampler::sample_li`: down the light
+/// tree, each node's children weighed by irradiance and by the BSDF toward them in SIMD lanes,
+/// then a sample of the chosen emitter) at [`BATCH`] points of `rainy_street`'s road (142
+/// emitters, a two-level tree), for every model. The lanes' width is the process's
+/// (`streaks_render::simd::level`): compare widths with `STREAKS_SIMD=sse|avx2|avx512 cargo
+/// bench --bench bsdf -- light_choice`.
+fn bench_light_choice(c: &mut Criterion) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/rainy_street.gltf");
+    let scene = match Scene::load(&path) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("skipping the light-choice bench: {e}");
+            return;
+        }
+    };
     let mut rng = Pcg32::new(4, 7);
-    let groups: Vec<[Vec4; 3]> = (0..BATCH * CHILDREN / 4)
+    // Road points ahead of the camera, seen from the driver's height.
+    let points: Vec<(Vec3, Vec3, [f32; 3])> = (0..BATCH)
         .map(|_| {
-            let w: [Vec3; 4] = std::array::from_fn(|_| {
-                let w = square_to_cosine_hemisphere(rng.next_2d());
-                if rng.next_f32() < 0.2 {
-                    -w
-                } else {
-                    w
-                }
-            });
-            [0, 1, 2].map(|k| Vec4::from_array(w.map(|w| w.to_array()[k])))
+            let p = Vec3::new(
+                rng.next_f32() * 8.0 - 4.0,
+                0.0,
+                -2.0 - rng.next_f32() * 40.0,
+            );
+            let wo = (Vec3::new(0.0, 1.3, 0.0) - p).normalize();
+            (p, wo, [rng.next_f32(), rng.next_f32(), rng.next_f32()])
         })
         .collect();
-    let mut group = c.benchmark_group("luminance");
-    group.throughput(Throughput::Elements((BATCH * CHILDREN) as u64));
+    let frame = Frame::from_normal(Vec3::Y);
+    let mut group = c.benchmark_group("light_choice");
+    group.throughput(Throughput::Elements(BATCH as u64));
+    let level = streaks_render::simd::level().name();
     for (name, bsdf) in models() {
-        group.bench_with_input(BenchmarkId::new("eval4", name), &bsdf, |b, bsdf| {
+        group.bench_with_input(BenchmarkId::new(level, name), &bsdf, |b, bsdf| {
             b.iter(|| {
-                let mut acc = Vec4::ZERO;
-                for (i, dirs) in input.iter().zip(groups.chunks_exact(CHILDREN / 4)) {
-                    let f = black_box(bsdf).luminance_at(i.wo);
-                    for d in dirs {
-                        acc += f.eval4(*d);
-                    }
+                let mut acc = 0.0f32;
+                for &(p, wo, [u_light, u0, u1]) in &points {
+                    let rx = Receiver {
+                        p,
+                        ng: Vec3::Y,
+                        frame,
+                        wo_local: frame.to_local(wo),
+                        bsdf: *black_box(bsdf),
+                    };
+                    let ls = scene.light_sampler.sample_li(
+                        &scene.materials,
+                        &scene.textures,
+                        &rx,
+                        u_light,
+                        Vec2::new(u0, u1),
+                    );
+                    acc += ls.map_or(0.0, |s| s.pdf);
                 }
                 acc
             })
@@ -310,7 +334,7 @@ fn bench_sampler(c: &mut Criterion) {
 criterion_group!(
     benches,
     bench_models,
-    bench_luminance,
+    bench_light_choice,
     bench_dispatch,
     bench_sampler
 );

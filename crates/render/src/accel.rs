@@ -34,7 +34,7 @@
 //! SSE lanes. Where the CPU has AVX2 (detected once per process at run time), the traversal
 //! tests all eight in one AVX2 pass ([`NodeTest`]); both do the same IEEE operations per lane
 //! (no fused multiply-add), so they find the same hits, bit for bit, and images do not depend
-//! on the CPU's SIMD width. `STREAKS_SIMD=sse` forces the SSE test.
+//! on the CPU's SIMD width. `STREAKS_SIMD=sse` forces the SSE test ([`crate::simd`]).
 
 use crate::geometry::Ray;
 use glam::{Vec2, Vec3, Vec3A};
@@ -415,16 +415,14 @@ pub enum NodeTest {
 }
 
 impl NodeTest {
-    /// The best test this CPU runs, unless `STREAKS_SIMD=sse` asks for SSE.
+    /// The widest test of the process's [`crate::simd::level`] (so `STREAKS_SIMD=sse` asks
+    /// for SSE): AVX2 on AVX2 and AVX-512 CPUs, a node having eight children.
     fn detect() -> Self {
-        if std::env::var("STREAKS_SIMD").is_ok_and(|v| v.eq_ignore_ascii_case("sse")) {
-            return Self::Sse;
+        if crate::simd::level() >= crate::simd::SimdLevel::Avx2 {
+            Self::Avx2
+        } else {
+            Self::Sse
         }
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            return Self::Avx2;
-        }
-        Self::Sse
     }
 }
 

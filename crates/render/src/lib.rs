@@ -17,6 +17,7 @@
 //!   ([`light::Emitters`]: punctual lights and meshes of emissive triangles, built once with the
 //!   scene), the light tree ([`light::LightTree`]) and the light choice ([`light::LightSampler`]).
 //! - [`accel`]: the only module that sees obvhs; closest-hit and shadow queries.
+//! - [`simd`]: the SIMD width (SSE, AVX2, AVX-512) of the hot kernels, chosen at run time.
 //! - [`scene`]: loading glTF 2.0 and OBJ into a [`scene::Scene`], with errors that name the file
 //!   and the element.
 //! - [`camera`]: the pinhole camera of DESIGN.md (pixel centres at `i + 0.5`, `f = (H/2)/tan(yfov/2)`).
@@ -87,5 +88,6 @@ pub mod output;
 pub mod regression;
 pub mod sampling;
 pub mod scene;
+pub mod simd;
 pub mod testing;
 pub mod texture;

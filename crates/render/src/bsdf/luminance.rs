@@ -1,5 +1,5 @@
 //! [`LuminanceEval`]: `luminance(f(wo, wi))` for one `wo` and many `wi`, the light choice's
-//! per-emitter BSDF weight, one direction at a time or four in SIMD lanes. It evaluates each
+//! per-emitter BSDF weight, one direction at a time or 4, 8 or 16 in SIMD lanes. It evaluates each
 //! model's own lobes (the functions `eval` uses) with the model's reflectances replaced by
 //! their luminances, so it is the luminance of `eval` up to rounding. What depends on `wo`
 //! alone (the reflectances' luminances, the model's `Model::AtWo`) is computed once, by
@@ -8,12 +8,12 @@
 
 use super::lanes::Lanes;
 use super::{BlinnPhong, Bsdf, Diffuse, Ggx, GltfPbr, Lobes, Model, Reflectances, Ward};
-use glam::{Vec3, Vec4};
+use glam::Vec3;
 use streaks_image::luminance;
 
 /// `luminance(f(wo, wi))` for one `wo` and any `wi` (see [`Bsdf::luminance_at`]):
-/// [`LuminanceEval::eval`] evaluates one direction and [`LuminanceEval::eval4`] four at once
-/// in SIMD lanes, each lane exactly the scalar value. Equal to `luminance(bsdf.eval(wo, wi))`
+/// [`LuminanceEval::eval`] evaluates one direction and `eval_lanes` (crate-internal) 4, 8 or
+/// 16 at once in SIMD lanes, each lane exactly the scalar value. Equal to `luminance(bsdf.eval(wo, wi))`
 /// up to rounding (tested), except below the surface for a transmissive [`GltfPbr`]: its
 /// transmission is not evaluated here (zero), so the light choice's BSDF-aware share looks at
 /// reflection only.
@@ -43,14 +43,10 @@ impl LuminanceEval {
         self.eval_lanes(wi.to_array())
     }
 
-    /// [`LuminanceEval::eval`] of four directions at once, given as their x, y and z lanes.
-    #[inline]
-    pub fn eval4(&self, wi: [Vec4; 3]) -> Vec4 {
-        self.eval_lanes(wi)
-    }
-
+    /// [`LuminanceEval::eval`] of several directions at once, given as their x, y and z
+    /// lanes; each lane is exactly the scalar value.
     #[inline(always)]
-    fn eval_lanes<L: Lanes>(&self, wi: [L; 3]) -> L {
+    pub(crate) fn eval_lanes<L: Lanes>(&self, wi: [L; 3]) -> L {
         if self.wo.z > 0.0 {
             let (r, wo) = (self.reflectances.map(L::splat), self.wo);
             let lobes: Lobes<L, L> = match &self.at {
@@ -64,6 +60,16 @@ impl LuminanceEval {
         } else {
             L::splat(0.0)
         }
+    }
+}
+
+impl LuminanceEval {
+    /// Whether its lobes call the C library per lane (Ward's `exp`, Blinn-Phong's `pow`):
+    /// such a model is evaluated four lanes at a time even where wider lanes exist, since a
+    /// call per lane from a wide kernel costs more than the lanes save (BENCHMARKS.md).
+    #[inline]
+    pub(crate) fn calls_libm(&self) -> bool {
+        matches!(self.at, AtWo::Ward(_) | AtWo::BlinnPhong(_))
     }
 }
 
@@ -90,9 +96,11 @@ impl Bsdf {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bsdf::lanes::{Wide, WideLanes};
     use crate::bsdf::tests::{all_models, random_dir};
     use crate::bsdf::{Ggx, MIN_ALPHA};
     use crate::sampling::Pcg32;
+    use glam::Vec4;
 
     #[test]
     fn luminance_eval_is_luminance_of_eval() {
@@ -112,16 +120,27 @@ mod tests {
         }
     }
 
-    /// Four directions in SIMD lanes give exactly the four scalar values, below the surface
-    /// included, for every model.
+    /// Directions in SIMD lanes (4, 8 and 16 of them) give exactly the scalar values, below
+    /// the surface included, for every model.
     #[test]
     fn luminance_eval_lanes_are_the_scalar_values() {
+        fn check<L: WideLanes>(b: &Bsdf, f: &LuminanceEval, wo: Vec3, wi: &[Vec3]) {
+            let mut coord = [[0.0f32; 16]; 3];
+            for (i, w) in wi.iter().enumerate() {
+                [coord[0][i], coord[1][i], coord[2][i]] = w.to_array();
+            }
+            let mut got = [0.0f32; 16];
+            f.eval_lanes(coord.map(|c| L::load(&c))).store(&mut got);
+            for (w, g) in wi.iter().zip(&got[..L::WIDTH]) {
+                assert_eq!(g.to_bits(), f.eval(*w).to_bits(), "{b:?} {wo} {w}");
+            }
+        }
         let mut rng = Pcg32::new(12, 5);
         for b in all_models() {
             for _ in 0..500 {
                 let wo = random_dir(&mut rng);
                 let f = b.luminance_at(wo);
-                let wi: [Vec3; 4] = std::array::from_fn(|_| {
+                let wi: [Vec3; 16] = std::array::from_fn(|_| {
                     let w = random_dir(&mut rng);
                     // Some below the surface.
                     if rng.next_f32() < 0.2 {
@@ -130,11 +149,9 @@ mod tests {
                         w
                     }
                 });
-                let lanes = [0, 1, 2].map(|k| Vec4::from_array(wi.map(|w| w.to_array()[k])));
-                let got = f.eval4(lanes).to_array();
-                for (w, g) in wi.iter().zip(got) {
-                    assert_eq!(g.to_bits(), f.eval(*w).to_bits(), "{b:?} {wo} {w}");
-                }
+                check::<Vec4>(&b, &f, wo, &wi[..4]);
+                check::<Wide<8>>(&b, &f, wo, &wi[..8]);
+                check::<Wide<16>>(&b, &f, wo, &wi);
             }
         }
     }

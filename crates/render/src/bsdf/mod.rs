@@ -68,7 +68,7 @@ mod dielectric;
 mod diffuse;
 mod ggx;
 mod gltf;
-mod lanes;
+pub(crate) mod lanes;
 mod luminance;
 mod ward;
 

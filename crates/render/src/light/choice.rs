@@ -18,22 +18,21 @@
 //!   would miss the lamp).
 //!
 //! The choice descends the tree from the root, one child per level, weighing a node's children
-//! once: at most [`BRANCHING`] BSDF evaluations per level, four at a time in SIMD lanes
-//! ([`LuminanceEval::eval4`]). Every choice is a deterministic function of the point, so
+//! once: at most [`BRANCHING`] BSDF evaluations per level, all of a node's children in SIMD
+//! lanes, 4, 8 or 16 at a time ([`super::lanes`]). Every choice is a deterministic function of the point, so
 //! [`LightSampler::sample_li`] and [`LightSampler::pdf_li`] agree exactly, which MIS needs.
 
-use super::emitter::{clean_power, Emitter, Emitters, SurfaceMesh};
-use super::tree::{LightTree, Node, BRANCHING};
+use super::emitter::{Emitter, Emitters, SurfaceMesh};
+use super::lanes::{TreeLanes, Weights};
+use super::tree::{LightTree, Node};
 use super::{Light, LightSample};
 use crate::bsdf::{Bsdf, LuminanceEval};
 use crate::geometry::{Frame, SurfaceHit};
 use crate::material::Material;
 use crate::sampling::ONE_MINUS_EPSILON;
 use crate::texture::Texture;
-use glam::{Vec2, Vec3, Vec4};
-use std::f32::consts::PI;
+use glam::{Vec2, Vec3};
 use std::ops::Range;
-use streaks_image::luminance;
 
 /// Share of the light choice made by irradiance alone when it is BSDF-aware (defensive
 /// sampling, see the module documentation).
@@ -55,15 +54,14 @@ pub struct Receiver {
     pub bsdf: Bsdf,
 }
 
-/// The weights `E_c` and `E_c F_c` of a node's children, with their sums.
-type Weights = ([f32; BRANCHING], [f32; BRANCHING], f32, f32);
-
 /// Chooses an emitter and a sample on it for next-event estimation (see the module
 /// documentation). Built once per scene, with the scene.
 #[derive(Clone, Debug, Default)]
 pub struct LightSampler {
     emitters: Emitters,
     tree: LightTree,
+    /// The tree's sibling sets in lanes, for the weights.
+    lanes: TreeLanes,
 }
 
 /// Chooses index `i` with probability `w_i / sum` by inverting the cumulative sum at `u sum`
@@ -129,7 +127,12 @@ impl LightSampler {
     pub fn new(lights: &[Light], mesh: SurfaceMesh<'_>, scene_radius: f32) -> Self {
         let emitters = Emitters::build(lights, mesh);
         let tree = LightTree::build(&emitters.bounds(scene_radius));
-        Self { emitters, tree }
+        let lanes = TreeLanes::build(&tree, &emitters);
+        Self {
+            emitters,
+            tree,
+            lanes,
+        }
     }
 
     /// The emitters (punctual lights first, then the emitter meshes).
@@ -144,83 +147,11 @@ impl LightSampler {
         &self.tree
     }
 
-    /// The irradiance-like weight `E` of emitter `e` at `p` and, when it is positive, the
-    /// direction the BSDF weight looks in (toward a mesh's centre, a point or spot light, or
-    /// against a directional light's direction).
-    #[inline(always)]
-    fn irradiance(&self, e: usize, p: Vec3) -> (f32, Vec3) {
-        match self.emitters.get(e) {
-            Emitter::Mesh(m) => {
-                let e = m.irradiance(p);
-                if e > 0.0 {
-                    (e, (m.centre() - p).normalize_or_zero())
-                } else {
-                    (0.0, Vec3::ZERO)
-                }
-            }
-            // A punctual light's sample is its irradiance at p, and its direction.
-            Emitter::Punctual(light) => match light.sample_li(p) {
-                Some(ls) => (clean_power(luminance(ls.li)), ls.wi),
-                None => (0.0, Vec3::ZERO),
-            },
-        }
-    }
-
     /// The weights `E_c` and `E_c F_c` of the nodes `nodes` (one node's children), with their
-    /// sums. First every child's `E_c` and direction, then the directions' normalisation,
-    /// shading-frame coordinates and BSDF values four children at a time in SIMD lanes.
+    /// sums, in SIMD lanes ([`super::lanes`]).
     #[inline]
     fn weights(&self, rx: &Receiver, f: &LuminanceEval, nodes: Range<usize>) -> Weights {
-        let children = &self.tree.nodes()[nodes];
-        let mut e_w = [0.0f32; BRANCHING];
-        // The directions toward the children (not normalised), by coordinate; zero (so no
-        // BSDF weight) unless the child lights the point.
-        let mut dir = [[0.0f32; BRANCHING]; 3];
-        for (c, child) in children.iter().enumerate() {
-            let (e, d) = match child {
-                Node::Emitter(i) => match self.irradiance(*i as usize, rx.p) {
-                    (e, wi) if e > 0.0 => (e, wi),
-                    _ => continue,
-                },
-                Node::Group(g) => {
-                    let d2 = (g.centre - rx.p).length_squared().max(g.radius * g.radius);
-                    (clean_power(g.power / (4.0 * PI * d2)), g.anchor - rx.p)
-                }
-            };
-            e_w[c] = e;
-            [dir[0][c], dir[1][c], dir[2][c]] = d.to_array();
-        }
-        let n = children.len();
-        let mut f_w = [0.0f32; BRANCHING];
-        let mut cos_w = [0.0f32; BRANCHING];
-        let (frame, ng) = (&rx.frame, rx.ng);
-        for k in (0..n).step_by(4) {
-            let [x, y, z] = dir.map(|d| Vec4::from_slice(&d[k..k + 4]));
-            // `normalize_or_zero`, lane by lane.
-            let r = Vec4::ONE / (x * x + y * y + z * z).sqrt();
-            let r = Vec4::select(r.is_finite_mask() & r.cmpgt(Vec4::ZERO), r, Vec4::ZERO);
-            let [x, y, z] = [x * r, y * r, z * r];
-            // `Frame::to_local` and the geometric normal's side.
-            let dot = |v: Vec3| x * v.x + y * v.y + z * v.z;
-            let local = [dot(frame.s), dot(frame.t), dot(frame.n)];
-            let lit = dot(ng).cmpgt(Vec4::ZERO) & local[2].cmpgt(Vec4::ZERO);
-            let cos = Vec4::select(lit, local[2], Vec4::ZERO);
-            f.eval4([local[0], local[1], cos])
-                .write_to_slice(&mut f_w[k..k + 4]);
-            cos.write_to_slice(&mut cos_w[k..k + 4]);
-        }
-        let mut ef_w = [0.0f32; BRANCHING];
-        let (mut e_sum, mut ef_sum) = (0.0f32, 0.0f32);
-        for c in 0..n {
-            let e = e_w[c];
-            if e > 0.0 {
-                let ef = e * clean_power(f_w[c] * cos_w[c]);
-                ef_w[c] = ef;
-                e_sum += e;
-                ef_sum += ef;
-            }
-        }
-        (e_w, ef_w, e_sum, ef_sum)
+        self.lanes.weights(rx, f, nodes)
     }
 
     /// Chooses an emitter for the receiver: `(emitter, probability, u rescaled within it)`.
@@ -305,8 +236,10 @@ mod tests {
         check_tree, cone_emitter, estimate_irradiance, lamp_scene, normal, polygon_irradiance,
         receiver, vertices,
     };
+    use crate::light::BRANCHING;
     use crate::material::Material;
     use crate::scene::{Scene, SceneParts};
+    use streaks_image::luminance;
 
     #[test]
     fn cone_sampling_of_a_sphere_lamp_gives_its_exact_irradiance() {
@@ -430,6 +363,15 @@ mod tests {
         }
     }
 
+    /// Whether emitter `e` lights `p`, by the emitter's own light (not the choice's lanes):
+    /// a punctual light's sample, a mesh's irradiance-like weight.
+    fn lights_point(ls: &LightSampler, e: usize, p: Vec3) -> bool {
+        match ls.emitters().get(e) {
+            Emitter::Mesh(m) => m.irradiance(p) > 0.0,
+            Emitter::Punctual(light) => light.sample_li(p).is_some_and(|s| luminance(s.li) > 0.0),
+        }
+    }
+
     /// Checks that the choice at `rx` is a distribution over exactly the emitters that light
     /// it, that `choose` returns `emitter_pmf`'s probabilities, and that its frequencies follow
     /// them.
@@ -438,7 +380,7 @@ mod tests {
         let pmfs: Vec<f32> = (0..n_e).map(|e| ls.emitter_pmf(rx, e)).collect();
         assert!((pmfs.iter().sum::<f32>() - 1.0).abs() < 1e-5, "{pmfs:?}");
         for (e, pmf) in pmfs.iter().enumerate() {
-            assert_eq!(*pmf > 0.0, ls.irradiance(e, rx.p).0 > 0.0, "{e}");
+            assert_eq!(*pmf > 0.0, lights_point(ls, e, rx.p), "{e}");
         }
         let n = 40_000;
         let mut counts = vec![0usize; n_e];

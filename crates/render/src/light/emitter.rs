@@ -472,9 +472,17 @@ impl MeshEmitter {
         self.front.is_some()
     }
 
-    /// The irradiance-like weight `power / (4 pi max(d, r)^2)`, zero behind a flat one-sided
-    /// emitter.
+    /// For a flat one-sided emitter, its plane `(n, offset)`: a point `p` with
+    /// `n . p <= offset` is behind it and gets no light.
     #[inline]
+    pub(crate) fn front_plane(&self) -> Option<(Vec3, f32)> {
+        self.front
+    }
+
+    /// The irradiance-like weight `power / (4 pi max(d, r)^2)`, zero behind a flat one-sided
+    /// emitter: what the light choice's lanes compute for it (`super::lanes`), one at a time,
+    /// for tests.
+    #[cfg(test)]
     pub(crate) fn irradiance(&self, p: Vec3) -> f32 {
         if let Some((n, offset)) = self.front {
             if n.dot(p) <= offset {

@@ -6,7 +6,9 @@
 //!   area lights); [`Emitters`] builds the list once, with the scene;
 //! - [`tree`]: [`LightTree`], the emitters grouped by position into a flat 16-ary tree;
 //! - [`choice`]: [`LightSampler`], which picks an emitter per shading point by the irradiance
-//!   and the BSDF toward it, down the tree, and samples it; and the density of that choice.
+//!   and the BSDF toward it, down the tree, and samples it; and the density of that choice;
+//! - `lanes`: the weights of a tree node's children, computed in SIMD lanes (4, 8 or 16 at a
+//!   time, by [`crate::simd::level`]) from a structure-of-arrays copy of each node's children.
 //!
 //! A [`crate::scene::Scene`] builds its [`LightSampler`] when it is built: every render of the
 //! scene (both eyes of a stereo pair) uses the same emitters and tree, and `rig.json` records
@@ -21,6 +23,7 @@
 
 pub mod choice;
 pub mod emitter;
+mod lanes;
 pub mod punctual;
 #[cfg(test)]
 mod test_scenes;
