@@ -17,6 +17,12 @@
 //!
 //! Run: `cargo bench --bench bvh` (`cargo bench --bench bvh -- coherent` for the coherent rays
 //! alone). The ray benches are skipped, with a message, when the scene file is missing.
+//! Instruction counts of the coherent sets: run the bench binary under
+//! `valgrind --tool=callgrind` with `--bench coherent_<street> --profile-time 1` and
+//! `STREAKS_COHERENT_HEIGHT=60` (a smaller image, so that making the rays takes minutes, not
+//! hours); each ray set is traced by its own instance of `trace_single::<SET>` or
+//! `trace_packets::<SET>`, so `callgrind_annotate --inclusive=yes` gives each set's
+//! instructions (divide by the calls and the set's rays).
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use glam::{Vec2, Vec3};
@@ -249,7 +255,8 @@ fn bench_rays(c: &mut Criterion) {
     group.finish();
 }
 
-/// Image height of the coherent-ray sets; the width follows the camera's aspect ratio.
+/// Image height of the coherent-ray sets (`STREAKS_COHERENT_HEIGHT` overrides it); the
+/// width follows the camera's aspect ratio.
 const COHERENT_HEIGHT: u32 = 240;
 
 /// Samples per pixel of the "one pixel's samples" sets (one packet per pixel).
@@ -376,7 +383,10 @@ struct CoherentSets {
 }
 
 fn coherent_sets(scene: &Scene, camera: &Camera) -> CoherentSets {
-    let height = COHERENT_HEIGHT;
+    let height = std::env::var("STREAKS_COHERENT_HEIGHT")
+        .ok()
+        .and_then(|h| h.parse().ok())
+        .unwrap_or(COHERENT_HEIGHT);
     let width = (height as f32 * camera.aspect_ratio.unwrap_or(4.0 / 3.0)).round() as u32;
     let mut rng = Pcg32::new(23, 0);
     let centre = |x: u32, y: u32| {
@@ -452,9 +462,12 @@ fn coherent_sets(scene: &Scene, camera: &Camera) -> CoherentSets {
     }
 }
 
-/// Closest hits of `rays`, one at a time, in order; how many hit.
+/// Closest hits of `rays`, one at a time, in order; how many hit. `SET` only names the ray
+/// set, so that callgrind counts each set's calls apart.
 #[inline(never)]
-fn trace_single(accel: &Accel, rays: &[Ray]) -> u32 {
+fn trace_single<const SET: u8>(accel: &Accel, rays: &[Ray]) -> u32 {
+    // Keeps the instances apart (identical code would be merged into one symbol).
+    black_box(SET);
     let mut hits = 0u32;
     for r in rays {
         hits += u32::from(accel.intersect(black_box(r)).is_some());
@@ -462,9 +475,11 @@ fn trace_single(accel: &Accel, rays: &[Ray]) -> u32 {
     hits
 }
 
-/// Closest hits of `packets`, a packet at a time; how many hit.
+/// Closest hits of `packets`, a packet at a time; how many hit (`SET` as in
+/// [`trace_single`]).
 #[inline(never)]
-fn trace_packets(accel: &Accel, packets: &Packets) -> u32 {
+fn trace_packets<const SET: u8>(accel: &Accel, packets: &Packets) -> u32 {
+    black_box(SET);
     let mut found = [None; PACKET_WIDTH];
     let mut hits = 0u32;
     for p in packets.iter() {
@@ -546,7 +561,7 @@ fn bench_coherent(c: &mut Criterion) {
         .map(|p| check_packets(accel, p))
         .sum();
         let bounce_sorted = Packets::chunks(&sets.bounce_sorted);
-        let hit = |rays: &[Ray]| trace_single(accel, rays) as f64 / rays.len().max(1) as f64;
+        let hit = |rays: &[Ray]| trace_single::<0>(accel, rays) as f64 / rays.len().max(1) as f64;
         eprintln!(
             "{name}: {} triangles, {} instances, {}x{} pixels, {} road bounces ({:.0}% of the \
              pixels; {:.0}% of them hit), {} samples' bounces; packets checked against single \
@@ -562,30 +577,50 @@ fn bench_coherent(c: &mut Criterion) {
         );
         let mut group = c.benchmark_group(format!("coherent_{name}"));
         group.sample_size(20);
-        let singles: [(&str, &[Ray]); 7] = [
-            ("primary/scanline", &sets.scanline),
-            ("primary/morton", &sets.morton),
-            ("primary/tiles4x4", &sets.tiles),
-            ("primary_spp8/single", &sets.pixel_samples.rays),
-            ("bounce/scanline", &sets.bounce),
-            ("bounce/sorted", &sets.bounce_sorted),
-            ("bounce_spp8/single", &sets.bounce_pixel_samples.rays),
-        ];
-        for (id, rays) in singles {
+        let mut single = |id: &str, rays: &[Ray], trace: fn(&Accel, &[Ray]) -> u32| {
             group.throughput(Throughput::Elements(rays.len() as u64));
-            group.bench_function(id, |b| b.iter(|| trace_single(accel, rays)));
-        }
-        let packets: [(&str, &Packets); 5] = [
-            ("primary/packets_tile4x2", &sets.tile_packets),
-            ("primary_spp8/packets_pixel", &sets.pixel_samples),
-            ("bounce/packets_tile4x2", &sets.bounce_tile_packets),
-            ("bounce/packets_sorted", &bounce_sorted),
-            ("bounce_spp8/packets_pixel", &sets.bounce_pixel_samples),
-        ];
-        for (id, p) in packets {
+            group.bench_function(id, |b| b.iter(|| trace(accel, rays)));
+        };
+        single("primary/scanline", &sets.scanline, trace_single::<1>);
+        single("primary/morton", &sets.morton, trace_single::<2>);
+        single("primary/tiles4x4", &sets.tiles, trace_single::<3>);
+        single(
+            "primary_spp8/single",
+            &sets.pixel_samples.rays,
+            trace_single::<4>,
+        );
+        single("bounce/scanline", &sets.bounce, trace_single::<5>);
+        single("bounce/sorted", &sets.bounce_sorted, trace_single::<6>);
+        single(
+            "bounce_spp8/single",
+            &sets.bounce_pixel_samples.rays,
+            trace_single::<7>,
+        );
+        let mut packets = |id: &str, p: &Packets, trace: fn(&Accel, &Packets) -> u32| {
             group.throughput(Throughput::Elements(p.rays.len() as u64));
-            group.bench_function(id, |b| b.iter(|| trace_packets(accel, p)));
-        }
+            group.bench_function(id, |b| b.iter(|| trace(accel, p)));
+        };
+        packets(
+            "primary/packets_tile4x2",
+            &sets.tile_packets,
+            trace_packets::<8>,
+        );
+        packets(
+            "primary_spp8/packets_pixel",
+            &sets.pixel_samples,
+            trace_packets::<9>,
+        );
+        packets(
+            "bounce/packets_tile4x2",
+            &sets.bounce_tile_packets,
+            trace_packets::<10>,
+        );
+        packets("bounce/packets_sorted", &bounce_sorted, trace_packets::<11>);
+        packets(
+            "bounce_spp8/packets_pixel",
+            &sets.bounce_pixel_samples,
+            trace_packets::<12>,
+        );
         // What sorting the bounce rays costs, per ray.
         group.throughput(Throughput::Elements(sets.bounce.len() as u64));
         group.bench_function("bounce/sort", |b| {
