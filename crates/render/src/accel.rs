@@ -159,12 +159,6 @@ impl Accel {
         self.t_min
     }
 
-    /// Whether some triangle is alpha-tested (then only the filtered queries skip its
-    /// rejected hits).
-    pub fn has_alpha_tested(&self) -> bool {
-        !self.alpha_tested.is_empty()
-    }
-
     /// Number of triangles in the BVH.
     pub fn triangle_count(&self) -> usize {
         self.tris.len()

@@ -118,11 +118,10 @@
 //! - `spp`: the number of samples the pixel took (kept and dropped), `spp` everywhere unless
 //!   adaptive sampling stopped it earlier.
 
-use crate::accel::PACKET_WIDTH;
 use crate::bsdf::Bsdf;
 use crate::camera::Camera;
 use crate::film::{Film, Pixel};
-use crate::geometry::{offset_ray_origin, Frame, Ray, SurfaceHit};
+use crate::geometry::{offset_ray_origin, Frame, Ray};
 use crate::light::{LightSampler, Receiver, Visibility};
 use crate::material::Volume;
 use crate::sampling::{power_heuristic, Sampler};
@@ -297,29 +296,16 @@ pub fn render(
                 row_rays += 1;
                 first_hit_layers(scene, &ray, camera.position(), forward, pixel);
             }
-            let mut rays = [Ray::new(Vec3::ZERO, Vec3::Z); PACKET_WIDTH];
-            let mut firsts = [None; PACKET_WIDTH];
-            'pixel: for s0 in (0..settings.spp).step_by(PACKET_WIDTH) {
-                let n = (settings.spp - s0).min(PACKET_WIDTH as u32) as usize;
-                for (k, ray) in rays.iter_mut().enumerate().take(n) {
-                    sampler.start_pixel_sample((x, y), s0 + k as u32);
-                    let film_pos = Vec2::new(x as f32, y as f32) + sampler.next_2d();
-                    *ray = camera.generate_ray(film_pos, width, height);
-                }
-                if settings.max_depth > 0 {
-                    scene.intersect_packet(&rays[..n], &mut firsts[..n]);
-                }
-                for k in 0..n {
-                    let s = s0 + k as u32;
-                    sampler.start_pixel_sample((x, y), s);
-                    let _ = sampler.next_2d();
-                    let path = trace_path(scene, rays[k], firsts[k], &mut sampler, settings);
-                    row_rays += path.rays;
-                    pixel.add_sample(path.radiance, path.specular);
-                    if let Some(target) = settings.noise_target {
-                        if adaptive_stop(pixel, s + 1, target, settings.spp) {
-                            break 'pixel;
-                        }
+            for s in 0..settings.spp {
+                sampler.start_pixel_sample((x, y), s);
+                let film_pos = Vec2::new(x as f32, y as f32) + sampler.next_2d();
+                let ray = camera.generate_ray(film_pos, width, height);
+                let path = trace_path(scene, ray, &mut sampler, settings);
+                row_rays += path.rays;
+                pixel.add_sample(path.radiance, path.specular);
+                if let Some(target) = settings.noise_target {
+                    if adaptive_stop(pixel, s + 1, target, settings.spp) {
+                        break;
                     }
                 }
             }
@@ -365,7 +351,6 @@ fn first_hit_layers(scene: &Scene, ray: &Ray, origin: Vec3, forward: Vec3, pixel
 fn trace_path(
     scene: &Scene,
     mut ray: Ray,
-    first_hit: Option<SurfaceHit>,
     sampler: &mut Sampler,
     settings: &RenderSettings,
 ) -> PathResult {
@@ -390,12 +375,7 @@ fn trace_path(
 
     while depth < max_depth {
         out.rays += 1;
-        let hit = if depth == 0 {
-            first_hit
-        } else {
-            scene.intersect(&ray)
-        };
-        let Some(hit) = hit else {
+        let Some(hit) = scene.intersect(&ray) else {
             break;
         };
         let wo = -ray.direction;

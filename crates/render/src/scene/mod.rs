@@ -523,30 +523,6 @@ impl Scene {
         Some(self.shade(ray, hit.t, hit.triangle, surface, tangent))
     }
 
-    /// [`Scene::intersect`] of each of `rays` (at most [`crate::accel::PACKET_WIDTH`]) into
-    /// the same place of `hits`, the same hits bit for bit: the flat triangles' BVH is
-    /// traversed by the rays together ([`Accel::intersect_packet`]) when the scene has no
-    /// instances and no alpha-tested triangles, and one ray at a time otherwise.
-    pub fn intersect_packet(&self, rays: &[Ray], hits: &mut [Option<SurfaceHit>]) {
-        if !self.instances.is_empty() || self.accel.has_alpha_tested() {
-            for (ray, hit) in rays.iter().zip(hits.iter_mut()) {
-                *hit = self.intersect(ray);
-            }
-            return;
-        }
-        let mut found = [None; crate::accel::PACKET_WIDTH];
-        self.accel.intersect_packet(rays, &mut found);
-        let geometry = self.geometry();
-        for ((ray, hit), found) in rays.iter().zip(hits.iter_mut()).zip(found) {
-            *hit = found.map(|h| {
-                let b = h.barycentrics;
-                let surface = geometry.surface_at(h.triangle, b);
-                let tangent = || geometry.tangent_at(h.triangle, b);
-                self.shade(ray, h.t, h.triangle, surface, tangent)
-            });
-        }
-    }
-
     /// The [`SurfaceHit`] at parameter `t` of `ray` on the world-space point `s` of
     /// triangle `triangle`, with the normal map applied (`tangent` gives the interpolated
     /// world-space tangent, asked only for a normal-mapped material), with the smooth and the
