@@ -252,8 +252,8 @@ impl Accel {
         while todo != 0 {
             let oct_inv4 = octant[todo.trailing_zeros() as usize];
             let mut group = 0u32;
-            for i in 0..rays.len() {
-                if todo & (1 << i) != 0 && octant[i] == oct_inv4 {
+            for (i, &o) in octant.iter().enumerate() {
+                if todo & (1 << i) != 0 && o == oct_inv4 {
                     group |= 1 << i;
                 }
             }
