@@ -2,11 +2,27 @@
 //! and shadow rays per second on `scenes/rainy_street.gltf` for primary (coherent) and
 //! diffuse-bounce (incoherent) rays.
 //!
+//! Coherent rays (issue 19, point 4; `coherent_<street>` groups): primary rays and the road's
+//! first glossy bounce on `rainy_street` and on a procedural street (the generator's default
+//! config, seed 0, sample 0: the scene of `streaks dataset generate --count 1`'s
+//! `samples/000000`, camera `driver`), closest hits traced one at a time in scanline order,
+//! in sorted orders (pixels in Morton and 4x4-tile order; bounce rays by direction octant,
+//! then origin Morton code), and as packets of eight ([`Accel::intersect_packet`]), in 4x2
+//! pixel tiles, in sorted order, or one pixel's eight samples together (the order a renderer
+//! that traces a pixel's samples in turn has). Before timing, every packet's hits are checked
+//! against single-ray traversal, bit for bit.
+//!
 //! Before the timed runs the bench prints the peak heap memory of one 1M-triangle build (a
 //! counting global allocator wraps the system one), for the "< 300 MB" target of BENCHMARKS.md.
 //!
-//! Run: `cargo bench --bench bvh`. The ray benches are skipped, with a message, when the scene
-//! file is missing.
+//! Run: `cargo bench --bench bvh` (`cargo bench --bench bvh -- coherent` for the coherent rays
+//! alone). The ray benches are skipped, with a message, when the scene file is missing.
+//! Instruction counts of the coherent sets: run the bench binary under
+//! `valgrind --tool=callgrind` with `--bench coherent_<street> --profile-time 1` and
+//! `STREAKS_COHERENT_HEIGHT=60` (a smaller image, so that making the rays takes minutes, not
+//! hours); each ray set is traced by its own instance of `trace_single::<SET>` or
+//! `trace_packets::<SET>`, so `callgrind_annotate --inclusive=yes` gives each set's
+//! instructions (divide by the calls and the set's rays).
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use glam::{Vec2, Vec3};
@@ -15,11 +31,13 @@ use std::hint::black_box;
 use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
-use streaks_render::accel::Accel;
+use streaks_render::accel::{Accel, AccelHit, PACKET_WIDTH};
+use streaks_render::camera::Camera;
 use streaks_render::geometry::{offset_ray_origin, Frame, Ray};
 use streaks_render::light::Light;
 use streaks_render::sampling::{square_to_cosine_hemisphere, Pcg32};
 use streaks_render::scene::Scene;
+use streaks_scenes::procedural::{sample, GeneratorConfig};
 
 /// The system allocator, counting live and peak heap bytes.
 struct CountingAlloc;
@@ -237,5 +255,380 @@ fn bench_rays(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench_build, bench_rays);
+/// Image height of the coherent-ray sets (`STREAKS_COHERENT_HEIGHT` overrides it); the
+/// width follows the camera's aspect ratio.
+const COHERENT_HEIGHT: u32 = 240;
+
+/// Samples per pixel of the "one pixel's samples" sets (one packet per pixel).
+const PIXEL_SAMPLES: u32 = PACKET_WIDTH as u32;
+
+/// GGX alpha of the road's glossy bounce (the wet asphalt of both streets has 0.02-0.04).
+const ROAD_ALPHA: f32 = 0.03;
+
+/// Rays in packets: packet `i` is `rays[starts[i]..starts[i + 1]]`, at most
+/// [`PACKET_WIDTH`] rays each.
+#[derive(Default)]
+struct Packets {
+    rays: Vec<Ray>,
+    starts: Vec<usize>,
+}
+
+impl Packets {
+    /// Starts a new packet (a no-op if the last one is still empty).
+    fn begin(&mut self) {
+        if self.starts.last() != Some(&self.rays.len()) {
+            self.starts.push(self.rays.len());
+        }
+    }
+
+    /// Adds a ray to the current packet, starting a new one when it is full.
+    fn push(&mut self, ray: Ray) {
+        if self.starts.is_empty() || self.rays.len() - self.starts.last().unwrap() == PACKET_WIDTH {
+            self.starts.push(self.rays.len());
+        }
+        self.rays.push(ray);
+    }
+
+    /// Consecutive rays of `rays` in packets of [`PACKET_WIDTH`].
+    fn chunks(rays: &[Ray]) -> Self {
+        let mut p = Self::default();
+        for r in rays {
+            p.push(*r);
+        }
+        p
+    }
+
+    /// The packets, each a slice of rays.
+    fn iter(&self) -> impl Iterator<Item = &[Ray]> + '_ {
+        let ends = self.starts.iter().skip(1).copied().chain([self.rays.len()]);
+        self.starts
+            .iter()
+            .zip(ends)
+            .filter(|&(&a, b)| a < b)
+            .map(|(&a, b)| &self.rays[a..b])
+    }
+}
+
+/// The bits of `x` spread to every `stride`-th bit (`stride` 2 or 3; `bits` of them).
+fn spread(x: u32, bits: u32, stride: u32) -> u64 {
+    (0..bits).fold(0, |m, i| m | (u64::from(x >> i & 1) << (i * stride)))
+}
+
+/// Morton code of pixel `(x, y)`.
+fn morton2(x: u32, y: u32) -> u64 {
+    spread(x, 16, 2) | spread(y, 16, 2) << 1
+}
+
+/// Morton code of `p` in the box `[lo, hi]`, 10 bits per axis.
+fn morton3(p: Vec3, lo: Vec3, hi: Vec3) -> u64 {
+    let q = ((p - lo) / (hi - lo).max(Vec3::splat(1e-6)) * 1023.0)
+        .clamp(Vec3::ZERO, Vec3::splat(1023.0));
+    spread(q.x as u32, 10, 3) | spread(q.y as u32, 10, 3) << 1 | spread(q.z as u32, 10, 3) << 2
+}
+
+/// Bounce rays sorted by direction octant, then by the Morton code of their origin in the
+/// origins' bounding box (the sort key costs and the sort itself are what a renderer would
+/// pay on top; the `sort` bench measures them).
+fn sorted_by_octant_and_origin(rays: &[Ray]) -> Vec<Ray> {
+    let (lo, hi) = rays.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), r| (lo.min(r.origin), hi.max(r.origin)),
+    );
+    let mut keyed: Vec<(u64, Ray)> = rays
+        .iter()
+        .map(|r| {
+            let d = r.direction;
+            let octant =
+                u64::from(d.x < 0.0) << 2 | u64::from(d.y < 0.0) << 1 | u64::from(d.z < 0.0);
+            (octant << 30 | morton3(r.origin, lo, hi), *r)
+        })
+        .collect();
+    keyed.sort_by_key(|(k, _)| *k);
+    keyed.into_iter().map(|(_, r)| r).collect()
+}
+
+/// A GGX reflection of `ray` at its hit on the road: the microfacet normal drawn from
+/// `D(m) cos(m)` (alpha [`ROAD_ALPHA`]) about the shading normal `n` (facing the ray's
+/// origin), the direction reflected about it; `None` if that goes below the surface.
+fn glossy_bounce(ray: &Ray, p: Vec3, n: Vec3, ng: Vec3, u: Vec2) -> Option<Ray> {
+    let tan2 = ROAD_ALPHA * ROAD_ALPHA * u.x / (1.0 - u.x);
+    let cos = 1.0 / (1.0 + tan2).sqrt();
+    let sin = (1.0 - cos * cos).max(0.0).sqrt();
+    let phi = std::f32::consts::TAU * u.y;
+    let m = Frame::from_normal(n).to_world(Vec3::new(sin * phi.cos(), sin * phi.sin(), cos));
+    let d = ray.direction - 2.0 * ray.direction.dot(m) * m;
+    let ng = if ng.dot(ray.direction) > 0.0 { -ng } else { ng };
+    (d.dot(ng) > 0.0).then(|| Ray::new(offset_ray_origin(p, ng, d), d.normalize()))
+}
+
+/// The coherent ray sets of one street (see the module documentation).
+struct CoherentSets {
+    width: u32,
+    height: u32,
+    /// Pixel-centre rays in scanline, Morton and 4x4-tile order.
+    scanline: Vec<Ray>,
+    morton: Vec<Ray>,
+    tiles: Vec<Ray>,
+    /// Pixel-centre rays in 4x2-pixel packets (tiles in scanline order).
+    tile_packets: Packets,
+    /// [`PIXEL_SAMPLES`] jittered rays per pixel, pixels in scanline order: one packet each.
+    pixel_samples: Packets,
+    /// Glossy bounces off the road from the pixel-centre hits, in scanline order, sorted,
+    /// and in packets of the bounces of a 4x2-pixel tile.
+    bounce: Vec<Ray>,
+    bounce_sorted: Vec<Ray>,
+    bounce_tile_packets: Packets,
+    /// Glossy bounces of the jittered rays that hit the road, one packet per pixel.
+    bounce_pixel_samples: Packets,
+}
+
+fn coherent_sets(scene: &Scene, camera: &Camera) -> CoherentSets {
+    let height = std::env::var("STREAKS_COHERENT_HEIGHT")
+        .ok()
+        .and_then(|h| h.parse().ok())
+        .unwrap_or(COHERENT_HEIGHT);
+    let width = (height as f32 * camera.aspect_ratio.unwrap_or(4.0 / 3.0)).round() as u32;
+    let mut rng = Pcg32::new(23, 0);
+    let centre = |x: u32, y: u32| {
+        camera.generate_ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5), width, height)
+    };
+    let road_bounce = |ray: &Ray, u: Vec2| {
+        let hit = scene.intersect(ray)?;
+        if !scene.materials[hit.material as usize].road {
+            return None;
+        }
+        let n = if hit.ns.dot(ray.direction) > 0.0 {
+            -hit.ns
+        } else {
+            hit.ns
+        };
+        glossy_bounce(ray, hit.p, n, hit.ng, u)
+    };
+    let mut pixels: Vec<(u32, u32)> = (0..height)
+        .flat_map(|y| (0..width).map(move |x| (x, y)))
+        .collect();
+    let scanline: Vec<Ray> = pixels.iter().map(|&(x, y)| centre(x, y)).collect();
+    let mut bounce_of = vec![None; pixels.len()];
+    for (i, r) in scanline.iter().enumerate() {
+        bounce_of[i] = road_bounce(r, rng.next_2d());
+    }
+    let bounce: Vec<Ray> = bounce_of.iter().flatten().copied().collect();
+    pixels.sort_by_key(|&(x, y)| morton2(x, y));
+    let morton = pixels.iter().map(|&(x, y)| centre(x, y)).collect();
+    pixels.sort_by_key(|&(x, y)| (y / 4, x / 4, y % 4, x % 4));
+    let tiles = pixels.iter().map(|&(x, y)| centre(x, y)).collect();
+    let (mut tile_packets, mut bounce_tile_packets) = (Packets::default(), Packets::default());
+    for ty in (0..height).step_by(2) {
+        for tx in (0..width).step_by(4) {
+            tile_packets.begin();
+            bounce_tile_packets.begin();
+            for y in ty..(ty + 2).min(height) {
+                for x in tx..(tx + 4).min(width) {
+                    tile_packets.push(scanline[(y * width + x) as usize]);
+                    if let Some(b) = bounce_of[(y * width + x) as usize] {
+                        bounce_tile_packets.push(b);
+                    }
+                }
+            }
+        }
+    }
+    let (mut pixel_samples, mut bounce_pixel_samples) = (Packets::default(), Packets::default());
+    for y in 0..height {
+        for x in 0..width {
+            pixel_samples.begin();
+            bounce_pixel_samples.begin();
+            for _ in 0..PIXEL_SAMPLES {
+                let film = Vec2::new(x as f32, y as f32) + rng.next_2d();
+                let ray = camera.generate_ray(film, width, height);
+                pixel_samples.push(ray);
+                if let Some(b) = road_bounce(&ray, rng.next_2d()) {
+                    bounce_pixel_samples.push(b);
+                }
+            }
+        }
+    }
+    CoherentSets {
+        width,
+        height,
+        scanline,
+        morton,
+        tiles,
+        tile_packets,
+        pixel_samples,
+        bounce_sorted: sorted_by_octant_and_origin(&bounce),
+        bounce,
+        bounce_tile_packets,
+        bounce_pixel_samples,
+    }
+}
+
+/// Closest hits of `rays`, one at a time, in order; how many hit. `SET` only names the ray
+/// set, so that callgrind counts each set's calls apart.
+#[inline(never)]
+fn trace_single<const SET: u8>(accel: &Accel, rays: &[Ray]) -> u32 {
+    // Keeps the instances apart (identical code would be merged into one symbol).
+    black_box(SET);
+    let mut hits = 0u32;
+    for r in rays {
+        hits += u32::from(accel.intersect(black_box(r)).is_some());
+    }
+    hits
+}
+
+/// Closest hits of `packets`, a packet at a time; how many hit (`SET` as in
+/// [`trace_single`]).
+#[inline(never)]
+fn trace_packets<const SET: u8>(accel: &Accel, packets: &Packets) -> u32 {
+    black_box(SET);
+    let mut found = [None; PACKET_WIDTH];
+    let mut hits = 0u32;
+    for p in packets.iter() {
+        accel.intersect_packet(black_box(p), &mut found);
+        hits += found[..p.len()].iter().filter(|h| h.is_some()).count() as u32;
+    }
+    hits
+}
+
+/// Panics unless every packet finds exactly the single-ray hits; the number of rays checked.
+fn check_packets(accel: &Accel, packets: &Packets) -> usize {
+    let bits = |h: Option<AccelHit>| {
+        h.map(|h| {
+            (
+                h.t.to_bits(),
+                h.triangle,
+                h.barycentrics.x.to_bits(),
+                h.barycentrics.y.to_bits(),
+            )
+        })
+    };
+    let mut found = [None; PACKET_WIDTH];
+    for p in packets.iter() {
+        accel.intersect_packet(p, &mut found);
+        for (r, h) in p.iter().zip(found) {
+            assert_eq!(
+                bits(h),
+                bits(accel.intersect(r)),
+                "packet and single ray differ: {r:?}"
+            );
+        }
+    }
+    packets.rays.len()
+}
+
+/// `rainy_street` (its first camera) and the procedural street (camera `driver`); a street
+/// that cannot be made is skipped with a message.
+fn coherent_streets() -> Vec<(&'static str, Scene, String)> {
+    let mut streets = vec![];
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/rainy_street.gltf");
+    match Scene::load(&path) {
+        Ok(s) if !s.cameras.is_empty() => {
+            let camera = s.cameras[0].name.clone();
+            streets.push(("rainy_street", s, camera));
+        }
+        Ok(_) => eprintln!("skipping rainy_street: no camera"),
+        Err(e) => eprintln!("skipping rainy_street: {e}"),
+    }
+    let procedural = || -> Result<(Scene, String), String> {
+        let s = sample(&GeneratorConfig::default(), 0, 0).map_err(|e| e.to_string())?;
+        let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+        s.doc.write(dir.path()).map_err(|e| e.to_string())?;
+        let scene = Scene::load(&dir.path().join("scene.gltf")).map_err(|e| e.to_string())?;
+        Ok((scene, s.camera))
+    };
+    match procedural() {
+        Ok((scene, camera)) => streets.push(("procedural", scene, camera)),
+        Err(e) => eprintln!("skipping the procedural street: {e}"),
+    }
+    streets
+}
+
+fn bench_coherent(c: &mut Criterion) {
+    for (name, scene, camera) in coherent_streets() {
+        let Ok(cam) = scene.camera(Some(&camera)) else {
+            eprintln!("skipping {name}: no camera {camera}");
+            continue;
+        };
+        let sets = coherent_sets(&scene, cam);
+        let accel = &scene.accel;
+        let checked: usize = [
+            &sets.tile_packets,
+            &sets.pixel_samples,
+            &sets.bounce_tile_packets,
+            &sets.bounce_pixel_samples,
+            &Packets::chunks(&sets.bounce_sorted),
+        ]
+        .into_iter()
+        .map(|p| check_packets(accel, p))
+        .sum();
+        let bounce_sorted = Packets::chunks(&sets.bounce_sorted);
+        let hit = |rays: &[Ray]| trace_single::<0>(accel, rays) as f64 / rays.len().max(1) as f64;
+        eprintln!(
+            "{name}: {} triangles, {} instances, {}x{} pixels, {} road bounces ({:.0}% of the \
+             pixels; {:.0}% of them hit), {} samples' bounces; packets checked against single \
+             rays on {checked} rays: identical hits",
+            accel.triangle_count(),
+            scene.instances.instances.len(),
+            sets.width,
+            sets.height,
+            sets.bounce.len(),
+            100.0 * sets.bounce.len() as f64 / sets.scanline.len() as f64,
+            100.0 * hit(&sets.bounce),
+            sets.bounce_pixel_samples.rays.len(),
+        );
+        let mut group = c.benchmark_group(format!("coherent_{name}"));
+        group.sample_size(20);
+        let mut single = |id: &str, rays: &[Ray], trace: fn(&Accel, &[Ray]) -> u32| {
+            group.throughput(Throughput::Elements(rays.len() as u64));
+            group.bench_function(id, |b| b.iter(|| trace(accel, rays)));
+        };
+        single("primary/scanline", &sets.scanline, trace_single::<1>);
+        single("primary/morton", &sets.morton, trace_single::<2>);
+        single("primary/tiles4x4", &sets.tiles, trace_single::<3>);
+        single(
+            "primary_spp8/single",
+            &sets.pixel_samples.rays,
+            trace_single::<4>,
+        );
+        single("bounce/scanline", &sets.bounce, trace_single::<5>);
+        single("bounce/sorted", &sets.bounce_sorted, trace_single::<6>);
+        single(
+            "bounce_spp8/single",
+            &sets.bounce_pixel_samples.rays,
+            trace_single::<7>,
+        );
+        let mut packets = |id: &str, p: &Packets, trace: fn(&Accel, &Packets) -> u32| {
+            group.throughput(Throughput::Elements(p.rays.len() as u64));
+            group.bench_function(id, |b| b.iter(|| trace(accel, p)));
+        };
+        packets(
+            "primary/packets_tile4x2",
+            &sets.tile_packets,
+            trace_packets::<8>,
+        );
+        packets(
+            "primary_spp8/packets_pixel",
+            &sets.pixel_samples,
+            trace_packets::<9>,
+        );
+        packets(
+            "bounce/packets_tile4x2",
+            &sets.bounce_tile_packets,
+            trace_packets::<10>,
+        );
+        packets("bounce/packets_sorted", &bounce_sorted, trace_packets::<11>);
+        packets(
+            "bounce_spp8/packets_pixel",
+            &sets.bounce_pixel_samples,
+            trace_packets::<12>,
+        );
+        // What sorting the bounce rays costs, per ray.
+        group.throughput(Throughput::Elements(sets.bounce.len() as u64));
+        group.bench_function("bounce/sort", |b| {
+            b.iter(|| sorted_by_octant_and_origin(black_box(&sets.bounce)))
+        });
+        group.finish();
+    }
+}
+
+criterion_group!(benches, bench_build, bench_rays, bench_coherent);
 criterion_main!(benches);

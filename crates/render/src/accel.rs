@@ -35,6 +35,13 @@
 //! tests all eight in one AVX2 pass ([`NodeTest`]); both do the same IEEE operations per lane
 //! (no fused multiply-add), so they find the same hits, bit for bit, and images do not depend
 //! on the CPU's SIMD width. `STREAKS_SIMD=sse` forces the SSE test ([`crate::simd`]).
+//!
+//! Packets: [`Accel::intersect_packet`] traverses up to [`PACKET_WIDTH`] rays together (one
+//! node stack per packet, each node's child boxes tested against every active ray in AVX2
+//! lanes, one lane per ray) and finds, for each ray, exactly the hit of
+//! [`Accel::intersect`] (see [`Accel::intersect_packet`] for why). BENCHMARKS.md ("Coherent
+//! rays") measures it against one ray at a time; the integrator does not use it (a whole
+//! render gained 1-4%, too little for the restructuring it needs).
 
 use crate::geometry::Ray;
 use glam::{Vec2, Vec3, Vec3A};
@@ -64,6 +71,9 @@ pub struct Accel {
     /// Hits at `t <= t_min` are ignored (see the module documentation).
     t_min: f32,
 }
+
+/// The most rays [`Accel::intersect_packet`] traverses together (one per AVX2 lane).
+pub const PACKET_WIDTH: usize = 8;
 
 /// A closest hit found by [`Accel::intersect`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -185,6 +195,91 @@ impl Accel {
     /// Closest hit with `t_min < t < ray.t_max`.
     pub fn intersect(&self, ray: &Ray) -> Option<AccelHit> {
         self.closest::<false>(ray, self.t_min, |_, _| true)
+    }
+
+    /// [`Accel::intersect`] of each of `rays` (at most [`PACKET_WIDTH`]) into the same
+    /// place of `hits` (which must be at least as long), the rays traversed together: one
+    /// node stack for the packet, each node's child boxes tested against all of its active
+    /// rays at once. For coherent rays (neighbouring pixels, one pixel's samples, a glossy
+    /// reflection's directions) that shares the node fetches and the traversal's bookkeeping.
+    ///
+    /// The hits are exactly those of [`Accel::intersect`], `t`, triangle and barycentrics bit
+    /// for bit: the rays are traversed in groups of one direction octant (one group for a
+    /// coherent packet), so every ray meets its nodes and triangles in the order of its own
+    /// traversal, each child box is entered by the rays that entered it in the single-ray test
+    /// (the same IEEE operations per lane), and a ray's end shrinks only with its own hits.
+    /// Without AVX2 (or with `STREAKS_SIMD=sse`) the rays are traced one at a time.
+    ///
+    /// # Panics
+    /// If `rays` is longer than [`PACKET_WIDTH`] or `hits` shorter than `rays`.
+    pub fn intersect_packet(&self, rays: &[Ray], hits: &mut [Option<AccelHit>]) {
+        assert!(rays.len() <= PACKET_WIDTH && hits.len() >= rays.len());
+        #[cfg(target_arch = "x86_64")]
+        if node_test() == NodeTest::Avx2 && std::arch::is_x86_feature_detected!("avx2") {
+            if let Some(bvh) = &self.bvh {
+                // SAFETY: the CPU has AVX2 (checked just above).
+                unsafe { self.packet_avx2(bvh, rays, hits) };
+                return;
+            }
+        }
+        for (ray, hit) in rays.iter().zip(hits.iter_mut()) {
+            *hit = self.intersect(ray);
+        }
+    }
+
+    /// [`Accel::intersect_packet`] on a CPU with AVX2.
+    ///
+    /// # Safety
+    /// The CPU must have AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn packet_avx2(&self, bvh: &CwBvh, rays: &[Ray], hits: &mut [Option<AccelHit>]) {
+        let t_min = self.t_min;
+        let mut lanes = [BvhRay::new_inf(Vec3A::ZERO, Vec3A::X); PACKET_WIDTH];
+        // Lanes still to traverse, and each lane's octant.
+        let mut todo = 0u32;
+        let mut octant = [0u32; PACKET_WIDTH];
+        for (i, ray) in rays.iter().enumerate() {
+            hits[i] = None;
+            if let Some(r) = bvh_ray(ray, t_min) {
+                lanes[i] = r;
+                octant[i] = octant_inv4(&r.direction);
+                todo |= 1 << i;
+            }
+        }
+        let tris = &self.tris;
+        let mut found = [RayHit::none(); PACKET_WIDTH];
+        let mut barycentrics = [Vec2::ZERO; PACKET_WIDTH];
+        while todo != 0 {
+            let oct_inv4 = octant[todo.trailing_zeros() as usize];
+            let mut group = 0u32;
+            for (i, &o) in octant.iter().enumerate() {
+                if todo & (1 << i) != 0 && o == oct_inv4 {
+                    group |= 1 << i;
+                }
+            }
+            todo &= !group;
+            // SAFETY: the caller's CPU has AVX2.
+            unsafe {
+                avx2::closest_packet(bvh, &lanes, group, oct_inv4, &mut found, |lane, r, id| {
+                    let (t, b) = intersect_triangle(&tris[id], r, t_min);
+                    if t < r.tmax {
+                        barycentrics[lane] = b;
+                    }
+                    t
+                })
+            };
+        }
+        for (i, hit) in hits.iter_mut().enumerate().take(rays.len()) {
+            let h = &found[i];
+            if h.t < lanes[i].tmax {
+                *hit = Some(AccelHit {
+                    t: h.t,
+                    triangle: self.ids[h.primitive_id as usize],
+                    barycentrics: barycentrics[i],
+                });
+            }
+        }
     }
 
     /// Whether any triangle is hit with `t_min < t < ray.t_max` (any-hit query).
@@ -333,6 +428,15 @@ fn bvh_ray(ray: &Ray, t_min: f32) -> Option<BvhRay> {
     // adding +0.0 turns -0.0 into +0.0.
     let direction = Vec3A::from(ray.direction) + Vec3A::ZERO;
     Some(BvhRay::new(ray.origin.into(), direction, t_min, ray.t_max))
+}
+
+/// obvhs' traversal-order code of a direction (its private `ray_get_octant_inv4`): the
+/// inverted octant in each of the four bytes.
+#[inline(always)]
+fn octant_inv4(d: &Vec3A) -> u32 {
+    (if d.x < 0.0 { 0 } else { 0x0404_0404 })
+        | if d.y < 0.0 { 0 } else { 0x0202_0202 }
+        | if d.z < 0.0 { 0 } else { 0x0101_0101 }
 }
 
 /// A top-level BVH: an obvhs CWBVH over boxes (the world bounds of a scene's instances),
@@ -581,6 +685,191 @@ mod avx2 {
         hit.t < ray.tmax
     }
 
+    /// A CWBVH traversal of the lanes `group` of `rays` together, all of direction octant
+    /// `oct_inv4` (obvhs' code): obvhs' `traverse!` loop, with each stack entry carrying, for
+    /// each of its child nodes, the lanes that entered the child's box, and each node's child
+    /// boxes tested against its lanes in AVX2 lanes (one ray per lane). For each lane it
+    /// calls `intersect(lane, ray, primitive)` (the ray with its current end) for the
+    /// primitives that lane's own traversal would test, in the same order, and keeps the
+    /// nearest hit in `hits[lane]` as `CwBvh::ray_traverse` does.
+    ///
+    /// # Safety
+    /// The CPU must have AVX2.
+    #[target_feature(enable = "avx2")]
+    pub(super) unsafe fn closest_packet(
+        bvh: &CwBvh,
+        rays: &[BvhRay; 8],
+        group: u32,
+        oct_inv4: u32,
+        hits: &mut [RayHit; 8],
+        mut intersect: impl FnMut(usize, &BvhRay, usize) -> f32,
+    ) {
+        use obvhs::cwbvh::firstbithigh;
+        use obvhs::faststack::{FastStack, StackStack};
+        let mut rays = *rays;
+        let mut tmax = [0.0f32; 8];
+        let (mut ox, mut oy, mut oz) = ([0.0f32; 8], [0.0f32; 8], [0.0f32; 8]);
+        let (mut ix, mut iy, mut iz) = ([0.0f32; 8], [0.0f32; 8], [0.0f32; 8]);
+        for l in 0..8 {
+            let r = &rays[l];
+            tmax[l] = r.tmax;
+            (ox[l], oy[l], oz[l]) = (r.origin.x, r.origin.y, r.origin.z);
+            (ix[l], iy[l], iz[l]) = (r.inv_direction.x, r.inv_direction.y, r.inv_direction.z);
+        }
+        let first = &rays[group.trailing_zeros() as usize];
+        let negative = [
+            first.direction.x < 0.0,
+            first.direction.y < 0.0,
+            first.direction.z < 0.0,
+        ];
+        // SAFETY (of every intrinsic below): the caller's CPU has AVX2; loads and stores
+        // are unaligned, of whole `[f32; 8]` arrays.
+        let load = |a: &[f32; 8]| unsafe { _mm256_loadu_ps(a.as_ptr()) };
+        let (ox, oy, oz) = (load(&ox), load(&oy), load(&oz));
+        let (ix, iy, iz) = (load(&ix), load(&iy), load(&iz));
+        let eps = _mm256_set1_ps(EPSILON);
+        // Each node's children's quantised bounds as f32.
+        let q = |v: &[u8; 8]| unsafe {
+            let mut out = [0.0f32; 8];
+            _mm256_storeu_ps(
+                out.as_mut_ptr(),
+                _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(
+                    v.as_ptr().cast::<__m128i>(),
+                ))),
+            );
+            out
+        };
+
+        let mut stack: StackStack<(UVec2, u64), 32> = StackStack::default();
+        // Child groups as in `traverse!`, with the lanes of child bit 24 + k in byte k.
+        let mut current = (UVec2::new(0, 0x8000_0000), u64::from(group) << 56);
+        // The leaf primitives of the last node: bits as in `traverse!`, and the lanes of
+        // each bit.
+        let mut primitive_base = 0u32;
+        let mut primitives = 0u32;
+        let mut primitive_lanes = [0u8; 24];
+        loop {
+            while primitives != 0 {
+                let bit = firstbithigh(primitives);
+                primitives &= !(1u32 << bit);
+                let id = (primitive_base + bit) as usize;
+                let mut lanes = primitive_lanes[bit as usize];
+                while lanes != 0 {
+                    let l = lanes.trailing_zeros() as usize;
+                    lanes &= lanes - 1;
+                    let t = intersect(l, &rays[l], id);
+                    if t < rays[l].tmax {
+                        hits[l].primitive_id = id as u32;
+                        hits[l].t = t;
+                        rays[l].tmax = t;
+                        tmax[l] = t;
+                    }
+                }
+            }
+
+            if current.0.y & 0xff00_0000 != 0 {
+                let hits_imask = current.0.y;
+                let child_index_offset = firstbithigh(hits_imask);
+                let child_index_base = current.0.x;
+                current.0.y &= !(1u32 << child_index_offset);
+                let lanes = (current.1 >> ((child_index_offset - 24) * 8)) as u8;
+                if current.0.y & 0xff00_0000 != 0 {
+                    stack.push(current);
+                }
+                let slot_index = (child_index_offset - 24) ^ (oct_inv4 & 0xff);
+                let relative_index = (hits_imask & !(0xffff_ffffu32 << slot_index)).count_ones();
+                let node = &bvh.nodes[(child_index_base + relative_index) as usize];
+
+                // The node test, children by child, rays across lanes: obvhs' operations
+                // in obvhs' order for each (ray, child) pair.
+                let extent = node.compute_extent();
+                let p = Vec3A::from(node.p);
+                let adx = _mm256_mul_ps(_mm256_set1_ps(extent.x), ix);
+                let ady = _mm256_mul_ps(_mm256_set1_ps(extent.y), iy);
+                let adz = _mm256_mul_ps(_mm256_set1_ps(extent.z), iz);
+                let aox = _mm256_mul_ps(_mm256_sub_ps(_mm256_set1_ps(p.x), ox), ix);
+                let aoy = _mm256_mul_ps(_mm256_sub_ps(_mm256_set1_ps(p.y), oy), iy);
+                let aoz = _mm256_mul_ps(_mm256_sub_ps(_mm256_set1_ps(p.z), oz), iz);
+                let ray_tmax = load(&tmax);
+                let pick = |negative: bool, lo: &[u8; 8], hi: &[u8; 8]| {
+                    if negative {
+                        (q(hi), q(lo))
+                    } else {
+                        (q(lo), q(hi))
+                    }
+                };
+                let (near_x, far_x) = pick(negative[0], &node.child_min_x, &node.child_max_x);
+                let (near_y, far_y) = pick(negative[1], &node.child_min_y, &node.child_max_y);
+                let (near_z, far_z) = pick(negative[2], &node.child_min_z, &node.child_max_z);
+                let (child_bits8, bit_index8) = node.get_child_and_index_bits(oct_inv4);
+                let slab = |q: f32, d: __m256, o: __m256| {
+                    _mm256_add_ps(_mm256_mul_ps(_mm256_set1_ps(q), d), o)
+                };
+                let mut hit_mask = 0u32;
+                let mut child_lanes = 0u64;
+                // Non-empty children (an empty slot's meta byte is zero).
+                let meta = u64::from_le_bytes(node.child_meta);
+                let mut children = 0u32;
+                for c in 0..8 {
+                    if (meta >> (c * 8)) & 0xff != 0 {
+                        children |= 1 << c;
+                    }
+                }
+                while children != 0 {
+                    let c = children.trailing_zeros() as usize;
+                    children &= children - 1;
+                    let tmin_x = slab(near_x[c], adx, aox);
+                    let tmax_x = slab(far_x[c], adx, aox);
+                    let tmin_y = slab(near_y[c], ady, aoy);
+                    let tmax_y = slab(far_y[c], ady, aoy);
+                    let tmin_z = slab(near_z[c], adz, aoz);
+                    let tmax_z = slab(far_z[c], adz, aoz);
+                    let tmin = _mm256_max_ps(tmin_x, _mm256_max_ps(tmin_y, tmin_z));
+                    let tmax = _mm256_min_ps(tmax_x, _mm256_min_ps(tmax_y, tmax_z));
+                    let tmin = _mm256_max_ps(tmin, eps);
+                    let tmax = _mm256_min_ps(tmax, ray_tmax);
+                    let entered = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OS>(tmin, tmax))
+                        as u32
+                        & u32::from(lanes);
+                    if entered == 0 {
+                        continue;
+                    }
+                    let child_bits = obvhs::cwbvh::node::extract_byte64(child_bits8, c);
+                    let bit_index = obvhs::cwbvh::node::extract_byte64(bit_index8, c);
+                    hit_mask |= child_bits << bit_index;
+                    if bit_index >= 24 {
+                        child_lanes |= u64::from(entered) << ((bit_index - 24) * 8);
+                    } else {
+                        let mut bits = child_bits << bit_index;
+                        while bits != 0 {
+                            primitive_lanes[bits.trailing_zeros() as usize] = entered as u8;
+                            bits &= bits - 1;
+                        }
+                    }
+                }
+
+                current = (
+                    UVec2::new(
+                        node.child_base_idx,
+                        (hit_mask & 0xff00_0000) | node.imask as u32,
+                    ),
+                    child_lanes,
+                );
+                primitive_base = node.primitive_base_idx;
+                primitives = hit_mask & 0x00ff_ffff;
+            } else {
+                current = (UVec2::ZERO, 0);
+            }
+
+            if primitives == 0 && current.0.y & 0xff00_0000 == 0 {
+                if stack.is_empty() {
+                    break;
+                }
+                current = stack.pop_fast();
+            }
+        }
+    }
+
     /// `CwBvh::ray_traverse_miss` with [`intersect_node`].
     ///
     /// # Safety
@@ -771,6 +1060,138 @@ mod tests {
         // Both kinds of answer occur often.
         assert!((1_000..19_000).contains(&hits), "{hits} hits");
         assert!(blocked > 500, "{blocked} blocked");
+    }
+
+    /// Packets find exactly the single-ray hits (`t` and barycentrics bit for bit, the same
+    /// triangle): random rays in random packets (mixed octants, some not finite or ending
+    /// early), coherent packets (pinhole-camera tiles through a random soup, and glossy
+    /// reflections off a plane), and rays aimed at the shared edges and vertices of a grid,
+    /// where two triangles give the same `t` and the traversal order decides.
+    #[test]
+    fn packets_find_the_single_ray_hits() {
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rnd = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let mut positions = vec![];
+        let mut triangles = vec![];
+        for i in 0..3000u32 {
+            let c = Vec3::new(rnd(), rnd(), rnd()) * 20.0 - 10.0;
+            for _ in 0..3 {
+                positions.push(c + Vec3::new(rnd(), rnd(), rnd()) - 0.5);
+            }
+            triangles.push([3 * i, 3 * i + 1, 3 * i + 2]);
+        }
+        // A 40 x 40 grid of unit quads at y = -12, two triangles each.
+        let base = positions.len() as u32;
+        for j in 0..=40 {
+            for i in 0..=40 {
+                positions.push(Vec3::new(i as f32 - 20.0, -12.0, j as f32 - 20.0));
+            }
+        }
+        let at = |i: u32, j: u32| base + j * 41 + i;
+        for j in 0..40 {
+            for i in 0..40 {
+                triangles.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+                triangles.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+            }
+        }
+        let accel = Accel::build(&positions, &triangles);
+        let mut packets: Vec<Vec<Ray>> = vec![];
+        // Random rays, random packet sizes.
+        for k in 0..1500 {
+            let n = 1 + (rnd() * PACKET_WIDTH as f32) as usize % PACKET_WIDTH;
+            packets.push(
+                (0..n)
+                    .map(|i| {
+                        let origin = Vec3::new(rnd(), rnd(), rnd()) * 30.0 - 15.0;
+                        let direction = (Vec3::new(rnd(), rnd(), rnd()) - 0.5).normalize();
+                        let t_max = match (k + i) % 7 {
+                            0 => 8.0 * rnd(),
+                            1 if k % 50 == 0 => f32::NAN,
+                            _ => f32::INFINITY,
+                        };
+                        Ray {
+                            origin,
+                            direction,
+                            t_max,
+                        }
+                    })
+                    .collect(),
+            );
+        }
+        // Camera tiles (4 x 2 pixels) of a pinhole at the soup's edge looking in.
+        for _ in 0..1500 {
+            let eye = Vec3::new(rnd() - 0.5, rnd() - 0.5, 16.0);
+            let (x0, y0) = (rnd() * 2.0 - 1.0, rnd() * 2.0 - 1.0);
+            packets.push(
+                (0..8)
+                    .map(|i| {
+                        let pixel = Vec3::new(
+                            x0 + (i % 4) as f32 * 0.004,
+                            y0 + (i / 4) as f32 * 0.004,
+                            -1.0,
+                        );
+                        Ray::new(eye, pixel.normalize())
+                    })
+                    .collect(),
+            );
+        }
+        // Glossy reflections off the grid: a pixel's eight rays about one mirror direction.
+        for _ in 0..1000 {
+            let p = Vec3::new(rnd() * 30.0 - 15.0, -12.0, rnd() * 30.0 - 15.0);
+            let mirror = Vec3::new(rnd() - 0.5, 0.3 + rnd(), rnd() - 0.5).normalize();
+            packets.push(
+                (0..8)
+                    .map(|_| {
+                        let jitter = (Vec3::new(rnd(), rnd(), rnd()) - 0.5) * 0.1;
+                        Ray::new(p, (mirror + jitter).normalize())
+                    })
+                    .collect(),
+            );
+        }
+        // Through the grid's lattice points and edge midpoints, from above.
+        for _ in 0..1000 {
+            let (i, j) = ((rnd() * 40.0) as i32 - 20, (rnd() * 40.0) as i32 - 20);
+            let eye = Vec3::new(rnd() * 4.0 - 2.0, 30.0, rnd() * 4.0 - 2.0);
+            packets.push(
+                (0..8)
+                    .map(|k| {
+                        let target = Vec3::new(
+                            (i + k % 3) as f32 + if k == 6 { 0.5 } else { 0.0 },
+                            -12.0,
+                            (j + k / 3) as f32 + if k == 7 { 0.5 } else { 0.0 },
+                        );
+                        Ray::new(eye, (target - eye).normalize())
+                    })
+                    .collect(),
+            );
+        }
+        let bits = |h: Option<AccelHit>| {
+            h.map(|h| {
+                (
+                    h.t.to_bits(),
+                    h.triangle,
+                    h.barycentrics.x.to_bits(),
+                    h.barycentrics.y.to_bits(),
+                )
+            })
+        };
+        let (mut rays, mut hit) = (0, 0);
+        for packet in &packets {
+            let mut hits = [None; PACKET_WIDTH];
+            accel.intersect_packet(packet, &mut hits);
+            for (ray, h) in packet.iter().zip(hits) {
+                assert_eq!(bits(h), bits(accel.intersect(ray)), "{ray:?}");
+                rays += 1;
+                hit += h.is_some() as u32;
+            }
+        }
+        assert!(rays > 30_000, "{rays} rays");
+        assert!(hit > rays / 4 && hit < rays * 9 / 10, "{hit} of {rays} hit");
     }
 
     /// The step-by-step build makes exactly the BVH of obvhs' own `medium_build` path, on
