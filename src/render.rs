@@ -40,9 +40,9 @@ pub struct RenderOpts {
     /// Samples per pixel (per eye for a stereo pair); the cap with --noise-target.
     #[arg(long, default_value_t = 64)]
     pub spp: u32,
-    /// Adaptive sampling: stop each pixel once the estimated relative standard error of its
-    /// mean luminance is below REL (e.g. 0.05), after at least 16 samples, --spp being the cap.
-    /// Deterministic: the same image for a seed on any number of threads.
+    /// Adaptive sampling: stop each 16x16 tile of pixels once the estimated relative standard
+    /// error of its pixels' mean luminance is below REL (e.g. 0.1), after at least 16 samples,
+    /// --spp being the cap. Deterministic: the same image for a seed on any number of threads.
     #[arg(long, value_name = "REL", allow_negative_numbers = true)]
     pub noise_target: Option<f32>,
     /// Image width in pixels [default: from the height and the camera's aspect ratio].

@@ -39,6 +39,8 @@ def test_a_bad_shard_is_a_usage_error(tmp_path, capsys, shard, says):
         (["--count", "4", "--chunk", "x"], "argument --chunk: 'x' is not a whole number"),
         (["--count", "4", "--max-retries", "-1"], "argument --max-retries: -1 is less than 0"),
         (["--count", "4", "--threads", "2"], "unrecognized arguments: --threads 2"),
+        (["--count", "4", "--noise-target", "low"], "'low' is neither a number nor off"),
+        (["--count", "4", "--noise-target", "0"], "0 is not a positive, finite number"),
         ([], "the following arguments are required: --count"),
     ],
 )

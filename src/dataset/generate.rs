@@ -41,9 +41,14 @@ pub struct Args {
     /// Image height in pixels.
     #[arg(long, default_value_t = 384)]
     pub height: u32,
-    /// Samples per pixel per eye.
-    #[arg(long, default_value_t = 64)]
+    /// Samples per pixel per eye (the cap, with --noise-target).
+    #[arg(long, default_value_t = DEFAULT_SPP)]
     pub spp: u32,
+    /// Adaptive sampling (`streaks render --noise-target`): stop each tile of pixels once its
+    /// estimated relative standard error is below REL, --spp being the cap; `off` takes --spp
+    /// samples everywhere.
+    #[arg(long, value_name = "REL|off", default_value_t = NoiseTarget(Some(DEFAULT_NOISE_TARGET)))]
+    pub noise_target: NoiseTarget,
     /// Render only the samples whose index is K modulo N (0 <= K < N); shards may run at the
     /// same time into one folder; then run `streaks dataset index DIR`.
     #[arg(long, value_name = "K/N")]
@@ -58,6 +63,44 @@ pub struct Args {
     /// in indirect light; see `streaks render --regularize`).
     #[arg(long)]
     pub no_regularize: bool,
+}
+
+/// The default cap of samples per pixel per eye (see BENCHMARKS.md, "Adaptive sampling").
+pub const DEFAULT_SPP: u32 = 64;
+
+/// The default adaptive-sampling target of a dataset (see BENCHMARKS.md, "Adaptive sampling").
+pub const DEFAULT_NOISE_TARGET: f64 = 0.1;
+
+/// `--noise-target`: a positive, finite relative standard error, or `off` (`None`). Kept as
+/// the `f64` of its decimal text, so that `dataset.json` records `0.1` and reads back equal (the
+/// renderer gets it as `f32`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NoiseTarget(pub Option<f64>);
+
+impl std::fmt::Display for NoiseTarget {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.0 {
+            Some(rel) => write!(f, "{rel}"),
+            None => f.write_str("off"),
+        }
+    }
+}
+
+impl std::str::FromStr for NoiseTarget {
+    type Err = String;
+
+    fn from_str(s: &str) -> std::result::Result<Self, Self::Err> {
+        if s == "off" {
+            return Ok(Self(None));
+        }
+        match s.parse::<f64>() {
+            Ok(rel) if rel.is_finite() && rel > 0.0 && (rel as f32) > 0.0 => Ok(Self(Some(rel))),
+            _ => Err(format!(
+                "expected a positive, finite relative standard error (such as 0.1) or `off`, \
+                 got {s:?}"
+            )),
+        }
+    }
 }
 
 /// sha256 of bytes, lowercase hex.
@@ -107,6 +150,7 @@ pub fn run(args: Args) -> Result<()> {
         spp: args.spp,
         max_depth: args.max_depth,
         regularize: !args.no_regularize,
+        noise_target: args.noise_target.0,
         files: FileList::current(),
         conventions: Conventions::current(),
     };
@@ -131,6 +175,7 @@ pub fn run(args: Args) -> Result<()> {
         spp: args.spp,
         max_depth: args.max_depth,
         regularize: !args.no_regularize,
+        noise_target: args.noise_target.0,
     };
     let bar = progress_bar(indices.len() as u64);
     let start = Instant::now();

@@ -311,6 +311,11 @@ pub struct DatasetInfo {
     /// the field existed has none and was rendered without it: it reads as `false`.
     #[serde(default)]
     pub regularize: bool,
+    /// Adaptive sampling's target (`--noise-target`; `None`: `spp` samples everywhere). A
+    /// `dataset.json` written before the field existed has none and was rendered at fixed
+    /// spp: it reads as `None`.
+    #[serde(default)]
+    pub noise_target: Option<f64>,
     /// The files.
     pub files: FileList,
     /// The conventions.
@@ -337,16 +342,21 @@ impl DatasetInfo {
     /// `dataset.json` as JSON) describes the same dataset as `self`. A `dataset.json` without
     /// `regularize` (written before the field existed) describes a dataset rendered without
     /// path regularisation: it matches a run with `--no-regularize`, and the message for any
-    /// other run says so.
+    /// other run says so. Likewise one without `noise_target` was rendered at fixed spp: it
+    /// matches a run with `--noise-target off`.
     pub fn check_same(&self, existing: &Value, path: &Path) -> Result<()> {
         let mut existing = existing.clone();
-        let unrecorded = match &mut existing {
-            Value::Object(map) if !map.contains_key("regularize") => {
+        let (mut unrecorded, mut target_unrecorded) = (false, false);
+        if let Value::Object(map) = &mut existing {
+            if !map.contains_key("regularize") {
                 map.insert("regularize".into(), Value::Bool(false));
-                true
+                unrecorded = true;
             }
-            _ => false,
-        };
+            if !map.contains_key("noise_target") {
+                map.insert("noise_target".into(), Value::Null);
+                target_unrecorded = true;
+            }
+        }
         let new = serde_json::to_value(self)?;
         if let Some((field, old, new)) = first_difference("", &existing, &new) {
             let hint = match field.as_str() {
@@ -356,6 +366,11 @@ impl DatasetInfo {
                 }
                 "regularize" if self.regularize => " (add --no-regularize to continue it)",
                 "regularize" => " (drop --no-regularize to continue it)",
+                "noise_target" if target_unrecorded => {
+                    " (it predates the setting and was rendered at fixed spp: add \
+                     --noise-target off to continue it)"
+                }
+                "noise_target" => " (give its --noise-target to continue it)",
                 _ => "",
             };
             bail!(
@@ -446,6 +461,7 @@ mod tests {
             spp: 2,
             max_depth: 8,
             regularize,
+            noise_target: None,
             files: FileList::current(),
             conventions: Conventions::current(),
         }
@@ -472,6 +488,35 @@ mod tests {
         info(true).check_same(&new, path).unwrap();
         let err = info(false).check_same(&new, path).unwrap_err().to_string();
         assert!(err.contains("drop --no-regularize"), "{err}");
+    }
+
+    /// A dataset.json from before `noise_target` existed reads as rendered at fixed spp: it
+    /// is continued with --noise-target off, and refused otherwise with a message that says
+    /// so; a recorded target must be given again.
+    #[test]
+    fn datasets_without_the_noise_target_field_are_fixed_spp() {
+        let path = Path::new("d/dataset.json");
+        let mut old = serde_json::to_value(info(true)).unwrap();
+        old.as_object_mut().unwrap().remove("noise_target");
+        let back: DatasetInfo = serde_json::from_value(old.clone()).unwrap();
+        assert_eq!(back.noise_target, None);
+        info(true).check_same(&old, path).unwrap();
+        let adaptive = DatasetInfo {
+            noise_target: Some(0.25),
+            ..info(true)
+        };
+        let err = adaptive.check_same(&old, path).unwrap_err().to_string();
+        assert!(
+            err.contains("its noise_target is null, this run's is 0.25")
+                && err.contains("predates the setting")
+                && err.contains("--noise-target off"),
+            "{err}"
+        );
+        let new = serde_json::to_value(&adaptive).unwrap();
+        assert_eq!(new["noise_target"], serde_json::json!(0.25));
+        adaptive.check_same(&new, path).unwrap();
+        let err = info(true).check_same(&new, path).unwrap_err().to_string();
+        assert!(err.contains("give its --noise-target"), "{err}");
     }
 
     #[test]

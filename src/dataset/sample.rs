@@ -40,6 +40,8 @@ pub struct SampleSettings {
     pub max_depth: u32,
     /// Path regularisation.
     pub regularize: bool,
+    /// Adaptive sampling's target (`None`: `spp` everywhere).
+    pub noise_target: Option<f64>,
 }
 
 /// The render seed of sample `index` of a dataset of seed `seed` (SplitMix64 of the pair, high
@@ -108,6 +110,14 @@ pub struct RenderMeta {
     /// Path regularisation (absent, `false`, in samples written before the field existed).
     #[serde(default)]
     pub regularize: bool,
+    /// Adaptive sampling's target (`None`, also in samples written before the field existed:
+    /// `spp` samples everywhere).
+    #[serde(default)]
+    pub noise_target: Option<f64>,
+    /// Mean samples per pixel actually taken, left and right eye (`spp` at fixed spp; absent
+    /// in samples written before the field existed).
+    #[serde(default)]
+    pub mean_spp: Option<[f64; 2]>,
 }
 
 /// `meta.json` of a sample (no wall time: the file is the same on every run).
@@ -288,7 +298,7 @@ fn write_sample(
     let seed = render_seed(settings.seed, index);
     let pair = PairSettings {
         spp: settings.spp,
-        noise_target: None,
+        noise_target: settings.noise_target.map(|rel| rel as f32),
         max_depth: settings.max_depth,
         seed,
         exposure_ev: s.exposure_ev,
@@ -371,6 +381,8 @@ fn write_sample(
             seed_left: seed,
             seed_right: seed.wrapping_add(1),
             regularize: settings.regularize,
+            noise_target: settings.noise_target,
+            mean_spp: Some([left, right].map(|v| v.output.stats.samples as f64 / pixels)),
         },
     };
     let mut text = serde_json::to_string_pretty(&meta)?;

@@ -316,3 +316,80 @@ fn bad_dataset_arguments_are_refused() {
     t.streaks(&["dataset", "index", "nowhere"])
         .assert_failure_mentioning("nowhere");
 }
+
+/// Adaptive sampling in datasets (`--noise-target`): byte-identical across thread counts,
+/// recorded in `dataset.json` and `meta.json` with the samples each eye took, on by default,
+/// `off` recorded as null, and a dataset is continued only with its own target.
+#[test]
+fn adaptive_datasets_record_their_target_and_are_deterministic() {
+    let t = TestDir::new();
+    let adaptive = |dir: &str, threads: &str| {
+        t.streaks(&[
+            "dataset",
+            "generate",
+            "-o",
+            dir,
+            "--count",
+            "1",
+            "--width",
+            "64",
+            "--height",
+            "40",
+            "--spp",
+            "32",
+            "--noise-target",
+            "0.3",
+            "--threads",
+            threads,
+        ])
+    };
+    adaptive("a", "1").assert_success();
+    adaptive("b", "2").assert_success();
+    assert_same_tree(&t.join("a"), &t.join("b"));
+    let json = |path: &str| -> serde_json::Value {
+        serde_json::from_slice(&std::fs::read(t.join(path)).unwrap()).unwrap()
+    };
+    assert_eq!(
+        json("a/dataset.json")["noise_target"],
+        serde_json::json!(0.3)
+    );
+    let render = &json("a/samples/000000/meta.json")["render"];
+    assert_eq!(render["noise_target"], serde_json::json!(0.3));
+    let mean_spp: Vec<f64> = render["mean_spp"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert_eq!(mean_spp.len(), 2);
+    assert!(
+        mean_spp.iter().all(|&n| (16.0..32.0).contains(&n)),
+        "{mean_spp:?}: the black sky stops at 16"
+    );
+
+    // The default target is recorded; `off` is null and takes --spp everywhere.
+    generate_n(&t, "c", "1", &[]).assert_success();
+    assert_eq!(
+        json("c/dataset.json")["noise_target"],
+        serde_json::json!(0.1)
+    );
+    generate_n(&t, "d", "1", &["--noise-target", "off"]).assert_success();
+    assert!(json("d/dataset.json")["noise_target"].is_null());
+    let render = &json("d/samples/000000/meta.json")["render"];
+    assert!(render["noise_target"].is_null());
+    assert_eq!(render["mean_spp"], serde_json::json!([2.0, 2.0]));
+    // With a cap of 2 (below the minimum of 16) the target changes no pixel.
+    assert_eq!(
+        std::fs::read(t.join("c/samples/000000/im0.exr")).unwrap(),
+        std::fs::read(t.join("d/samples/000000/im0.exr")).unwrap()
+    );
+
+    // Another target does not continue a dataset; bad targets are refused.
+    generate_n(&t, "d", "1", &[])
+        .assert_failure_mentioning("its noise_target is null, this run's is 0.1");
+    generate_n(&t, "c", "1", &["--noise-target", "0.2"])
+        .assert_failure_mentioning("give its --noise-target");
+    generate_n(&t, "x", "1", &["--noise-target", "0"]).assert_failure_mentioning("positive");
+    generate_n(&t, "x", "1", &["--noise-target", "low"]).assert_failure_mentioning("off");
+    assert!(!t.join("x").exists());
+}

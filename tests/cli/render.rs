@@ -307,8 +307,8 @@ fn regularize_keeps_the_streaks_and_compare_measures_it() {
 }
 
 /// `--noise-target` with the `spp` layer: deterministic across thread counts, the layer holds
-/// the counts (the black sky at the minimum of 16, never above the cap), and the samples
-/// reported are the ones taken.
+/// the counts (one per 16x16 tile; the tiles of black sky at the minimum of 16, never above
+/// the cap), and the samples reported are the ones taken.
 #[test]
 fn noise_target_writes_the_spp_layer_and_is_deterministic() {
     let t = TestDir::new();
@@ -325,7 +325,7 @@ fn noise_target_writes_the_spp_layer_and_is_deterministic() {
             "--noise-target",
             "0.05",
             "--height",
-            "12",
+            "48",
             "--max-depth",
             "3",
             "--threads",
@@ -341,7 +341,17 @@ fn noise_target_writes_the_spp_layer_and_is_deterministic() {
     assert_eq!(one, two);
     let spp = read_exr_layer(&t.join("one.exr"), "spp").unwrap();
     assert_eq!(spp, read_exr_layer(&t.join("two.exr"), "spp").unwrap());
+    // The horizon is near y = 18: the top row of tiles sees only the black sky.
     assert_eq!(spp.get(0, 0).x, 16.0, "the black sky stops at the minimum");
+    for y in 0..spp.height {
+        for x in 0..spp.width {
+            assert_eq!(
+                spp.get(x, y),
+                spp.get(x / 16 * 16, y / 16 * 16),
+                "({x}, {y})"
+            );
+        }
+    }
     assert!(spp.pixels.iter().all(|n| (16.0..=64.0).contains(&n.x)));
     assert!(
         spp.pixels.iter().any(|n| n.x > 16.0),

@@ -12,9 +12,9 @@
 //! For adaptive sampling ([`crate::integrator::RenderSettings::noise_target`]) each pixel also
 //! keeps the running mean and sum of squared deviations of its kept samples' luminance
 //! (Welford's update: two `f32`s, no allocation, stable where a running sum of squares would
-//! cancel), from which [`Pixel::relative_error`] estimates the relative standard error of the
-//! pixel's mean. These statistics never enter the image: the beauty and specular sums are
-//! accumulated exactly as without them.
+//! cancel), from which [`Pixel::mean_variance`] estimates the variance of the pixel's mean; the
+//! integrator pools these over a tile of pixels. These statistics never enter the image: the
+//! beauty and specular sums are accumulated exactly as without them.
 
 use glam::Vec3;
 use streaks_image::color::luminance;
@@ -102,19 +102,15 @@ impl Pixel {
         self.kept + self.dropped
     }
 
-    /// Estimated relative standard error of the pixel's mean luminance,
-    /// `sqrt(s^2 / n) / max(mean, dark_floor)` over its `n` kept samples (`s^2` the sample
-    /// variance); infinite with fewer than two kept samples (no estimate yet). `dark_floor`
-    /// (a luminance) turns the criterion into an absolute one for dark pixels, so that a black
-    /// or nearly black pixel converges instead of chasing a relative error of a tiny mean.
+    /// Estimated variance of the pixel's mean luminance, `s^2 / n` over its `n` kept samples
+    /// (`s^2` the sample variance); `None` with fewer than two kept samples (no estimate yet).
     #[inline]
-    pub fn relative_error(&self, dark_floor: f32) -> f32 {
+    pub fn mean_variance(&self) -> Option<f32> {
         if self.kept < 2 {
-            return f32::INFINITY;
+            return None;
         }
         let n = self.kept as f32;
-        let variance = (self.lum_m2 / (n - 1.0)).max(0.0);
-        (variance / n).sqrt() / self.lum_mean.max(dark_floor)
+        Some((self.lum_m2 / (n - 1.0)).max(0.0) / n)
     }
 
     /// The box-filtered specular part.
@@ -153,6 +149,14 @@ impl Film {
     pub fn par_rows_mut(&mut self) -> rayon::slice::ChunksExactMut<'_, Pixel> {
         use rayon::slice::ParallelSliceMut;
         self.pixels.par_chunks_exact_mut(self.width.max(1) as usize)
+    }
+
+    /// Mutable bands of `rows` full rows each (the last one may be shorter), for filling
+    /// them in parallel.
+    pub fn par_bands_mut(&mut self, rows: u32) -> rayon::slice::ChunksMut<'_, Pixel> {
+        use rayon::slice::ParallelSliceMut;
+        let len = self.width.max(1) as usize * rows.max(1) as usize;
+        self.pixels.par_chunks_mut(len)
     }
 
     fn map(&self, f: impl Fn(&Pixel) -> Vec3) -> RgbImage {
@@ -244,9 +248,16 @@ mod tests {
     }
 
     #[test]
-    fn welford_statistics_give_the_relative_standard_error() {
+    fn welford_statistics_give_the_variance_of_the_mean() {
         let mut p = Pixel::default();
-        assert_eq!(p.relative_error(1e-3), f32::INFINITY);
+        assert_eq!(p.mean_variance(), None);
+        assert!(p.add_sample(Vec3::splat(7.0), Vec3::ZERO));
+        assert_eq!(
+            p.mean_variance(),
+            None,
+            "one sample has no variance estimate"
+        );
+        let mut p = Pixel::default();
         // Luminances 1, 2, 3, 4 (grey samples): mean 2.5, sample variance 5/3.
         for v in [1.0f32, 2.0, 3.0, 4.0] {
             assert!(p.add_sample(Vec3::splat(v), Vec3::ZERO));
@@ -254,16 +265,15 @@ mod tests {
         assert!(!p.add_sample(Vec3::splat(f32::NAN), Vec3::ZERO));
         assert!((p.lum_mean - 2.5).abs() < 1e-6);
         assert!((p.lum_m2 / 3.0 - 5.0 / 3.0).abs() < 1e-5);
-        let want = (5.0f32 / 3.0 / 4.0).sqrt() / 2.5;
-        assert!((p.relative_error(1e-3) - want).abs() < 1e-6);
-        // Below the floor the error is relative to the floor.
-        assert!((p.relative_error(10.0) - want * 2.5 / 10.0).abs() < 1e-6);
+        // The dropped sample does not count: 4 kept samples.
+        let want = 5.0f32 / 3.0 / 4.0;
+        assert!((p.mean_variance().unwrap() - want).abs() < 1e-6);
         assert_eq!(p.taken(), 5);
-        // A black pixel has no error at all.
+        // A black pixel has no variance at all.
         let mut black = Pixel::default();
         for _ in 0..3 {
             black.add_sample(Vec3::ZERO, Vec3::ZERO);
         }
-        assert_eq!(black.relative_error(1e-3), 0.0);
+        assert_eq!(black.mean_variance(), Some(0.0));
     }
 }

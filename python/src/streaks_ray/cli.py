@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -33,6 +34,19 @@ def _integer(minimum: int) -> Callable[[str], int]:
         return value
 
     return parse
+
+
+def _noise_target(text: str) -> str:
+    """`--noise-target`: `off`, or a positive, finite number (passed on as written)."""
+    if text == "off":
+        return text
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"'{text}' is neither a number nor off") from None
+    if not (math.isfinite(value) and value > 0.0):
+        raise argparse.ArgumentTypeError(f"{text} is not a positive, finite number")
+    return text
 
 
 def _shard(text: str) -> Shard:
@@ -110,6 +124,15 @@ def parser() -> argparse.ArgumentParser:
     flags.add_argument("--spp", type=_integer(1), metavar="P", help="samples per pixel")
     flags.add_argument("--max-depth", type=_integer(1), metavar="D", help="path depth")
     flags.add_argument(
+        "--noise-target",
+        type=_noise_target,
+        metavar="REL|off",
+        help="adaptive sampling's target relative error, --spp the cap; off: fixed --spp",
+    )
+    flags.add_argument(
+        "--no-regularize", action="store_true", help="render without path regularisation"
+    )
+    flags.add_argument(
         "--shard",
         type=_shard,
         default=Shard(0, 1),
@@ -135,6 +158,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             height=args.height,
             spp=args.spp,
             max_depth=args.max_depth,
+            noise_target=args.noise_target,
+            no_regularize=args.no_regularize,
         ),
         shard=args.shard,
         num_cpus=args.num_cpus,

@@ -299,6 +299,8 @@ def generate(job: Job) -> int:
         height=job.flags.height,
         spp=job.flags.spp,
         max_depth=job.flags.max_depth,
+        noise_target=job.flags.noise_target,
+        no_regularize=job.flags.no_regularize,
     )
     job = Job(job.address, binary, flags, job.shard, job.num_cpus, job.chunk, job.max_retries)
     chunks = plan_chunks(flags.count, job.shard, job.chunk)

@@ -114,6 +114,9 @@ class GenerateFlags:
     height: int | None = None
     spp: int | None = None
     max_depth: int | None = None
+    noise_target: str | None = None
+    """Adaptive sampling's target: a positive number as text, or `off`."""
+    no_regularize: bool = False
 
     def arguments(self, shard: Shard, threads: int) -> list[str]:
         """The arguments after the binary: `dataset generate -o DIR --count N ... --shard K/N`."""
@@ -125,10 +128,13 @@ class GenerateFlags:
             ("--height", self.height),
             ("--spp", self.spp),
             ("--max-depth", self.max_depth),
+            ("--noise-target", self.noise_target),
         ]
         for flag, value in optional:
             if value is not None:
                 args += [flag, str(value)]
+        if self.no_regularize:
+            args.append("--no-regularize")
         return args + ["--shard", str(shard), "--threads", str(threads)]
 
 
