@@ -271,11 +271,19 @@ impl NodeLanes {
     }
 
     /// The weights of the first `n` children at the receiver, at SIMD level `simd` (which the
-    /// CPU must have: [`crate::simd::level`] is always one it has), or in SSE for a BSDF whose
-    /// lanes call the C library ([`LuminanceEval::calls_libm`]): the same bits either way.
+    /// CPU must have: [`crate::simd::level`] is always one it has), at most as wide as `n`
+    /// needs (two children in 16 lanes would pay for 14 empty ones), and in SSE for a BSDF
+    /// whose lanes call the C library ([`LuminanceEval::calls_libm`]): the same bits either
+    /// way.
     #[inline]
     fn weights_at(&self, simd: SimdLevel, n: usize, rx: &Receiver, f: &LuminanceEval) -> Weights {
-        let simd = if f.calls_libm() { SimdLevel::Sse } else { simd };
+        let needed = match n {
+            _ if f.calls_libm() => SimdLevel::Sse,
+            0..=4 => SimdLevel::Sse,
+            5..=8 => SimdLevel::Avx2,
+            _ => SimdLevel::Avx512,
+        };
+        let simd = simd.min(needed);
         match simd {
             // SAFETY: `simd` is a level the CPU has.
             #[cfg(target_arch = "x86_64")]
