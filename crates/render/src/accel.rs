@@ -989,6 +989,31 @@ fn build_cwbvh(aabbs: impl ExactSizeIterator<Item = Aabb>, reinsertion_ratio: f3
 mod tests {
     use super::*;
 
+    /// A xorshift64 generator of floats in [0, 1) from `seed`.
+    fn xorshift(mut seed: u64) -> impl FnMut() -> f32 {
+        move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 40) as f32 / (1u64 << 24) as f32
+        }
+    }
+
+    /// `n` small random triangles (each inside a unit cube) scattered through a 20 m cube:
+    /// positions and triangles for [`Accel::build`].
+    fn triangle_soup(n: u32, rnd: &mut impl FnMut() -> f32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+        let mut positions = vec![];
+        let mut triangles = vec![];
+        for i in 0..n {
+            let c = Vec3::new(rnd(), rnd(), rnd()) * 20.0 - 10.0;
+            for _ in 0..3 {
+                positions.push(c + Vec3::new(rnd(), rnd(), rnd()) - 0.5);
+            }
+            triangles.push([3 * i, 3 * i + 1, 3 * i + 2]);
+        }
+        (positions, triangles)
+    }
+
     /// The AVX2 node test finds exactly the SSE test's hits (same `t` bits, same triangle),
     /// for closest-hit and occlusion queries, on a soup of small random triangles crossed by
     /// random rays (skipped on a CPU without AVX2).
@@ -1002,22 +1027,8 @@ mod tests {
             eprintln!("no AVX2 on this CPU: nothing to compare");
             return;
         }
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut rnd = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 40) as f32 / (1u64 << 24) as f32
-        };
-        let mut positions = vec![];
-        let mut triangles = vec![];
-        for i in 0..4000u32 {
-            let c = Vec3::new(rnd(), rnd(), rnd()) * 20.0 - 10.0;
-            for _ in 0..3 {
-                positions.push(c + Vec3::new(rnd(), rnd(), rnd()) - 0.5);
-            }
-            triangles.push([3 * i, 3 * i + 1, 3 * i + 2]);
-        }
+        let mut rnd = xorshift(0x2545_f491_4f6c_dd1d);
+        let (positions, triangles) = triangle_soup(4000, &mut rnd);
         let accel = Accel::build(&positions, &triangles);
         let (mut hits, mut blocked) = (0, 0);
         for k in 0..20_000 {
@@ -1069,22 +1080,8 @@ mod tests {
     /// where two triangles give the same `t` and the traversal order decides.
     #[test]
     fn packets_find_the_single_ray_hits() {
-        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-        let mut rnd = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 40) as f32 / (1u64 << 24) as f32
-        };
-        let mut positions = vec![];
-        let mut triangles = vec![];
-        for i in 0..3000u32 {
-            let c = Vec3::new(rnd(), rnd(), rnd()) * 20.0 - 10.0;
-            for _ in 0..3 {
-                positions.push(c + Vec3::new(rnd(), rnd(), rnd()) - 0.5);
-            }
-            triangles.push([3 * i, 3 * i + 1, 3 * i + 2]);
-        }
+        let mut rnd = xorshift(0x9e37_79b9_7f4a_7c15);
+        let (mut positions, mut triangles) = triangle_soup(3000, &mut rnd);
         // A 40 x 40 grid of unit quads at y = -12, two triangles each.
         let base = positions.len() as u32;
         for j in 0..=40 {
