@@ -71,6 +71,19 @@ impl LuminanceEval {
     pub(crate) fn calls_libm(&self) -> bool {
         matches!(self.at, AtWo::Ward(_) | AtWo::BlinnPhong(_))
     }
+
+    /// Whether the model has a glossy lobe, whose peak lies near the mirror direction of `wo`
+    /// (every model but [`Diffuse`]).
+    #[inline]
+    pub(crate) fn has_glossy(&self) -> bool {
+        !matches!(self.at, AtWo::Diffuse(_))
+    }
+
+    /// The luminance of the glossy lobe's reflectance (`ks`, or a glTF material's `F0`).
+    #[inline]
+    pub(crate) fn glossy_reflectance(&self) -> f32 {
+        self.reflectances.glossy
+    }
 }
 
 impl Bsdf {

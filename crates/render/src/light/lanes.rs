@@ -15,7 +15,11 @@
 //! - the direction the BSDF weight `F` looks in: toward a group's most powerful member, a
 //!   mesh's centre or a punctual light, or against a directional light's direction;
 //! - then, as before the lanes, the direction's shading-frame coordinates, the side tests and
-//!   [`LuminanceEval`]'s value, and `E F` with `F` = the BSDF's luminance times the cosine.
+//!   [`LuminanceEval`]'s value, and `E F` with `F` = the BSDF's luminance times the cosine;
+//! - for a BSDF with a glossy lobe ([`BsdfWeight`], made once per choice), `F` of a group or
+//!   mesh whose bounding cone holds the lobe's mirror direction is at least the lobe's
+//!   reflectance over the cone's solid angle, capped by the lobe's peak (see
+//!   [`super::choice`]).
 //!
 //! The sums `sum E` and `sum E F` are taken child by child in order, so the weights and the
 //! choice are bit for bit the same at every width (tested on every width this CPU has).
@@ -27,6 +31,7 @@ use super::Light;
 use crate::bsdf::lanes::{Wide, WideLanes};
 use crate::bsdf::LuminanceEval;
 use crate::simd::{level, SimdLevel};
+use glam::Vec3;
 use std::f32::consts::PI;
 use std::ops::Range;
 use streaks_image::luminance;
@@ -174,12 +179,20 @@ impl NodeLanes {
     /// The weights of the first `n` children at the receiver, `L::WIDTH` children at a time
     /// (see the module documentation).
     #[inline(always)]
-    fn weights_in<L: WideLanes>(&self, n: usize, rx: &Receiver, f: &LuminanceEval) -> Weights {
+    fn weights_in<L: WideLanes>(&self, n: usize, rx: &Receiver, w: &BsdfWeight) -> Weights {
         let mut e_w = [0.0f32; BRANCHING];
         let mut ef_w = [0.0f32; BRANCHING];
         let p = rx.p.to_array();
         let (frame, ng) = (&rx.frame, rx.ng);
         let (zero, one) = (L::splat(0.0), L::splat(1.0));
+        let lobe = w.peak.map(|g| {
+            (
+                g.mirror.to_array().map(L::splat),
+                L::splat(g.peak),
+                L::splat(g.reflectance_over_2pi),
+            )
+        });
+        let f = &w.f;
         for k in (0..n).step_by(L::WIDTH) {
             let at = |s: &Slots| L::load(&s[k..]);
             let flag = |s: &Slots| at(s).gt(zero);
@@ -238,6 +251,21 @@ impl NodeLanes {
             let lit = geometric.gt(zero) & local[2].gt(zero);
             let cos = L::select(lit, local[2], zero);
             let fc = f.eval_lanes([local[0], local[1], cos]) * cos;
+            let fc = match lobe {
+                // A bounded child (group or mesh) whose cone holds the glossy lobe's mirror
+                // direction: at least the lobe's mean over the cone, capped by its peak.
+                Some((m, peak, rho)) => {
+                    let inv = one / dist;
+                    let cm = (d[0] * m[0] + d[1] * m[1] + d[2] * m[2]) * inv;
+                    let sin2 = (at(&self.radius2) / d2).saturate();
+                    let cos_t = (one - sin2).sqrt();
+                    let mean = rho * (one + cos_t) / sin2;
+                    let mean = L::select(peak.gt(mean), mean, peak);
+                    let holds = cm.ge(cos_t) & flag(&self.radius2) & inv.positive_finite();
+                    fc.max(L::select(holds, mean, zero))
+                }
+                None => fc,
+            };
             let fc = L::select(fc.positive_finite(), fc, zero);
             e.store(&mut e_w[k..]);
             (e * fc).store(&mut ef_w[k..]);
@@ -256,8 +284,8 @@ impl NodeLanes {
     /// The CPU must have AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn weights_avx2(&self, n: usize, rx: &Receiver, f: &LuminanceEval) -> Weights {
-        self.weights_in::<Wide<8>>(n, rx, f)
+    unsafe fn weights_avx2(&self, n: usize, rx: &Receiver, w: &BsdfWeight) -> Weights {
+        self.weights_in::<Wide<8>>(n, rx, w)
     }
 
     /// [`NodeLanes::weights_in`] in AVX-512's sixteen lanes.
@@ -266,8 +294,8 @@ impl NodeLanes {
     /// The CPU must have AVX-512F.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f")]
-    unsafe fn weights_avx512(&self, n: usize, rx: &Receiver, f: &LuminanceEval) -> Weights {
-        self.weights_in::<Wide<16>>(n, rx, f)
+    unsafe fn weights_avx512(&self, n: usize, rx: &Receiver, w: &BsdfWeight) -> Weights {
+        self.weights_in::<Wide<16>>(n, rx, w)
     }
 
     /// The weights of the first `n` children at the receiver, at SIMD level `simd` (which the
@@ -276,9 +304,9 @@ impl NodeLanes {
     /// whose lanes call the C library ([`LuminanceEval::calls_libm`]): the same bits either
     /// way.
     #[inline]
-    fn weights_at(&self, simd: SimdLevel, n: usize, rx: &Receiver, f: &LuminanceEval) -> Weights {
+    fn weights_at(&self, simd: SimdLevel, n: usize, rx: &Receiver, w: &BsdfWeight) -> Weights {
         let needed = match n {
-            _ if f.calls_libm() => SimdLevel::Sse,
+            _ if w.f.calls_libm() => SimdLevel::Sse,
             0..=4 => SimdLevel::Sse,
             5..=8 => SimdLevel::Avx2,
             _ => SimdLevel::Avx512,
@@ -287,12 +315,52 @@ impl NodeLanes {
         match simd {
             // SAFETY: `simd` is a level the CPU has.
             #[cfg(target_arch = "x86_64")]
-            SimdLevel::Avx512 => unsafe { self.weights_avx512(n, rx, f) },
+            SimdLevel::Avx512 => unsafe { self.weights_avx512(n, rx, w) },
             // SAFETY: as above.
             #[cfg(target_arch = "x86_64")]
-            SimdLevel::Avx2 => unsafe { self.weights_avx2(n, rx, f) },
-            _ => self.weights_in::<glam::Vec4>(n, rx, f),
+            SimdLevel::Avx2 => unsafe { self.weights_avx2(n, rx, w) },
+            _ => self.weights_in::<glam::Vec4>(n, rx, w),
         }
+    }
+}
+
+/// What the weights need of a receiver's BSDF, made once per light choice (not once per
+/// level of the tree): its [`LuminanceEval`] and, for a glossy lobe, [`GlossyPeak`].
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct BsdfWeight {
+    /// `luminance(f(wo, wi))` for any `wi`.
+    pub(crate) f: LuminanceEval,
+    /// The glossy lobe's peak, if the BSDF has a glossy lobe.
+    peak: Option<GlossyPeak>,
+}
+
+/// A glossy lobe seen from `wo`, for the weight of a bounded child (group or emitter mesh):
+/// its mirror direction, `f cos` there, and its reflectance.
+#[derive(Clone, Copy, Debug)]
+struct GlossyPeak {
+    /// The mirror direction of `wo` about the shading normal, world space.
+    mirror: Vec3,
+    /// `luminance(f) cos` toward it.
+    peak: f32,
+    /// The luminance of the lobe's reflectance over `2 pi`.
+    reflectance_over_2pi: f32,
+}
+
+impl BsdfWeight {
+    /// The receiver's BSDF, as the weights need it.
+    #[inline]
+    pub(crate) fn new(rx: &Receiver) -> Self {
+        let f = rx.bsdf.luminance_at(rx.wo_local);
+        let peak = f.has_glossy().then(|| {
+            let wo = rx.wo_local;
+            let m = Vec3::new(-wo.x, -wo.y, wo.z);
+            GlossyPeak {
+                mirror: rx.frame.to_world(m),
+                peak: f.eval(m) * m.z,
+                reflectance_over_2pi: f.glossy_reflectance() / (2.0 * PI),
+            }
+        });
+        Self { f, peak }
     }
 }
 
@@ -334,10 +402,10 @@ impl TreeLanes {
     }
 
     /// The weights of the sibling set `nodes` (the root's children or a group's) at the
-    /// receiver, with `f` its BSDF's [`LuminanceEval`].
+    /// receiver, with `w` its BSDF ([`BsdfWeight::new`]).
     #[inline]
-    pub(crate) fn weights(&self, rx: &Receiver, f: &LuminanceEval, nodes: Range<usize>) -> Weights {
-        self.weights_at_level(level(), rx, f, nodes)
+    pub(crate) fn weights(&self, rx: &Receiver, w: &BsdfWeight, nodes: Range<usize>) -> Weights {
+        self.weights_at_level(level(), rx, w, nodes)
     }
 
     /// [`TreeLanes::weights`] at SIMD level `simd`, which the CPU must have.
@@ -346,14 +414,14 @@ impl TreeLanes {
         &self,
         simd: SimdLevel,
         rx: &Receiver,
-        f: &LuminanceEval,
+        w: &BsdfWeight,
         nodes: Range<usize>,
     ) -> Weights {
         if nodes.is_empty() {
             return ([0.0; BRANCHING], [0.0; BRANCHING], 0.0, 0.0);
         }
         let set = &self.sets[self.set_of_node[nodes.start] as usize];
-        set.weights_at(simd, nodes.len(), rx, f)
+        set.weights_at(simd, nodes.len(), rx, w)
     }
 }
 
@@ -453,8 +521,16 @@ mod tests {
             }),
         ];
         let mut rng = Pcg32::new(4, 1);
+        let centres: Vec<Vec3> = tree
+            .nodes()
+            .iter()
+            .filter_map(|n| match n {
+                Node::Group(g) => Some(g.centre),
+                Node::Emitter(_) => None,
+            })
+            .collect();
         let mut positive = 0;
-        for _ in 0..300 {
+        for i in 0..300 {
             let p = Vec3::new(
                 rng.next_f32() * 20.0 - 10.0,
                 rng.next_f32() * 0.5,
@@ -465,9 +541,18 @@ mod tests {
                 rng.next_f32() + 0.05,
                 rng.next_f32() - 0.5,
             );
+            // Every other receiver sees a group's centre in its mirror direction (the cone
+            // term of a glossy lobe).
+            let wo = match centres.get(i % (2 * centres.len().max(1)) / 2) {
+                Some(&c) if i % 2 == 1 => {
+                    let d = (c - p).normalize();
+                    Vec3::new(-d.x, d.y, -d.z)
+                }
+                _ => wo,
+            };
             for bsdf in models {
                 let rx = receiver(p, bsdf, wo);
-                let f = bsdf.luminance_at(rx.wo_local);
+                let f = BsdfWeight::new(&rx);
                 for set in &sets {
                     let want = lanes.weights_at_level(SimdLevel::Sse, &rx, &f, set.clone());
                     positive += want.0.iter().filter(|&&e| e > 0.0).count();
@@ -512,7 +597,7 @@ mod tests {
                 -rng.next_f32() * 30.0,
             );
             let rx = receiver(p, bsdf, Vec3::Y);
-            let f = bsdf.luminance_at(rx.wo_local);
+            let f = BsdfWeight::new(&rx);
             for e in 0..ls.emitters().len() {
                 let node = tree.node_of_emitter(e).unwrap();
                 let siblings = tree.siblings(node);
