@@ -47,6 +47,19 @@ impl LuminanceEval {
     /// lanes; each lane is exactly the scalar value.
     #[inline(always)]
     pub(crate) fn eval_lanes<L: Lanes>(&self, wi: [L; 3]) -> L {
+        self.lobes_lanes(wi, |lobes| lobes.diffuse + lobes.glossy)
+    }
+
+    /// The glossy lobe's part of [`LuminanceEval::eval`].
+    #[inline]
+    pub(crate) fn eval_glossy(&self, wi: Vec3) -> f32 {
+        self.lobes_lanes(wi.to_array(), |lobes| lobes.glossy)
+    }
+
+    /// `part` of the lobes' luminances toward `wi`; zero when either direction is below the
+    /// surface.
+    #[inline(always)]
+    fn lobes_lanes<L: Lanes>(&self, wi: [L; 3], part: impl Fn(Lobes<L, L>) -> L) -> L {
         if self.wo.z > 0.0 {
             let (r, wo) = (self.reflectances.map(L::splat), self.wo);
             let lobes: Lobes<L, L> = match &self.at {
@@ -56,7 +69,7 @@ impl LuminanceEval {
                 AtWo::BlinnPhong(at) => BlinnPhong::lobes(at, r, wo, wi),
                 AtWo::GltfPbr(at) => GltfPbr::lobes(at, r, wo, wi),
             };
-            (lobes.diffuse + lobes.glossy).where_positive(wi[2])
+            part(lobes).where_positive(wi[2])
         } else {
             L::splat(0.0)
         }
@@ -129,6 +142,32 @@ mod tests {
                     (got - want).abs() <= 1e-5 * want.abs().max(1e-3),
                     "{b:?} {wo} {wi}: {got} vs {want}"
                 );
+            }
+        }
+    }
+
+    /// The glossy part is the whole value without a diffuse lobe, none of it for a Lambertian
+    /// BSDF, and never more than the whole.
+    #[test]
+    fn eval_glossy_is_the_glossy_part() {
+        let mut rng = Pcg32::new(13, 7);
+        let (kd, ks) = (Vec3::new(0.2, 0.3, 0.1), Vec3::new(0.7, 0.5, 0.9));
+        let pure = Bsdf::Ggx(Ggx {
+            kd: Vec3::ZERO,
+            ks,
+            alpha: 0.2,
+        });
+        let mixed = Bsdf::Ggx(Ggx { kd, ks, alpha: 0.2 });
+        let lambert = Bsdf::Diffuse(crate::bsdf::Diffuse { kd });
+        for _ in 0..500 {
+            let (wo, wi) = (random_dir(&mut rng), random_dir(&mut rng));
+            let f = pure.luminance_at(wo);
+            assert_eq!(f.eval_glossy(wi).to_bits(), f.eval(wi).to_bits());
+            let f = mixed.luminance_at(wo);
+            assert!(f.eval_glossy(wi) <= f.eval(wi));
+            assert_eq!(lambert.luminance_at(wo).eval_glossy(wi), 0.0);
+            if wo.z > 0.0 && wi.z > 0.0 {
+                assert!(f.eval(wi) - f.eval_glossy(wi) > 0.0, "{wo} {wi}");
             }
         }
     }

@@ -21,9 +21,12 @@
 //!   BSDF with a glossy lobe, a bounded child (group or emitter mesh) whose bounding cone holds
 //!   the lobe's mirror direction gets at least `F = min(peak, rho / Omega)`: the lobe's
 //!   reflectance `rho` spread over the cone's solid angle `Omega` (its mean over the cone, were
-//!   the lobe inside it), capped by the lobe's peak `f cos` at the mirror direction. On a
-//!   procedural street this took the choice of such a light from 0.0004 to 0.002-0.005 and the
-//!   image's relative RMSE at 64 spp from 1.1 to 0.6 (BENCHMARKS.md, "Sharp glossy lobes in
+//!   the lobe inside it), capped by the glossy lobe's peak `f cos` at the mirror direction. On
+//!   a procedural street this took the choice of such a light from 0.0004 to 0.002-0.005 and
+//!   the image's relative RMSE at 64 spp from 1.1 to 0.6; on `rainy_street` the road's fell by
+//!   a quarter, while lamp heads seen directly got noisier: a lens lit from behind by its bulb
+//!   has no `F` toward it (the BSDF-aware share looks at reflection only), and far groups in
+//!   its mirror direction now take some of its samples (BENCHMARKS.md, "Sharp glossy lobes in
 //!   the light choice").
 //!
 //! The choice descends the tree from the root, one child per level, weighing a node's children

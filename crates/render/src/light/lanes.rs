@@ -340,7 +340,8 @@ pub(crate) struct BsdfWeight {
 struct GlossyPeak {
     /// The mirror direction of `wo` about the shading normal, world space.
     mirror: Vec3,
-    /// `luminance(f) cos` toward it.
+    /// The glossy lobe's `luminance(f) cos` toward it (its diffuse part left out: a
+    /// diffuse-dominated surface keeps its weight toward the anchor).
     peak: f32,
     /// The luminance of the lobe's reflectance over `2 pi`.
     reflectance_over_2pi: f32,
@@ -356,7 +357,7 @@ impl BsdfWeight {
             let m = Vec3::new(-wo.x, -wo.y, wo.z);
             GlossyPeak {
                 mirror: rx.frame.to_world(m),
-                peak: f.eval(m) * m.z,
+                peak: f.eval_glossy(m) * m.z,
                 reflectance_over_2pi: f.glossy_reflectance() / (2.0 * PI),
             }
         });
