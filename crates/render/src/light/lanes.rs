@@ -17,9 +17,9 @@
 //! - then, as before the lanes, the direction's shading-frame coordinates, the side tests and
 //!   [`LuminanceEval`]'s value, and `E F` with `F` = the BSDF's luminance times the cosine;
 //! - for a BSDF with a glossy lobe ([`BsdfWeight`], made once per choice), `F` of a group or
-//!   mesh whose bounding cone holds the lobe's mirror direction is at least the lobe's
-//!   reflectance over the cone's solid angle, capped by the lobe's peak (see
-//!   [`super::choice`]).
+//!   mesh whose bounding cone holds the lobe's mirror direction and is more than
+//!   [`SHARP_LOBE_CONE_RATIO`] times as wide as the lobe is at least the lobe's reflectance
+//!   over the cone's solid angle (see [`super::choice`]).
 //!
 //! The sums `sum E` and `sum E F` are taken child by child in order, so the weights and the
 //! choice are bit for bit the same at every width (tested on every width this CPU has).
@@ -188,7 +188,7 @@ impl NodeLanes {
         let lobe = w.peak.map(|g| {
             (
                 g.mirror.to_array().map(L::splat),
-                L::splat(g.peak),
+                L::splat(g.peak / SHARP_LOBE_CONE_RATIO),
                 L::splat(g.reflectance_over_2pi),
             )
         });
@@ -253,15 +253,18 @@ impl NodeLanes {
             let fc = f.eval_lanes([local[0], local[1], cos]) * cos;
             let fc = match lobe {
                 // A bounded child (group or mesh) whose cone holds the glossy lobe's mirror
-                // direction: at least the lobe's mean over the cone, capped by its peak.
-                Some((m, peak, rho)) => {
+                // direction and is much wider than the lobe: at least the lobe's mean over
+                // the cone.
+                Some((m, peak_over_ratio, rho)) => {
                     let inv = one / dist;
                     let cm = (d[0] * m[0] + d[1] * m[1] + d[2] * m[2]) * inv;
                     let sin2 = (at(&self.radius2) / d2).saturate();
                     let cos_t = (one - sin2).sqrt();
                     let mean = rho * (one + cos_t) / sin2;
-                    let mean = L::select(peak.gt(mean), mean, peak);
-                    let holds = cm.ge(cos_t) & flag(&self.radius2) & inv.positive_finite();
+                    let holds = cm.ge(cos_t)
+                        & peak_over_ratio.gt(mean)
+                        & flag(&self.radius2)
+                        & inv.positive_finite();
                     fc.max(L::select(holds, mean, zero))
                 }
                 None => fc,
@@ -333,6 +336,17 @@ pub(crate) struct BsdfWeight {
     /// The glossy lobe's peak, if the BSDF has a glossy lobe.
     peak: Option<GlossyPeak>,
 }
+
+/// How many times the lobe's solid angle a bounded child's cone must span before its `F`
+/// looks past its anchor ([`GlossyPeak`]). The lobe's solid angle is taken as `rho / peak`
+/// (its reflectance over its peak `f cos`), the cone's as `2 pi (1 - cos theta)`, so the
+/// test is `peak / SHARP_LOBE_CONE_RATIO > rho / Omega`. In a cone as wide as the lobe, an
+/// anchor inside the cone lies inside the lobe and sees it; only a cone several lobes wide
+/// can hold the lobe where its anchor does not look. With a ratio of 1, a rough lens seen at
+/// grazing (GGX alpha 1) raised nearby groups in its mirror direction above the bulb 0.1 m
+/// away that lights it, and `rainy_street`'s lamp heads got noisier (BENCHMARKS.md, "Sharp
+/// glossy lobes in the light choice").
+const SHARP_LOBE_CONE_RATIO: f32 = 4.0;
 
 /// A glossy lobe seen from `wo`, for the weight of a bounded child (group or emitter mesh):
 /// its mirror direction, `f cos` there, and its reflectance.
