@@ -255,16 +255,18 @@ impl NodeLanes {
                 // A bounded child (group or mesh) whose cone holds the glossy lobe's mirror
                 // direction and is much wider than the lobe: at least the lobe's mean over
                 // the cone.
+                // With `t = sqrt(d^2 - r^2)` the tangent length (0 inside the sphere), the
+                // cone's half-angle has `cos = t / dist`: it holds the mirror direction `m`
+                // when `d.m >= t`, and the lobe's mean over it, `rho (1 + cos) / sin^2` (with
+                // `rho` over 2 pi), is `rho (d^2 + t dist) / r^2`, or `rho` inside the sphere.
+                // One division, where the angles' sines and cosines took three.
                 Some((m, peak_over_ratio, rho)) => {
-                    let inv = one / dist;
-                    let cm = (d[0] * m[0] + d[1] * m[1] + d[2] * m[2]) * inv;
-                    let sin2 = (at(&self.radius2) / d2).saturate();
-                    let cos_t = (one - sin2).sqrt();
-                    let mean = rho * (one + cos_t) / sin2;
-                    let holds = cm.ge(cos_t)
-                        & peak_over_ratio.gt(mean)
-                        & flag(&self.radius2)
-                        & inv.positive_finite();
+                    let r2 = at(&self.radius2);
+                    let t = (d2 - r2).max(zero).sqrt();
+                    let dm = d[0] * m[0] + d[1] * m[1] + d[2] * m[2];
+                    let mean = rho * ((d2 + t * dist) / r2).max(one);
+                    let holds =
+                        dm.ge(t) & peak_over_ratio.gt(mean) & r2.gt(zero) & dist.positive_finite();
                     fc.max(L::select(holds, mean, zero))
                 }
                 None => fc,
