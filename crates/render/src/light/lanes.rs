@@ -344,10 +344,10 @@ pub(crate) struct BsdfWeight {
 /// (its reflectance over its peak `f cos`), the cone's as `2 pi (1 - cos theta)`, so the
 /// test is `peak / SHARP_LOBE_CONE_RATIO > rho / Omega`. In a cone as wide as the lobe, an
 /// anchor inside the cone lies inside the lobe and sees it; only a cone several lobes wide
-/// can hold the lobe where its anchor does not look. With a ratio of 1, a rough lens seen at
+/// can hold the lobe where its anchor does not look. Without this test, a rough lens seen at
 /// grazing (GGX alpha 1) raised nearby groups in its mirror direction above the bulb 0.1 m
-/// away that lights it, and `rainy_street`'s lamp heads got noisier (BENCHMARKS.md, "Sharp
-/// glossy lobes in the light choice").
+/// away that lights it, and `rainy_street`'s lamp heads got noisier; with a ratio of 1 they
+/// got back only a third of that (BENCHMARKS.md, "Only cones much wider than the lobe").
 const SHARP_LOBE_CONE_RATIO: f32 = 4.0;
 
 /// A glossy lobe seen from `wo`, for the weight of a bounded child (group or emitter mesh):
