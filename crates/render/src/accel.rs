@@ -21,7 +21,7 @@
 //! the plain ones.
 //!
 //! Instancing: an instanced mesh has its own [`Accel`] in object space, queried with a ray
-//! taken into that space ([`Accel::intersect_object`], [`Accel::occluded_object`]): the
+//! taken into that space (`Accel::intersect_object`, `Accel::occluded_object`): the
 //! direction is transformed but not renormalised, so `t` stays the world ray's parameter and
 //! the scene's `t_min` applies unchanged. A [`Tlas`] over the instances' world boxes finds the
 //! instances a ray may hit; each box's query runs the instance's BLAS traversal nested in the
@@ -530,7 +530,7 @@ impl NodeTest {
     }
 }
 
-/// The node test every traversal of this process uses ([`NodeTest::detect`], once).
+/// The node test every traversal of this process uses (`NodeTest::detect`, once).
 pub fn node_test() -> NodeTest {
     static TEST: std::sync::OnceLock<NodeTest> = std::sync::OnceLock::new();
     *TEST.get_or_init(NodeTest::detect)

@@ -84,7 +84,7 @@
 //! only on its own pixels' samples, so the image stays bit-identical whatever the thread count:
 //! - round one takes [`ADAPTIVE_MIN_SPP`] = 16 samples in every pixel of the tile (or the cap,
 //!   if smaller), each later round [`ADAPTIVE_BATCH`] = 8 more; after each round the tile's
-//!   error is checked ([`tile_relative_error`]):
+//!   error is checked (`tile_relative_error`):
 //!   `sqrt(mean_i(s_i^2 / n_i)) / max(mean_i(m_i), ADAPTIVE_DARK_FLOOR) < noise_target`, over
 //!   the tile's pixels `i` with `n_i` kept samples of luminance mean `m_i` and sample variance
 //!   `s_i^2` ([`crate::film::Pixel::mean_variance`]): the root mean square standard error of

@@ -27,12 +27,13 @@
 //!   fell by 30 %. A cone not that much wider than the lobe keeps its anchor's `F`: the
 //!   anchor then lies in the lobe. (Raising every cone that holds the mirror direction made
 //!   a rough lens seen at grazing send its shadow rays to groups rather than to its bulb 0.1 m
-//!   away; BENCHMARKS.md, "Sharp glossy lobes in the light choice".)
+//!   away; BENCHMARKS.md, "Only cones much wider than the lobe".)
 //!
 //! The choice descends the tree from the root, one child per level, weighing a node's children
-//! once: at most [`BRANCHING`] BSDF evaluations per level, all of a node's children in SIMD
-//! lanes, 4, 8 or 16 at a time ([`super::lanes`]). Every choice is a deterministic function of the point, so
-//! [`LightSampler::sample_li`] and [`LightSampler::pdf_li`] agree exactly, which MIS needs.
+//! once: at most `BRANCHING` (16) BSDF evaluations per level, all of a node's children in SIMD
+//! lanes, 4, 8 or 16 at a time (the crate's `light::lanes`). Every choice is a deterministic
+//! function of the point, so [`LightSampler::sample_li`] and [`LightSampler::pdf_li`] agree
+//! exactly, which MIS needs.
 
 use super::emitter::{Emitter, Emitters, SurfaceMesh};
 use super::lanes::{BsdfWeight, TreeLanes, Weights};
