@@ -478,13 +478,10 @@ mod tests {
         assert!((est / exact - 1.0).abs() < 0.01, "{est} vs {exact}");
     }
 
-    /// A sharp glossy lobe (a window pane) that mirrors a weak point light of a group whose
-    /// most powerful member lies elsewhere still sends most of its shadow rays to that light:
-    /// the group's weight holds the lobe's mean over the group's cone, not only its value
-    /// toward the group's anchor (which is nearly zero for so sharp a lobe).
-    #[test]
-    fn a_sharp_lobe_finds_a_weak_light_in_a_group() {
-        let lights: Vec<Light> = (0..40)
+    /// 40 point lights along a street, 2-5 m high over 23 m, of seven intensities (1 to 61),
+    /// the weakest every seventh: more than [`BRANCHING`], so a two-level tree of groups.
+    fn street_lights() -> Vec<Light> {
+        (0..40)
             .map(|i| {
                 let f = i as f32;
                 Light::Point {
@@ -497,7 +494,16 @@ mod tests {
                     range: None,
                 }
             })
-            .collect();
+            .collect()
+    }
+
+    /// A sharp glossy lobe (a window pane) that mirrors a weak point light of a group whose
+    /// most powerful member lies elsewhere still sends most of its shadow rays to that light:
+    /// the group's weight holds the lobe's mean over the group's cone, not only its value
+    /// toward the group's anchor (which is nearly zero for so sharp a lobe).
+    #[test]
+    fn a_sharp_lobe_finds_a_weak_light_in_a_group() {
+        let lights = street_lights();
         let s = lamp_scene(Vec3::new(0.0, 2.0, -3.0), 5.0, lights.clone());
         let ls = &s.light_sampler;
         assert_eq!(check_tree(ls.tree(), ls.emitters().len()), 2);
@@ -533,20 +539,7 @@ mod tests {
     /// lens's light: its choice fell from 0.68 to 0.28.) A sharp lobe's groups still get it.
     #[test]
     fn only_a_lobe_much_narrower_than_a_cone_looks_past_the_anchor() {
-        let lights: Vec<Light> = (0..40)
-            .map(|i| {
-                let f = i as f32;
-                Light::Point {
-                    position: Vec3::new(
-                        (f * 2.3) % 17.0 - 8.0,
-                        2.0 + (f * 0.7) % 3.0,
-                        -2.0 - (f * 1.9) % 23.0,
-                    ),
-                    intensity: Vec3::splat(1.0 + 10.0 * (i % 7) as f32),
-                    range: None,
-                }
-            })
-            .collect();
+        let lights = street_lights();
         let s = lamp_scene(Vec3::new(0.0, 2.0, -3.0), 5.0, lights);
         let ls = &s.light_sampler;
         let lobe = |alpha| {
