@@ -188,7 +188,7 @@ impl NodeLanes {
         let lobe = w.peak.map(|g| {
             (
                 g.mirror.to_array().map(L::splat),
-                L::splat(g.peak / SHARP_LOBE_CONE_RATIO),
+                L::splat(g.peak_over_ratio),
                 L::splat(g.reflectance_over_2pi),
             )
         });
@@ -254,8 +254,7 @@ impl NodeLanes {
             let fc = match lobe {
                 // A bounded child (group or mesh) whose cone holds the glossy lobe's mirror
                 // direction and is much wider than the lobe: at least the lobe's mean over
-                // the cone.
-                // With `t = sqrt(d^2 - r^2)` the tangent length (0 inside the sphere), the
+                // the cone. With `t = sqrt(d^2 - r^2)` the tangent length (0 inside the sphere), the
                 // cone's half-angle has `cos = t / dist`: it holds the mirror direction `m`
                 // when `d.m >= t`, and the lobe's mean over it, `rho (1 + cos) / sin^2` (with
                 // `rho` over 2 pi), is `rho (d^2 + t dist) / r^2`, or `rho` inside the sphere.
@@ -351,14 +350,15 @@ pub(crate) struct BsdfWeight {
 const SHARP_LOBE_CONE_RATIO: f32 = 4.0;
 
 /// A glossy lobe seen from `wo`, for the weight of a bounded child (group or emitter mesh):
-/// its mirror direction, `f cos` there, and its reflectance.
+/// its mirror direction, `f cos` there over [`SHARP_LOBE_CONE_RATIO`], and its reflectance.
 #[derive(Clone, Copy, Debug)]
 struct GlossyPeak {
     /// The mirror direction of `wo` about the shading normal, world space.
     mirror: Vec3,
     /// The glossy lobe's `luminance(f) cos` toward it (its diffuse part left out: a
-    /// diffuse-dominated surface keeps its weight toward the anchor).
-    peak: f32,
+    /// diffuse-dominated surface keeps its weight toward the anchor), over
+    /// [`SHARP_LOBE_CONE_RATIO`]: a cone's mean below it raises the child.
+    peak_over_ratio: f32,
     /// The luminance of the lobe's reflectance over `2 pi`.
     reflectance_over_2pi: f32,
 }
@@ -373,7 +373,7 @@ impl BsdfWeight {
             let m = Vec3::new(-wo.x, -wo.y, wo.z);
             GlossyPeak {
                 mirror: rx.frame.to_world(m),
-                peak: f.eval_glossy(m) * m.z,
+                peak_over_ratio: f.eval_glossy(m) * m.z / SHARP_LOBE_CONE_RATIO,
                 reflectance_over_2pi: f.glossy_reflectance() / (2.0 * PI),
             }
         });
