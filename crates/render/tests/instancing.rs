@@ -57,8 +57,10 @@ fn image(scene: &Scene) -> Vec<Vec3> {
         .pixels
 }
 
-/// Whether two renders agree: the mean differs by less than 1% and at most 2% of the pixels
-/// differ by more than 5% of the image's mean (a path that rounding sends elsewhere).
+/// Whether two renders agree: the mean differs by less than 1% and at most 0.5% of the pixels
+/// differ by more than 5% of the image's mean (a path that rounding sends elsewhere; the
+/// instanced scenes have none such, the moved post 29-31 of 1536, 1.9-2.0%, so a 2% bound
+/// let the outcome hang on the light choice's noise).
 fn agree(a: &[Vec3], b: &[Vec3]) -> Result<(), String> {
     let mean = |img: &[Vec3]| img.iter().map(|p| p.element_sum()).sum::<f32>() / img.len() as f32;
     let (ma, mb) = (mean(a), mean(b));
@@ -67,7 +69,7 @@ fn agree(a: &[Vec3], b: &[Vec3]) -> Result<(), String> {
         .zip(b)
         .filter(|(p, q)| (**p - **q).abs().max_element() > 0.05 * ma / 3.0)
         .count();
-    if (ma - mb).abs() > 0.01 * ma || off * 50 > a.len() {
+    if (ma - mb).abs() > 0.01 * ma || off * 200 > a.len() {
         return Err(format!(
             "means {ma} and {mb}, {off} of {} pixels differ",
             a.len()
