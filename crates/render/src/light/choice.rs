@@ -14,7 +14,8 @@
 //! an emitter mesh that `F` misses is found by BSDF sampling (and weighed by MIS), and a
 //! sharp lobe's view of a group by the cone rule below. A share of 10% cost the `crosscheck`
 //! road 1.7x its variance at 64 spp, and lowering it made no scene noisier
-//! (BENCHMARKS.md, "The defensive share").
+//! (BENCHMARKS.md, "The defensive share"). At a transmissive BSDF the share stays 10%: its
+//! `F` leaves out the transmission, so a light behind it has this share alone.
 //!
 //! - An emitter's `E`: intensity, spot falloff and range window over `d^2` for point and spot
 //!   lights, the irradiance for a directional light, `power / (4 pi max(d, r)^2)` for a mesh of
@@ -57,6 +58,21 @@ use std::ops::Range;
 /// Share of the light choice made by irradiance alone when it is BSDF-aware (defensive
 /// sampling, see the module documentation).
 const DEFENSIVE_SHARE: f32 = 0.01;
+
+/// [`DEFENSIVE_SHARE`] at a transmissive BSDF ([`Bsdf::transmits`]): its `F` leaves out the
+/// transmission (see [`crate::bsdf::LuminanceEval`]), so a light behind it, a point light
+/// especially (which BSDF sampling never hits), is reached through this share alone.
+const TRANSMISSIVE_DEFENSIVE_SHARE: f32 = 0.1;
+
+/// The defensive share of the choice at a receiver with BSDF `bsdf`.
+#[inline]
+fn defensive_share(bsdf: &Bsdf) -> f32 {
+    if bsdf.transmits() {
+        TRANSMISSIVE_DEFENSIVE_SHARE
+    } else {
+        DEFENSIVE_SHARE
+    }
+}
 
 /// What the light choice may know about the shading point: position, geometric normal,
 /// shading frame, outgoing direction and BSDF.
@@ -110,12 +126,13 @@ fn mixture_valid(e_sum: f32, ef_sum: f32) -> bool {
 }
 
 /// The probability of an item with weights `e` and `ef` under the mixture: by `E` alone with
-/// probability [`DEFENSIVE_SHARE`] (all of it when every `E F` is 0), else by `E F`.
-fn mixture_pmf(e: f32, ef: f32, e_sum: f32, ef_sum: f32) -> f32 {
+/// probability `share` (the [`defensive_share`]; all of it when every `E F` is 0), else by
+/// `E F`.
+fn mixture_pmf(e: f32, ef: f32, e_sum: f32, ef_sum: f32, share: f32) -> f32 {
     if !mixture_valid(e_sum, ef_sum) {
         0.0
     } else if ef_sum > 0.0 {
-        DEFENSIVE_SHARE * e / e_sum + (1.0 - DEFENSIVE_SHARE) * ef / ef_sum
+        share * e / e_sum + (1.0 - share) * ef / ef_sum
     } else {
         e / e_sum
     }
@@ -128,11 +145,12 @@ fn choose_mixture(
     e_sum: f32,
     ef_sum: f32,
     u: f32,
+    share: f32,
 ) -> Option<(usize, f32)> {
     if !mixture_valid(e_sum, ef_sum) {
         return None;
     }
-    let share = if ef_sum > 0.0 { DEFENSIVE_SHARE } else { 1.0 };
+    let share = if ef_sum > 0.0 { share } else { 1.0 };
     if u < share {
         choose_in(e_w.iter().copied(), e_sum, u / share)
     } else {
@@ -179,12 +197,13 @@ impl LightSampler {
     #[inline]
     fn choose(&self, rx: &Receiver, u: f32) -> Option<(usize, f32, f32)> {
         let f = BsdfWeight::new(rx);
+        let share = defensive_share(&rx.bsdf);
         let (mut nodes, mut u, mut pmf) = (self.tree.root(), u, 1.0f32);
         loop {
             let (e_w, ef_w, e_sum, ef_sum) = self.weights(rx, &f, nodes.clone());
             let n = nodes.len();
-            let (c, u_c) = choose_mixture(&e_w[..n], &ef_w[..n], e_sum, ef_sum, u)?;
-            pmf *= mixture_pmf(e_w[c], ef_w[c], e_sum, ef_sum);
+            let (c, u_c) = choose_mixture(&e_w[..n], &ef_w[..n], e_sum, ef_sum, u, share)?;
+            pmf *= mixture_pmf(e_w[c], ef_w[c], e_sum, ef_sum, share);
             u = u_c;
             match self.tree.nodes()[nodes.start + c] {
                 Node::Emitter(e) => return (pmf > 0.0).then_some((e as usize, pmf, u)),
@@ -200,12 +219,13 @@ impl LightSampler {
             return 0.0;
         };
         let f = BsdfWeight::new(rx);
+        let share = defensive_share(&rx.bsdf);
         let mut pmf = 1.0f32;
         loop {
             let siblings = self.tree.siblings(node);
             let slot = node - siblings.start;
             let (e_w, ef_w, e_sum, ef_sum) = self.weights(rx, &f, siblings);
-            pmf *= mixture_pmf(e_w[slot], ef_w[slot], e_sum, ef_sum);
+            pmf *= mixture_pmf(e_w[slot], ef_w[slot], e_sum, ef_sum, share);
             match self.tree.parent(node) {
                 Some(parent) if pmf > 0.0 => node = parent,
                 _ => return pmf,
@@ -382,6 +402,51 @@ mod tests {
                     assert_eq!(ls.emitter_pmf(&above, e), 0.0);
                 }
             }
+        }
+    }
+
+    /// A light behind the surface has no `F`, so only the defensive share reaches it: 1 % of
+    /// the choice at an opaque BSDF (it cannot light the point), 10 % at a transmissive one,
+    /// whose transmission `F` leaves out and which BSDF sampling cannot carry to a point light.
+    #[test]
+    fn a_light_behind_a_transmissive_surface_keeps_the_larger_defensive_share() {
+        let lights = vec![
+            Light::Point {
+                position: Vec3::new(0.0, 3.0, -6.0),
+                intensity: Vec3::splat(40.0),
+                range: None,
+            },
+            Light::Point {
+                position: Vec3::new(0.5, -2.0, 0.5),
+                intensity: Vec3::splat(40.0),
+                range: None,
+            },
+        ];
+        let s = lamp_scene(Vec3::new(-3.0, 2.0, -10.0), 50.0, lights);
+        let ls = &s.light_sampler;
+        let p = Vec3::new(0.0, 0.5, 0.0);
+        let wo = Vec3::new(0.0, 2.5, 6.0);
+        let opaque = Bsdf::Ggx(Ggx {
+            kd: Vec3::splat(0.02),
+            ks: Vec3::splat(0.6),
+            alpha: 0.05,
+        });
+        let pane = Bsdf::GltfPbr(crate::bsdf::GltfPbr {
+            transmission: 1.0,
+            thin_walled: true,
+            roughness: 0.05,
+            ..Default::default()
+        });
+        assert!(!opaque.transmits() && pane.transmits());
+        let behind = |bsdf| ls.emitter_pmf(&receiver(p, bsdf, wo), 1);
+        let (at_opaque, at_pane) = (behind(opaque), behind(pane));
+        assert!(at_opaque > 0.0 && at_opaque < 0.01, "{at_opaque}");
+        assert!(
+            (at_pane / at_opaque - 10.0).abs() < 1e-3,
+            "{at_pane} {at_opaque}"
+        );
+        for bsdf in [opaque, pane] {
+            check_choice(ls, &receiver(p, bsdf, wo));
         }
     }
 
