@@ -254,11 +254,12 @@ impl NodeLanes {
             let fc = match lobe {
                 // A bounded child (group or mesh) whose cone holds the glossy lobe's mirror
                 // direction and is much wider than the lobe: at least the lobe's mean over
-                // the cone. With `t = sqrt(d^2 - r^2)` the tangent length (0 inside the sphere), the
-                // cone's half-angle has `cos = t / dist`: it holds the mirror direction `m`
-                // when `d.m >= t`, and the lobe's mean over it, `rho (1 + cos) / sin^2` (with
-                // `rho` over 2 pi), is `rho (d^2 + t dist) / r^2`, or `rho` inside the sphere.
-                // One division, where the angles' sines and cosines took three.
+                // the cone. With `t = sqrt(d^2 - r^2)` the tangent length (0 inside the
+                // sphere), the cone's half-angle has `cos = t / dist`: it holds the mirror
+                // direction `m` when `d.m >= t`, and the lobe's mean over it,
+                // `rho (1 + cos) / sin^2` (with `rho` over 2 pi), is `rho (d^2 + t dist) / r^2`,
+                // or `rho` inside the sphere. One division, where the angles' sines and
+                // cosines took three.
                 Some((m, peak_over_ratio, rho)) => {
                     let r2 = at(&self.radius2);
                     let t = (d2 - r2).max(zero).sqrt();
