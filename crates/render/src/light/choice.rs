@@ -21,8 +21,9 @@
 //!   lights, the irradiance for a directional light, `power / (4 pi max(d, r)^2)` for a mesh of
 //!   bounding radius `r` (zero behind a flat one-sided mesh); its `F` looks toward the light or
 //!   the mesh's centre.
-//! - A group's `E`: its total power over its bounding sphere, the same way; its `F` looks toward
-//!   its most powerful member (toward the middle of a lamp and its neighbours, the glossy lobe
+//! - A group's `E`: its total power over its bounding sphere, the same way, except for its
+//!   spot lights, whose summed intensity counts only where the point may lie in their beams
+//!   ([`super::tree::GroupBeam`]); its `F` looks toward its most powerful member (toward the middle of a lamp and its neighbours, the glossy lobe
 //!   would miss the lamp).
 //! - A sharp glossy lobe sees little of a group that way when what it mirrors is a weaker
 //!   member: a window pane (GGX alpha 0.02) reflecting one street light of a cluster. So for a

@@ -224,6 +224,20 @@ pub struct EmitterBounds {
     pub radius: f32,
     /// Power (luminance, W).
     pub power: f32,
+    /// For a spot light, its beam: a group holding it weighs it by its intensity inside the
+    /// beam rather than by its power spread over every direction.
+    pub beam: Option<Beam>,
+}
+
+/// A spot light's beam, as the light tree bounds it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Beam {
+    /// The unit direction it points along.
+    pub axis: Vec3,
+    /// The cosine of its outer cone's half-angle.
+    pub cos_outer: f32,
+    /// The luminance of its intensity (W/sr).
+    pub intensity: f32,
 }
 
 /// The scene's emitters: its punctual lights (in file order), then its emitter meshes (in the
@@ -312,11 +326,25 @@ impl Emitters {
                     position: Some(m.centre),
                     radius: m.radius,
                     power: m.power,
+                    beam: None,
                 },
                 Emitter::Punctual(light) => EmitterBounds {
                     position: light.position(),
                     radius: 0.0,
                     power: clean_power(light.power(scene_radius)),
+                    beam: match *light {
+                        Light::Spot {
+                            direction,
+                            intensity,
+                            cos_outer,
+                            ..
+                        } => Some(Beam {
+                            axis: direction,
+                            cos_outer,
+                            intensity: clean_power(luminance(intensity)),
+                        }),
+                        _ => None,
+                    },
                 },
             })
             .collect()

@@ -8,7 +8,10 @@
 //!
 //! - `E`, the irradiance-like weight: `scale / max(d^2, r^2)` for groups and emitter meshes
 //!   (`scale` = power / 4 pi, `r` the bounding radius; zero behind a flat one-sided mesh's
-//!   plane), `scale * falloff * window / d^2` for point and spot lights (`scale` = the
+//!   plane), plus for a group with spot lights their summed intensity over `max(d^2, r^2)`
+//!   where the point may lie in their beams ([`super::tree::GroupBeam`]: within the beam's
+//!   half-angle plus the group's angular radius `asin(r / d)` of its axis, or inside the
+//!   group's sphere), `scale * falloff * window / d^2` for point and spot lights (`scale` = the
 //!   luminance of the intensity; the spot's KHR_lights_punctual falloff and the range window,
 //!   1 where absent), `scale` itself for a directional light (the luminance of its irradiance);
 //!   zero unless positive and finite;
@@ -69,6 +72,13 @@ pub(crate) struct NodeLanes {
     cone_width: Slots,
     /// A light's `range` (infinite without one).
     range: Slots,
+    /// A group's spot lights' summed intensity (0 without any: see [`super::tree::GroupBeam`];
+    /// the beam's axis is in `axis`).
+    beam_scale: Slots,
+    /// Cosine of a group's beam's half-angle.
+    beam_cos: Slots,
+    /// Sine of a group's beam's half-angle.
+    beam_sin: Slots,
     /// 1 for point and spot lights.
     punctual: Slots,
     /// 1 for spot lights.
@@ -97,6 +107,9 @@ impl NodeLanes {
             cos_outer: [0.0; BRANCHING],
             cone_width: [1.0; BRANCHING],
             range: [f32::INFINITY; BRANCHING],
+            beam_scale: [0.0; BRANCHING],
+            beam_cos: [1.0; BRANCHING],
+            beam_sin: [0.0; BRANCHING],
             punctual: [0.0; BRANCHING],
             spot: [0.0; BRANCHING],
             hard_edge: [0.0; BRANCHING],
@@ -111,7 +124,13 @@ impl NodeLanes {
                     set3(&mut l.pos, c, g.centre);
                     set3(&mut l.look, c, g.anchor);
                     l.radius2[c] = g.radius * g.radius;
-                    l.scale[c] = g.power / (4.0 * PI);
+                    l.scale[c] = g.isotropic_power / (4.0 * PI);
+                    if let Some(b) = g.beam {
+                        set3(&mut l.axis, c, b.axis);
+                        l.beam_scale[c] = b.intensity;
+                        l.beam_cos[c] = b.cos;
+                        l.beam_sin[c] = b.sin;
+                    }
                 }
                 Node::Emitter(e) => match emitters.get(e as usize) {
                     Emitter::Mesh(m) => {
@@ -219,14 +238,20 @@ impl NodeLanes {
             );
             let falloff = L::select(flag(&self.spot), t * t, one);
             let scale = at(&self.scale);
+            // A group's beam: the point may see its spots if its direction from the centre
+            // (`cos` to the axis, as for a spot) is within the beam's half-angle plus the
+            // group's angular radius `asin(r / d)`, or if it is inside the group's sphere.
+            let r2 = at(&self.radius2);
+            let sin_r2 = (r2 / d2).saturate();
+            let edge =
+                at(&self.beam_cos) * (one - sin_r2).sqrt() - at(&self.beam_sin) * sin_r2.sqrt();
+            let edge = L::select(r2.ge(d2), L::splat(-2.0), edge);
+            let in_beam = cos.ge(edge);
+            let bounded = scale + L::select(in_beam, at(&self.beam_scale), zero);
             let e = L::select(
                 flag(&self.punctual),
                 scale * (falloff * window) / d2,
-                L::select(
-                    flag(&self.directional),
-                    scale,
-                    scale / d2.max(at(&self.radius2)),
-                ),
+                L::select(flag(&self.directional), scale, bounded / d2.max(r2)),
             );
             let front =
                 at(&self.plane[0]) * p[0] + at(&self.plane[1]) * p[1] + at(&self.plane[2]) * p[2];
@@ -641,5 +666,74 @@ mod tests {
             }
         }
         assert!(lit > 1000 && dark > 100, "{lit} lit, {dark} dark");
+    }
+
+    /// A group of spot lights is weighed by their intensity where it may lie in their beams:
+    /// in front of a cluster of headlights its `E` is at least what its members give there
+    /// (their intensity over the squared distance), not their power spread over `4 pi`, which
+    /// is 44 times less for these 0.28 sr beams; behind them it is zero.
+    #[test]
+    fn a_group_of_spot_lights_is_weighed_by_its_beams() {
+        let spot = |x: f32| Light::Spot {
+            position: Vec3::new(x, 0.7, 0.0),
+            direction: Vec3::Z,
+            intensity: Vec3::splat(20.0),
+            cos_inner: 0.99,
+            cos_outer: 0.92,
+            range: None,
+        };
+        // Two clusters of 20 headlights each: more than BRANCHING emitters, so groups.
+        let lights: Vec<Light> = (0..40)
+            .map(|i| spot(if i < 20 { -20.0 } else { 20.0 } + (i % 20) as f32 * 0.05))
+            .collect();
+        let scene = lamp_scene(Vec3::new(0.0, 30.0, -50.0), 0.0, lights);
+        let ls: &LightSampler = &scene.light_sampler;
+        let tree = ls.tree();
+        let lanes = TreeLanes::build(tree, ls.emitters());
+        let bsdf = Bsdf::Diffuse(Diffuse {
+            kd: Vec3::splat(0.5),
+        });
+        // The root's child that holds the first headlight, and its members' exact `E`.
+        let group = tree.root().find(|&c| match tree.nodes()[c] {
+            Node::Group(g) => g.children().any(|n| tree.nodes()[n] == Node::Emitter(0)),
+            Node::Emitter(_) => false,
+        });
+        let group = group.expect("the headlights are grouped");
+        let Node::Group(g) = tree.nodes()[group] else {
+            unreachable!()
+        };
+        assert!(g.beam.is_some() && g.isotropic_power == 0.0, "{g:?}");
+        let slot = group - tree.root().start;
+        let members_e = |p: Vec3| -> f32 {
+            g.children()
+                .map(|n| match tree.nodes()[n] {
+                    Node::Emitter(e) => match ls.emitters().get(e as usize) {
+                        Emitter::Punctual(l) => l.sample_li(p).map_or(0.0, |s| luminance(s.li)),
+                        Emitter::Mesh(_) => 0.0,
+                    },
+                    Node::Group(_) => 0.0,
+                })
+                .sum()
+        };
+        for (p, lit) in [
+            (Vec3::new(-19.5, 0.0, 30.0), true),
+            (Vec3::new(-15.0, 0.0, 12.0), true),
+            (Vec3::new(-19.5, 0.0, -30.0), false),
+            (Vec3::new(-19.5, 40.0, 1.0), false),
+        ] {
+            let rx = receiver(p, bsdf, Vec3::Y);
+            let f = BsdfWeight::new(&rx);
+            let e = lanes.weights(&rx, &f, tree.root()).0[slot];
+            let want = members_e(p);
+            if lit {
+                let spread = g.power / (4.0 * PI) / (g.centre - p).length_squared();
+                assert!(
+                    want > 0.0 && e >= 0.9 * want && e > 20.0 * spread,
+                    "{p}: {e} vs {want}"
+                );
+            } else {
+                assert_eq!((e, want), (0.0, 0.0), "{p}");
+            }
+        }
     }
 }
