@@ -246,10 +246,12 @@ fn group_beam(bounds: &[EmitterBounds], members: &[u32]) -> (f32, Option<GroupBe
     let axis = beams()
         .fold(Vec3::ZERO, |a, b| a + b.intensity * b.axis)
         .normalize_or_zero();
-    // The widest angle from the axis that a member's outer cone reaches.
+    // The widest angle from the axis that a member's outer cone reaches, widened by a
+    // milliradian against rounding at the edge.
     let half_angle = beams()
         .map(|b| axis.dot(b.axis).clamp(-1.0, 1.0).acos() + b.cos_outer.clamp(-1.0, 1.0).acos())
-        .fold(0.0f32, f32::max);
+        .fold(0.0f32, f32::max)
+        + 1e-3;
     if axis == Vec3::ZERO || half_angle > 0.5 * PI {
         return (isotropic + 4.0 * PI * intensity, None);
     }
