@@ -23,8 +23,8 @@
 //!   the mesh's centre.
 //! - A group's `E`: its total power over its bounding sphere, the same way, except for its
 //!   spot lights, whose summed intensity counts only where the point may lie in their beams
-//!   ([`super::tree::GroupBeam`]); its `F` looks toward its most powerful member (toward the middle of a lamp and its neighbours, the glossy lobe
-//!   would miss the lamp).
+//!   ([`super::tree::GroupBeam`]); its `F` looks toward its most powerful member (toward the
+//!   middle of a lamp and its neighbours, the glossy lobe would miss the lamp).
 //! - A sharp glossy lobe sees little of a group that way when what it mirrors is a weaker
 //!   member: a window pane (GGX alpha 0.02) reflecting one street light of a cluster. So for a
 //!   BSDF with a glossy lobe, a bounded child (group or emitter mesh) whose bounding cone holds

@@ -286,7 +286,6 @@ impl NodeLanes {
                 // or `rho` inside the sphere. One division, where the angles' sines and
                 // cosines took three.
                 Some((m, peak_over_ratio, rho)) => {
-                    let r2 = at(&self.radius2);
                     let t = (d2 - r2).max(zero).sqrt();
                     let dm = d[0] * m[0] + d[1] * m[1] + d[2] * m[2];
                     let mean = rho * ((d2 + t * dist) / r2).max(one);
