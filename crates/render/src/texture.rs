@@ -146,6 +146,11 @@ enum Texels {
     /// fetch by table: `srgb` says whether RGB is sRGB-encoded (alpha never is). The decoded
     /// values are exactly those of decoding at load time.
     Rgba8 { texels: Vec<[u8; 4]>, srgb: bool },
+    /// An 8-bit image whose every texel is grey and opaque (`r = g = b`, `a = 255`; a grey
+    /// PNG such as a road's asphalt), one byte per texel, decoded as [`Texels::Rgba8`] would:
+    /// the same values in a quarter of its memory, so that a street's textures stay in the
+    /// core's cache (BENCHMARKS.md, "Grey textures in one byte").
+    Grey8 { texels: Vec<u8>, srgb: bool },
     /// Linear float RGBA (16-bit and float images, procedural textures).
     Rgba32F(Vec<Vec4>),
 }
@@ -200,17 +205,28 @@ impl Texture {
         if bytes.len() % 4 != 0 || !Self::size_matches(width, height, bytes.len() / 4) {
             return None;
         }
-        let texels = bytes
+        let srgb = space == ColorSpace::Srgb;
+        let grey = bytes
             .chunks_exact(4)
-            .map(|c| [c[0], c[1], c[2], c[3]])
-            .collect();
+            .all(|c| c[0] == c[1] && c[1] == c[2] && c[3] == u8::MAX);
+        let texels = if grey {
+            Texels::Grey8 {
+                texels: bytes.iter().step_by(4).copied().collect(),
+                srgb,
+            }
+        } else {
+            Texels::Rgba8 {
+                texels: bytes
+                    .chunks_exact(4)
+                    .map(|c| [c[0], c[1], c[2], c[3]])
+                    .collect(),
+                srgb,
+            }
+        };
         Some(Self {
             width,
             height,
-            texels: Texels::Rgba8 {
-                texels,
-                srgb: space == ColorSpace::Srgb,
-            },
+            texels,
         })
     }
 
@@ -222,6 +238,7 @@ impl Texture {
     pub fn texel_count(&self) -> usize {
         match &self.texels {
             Texels::Rgba8 { texels, .. } => texels.len(),
+            Texels::Grey8 { texels, .. } => texels.len(),
             Texels::Rgba32F(texels) => texels.len(),
         }
     }
@@ -233,6 +250,10 @@ impl Texture {
             Texels::Rgba8 { texels, srgb } => {
                 let rgb = if *srgb { &SRGB_BYTES } else { &LINEAR_BYTES };
                 decode_rgba8(texels[index], rgb, &LINEAR_BYTES)
+            }
+            Texels::Grey8 { texels, srgb } => {
+                let rgb = if *srgb { &SRGB_BYTES } else { &LINEAR_BYTES };
+                decode_grey8(texels[index], rgb)
             }
             Texels::Rgba32F(texels) => texels[index],
         }
@@ -275,6 +296,10 @@ impl Texture {
                     &*LINEAR_BYTES,
                 );
                 [i00, i10, i01, i11].map(|i| decode_rgba8(texels[i], rgb, alpha))
+            }
+            Texels::Grey8 { texels, srgb } => {
+                let rgb = if *srgb { &*SRGB_BYTES } else { &*LINEAR_BYTES };
+                [i00, i10, i01, i11].map(|i| decode_grey8(texels[i], rgb))
             }
             Texels::Rgba32F(texels) => [i00, i10, i01, i11].map(|i| texels[i]),
         };
@@ -361,6 +386,14 @@ fn decode_rgba8(c: [u8; 4], rgb: &[f32; 256], alpha: &[f32; 256]) -> Vec4 {
         rgb[usize::from(c[2])],
         alpha[usize::from(c[3])],
     )
+}
+
+/// One grey, opaque 8-bit texel's linear value: its byte through `rgb` in R, G and B, and
+/// alpha 1 (`LINEAR_BYTES[255]`, exactly what [`decode_rgba8`] gives an opaque texel).
+#[inline]
+fn decode_grey8(v: u8, rgb: &[f32; 256]) -> Vec4 {
+    let c = rgb[usize::from(v)];
+    Vec4::new(c, c, c, 1.0)
 }
 
 #[cfg(test)]
@@ -557,6 +590,46 @@ mod tests {
             }
         }
         assert!(Texture::from_rgba8(5, 3, &bytes[..56], ColorSpace::Linear).is_none());
+    }
+
+    /// A grey, opaque image is kept one byte per texel and samples to exactly the values of
+    /// decoding it at load time; one coloured or translucent texel keeps all four bytes.
+    #[test]
+    fn grey_bytes_sample_as_decoded_floats() {
+        let mut rng = crate::sampling::Pcg32::new(7, 3);
+        let grey: Vec<u8> = (0..6 * 4)
+            .flat_map(|_| {
+                let v = (rng.next_f32() * 256.0) as u8;
+                [v, v, v, 255]
+            })
+            .collect();
+        for space in [ColorSpace::Srgb, ColorSpace::Linear] {
+            let floats = grey
+                .chunks_exact(4)
+                .map(|c| Vec4::new(c[0] as f32, c[1] as f32, c[2] as f32, c[3] as f32) / 255.0)
+                .collect();
+            let a = Texture::from_rgba8(6, 4, &grey, space).unwrap();
+            assert!(matches!(a.texels, Texels::Grey8 { .. }), "{space:?}");
+            let b = Texture::from_rgba(6, 4, floats, space).unwrap();
+            assert!(a.texels().eq(b.texels()));
+            for _ in 0..200 {
+                let uv = Vec2::new(rng.next_f32() * 4.0 - 2.0, rng.next_f32() * 4.0 - 2.0);
+                for filter in [Filter::Linear, Filter::Nearest] {
+                    let s = Sampler {
+                        filter,
+                        ..Sampler::default()
+                    };
+                    let (x, y) = (a.sample_with(uv, s), b.sample_with(uv, s));
+                    assert_eq!(x, y, "{space:?} {filter:?} at {uv}");
+                }
+            }
+        }
+        for (k, v) in [(1, 7), (3, 254)] {
+            let mut bytes = grey.clone();
+            bytes[4 * 5 + k] = v;
+            let t = Texture::from_rgba8(6, 4, &bytes, ColorSpace::Linear).unwrap();
+            assert!(matches!(t.texels, Texels::Rgba8 { .. }), "byte {k} = {v}");
+        }
     }
 
     #[test]
