@@ -7,6 +7,15 @@
 //! intersection-friendly layout, so traversal reads them contiguously and never goes through
 //! `primitive_indices`; each slot remembers the scene triangle it came from.
 //!
+//! Watertight triangles: the triangle test is Woop, Benthin and Wald's (2013), so a ray
+//! through an edge or vertex that triangles share hits one of them (`intersect_triangle`).
+//! The node test is obvhs' slab test, which is not widened for rounding (Ize 2013): a ray that
+//! grazes a box exactly at a corner, or runs along a face from an origin on it, may still miss
+//! what is inside. Of the watertightness test's rays through a closed UV sphere, traced
+//! through the BVH, 16 of 3,382 aimed at its vertices from inside missed it, and 1,035 of
+//! 41,362 from its exact centre, whose coordinates lie on box faces; none of 200,000 random
+//! rays from inside did.
+//!
 //! Self-intersection: callers offset ray origins with
 //! [`crate::geometry::offset_ray_origin`]; on top of that every query ignores hits with
 //! `t <= t_min`, where `t_min = 16 * f32::EPSILON * max(1, largest absolute coordinate of the
@@ -44,7 +53,7 @@
 //! render gained 1-4%, too little for the restructuring it needs).
 
 use crate::geometry::Ray;
-use glam::{Vec2, Vec3, Vec3A};
+use glam::{Vec2, Vec3, Vec3A, Vec3Swizzles};
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::node::Bvh2Node;
 use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
@@ -54,7 +63,6 @@ use obvhs::cwbvh::node::CwBvhNode;
 use obvhs::cwbvh::CwBvh;
 use obvhs::ploc::PlocBuilder;
 use obvhs::ray::{Ray as BvhRay, RayHit};
-use obvhs::rt_triangle::RtTriangle;
 use obvhs::BvhBuildParams;
 
 /// An obvhs CWBVH over the scene's triangles.
@@ -62,7 +70,7 @@ pub struct Accel {
     /// `None` when the scene has no triangles (every ray misses).
     bvh: Option<CwBvh>,
     /// Triangles in BVH order (`tris[i]` is primitive slot `i`).
-    tris: Vec<RtTriangle>,
+    tris: Vec<Triangle>,
     /// Scene triangle index of each slot.
     ids: Vec<u32>,
     /// Bit `i % 64` of word `i / 64` is set when slot `i` is alpha-tested; empty when no
@@ -132,10 +140,7 @@ impl Accel {
         let tris = bvh
             .primitive_indices
             .iter()
-            .map(|&i| {
-                let [a, b, c] = triangles[i as usize].map(vertex);
-                RtTriangle::new(a, b, c)
-            })
+            .map(|&i| Triangle::new(triangles[i as usize].map(vertex)))
             .collect();
         let ids = bvh.primitive_indices.clone();
         let mut bits = vec![0u64; ids.len().div_ceil(64)];
@@ -236,6 +241,7 @@ impl Accel {
     unsafe fn packet_avx2(&self, bvh: &CwBvh, rays: &[Ray], hits: &mut [Option<AccelHit>]) {
         let t_min = self.t_min;
         let mut lanes = [BvhRay::new_inf(Vec3A::ZERO, Vec3A::X); PACKET_WIDTH];
+        let mut shears = [Shear::new(&lanes[0]); PACKET_WIDTH];
         // Lanes still to traverse, and each lane's octant.
         let mut todo = 0u32;
         let mut octant = [0u32; PACKET_WIDTH];
@@ -243,6 +249,7 @@ impl Accel {
             hits[i] = None;
             if let Some(r) = bvh_ray(ray, t_min) {
                 lanes[i] = r;
+                shears[i] = Shear::new(&r);
                 octant[i] = octant_inv4(&r.direction);
                 todo |= 1 << i;
             }
@@ -262,7 +269,7 @@ impl Accel {
             // SAFETY: the caller's CPU has AVX2.
             unsafe {
                 avx2::closest_packet(bvh, &lanes, group, oct_inv4, &mut found, |lane, r, id| {
-                    let (t, b) = intersect_triangle(&tris[id], r, t_min);
+                    let (t, b) = intersect_triangle(&tris[id], r, &shears[lane], t_min);
                     if t < r.tmax {
                         barycentrics[lane] = b;
                     }
@@ -371,8 +378,9 @@ impl Accel {
         let mut hit = RayHit::none();
         let mut barycentrics = Vec2::ZERO;
         let tris = &self.tris;
+        let shear = Shear::new(&r);
         if !traverse_closest(node_test(), bvh, r, &mut hit, |r, id| {
-            let (t, b) = intersect_triangle(&tris[id], r, t_min);
+            let (t, b) = intersect_triangle(&tris[id], r, &shear, t_min);
             // obvhs keeps a hit exactly when it is nearer than the ray's current end.
             if t < r.tmax {
                 if !self.counts::<FILTER>(id, b, &mut stops) {
@@ -403,8 +411,9 @@ impl Accel {
             return false;
         };
         let tris = &self.tris;
+        let shear = Shear::new(&r);
         !traverse_miss(node_test(), bvh, r, |r, id| {
-            let (t, b) = intersect_triangle(&tris[id], r, t_min);
+            let (t, b) = intersect_triangle(&tris[id], r, &shear, t_min);
             if t < r.tmax && !self.counts::<FILTER>(id, b, &mut stops) {
                 return f32::INFINITY;
             }
@@ -903,26 +912,116 @@ mod avx2 {
     }
 }
 
-/// obvhs' `RtTriangle::intersect` (Möller-Trumbore, the same operations, so the same `t`),
-/// which also returns the barycentric weights `(u, v)` of the second and third vertices that
-/// it computes on the way; `t` is infinite for a miss or a hit at or before `t_min`.
-#[inline(always)]
-fn intersect_triangle(tri: &RtTriangle, ray: &BvhRay, t_min: f32) -> (f32, Vec2) {
-    let c = tri.v0 - ray.origin;
-    let r = ray.direction.cross(c);
-    let inv_det = 1.0 / tri.ng.dot(ray.direction);
-    let u = r.dot(tri.e2) * inv_det;
-    let v = r.dot(tri.e1) * inv_det;
-    let w = 1.0 - u - v;
-    // All three non-negative, -0.0 included as negative (as in obvhs).
-    let signs = u.to_bits() | v.to_bits() | w.to_bits();
-    if inv_det != 0.0 && signs & 0x8000_0000 == 0 {
-        let t = tri.ng.dot(c) * inv_det;
-        if t >= ray.tmin && t <= ray.tmax && t > t_min {
-            return (t, Vec2::new(u, v));
+/// A triangle's three vertices as the scene gives them, by axis: `p[k]` holds the `k`
+/// coordinates of the first, second and third vertex. The [watertight test](
+/// intersect_triangle) needs the shared vertices of neighbouring triangles bit for bit, which
+/// edges stored as differences (obvhs' `RtTriangle`) do not keep, and by axis it reads the
+/// three vertices' coordinates along the ray's permuted axes as three loads.
+#[derive(Clone, Copy, Debug)]
+struct Triangle {
+    p: [Vec3A; 3],
+}
+
+impl Triangle {
+    fn new(v: [Vec3A; 3]) -> Self {
+        Self {
+            p: [0, 1, 2].map(|k| Vec3A::new(v[0][k], v[1][k], v[2][k])),
         }
     }
-    (f32::INFINITY, Vec2::ZERO)
+}
+
+/// What the watertight triangle test needs of a ray, computed once per ray (Woop, Benthin and
+/// Wald 2013): the axis `z` its direction is largest along and the other two, `x` and `y`
+/// (swapped where the direction's `z` is negative, which keeps the winding); the shear
+/// `S_z = 1 / d_z`, `S_x = d_x S_z`, `S_y = d_y S_z` that makes the ray the `z` axis; and the
+/// origin's coordinates on those axes.
+#[derive(Clone, Copy, Debug)]
+struct Shear {
+    /// The axes `x`, `y`, `z` of the sheared frame (indices into world x, y, z).
+    k: [usize; 3],
+    /// `S_x`, `S_y`, `S_z`.
+    s: [f32; 3],
+    /// The ray origin's coordinates along `k`.
+    o: [f32; 3],
+}
+
+impl Shear {
+    #[inline(always)]
+    fn new(ray: &BvhRay) -> Self {
+        let (d, o) = (ray.direction.to_array(), ray.origin.to_array());
+        let a = ray.direction.abs();
+        let kz = if a.x >= a.y {
+            if a.x >= a.z {
+                0
+            } else {
+                2
+            }
+        } else if a.y >= a.z {
+            1
+        } else {
+            2
+        };
+        let (kx, ky) = if d[kz] < 0.0 {
+            ((kz + 2) % 3, (kz + 1) % 3)
+        } else {
+            ((kz + 1) % 3, (kz + 2) % 3)
+        };
+        // One division: any `S` serves, as long as every triangle sees the same.
+        let sz = 1.0 / d[kz];
+        Self {
+            k: [kx, ky, kz],
+            s: [d[kx] * sz, d[ky] * sz, sz],
+            o: [o[kx], o[ky], o[kz]],
+        }
+    }
+}
+
+/// The watertight ray-triangle test of Woop, Benthin and Wald (2013), as Embree's robust mode
+/// and pbrt-v4 use it. In the ray's sheared frame ([`Shear`]) the ray is the `z` axis: each
+/// vertex relative to the origin becomes `(a_x - S_x a_z, a_y - S_y a_z, S_z a_z)`, and the
+/// triangle's 2D edge functions `U`, `V`, `W` at the origin decide the hit: all of one sign.
+/// Two triangles sharing an edge compute its function from the same transformed vertices, so
+/// one gets exactly the negation of the other's and a ray through the edge hits one of them
+/// (both, at an exact zero); an exact zero is recomputed in double precision, whose products
+/// of two floats are exact, so its sign is right. Möller-Trumbore, which this replaced, let
+/// one in eight rays aimed at a UV sphere's edges from inside pass between two triangles
+/// (tested). The three vertices go through it together, one per lane.
+///
+/// Returns `t` and the barycentric weights `(V, W) / (U + V + W)` of the second and third
+/// vertices; `t` is infinite for a miss, a ray parallel to the triangle, or a hit outside
+/// `[ray.tmin, ray.tmax]` or at or before `t_min`. Both sides count.
+#[inline(always)]
+fn intersect_triangle(tri: &Triangle, ray: &BvhRay, shear: &Shear, t_min: f32) -> (f32, Vec2) {
+    const MISS: (f32, Vec2) = (f32::INFINITY, Vec2::ZERO);
+    let ([kx, ky, kz], [sx, sy, sz], [ox, oy, oz]) = (shear.k, shear.s, shear.o);
+    // The three vertices' sheared coordinates, one vertex per lane.
+    let z = tri.p[kz] - Vec3A::splat(oz);
+    let x = (tri.p[kx] - Vec3A::splat(ox)) - Vec3A::splat(sx) * z;
+    let y = (tri.p[ky] - Vec3A::splat(oy)) - Vec3A::splat(sy) * z;
+    // (U, V, W) = (c_x b_y - c_y b_x, a_x c_y - a_y c_x, b_x a_y - b_y a_x).
+    let (x1, y1) = (x.yzx(), y.yzx());
+    let (x2, y2) = (x.zxy(), y.zxy());
+    let mut uvw = x2 * y1 - y2 * x1;
+    if uvw.cmpeq(Vec3A::ZERO).any() {
+        let e = |i: usize, j: usize| {
+            (f64::from(x[i]) * f64::from(y[j]) - f64::from(y[i]) * f64::from(x[j])) as f32
+        };
+        uvw = Vec3A::new(e(2, 1), e(0, 2), e(1, 0));
+    }
+    if uvw.cmplt(Vec3A::ZERO).any() && uvw.cmpgt(Vec3A::ZERO).any() {
+        return MISS;
+    }
+    let det = uvw.x + uvw.y + uvw.z;
+    if det == 0.0 {
+        return MISS;
+    }
+    let inv_det = 1.0 / det;
+    let t = uvw.dot(z * sz) * inv_det;
+    if t >= ray.tmin && t <= ray.tmax && t > t_min {
+        (t, Vec2::new(uvw.y * inv_det, uvw.z * inv_det))
+    } else {
+        MISS
+    }
 }
 
 /// obvhs' `medium_build` preset, which [`build_cwbvh`] follows step by step.
@@ -1046,16 +1145,17 @@ mod tests {
             };
             let (bvh, r) = accel.bvh_ray(&ray, accel.t_min).unwrap();
             let tris = &accel.tris;
+            let shear = Shear::new(&r);
             let closest = |test| {
                 let mut hit = RayHit::none();
                 let found = traverse_closest(test, bvh, r, &mut hit, |r, id| {
-                    intersect_triangle(&tris[id], r, accel.t_min).0
+                    intersect_triangle(&tris[id], r, &shear, accel.t_min).0
                 });
                 (found, hit.t.to_bits(), found.then_some(hit.primitive_id))
             };
             let miss = |test| {
                 traverse_miss(test, bvh, r, |r, id| {
-                    intersect_triangle(&tris[id], r, accel.t_min).0
+                    intersect_triangle(&tris[id], r, &shear, accel.t_min).0
                 })
             };
             let sse = closest(NodeTest::Sse);
@@ -1238,6 +1338,73 @@ mod tests {
         let r = Ray::new(Vec3::ZERO, Vec3::Z);
         assert!(a.intersect(&r).is_none());
         assert!(!a.occluded(&r));
+    }
+
+    /// A closed UV sphere, its triangles sharing edges and vertices bit for bit.
+    fn uv_sphere(rings: u32, segments: u32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+        let mut p = vec![Vec3::Y, -Vec3::Y];
+        for i in 1..rings {
+            let theta = std::f32::consts::PI * i as f32 / rings as f32;
+            for j in 0..segments {
+                let phi = std::f32::consts::TAU * j as f32 / segments as f32;
+                p.push(Vec3::new(
+                    theta.sin() * phi.cos(),
+                    theta.cos(),
+                    theta.sin() * phi.sin(),
+                ));
+            }
+        }
+        let at = |i: u32, j: u32| 2 + (i - 1) * segments + j % segments;
+        let mut t = Vec::new();
+        for j in 0..segments {
+            t.push([0, at(1, j + 1), at(1, j)]);
+            t.push([1, at(rings - 1, j), at(rings - 1, j + 1)]);
+            for i in 1..rings - 1 {
+                let [a, b, c, d] = [at(i, j), at(i, j + 1), at(i + 1, j), at(i + 1, j + 1)];
+                t.push([a, b, d]);
+                t.push([a, d, c]);
+            }
+        }
+        (p, t)
+    }
+
+    /// Watertightness of the triangle test: every ray from a point inside a closed mesh
+    /// toward one of its shared edges or vertices hits one of its triangles. With
+    /// Möller-Trumbore, 51,400 of these 413,620 rays passed between two triangles.
+    #[test]
+    fn rays_through_shared_edges_and_vertices_hit_a_closed_mesh() {
+        let (p, t) = uv_sphere(12, 16);
+        let tris: Vec<Triangle> = t
+            .iter()
+            .map(|t| Triangle::new(t.map(|i| Vec3A::from(p[i as usize]))))
+            .collect();
+        let mut rnd = xorshift(17);
+        let mut targets = p.clone();
+        for tri in &t {
+            for e in 0..3 {
+                let (a, b) = (p[tri[e] as usize], p[tri[(e + 1) % 3] as usize]);
+                for k in 1..40 {
+                    targets.push(a.lerp(b, k as f32 / 40.0));
+                }
+            }
+        }
+        let t_min = 16.0 * f32::EPSILON;
+        let (mut lost, mut rays) = (0, 0);
+        for k in 0..10 {
+            let origin = (Vec3::new(rnd(), rnd(), rnd()) - 0.5) * if k == 0 { 0.0 } else { 0.8 };
+            for &q in &targets {
+                let r = bvh_ray(&Ray::new(origin, (q - origin).normalize()), t_min).unwrap();
+                let shear = Shear::new(&r);
+                rays += 1;
+                if !tris
+                    .iter()
+                    .any(|tri| intersect_triangle(tri, &r, &shear, t_min).0.is_finite())
+                {
+                    lost += 1;
+                }
+            }
+        }
+        assert_eq!(lost, 0, "{lost} of {rays} rays left the closed mesh");
     }
 
     #[test]
