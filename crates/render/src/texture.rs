@@ -569,6 +569,16 @@ mod tests {
         assert!((TextureRef::new(0).sample(uvs, &textures).x - 15.0).abs() < 1e-5);
     }
 
+    /// The texture of RGBA `bytes` decoded to floats at load time, as 8-bit textures were
+    /// before they kept their bytes.
+    fn decoded_at_load(width: u32, height: u32, bytes: &[u8], space: ColorSpace) -> Texture {
+        let floats = bytes
+            .chunks_exact(4)
+            .map(|c| Vec4::new(c[0] as f32, c[1] as f32, c[2] as f32, c[3] as f32) / 255.0)
+            .collect();
+        Texture::from_rgba(width, height, floats, space).unwrap()
+    }
+
     /// Bytes kept as bytes sample to exactly the values of decoding them at load time.
     #[test]
     fn rgba8_samples_as_decoded_floats() {
@@ -577,12 +587,8 @@ mod tests {
             .map(|_| (rng.next_f32() * 256.0) as u8)
             .collect();
         for space in [ColorSpace::Srgb, ColorSpace::Linear] {
-            let floats = bytes
-                .chunks_exact(4)
-                .map(|c| Vec4::new(c[0] as f32, c[1] as f32, c[2] as f32, c[3] as f32) / 255.0)
-                .collect();
             let a = Texture::from_rgba8(5, 3, &bytes, space).unwrap();
-            let b = Texture::from_rgba(5, 3, floats, space).unwrap();
+            let b = decoded_at_load(5, 3, &bytes, space);
             assert!(a.texels().eq(b.texels()));
             for _ in 0..200 {
                 let uv = Vec2::new(rng.next_f32() * 4.0 - 2.0, rng.next_f32() * 4.0 - 2.0);
@@ -604,13 +610,9 @@ mod tests {
             })
             .collect();
         for space in [ColorSpace::Srgb, ColorSpace::Linear] {
-            let floats = grey
-                .chunks_exact(4)
-                .map(|c| Vec4::new(c[0] as f32, c[1] as f32, c[2] as f32, c[3] as f32) / 255.0)
-                .collect();
             let a = Texture::from_rgba8(6, 4, &grey, space).unwrap();
             assert!(matches!(a.texels, Texels::Grey8 { .. }), "{space:?}");
-            let b = Texture::from_rgba(6, 4, floats, space).unwrap();
+            let b = decoded_at_load(6, 4, &grey, space);
             assert!(a.texels().eq(b.texels()));
             for _ in 0..200 {
                 let uv = Vec2::new(rng.next_f32() * 4.0 - 2.0, rng.next_f32() * 4.0 - 2.0);
