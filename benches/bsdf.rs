@@ -1,7 +1,7 @@
 //! BSDF benchmarks: each model's `sample`, `eval` and `pdf` on a batch of fixed random
 //! directions, the light choice that weighs emitters by each model's BSDF in SIMD lanes
 //! (`LightSampler::sample_li` on `rainy_street`'s road), and the closed-enum dispatch of [`Bsdf`] against
-//! a trait-object version of the same calls (DESIGN.md and STYLE.md choose the enum; this
+//! a trait-object version of the same calls (docs/design.md chooses the enum; this
 //! measures the choice).
 //!
 //! The Owen-scrambled Sobol sampler's `next_1d` and `next_2d` are measured here too.

@@ -13,7 +13,7 @@
 //! against single-ray traversal, bit for bit.
 //!
 //! Before the timed runs the bench prints the peak heap memory of one 1M-triangle build (a
-//! counting global allocator wraps the system one), for the "< 300 MB" target of BENCHMARKS.md.
+//! counting global allocator wraps the system one), for the "< 300 MB" target in docs/benchmarks.md.
 //!
 //! Run: `cargo bench --bench bvh` (`cargo bench --bench bvh -- coherent` for the coherent rays
 //! alone). The ray benches are skipped, with a message, when the scene file is missing.

@@ -65,10 +65,10 @@ pub struct Args {
     pub no_regularize: bool,
 }
 
-/// The default cap of samples per pixel per eye (see BENCHMARKS.md, "Adaptive sampling").
+/// The default cap of samples per pixel per eye (see docs/decisions/0013).
 pub const DEFAULT_SPP: u32 = 64;
 
-/// The default adaptive-sampling target of a dataset (see BENCHMARKS.md, "Adaptive sampling").
+/// The default adaptive-sampling target of a dataset (see docs/benchmarks.md, "Adaptive sampling").
 pub const DEFAULT_NOISE_TARGET: f64 = 0.1;
 
 /// `--noise-target`: a positive, finite relative standard error, or `off` (`None`). Kept as

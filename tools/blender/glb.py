@@ -4,7 +4,7 @@ The Lambert variant isolates the exporter's lights and emission from the materia
 material that Cycles renders as a pure Lambertian (a Principled BSDF with Specular IOR Level 0,
 metallic 0, no coat, transmission or textures) gets `extras.streaks = {"bsdf": "ggx", "kd":
 the exported baseColorFactor, "ks": 0, "alpha": 1}`, which streaks renders as exactly
-`kd / pi` (the paper models of DESIGN.md), whatever glTF material extensions it honours.
+`kd / pi` (the paper models of docs/design.md), whatever glTF material extensions it honours.
 Lights, emission, geometry and camera are the exporter's, unchanged.
 """
 

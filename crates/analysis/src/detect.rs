@@ -23,7 +23,7 @@
 //!    elongation.
 //!
 //! [`score_mask`] compares a detection mask with a ground-truth mask (precision and recall).
-//! Coordinates follow DESIGN.md: image x and y with pixel centres at `i + 0.5`; rows are indices.
+//! Coordinates follow docs/design.md: image x and y with pixel centres at `i + 0.5`; rows are indices.
 
 use crate::filter::{median, Axis};
 use streaks_image::GrayImage;

@@ -22,7 +22,7 @@
 //! this cuts the integer search by about `2^(levels-1)`, and the coarse levels see a larger
 //! part of the image, which steers a window with repetitive texture to the right match.
 //!
-//! Coordinates follow DESIGN.md: `x` is an image coordinate in pixels (pixel `i` covers
+//! Coordinates follow docs/design.md: `x` is an image coordinate in pixels (pixel `i` covers
 //! `[i, i+1)`, its centre is `i + 0.5`); rows are pixel indices; `d = x_left - x_right`.
 
 use streaks_image::{GrayImage, ImageError, Region};

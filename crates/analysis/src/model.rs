@@ -4,7 +4,7 @@
 //!
 //! # Frame and conventions
 //!
-//! Everything is in the road frame of DESIGN.md: metres, Y up, the road is the plane Y = 0,
+//! Everything is in the road frame of docs/design.md: metres, Y up, the road is the plane Y = 0,
 //! Z points forward (from the viewer towards the light), X to the right. Eq. 4 uses only dot
 //! products and reflections, so the frame's handedness does not matter. All maths is in `f64`
 //! ([`glam::DVec3`]) so that the proposition's invariance holds to `f64` precision.

@@ -17,7 +17,7 @@
 //!    the PFM convention.
 //!
 //! Memory: `2 W H D` bytes (128 MB for a megapixel at D = 64) plus row buffers.
-//! Disparity follows DESIGN.md: `d = x_left - x_right`; the range `[min_disp, max_disp]` may
+//! Disparity follows docs/design.md: `d = x_left - x_right`; the range `[min_disp, max_disp]` may
 //! include negative values (photographs aligned by hand).
 
 use rayon::prelude::*;

@@ -7,7 +7,7 @@
 //! from the top row to the bottom row (like a road: slanted, constant along each row); boxes in
 //! front of it carry constant disparities. The right image sees, at each pixel, the front-most
 //! surface (largest disparity), so occlusions are physically consistent. Pixels are sampled at
-//! their centres; disparity follows DESIGN.md: `d = x_left - x_right`.
+//! their centres; disparity follows docs/design.md: `d = x_left - x_right`.
 
 use std::path::Path;
 use streaks_image::pfm::write_pfm;

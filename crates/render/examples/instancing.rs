@@ -4,7 +4,7 @@
 //! over the instances) and one where each node has its own copy of it (flattened into 2.3 M
 //! world triangles). Prints, for each: load time (file to BVH, best of `--loads`), stored
 //! triangles, approximate heap memory of the geometry and BVHs, and the time of a render
-//! (320x240, 4 spp, max depth 3). Figures in BENCHMARKS.md ("Instancing").
+//! (320x240, 4 spp, max depth 3). Figures in docs/benchmarks.md ("Instancing").
 //!
 //! Run: `cargo run --release -p streaks-render --example instancing [-- --loads N]`.
 

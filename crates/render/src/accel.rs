@@ -48,8 +48,8 @@
 //! Packets: [`Accel::intersect_packet`] traverses up to [`PACKET_WIDTH`] rays together (one
 //! node stack per packet, each node's child boxes tested against every active ray in AVX2
 //! lanes, one lane per ray) and finds, for each ray, exactly the hit of
-//! [`Accel::intersect`] (see [`Accel::intersect_packet`] for why). BENCHMARKS.md ("Coherent
-//! rays") measures it against one ray at a time; the integrator does not use it (a whole
+//! [`Accel::intersect`] (see [`Accel::intersect_packet`] for why); docs/decisions/0006
+//! measures it against one ray at a time; the integrator does not use it (a whole
 //! render gained 1-4%, too little for the restructuring it needs).
 
 use crate::geometry::Ray;
@@ -1030,7 +1030,7 @@ const BUILD_PARAMS: BvhBuildParams = BvhBuildParams::medium_build();
 /// How many nodes the reinsertion optimiser moves, at most: all of them up to this many
 /// triangles, `BUILD_PARAMS`' 5% from twenty times as many on. A full pass gives street-size
 /// scenes a better BVH for a build time that grows with the triangle count, so large scenes
-/// keep the preset's share (BENCHMARKS.md has the measurements).
+/// keep the preset's share (docs/decisions/0012 has the measurements).
 const REINSERTION_BUDGET: f32 = 50_000.0;
 
 /// The reinsertion batch ratio for `triangles` triangles (see [`REINSERTION_BUDGET`]).
@@ -1045,7 +1045,7 @@ const PLOC_SEARCH_DISTANCE: usize = 14;
 /// Builds a CWBVH over primitives given by their bounding boxes, as obvhs'
 /// `build_cwbvh_from_tris` does with `medium_build` but with `reinsertion_ratio` as the
 /// reinsertion batch ratio, and with a lower peak memory (with the preset's ratio, the BVH is
-/// the same; BENCHMARKS.md has the figures):
+/// the same; docs/decisions/0012 has the figures):
 /// - the PLOC leaves are made straight from the boxes, without a triangle soup (48 bytes per
 ///   triangle) or a pre-sized builder (whose Morton buffer is twice what a 64-bit sort needs);
 /// - the builder's buffers are freed before reinsertion, and the reinsertion's parent links

@@ -1,4 +1,4 @@
-//! The pinhole camera of DESIGN.md.
+//! The pinhole camera of docs/design.md.
 //!
 //! A glTF perspective camera looks along its node's local -Z with local +Y up. Pixels: x to
 //! the right, y down; pixel (i, j) covers [i, i+1) x [j, j+1). Focal length in pixels

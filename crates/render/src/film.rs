@@ -7,7 +7,7 @@
 //! whatever the sample count.
 //!
 //! A sample whose radiance (or specular part) is NaN or infinite is dropped and counted,
-//! never accumulated (DESIGN.md).
+//! never accumulated (docs/design.md).
 //!
 //! For adaptive sampling ([`crate::integrator::RenderSettings::noise_target`]) each pixel also
 //! keeps the running mean and sum of squared deviations of its kept samples' luminance

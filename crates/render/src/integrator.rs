@@ -21,7 +21,7 @@
 //! On a night street the light of the second and later indirect bounces is about 1% of the
 //! image and paths through them were a third of the work; starting at 3 instead of 5 took
 //! 20-30% off a render's time and added under 0.5% to its error at equal samples
-//! (BENCHMARKS.md, "Russian roulette from depth 3").
+//! (docs/decisions/0009-russian-roulette-from-depth-3.md).
 //!
 //! Shading uses the interpolated shading normal's frame (through the material's normal map, if
 //! any: [`crate::normal_map`]); a direction must also lie on the same side of the *geometric*
@@ -105,8 +105,8 @@
 //! moves it by 1/256, and a kind of rare path that a region has (every pixel of a wet patch
 //! sees the lamp now and then) is in the pooled variance long before the tile stops. Measured
 //! against a pixel rule with the tile's pooled variance as a floor, Cycles-like dilation of
-//! unconverged pixels, and pixel statistics without each pixel's largest sample (BENCHMARKS.md,
-//! "Adaptive sampling"), the tile rule was the least biased for its cost; its price is that a
+//! unconverged pixels, and pixel statistics without each pixel's largest sample
+//! (docs/decisions/0013), the tile rule was the least biased for its cost; its price is that a
 //! tile's pixels all take the same count. The bias left is within the noise of fixed-spp
 //! renders on the measured streets, not zero (a rare path rare even at the tile's scale still
 //! stops the tile early).

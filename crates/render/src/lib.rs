@@ -20,7 +20,7 @@
 //! - [`simd`]: the SIMD width (SSE, AVX2, AVX-512) of the hot kernels, chosen at run time.
 //! - [`scene`]: loading glTF 2.0 and OBJ into a [`scene::Scene`], with errors that name the file
 //!   and the element.
-//! - [`camera`]: the pinhole camera of DESIGN.md (pixel centres at `i + 0.5`, `f = (H/2)/tan(yfov/2)`).
+//! - [`camera`]: the pinhole camera of docs/design.md (pixel centres at `i + 0.5`, `f = (H/2)/tan(yfov/2)`).
 //! - [`integrator`]: unidirectional path tracing with next-event estimation and MIS.
 //! - [`film`]: the box-filtered film with its layers; [`output`]: the renderer's EXR layout
 //!   (images, regions, file formats and comparisons are the `streaks-image` crate's).

@@ -6,7 +6,7 @@
 //! folder (`scene.xml`, `meshes/*.ply`, `textures/*.exr`), each file through a temporary file
 //! and a rename.
 //!
-//! # Mapping (DESIGN.md, "Mitsuba 3 as the reference")
+//! # Mapping (docs/design.md, "Mitsuba 3 as the reference")
 //!
 //! | ours | Mitsuba 3 | exact? |
 //! |---|---|---|
@@ -255,7 +255,7 @@ fn v3(v: Vec3) -> String {
 /// The `blendbsdf` weight `w` (the roughconductor's share) for a paper material whose largest
 /// diffuse and specular reflectances are `kd_max` and `ks_max`. The blend of diffuse with
 /// reflectance `kd / (1 - w)` and roughconductor with `ks / w` equals ours, and Mitsuba requires
-/// both reflectances to be at most 1. DESIGN.md's mapping (w = 0.5: diffuse 2 kd, conductor
+/// both reflectances to be at most 1. docs/design.md's mapping (w = 0.5: diffuse 2 kd, conductor
 /// 2 ks) is used whenever it is valid; otherwise w = ks_max / (kd_max + ks_max). The flag is
 /// false when kd_max + ks_max > 1, where no weight is exact.
 fn blend_weight(kd_max: f32, ks_max: f32) -> (f32, bool) {

@@ -149,7 +149,7 @@ enum Texels {
     /// An 8-bit image whose every texel is grey and opaque (`r = g = b`, `a = 255`; a grey
     /// PNG such as a road's asphalt), one byte per texel, decoded as [`Texels::Rgba8`] would:
     /// the same values in a quarter of its memory, so that a street's textures stay in the
-    /// core's cache (BENCHMARKS.md, "Grey textures in one byte").
+    /// core's cache (docs/decisions/0017-textures-as-bytes.md).
     Grey8 { texels: Vec<u8>, srgb: bool },
     /// Linear float RGBA (16-bit and float images, procedural textures).
     Rgba32F(Vec<Vec4>),

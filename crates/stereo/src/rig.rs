@@ -1,6 +1,6 @@
-//! The rectified stereo rig of DESIGN.md: two pinhole eyes with parallel axes.
+//! The rectified stereo rig of docs/design.md: two pinhole eyes with parallel axes.
 //!
-//! Conventions (all from DESIGN.md):
+//! Conventions (all from docs/design.md):
 //! - World: right-handed, +Y up, metres; the road is the plane Y = 0.
 //! - An eye looks along its local -Z with local +Y up and local +X to its right (glTF).
 //! - Pixels: x right, y down; pixel (i, j) has its centre at (i + 0.5, j + 0.5); the principal

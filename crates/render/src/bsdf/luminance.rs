@@ -79,7 +79,8 @@ impl LuminanceEval {
 impl LuminanceEval {
     /// Whether its lobes call the C library per lane (Ward's `exp`, Blinn-Phong's `pow`):
     /// such a model is evaluated four lanes at a time even where wider lanes exist, since a
-    /// call per lane from a wide kernel costs more than the lanes save (BENCHMARKS.md).
+    /// call per lane from a wide kernel costs more than the lanes save
+    /// (docs/decisions/0003-light-choice-in-simd-lanes.md).
     #[inline]
     pub(crate) fn calls_libm(&self) -> bool {
         matches!(self.at, AtWo::Ward(_) | AtWo::BlinnPhong(_))

@@ -14,7 +14,7 @@
 //! an emitter mesh that `F` misses is found by BSDF sampling (and weighed by MIS), and a
 //! sharp lobe's view of a group by the cone rule below. A share of 10% cost the `crosscheck`
 //! road 1.7x its variance at 64 spp, and lowering it made no scene noisier
-//! (BENCHMARKS.md, "The defensive share"). At a transmissive BSDF the share stays 10%: its
+//! (docs/decisions/0008). At a transmissive BSDF the share stays 10%: its
 //! `F` leaves out the transmission, so a light behind it has this share alone.
 //!
 //! - An emitter's `E`: intensity, spot falloff and range window over `d^2` for point and spot
@@ -36,7 +36,7 @@
 //!   fell by 30 %. A cone not that much wider than the lobe keeps its anchor's `F`: the
 //!   anchor then lies in the lobe. (Raising every cone that holds the mirror direction made
 //!   a rough lens seen at grazing send its shadow rays to groups rather than to its bulb 0.1 m
-//!   away; BENCHMARKS.md, "Only cones much wider than the lobe".)
+//!   away; docs/decisions/0016-sharp-lobes-see-past-the-anchor.md.)
 //!
 //! The choice descends the tree from the root, one child per level, weighing a node's children
 //! once: at most `BRANCHING` (16) BSDF evaluations per level, all of a node's children in SIMD

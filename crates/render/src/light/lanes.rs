@@ -371,7 +371,7 @@ pub(crate) struct BsdfWeight {
 /// can hold the lobe where its anchor does not look. Without this test, a rough lens seen at
 /// grazing (GGX alpha 1) raised nearby groups in its mirror direction above the bulb 0.1 m
 /// away that lights it, and `rainy_street`'s lamp heads got noisier; with a ratio of 1 they
-/// got back only a third of that (BENCHMARKS.md, "Only cones much wider than the lobe").
+/// got back only a third of that (docs/decisions/0016-sharp-lobes-see-past-the-anchor.md).
 const SHARP_LOBE_CONE_RATIO: f32 = 4.0;
 
 /// A glossy lobe seen from `wo`, for the weight of a bounded child (group or emitter mesh):

@@ -2,7 +2,7 @@
 //!
 //! Units: a [`Light`] is radiometric, its intensity in W/sr (point, spot) and its irradiance in
 //! W/m^2 (directional), linear RGB. The glTF loader converts KHR_lights_punctual's photometric
-//! units (candela, lux) with [`LUMINOUS_EFFICACY`], as Blender's glTF importer does (DESIGN.md).
+//! units (candela, lux) with [`LUMINOUS_EFFICACY`], as Blender's glTF importer does (docs/design.md).
 //!
 //! `range` follows the specification's recommended window: the inverse-square law times
 //! `clamp(1 - (d / range)^4, 0, 1)`, so that light fades smoothly to exactly zero at

@@ -3,7 +3,7 @@
 //! lights, cameras and the BVH, loaded from glTF 2.0 (`.gltf`, `.glb`) or OBJ/MTL
 //! ([`Scene::load`]) or built from memory ([`Scene::from_parts`]).
 //!
-//! # The scene contract (see DESIGN.md)
+//! # The scene contract (see docs/design.md)
 //!
 //! - glTF: the default scene (else scene 0) is flattened, `world = parent * local`. Triangle
 //!   primitives (strips and fans are converted) become world-space triangles; points and lines
