@@ -8,10 +8,17 @@
 //! regions            what each region means
 //! methods[]          name, kind (built-in, command), description
 //! summary[]          per method: pooled errors by region, phantom-hole rate, seconds,
-//!                    megapixels, seconds per megapixel
+//!                    megapixels, seconds per megapixel, samples, failed (how many of them
+//!                    the method failed on)
 //! samples[]          per sample: id, folder, size, whether it has a road mask, and per
-//!                    method the same figures for that sample alone
+//!                    method the same figures for that sample alone, with `failure` (kind,
+//!                    reason, stderr_tail, stdout_tail) when the method failed on it
+//! failure_scoring    how a failed sample counts in the scores
 //! ```
+//!
+//! A method that fails on a sample (a command that exits non-zero, runs past its time limit, is
+//! killed by a signal, writes no map or an unreadable one or one of the wrong size) is scored
+//! on it as a map with no value at all ([`FAILURE_SCORING`]).
 //!
 //! Errors by region are [`RegionErrors`]: `all`, `streak`, `non_streak`, and with a road mask
 //! `road` (road surface off the streaks), `off_road` and `road_surface` (the whole road, whose
@@ -29,6 +36,12 @@ pub const FORMAT: &str = "streaks-benchmark/1";
 pub const AGGREGATION: &str = "pixel-weighted: every pixel of every sample counts once (the \
     KITTI convention); shares of valid pixels (EPE, bad-N, D1) over all samples' valid pixels, \
     shares of truth pixels (valid share, phantom holes) over all samples' truth pixels";
+
+/// How a failed sample counts, as the report states it.
+pub const FAILURE_SCORING: &str = "a sample a method failed on counts as a disparity map with \
+    no value: its pixels leave EPE, bad-N and D1 (figures over the pixels with a value) as they \
+    are and lower the valid share, and count as bad in bad_all; `failed` says how many samples \
+    that was";
 
 /// The regions, as the report states them.
 pub const REGIONS: [(&str, &str); 6] = [
@@ -65,6 +78,42 @@ pub struct Report {
     pub summary: Vec<MethodScore>,
     /// Per sample.
     pub samples: Vec<SampleReport>,
+    /// [`FAILURE_SCORING`].
+    pub failure_scoring: &'static str,
+}
+
+/// Why a method failed on a sample.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FailureKind {
+    /// The command could not be started (no such program, not executable).
+    Spawn,
+    /// It exited with a non-zero status.
+    Exit,
+    /// It was killed by a signal (not by the time limit).
+    Signal,
+    /// It ran past `--method-timeout`; its process group was killed.
+    Timeout,
+    /// It exited with status 0 but wrote no map.
+    NoOutput,
+    /// Its map is not a regular file, not a readable PFM, too large, or of the wrong size.
+    BadOutput,
+    /// A built-in method's error, or the run could not prepare the command.
+    Error,
+}
+
+/// A method's failure on one sample.
+#[derive(Clone, Debug, Serialize)]
+pub struct Failure {
+    /// What kind of failure.
+    pub kind: FailureKind,
+    /// What happened, in a sentence.
+    pub reason: String,
+    /// The end of the command's stderr (its last lines, at most a few thousand characters;
+    /// empty for a built-in).
+    pub stderr_tail: String,
+    /// The end of its stdout, likewise.
+    pub stdout_tail: String,
 }
 
 /// The input folder.
@@ -104,12 +153,30 @@ pub struct MethodScore {
     pub megapixels: f64,
     /// `seconds / megapixels`.
     pub seconds_per_megapixel: f64,
+    /// Samples these figures cover.
+    pub samples: usize,
+    /// How many of them the method failed on (scored as no value, see [`FAILURE_SCORING`]).
+    pub failed: usize,
+    /// Why the method failed on this sample (per-sample figures only; absent when it did
+    /// not).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub failure: Option<Failure>,
 }
 
 impl MethodScore {
-    /// The figures of `method` from its errors and time.
-    pub fn new(method: &str, errors: RegionErrors, seconds: f64, megapixels: f64) -> Self {
+    /// The figures of `method` on one sample from its errors and time, and its failure there
+    /// if it failed.
+    pub fn new(
+        method: &str,
+        errors: RegionErrors,
+        seconds: f64,
+        megapixels: f64,
+        failure: Option<Failure>,
+    ) -> Self {
         Self {
+            samples: 1,
+            failed: usize::from(failure.is_some()),
+            failure,
             method: method.to_string(),
             phantom_hole_rate: errors.phantom_hole_rate(),
             errors,
@@ -126,12 +193,17 @@ impl MethodScore {
     /// The pooled figures of one method's per-sample figures.
     pub fn pooled(method: &str, parts: &[&MethodScore]) -> Option<Self> {
         let errors: Vec<RegionErrors> = parts.iter().map(|p| p.errors).collect();
-        Some(Self::new(
-            method,
-            RegionErrors::pooled(&errors)?,
-            parts.iter().map(|p| p.seconds).sum(),
-            parts.iter().map(|p| p.megapixels).sum(),
-        ))
+        Some(Self {
+            samples: parts.iter().map(|p| p.samples).sum(),
+            failed: parts.iter().map(|p| p.failed).sum(),
+            ..Self::new(
+                method,
+                RegionErrors::pooled(&errors)?,
+                parts.iter().map(|p| p.seconds).sum(),
+                parts.iter().map(|p| p.megapixels).sum(),
+                None,
+            )
+        })
     }
 }
 
