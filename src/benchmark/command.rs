@@ -90,7 +90,7 @@ fn has_placeholder(word: &str) -> bool {
 /// `python3`, `/usr/bin/bash` -> `bash`).
 fn program_name(word: &str) -> &str {
     let base = word.rsplit('/').next().unwrap_or(word);
-    match base.find(|c: char| c == '.' || c == '-') {
+    match base.find(['.', '-']) {
         Some(i)
             if base[i + 1..]
                 .chars()

@@ -73,7 +73,7 @@ fn parse_timeout(s: &str) -> std::result::Result<Duration, String> {
         .trim()
         .parse()
         .map_err(|_| format!("{s:?} is not a number of seconds"))?;
-    if !(secs > 0.0) {
+    if secs.is_nan() || secs <= 0.0 {
         return Err(format!("{s} s: the time limit must be more than 0 s"));
     }
     Duration::try_from_secs_f64(secs).map_err(|_| format!("{s} s is too long a time limit"))

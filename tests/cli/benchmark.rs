@@ -248,11 +248,9 @@ fn bad_benchmark_input_fails_clearly_without_a_report() {
         &["pair", "--method-cmd", "q=sh -c 'run {left} > {out}'"],
         "program text",
     );
-    for bad in ["0", "-1", "soon"] {
-        fails(
-            &["pair", "--method", "sgm", "--method-timeout", bad],
-            "--method-timeout",
-        );
+    for bad in ["0", "-1", "soon", "inf"] {
+        let flag = format!("--method-timeout={bad}");
+        fails(&["pair", "--method", "sgm", &flag], "--method-timeout");
     }
 }
 
@@ -290,7 +288,7 @@ fn failing_commands_are_recorded_and_the_run_goes_on() {
     ];
     // Every failure is named on stderr, the report is written, and the exit status says so.
     let run = t.streaks(&args);
-    run.assert_failure_mentioning("6 method runs failed");
+    run.assert_failure_mentioning("7 method runs failed");
     let err = run.stderr();
     assert!(
         err.contains("method boom failed on sample \"pair\": exited with status 3")
@@ -338,7 +336,7 @@ fn failing_commands_are_recorded_and_the_run_goes_on() {
     allowed.push("--allow-failures");
     let run = t.streaks(&allowed);
     run.assert_success();
-    assert!(run.stderr().contains("warning: 6 method runs failed"));
+    assert!(run.stderr().contains("warning: 7 method runs failed"));
 }
 
 /// A dataset of two 96x64 samples at 4 spp in `dir` of the test folder.
@@ -354,52 +352,63 @@ fn tiny_dataset(t: &TestDir, dir: &str) {
 fn hostile_folder_names_reach_a_method_as_literal_paths() {
     let t = TestDir::new();
     tiny_dataset(&t, "ds");
-    // Placeholders, quotes, command substitutions, separators, a newline: in the old
-    // substitution, `{right}` inside the left path spliced an unquoted path into the line.
-    let name = "ds {out} {right} '\"$(touch PWNED1)\" `touch PWNED2`;touch PWNED3\n$HOME";
-    std::fs::rename(t.join("ds"), t.join(name)).unwrap();
+    let names = [
+        // The old substitution put `{right}`'s quoted path inside the quoted left path, which
+        // unquoted it: its command substitutions ran.
+        "ds {right} \"$(touch PWNED1)\" `touch PWNED2`;touch PWNED3",
+        // Placeholders, quotes, a newline, a variable.
+        "ds {out} {left} '\"$(touch PWNED4)\" it's\n$HOME;touch PWNED5 \\",
+    ];
     let recorder = "recorder=sh -c 'printf %s \"$1\" > args.txt; \
                     printf %s \"$STREAKS_LEFT|$STREAKS_OUT\" > env.txt' sh {left} {out}";
     let cmd = again();
-    t.streaks(&[
-        "benchmark",
-        name,
-        "--method",
-        "sgm",
-        "--method-cmd",
-        &cmd,
-        "--method-cmd",
-        recorder,
-        "--allow-failures",
-        "-o",
-        "out",
-    ])
-    .assert_success();
-    for f in ["PWNED1", "PWNED2", "PWNED3"] {
-        assert!(!t.join(f).exists(), "{f} was created");
-        assert!(!t.join(name).join(f).exists(), "{f} was created");
+    let mut from = "ds";
+    for name in names {
+        std::fs::rename(t.join(from), t.join(name)).unwrap();
+        from = name;
+        t.streaks(&[
+            "benchmark",
+            name,
+            "--method",
+            "sgm",
+            "--method-cmd",
+            &cmd,
+            "--method-cmd",
+            recorder,
+            "--allow-failures",
+            "-o",
+            "out",
+        ])
+        .assert_success();
+        for k in 1..=5 {
+            let f = format!("PWNED{k}");
+            assert!(!t.join(&f).exists(), "{name:?} created {f}");
+            assert!(!t.join(name).join(&f).exists(), "{name:?} created {f}");
+        }
+        let r = report(&t, "out");
+        // The command got the right images: it scores as `sgm` does.
+        assert_eq!(summary(&r, "again")["errors"], summary(&r, "sgm")["errors"]);
+        assert_eq!(summary(&r, "again")["failed"], 0);
+        // The path arrived byte for byte, as an argument and in the environment.
+        let left = t.path().join(name).join("samples/000001/im0.png");
+        let got = std::fs::read_to_string(t.join("args.txt")).unwrap();
+        assert_eq!(got, left.to_str().unwrap());
+        let env = std::fs::read_to_string(t.join("env.txt")).unwrap();
+        let (env_left, env_out) = env.split_once('|').unwrap();
+        assert_eq!(env_left, got);
+        // The output path is in the run's private folder, named by the sample's index.
+        assert!(env_out.ends_with("/000001-recorder.pfm"), "{env_out}");
+        assert!(
+            !std::path::Path::new(env_out).exists(),
+            "the private folder is left behind"
+        );
+        assert_eq!(summary(&r, "recorder")["failed"], 2);
     }
-    let r = report(&t, "out");
-    // The command got the right images: it scores as `sgm` does.
-    assert_eq!(summary(&r, "again")["errors"], summary(&r, "sgm")["errors"]);
-    assert_eq!(summary(&r, "again")["failed"], 0);
-    // The path arrived byte for byte, as an argument and in the environment.
-    let left = t.path().join(name).join("samples/000001/im0.png");
-    let got = std::fs::read_to_string(t.join("args.txt")).unwrap();
-    assert_eq!(got, left.to_str().unwrap());
-    let env = std::fs::read_to_string(t.join("env.txt")).unwrap();
-    let (env_left, env_out) = env.split_once('|').unwrap();
-    assert_eq!(env_left, got);
-    // The output path is in the run's private folder, named by the sample's index.
-    assert!(env_out.ends_with("/000001-recorder.pfm"), "{env_out}");
-    assert!(
-        !std::path::Path::new(env_out).exists(),
-        "the private folder is left behind"
-    );
-    assert_eq!(summary(&r, "recorder")["failed"], 2);
 }
 
 /// Runs `streaks ARGS` in `t`, and gives its exit status, stderr and peak memory (kB).
+// The child is reaped by wait4, which also gives its resource usage, not by `Child::wait`.
+#[allow(clippy::zombie_processes)]
 fn streaks_peak_memory(t: &TestDir, args: &[&str]) -> (bool, String, i64) {
     let child = std::process::Command::new(env!("CARGO_BIN_EXE_streaks"))
         .args(args)
