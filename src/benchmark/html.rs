@@ -394,8 +394,8 @@ pub fn page(report: &Report, thumbs: &[SampleThumbs]) -> String {
             .collect();
         let _ = write!(
             o,
-            "<p class=\"fail\" id=\"failed\">{}. A failed sample counts as a map with no \
-             value (see <a href=\"#failures\">Failures</a>).</p>",
+            "<p class=\"fail\" id=\"failed\">{}. A method's figures cover the samples it \
+             succeeded on (see <a href=\"#failures\">Failures</a>).</p>",
             each.join("; ")
         );
     }
@@ -424,6 +424,8 @@ pub fn page(report: &Report, thumbs: &[SampleThumbs]) -> String {
             .summary
             .iter()
             .enumerate()
+            // A method with no values at all (it failed on every sample) has no bar.
+            .filter(|(_, m)| m.errors.all.valid_pixels > 0)
             .filter_map(|(i, m)| f(m).map(|v| (m.method.clone(), colour(i).to_string(), v)))
             .collect()
     };

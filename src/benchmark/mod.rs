@@ -11,7 +11,7 @@
 //!
 //! Scoring is [`streaks_analysis::benchmark`]. Every method runs on every sample (a progress
 //! bar over samples x methods). A method that fails on a sample (see [`report::FailureKind`])
-//! is recorded as failed there with its reason and stderr tail, scored as a map with no value
+//! is recorded as failed there with its reason and output tails, left out of its summary
 //! ([`report::FAILURE_SCORING`]), and the run goes on; at the end both outputs are written
 //! atomically, the failures listed, and the command exits non-zero unless
 //! `--allow-failures`. Bad input (no samples, an unreadable ground truth or mask) still stops
@@ -339,7 +339,7 @@ fn summary_table(report: &Report) -> String {
                 if m.failed == m.samples {
                     ": every sample, it has no score"
                 } else {
-                    " (scored there as no value)"
+                    " (its figures cover the others)"
                 }
             ));
         }

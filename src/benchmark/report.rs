@@ -17,8 +17,8 @@
 //! ```
 //!
 //! A method that fails on a sample (a command that exits non-zero, runs past its time limit, is
-//! killed by a signal, writes no map or an unreadable one or one of the wrong size) is scored
-//! on it as a map with no value at all ([`FAILURE_SCORING`]).
+//! killed by a signal, writes no map or an unreadable one or one of the wrong size) is left out
+//! of its summary, which covers the samples it succeeded on ([`FAILURE_SCORING`]).
 //!
 //! Errors by region are [`RegionErrors`]: `all`, `streak`, `non_streak`, and with a road mask
 //! `road` (road surface off the streaks), `off_road` and `road_surface` (the whole road, whose
@@ -38,10 +38,11 @@ pub const AGGREGATION: &str = "pixel-weighted: every pixel of every sample count
     shares of truth pixels (valid share, phantom holes) over all samples' truth pixels";
 
 /// How a failed sample counts, as the report states it.
-pub const FAILURE_SCORING: &str = "a sample a method failed on counts as a disparity map with \
-    no value: its pixels leave EPE, bad-N and D1 (figures over the pixels with a value) as they \
-    are and lower the valid share, and count as bad in bad_all; `failed` says how many samples \
-    that was";
+pub const FAILURE_SCORING: &str = "a method's summary covers the samples it succeeded on \
+    (`samples` minus `failed`), time included: methods whose `failed` differ were scored on \
+    different samples; a sample it failed on keeps its failure and the figures of a map with no \
+    value (valid share 0, no phantom-hole rate); a method that failed on every sample has no \
+    values in its summary";
 
 /// The regions, as the report states them.
 pub const REGIONS: [(&str, &str); 6] = [
@@ -145,7 +146,8 @@ pub struct MethodScore {
     pub method: String,
     /// Errors by region.
     pub errors: RegionErrors,
-    /// The phantom-hole rate (`errors.road_surface.below_1px`; `null` without road masks).
+    /// The phantom-hole rate (`errors.road_surface.below_1px`; `null` without road masks, and
+    /// for a failure).
     pub phantom_hole_rate: Option<f64>,
     /// The method's wall time, seconds.
     pub seconds: f64,
@@ -153,9 +155,10 @@ pub struct MethodScore {
     pub megapixels: f64,
     /// `seconds / megapixels`.
     pub seconds_per_megapixel: f64,
-    /// Samples these figures cover.
+    /// Samples the method ran on.
     pub samples: usize,
-    /// How many of them the method failed on (scored as no value, see [`FAILURE_SCORING`]).
+    /// How many of them it failed on; the other figures leave them out (see
+    /// [`FAILURE_SCORING`]).
     pub failed: usize,
     /// Why the method failed on this sample (per-sample figures only; absent when it did
     /// not).
@@ -176,9 +179,9 @@ impl MethodScore {
         Self {
             samples: 1,
             failed: usize::from(failure.is_some()),
-            failure,
             method: method.to_string(),
-            phantom_hole_rate: errors.phantom_hole_rate(),
+            phantom_hole_rate: errors.phantom_hole_rate().filter(|_| failure.is_none()),
+            failure,
             errors,
             seconds,
             megapixels,
@@ -190,19 +193,32 @@ impl MethodScore {
         }
     }
 
-    /// The pooled figures of one method's per-sample figures.
+    /// The pooled figures of one method's per-sample figures: over the samples it succeeded
+    /// on, or, when it failed on all, their maps with no value (and no phantom-hole rate).
     pub fn pooled(method: &str, parts: &[&MethodScore]) -> Option<Self> {
-        let errors: Vec<RegionErrors> = parts.iter().map(|p| p.errors).collect();
+        let succeeded: Vec<&MethodScore> = parts
+            .iter()
+            .copied()
+            .filter(|p| p.failure.is_none())
+            .collect();
+        let scored = if succeeded.is_empty() {
+            parts
+        } else {
+            &succeeded
+        };
+        let errors: Vec<RegionErrors> = scored.iter().map(|p| p.errors).collect();
+        let pooled = Self::new(
+            method,
+            RegionErrors::pooled(&errors)?,
+            scored.iter().map(|p| p.seconds).sum(),
+            scored.iter().map(|p| p.megapixels).sum(),
+            None,
+        );
         Some(Self {
             samples: parts.iter().map(|p| p.samples).sum(),
             failed: parts.iter().map(|p| p.failed).sum(),
-            ..Self::new(
-                method,
-                RegionErrors::pooled(&errors)?,
-                parts.iter().map(|p| p.seconds).sum(),
-                parts.iter().map(|p| p.megapixels).sum(),
-                None,
-            )
+            phantom_hole_rate: pooled.phantom_hole_rate.filter(|_| !succeeded.is_empty()),
+            ..pooled
         })
     }
 }
@@ -222,4 +238,45 @@ pub struct SampleReport {
     pub road_mask: bool,
     /// Per method.
     pub results: Vec<MethodScore>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use streaks_analysis::benchmark::score_regions;
+    use streaks_image::GrayImage;
+
+    #[test]
+    fn failures_are_left_out_of_the_summary() {
+        let truth = GrayImage::new(4, 2, 5.0).unwrap();
+        let streaks = GrayImage::new(4, 2, 0.0).unwrap();
+        let road = GrayImage::new(4, 2, 255.0).unwrap();
+        let score = |estimate: f32| {
+            let est = GrayImage::new(4, 2, estimate).unwrap();
+            score_regions(&est, &truth, &streaks, Some(&road)).unwrap()
+        };
+        let failure = || Failure {
+            kind: FailureKind::Timeout,
+            reason: "slow".into(),
+            stderr_tail: String::new(),
+            stdout_tail: String::new(),
+        };
+        // Below the road everywhere where it succeeded; no value where it failed.
+        let ok = MethodScore::new("m", score(1.0), 2.0, 1.0, None);
+        let failed = MethodScore::new("m", score(f32::INFINITY), 600.0, 1.0, Some(failure()));
+        assert_eq!((failed.failed, failed.phantom_hole_rate), (1, None));
+        let pooled = MethodScore::pooled("m", &[&ok, &failed]).unwrap();
+        assert_eq!((pooled.samples, pooled.failed), (2, 1));
+        assert_eq!(pooled.errors, ok.errors);
+        assert_eq!(pooled.phantom_hole_rate, Some(1.0));
+        assert_eq!((pooled.seconds, pooled.seconds_per_megapixel), (2.0, 2.0));
+        assert!(pooled.failure.is_none());
+        // Every sample failed: no values, no phantom-hole rate.
+        let all = MethodScore::pooled("m", &[&failed, &failed]).unwrap();
+        assert_eq!((all.samples, all.failed), (2, 2));
+        assert_eq!(
+            (all.errors.all.valid_pixels, all.phantom_hole_rate),
+            (0, None)
+        );
+    }
 }

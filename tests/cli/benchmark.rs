@@ -324,6 +324,7 @@ fn failing_commands_are_recorded_and_the_run_goes_on() {
             (Some(0), Some(1.0))
         );
         assert_eq!(summary(&r, m)["failed"], 1);
+        assert!(summary(&r, m)["phantom_hole_rate"].is_null());
     }
     assert_eq!(failure("boom")["stderr_tail"], "kaputt");
     assert_eq!(failure("boom")["stdout_tail"], "said");
