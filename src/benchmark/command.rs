@@ -9,7 +9,9 @@
 //! - [`run`]: runs the words as a program (stdin from `/dev/null`, the paths also in the
 //!   environment as [`ENV_LEFT`], [`ENV_RIGHT`], [`ENV_OUT`]) in a fresh process group; on the
 //!   time limit the whole group is killed, and once the program ends its group is killed too,
-//!   so a child left behind cannot hold the output pipes open. Stdout and stderr are read by
+//!   so a child left behind cannot hold the output pipes open. Being in its own group, the
+//!   command does not get the terminal's Ctrl-C: SIGINT, SIGTERM and SIGHUP to `streaks` kill
+//!   the running command's group before `streaks` dies of them. Stdout and stderr are read by
 //!   two threads that keep only their last [`TAIL_BYTES`].
 
 use anyhow::{bail, Result};
@@ -18,6 +20,7 @@ use std::io::Read;
 use std::os::unix::process::CommandExt;
 use std::path::Path;
 use std::process::{Command, ExitStatus, Stdio};
+use std::sync::atomic::{AtomicI32, Ordering};
 use std::sync::{mpsc, Arc, Mutex};
 use std::time::{Duration, Instant};
 
@@ -332,12 +335,67 @@ pub struct Output {
     pub output_left_open: bool,
 }
 
+/// The process group of the command running now (0: none), for the signal handler.
+static RUNNING_GROUP: AtomicI32 = AtomicI32::new(0);
+
+/// On SIGINT, SIGTERM or SIGHUP: kills the running command's group (it is not in the
+/// terminal's foreground group, so Ctrl-C does not reach it), then dies of the signal as it
+/// would have without the handler.
+extern "C" fn on_terminating_signal(sig: libc::c_int) {
+    let pgid = RUNNING_GROUP.load(Ordering::SeqCst);
+    // SAFETY: killpg, signal and raise are async-signal-safe.
+    unsafe {
+        if pgid > 0 {
+            libc::killpg(pgid, libc::SIGKILL);
+        }
+        libc::signal(sig, libc::SIG_DFL);
+        libc::raise(sig);
+    }
+}
+
+/// Installs [`on_terminating_signal`] once, for the signals that end the process by default
+/// (a signal the process ignores stays ignored).
+fn install_signal_handler() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        for sig in [libc::SIGINT, libc::SIGTERM, libc::SIGHUP] {
+            // SAFETY: the handler only touches an atomic and calls async-signal-safe functions.
+            unsafe {
+                let handler = on_terminating_signal as extern "C" fn(libc::c_int);
+                let old = libc::signal(sig, handler as libc::sighandler_t);
+                if old == libc::SIG_IGN {
+                    libc::signal(sig, libc::SIG_IGN);
+                }
+            }
+        }
+    });
+}
+
 /// Sends SIGKILL to the process group `pgid` (nothing when it is already empty).
 fn kill_group(pgid: libc::pid_t) {
     // SAFETY: killpg only sends a signal; `pgid` is the group this run created for its child,
     // whose leader is not yet reaped, so the id cannot have been reused.
     unsafe {
         libc::killpg(pgid, libc::SIGKILL);
+    }
+}
+
+/// A running command's process group: registered for the signal handler while it lives, and
+/// killed when dropped (on every way out of [`run`]).
+struct Group(libc::pid_t);
+
+impl Group {
+    /// Registers the group `pgid`.
+    fn new(pgid: libc::pid_t) -> Self {
+        RUNNING_GROUP.store(pgid, Ordering::SeqCst);
+        Self(pgid)
+    }
+}
+
+impl Drop for Group {
+    fn drop(&mut self) {
+        kill_group(self.0);
+        RUNNING_GROUP.store(0, Ordering::SeqCst);
     }
 }
 
@@ -386,9 +444,11 @@ pub fn run(
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .process_group(0);
+    install_signal_handler();
     let start = Instant::now();
     let mut child = cmd.spawn()?;
     let pid = child.id() as libc::pid_t;
+    let group = Group::new(pid);
     let stdout = child.stdout.take().map(TailReader::start);
     let stderr = child.stderr.take().map(TailReader::start);
     let mut poll = Duration::from_millis(2);
@@ -406,8 +466,9 @@ pub fn run(
         poll = (poll * 2).min(Duration::from_millis(50));
     };
     let seconds = start.elapsed().as_secs_f64();
-    // Whatever the program left behind in its group goes with it.
-    kill_group(pid);
+    // Whatever the program left behind in its group goes with it (before the leader is
+    // reaped, while the group's id is still reserved).
+    drop(group);
     let status = child.wait()?;
     let finish = |r: Option<TailReader>| match r {
         Some(r) => r.finish(DRAIN_GRACE),

@@ -493,3 +493,47 @@ fn hanging_loud_and_forking_methods_are_bounded() {
         "{ps}"
     );
 }
+
+#[test]
+fn a_terminated_benchmark_takes_its_running_method_with_it() {
+    let t = TestDir::new();
+    road_pair(&t, "pair");
+    // The command runs in a process group of its own, out of reach of the terminal's Ctrl-C
+    // and of a signal to `streaks`' group: `streaks` must kill it when it is told to end.
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_streaks"))
+        .args([
+            "benchmark",
+            "pair",
+            "--method-cmd",
+            "slow=sh -c 'touch started; sleep 97.5' sh {out}",
+            "-o",
+            "out",
+        ])
+        .current_dir(t.path())
+        .env("CI", "true")
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while !t.join("started").exists() {
+        assert!(start.elapsed().as_secs() < 30, "the method did not start");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    // SAFETY: kill only sends a signal to our own child.
+    unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGTERM) };
+    let status = child.wait().unwrap();
+    assert!(!status.success());
+    let gone = std::time::Instant::now();
+    loop {
+        let ps = std::process::Command::new("ps")
+            .args(["-eo", "args"])
+            .output()
+            .unwrap();
+        if !String::from_utf8_lossy(&ps.stdout).contains("sleep 97.5") {
+            break;
+        }
+        assert!(gone.elapsed().as_secs() < 5, "the method outlived streaks");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    assert!(!t.join("out/report.json").exists());
+}
