@@ -412,9 +412,9 @@ fn has_ended(pid: libc::pid_t, block: bool) -> std::io::Result<bool> {
         let mut info: libc::siginfo_t = unsafe { std::mem::zeroed() };
         let r = unsafe { libc::waitid(libc::P_PID, pid as libc::id_t, &mut info, flags) };
         if r == 0 {
-            // With WNOHANG and nothing to report, waitid leaves si_pid at 0.
-            // SAFETY: si_pid is set for the SIGCHLD-type info waitid returns.
-            return Ok(unsafe { info.si_pid() } != 0);
+            // With WNOHANG and nothing to report, waitid leaves the zeroed info as it is; a
+            // report is a SIGCHLD.
+            return Ok(info.si_signo == libc::SIGCHLD);
         }
         let err = std::io::Error::last_os_error();
         if err.kind() != std::io::ErrorKind::Interrupted {
@@ -470,8 +470,9 @@ pub fn run(
     // reaped, while the group's id is still reserved).
     drop(group);
     let status = child.wait()?;
+    let drained_by = Instant::now() + DRAIN_GRACE;
     let finish = |r: Option<TailReader>| match r {
-        Some(r) => r.finish(DRAIN_GRACE),
+        Some(r) => r.finish(drained_by.saturating_duration_since(Instant::now())),
         None => (Tail::default(), true),
     };
     let ((stdout, out_ended), (stderr, err_ended)) = (finish(stdout), finish(stderr));
