@@ -1,7 +1,7 @@
 //! `OUT/index.html` of `streaks benchmark`: one self-contained page (inline CSS, inline SVG
 //! bar charts, thumbnails as base64 PNG data URIs), readable offline.
 
-use super::report::{MethodScore, Report, REGIONS};
+use super::report::{FailureKind, MethodScore, Report, REGIONS};
 use anyhow::Result;
 use std::fmt::Write;
 use streaks_analysis::benchmark::{
@@ -128,7 +128,21 @@ figure img { display: block; width: 100%; height: auto; border-radius: 4px;
              border: 1px solid var(--line); }
 figcaption { font-size: 12.5px; color: var(--muted); margin-top: 3px; }
 code { background: #eef1f5; padding: 1px 5px; border-radius: 4px; font-size: 13px; }
+.fail { color: #b3261e; font-weight: 600; }
+p.fail { background: #fdecea; border: 1px solid #f3b8b3; border-radius: 6px; padding: 8px 12px; }
+pre { background: #f3f4f7; padding: 6px 8px; border-radius: 4px; font-size: 12px;
+      max-height: 260px; overflow: auto; white-space: pre-wrap; text-align: left; }
+td.reason { text-align: left; max-width: 700px; }
 "#;
+
+/// The failed-samples cell of a summary row: `–` when none.
+fn failed_cell(m: &MethodScore) -> String {
+    match m.failed {
+        0 => "<td class=\"none\">–</td>".to_string(),
+        n if n == m.samples => format!("<td class=\"fail\">all {n}: no score</td>"),
+        n => format!("<td class=\"fail\">{n} of {}</td>", m.samples),
+    }
+}
 
 /// The columns of a region table.
 fn region_row(out: &mut String, method: &str, colour: &str, e: &DisparityErrors) {
@@ -248,6 +262,63 @@ fn region_of<'a>(m: &'a MethodScore, region: &str) -> Option<&'a DisparityErrors
     }
 }
 
+/// A failure kind as the report spells it.
+fn kind_name(kind: FailureKind) -> String {
+    serde_json::to_value(kind)
+        .ok()
+        .and_then(|v| v.as_str().map(|s| s.replace('_', " ")))
+        .unwrap_or_default()
+}
+
+/// The failures section: per method, each failed sample with the kind, the reason and the
+/// end of the command's stderr. Nothing when no method failed.
+fn failures(o: &mut String, report: &Report) {
+    if report.summary.iter().all(|m| m.failed == 0) {
+        return;
+    }
+    let _ = write!(
+        o,
+        "<section id=\"failures\"><h2>Failures</h2><p class=\"note\">{}.</p>",
+        esc_code(report.failure_scoring)
+    );
+    for m in report.summary.iter().filter(|m| m.failed > 0) {
+        let _ = write!(
+            o,
+            "<h3>{}: failed on {} of {} samples</h3><table class=\"failures\"><tr>\
+             <th>sample</th><th class=\"l\">kind</th><th class=\"l\">reason</th></tr>",
+            esc(&m.method),
+            m.failed,
+            m.samples
+        );
+        for s in &report.samples {
+            for r in s.results.iter().filter(|r| r.method == m.method) {
+                let Some(f) = &r.failure else { continue };
+                let tail: String = [("stderr", &f.stderr_tail), ("stdout", &f.stdout_tail)]
+                    .iter()
+                    .filter(|(_, t)| !t.is_empty())
+                    .map(|(stream, t)| {
+                        format!(
+                            "<details><summary>end of its {stream}</summary><pre>{}</pre>\
+                             </details>",
+                            esc(t)
+                        )
+                    })
+                    .collect();
+                let _ = write!(
+                    o,
+                    "<tr><td>{}</td><td class=\"l\">{}</td><td class=\"reason\">{}{tail}</td>\
+                     </tr>",
+                    esc(&s.id),
+                    esc(&kind_name(f.kind)),
+                    esc(&f.reason)
+                );
+            }
+        }
+        o.push_str("</table>");
+    }
+    o.push_str("</section>\n");
+}
+
 /// A bar of a chart: label, colour, value.
 type Bar = (String, String, f64);
 
@@ -303,13 +374,38 @@ pub fn page(report: &Report, thumbs: &[SampleThumbs]) -> String {
          scoring.</p></section>\n",
     );
     // Headline: phantom holes and time, and the charts.
-    o.push_str("<section><h2>Summary</h2><table id=\"summary\"><tr><th>method</th><th>EPE px</th><th>bad-2</th><th>D1</th><th>valid</th><th>streak EPE px</th><th>phantom-hole rate</th><th>s / megapixel</th></tr>");
+    o.push_str("<section><h2>Summary</h2>");
+    let failing: Vec<&MethodScore> = report.summary.iter().filter(|m| m.failed > 0).collect();
+    if !failing.is_empty() {
+        let each: Vec<String> = failing
+            .iter()
+            .map(|m| {
+                if m.failed == m.samples {
+                    format!("{} failed on every sample ({})", esc(&m.method), m.samples)
+                } else {
+                    format!(
+                        "{} failed on {} of {} samples",
+                        esc(&m.method),
+                        m.failed,
+                        m.samples
+                    )
+                }
+            })
+            .collect();
+        let _ = write!(
+            o,
+            "<p class=\"fail\" id=\"failed\">{}. A method's figures cover the samples it \
+             succeeded on (see <a href=\"#failures\">Failures</a>).</p>",
+            each.join("; ")
+        );
+    }
+    o.push_str("<table id=\"summary\"><tr><th>method</th><th>EPE px</th><th>bad-2</th><th>D1</th><th>valid</th><th>streak EPE px</th><th>phantom-hole rate</th><th>s / megapixel</th><th>failed samples</th></tr>");
     for (i, m) in report.summary.iter().enumerate() {
         let e = &m.errors;
         let _ = write!(
             o,
             "<tr><td><span class=\"swatch\" style=\"background:{}\"></span>{}</td>{}{}{}\
-             <td>{}</td>{}<td>{}</td><td>{:.2}</td></tr>",
+             <td>{}</td>{}<td>{}</td><td>{:.2}</td>{}</tr>",
             colour(i),
             esc(&m.method),
             cell(&e.all, format!("{:.3}", e.all.mean_abs)),
@@ -318,7 +414,8 @@ pub fn page(report: &Report, thumbs: &[SampleThumbs]) -> String {
             pct(e.all.density),
             cell(&e.streak, format!("{:.3}", e.streak.mean_abs)),
             m.phantom_hole_rate.map(pct).unwrap_or_else(|| "–".into()),
-            m.seconds_per_megapixel
+            m.seconds_per_megapixel,
+            failed_cell(m)
         );
     }
     o.push_str("</table><p class=\"note\">The phantom-hole rate is the share of road pixels (streaks included) whose estimate is more than 1 px below the true disparity: stereo puts them beneath the road.</p><div class=\"grid\">");
@@ -327,6 +424,8 @@ pub fn page(report: &Report, thumbs: &[SampleThumbs]) -> String {
             .summary
             .iter()
             .enumerate()
+            // A method with no values at all (it failed on every sample) has no bar.
+            .filter(|(_, m)| m.errors.all.valid_pixels > 0)
             .filter_map(|(i, m)| f(m).map(|v| (m.method.clone(), colour(i).to_string(), v)))
             .collect()
     };
@@ -397,7 +496,7 @@ pub fn page(report: &Report, thumbs: &[SampleThumbs]) -> String {
     }
     o.push_str("<p class=\"note\">D1 is KITTI 2015's: off by more than 3 px and by more than 5 % of the true disparity. Without road masks (pair folders of scenes that flag no road) the road regions are left out.</p></section>\n");
     // Per-sample table.
-    o.push_str("<section><h2>Per sample</h2><table id=\"samples\"><tr><th>sample</th><th class=\"l\">method</th><th>EPE px</th><th>bad-2</th><th>streak EPE px</th><th>valid</th><th>phantom-hole rate</th><th>seconds</th></tr>");
+    o.push_str("<section><h2>Per sample</h2><table id=\"samples\"><tr><th>sample</th><th class=\"l\">method</th><th>EPE px</th><th>bad-2</th><th>streak EPE px</th><th>valid</th><th>phantom-hole rate</th><th>seconds</th><th class=\"l\">status</th></tr>");
     for s in &report.samples {
         for (j, r) in s.results.iter().enumerate() {
             let first = if j == 0 {
@@ -412,10 +511,18 @@ pub fn page(report: &Report, thumbs: &[SampleThumbs]) -> String {
                 String::new()
             };
             let e = &r.errors;
+            let status = match &r.failure {
+                Some(f) => format!(
+                    "<td class=\"l fail\" title=\"{}\">failed: {}</td>",
+                    esc(&f.reason),
+                    esc(&kind_name(f.kind))
+                ),
+                None => "<td class=\"l\">ok</td>".to_string(),
+            };
             let _ = write!(
                 o,
                 "<tr>{first}<td class=\"l\">{}</td>{}{}{}<td>{}</td><td>{}</td><td>{:.2}</td>\
-                 </tr>",
+                 {status}</tr>",
                 esc(&r.method),
                 cell(&e.all, format!("{:.3}", e.all.mean_abs)),
                 cell(&e.all, pct(e.all.bad_2)),
@@ -427,6 +534,7 @@ pub fn page(report: &Report, thumbs: &[SampleThumbs]) -> String {
         }
     }
     o.push_str("</table></section>\n");
+    failures(&mut o, report);
     // Thumbnails.
     if !thumbs.is_empty() {
         let _ = write!(

@@ -1,10 +1,11 @@
 //! The methods `streaks benchmark` runs: the built-ins and external commands.
 
+use super::command::{self, Ended, Paths, Template};
 use super::input::Sample;
+use super::report::{Failure, FailureKind};
 use anyhow::{bail, Context, Result};
 use std::path::Path;
-use std::process::Command;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 use streaks_analysis::benchmark::{lk_streak_disparity, streak_lk_params};
 use streaks_analysis::detect::DetectParams;
 use streaks_analysis::repair::StreakHandling;
@@ -45,8 +46,8 @@ pub enum Method {
     Command {
         /// The method's name.
         name: String,
-        /// The template.
-        template: String,
+        /// The template, split into words.
+        template: Template,
     },
 }
 
@@ -77,15 +78,9 @@ impl Method {
         if Method::built_in(name).is_some() {
             bail!("--method-cmd {name}: {name} is a built-in method; choose another name");
         }
-        if !template.contains("{out}") {
-            bail!(
-                "--method-cmd {name}: the template {template:?} has no {{out}}, the PFM the \
-                 command must write (use {{left}}, {{right}} and {{out}})"
-            );
-        }
         Ok(Method::Command {
             name: name.to_string(),
-            template: template.to_string(),
+            template: Template::parse(name, template)?,
         })
     }
 
@@ -102,7 +97,9 @@ impl Method {
     /// What the method is, for the report.
     pub fn description(&self) -> String {
         match self {
-            Method::Command { template, .. } => format!("external command: {template}"),
+            Method::Command { template, .. } => {
+                format!("external command: `{}`", template.text())
+            }
             m => BUILT_INS
                 .iter()
                 .find(|(n, _)| *n == m.name())
@@ -111,49 +108,65 @@ impl Method {
         }
     }
 
-    /// Runs the method on `sample` (its PNGs), with `work` a folder for the command's output.
-    /// Returns the disparity of the left view (no value: `inf`; a disparity that is not
-    /// finite or not positive is no value, whatever the method) and the method's wall time in
-    /// seconds: for a built-in, reading the two PNGs and estimating; for a command, the whole
-    /// process.
-    pub fn run(&self, sample: &Sample, work: &Path) -> Result<(GrayImage, f64)> {
-        let start = Instant::now();
-        let mut disp = match self {
-            Method::Sgm | Method::SgmStreaks | Method::Lk => {
-                let left = GrayImage::load(&sample.left)
-                    .with_context(|| format!("reading {}", sample.left.display()))?;
-                let right = GrayImage::load(&sample.right)
-                    .with_context(|| format!("reading {}", sample.right.display()))?;
-                match self {
-                    Method::Sgm => {
-                        crate::disparity::estimate(&left, &right, &SgmParams::default(), None)?
-                            .disparity
-                    }
-                    Method::SgmStreaks => {
-                        crate::disparity::estimate(
-                            &left,
-                            &right,
-                            &SgmParams::default(),
-                            Some(StreakHandling::Repair),
-                        )?
-                        .disparity
-                    }
-                    _ => lk_streak_disparity(
-                        &left,
-                        &right,
-                        &streak_lk_params(),
-                        &DetectParams::default(),
-                    )?,
-                }
-            }
+    /// Runs the method on `sample` (its PNGs, the `index`-th sample), with `work` the run's
+    /// private folder for a command's output and `timeout` a command's time limit. Gives the
+    /// disparity of the left view (no value: `inf`; a disparity that is not finite or not
+    /// positive is no value, whatever the method), or why the method failed on the sample,
+    /// and the method's wall time in seconds: for a built-in, reading the two PNGs and
+    /// estimating; for a command, the whole process.
+    pub fn run(
+        &self,
+        sample: &Sample,
+        index: usize,
+        work: &Path,
+        timeout: Duration,
+    ) -> (std::result::Result<GrayImage, Failure>, f64) {
+        match self {
             Method::Command { name, template } => {
-                let out = work.join(format!("{}-{name}.pfm", sample.id));
-                return run_command(name, template, sample, &out);
+                // Named by the sample's index and the checked method name: nothing of the
+                // input's folder names reaches the output path.
+                let out = work.join(format!("{index:06}-{name}.pfm"));
+                run_command(template, sample, &out, timeout)
             }
+            _ => {
+                let start = Instant::now();
+                let result = self.run_built_in(sample).map_err(|e| Failure {
+                    kind: FailureKind::Error,
+                    reason: format!("{e:#}"),
+                    stderr_tail: String::new(),
+                    stdout_tail: String::new(),
+                });
+                (result, start.elapsed().as_secs_f64())
+            }
+        }
+    }
+
+    /// A built-in method's disparity on `sample`.
+    fn run_built_in(&self, sample: &Sample) -> Result<GrayImage> {
+        let left = GrayImage::load(&sample.left)
+            .with_context(|| format!("reading {}", sample.left.display()))?;
+        let right = GrayImage::load(&sample.right)
+            .with_context(|| format!("reading {}", sample.right.display()))?;
+        let mut disp = match self {
+            Method::Sgm => {
+                crate::disparity::estimate(&left, &right, &SgmParams::default(), None)?.disparity
+            }
+            Method::SgmStreaks => {
+                crate::disparity::estimate(
+                    &left,
+                    &right,
+                    &SgmParams::default(),
+                    Some(StreakHandling::Repair),
+                )?
+                .disparity
+            }
+            Method::Lk => {
+                lk_streak_disparity(&left, &right, &streak_lk_params(), &DetectParams::default())?
+            }
+            Method::Command { name, .. } => bail!("{name} is not a built-in method"),
         };
-        let seconds = start.elapsed().as_secs_f64();
         no_value_below_zero(&mut disp);
-        Ok((disp, seconds))
+        Ok(disp)
     }
 }
 
@@ -166,77 +179,157 @@ fn no_value_below_zero(disp: &mut GrayImage) {
     }
 }
 
-/// `s` quoted for `sh`: in single quotes, each `'` written `'\''`.
-pub fn shell_quote(s: &str) -> String {
-    format!("'{}'", s.replace('\'', r"'\''"))
-}
+/// How much of a command's stderr a failure keeps: its last lines and characters.
+const FAILURE_TAIL: (usize, usize) = (40, 4000);
 
-/// The last `lines` lines of `text` (at most 2000 characters).
-fn tail(text: &str, lines: usize) -> String {
-    let all: Vec<&str> = text.trim_end().lines().collect();
-    let t = all[all.len().saturating_sub(lines)..].join("\n");
-    match t.char_indices().rev().nth(1999) {
-        Some((i, _)) => format!("...{}", &t[i..]),
-        None => t,
-    }
-}
+/// Largest header a PFM of the expected size may have beside its pixels, bytes: a file
+/// larger than its pixels and this is refused before it is read.
+const PFM_HEADER_SLACK: u64 = 4096;
 
-/// Runs an external method's command on `sample`, writing `out`, and reads its PFM.
+/// Runs an external method's command on `sample`, writing `out`, and reads its PFM. A failure
+/// names why and keeps the end of the command's stderr.
 fn run_command(
-    name: &str,
-    template: &str,
+    template: &Template,
     sample: &Sample,
     out: &Path,
-) -> Result<(GrayImage, f64)> {
+    timeout: Duration,
+) -> (std::result::Result<GrayImage, Failure>, f64) {
+    let fail = |kind, reason: String| Failure {
+        kind,
+        reason,
+        stderr_tail: String::new(),
+        stdout_tail: String::new(),
+    };
     let abs = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
-    let line = template
-        .replace("{left}", &shell_quote(&abs(&sample.left).to_string_lossy()))
-        .replace(
-            "{right}",
-            &shell_quote(&abs(&sample.right).to_string_lossy()),
+    let (left, right, out) = (abs(&sample.left), abs(&sample.right), abs(out));
+    // A leftover of any earlier run is never taken for this run's output.
+    match std::fs::remove_file(&out) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            return (
+                Err(fail(
+                    FailureKind::Error,
+                    format!("cannot remove the old output {}: {e}", out.display()),
+                )),
+                0.0,
+            )
+        }
+        _ => {}
+    }
+    let paths = Paths {
+        left: &left,
+        right: &right,
+        out: &out,
+    };
+    let argv = template.argv(&paths);
+    let output = match command::run(&argv, &paths.env(), timeout) {
+        Ok(o) => o,
+        Err(e) => {
+            let program = argv
+                .first()
+                .map(|p| p.to_string_lossy())
+                .unwrap_or_default();
+            return (
+                Err(fail(
+                    FailureKind::Spawn,
+                    format!("cannot run {program:?}: {e}"),
+                )),
+                0.0,
+            );
+        }
+    };
+    let seconds = output.seconds;
+    let (lines, chars) = FAILURE_TAIL;
+    let failed = |kind, mut reason: String| {
+        if output.output_left_open {
+            reason
+                .push_str("; a process it started left its process group and held its output open");
+        }
+        (
+            Err(Failure {
+                kind,
+                reason,
+                stderr_tail: output.stderr.text(lines, chars),
+                stdout_tail: output.stdout.text(lines, chars),
+            }),
+            seconds,
         )
-        .replace("{out}", &shell_quote(&abs(out).to_string_lossy()));
-    let what = || format!("method {name} on sample {}", sample.id);
-    let start = Instant::now();
-    let output = Command::new("sh")
-        .arg("-c")
-        .arg(&line)
-        .stdin(std::process::Stdio::null())
-        .output()
-        .with_context(|| format!("{}: cannot run sh -c {line:?}", what()))?;
-    let seconds = start.elapsed().as_secs_f64();
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    if !output.status.success() {
-        bail!(
-            "{}: the command failed ({}): {line}\nits stderr ended:\n{}",
-            what(),
-            output.status,
-            tail(&stderr, 12)
+    };
+    let status = match output.ended {
+        Ended::TimedOut => {
+            return failed(
+                FailureKind::Timeout,
+                format!(
+                    "ran longer than --method-timeout {} s: its process group was killed",
+                    timeout.as_secs_f64()
+                ),
+            )
+        }
+        Ended::Status(s) => s,
+    };
+    if !status.success() {
+        use std::os::unix::process::ExitStatusExt;
+        return match status.signal() {
+            Some(sig) => failed(FailureKind::Signal, format!("killed by signal {sig}")),
+            None => failed(
+                FailureKind::Exit,
+                format!("exited with status {}", status.code().unwrap_or(-1)),
+            ),
+        };
+    }
+    let meta = match std::fs::symlink_metadata(&out) {
+        Ok(m) => m,
+        Err(_) => {
+            return failed(
+                FailureKind::NoOutput,
+                format!("exited with status 0 but wrote no {}", out.display()),
+            )
+        }
+    };
+    let Ok((w, h)) = image::image_dimensions(&sample.left) else {
+        return failed(
+            FailureKind::Error,
+            format!("cannot read the size of {}", sample.left.display()),
+        );
+    };
+    let most = u64::from(w) * u64::from(h) * 4 + PFM_HEADER_SLACK;
+    if !meta.file_type().is_file() {
+        return failed(
+            FailureKind::BadOutput,
+            format!(
+                "its output {} is not a regular file (a link, folder or device)",
+                out.display()
+            ),
         );
     }
-    if !out.is_file() {
-        bail!(
-            "{}: the command succeeded but wrote no {}: {line}\nits stderr ended:\n{}",
-            what(),
-            out.display(),
-            tail(&stderr, 12)
+    if meta.len() > most {
+        return failed(
+            FailureKind::BadOutput,
+            format!(
+                "its output is {} bytes, more than a {w}x{h} PFM's {most}",
+                meta.len()
+            ),
         );
     }
-    let mut disp = read_pfm(out).with_context(|| format!("{}: reading its output", what()))?;
-    let truth_size = image::image_dimensions(&sample.left)
-        .with_context(|| format!("reading the size of {}", sample.left.display()))?;
-    if (disp.width as u32, disp.height as u32) != truth_size {
-        bail!(
-            "{}: the command wrote a {}x{} disparity map, the sample is {}x{}: {line}",
-            what(),
-            disp.width,
-            disp.height,
-            truth_size.0,
-            truth_size.1
+    let mut disp = match read_pfm(&out) {
+        Ok(d) => d,
+        Err(e) => {
+            return failed(
+                FailureKind::BadOutput,
+                format!("its output is not a readable PFM: {e}"),
+            )
+        }
+    };
+    if (disp.width as u64, disp.height as u64) != (u64::from(w), u64::from(h)) {
+        return failed(
+            FailureKind::BadOutput,
+            format!(
+                "it wrote a {}x{} disparity map, the sample is {w}x{h}",
+                disp.width, disp.height
+            ),
         );
     }
     no_value_below_zero(&mut disp);
-    Ok((disp, seconds))
+    (Ok(disp), seconds)
 }
 
 #[cfg(test)]
@@ -244,15 +337,16 @@ mod tests {
     use super::*;
 
     #[test]
-    fn quoting_and_templates() {
-        assert_eq!(shell_quote("a b"), "'a b'");
-        assert_eq!(shell_quote("it's"), r"'it'\''s'");
+    fn method_specs() {
         assert!(Method::command("x=run {left} {right}").is_err());
         assert!(Method::command("sgm=run {out}").is_err());
         assert!(Method::command("no template").is_err());
         assert!(Method::command("a b=run {out}").is_err());
         let m = Method::command("net=python net.py {left} {right} {out}").unwrap();
         assert_eq!(m.name(), "net");
-        assert_eq!(tail("a\nb\nc\n", 2), "b\nc");
+        assert_eq!(
+            m.description(),
+            "external command: `python net.py {left} {right} {out}`"
+        );
     }
 }

@@ -5,14 +5,19 @@
 //!
 //! - [`input`]: the samples of DIR;
 //! - [`method`]: the built-in methods (`sgm`, `sgm-streaks`, `lk`) and external commands;
+//! - [`command`]: an external command's template and process, run without a shell;
 //! - [`report`]: the report's schema;
 //! - [`html`]: the page.
 //!
 //! Scoring is [`streaks_analysis::benchmark`]. Every method runs on every sample (a progress
-//! bar over samples x methods); the first failure stops the run with an error naming the
-//! method and the sample (and a command's stderr), and nothing is written. Both outputs are
-//! written atomically at the end.
+//! bar over samples x methods). A method that fails on a sample (see [`report::FailureKind`])
+//! is recorded as failed there with its reason and output tails, left out of its summary
+//! ([`report::FAILURE_SCORING`]), and the run goes on; at the end both outputs are written
+//! atomically, the failures listed, and the command exits non-zero unless
+//! `--allow-failures`. Bad input (no samples, an unreadable ground truth or mask) still stops
+//! the run before anything is written.
 
+pub mod command;
 pub mod html;
 pub mod input;
 pub mod method;
@@ -22,6 +27,7 @@ use anyhow::{bail, Context, Result};
 use method::Method;
 use report::{Input, MethodInfo, MethodScore, Report, SampleReport};
 use std::path::PathBuf;
+use std::time::Duration;
 use streaks_analysis::benchmark::{error_map, score_regions, BAD_THRESHOLD_PX};
 use streaks_image::pfm::read_pfm;
 use streaks_image::{write_bytes_atomically, GrayImage};
@@ -36,11 +42,20 @@ pub struct Args {
     /// (every --method-cmd runs, named here or not).
     #[arg(long = "method", value_name = "NAME", num_args = 1..)]
     pub methods: Vec<String>,
-    /// An external method: NAME=TEMPLATE, a shell command (run by `sh -c`) in which
-    /// `{left}`, `{right}` and `{out}` are replaced by the quoted paths of the left and right
-    /// PNGs and of the PFM disparity map it must write (inf, NaN or <= 0: no value).
+    /// An external method: NAME=TEMPLATE, a program and its arguments (split into words like a
+    /// shell would, but run without one) in which `{left}`, `{right}` and `{out}` are replaced
+    /// by the absolute paths of the left and right PNGs and of the PFM disparity map it must
+    /// write (inf, NaN or <= 0: no value); the paths are also in $STREAKS_LEFT,
+    /// $STREAKS_RIGHT and $STREAKS_OUT.
     #[arg(long = "method-cmd", value_name = "NAME=TEMPLATE")]
     pub method_cmds: Vec<String>,
+    /// Time limit of an external method on one sample, seconds: past it the command and its
+    /// whole process group are killed and the sample is recorded as failed.
+    #[arg(long, value_name = "SECONDS", default_value = "600", value_parser = parse_timeout)]
+    pub method_timeout: Duration,
+    /// Exit 0 even when a method failed on some samples (the report records them either way).
+    #[arg(long)]
+    pub allow_failures: bool,
     /// Only this split of a dataset (train, val, test).
     #[arg(long)]
     pub split: Option<String>,
@@ -50,6 +65,18 @@ pub struct Args {
     /// How many samples get thumbnails on the page (the first ones).
     #[arg(long, default_value_t = 8)]
     pub thumbnails: usize,
+}
+
+/// `--method-timeout`: positive seconds, fractions allowed.
+fn parse_timeout(s: &str) -> std::result::Result<Duration, String> {
+    let secs: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("{s:?} is not a number of seconds"))?;
+    if secs.is_nan() || secs <= 0.0 {
+        return Err(format!("{s} s: the time limit must be more than 0 s"));
+    }
+    Duration::try_from_secs_f64(secs).map_err(|_| format!("{s} s is too long a time limit"))
 }
 
 /// The methods of the arguments, in order: `--method` names, then the other `--method-cmd`s.
@@ -138,13 +165,26 @@ pub fn run(args: Args) -> Result<()> {
         let mut maps = Vec::new();
         for m in &methods {
             let what = || format!("method {} on sample {}", m.name(), sample.id);
-            let (disp, seconds) = m.run(sample, work.path()).with_context(what)?;
+            let (result, seconds) = m.run(sample, k, work.path(), args.method_timeout);
+            let (disp, failure) = match result {
+                Ok(disp) => (disp, None),
+                Err(f) => {
+                    bar.suspend(|| eprintln!("{}", failure_line(m.name(), &sample.id, &f)));
+                    (GrayImage::new(size.0, size.1, f32::INFINITY)?, Some(f))
+                }
+            };
             let errors =
                 score_regions(&disp, &truth, &streaks, road.as_ref()).with_context(what)?;
             if k < args.thumbnails {
                 maps.push((m.name().to_string(), error_map(&disp, &truth)?));
             }
-            results.push(MethodScore::new(m.name(), errors, seconds, megapixels));
+            results.push(MethodScore::new(
+                m.name(),
+                errors,
+                seconds,
+                megapixels,
+                failure,
+            ));
             bar.inc(1);
         }
         if k < args.thumbnails {
@@ -199,6 +239,7 @@ pub fn run(args: Args) -> Result<()> {
             .collect(),
         summary,
         samples: sample_reports,
+        failure_scoring: report::FAILURE_SCORING,
     };
     let page = html::page(&report, &thumbs);
     let mut json = serde_json::to_string_pretty(&report)?;
@@ -219,7 +260,44 @@ pub fn run(args: Args) -> Result<()> {
         json_path.display(),
         html_path.display()
     );
+    let failed: usize = report.summary.iter().map(|m| m.failed).sum();
+    if failed > 0 {
+        let per_method: Vec<String> = report
+            .summary
+            .iter()
+            .filter(|m| m.failed > 0)
+            .map(|m| format!("{} on {} of {} samples", m.method, m.failed, m.samples))
+            .collect();
+        let message = format!(
+            "{failed} method runs failed ({}); {} and {} record each failure with its reason",
+            per_method.join(", "),
+            json_path.display(),
+            html_path.display()
+        );
+        if args.allow_failures {
+            eprintln!("warning: {message}");
+        } else {
+            bail!("{message} (--allow-failures exits 0 all the same)");
+        }
+    }
     Ok(())
+}
+
+/// One line (and the stderr tail's last lines) saying that `method` failed on `sample`.
+fn failure_line(method: &str, sample: &str, f: &report::Failure) -> String {
+    let mut s = format!(
+        "warning: method {method} failed on sample {sample:?}: {}",
+        f.reason
+    );
+    let lines: Vec<&str> = f.stderr_tail.lines().collect();
+    if !lines.is_empty() {
+        s.push_str("\n  its stderr ended:");
+        for l in &lines[lines.len().saturating_sub(12)..] {
+            s.push_str("\n    ");
+            s.push_str(l);
+        }
+    }
+    s
 }
 
 /// The summary as a text table (EPE, bad-2, D1, valid share over all pixels; phantom holes;
@@ -229,20 +307,43 @@ fn summary_table(report: &Report) -> String {
         "{:<16} {:>8} {:>8} {:>8} {:>8} {:>10} {:>8} {:>8}\n",
         "method", "EPE", "bad-2", "D1", "valid", "streak EPE", "phantom", "s/MP"
     );
+    let mut notes = String::new();
     let pct = |v: f64| format!("{:.1}%", 100.0 * v);
     for m in &report.summary {
         let e = &m.errors;
+        // A figure over the pixels with a value: `-` when there are none.
+        let valued = |d: &streaks_analysis::sgm::DisparityErrors, text: String| {
+            if d.valid_pixels == 0 {
+                "-".to_string()
+            } else {
+                text
+            }
+        };
         s.push_str(&format!(
-            "{:<16} {:>8.3} {:>8} {:>8} {:>8} {:>10.3} {:>8} {:>8.2}\n",
+            "{:<16} {:>8} {:>8} {:>8} {:>8} {:>10} {:>8} {:>8.2}\n",
             m.method,
-            e.all.mean_abs,
-            pct(e.all.bad_2),
-            pct(e.all.d1),
+            valued(&e.all, format!("{:.3}", e.all.mean_abs)),
+            valued(&e.all, pct(e.all.bad_2)),
+            valued(&e.all, pct(e.all.d1)),
             pct(e.all.density),
-            e.streak.mean_abs,
+            valued(&e.streak, format!("{:.3}", e.streak.mean_abs)),
             m.phantom_hole_rate.map(pct).unwrap_or_else(|| "-".into()),
             m.seconds_per_megapixel
         ));
+        if m.failed > 0 {
+            notes.push_str(&format!(
+                "{} failed on {} of {} samples{}\n",
+                m.method,
+                m.failed,
+                m.samples,
+                if m.failed == m.samples {
+                    ": every sample, it has no score"
+                } else {
+                    " (its figures cover the others)"
+                }
+            ));
+        }
     }
+    s.push_str(&notes);
     s
 }

@@ -240,35 +240,300 @@ fn bad_benchmark_input_fails_clearly_without_a_report() {
         &["pair", "--split", "test", "--method", "sgm"],
         "needs a dataset",
     );
-    // A failing command: its name, the sample and its stderr.
     fails(
-        &[
-            "pair",
-            "--method",
-            "sgm",
-            "--method-cmd",
-            "boom=echo kaputt >&2; exit 3 # {out}",
-        ],
-        "kaputt",
+        &["pair", "--method-cmd", "q=run 'unclosed {out}"],
+        "unclosed quote",
     );
-    let run = t.streaks(&[
-        "benchmark",
-        "pair",
-        "--method-cmd",
-        "boom=echo kaputt >&2; exit 3 # {out}",
-        "-o",
-        "out",
-    ]);
-    let err = run.stderr();
-    assert!(
-        err.contains("method boom on sample pair") && err.contains("exit status: 3"),
-        "{err}"
+    fails(
+        &["pair", "--method-cmd", "q=sh -c 'run {left} > {out}'"],
+        "program text",
     );
-    // A command that writes nothing, and one that writes a map of the wrong size.
-    fails(&["pair", "--method-cmd", "lazy=true {out}"], "wrote no");
+    for bad in ["0", "-1", "soon", "inf"] {
+        let flag = format!("--method-timeout={bad}");
+        fails(&["pair", "--method", "sgm", &flag], "--method-timeout");
+    }
+}
+
+#[test]
+fn failing_commands_are_recorded_and_the_run_goes_on() {
+    let t = TestDir::new();
+    road_pair(&t, "pair");
     let small = t.join("small.pfm");
     streaks_image::pfm::write_pfm(&small, &streaks_image::GrayImage::new(5, 4, 1.0).unwrap())
         .unwrap();
-    let copy = format!("small=cp {} {{out}}", small.display());
-    fails(&["pair", "--method-cmd", &copy], "5x4 disparity map");
+    std::fs::write(t.join("junk.pfm"), "not a pfm").unwrap();
+    let copy = |name: &str, from: &str| format!("{name}=cp {} {{out}}", t.join(from).display());
+    let (small_cmd, junk_cmd) = (copy("small", "small.pfm"), copy("junk", "junk.pfm"));
+    let args = [
+        "benchmark",
+        "pair",
+        "--method",
+        "sgm",
+        "--method-cmd",
+        "boom=sh -c 'echo kaputt >&2; echo said >&1; exit 3' sh {out}",
+        "--method-cmd",
+        "lazy=true {out}",
+        "--method-cmd",
+        &small_cmd,
+        "--method-cmd",
+        &junk_cmd,
+        "--method-cmd",
+        "missing=/no/such/program {out}",
+        "--method-cmd",
+        "killed=sh -c 'kill -9 $$' sh {out}",
+        "--method-cmd",
+        "link=ln -s /dev/zero {out}",
+        "-o",
+        "out",
+    ];
+    // Every failure is named on stderr, the report is written, and the exit status says so.
+    let run = t.streaks(&args);
+    run.assert_failure_mentioning("7 method runs failed");
+    let err = run.stderr();
+    assert!(
+        err.contains("method boom failed on sample \"pair\": exited with status 3")
+            && err.contains("kaputt"),
+        "{err}"
+    );
+    let r = report(&t, "out");
+    let results = r["samples"][0]["results"].as_array().unwrap();
+    let failure = |m: &str| {
+        results
+            .iter()
+            .find(|x| x["method"] == m)
+            .unwrap_or_else(|| panic!("no {m}"))["failure"]
+            .clone()
+    };
+    assert!(failure("sgm").is_null());
+    for (m, kind, reason) in [
+        ("boom", "exit", "exited with status 3"),
+        ("lazy", "no_output", "wrote no"),
+        ("small", "bad_output", "5x4 disparity map"),
+        ("junk", "bad_output", "not a readable PFM"),
+        ("missing", "spawn", "/no/such/program"),
+        ("killed", "signal", "signal 9"),
+        ("link", "bad_output", "not a regular file"),
+    ] {
+        let f = failure(m);
+        assert_eq!(f["kind"], kind, "{m}: {f}");
+        assert!(f["reason"].as_str().unwrap().contains(reason), "{m}: {f}");
+        // A failed sample is scored as no value: nothing valid, everything bad.
+        let e = &summary(&r, m)["errors"]["all"];
+        assert_eq!(
+            (e["valid_pixels"].as_u64(), e["bad_all"].as_f64()),
+            (Some(0), Some(1.0))
+        );
+        assert_eq!(summary(&r, m)["failed"], 1);
+        assert!(summary(&r, m)["phantom_hole_rate"].is_null());
+    }
+    assert_eq!(failure("boom")["stderr_tail"], "kaputt");
+    assert_eq!(failure("boom")["stdout_tail"], "said");
+    assert_eq!(summary(&r, "sgm")["failed"], 0);
+    let page = std::fs::read_to_string(t.join("out/index.html")).unwrap();
+    assert!(page.contains("id=\"failures\"") && page.contains("boom failed on every sample"));
+    assert!(page.contains("kaputt") && page.contains("exited with status 3"));
+    // --allow-failures: the same report, exit 0.
+    let mut allowed = args.to_vec();
+    allowed.push("--allow-failures");
+    let run = t.streaks(&allowed);
+    run.assert_success();
+    assert!(run.stderr().contains("warning: 7 method runs failed"));
+}
+
+/// A dataset of two 96x64 samples at 4 spp in `dir` of the test folder.
+fn tiny_dataset(t: &TestDir, dir: &str) {
+    t.streaks(&[
+        "dataset", "generate", "-o", dir, "--count", "2", "--width", "96", "--height", "64",
+        "--spp", "4",
+    ])
+    .assert_success();
+}
+
+#[test]
+fn hostile_folder_names_reach_a_method_as_literal_paths() {
+    let t = TestDir::new();
+    tiny_dataset(&t, "ds");
+    let names = [
+        // The old substitution put `{right}`'s quoted path inside the quoted left path, which
+        // unquoted it: its command substitutions ran.
+        "ds {right} \"$(touch PWNED1)\" `touch PWNED2`;touch PWNED3",
+        // Placeholders, quotes, a newline, a variable.
+        "ds {out} {left} '\"$(touch PWNED4)\" it's\n$HOME;touch PWNED5 \\",
+    ];
+    let recorder = "recorder=sh -c 'printf %s \"$1\" > args.txt; \
+                    printf %s \"$STREAKS_LEFT|$STREAKS_OUT\" > env.txt' sh {left} {out}";
+    let cmd = again();
+    let mut from = "ds";
+    for name in names {
+        std::fs::rename(t.join(from), t.join(name)).unwrap();
+        from = name;
+        t.streaks(&[
+            "benchmark",
+            name,
+            "--method",
+            "sgm",
+            "--method-cmd",
+            &cmd,
+            "--method-cmd",
+            recorder,
+            "--allow-failures",
+            "-o",
+            "out",
+        ])
+        .assert_success();
+        for k in 1..=5 {
+            let f = format!("PWNED{k}");
+            assert!(!t.join(&f).exists(), "{name:?} created {f}");
+            assert!(!t.join(name).join(&f).exists(), "{name:?} created {f}");
+        }
+        let r = report(&t, "out");
+        // The command got the right images: it scores as `sgm` does.
+        assert_eq!(summary(&r, "again")["errors"], summary(&r, "sgm")["errors"]);
+        assert_eq!(summary(&r, "again")["failed"], 0);
+        // The path arrived byte for byte, as an argument and in the environment.
+        let left = t.path().join(name).join("samples/000001/im0.png");
+        let got = std::fs::read_to_string(t.join("args.txt")).unwrap();
+        assert_eq!(got, left.to_str().unwrap());
+        let env = std::fs::read_to_string(t.join("env.txt")).unwrap();
+        let (env_left, env_out) = env.split_once('|').unwrap();
+        assert_eq!(env_left, got);
+        // The output path is in the run's private folder, named by the sample's index.
+        assert!(env_out.ends_with("/000001-recorder.pfm"), "{env_out}");
+        assert!(
+            !std::path::Path::new(env_out).exists(),
+            "the private folder is left behind"
+        );
+        assert_eq!(summary(&r, "recorder")["failed"], 2);
+    }
+}
+
+/// Runs `streaks ARGS` in `t`, and gives its exit status, stderr and peak memory (kB).
+// The child is reaped by wait4, which also gives its resource usage, not by `Child::wait`.
+#[allow(clippy::zombie_processes)]
+fn streaks_peak_memory(t: &TestDir, args: &[&str]) -> (bool, String, i64) {
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_streaks"))
+        .args(args)
+        .current_dir(t.path())
+        .env("CI", "true")
+        .stdout(std::process::Stdio::null())
+        .stderr(std::fs::File::create(t.join("stderr.txt")).unwrap())
+        .spawn()
+        .unwrap();
+    let mut status = 0;
+    // SAFETY: a zeroed rusage is valid; wait4 reaps our own child and fills both.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    let pid = unsafe { libc::wait4(child.id() as libc::pid_t, &mut status, 0, &mut usage) };
+    assert_eq!(pid, child.id() as libc::pid_t);
+    let ok = libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0;
+    let err = std::fs::read_to_string(t.join("stderr.txt")).unwrap();
+    (ok, err, usage.ru_maxrss)
+}
+
+#[test]
+fn hanging_loud_and_forking_methods_are_bounded() {
+    let t = TestDir::new();
+    tiny_dataset(&t, "ds");
+    let cmd = again();
+    let bg = format!(
+        "bg=sh -c 'sleep 1237 & exec {} disparity \"$1\" \"$2\" -o \"$3\"' sh {{left}} {{right}} {{out}}",
+        env!("CARGO_BIN_EXE_streaks")
+    );
+    let start = std::time::Instant::now();
+    let (ok, err, peak_kb) = streaks_peak_memory(
+        &t,
+        &[
+            "benchmark",
+            "ds",
+            "--method-timeout",
+            "2",
+            "--method-cmd",
+            &cmd,
+            "--method-cmd",
+            "slow=sh -c 'echo waiting >&2; sleep 1236' sh {out}",
+            "--method-cmd",
+            &bg,
+            "--method-cmd",
+            "loud=sh -c 'head -c 300000000 /dev/zero; echo last words >&2; exit 3' sh {out}",
+            "-o",
+            "out",
+        ],
+    );
+    let seconds = start.elapsed().as_secs_f64();
+    // Two 2 s timeouts and the rest; unbounded, `slow` alone would take 41 minutes and `bg`
+    // would hang on the pipes its child holds.
+    assert!(seconds < 30.0, "{seconds} s");
+    assert!(!ok && err.contains("4 method runs failed"), "{err}");
+    // 300 MB printed per sample, a bounded tail kept: far below the output's size.
+    assert!(peak_kb < 120_000, "{peak_kb} kB");
+    let r = report(&t, "out");
+    for s in r["samples"].as_array().unwrap() {
+        let res = s["results"].as_array().unwrap();
+        let by = |m: &str| res.iter().find(|x| x["method"] == m).unwrap();
+        assert_eq!(by("slow")["failure"]["kind"], "timeout", "{s}");
+        assert!(by("slow")["failure"]["reason"]
+            .as_str()
+            .unwrap()
+            .contains("--method-timeout 2 s"));
+        assert_eq!(by("slow")["failure"]["stderr_tail"], "waiting");
+        assert!(by("slow")["seconds"].as_f64().unwrap() < 10.0);
+        assert!(by("bg")["failure"].is_null(), "{s}");
+        assert_eq!(by("bg")["errors"], by("again")["errors"]);
+        assert_eq!(by("loud")["failure"]["stderr_tail"], "last words");
+        let out_tail = by("loud")["failure"]["stdout_tail"].as_str().unwrap();
+        assert!(out_tail.len() < 20_000, "{}", out_tail.len());
+    }
+    // No process of the commands is left running.
+    let ps = std::process::Command::new("ps")
+        .args(["-eo", "args"])
+        .output()
+        .unwrap();
+    let ps = String::from_utf8_lossy(&ps.stdout);
+    assert!(
+        !ps.contains("sleep 1236") && !ps.contains("sleep 1237"),
+        "{ps}"
+    );
+}
+
+#[test]
+fn a_terminated_benchmark_takes_its_running_method_with_it() {
+    let t = TestDir::new();
+    road_pair(&t, "pair");
+    // The command runs in a process group of its own, out of reach of the terminal's Ctrl-C
+    // and of a signal to `streaks`' group: `streaks` must kill it when it is told to end.
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_streaks"))
+        .args([
+            "benchmark",
+            "pair",
+            "--method-cmd",
+            "slow=sh -c 'touch started; sleep 97.5' sh {out}",
+            "-o",
+            "out",
+        ])
+        .current_dir(t.path())
+        .env("CI", "true")
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while !t.join("started").exists() {
+        assert!(start.elapsed().as_secs() < 30, "the method did not start");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    // SAFETY: kill only sends a signal to our own child.
+    unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGTERM) };
+    let status = child.wait().unwrap();
+    assert!(!status.success());
+    let gone = std::time::Instant::now();
+    loop {
+        let ps = std::process::Command::new("ps")
+            .args(["-eo", "args"])
+            .output()
+            .unwrap();
+        if !String::from_utf8_lossy(&ps.stdout).contains("sleep 97.5") {
+            break;
+        }
+        assert!(gone.elapsed().as_secs() < 5, "the method outlived streaks");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    assert!(!t.join("out/report.json").exists());
 }
