@@ -2,7 +2,7 @@
 //! and shadow rays per second on `scenes/rainy_street.gltf` for primary (coherent) and
 //! diffuse-bounce (incoherent) rays.
 //!
-//! Coherent rays (issue 19, point 4; `coherent_<street>` groups): primary rays and the road's
+//! Coherent rays (`coherent_<street>` groups; docs/decisions/0006): primary rays and the road's
 //! first glossy bounce on `rainy_street` and on a procedural street (the generator's default
 //! config, seed 0, sample 0: the scene of `streaks dataset generate --count 1`'s
 //! `samples/000000`, camera `driver`), closest hits traced one at a time in scanline order,

@@ -321,7 +321,7 @@ pub struct DatasetScore {
     pub samples: Vec<SampleScore>,
 }
 
-/// The precision at which [`DatasetScore::road_at_precision`] reads the curve (issue 18's
+/// The precision at which [`DatasetScore::road_at_precision`] reads the curve (the detector's
 /// target: recall 0.8 at precision 0.9).
 pub const AT_PRECISION: f64 = 0.9;
 

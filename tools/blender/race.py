@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Race `streaks render` against Blender's Cycles at equal samples on a glTF scene as Blender's
-glTF importer reads it (issue 19's "against Cycles" target: `scenes/rainy_street.gltf`).
+glTF importer reads it (the "against Cycles" target of docs/benchmarks.md:
+`scenes/rainy_street.gltf`).
 
 Blender imports the scene once (`bpy.ops.import_scene.gltf`, the importer's defaults) and the
 scene camera is made the active one; Cycles gets the cross-check's settings (build.py,

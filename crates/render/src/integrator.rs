@@ -99,7 +99,7 @@
 //! estimated from the very samples that are averaged. A pixel whose rare bright paths (a lamp
 //! reflected through the wet road, a firefly) have not shown up in its first samples estimates
 //! a small variance and stops, too dark; a pixel that did see one runs on and dilutes it. A rule
-//! that judged each pixel by its own samples (this module's rule until issue 19's second pass)
+//! that judged each pixel by its own samples (this module's earlier rule)
 //! made rainy_street 1.4 % darker overall and 1.8 % on the road, and the procedural streets up
 //! to 2.9 % on the road. A tile's decision pools 256 pixels' samples: a rare path of one pixel
 //! moves it by 1/256, and a kind of rare path that a region has (every pixel of a wet patch
