@@ -4,6 +4,8 @@
 //! DIR/dataset.json                      settings, generator version, config, conventions
 //! DIR/samples/NNNNNN/                   one sample (Middlebury style, see SAMPLE_FILES)
 //! DIR/samples/.tmp-NNNNNN-PID/          a sample being rendered (renamed when complete)
+//! DIR/samples/.lock-NNNNNN              its lock, while a run checks or renders it
+//! DIR/.lock                             the dataset lock, while a run uses the folder
 //! DIR/kitti/training/image_2/NNNNNN_10.png       = im0.png
 //! DIR/kitti/training/image_3/NNNNNN_10.png       = im1.png
 //! DIR/kitti/training/disp_occ_0/NNNNNN_10.png    disp0 as uint16 x 256, 0 = no value
@@ -36,6 +38,12 @@ pub const SAMPLE_FILES: [&str; 10] = [
     "meta.json",
     "streaks0.png",
 ];
+
+/// The dataset lock's file name in the dataset folder.
+pub const LOCK: &str = ".lock";
+
+/// The name prefix of the sample locks in `samples/`: `.lock-NNNNNN`.
+pub const SAMPLE_LOCK_PREFIX: &str = ".lock-";
 
 /// The road-surface mask, present when the scene flags a road material.
 pub const ROAD_MASK: &str = "road0.png";
@@ -96,6 +104,23 @@ impl Layout {
     /// `manifest.jsonl`.
     pub fn manifest(&self) -> PathBuf {
         self.root.join("manifest.jsonl")
+    }
+
+    /// Whether `manifest.jsonl` exists (as anything: a symbolic link or folder there is
+    /// refused when it is read).
+    pub fn manifest_present(&self) -> bool {
+        std::fs::symlink_metadata(self.manifest()).is_ok()
+    }
+
+    /// `.lock`: the dataset lock (see [`super::lock`]).
+    pub fn lock(&self) -> PathBuf {
+        self.root.join(LOCK)
+    }
+
+    /// `samples/.lock-NNNNNN`: the lock of sample `index` (see [`super::lock`]).
+    pub fn sample_lock(&self, index: u64) -> PathBuf {
+        self.samples_dir()
+            .join(format!("{SAMPLE_LOCK_PREFIX}{}", sample_id(index)))
     }
 
     /// `splits/`.
