@@ -299,7 +299,7 @@ pub fn index_dir(layout: &Layout) -> Result<IndexReport> {
 
     // Every sample, in parallel; the results in index order.
     let bar = progress_bar(info.count);
-    let checked: Vec<Option<(Result<(ManifestLine, String)>, usize)>> = (0..info.count)
+    let checked: Vec<_> = (0..info.count)
         .into_par_iter()
         .map(|index| {
             let dir = layout.sample_dir(index);

@@ -212,7 +212,7 @@ fn ground_truth_reads_back_as_stereo_loaders_read_it() {
         (calib.vmin as f32, calib.vmax as f32),
         (lo as f32, hi as f32)
     );
-    assert!(calib.ndisp as f64 > hi && calib.ndisp % 16 == 0);
+    assert!(calib.ndisp as f64 > hi && calib.ndisp.is_multiple_of(16));
     // image_2 is im0.png, image_3 is im1.png.
     let bytes = |p: &str| std::fs::read(t.join(p)).unwrap();
     assert_eq!(
@@ -601,10 +601,7 @@ fn a_killed_runs_leftovers_are_cleaned() {
         err.contains("sample 000001: removed samples/.tmp-000001-999999, the temporary folder of an interrupted run"),
         "{err}"
     );
-    assert!(
-        err.contains("0 samples rendered, 3 already done"),
-        "{err}"
-    );
+    assert!(err.contains("0 samples rendered, 3 already done"), "{err}");
     assert_eq!(tree(&t.join("ds")), good);
 
     // A run that holds sample 000002's lock: a shard run waits for it, then finds the sample
@@ -635,10 +632,7 @@ fn a_killed_runs_leftovers_are_cleaned() {
         err.contains("sample 000002: PID 4242 (a test) is on it; waiting"),
         "{err}"
     );
-    assert!(
-        err.contains("0 samples rendered, 3 already done"),
-        "{err}"
-    );
+    assert!(err.contains("0 samples rendered, 3 already done"), "{err}");
     assert_eq!(tree(&t.join("ds")), good);
 }
 
