@@ -188,7 +188,8 @@ pub fn run(args: Args) -> Result<()> {
     };
     let _dataset_lock = dataset_lock(&layout, mode, &what)?;
     prepare_folder(&layout, &info)?;
-    let manifest = match Manifest::load(&layout, args.count) {
+    let shard = args.shard.unwrap_or(Shard::ALL);
+    let manifest = match Manifest::load(&layout, args.count, &|i| shard.contains(i)) {
         Ok(m) => m,
         Err(e) => {
             eprintln!(
@@ -204,7 +205,6 @@ pub fn run(args: Args) -> Result<()> {
     };
 
     // Phase 3: check the samples of this shard.
-    let shard = args.shard.unwrap_or(Shard::ALL);
     let indices: Vec<u64> = (0..args.count).filter(|&i| shard.contains(i)).collect();
     let settings = SampleSettings {
         config,

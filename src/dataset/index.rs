@@ -146,11 +146,19 @@ pub fn run(args: Args) -> Result<()> {
     } else {
         "streaks dataset index"
     };
-    let _lock = dataset_lock(&layout, mode, what)?;
+    let _lock = match dataset_lock(&layout, mode, what) {
+        Ok(lock) => Some(lock),
+        // A copy on a read-only disk can still be verified: nothing can write it either.
+        Err(e) if !rebuild && unwritable(&e) => {
+            eprintln!("warning: {e:#}; verifying without the lock");
+            None
+        }
+        Err(e) => return Err(e),
+    };
     if rebuild {
         return pool.install(|| index_dir(&layout))?.finish(&layout);
     }
-    let manifest = Manifest::load(&layout, info.count)
+    let manifest = Manifest::load(&layout, info.count, &|_| true)
         .context(
             "cannot verify against the manifest (`--rebuild` writes it again from the samples)",
         )?
@@ -172,6 +180,15 @@ pub fn dataset_lock(layout: &Layout, mode: Mode, what: &str) -> Result<Lock> {
         ),
         Err(e) => Err(e.into()),
     }
+}
+
+/// Whether `e` says the lock file cannot be created because the folder is not writable.
+fn unwritable(e: &anyhow::Error) -> bool {
+    use std::io::ErrorKind::{PermissionDenied, ReadOnlyFilesystem};
+    matches!(
+        e.downcast_ref::<LockError>(),
+        Some(LockError::Io { source, .. }) if matches!(source.kind(), PermissionDenied | ReadOnlyFilesystem)
+    )
 }
 
 /// Verifies the files of the dataset in `layout` against `manifest`; writes nothing and fails
@@ -228,10 +245,11 @@ pub fn verify(layout: &Layout, info: &DatasetInfo, manifest: &Manifest) -> Resul
     let seconds = start.elapsed().as_secs_f64();
     if problems > 0 {
         bail!(
-            "the dataset {root} differs from its manifest.jsonl in {problems} places (see above; \
+            "the dataset {root} differs from its manifest.jsonl in {problems} place{} (see above; \
              the manifest is unchanged): `streaks dataset generate` with the dataset's arguments \
              renders missing and damaged samples again, `streaks dataset index --rebuild {root}` \
-             writes the manifest from the samples on disk"
+             writes the manifest from the samples on disk",
+            if problems == 1 { "" } else { "s" }
         );
     }
     eprintln!(
@@ -358,11 +376,48 @@ fn scene_files(gltf: &Path) -> Result<Vec<String>> {
     for key in ["buffers", "images"] {
         for item in json[key].as_array().into_iter().flatten() {
             if let Some(uri) = item["uri"].as_str().filter(|u| !u.starts_with("data:")) {
+                // The generator writes plain names next to scene.gltf; nothing else is looked at.
+                if uri.is_empty() || uri == "." || uri == ".." || uri.contains(['/', '\\', ':']) {
+                    bail!("scene.gltf refers to {uri:?}, not a file of the sample's folder");
+                }
                 files.push(uri.to_owned());
             }
         }
     }
     Ok(files)
+}
+
+/// Fails unless the sample folder `dir` is a folder (not a symbolic link) whose entries, and
+/// the sample's KITTI files that exist, are all regular files.
+fn only_regular_files(layout: &Layout, index: u64, dir: &Path) -> Result<()> {
+    let what = |m: &std::fs::Metadata| {
+        if m.file_type().is_symlink() {
+            "a symbolic link"
+        } else if m.is_dir() {
+            "a folder"
+        } else {
+            "a special file"
+        }
+    };
+    let m =
+        std::fs::symlink_metadata(dir).with_context(|| format!("cannot read {}", dir.display()))?;
+    if !m.is_dir() {
+        bail!("{} is {}", layout.relative(dir), what(&m));
+    }
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(dir)
+        .with_context(|| format!("cannot list {}", dir.display()))?
+        .map(|e| e.map(|e| e.path()))
+        .collect::<Result<_, _>>()
+        .with_context(|| format!("cannot list {}", dir.display()))?;
+    let kitti = layout.kitti(index);
+    paths.extend(kitti.named(layout).map(|(_, p)| p.to_path_buf()));
+    for path in paths {
+        match std::fs::symlink_metadata(&path) {
+            Ok(m) if !m.is_file() => bail!("{} is {}", layout.relative(&path), what(&m)),
+            _ => {}
+        }
+    }
+    Ok(())
 }
 
 /// Checks that `path` is an image of `w` x `h` pixels.
@@ -392,6 +447,8 @@ pub fn check_sample(
     dir: &Path,
     kitti_repaired: Option<&mut usize>,
 ) -> Result<(ManifestLine, String)> {
+    // Nothing is read through a symbolic link or from a special file (a FIFO would block).
+    only_regular_files(layout, index, dir)?;
     let meta = SampleMeta::load(&dir.join("meta.json"))
         .map_err(|e| anyhow::anyhow!("meta.json: {e:#}"))?;
     if meta.index != index || meta.seed != info.seed || meta.config_hash != info.config_hash {

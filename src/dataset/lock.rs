@@ -107,7 +107,16 @@ impl Lock {
             match tried {
                 Ok(()) => {}
                 Err(TryLockError::WouldBlock) => {
-                    let holder = read_holder(&file);
+                    // The holder writes its line just after it gets the lock: give it a moment.
+                    let mut holder = read_holder(&file);
+                    for _ in 0..20 {
+                        if holder.is_some() {
+                            break;
+                        }
+                        std::thread::sleep(std::time::Duration::from_millis(5));
+                        holder = read_holder(&file);
+                    }
+                    let holder = holder.unwrap_or_else(|| "an unknown process".to_owned());
                     if !wait {
                         return Err(LockError::Busy {
                             path: path.to_path_buf(),
@@ -158,8 +167,8 @@ impl Drop for Lock {
 }
 
 /// The holder's description in a lock file: its first line, printable, at most
-/// [`HOLDER_BYTES`] bytes; `an unknown process` when empty.
-fn read_holder(file: &File) -> String {
+/// [`HOLDER_BYTES`] bytes; `None` when empty.
+fn read_holder(file: &File) -> Option<String> {
     let mut bytes = Vec::new();
     let mut f = file;
     let _ = f
@@ -173,11 +182,8 @@ fn read_holder(file: &File) -> String {
         .chars()
         .filter(|c| !c.is_control())
         .collect();
-    if line.trim().is_empty() {
-        "an unknown process".to_owned()
-    } else {
-        line.trim().to_owned()
-    }
+    let line = line.trim();
+    (!line.is_empty()).then(|| line.to_owned())
 }
 
 /// Whether the open `file` is still the file at `path` (same device and inode).

@@ -118,6 +118,12 @@ pub enum ManifestError {
     },
 }
 
+/// The index of a manifest line (the rest is skipped by the parser, unallocated).
+#[derive(Deserialize)]
+struct IndexOnly {
+    index: u64,
+}
+
 /// The part of a manifest line that checking needs.
 #[derive(Deserialize)]
 struct RawLine {
@@ -143,11 +149,19 @@ pub struct Manifest {
     /// The samples, in the order of the file.
     pub entries: Vec<Entry>,
     by_index: HashMap<u64, usize>,
+    lines: usize,
 }
 
 impl Manifest {
     /// Reads `layout`'s manifest of a dataset of `count` samples; `None` if there is none.
-    pub fn load(layout: &Layout, count: u64) -> Result<Option<Manifest>, ManifestError> {
+    /// Only the samples for which `keep` holds are kept (and their files checked): a shard
+    /// of a large dataset holds its own lines only; every line is still checked to be JSON,
+    /// of a sample of the dataset, and listed once.
+    pub fn load(
+        layout: &Layout,
+        count: u64,
+        keep: &dyn Fn(u64) -> bool,
+    ) -> Result<Option<Manifest>, ManifestError> {
         let path = layout.manifest();
         match std::fs::symlink_metadata(&path) {
             Ok(m) if m.file_type().is_file() => {}
@@ -159,13 +173,15 @@ impl Manifest {
             path: path.clone(),
             source,
         })?;
-        Self::parse(layout, count, BufReader::new(file), &path).map(Some)
+        Self::parse(layout, count, keep, BufReader::new(file), &path).map(Some)
     }
 
-    /// Parses manifest lines from `reader` (`path` names it in errors).
+    /// Parses manifest lines from `reader` (`path` names it in errors), keeping the samples
+    /// for which `keep` holds.
     pub fn parse(
         layout: &Layout,
         count: u64,
+        keep: &dyn Fn(u64) -> bool,
         mut reader: impl BufRead,
         path: &Path,
     ) -> Result<Manifest, ManifestError> {
@@ -197,19 +213,44 @@ impl Manifest {
             if buf.iter().all(u8::is_ascii_whitespace) {
                 continue;
             }
-            if manifest.entries.len() as u64 >= count {
+            if manifest.lines as u64 >= count {
                 return Err(ManifestError::TooManyLines {
                     path: path.to_path_buf(),
                     line,
                     count,
                 });
             }
-            let raw: RawLine =
-                serde_json::from_slice(&buf).map_err(|source| ManifestError::Json {
-                    path: path.to_path_buf(),
-                    line,
-                    source,
-                })?;
+            let json = |source| ManifestError::Json {
+                path: path.to_path_buf(),
+                line,
+                source,
+            };
+            let index = serde_json::from_slice::<IndexOnly>(&buf)
+                .map_err(json)?
+                .index;
+            if !keep(index) {
+                if index >= count {
+                    return Err(ManifestError::NotASample {
+                        path: path.to_path_buf(),
+                        line,
+                        id: String::new(),
+                        index,
+                        last: sample_id(count.saturating_sub(1)),
+                    });
+                }
+                if let Some(&first) = first_line.get(&index) {
+                    return Err(ManifestError::Duplicate {
+                        path: path.to_path_buf(),
+                        line,
+                        id: sample_id(index),
+                        first,
+                    });
+                }
+                first_line.insert(index, line);
+                manifest.lines += 1;
+                continue;
+            }
+            let raw: RawLine = serde_json::from_slice(&buf).map_err(json)?;
             if raw.index >= count || raw.id != sample_id(raw.index) {
                 return Err(ManifestError::NotASample {
                     path: path.to_path_buf(),
@@ -246,6 +287,7 @@ impl Manifest {
                 }
             }
             first_line.insert(raw.index, line);
+            manifest.lines += 1;
             manifest.by_index.insert(raw.index, manifest.entries.len());
             manifest.entries.push(Entry {
                 line,
@@ -468,7 +510,13 @@ mod tests {
 
     fn parse(text: &str) -> Result<Manifest, ManifestError> {
         let layout = Layout::new(Path::new("/data/ds"));
-        Manifest::parse(&layout, 3, text.as_bytes(), Path::new("manifest.jsonl"))
+        Manifest::parse(
+            &layout,
+            3,
+            &|_| true,
+            text.as_bytes(),
+            Path::new("manifest.jsonl"),
+        )
     }
 
     const SHA: &str = "0123456789abcdef0123456789abcdef0123456789abcdef0123456789abcdef";
@@ -485,6 +533,30 @@ mod tests {
         assert_eq!(m.entries.len(), 2);
         assert_eq!(m.get(2).unwrap().line, 2);
         assert!(m.get(1).is_none());
+    }
+
+    #[test]
+    fn a_shard_keeps_its_lines_and_still_checks_the_others() {
+        let layout = Layout::new(Path::new("/data/ds"));
+        let text = line("000000", 0, "samples/000000/im0.png")
+            + &line("000001", 1, "samples/000001/../../x")
+            + &line("000002", 2, "samples/000002/im0.png");
+        let even = |i: u64| i % 2 == 0;
+        let m = Manifest::parse(&layout, 3, &even, text.as_bytes(), Path::new("m")).unwrap();
+        assert_eq!(m.entries.len(), 2);
+        let dup = text.clone() + &line("000001", 1, "samples/000001/im0.png");
+        let err = Manifest::parse(&layout, 4, &even, dup.as_bytes(), Path::new("m")).unwrap_err();
+        assert!(
+            err.to_string()
+                .contains("line 4: sample 000001 is listed again"),
+            "{err}"
+        );
+        let bad = text + "{\"index\": 1, \n";
+        let err = Manifest::parse(&layout, 4, &even, bad.as_bytes(), Path::new("m")).unwrap_err();
+        assert!(
+            err.to_string().contains("line 4: not a manifest line"),
+            "{err}"
+        );
     }
 
     #[test]

@@ -332,13 +332,43 @@ fn changed_files_are_found_by_their_hash_and_restored_byte_for_byte() {
     flip("ds/samples/000001/im0.exr");
     flip("ds/kitti/training/disp_occ_0/000002_10.png");
     std::fs::write(t.join("ds/samples/000000/notes.txt"), "mine").unwrap();
+    // A file replaced by a symbolic link out of the folder, another by a FIFO: reported, never
+    // followed nor opened (a FIFO would block the reader forever).
+    let secret = t.join("secret.txt");
+    std::fs::write(&secret, "outside").unwrap();
+    let mut places = 3;
+    #[cfg(unix)]
+    {
+        std::fs::remove_file(t.join("ds/samples/000002/calib.txt")).unwrap();
+        std::os::unix::fs::symlink(&secret, t.join("ds/samples/000002/calib.txt")).unwrap();
+        std::fs::remove_file(t.join("ds/samples/000000/meta.json")).unwrap();
+        let made = Command::new("mkfifo")
+            .arg(t.join("ds/samples/000000/meta.json"))
+            .status()
+            .unwrap();
+        assert!(made.success());
+        places += 2;
+    }
     let hex = |bytes: &[u8]| format!("{:x}", <sha2::Sha256 as sha2::Digest>::digest(bytes));
     let bad = hex(&std::fs::read(t.join("ds/samples/000001/im0.exr")).unwrap());
     let expected = hex(&good["samples/000001/im0.exr"]);
 
     let run = t.streaks(&["dataset", "index", "ds"]);
-    run.assert_failure_mentioning("differs from its manifest.jsonl in 3 places");
+    run.assert_failure_mentioning(&format!(
+        "differs from its manifest.jsonl in {places} places"
+    ));
     let err = run.stderr();
+    #[cfg(unix)]
+    {
+        assert!(
+            err.contains("samples/000002/calib.txt: samples/000002/calib.txt is a symbolic link"),
+            "{err}"
+        );
+        assert!(
+            err.contains("samples/000000/meta.json: not a regular file"),
+            "{err}"
+        );
+    }
     assert!(
         err.contains(&format!(
             "sample 000001 (manifest line 2): samples/000001/im0.exr: sha256 {bad}, the manifest \
@@ -382,6 +412,7 @@ fn changed_files_are_found_by_their_hash_and_restored_byte_for_byte() {
         "{err}"
     );
     assert_eq!(tree(&t.join("ds")), good);
+    assert_eq!(std::fs::read_to_string(&secret).unwrap(), "outside");
     let run = t.streaks(&["dataset", "index", "ds"]);
     run.assert_success();
     assert!(
@@ -474,6 +505,59 @@ fn hostile_manifests_are_refused_with_their_line_number() {
     assert_eq!(
         std::fs::read_to_string(t.join("ds/manifest.jsonl")).unwrap(),
         good
+    );
+}
+
+/// Rebuilding (and `generate` without a manifest) never reads a sample's file through a
+/// symbolic link or from a FIFO, nor a file its scene names outside its folder: they are
+/// reported as damage, and `generate` renders the sample again.
+#[cfg(unix)]
+#[test]
+fn rebuild_reports_special_files_without_opening_them() {
+    let t = TestDir::new();
+    generate(&t, "ds", &[]).assert_success();
+    let good = tree(&t.join("ds"));
+    std::fs::remove_file(t.join("ds/manifest.jsonl")).unwrap();
+    std::fs::write(t.join("secret.txt"), "outside").unwrap();
+    std::fs::remove_file(t.join("ds/samples/000000/meta.json")).unwrap();
+    let made = Command::new("mkfifo")
+        .arg(t.join("ds/samples/000000/meta.json"))
+        .status()
+        .unwrap();
+    assert!(made.success());
+    std::fs::remove_file(t.join("ds/samples/000001/calib.txt")).unwrap();
+    std::os::unix::fs::symlink(t.join("secret.txt"), t.join("ds/samples/000001/calib.txt"))
+        .unwrap();
+    let gltf = t.join("ds/samples/000002/scene.gltf");
+    let text = std::fs::read_to_string(&gltf).unwrap();
+    std::fs::write(
+        &gltf,
+        text.replacen("\"scene.bin\"", "\"../../../secret.txt\"", 1),
+    )
+    .unwrap();
+    let run = t.streaks(&["dataset", "index", "ds"]);
+    run.assert_failure_mentioning("incomplete");
+    let err = run.stderr();
+    for needle in [
+        "corrupt: 000000: samples/000000/meta.json is a special file",
+        "corrupt: 000001: samples/000001/calib.txt is a symbolic link",
+        "corrupt: 000002: scene.gltf refers to \"../../../secret.txt\"",
+    ] {
+        assert!(err.contains(needle), "{needle}: {err}");
+    }
+    std::fs::remove_file(t.join("ds/manifest.jsonl")).unwrap();
+    let run = generate(&t, "ds", &[]);
+    run.assert_success();
+    assert!(
+        run.stderr()
+            .contains("3 samples rendered (3 of them repaired)"),
+        "{}",
+        run.stderr()
+    );
+    assert_eq!(tree(&t.join("ds")), good);
+    assert_eq!(
+        std::fs::read_to_string(t.join("secret.txt")).unwrap(),
+        "outside"
     );
 }
 
