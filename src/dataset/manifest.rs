@@ -541,7 +541,7 @@ mod tests {
         let text = line("000000", 0, "samples/000000/im0.png")
             + &line("000001", 1, "samples/000001/../../x")
             + &line("000002", 2, "samples/000002/im0.png");
-        let even = |i: u64| i % 2 == 0;
+        let even = |i: u64| i.is_multiple_of(2);
         let m = Manifest::parse(&layout, 3, &even, text.as_bytes(), Path::new("m")).unwrap();
         assert_eq!(m.entries.len(), 2);
         let dup = text.clone() + &line("000001", 1, "samples/000001/im0.png");
