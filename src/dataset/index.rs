@@ -23,7 +23,7 @@
 use super::generate::sha256_hex;
 use super::layout::{sample_id, DatasetInfo, Layout, ROAD_MASK, SAMPLE_FILES, SCENE_GLTF, SPLITS};
 use super::lock::{Lock, LockError, Mode};
-use super::manifest::{verify_all, Manifest};
+use super::manifest::{verify_batch, Lines};
 use super::sample::{write_kitti, SampleMeta, SampleStats};
 use crate::render::progress_bar;
 use anyhow::{bail, Context, Result};
@@ -158,12 +158,10 @@ pub fn run(args: Args) -> Result<()> {
     if rebuild {
         return pool.install(|| index_dir(&layout))?.finish(&layout);
     }
-    let manifest = Manifest::load(&layout, info.count, &|_| true)
-        .context(
-            "cannot verify against the manifest (`--rebuild` writes it again from the samples)",
-        )?
+    let lines = Lines::open(&layout, info.count)
+        .context("cannot verify against the manifest")?
         .context("the manifest disappeared")?;
-    pool.install(|| verify(&layout, &info, &manifest))
+    pool.install(|| verify(&layout, &info, lines))
 }
 
 /// Takes the dataset lock of `layout` (see [`super::lock`]), or fails naming the folder and
@@ -191,31 +189,56 @@ fn unwritable(e: &anyhow::Error) -> bool {
     )
 }
 
-/// Verifies the files of the dataset in `layout` against `manifest`; writes nothing and fails
-/// if anything differs.
-pub fn verify(layout: &Layout, info: &DatasetInfo, manifest: &Manifest) -> Result<()> {
+/// Samples hashed per batch by [`verify`]: enough to keep every core busy, few enough that
+/// memory stays small whatever the manifest's size.
+const VERIFY_BATCH: usize = 1024;
+
+/// Verifies the files of the dataset in `layout` against its manifest (read as `lines`, in
+/// batches); writes nothing and fails if anything differs.
+pub fn verify<R: std::io::BufRead>(
+    layout: &Layout,
+    info: &DatasetInfo,
+    mut lines: Lines<R>,
+) -> Result<()> {
     let root = layout.root().display();
     let start = std::time::Instant::now();
-    let bar = progress_bar(manifest.entries.len() as u64);
-    let differences = verify_all(layout, manifest, &|| bar.inc(1));
-    bar.finish_and_clear();
+    let bar = progress_bar(info.count);
     let mut problems = 0usize;
-    let mut files = 0usize;
-    for (entry, diffs) in manifest.entries.iter().zip(&differences) {
-        files += entry.files.len();
-        for d in diffs {
-            eprintln!(
-                "sample {} (manifest line {}): {d}",
-                sample_id(entry.index),
-                entry.line
-            );
-            problems += 1;
+    let (mut samples, mut files) = (0usize, 0usize);
+    loop {
+        let mut batch = Vec::with_capacity(VERIFY_BATCH);
+        while batch.len() < VERIFY_BATCH {
+            match lines.next_kept(&|_| true).context(
+                "cannot verify against the manifest (`--rebuild` writes it again from the samples)",
+            )? {
+                Some(entry) => batch.push(entry),
+                None => break,
+            }
+        }
+        if batch.is_empty() {
+            break;
+        }
+        let differences = verify_batch(layout, &batch, &|| bar.inc(1));
+        for (entry, diffs) in batch.iter().zip(&differences) {
+            samples += 1;
+            files += entry.files.len();
+            for d in diffs {
+                bar.suspend(|| {
+                    eprintln!(
+                        "sample {} (manifest line {}): {d}",
+                        sample_id(entry.index),
+                        entry.line
+                    )
+                });
+                problems += 1;
+            }
         }
     }
+    bar.finish_and_clear();
     let mut unlisted = Vec::new();
     let mut missing = Vec::new();
     for index in 0..info.count {
-        if manifest.get(index).is_none() {
+        if !lines.listed(index) {
             if std::fs::symlink_metadata(layout.sample_dir(index)).is_ok() {
                 unlisted.push(sample_id(index));
             } else {
@@ -253,8 +276,7 @@ pub fn verify(layout: &Layout, info: &DatasetInfo, manifest: &Manifest) -> Resul
         );
     }
     eprintln!(
-        "verified {root}: {} samples, {files} files match manifest.jsonl ({seconds:.1} s)",
-        manifest.entries.len()
+        "verified {root}: {samples} samples, {files} files match manifest.jsonl ({seconds:.1} s)"
     );
     Ok(())
 }

@@ -25,6 +25,9 @@ pub const FORMAT: &str = "streaks-dataset/1";
 /// Sample ids have six digits: at most this many samples.
 pub const MAX_COUNT: u64 = 1_000_000;
 
+/// The largest `dataset.json` read (the file holds the settings and the generator config).
+pub const MAX_DATASET_JSON_BYTES: u64 = 16 << 20;
+
 /// The files of every sample folder besides the scene's, sorted.
 pub const SAMPLE_FILES: [&str; 10] = [
     "calib.txt",
@@ -349,11 +352,33 @@ pub struct DatasetInfo {
 
 impl DatasetInfo {
     /// Reads `dataset.json`.
+    /// The file must be a regular file of at most [`MAX_DATASET_JSON_BYTES`] (a FIFO or a
+    /// device is not opened) and its `count` in `1..=MAX_COUNT`, since commands loop over it.
     pub fn load(path: &Path) -> Result<Self> {
+        let meta =
+            std::fs::metadata(path).with_context(|| format!("cannot read {}", path.display()))?;
+        if !meta.is_file() {
+            bail!("{} is not a regular file", path.display());
+        }
+        if meta.len() > MAX_DATASET_JSON_BYTES {
+            bail!(
+                "{} is {} bytes, more than a dataset.json has ({MAX_DATASET_JSON_BYTES})",
+                path.display(),
+                meta.len()
+            );
+        }
         let text = std::fs::read_to_string(path)
             .with_context(|| format!("cannot read {}", path.display()))?;
-        serde_json::from_str(&text)
-            .with_context(|| format!("{} is not a dataset.json of {FORMAT}", path.display()))
+        let info: Self = serde_json::from_str(&text)
+            .with_context(|| format!("{} is not a dataset.json of {FORMAT}", path.display()))?;
+        if info.count == 0 || info.count > MAX_COUNT {
+            bail!(
+                "{}: count {} is not in 1..={MAX_COUNT}",
+                path.display(),
+                info.count
+            );
+        }
+        Ok(info)
     }
 
     /// The file's bytes (pretty JSON, a final newline).

@@ -128,7 +128,6 @@ struct IndexOnly {
 #[derive(Deserialize)]
 struct RawLine {
     id: String,
-    index: u64,
     files: BTreeMap<String, String>,
 }
 
@@ -149,7 +148,22 @@ pub struct Manifest {
     /// The samples, in the order of the file.
     pub entries: Vec<Entry>,
     by_index: HashMap<u64, usize>,
-    lines: usize,
+}
+
+/// Opens `layout`'s manifest (a regular file, never a link or a FIFO); `None` if there is none.
+fn open(layout: &Layout) -> Result<Option<(BufReader<std::fs::File>, PathBuf)>, ManifestError> {
+    let path = layout.manifest();
+    match std::fs::symlink_metadata(&path) {
+        Ok(m) if m.file_type().is_file() => {}
+        Ok(_) => return Err(ManifestError::NotAFile { path }),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(source) => return Err(ManifestError::Io { path, source }),
+    }
+    let file = std::fs::File::open(&path).map_err(|source| ManifestError::Io {
+        path: path.clone(),
+        source,
+    })?;
+    Ok(Some((BufReader::new(file), path)))
 }
 
 impl Manifest {
@@ -162,18 +176,10 @@ impl Manifest {
         count: u64,
         keep: &dyn Fn(u64) -> bool,
     ) -> Result<Option<Manifest>, ManifestError> {
-        let path = layout.manifest();
-        match std::fs::symlink_metadata(&path) {
-            Ok(m) if m.file_type().is_file() => {}
-            Ok(_) => return Err(ManifestError::NotAFile { path }),
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-            Err(source) => return Err(ManifestError::Io { path, source }),
+        match open(layout)? {
+            Some((reader, path)) => Self::parse(layout, count, keep, reader, &path).map(Some),
+            None => Ok(None),
         }
-        let file = std::fs::File::open(&path).map_err(|source| ManifestError::Io {
-            path: path.clone(),
-            source,
-        })?;
-        Self::parse(layout, count, keep, BufReader::new(file), &path).map(Some)
     }
 
     /// Parses manifest lines from `reader` (`path` names it in errors), keeping the samples
@@ -182,118 +188,16 @@ impl Manifest {
         layout: &Layout,
         count: u64,
         keep: &dyn Fn(u64) -> bool,
-        mut reader: impl BufRead,
+        reader: impl BufRead,
         path: &Path,
     ) -> Result<Manifest, ManifestError> {
+        let mut lines = Lines::new(layout, count, reader, path);
         let mut manifest = Manifest::default();
-        let mut buf = Vec::new();
-        let mut first_line: HashMap<u64, usize> = HashMap::new();
-        for line in 1.. {
-            buf.clear();
-            let n = reader
-                .by_ref()
-                .take(MAX_LINE_BYTES as u64 + 1)
-                .read_until(b'\n', &mut buf)
-                .map_err(|source| ManifestError::Io {
-                    path: path.to_path_buf(),
-                    source,
-                })?;
-            if n == 0 {
-                break;
-            }
-            if buf.last() == Some(&b'\n') {
-                buf.pop();
-            }
-            if buf.len() > MAX_LINE_BYTES {
-                return Err(ManifestError::LineTooLong {
-                    path: path.to_path_buf(),
-                    line,
-                });
-            }
-            if buf.iter().all(u8::is_ascii_whitespace) {
-                continue;
-            }
-            if manifest.lines as u64 >= count {
-                return Err(ManifestError::TooManyLines {
-                    path: path.to_path_buf(),
-                    line,
-                    count,
-                });
-            }
-            let json = |source| ManifestError::Json {
-                path: path.to_path_buf(),
-                line,
-                source,
-            };
-            let index = serde_json::from_slice::<IndexOnly>(&buf)
-                .map_err(json)?
-                .index;
-            if !keep(index) {
-                if index >= count {
-                    return Err(ManifestError::NotASample {
-                        path: path.to_path_buf(),
-                        line,
-                        id: String::new(),
-                        index,
-                        last: sample_id(count.saturating_sub(1)),
-                    });
-                }
-                if let Some(&first) = first_line.get(&index) {
-                    return Err(ManifestError::Duplicate {
-                        path: path.to_path_buf(),
-                        line,
-                        id: sample_id(index),
-                        first,
-                    });
-                }
-                first_line.insert(index, line);
-                manifest.lines += 1;
-                continue;
-            }
-            let raw: RawLine = serde_json::from_slice(&buf).map_err(json)?;
-            if raw.index >= count || raw.id != sample_id(raw.index) {
-                return Err(ManifestError::NotASample {
-                    path: path.to_path_buf(),
-                    line,
-                    id: raw.id,
-                    index: raw.index,
-                    last: sample_id(count.saturating_sub(1)),
-                });
-            }
-            if let Some(&first) = first_line.get(&raw.index) {
-                return Err(ManifestError::Duplicate {
-                    path: path.to_path_buf(),
-                    line,
-                    id: raw.id,
-                    first,
-                });
-            }
-            let own = own_files(layout, raw.index);
-            for (file, sha) in &raw.files {
-                if !own.is_own(file) {
-                    return Err(ManifestError::ForeignPath {
-                        path: path.to_path_buf(),
-                        line,
-                        id: raw.id.clone(),
-                        file: file.clone(),
-                    });
-                }
-                if sha.len() != 64 || !sha.bytes().all(|b| matches!(b, b'0'..=b'9' | b'a'..=b'f')) {
-                    return Err(ManifestError::BadHash {
-                        path: path.to_path_buf(),
-                        line,
-                        file: file.clone(),
-                    });
-                }
-            }
-            first_line.insert(raw.index, line);
-            manifest.lines += 1;
-            manifest.by_index.insert(raw.index, manifest.entries.len());
-            manifest.entries.push(Entry {
-                line,
-                index: raw.index,
-                files: raw.files,
-            });
+        while let Some(entry) = lines.next_kept(keep)? {
+            manifest
+                .by_index
+                .insert(entry.index, manifest.entries.len());
+            manifest.entries.push(entry);
         }
         Ok(manifest)
     }
@@ -301,6 +205,136 @@ impl Manifest {
     /// The entry of sample `index`, if listed.
     pub fn get(&self, index: u64) -> Option<&Entry> {
         self.by_index.get(&index).map(|&k| &self.entries[k])
+    }
+}
+
+/// Reads a manifest line by line, validating each (memory: one line, and the line number of
+/// each sample seen, for duplicates).
+pub struct Lines<R> {
+    reader: R,
+    path: PathBuf,
+    layout: Layout,
+    count: u64,
+    line: usize,
+    first_line: HashMap<u64, usize>,
+    buf: Vec<u8>,
+}
+
+impl Lines<BufReader<std::fs::File>> {
+    /// Opens `layout`'s manifest of a dataset of `count` samples; `None` if there is none.
+    pub fn open(layout: &Layout, count: u64) -> Result<Option<Self>, ManifestError> {
+        Ok(open(layout)?.map(|(reader, path)| Lines::new(layout, count, reader, &path)))
+    }
+}
+
+impl<R: BufRead> Lines<R> {
+    /// Reads the lines of `reader` (`path` names it in errors).
+    pub fn new(layout: &Layout, count: u64, reader: R, path: &Path) -> Self {
+        Lines {
+            reader,
+            path: path.to_path_buf(),
+            layout: layout.clone(),
+            count,
+            line: 0,
+            first_line: HashMap::new(),
+            buf: Vec::new(),
+        }
+    }
+
+    /// Whether a line read so far lists sample `index`.
+    pub fn listed(&self, index: u64) -> bool {
+        self.first_line.contains_key(&index)
+    }
+
+    /// The next line whose sample `keep` holds for (the others are checked to be JSON, of a
+    /// sample of the dataset and not listed before, and skipped); `None` at the end.
+    pub fn next_kept(
+        &mut self,
+        keep: &dyn Fn(u64) -> bool,
+    ) -> Result<Option<Entry>, ManifestError> {
+        loop {
+            self.buf.clear();
+            self.line += 1;
+            let (path, line, count) = (self.path.clone(), self.line, self.count);
+            let n = self
+                .reader
+                .by_ref()
+                .take(MAX_LINE_BYTES as u64 + 1)
+                .read_until(b'\n', &mut self.buf)
+                .map_err(|source| ManifestError::Io {
+                    path: path.clone(),
+                    source,
+                })?;
+            if n == 0 {
+                return Ok(None);
+            }
+            if self.buf.last() == Some(&b'\n') {
+                self.buf.pop();
+            }
+            if self.buf.len() > MAX_LINE_BYTES {
+                return Err(ManifestError::LineTooLong { path, line });
+            }
+            if self.buf.iter().all(u8::is_ascii_whitespace) {
+                continue;
+            }
+            if self.first_line.len() as u64 >= count {
+                return Err(ManifestError::TooManyLines { path, line, count });
+            }
+            let json = |source| ManifestError::Json {
+                path: path.clone(),
+                line,
+                source,
+            };
+            let index = serde_json::from_slice::<IndexOnly>(&self.buf)
+                .map_err(json)?
+                .index;
+            let kept = keep(index);
+            let (id, files) = if kept {
+                let raw: RawLine = serde_json::from_slice(&self.buf).map_err(json)?;
+                (raw.id, raw.files)
+            } else {
+                (sample_id(index), BTreeMap::new())
+            };
+            if index >= count || id != sample_id(index) {
+                return Err(ManifestError::NotASample {
+                    path,
+                    line,
+                    id,
+                    index,
+                    last: sample_id(count.saturating_sub(1)),
+                });
+            }
+            if let Some(&first) = self.first_line.get(&index) {
+                return Err(ManifestError::Duplicate {
+                    path,
+                    line,
+                    id,
+                    first,
+                });
+            }
+            let own = own_files(&self.layout, index);
+            for (file, sha) in &files {
+                if !own.is_own(file) {
+                    return Err(ManifestError::ForeignPath {
+                        path,
+                        line,
+                        id,
+                        file: file.clone(),
+                    });
+                }
+                if sha.len() != 64 || !sha.bytes().all(|b| matches!(b, b'0'..=b'9' | b'a'..=b'f')) {
+                    return Err(ManifestError::BadHash {
+                        path,
+                        line,
+                        file: file.clone(),
+                    });
+                }
+            }
+            self.first_line.insert(index, line);
+            if kept {
+                return Ok(Some(Entry { line, index, files }));
+            }
+        }
     }
 }
 
@@ -486,15 +520,14 @@ pub fn verify_entry(layout: &Layout, entry: &Entry) -> Vec<Difference> {
     out
 }
 
-/// Verifies every entry in parallel (in the current rayon pool), calling `done` after each;
-/// returns the differences of each entry, in the manifest's order.
-pub fn verify_all(
+/// Verifies `entries` in parallel (in the current rayon pool), calling `done` after each;
+/// returns the differences of each entry, in order.
+pub fn verify_batch(
     layout: &Layout,
-    manifest: &Manifest,
+    entries: &[Entry],
     done: &(dyn Fn() + Sync),
 ) -> Vec<Vec<Difference>> {
-    manifest
-        .entries
+    entries
         .par_iter()
         .map(|entry| {
             let d = verify_entry(layout, entry);

@@ -506,6 +506,20 @@ fn hostile_manifests_are_refused_with_their_line_number() {
         std::fs::read_to_string(t.join("ds/manifest.jsonl")).unwrap(),
         good
     );
+
+    // A dataset.json whose count no one could loop over is refused before any loop.
+    let json = std::fs::read_to_string(t.join("ds/dataset.json")).unwrap();
+    let huge = json.replacen("\"count\": 2,", "\"count\": 1000000000000000000,", 1);
+    assert_ne!(huge, json);
+    std::fs::write(t.join("ds/dataset.json"), huge).unwrap();
+    for rebuild in [false, true] {
+        let mut args = vec!["dataset", "index", "ds"];
+        if rebuild {
+            args.push("--rebuild");
+        }
+        t.streaks(&args)
+            .assert_failure_mentioning("count 1000000000000000000 is not in 1..=1000000");
+    }
 }
 
 /// Rebuilding (and `generate` without a manifest) never reads a sample's file through a
