@@ -712,8 +712,23 @@ fn a_killed_runs_leftovers_are_cleaned() {
         "dataset", "generate", "-o", "ds", "--count", "3", "--shard", "0/1",
     ];
     args.extend(SMALL);
-    let child = spawn(t.path(), &args);
-    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let mut child = spawn(t.path(), &args);
+    // Its stderr up to the line that says it waits.
+    let mut stderr = std::io::BufReader::new(child.stderr.take().unwrap());
+    let mut err = String::new();
+    loop {
+        let mut line = String::new();
+        let n = std::io::BufRead::read_line(&mut stderr, &mut line).unwrap();
+        assert!(n > 0, "the run ended without waiting: {err}");
+        err += &line;
+        if line.contains("is on it; waiting") {
+            break;
+        }
+    }
+    assert!(
+        err.contains("sample 000002: PID 4242 (a test) is on it; waiting"),
+        "{err}"
+    );
     // "Render" it as the holder would, then let go.
     std::fs::create_dir(t.join("ds/samples/000002")).unwrap();
     for (name, bytes) in &good {
@@ -723,13 +738,9 @@ fn a_killed_runs_leftovers_are_cleaned() {
     }
     std::fs::remove_file(t.join("ds/samples/.lock-000002")).unwrap();
     drop(lock);
-    let out = child.wait_with_output().unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{err}");
-    assert!(
-        err.contains("sample 000002: PID 4242 (a test) is on it; waiting"),
-        "{err}"
-    );
+    std::io::Read::read_to_string(&mut stderr, &mut err).unwrap();
+    let status = child.wait().unwrap();
+    assert!(status.success(), "{err}");
     assert!(err.contains("0 samples rendered, 3 already done"), "{err}");
     assert_eq!(tree(&t.join("ds")), good);
 }
