@@ -205,6 +205,8 @@ pub fn verify<R: std::io::BufRead>(
     let bar = progress_bar(info.count);
     let mut problems = 0usize;
     let (mut samples, mut files) = (0usize, 0usize);
+    // The splits as the manifest has them (`index --rebuild` writes them in manifest order).
+    let mut splits: BTreeMap<&str, String> = SPLITS.iter().map(|&s| (s, String::new())).collect();
     loop {
         let mut batch = Vec::with_capacity(VERIFY_BATCH);
         while batch.len() < VERIFY_BATCH {
@@ -220,6 +222,10 @@ pub fn verify<R: std::io::BufRead>(
         }
         let differences = verify_batch(layout, &batch, &|| bar.inc(1));
         for (entry, diffs) in batch.iter().zip(&differences) {
+            if let Some(list) = splits.get_mut(entry.split.as_str()) {
+                list.push_str(&sample_id(entry.index));
+                list.push('\n');
+            }
             samples += 1;
             files += entry.files.len();
             for d in diffs {
@@ -265,6 +271,23 @@ pub fn verify<R: std::io::BufRead>(
         eprintln!("{what}: {why}");
     }
     problems += unlisted.len() + missing.len() + strangers.len();
+    for (split, ids) in &splits {
+        let path = layout.splits_dir().join(format!("{split}.txt"));
+        let rel = layout.relative(&path);
+        let found = match std::fs::symlink_metadata(&path) {
+            Ok(m) if m.is_file() && m.len() == ids.len() as u64 => std::fs::read(&path)
+                .map(|bytes| bytes == ids.as_bytes())
+                .unwrap_or(false),
+            _ => false,
+        };
+        if !found {
+            eprintln!(
+                "{rel}: not the {} ids the manifest puts in {split}",
+                ids.lines().count()
+            );
+            problems += 1;
+        }
+    }
     let seconds = start.elapsed().as_secs_f64();
     if problems > 0 {
         bail!(

@@ -128,6 +128,8 @@ struct IndexOnly {
 #[derive(Deserialize)]
 struct RawLine {
     id: String,
+    #[serde(default)]
+    split: String,
     files: BTreeMap<String, String>,
 }
 
@@ -138,6 +140,8 @@ pub struct Entry {
     pub line: usize,
     /// The sample index.
     pub index: u64,
+    /// Its split, as the line names it.
+    pub split: String,
     /// sha256 of each file, by path relative to the dataset folder (validated).
     pub files: BTreeMap<String, String>,
 }
@@ -289,11 +293,11 @@ impl<R: BufRead> Lines<R> {
                 .map_err(json)?
                 .index;
             let kept = keep(index);
-            let (id, files) = if kept {
+            let (id, split, files) = if kept {
                 let raw: RawLine = serde_json::from_slice(&self.buf).map_err(json)?;
-                (raw.id, raw.files)
+                (raw.id, raw.split, raw.files)
             } else {
-                (sample_id(index), BTreeMap::new())
+                (sample_id(index), String::new(), BTreeMap::new())
             };
             if index >= count || id != sample_id(index) {
                 return Err(ManifestError::NotASample {
@@ -332,7 +336,12 @@ impl<R: BufRead> Lines<R> {
             }
             self.first_line.insert(index, line);
             if kept {
-                return Ok(Some(Entry { line, index, files }));
+                return Ok(Some(Entry {
+                    line,
+                    index,
+                    split,
+                    files,
+                }));
             }
         }
     }

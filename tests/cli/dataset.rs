@@ -258,6 +258,7 @@ fn interrupted_and_damaged_datasets_are_reported_then_repaired() {
     std::fs::write(t.join("ds/samples/.tmp-000000-4242/im0.png"), b"half").unwrap();
     std::fs::remove_dir_all(t.join("ds/samples/000002")).unwrap();
     std::fs::remove_file(t.join("ds/kitti/training/image_3/000000_10.png")).unwrap();
+    std::fs::write(t.join("ds/splits/val.txt"), "000001\n000002\n000007\n").unwrap();
 
     // Verifying (the default with a manifest) reports each difference and writes nothing.
     let run = t.streaks(&["dataset", "index", "ds"]);
@@ -268,6 +269,7 @@ fn interrupted_and_damaged_datasets_are_reported_then_repaired() {
         "sample 000002 (manifest line 3): the sample's folder is missing",
         "sample 000000 (manifest line 1): kitti/training/image_3/000000_10.png: missing",
         "samples/.tmp-000000-4242: temporary folder",
+        "splits/val.txt: not the ",
         "the manifest is unchanged",
     ] {
         assert!(err.contains(needle), "{needle}: {err}");
