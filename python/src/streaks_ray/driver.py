@@ -287,7 +287,7 @@ def _run_chunks(
 
 
 def generate(job: Job) -> int:
-    """Run the job; returns the exit status (that of `streaks dataset index --rebuild` on success)."""
+    """Run the job; returns the exit status (`streaks dataset index --rebuild`'s on success)."""
     started = time.monotonic()
     binary = resolve_binary(job.streaks_bin)
     flags = GenerateFlags(
@@ -353,9 +353,7 @@ def generate(job: Job) -> int:
         return 0
     # The driver wrote the samples, so it writes the manifest (as `generate` without --shard
     # does); `index` alone would verify against an older manifest.
-    index = subprocess.run(
-        [binary, "dataset", "index", "--rebuild", str(flags.out)], check=False
-    )
+    index = subprocess.run([binary, "dataset", "index", "--rebuild", str(flags.out)], check=False)
     status = "ok" if index.returncode == 0 else f"failed with status {index.returncode}"
     print(f"streaks-ray: {summary}; index {status}")
     return index.returncode
