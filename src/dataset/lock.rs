@@ -153,11 +153,11 @@ impl Lock {
 
 impl Drop for Lock {
     fn drop(&mut self) {
-        // The file is removed only by a sole holder: a shared holder first tries to become
-        // the exclusive one (if another holds it too, the file stays for the last one).
+        // The file is removed only by a sole holder: a shared holder lets go and tries to
+        // take it exclusively (if another holds it, the file stays for the last one).
         let sole = match self.mode {
             Mode::Exclusive => true,
-            Mode::Shared => self.file.try_lock().is_ok(),
+            Mode::Shared => self.file.unlock().is_ok() && self.file.try_lock().is_ok(),
         };
         if cfg!(unix) && sole && is_at(&self.file, &self.path).unwrap_or(false) {
             let _ = std::fs::remove_file(&self.path);
