@@ -1,21 +1,36 @@
 //! `streaks dataset generate`: render the samples of a dataset (or one shard of them).
 //!
-//! For each index `i` in `0..count` of the shard: if `samples/NNNNNN/` is complete it is
-//! skipped (and stale temporary folders of `i` removed); otherwise the sample is built with the
-//! procedural generator from `(config, seed, i)`, rendered into `samples/.tmp-NNNNNN-PID/`, its
-//! KITTI files written, and the folder renamed to `samples/NNNNNN/`. An incomplete published
-//! sample (files removed by hand) is rendered again. Without `--shard` the index is rebuilt at
-//! the end ([`super::index`]).
+//! First every sample of the shard is checked (in parallel): against `manifest.jsonl` when it
+//! lists the sample (every file's sha256, no file missing or extra), otherwise with the checks of
+//! `streaks dataset index --rebuild` (every file there, images decode at the dataset's size...).
+//! Then, for each index `i` of the shard: a good sample is skipped; a missing one, or a damaged
+//! one (removed first, the message says why), is built with the procedural generator from
+//! `(config, seed, i)`, rendered into `samples/.tmp-NNNNNN-PID/`, its KITTI files written, and
+//! the folder renamed to `samples/NNNNNN/`. Rendering is deterministic, so a repaired sample has
+//! the bytes the manifest lists (the message says whether it does).
+//!
+//! Locks ([`super::lock`]): a run of the whole dataset holds the dataset lock exclusively (a
+//! second one is refused, naming the holder), a shard holds it shared; a sample is cleaned and
+//! rendered under its own lock, so two shards never render one sample at once and temporary
+//! folders are removed only when no live run renders that sample. Without `--shard` the
+//! manifest is written at the end ([`super::index::index_dir`]).
 
-use super::index::index_dir;
-use super::layout::{sample_id, Conventions, DatasetInfo, FileList, Layout, FORMAT, MAX_COUNT};
+use super::index::{check_sample, dataset_lock, index_dir};
+use super::layout::{
+    sample_id, Conventions, DatasetInfo, FileList, Layout, FORMAT, LOCK, MAX_COUNT,
+    SAMPLE_LOCK_PREFIX,
+};
+use super::lock::{Lock, Mode};
+use super::manifest::{verify_entry, Difference, Manifest};
 use super::sample::{is_complete, remove_stale_tmp, render_sample, SampleSettings};
 use super::shard::Shard;
 use crate::render::{image_size, progress_bar};
 use anyhow::{bail, Context, Result};
+use rayon::prelude::*;
 use sha2::{Digest, Sha256};
 use std::cell::Cell;
-use std::path::PathBuf;
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 use streaks_image::write_bytes_atomically;
 use streaks_scenes::procedural::{GeneratorConfig, GENERATOR_VERSION};
@@ -159,12 +174,37 @@ pub fn run(args: Args) -> Result<()> {
         .build()
         .context("cannot start the worker threads")?;
 
-    // Phase 2: the folder: new, or the same dataset.
+    // Phase 2: the folder: new, or the same dataset; locked for this run.
     let layout = Layout::new(&args.output);
+    let root = layout.root();
+    std::fs::create_dir_all(root)
+        .with_context(|| format!("cannot create the dataset folder {}", root.display()))?;
+    let (mode, what) = match args.shard {
+        None => (Mode::Exclusive, "streaks dataset generate".to_owned()),
+        Some(s) => (
+            Mode::Shared,
+            format!("streaks dataset generate --shard {s}"),
+        ),
+    };
+    let _dataset_lock = dataset_lock(&layout, mode, &what)?;
     prepare_folder(&layout, &info)?;
-
-    // Phase 3: the samples of this shard.
     let shard = args.shard.unwrap_or(Shard::ALL);
+    let manifest = match Manifest::load(&layout, args.count, &|i| shard.contains(i)) {
+        Ok(m) => m,
+        Err(e) => {
+            eprintln!(
+                "warning: {e}; the samples are checked without it{}",
+                if args.shard.is_none() {
+                    " and it is written again at the end"
+                } else {
+                    ""
+                }
+            );
+            None
+        }
+    };
+
+    // Phase 3: check the samples of this shard.
     let indices: Vec<u64> = (0..args.count).filter(|&i| shard.contains(i)).collect();
     let settings = SampleSettings {
         config,
@@ -177,30 +217,71 @@ pub fn run(args: Args) -> Result<()> {
         regularize: !args.no_regularize,
         noise_target: args.noise_target.0,
     };
+    let check = |index: u64| health(&layout, &info, index, manifest.as_ref());
+    let bar = progress_bar(indices.len() as u64);
+    let healths: Vec<Health> = pool.install(|| {
+        indices
+            .par_iter()
+            .map(|&i| {
+                let h = check(i);
+                bar.inc(1);
+                h
+            })
+            .collect()
+    });
+    bar.finish_and_clear();
+    let leftovers = leftovers(&layout)?;
+
+    // Phase 4: render what is missing or damaged, each sample under its lock.
     let bar = progress_bar(indices.len() as u64);
     let start = Instant::now();
     let mut shares = Vec::new();
     let mut skipped = 0usize;
+    let mut repaired = 0usize;
     let warned_no_road = Cell::new(false);
-    for &index in &indices {
+    for (&index, found) in indices.iter().zip(healths) {
         let id = sample_id(index);
-        if is_complete(&layout, index) {
-            remove_stale_tmp(&layout, index)?;
+        if matches!(found, Health::Good) && !leftovers.contains(&index) {
             skipped += 1;
             bar.inc(1);
             continue;
         }
-        let dir = layout.sample_dir(index);
-        if dir.exists() {
+        let waited = Cell::new(false);
+        let _sample_lock = Lock::acquire(
+            &layout.sample_lock(index),
+            Mode::Exclusive,
+            &what,
+            true,
+            &|holder| {
+                waited.set(true);
+                bar.suspend(|| eprintln!("sample {id}: {holder} is on it; waiting"));
+            },
+        )?;
+        for stale in remove_stale_tmp(&layout, index)? {
             bar.suspend(|| {
                 eprintln!(
-                    "sample {id}: {} is incomplete; rendering it again",
-                    dir.display()
+                    "sample {id}: removed {}, the temporary folder of an interrupted run",
+                    layout.relative(&stale)
                 )
             });
-            std::fs::remove_dir_all(&dir).with_context(|| {
-                format!("cannot remove the incomplete sample {}", dir.display())
-            })?;
+        }
+        // Another run may have rendered or repaired it since the check.
+        let found = if waited.get() || !matches!(found, Health::Good) {
+            check(index)
+        } else {
+            found
+        };
+        match &found {
+            Health::Good => {
+                skipped += 1;
+                bar.inc(1);
+                continue;
+            }
+            Health::Missing => {}
+            Health::Damaged(why) => {
+                bar.suspend(|| eprintln!("sample {id}: {why}; removing it and rendering it again"));
+                remove_sample(&layout.sample_dir(index))?;
+            }
         }
         let rendered = pool.install(|| {
             render_sample(&layout, &settings, index, &|w| {
@@ -225,13 +306,38 @@ pub fn run(args: Args) -> Result<()> {
                 100.0 * share
             )
         });
+        if matches!(found, Health::Damaged(_)) {
+            repaired += 1;
+            if let Some(entry) = manifest.as_ref().and_then(|m| m.get(index)) {
+                let diffs = verify_entry(&layout, entry);
+                bar.suspend(|| {
+                    if diffs.is_empty() {
+                        eprintln!(
+                            "sample {id}: repaired; its files are again those manifest.jsonl lists"
+                        );
+                    } else {
+                        eprintln!(
+                            "warning: sample {id}: rendered again, but it differs from \
+                             manifest.jsonl ({}): the renderer or its settings changed since \
+                             the manifest was written",
+                            describe(&diffs)
+                        );
+                    }
+                });
+            }
+        }
         bar.inc(1);
     }
     bar.finish_and_clear();
 
     let seconds = start.elapsed().as_secs_f64();
+    let repairs = if repaired > 0 {
+        format!(" ({repaired} of them repaired)")
+    } else {
+        String::new()
+    };
     let mut summary = format!(
-        "shard {shard}: {} samples rendered, {skipped} already done, in {seconds:.1} s",
+        "shard {shard}: {} samples rendered{repairs}, {skipped} already done, in {seconds:.1} s",
         shares.len()
     );
     if !shares.is_empty() {
@@ -248,12 +354,103 @@ pub fn run(args: Args) -> Result<()> {
 
     if args.shard.is_some() {
         eprintln!(
-            "when all shards are done, run: streaks dataset index {}",
+            "when all shards are done, run: streaks dataset index --rebuild {}",
             layout.root().display()
         );
         return Ok(());
     }
     index_dir(&layout)?.finish(&layout)
+}
+
+/// What the check before rendering found of a sample.
+#[derive(Clone, Debug)]
+enum Health {
+    /// Its files are those the manifest lists, or (not listed) it passes the index's checks.
+    Good,
+    /// No folder.
+    Missing,
+    /// Anything else, with what is wrong.
+    Damaged(String),
+}
+
+/// Checks sample `index`: against `manifest` when it lists the sample, with the checks of
+/// `streaks dataset index --rebuild` (without writing KITTI files) otherwise.
+fn health(layout: &Layout, info: &DatasetInfo, index: u64, manifest: Option<&Manifest>) -> Health {
+    let dir = layout.sample_dir(index);
+    match std::fs::symlink_metadata(&dir) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Health::Missing,
+        Err(e) => return Health::Damaged(format!("{}: {e}", dir.display())),
+        Ok(m) if !m.is_dir() => {
+            return Health::Damaged(format!("{} is not a folder", layout.relative(&dir)))
+        }
+        Ok(_) => {}
+    }
+    match manifest.and_then(|m| m.get(index)) {
+        Some(entry) => {
+            let diffs = verify_entry(layout, entry);
+            if !diffs.is_empty() {
+                Health::Damaged(describe(&diffs))
+            } else if !is_complete(layout, index) {
+                Health::Damaged("its files match manifest.jsonl, which lists too few".into())
+            } else {
+                Health::Good
+            }
+        }
+        None => match check_sample(layout, info, index, &dir, None) {
+            Ok(_) => Health::Good,
+            Err(e) => Health::Damaged(format!("{e:#}")),
+        },
+    }
+}
+
+/// The first differences, and how many more.
+fn describe(diffs: &[Difference]) -> String {
+    let shown: Vec<String> = diffs.iter().take(3).map(|d| d.to_string()).collect();
+    let mut text = shown.join("; ");
+    if diffs.len() > 3 {
+        text += &format!(" (and {} more)", diffs.len() - 3);
+    }
+    text
+}
+
+/// The indices with a temporary folder or a lock file in `samples/` (maybe stale: cleaned
+/// under the sample's lock).
+fn leftovers(layout: &Layout) -> Result<BTreeSet<u64>> {
+    let dir = layout.samples_dir();
+    let mut out = BTreeSet::new();
+    for entry in
+        std::fs::read_dir(&dir).with_context(|| format!("cannot list {}", dir.display()))?
+    {
+        let name = entry
+            .with_context(|| format!("cannot list {}", dir.display()))?
+            .file_name();
+        let name = name.to_string_lossy();
+        let digits = name
+            .strip_prefix(".tmp-")
+            .or_else(|| name.strip_prefix(SAMPLE_LOCK_PREFIX))
+            .and_then(|rest| rest.get(..6))
+            .filter(|d| d.bytes().all(|b| b.is_ascii_digit()));
+        if let Some(index) = digits.and_then(|d| d.parse().ok()) {
+            out.insert(index);
+        }
+    }
+    Ok(out)
+}
+
+/// Removes a damaged sample folder (or whatever is at its path).
+fn remove_sample(dir: &Path) -> Result<()> {
+    let is_dir = std::fs::symlink_metadata(dir).is_ok_and(|m| m.is_dir());
+    let removed = if is_dir {
+        std::fs::remove_dir_all(dir)
+    } else {
+        std::fs::remove_file(dir)
+    };
+    match removed {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            Err(e).with_context(|| format!("cannot remove the damaged sample {}", dir.display()))
+        }
+        _ => Ok(()),
+    }
 }
 
 /// Fails unless the bytes of an existing `dataset.json` describe the dataset `info`.
@@ -263,12 +460,11 @@ fn check_existing(info: &DatasetInfo, existing: &[u8], path: &std::path::Path) -
     info.check_same(&value, path)
 }
 
-/// Creates the dataset folder and its `dataset.json`, or checks that the folder holds the
-/// same dataset; a folder with other files and no `dataset.json` is refused.
+/// Writes the dataset folder's `dataset.json`, or checks that the folder holds the same
+/// dataset; a folder with other files (besides the dataset lock) and no `dataset.json` is
+/// refused.
 fn prepare_folder(layout: &Layout, info: &DatasetInfo) -> Result<()> {
     let root = layout.root();
-    std::fs::create_dir_all(root)
-        .with_context(|| format!("cannot create the dataset folder {}", root.display()))?;
     let json = layout.dataset_json();
     match std::fs::read(&json) {
         Ok(existing) => check_existing(info, &existing, &json)?,
@@ -279,7 +475,7 @@ fn prepare_folder(layout: &Layout, info: &DatasetInfo) -> Result<()> {
                 .with_context(|| format!("cannot list {}", root.display()))?;
             for entry in entries {
                 let name = entry?.file_name().to_string_lossy().into_owned();
-                if name != "dataset.json" && !name.starts_with(".dataset.json.") {
+                if name != "dataset.json" && name != LOCK && !name.starts_with(".dataset.json.") {
                     bail!(
                         "{} is not empty (it holds {name}) and has no dataset.json: it is not a \
                          dataset; give an empty or new folder",

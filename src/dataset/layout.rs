@@ -4,6 +4,8 @@
 //! DIR/dataset.json                      settings, generator version, config, conventions
 //! DIR/samples/NNNNNN/                   one sample (Middlebury style, see SAMPLE_FILES)
 //! DIR/samples/.tmp-NNNNNN-PID/          a sample being rendered (renamed when complete)
+//! DIR/samples/.lock-NNNNNN              its lock, while a run checks or renders it
+//! DIR/.lock                             the dataset lock, while a run uses the folder
 //! DIR/kitti/training/image_2/NNNNNN_10.png       = im0.png
 //! DIR/kitti/training/image_3/NNNNNN_10.png       = im1.png
 //! DIR/kitti/training/disp_occ_0/NNNNNN_10.png    disp0 as uint16 x 256, 0 = no value
@@ -23,6 +25,9 @@ pub const FORMAT: &str = "streaks-dataset/1";
 /// Sample ids have six digits: at most this many samples.
 pub const MAX_COUNT: u64 = 1_000_000;
 
+/// The largest `dataset.json` read (the file holds the settings and the generator config).
+pub const MAX_DATASET_JSON_BYTES: u64 = 16 << 20;
+
 /// The files of every sample folder besides the scene's, sorted.
 pub const SAMPLE_FILES: [&str; 10] = [
     "calib.txt",
@@ -36,6 +41,12 @@ pub const SAMPLE_FILES: [&str; 10] = [
     "meta.json",
     "streaks0.png",
 ];
+
+/// The dataset lock's file name in the dataset folder.
+pub const LOCK: &str = ".lock";
+
+/// The name prefix of the sample locks in `samples/`: `.lock-NNNNNN`.
+pub const SAMPLE_LOCK_PREFIX: &str = ".lock-";
 
 /// The road-surface mask, present when the scene flags a road material.
 pub const ROAD_MASK: &str = "road0.png";
@@ -96,6 +107,23 @@ impl Layout {
     /// `manifest.jsonl`.
     pub fn manifest(&self) -> PathBuf {
         self.root.join("manifest.jsonl")
+    }
+
+    /// Whether `manifest.jsonl` exists (as anything: a symbolic link or folder there is
+    /// refused when it is read).
+    pub fn manifest_present(&self) -> bool {
+        std::fs::symlink_metadata(self.manifest()).is_ok()
+    }
+
+    /// `.lock`: the dataset lock (see [`super::lock`]).
+    pub fn lock(&self) -> PathBuf {
+        self.root.join(LOCK)
+    }
+
+    /// `samples/.lock-NNNNNN`: the lock of sample `index` (see [`super::lock`]).
+    pub fn sample_lock(&self, index: u64) -> PathBuf {
+        self.samples_dir()
+            .join(format!("{SAMPLE_LOCK_PREFIX}{}", sample_id(index)))
     }
 
     /// `splits/`.
@@ -324,11 +352,33 @@ pub struct DatasetInfo {
 
 impl DatasetInfo {
     /// Reads `dataset.json`.
+    /// The file must be a regular file of at most [`MAX_DATASET_JSON_BYTES`] (a FIFO or a
+    /// device is not opened) and its `count` in `1..=MAX_COUNT`, since commands loop over it.
     pub fn load(path: &Path) -> Result<Self> {
+        let meta =
+            std::fs::metadata(path).with_context(|| format!("cannot read {}", path.display()))?;
+        if !meta.is_file() {
+            bail!("{} is not a regular file", path.display());
+        }
+        if meta.len() > MAX_DATASET_JSON_BYTES {
+            bail!(
+                "{} is {} bytes, more than a dataset.json has ({MAX_DATASET_JSON_BYTES})",
+                path.display(),
+                meta.len()
+            );
+        }
         let text = std::fs::read_to_string(path)
             .with_context(|| format!("cannot read {}", path.display()))?;
-        serde_json::from_str(&text)
-            .with_context(|| format!("{} is not a dataset.json of {FORMAT}", path.display()))
+        let info: Self = serde_json::from_str(&text)
+            .with_context(|| format!("{} is not a dataset.json of {FORMAT}", path.display()))?;
+        if info.count == 0 || info.count > MAX_COUNT {
+            bail!(
+                "{}: count {} is not in 1..={MAX_COUNT}",
+                path.display(),
+                info.count
+            );
+        }
+        Ok(info)
     }
 
     /// The file's bytes (pretty JSON, a final newline).

@@ -2,9 +2,12 @@
 //!
 //! - [`generate`]: `streaks dataset generate -o DIR --count N ...` renders the samples (or one
 //!   shard of them) into `DIR/samples/NNNNNN/`, each published atomically, with its KITTI view;
-//! - [`index`]: `streaks dataset index DIR` checks what is on disk and rebuilds
-//!   `manifest.jsonl` and `splits/`;
+//! - [`index`]: `streaks dataset index DIR` verifies the files against `manifest.jsonl`, or
+//!   (the first time, or with `--rebuild`) checks what is on disk and writes `manifest.jsonl`
+//!   and `splits/`;
 //! - [`layout`]: the folder layout, `dataset.json` and the conventions it states;
+//! - [`lock`]: the advisory locks that make runs on one folder safe or refused;
+//! - [`manifest`]: reading `manifest.jsonl` back and checking files against it;
 //! - [`sample`]: rendering and writing one sample;
 //! - [`shard`]: `--shard K/N`.
 //!
@@ -13,6 +16,8 @@
 pub mod generate;
 pub mod index;
 pub mod layout;
+pub mod lock;
+pub mod manifest;
 pub mod sample;
 pub mod shard;
 
@@ -27,9 +32,11 @@ pub struct Args {
 
 #[derive(clap::Subcommand, Debug)]
 enum Command {
-    /// Render samples (all, or one shard) into a dataset folder; resumable.
+    /// Render samples (all, or one shard) into a dataset folder; resumable, repairs damaged
+    /// samples.
     Generate(generate::Args),
-    /// Check a dataset folder and rebuild manifest.jsonl and splits/ from what is on disk.
+    /// Verify a dataset folder against its manifest.jsonl (or, the first time or with
+    /// --rebuild, write manifest.jsonl and splits/ from what is on disk).
     Index(index::Args),
 }
 

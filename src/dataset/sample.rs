@@ -5,7 +5,7 @@ use super::layout::{sample_id, Layout, ROAD_MASK, SAMPLE_FILES, SCENE_GLTF};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 use streaks_image::kitti::write_kitti_disparity;
 use streaks_image::pfm::write_pfm;
@@ -191,22 +191,31 @@ pub fn is_complete(layout: &Layout, index: u64) -> bool {
     }
 }
 
-/// Removes sample `index`'s temporary folders left by interrupted runs (`.tmp-NNNNNN-*`).
-pub fn remove_stale_tmp(layout: &Layout, index: u64) -> Result<()> {
+/// Removes sample `index`'s temporary folders (`.tmp-NNNNNN-*`) and returns them. Call it
+/// only while holding the sample's lock ([`Layout::sample_lock`]): every run renders a sample
+/// under that lock, so then no live run owns such a folder and they are all stale.
+pub fn remove_stale_tmp(layout: &Layout, index: u64) -> Result<Vec<PathBuf>> {
     let prefix = Layout::tmp_prefix(index);
     let dir = layout.samples_dir();
     let Ok(entries) = std::fs::read_dir(&dir) else {
-        return Ok(());
+        return Ok(Vec::new());
     };
+    let mut removed = Vec::new();
     for entry in entries {
         let entry = entry.with_context(|| format!("cannot list {}", dir.display()))?;
         if entry.file_name().to_string_lossy().starts_with(&prefix) {
             let path = entry.path();
-            std::fs::remove_dir_all(&path)
-                .with_context(|| format!("cannot remove the stale folder {}", path.display()))?;
+            let is_dir = std::fs::symlink_metadata(&path).is_ok_and(|m| m.is_dir());
+            if is_dir {
+                std::fs::remove_dir_all(&path)
+            } else {
+                std::fs::remove_file(&path)
+            }
+            .with_context(|| format!("cannot remove the stale folder {}", path.display()))?;
+            removed.push(path);
         }
     }
-    Ok(())
+    Ok(removed)
 }
 
 /// Writes the KITTI view of a sample from its folder `dir` (image_2 and image_3 are copies of
@@ -232,7 +241,7 @@ fn create_parent(path: &Path) -> Result<()> {
 }
 
 /// Renders sample `index` into a temporary folder, writes its KITTI files and publishes it as
-/// `samples/NNNNNN/` (see the module documentation). `warn` receives the scene loader's
+/// `samples/NNNNNN/` (see the module documentation). The caller holds the sample's lock. `warn` receives the scene loader's
 /// warnings. Without a road material in the scene, `road0.png` is not written
 /// ([`Rendered::road_mask`] and `meta.json` say so).
 pub fn render_sample(

@@ -212,7 +212,7 @@ fn ground_truth_reads_back_as_stereo_loaders_read_it() {
         (calib.vmin as f32, calib.vmax as f32),
         (lo as f32, hi as f32)
     );
-    assert!(calib.ndisp as f64 > hi && calib.ndisp % 16 == 0);
+    assert!(calib.ndisp as f64 > hi && calib.ndisp.is_multiple_of(16));
     // image_2 is im0.png, image_3 is im1.png.
     let bytes = |p: &str| std::fs::read(t.join(p)).unwrap();
     assert_eq!(
@@ -258,12 +258,35 @@ fn interrupted_and_damaged_datasets_are_reported_then_repaired() {
     std::fs::write(t.join("ds/samples/.tmp-000000-4242/im0.png"), b"half").unwrap();
     std::fs::remove_dir_all(t.join("ds/samples/000002")).unwrap();
     std::fs::remove_file(t.join("ds/kitti/training/image_3/000000_10.png")).unwrap();
+    std::fs::write(t.join("ds/splits/val.txt"), "000001\n000002\n000007\n").unwrap();
+
+    // Verifying (the default with a manifest) reports each difference and writes nothing.
     let run = t.streaks(&["dataset", "index", "ds"]);
+    run.assert_failure_mentioning("differs from its manifest.jsonl");
+    let err = run.stderr();
+    for needle in [
+        "sample 000001 (manifest line 2): samples/000001/disp0.pfm: missing",
+        "sample 000002 (manifest line 3): the sample's folder is missing",
+        "sample 000000 (manifest line 1): kitti/training/image_3/000000_10.png: missing",
+        "samples/.tmp-000000-4242: temporary folder",
+        "splits/val.txt: not the ",
+        "the manifest is unchanged",
+    ] {
+        assert!(err.contains(needle), "{needle}: {err}");
+    }
+    assert_eq!(
+        std::fs::read(t.join("ds/manifest.jsonl")).unwrap(),
+        good["manifest.jsonl"]
+    );
+    assert!(!t.join("ds/kitti/training/image_3/000000_10.png").exists());
+
+    // Rebuilding checks what is on disk and writes the manifest of the good samples.
+    let run = t.streaks(&["dataset", "index", "--rebuild", "ds"]);
     run.assert_failure_mentioning("incomplete");
     let err = run.stderr();
     assert!(err.contains("000001: missing files: disp0.pfm"), "{err}");
     assert!(
-        err.contains("samples/.tmp-000000-4242: stale temporary folder"),
+        err.contains("samples/.tmp-000000-4242: temporary folder"),
         "{err}"
     );
     assert!(err.contains("missing samples (1): 000002"), "{err}");
@@ -277,11 +300,450 @@ fn interrupted_and_damaged_datasets_are_reported_then_repaired() {
     // A rerun renders what is missing, removes the stale folder, and the dataset is whole.
     let run = generate(&t, "ds", &[]);
     run.assert_success();
+    let err = run.stderr();
     assert!(
-        run.stderr().contains("2 samples rendered, 1 already done"),
+        err.contains("2 samples rendered (1 of them repaired), 1 already done"),
+        "{err}"
+    );
+    assert!(
+        err.contains("sample 000001: missing files: disp0.pfm; removing it and rendering it again"),
+        "{err}"
+    );
+    assert!(
+        err.contains("sample 000000: removed samples/.tmp-000000-4242, the temporary folder"),
+        "{err}"
+    );
+    assert_eq!(tree(&t.join("ds")), good);
+    t.streaks(&["dataset", "index", "ds"]).assert_success();
+}
+
+/// A file whose bytes changed (same size, so only its hash tells) is reported by `index` with
+/// both hashes, and `generate` renders its sample again, byte for byte as the manifest says.
+#[test]
+fn changed_files_are_found_by_their_hash_and_restored_byte_for_byte() {
+    let t = TestDir::new();
+    generate(&t, "ds", &[]).assert_success();
+    let good = tree(&t.join("ds"));
+    let flip = |rel: &str| {
+        let path = t.join(rel);
+        let mut bytes = std::fs::read(&path).unwrap();
+        let last = bytes.len() - 1;
+        bytes[last] ^= 0x5a;
+        std::fs::write(&path, bytes).unwrap();
+    };
+    flip("ds/samples/000001/im0.exr");
+    flip("ds/kitti/training/disp_occ_0/000002_10.png");
+    std::fs::write(t.join("ds/samples/000000/notes.txt"), "mine").unwrap();
+    // A file replaced by a symbolic link out of the folder, another by a FIFO: reported, never
+    // followed nor opened (a FIFO would block the reader forever).
+    let secret = t.join("secret.txt");
+    std::fs::write(&secret, "outside").unwrap();
+    let mut places = 3;
+    #[cfg(unix)]
+    {
+        std::fs::remove_file(t.join("ds/samples/000002/calib.txt")).unwrap();
+        std::os::unix::fs::symlink(&secret, t.join("ds/samples/000002/calib.txt")).unwrap();
+        std::fs::remove_file(t.join("ds/samples/000000/meta.json")).unwrap();
+        let made = Command::new("mkfifo")
+            .arg(t.join("ds/samples/000000/meta.json"))
+            .status()
+            .unwrap();
+        assert!(made.success());
+        places += 2;
+    }
+    let hex = |bytes: &[u8]| format!("{:x}", <sha2::Sha256 as sha2::Digest>::digest(bytes));
+    let bad = hex(&std::fs::read(t.join("ds/samples/000001/im0.exr")).unwrap());
+    let expected = hex(&good["samples/000001/im0.exr"]);
+
+    let run = t.streaks(&["dataset", "index", "ds"]);
+    run.assert_failure_mentioning(&format!(
+        "differs from its manifest.jsonl in {places} places"
+    ));
+    let err = run.stderr();
+    #[cfg(unix)]
+    {
+        assert!(
+            err.contains("samples/000002/calib.txt: samples/000002/calib.txt is a symbolic link"),
+            "{err}"
+        );
+        assert!(
+            err.contains("samples/000000/meta.json: not a regular file"),
+            "{err}"
+        );
+    }
+    assert!(
+        err.contains(&format!(
+            "sample 000001 (manifest line 2): samples/000001/im0.exr: sha256 {bad}, the manifest \
+             lists {expected}"
+        )),
+        "{err}"
+    );
+    assert!(
+        err.contains(
+            "sample 000002 (manifest line 3): kitti/training/disp_occ_0/000002_10.png: sha256"
+        ),
+        "{err}"
+    );
+    assert!(
+        err.contains(
+            "sample 000000 (manifest line 1): samples/000000/notes.txt: not in the manifest"
+        ),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read(t.join("ds/manifest.jsonl")).unwrap(),
+        good["manifest.jsonl"]
+    );
+
+    let run = generate(&t, "ds", &["--threads", "1"]);
+    run.assert_success();
+    let err = run.stderr();
+    assert!(
+        err.contains("3 samples rendered (3 of them repaired), 0 already done"),
+        "{err}"
+    );
+    assert!(
+        err.contains(&format!(
+            "sample 000001: samples/000001/im0.exr: sha256 {bad}, the manifest lists {expected}; \
+             removing it and rendering it again"
+        )),
+        "{err}"
+    );
+    assert!(
+        err.contains("sample 000001: repaired; its files are again those manifest.jsonl lists"),
+        "{err}"
+    );
+    assert_eq!(tree(&t.join("ds")), good);
+    assert_eq!(std::fs::read_to_string(&secret).unwrap(), "outside");
+    let run = t.streaks(&["dataset", "index", "ds"]);
+    run.assert_success();
+    assert!(
+        run.stderr().contains("verified ds: 3 samples, ")
+            && run.stderr().contains(" files match manifest.jsonl"),
         "{}",
         run.stderr()
     );
+}
+
+/// A hostile manifest (paths out of the folder, bad JSON, duplicates, a huge line) is refused
+/// with its line, and nothing outside the folder is read; `generate` warns, checks the samples
+/// without it and writes it again; `--rebuild` replaces it.
+#[test]
+fn hostile_manifests_are_refused_with_their_line_number() {
+    let t = TestDir::new();
+    generate_n(&t, "ds", "2", &[]).assert_success();
+    let good = std::fs::read_to_string(t.join("ds/manifest.jsonl")).unwrap();
+    let lines: Vec<&str> = good.lines().collect();
+    let secret = t.join("secret.txt");
+    std::fs::write(&secret, "outside").unwrap();
+    let escape = lines[1].replacen(
+        "\"samples/000001/calib.txt\"",
+        "\"samples/000001/../../../secret.txt\"",
+        1,
+    );
+    let absolute = lines[1].replacen(
+        "\"samples/000001/calib.txt\"",
+        &format!("{:?}", secret.display().to_string()),
+        1,
+    );
+    let cases = [
+        (
+            format!("{}\n{escape}\n", lines[0]),
+            "line 2: \"samples/000001/../../../secret.txt\" is not a file of sample 000001",
+        ),
+        (format!("{}\n{absolute}\n", lines[0]), "line 2: "),
+        (
+            format!("{}\n{{\"id\": \n", lines[0]),
+            "line 2: not a manifest line",
+        ),
+        (
+            format!("{}\n{}\n", lines[0], lines[0]),
+            "line 2: sample 000000 is listed again (first on line 1)",
+        ),
+        (
+            format!("{}\n{}\n", "x".repeat(2 << 20), lines[1]),
+            "line 1: longer than 1048576 bytes",
+        ),
+        (
+            format!("{}\n{}\n{}\n", lines[0], lines[1], lines[1]),
+            "line 3: more lines than the dataset's 2",
+        ),
+    ];
+    for (text, needle) in &cases {
+        std::fs::write(t.join("ds/manifest.jsonl"), text).unwrap();
+        t.streaks(&["dataset", "index", "ds"])
+            .assert_failure_mentioning(needle);
+        assert_eq!(
+            &std::fs::read_to_string(t.join("ds/manifest.jsonl")).unwrap(),
+            text
+        );
+    }
+    assert_eq!(std::fs::read_to_string(&secret).unwrap(), "outside");
+    // A manifest that is a FIFO or a symbolic link is not opened.
+    std::fs::remove_file(t.join("ds/manifest.jsonl")).unwrap();
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink(&secret, t.join("ds/manifest.jsonl")).unwrap();
+        t.streaks(&["dataset", "index", "ds"])
+            .assert_failure_mentioning("is not a regular file");
+        std::fs::remove_file(t.join("ds/manifest.jsonl")).unwrap();
+    }
+    // generate: a warning, the samples checked by decoding, the manifest written again.
+    std::fs::write(t.join("ds/manifest.jsonl"), &cases[0].0).unwrap();
+    let run = generate_n(&t, "ds", "2", &[]);
+    run.assert_success();
+    assert!(
+        run.stderr().contains("warning: ") && run.stderr().contains("checked without it"),
+        "{}",
+        run.stderr()
+    );
+    assert_eq!(
+        std::fs::read_to_string(t.join("ds/manifest.jsonl")).unwrap(),
+        good
+    );
+    std::fs::write(t.join("ds/manifest.jsonl"), "{bad").unwrap();
+    t.streaks(&["dataset", "index", "--rebuild", "ds"])
+        .assert_success();
+    assert_eq!(
+        std::fs::read_to_string(t.join("ds/manifest.jsonl")).unwrap(),
+        good
+    );
+
+    // A dataset.json whose count no one could loop over is refused before any loop.
+    let json = std::fs::read_to_string(t.join("ds/dataset.json")).unwrap();
+    let huge = json.replacen("\"count\": 2,", "\"count\": 1000000000000000000,", 1);
+    assert_ne!(huge, json);
+    std::fs::write(t.join("ds/dataset.json"), huge).unwrap();
+    for rebuild in [false, true] {
+        let mut args = vec!["dataset", "index", "ds"];
+        if rebuild {
+            args.push("--rebuild");
+        }
+        t.streaks(&args)
+            .assert_failure_mentioning("count 1000000000000000000 is not in 1..=1000000");
+    }
+}
+
+/// Rebuilding (and `generate` without a manifest) never reads a sample's file through a
+/// symbolic link or from a FIFO, nor a file its scene names outside its folder: they are
+/// reported as damage, and `generate` renders the sample again.
+#[cfg(unix)]
+#[test]
+fn rebuild_reports_special_files_without_opening_them() {
+    let t = TestDir::new();
+    generate(&t, "ds", &[]).assert_success();
+    let good = tree(&t.join("ds"));
+    std::fs::remove_file(t.join("ds/manifest.jsonl")).unwrap();
+    std::fs::write(t.join("secret.txt"), "outside").unwrap();
+    std::fs::remove_file(t.join("ds/samples/000000/meta.json")).unwrap();
+    let made = Command::new("mkfifo")
+        .arg(t.join("ds/samples/000000/meta.json"))
+        .status()
+        .unwrap();
+    assert!(made.success());
+    std::fs::remove_file(t.join("ds/samples/000001/calib.txt")).unwrap();
+    std::os::unix::fs::symlink(t.join("secret.txt"), t.join("ds/samples/000001/calib.txt"))
+        .unwrap();
+    let gltf = t.join("ds/samples/000002/scene.gltf");
+    let text = std::fs::read_to_string(&gltf).unwrap();
+    std::fs::write(
+        &gltf,
+        text.replacen("\"scene.bin\"", "\"../../../secret.txt\"", 1),
+    )
+    .unwrap();
+    let run = t.streaks(&["dataset", "index", "ds"]);
+    run.assert_failure_mentioning("incomplete");
+    let err = run.stderr();
+    for needle in [
+        "corrupt: 000000: samples/000000/meta.json is a special file",
+        "corrupt: 000001: samples/000001/calib.txt is a symbolic link",
+        "corrupt: 000002: scene.gltf refers to \"../../../secret.txt\"",
+    ] {
+        assert!(err.contains(needle), "{needle}: {err}");
+    }
+    std::fs::remove_file(t.join("ds/manifest.jsonl")).unwrap();
+    let run = generate(&t, "ds", &[]);
+    run.assert_success();
+    assert!(
+        run.stderr()
+            .contains("3 samples rendered (3 of them repaired)"),
+        "{}",
+        run.stderr()
+    );
+    assert_eq!(tree(&t.join("ds")), good);
+    assert_eq!(
+        std::fs::read_to_string(t.join("secret.txt")).unwrap(),
+        "outside"
+    );
+}
+
+/// Runs `streaks ARGS` in `dir` without waiting (CI=true, output captured).
+fn spawn(dir: &Path, args: &[&str]) -> std::process::Child {
+    Command::new(env!("CARGO_BIN_EXE_streaks"))
+        .args(args)
+        .current_dir(dir)
+        .env("CI", "true")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+/// Two identical runs of the whole dataset started at once: each finishes correctly, or the
+/// second is refused at once naming the folder and the holder's PID; a run while another
+/// holds the dataset lock is refused; shards started twice each render every sample once.
+#[test]
+fn concurrent_runs_on_one_folder_are_safe_or_refused() {
+    let t = TestDir::new();
+    generate(&t, "ref", &[]).assert_success();
+    let mut args = vec![
+        "dataset",
+        "generate",
+        "-o",
+        "ds",
+        "--count",
+        "3",
+        "--threads",
+        "1",
+    ];
+    args.extend(SMALL);
+    let children = [spawn(t.path(), &args), spawn(t.path(), &args)];
+    let outs: Vec<_> = children
+        .into_iter()
+        .map(|c| c.wait_with_output().unwrap())
+        .collect();
+    let mut finished = 0;
+    for out in &outs {
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!err.contains("panicked"), "{err}");
+        if out.status.success() {
+            finished += 1;
+        } else {
+            assert!(
+                err.contains("the dataset folder ds is in use by another run: PID ")
+                    && err.contains("(streaks dataset generate) holds ds/.lock"),
+                "{err}"
+            );
+        }
+    }
+    assert!(finished >= 1);
+    assert_same_tree(&t.join("ref"), &t.join("ds"));
+
+    // While this test holds the dataset lock, a run is refused at once, naming the holder.
+    let lock = std::fs::File::create(t.join("ds/.lock")).unwrap();
+    lock.lock().unwrap();
+    std::fs::write(t.join("ds/.lock"), "PID 4242 (a test)\n").unwrap();
+    let started = std::time::Instant::now();
+    generate(&t, "ds", &[])
+        .assert_failure_mentioning("ds is in use by another run: PID 4242 (a test) holds");
+    t.streaks(&["dataset", "index", "--rebuild", "ds"])
+        .assert_failure_mentioning("PID 4242 (a test)");
+    assert!(started.elapsed().as_secs() < 20);
+    drop(lock);
+    std::fs::remove_file(t.join("ds/.lock")).unwrap();
+
+    // The same shards twice at once (as a retried Ray task may be): both succeed, each sample
+    // is rendered once, and nothing is left behind.
+    let shard = |k: &str| {
+        let mut a = vec![
+            "dataset",
+            "generate",
+            "-o",
+            "sh",
+            "--count",
+            "3",
+            "--threads",
+            "1",
+        ];
+        a.extend(["--shard", k]);
+        a.extend(SMALL);
+        spawn(t.path(), &a)
+    };
+    let children = [shard("0/2"), shard("0/2"), shard("1/2"), shard("1/2")];
+    let mut rendered = 0;
+    for c in children {
+        let out = c.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{err}");
+        rendered += err.matches(", streak share ").count();
+    }
+    assert_eq!(rendered, 3, "each sample rendered by exactly one run");
+    t.streaks(&["dataset", "index", "sh"]).assert_success();
+    assert_same_tree(&t.join("ref"), &t.join("sh"));
+}
+
+/// A killed run leaves a temporary folder and its lock file behind (no process holds the
+/// lock): the next run removes both and says so; a sample someone renders (its lock held)
+/// is waited for.
+#[test]
+fn a_killed_runs_leftovers_are_cleaned() {
+    let t = TestDir::new();
+    generate(&t, "ds", &[]).assert_success();
+    let good = tree(&t.join("ds"));
+    std::fs::create_dir(t.join("ds/samples/.tmp-000001-999999")).unwrap();
+    std::fs::write(t.join("ds/samples/.tmp-000001-999999/im0.png"), b"half").unwrap();
+    std::fs::write(
+        t.join("ds/samples/.lock-000001"),
+        "PID 999999 (streaks dataset generate)\n",
+    )
+    .unwrap();
+    std::fs::write(
+        t.join("ds/.lock"),
+        "PID 999999 (streaks dataset generate)\n",
+    )
+    .unwrap();
+    t.streaks(&["dataset", "index", "ds"])
+        .assert_failure_mentioning("differs");
+    let run = generate(&t, "ds", &[]);
+    run.assert_success();
+    let err = run.stderr();
+    assert!(
+        err.contains("sample 000001: removed samples/.tmp-000001-999999, the temporary folder of an interrupted run"),
+        "{err}"
+    );
+    assert!(err.contains("0 samples rendered, 3 already done"), "{err}");
+    assert_eq!(tree(&t.join("ds")), good);
+
+    // A run that holds sample 000002's lock: a shard run waits for it, then finds the sample
+    // good and skips it.
+    std::fs::remove_dir_all(t.join("ds/samples/000002")).unwrap();
+    let lock = std::fs::File::create(t.join("ds/samples/.lock-000002")).unwrap();
+    lock.lock().unwrap();
+    std::fs::write(t.join("ds/samples/.lock-000002"), "PID 4242 (a test)\n").unwrap();
+    let mut args = vec![
+        "dataset", "generate", "-o", "ds", "--count", "3", "--shard", "0/1",
+    ];
+    args.extend(SMALL);
+    let mut child = spawn(t.path(), &args);
+    // Its stderr up to the line that says it waits.
+    let mut stderr = std::io::BufReader::new(child.stderr.take().unwrap());
+    let mut err = String::new();
+    loop {
+        let mut line = String::new();
+        let n = std::io::BufRead::read_line(&mut stderr, &mut line).unwrap();
+        assert!(n > 0, "the run ended without waiting: {err}");
+        err += &line;
+        if line.contains("is on it; waiting") {
+            break;
+        }
+    }
+    assert!(
+        err.contains("sample 000002: PID 4242 (a test) is on it; waiting"),
+        "{err}"
+    );
+    // "Render" it as the holder would, then let go.
+    std::fs::create_dir(t.join("ds/samples/000002")).unwrap();
+    for (name, bytes) in &good {
+        if let Some(file) = name.strip_prefix("samples/000002/") {
+            std::fs::write(t.join("ds/samples/000002").join(file), bytes).unwrap();
+        }
+    }
+    std::fs::remove_file(t.join("ds/samples/.lock-000002")).unwrap();
+    drop(lock);
+    std::io::Read::read_to_string(&mut stderr, &mut err).unwrap();
+    let status = child.wait().unwrap();
+    assert!(status.success(), "{err}");
+    assert!(err.contains("0 samples rendered, 3 already done"), "{err}");
     assert_eq!(tree(&t.join("ds")), good);
 }
 

@@ -15,7 +15,7 @@ from streaks_ray.plan import GenerateFlags, Shard, parse_shard
 DESCRIPTION = """\
 Run `streaks dataset generate` on a Ray cluster: the samples are split into Ray tasks of
 --chunk samples (each one `streaks dataset generate ... --shard`), failed tasks are retried,
-and `streaks dataset index DIR` runs at the end. The dataset is the one `streaks dataset
+and `streaks dataset index --rebuild DIR` runs at the end. The dataset is the one `streaks dataset
 generate` writes on one machine with the same flags, byte for byte.
 
 On a real cluster the output folder (and --config, and the streaks binary) must be at the

@@ -287,7 +287,7 @@ def _run_chunks(
 
 
 def generate(job: Job) -> int:
-    """Run the job; returns the exit status (that of `streaks dataset index` on success)."""
+    """Run the job; returns the exit status (`streaks dataset index --rebuild`'s on success)."""
     started = time.monotonic()
     binary = resolve_binary(job.streaks_bin)
     flags = GenerateFlags(
@@ -351,7 +351,9 @@ def generate(job: Job) -> int:
         # dataset once every shard is done.
         print(f"streaks-ray: {summary}; shard {job.shard} done (not indexed)")
         return 0
-    index = subprocess.run([binary, "dataset", "index", str(flags.out)], check=False)
+    # The driver wrote the samples, so it writes the manifest (as `generate` without --shard
+    # does); `index` alone would verify against an older manifest.
+    index = subprocess.run([binary, "dataset", "index", "--rebuild", str(flags.out)], check=False)
     status = "ok" if index.returncode == 0 else f"failed with status {index.returncode}"
     print(f"streaks-ray: {summary}; index {status}")
     return index.returncode
