@@ -4,8 +4,8 @@
 
 use crate::atomic::{write_atomically, WriteFailure};
 use crate::input::{check_pixels, open_regular, MAX_IMAGE_BYTES};
-use std::io::Seek;
 use crate::{ImageError, RgbImage};
+use std::io::Seek;
 use std::path::Path;
 
 /// One channel to write: its full name (`R`, `depth.Z`, ...) and `width * height` values.
@@ -104,9 +104,7 @@ pub fn read_exr_channels(
              {MAX_IMAGE_BYTES}"
         )));
     }
-    reader
-        .rewind()
-        .map_err(|e| read_err(e.to_string()))?;
+    reader.rewind().map_err(|e| read_err(e.to_string()))?;
     let image = exr::prelude::read()
         .no_deep_data()
         .largest_resolution_level()
@@ -249,9 +247,14 @@ mod tests {
         std::fs::write(&path, bytes).unwrap();
         let start = std::time::Instant::now();
         let err = read_exr_rgb(&path).unwrap_err().to_string();
-        assert!(err.contains("100000x100000") && err.contains("huge.exr"), "{err}");
+        assert!(
+            err.contains("100000x100000") && err.contains("huge.exr"),
+            "{err}"
+        );
         assert!(start.elapsed() < std::time::Duration::from_secs(1));
-        let err = read_exr_rgb(Path::new("/dev/zero")).unwrap_err().to_string();
+        let err = read_exr_rgb(Path::new("/dev/zero"))
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("not a regular file"), "{err}");
     }
 }

@@ -66,8 +66,22 @@ fn kind(t: std::fs::FileType) -> &'static str {
 fn not_regular(t: std::fs::FileType) -> io::Error {
     io::Error::new(
         io::ErrorKind::InvalidInput,
-        format!("{}, not a regular file: only regular files are read", kind(t)),
+        format!(
+            "{}, not a regular file: only regular files are read",
+            kind(t)
+        ),
     )
+}
+
+/// Checks from its metadata (after following symbolic links), without opening it, that
+/// `path` is a regular file; the error names what it is otherwise (a FIFO, a device...).
+pub fn check_regular(path: &Path) -> io::Result<()> {
+    let meta = std::fs::metadata(path)?;
+    if meta.is_file() {
+        Ok(())
+    } else {
+        Err(not_regular(meta.file_type()))
+    }
 }
 
 /// Opens `path` for reading if it is a regular file (after following symbolic links), with
@@ -75,10 +89,7 @@ fn not_regular(t: std::fs::FileType) -> io::Error {
 /// metadata before the open; the open does not block even if the file is swapped for a FIFO
 /// meanwhile, and the opened file's own type is checked again.
 pub fn open_regular(path: &Path) -> io::Result<(File, u64)> {
-    let meta = std::fs::metadata(path)?;
-    if !meta.is_file() {
-        return Err(not_regular(meta.file_type()));
-    }
+    check_regular(path)?;
     let mut options = std::fs::OpenOptions::new();
     options.read(true);
     #[cfg(unix)]
@@ -150,7 +161,10 @@ fn limits() -> Limits {
 
 /// Decodes an image from `reader` (format from its content, else `hint`), checking its
 /// header's size against [`MAX_PIXELS`] before decoding any pixel. Errors are the reason.
-fn decode_from<R: BufRead + Seek>(reader: R, hint: Option<ImageFormat>) -> Result<DynamicImage, String> {
+fn decode_from<R: BufRead + Seek>(
+    reader: R,
+    hint: Option<ImageFormat>,
+) -> Result<DynamicImage, String> {
     let mut reader = ImageReader::new(reader);
     if let Some(format) = hint {
         reader.set_format(format);
@@ -215,7 +229,10 @@ pub(crate) mod tests {
         ihdr.extend([depth, 6, 0, 0, 0]);
         let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
         png.extend(chunk(b"IHDR", &ihdr));
-        png.extend(chunk(b"IDAT", &[0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01]));
+        png.extend(chunk(
+            b"IDAT",
+            &[0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01],
+        ));
         png.extend(chunk(b"IEND", &[]));
         png
     }
@@ -226,7 +243,11 @@ pub(crate) mod tests {
         for &b in bytes {
             crc ^= u32::from(b);
             for _ in 0..8 {
-                crc = if crc & 1 != 0 { (crc >> 1) ^ 0xEDB8_8320 } else { crc >> 1 };
+                crc = if crc & 1 != 0 {
+                    (crc >> 1) ^ 0xEDB8_8320
+                } else {
+                    crc >> 1
+                };
             }
         }
         !crc
@@ -236,7 +257,10 @@ pub(crate) mod tests {
     fn a_huge_png_header_is_refused_before_decoding() {
         let start = Instant::now();
         let err = decode_image(&png_header(100_000, 100_000, 8), None).unwrap_err();
-        assert!(err.contains("100000x100000") && err.contains("limit"), "{err}");
+        assert!(
+            err.contains("100000x100000") && err.contains("limit"),
+            "{err}"
+        );
         // Under the pixel limit but over the allocation limit (16-bit RGBA): the decoder's.
         let err = decode_image(&png_header(16000, 16000, 16), None).unwrap_err();
         assert!(err.contains("needs more than the limit"), "{err}");
@@ -255,7 +279,11 @@ pub(crate) mod tests {
         let start = Instant::now();
         for path in [fifo.as_path(), Path::new("/dev/zero"), dir.path()] {
             let err = read_file(path, 1 << 20).unwrap_err().to_string();
-            assert!(err.contains("not a regular file"), "{}: {err}", path.display());
+            assert!(
+                err.contains("not a regular file"),
+                "{}: {err}",
+                path.display()
+            );
             assert!(read_file_prefix(path, 4).is_err());
             assert!(load_image(path).is_err());
         }
@@ -268,7 +296,10 @@ pub(crate) mod tests {
         let path = dir.path().join("f.bin");
         std::fs::write(&path, b"0123456789").unwrap();
         assert_eq!(read_file(&path, 10).unwrap(), b"0123456789");
-        assert!(read_file(&path, 9).unwrap_err().to_string().contains("limit of 9"));
+        assert!(read_file(&path, 9)
+            .unwrap_err()
+            .to_string()
+            .contains("limit of 9"));
         assert_eq!(read_file_prefix(&path, 4).unwrap(), b"0123");
         let err = read_file_prefix(&path, 4 << 30).unwrap_err().to_string();
         assert!(err.contains("fewer than the 4294967296 needed"), "{err}");

@@ -124,10 +124,16 @@ mod tests {
         let start = std::time::Instant::now();
         std::fs::write(&p, b"Pf\n100000 100000\n-1.0\n\0\0\0\0").unwrap();
         let err = read_pfm(&p).unwrap_err().to_string();
-        assert!(err.contains("100000x100000") && err.contains("huge.pfm"), "{err}");
+        assert!(
+            err.contains("100000x100000") && err.contains("huge.pfm"),
+            "{err}"
+        );
         std::fs::write(&p, b"Pf\n40000 40000\n-1.0\n\0\0\0\0").unwrap();
         let err = read_pfm(&p).unwrap_err().to_string();
-        assert!(err.contains("40000x40000") && err.contains("limit"), "{err}");
+        assert!(
+            err.contains("40000x40000") && err.contains("limit"),
+            "{err}"
+        );
         // Within the limit but not backed by the file's bytes.
         std::fs::write(&p, b"Pf\n16384 16384\n-1.0\n\0\0\0\0").unwrap();
         let err = read_pfm(&p).unwrap_err().to_string();
