@@ -109,6 +109,13 @@
 //!   emission. A missing MTL file is a warning (every material becomes grey diffuse). OBJ has no
 //!   cameras or punctual lights, and no normal maps (`map_Bump` is a warning).
 //!
+//! # Files a scene names
+//!
+//! Every buffer, image, material library and texture map a scene names is read through the
+//! `files` module: inside the scene file's folder unless [`LoadOptions::allow_outside`],
+//! regular files only, no more bytes than needed, and counts, decoded sizes and image sizes
+//! checked before memory is reserved (see [`LoadOptions`]).
+//!
 //! # Ray queries
 //!
 //! [`Scene::intersect`] and [`Scene::occluded`] go through [`Accel`] (and, when the scene has

@@ -4,7 +4,8 @@
 //! normalised blinn_phong with shininess `Ns` (default 1); otherwise Lambertian `Kd`, with
 //! `map_Kd` (sRGB) multiplying it. `Ke` is emitted radiance. A missing or unreadable MTL file is
 //! a warning: every material becomes the default grey diffuse (albedo 0.5), as do faces without
-//! a material. OBJ texture coordinates have v pointing up; they are stored as `(u, 1 - v)` to
+//! a material. An MTL file or texture map outside the OBJ's folder, or not a regular file, is
+//! an error (see the `files` module). OBJ texture coordinates have v pointing up; they are stored as `(u, 1 - v)` to
 //! match the glTF convention of [`crate::texture::Texture`]. Bump and normal maps (`map_Bump`,
 //! `bump`) are not read: a warning names the material.
 
