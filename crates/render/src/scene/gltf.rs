@@ -1615,12 +1615,14 @@ impl Loader<'_> {
                 (bytes.to_vec(), Some(mime_type.to_string()))
             }
         };
-        let hint = match mime.as_deref() {
-            Some("image/png") => Some(image::ImageFormat::Png),
-            Some("image/jpeg") => Some(image::ImageFormat::Jpeg),
-            _ => None,
+        // glTF images are PNG or JPEG: by their content, else by their MIME type.
+        let format = match (image::guess_format(&bytes), mime.as_deref()) {
+            (Ok(f @ (image::ImageFormat::Png | image::ImageFormat::Jpeg)), _) => f,
+            (Err(_), Some("image/png")) => image::ImageFormat::Png,
+            (Err(_), Some("image/jpeg")) => image::ImageFormat::Jpeg,
+            _ => return Err(self.bad(&element, "is not a PNG or JPEG image")),
         };
-        let decoded = streaks_image::input::decode_image(&bytes, hint)
+        let decoded = streaks_image::input::decode_image(&bytes, Some(format))
             .map_err(|reason| self.bad(&element, reason))?;
         drop(bytes);
         let texture = decode_image(decoded, space)
