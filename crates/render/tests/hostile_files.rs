@@ -264,11 +264,14 @@ fn sparse_and_viewless_accessors_claiming_huge_counts_are_refused() {
                           "values": {"bufferView": 0}}})
     };
     for (accessor, why) in [
-        // 2^31 zeros backed by nothing (24 GiB of floats).
-        (sparse(1 << 31, 1), "no bufferView"),
+        // A million zeros (12 MB) backed by nothing.
+        (sparse(1_000_000, 1), "no bufferView"),
+        // 2^31 of them (24 GiB of floats): refused by the scene's budget of vertex data
+        // before the accessor is even read.
+        (sparse(1 << 31, 1), "16 times the"),
         // 2^30 substitutions from a 36-byte view.
-        (sparse(3, 1 << 30), "sparse"),
-        (sparse(1 << 31, 1 << 30), "no bufferView"),
+        (sparse(3, 1 << 30), "sparse count"),
+        (sparse(1 << 31, 1 << 30), "16 times the"),
     ] {
         let d = with_normal_accessor(doc(&uri, 36), accessor);
         let err = refused(&write(&dir, &d), &LoadOptions::default());
@@ -431,4 +434,25 @@ fn images_claiming_huge_sizes_are_refused_from_their_header() {
         &refused(&obj, &LoadOptions::default()),
         &["scene.obj", "map_Kd", "big.png", "100000x100000"],
     );
+}
+
+#[test]
+fn an_accessor_read_by_very_many_primitives_is_refused_before_memory_runs_out() {
+    let (_root, dir) = folders();
+    // 50,000 vertices (600 kB) read by 400 primitives: 240 MB of positions alone.
+    let vertices = 50_000usize;
+    let bin: Vec<u8> = (0..vertices * 3)
+        .flat_map(|i| ((i % 7) as f32).to_le_bytes())
+        .collect();
+    std::fs::write(dir.join("big.bin"), &bin).unwrap();
+    let mut d = doc("big.bin", bin.len() as u64);
+    d["bufferViews"][0]["byteLength"] = json!(bin.len());
+    d["accessors"][0] = json!({"bufferView": 0, "componentType": 5126, "count": vertices,
+        "type": "VEC3", "min": [0, 0, 0], "max": [6, 6, 6]});
+    d["meshes"][0]["primitives"] = json!(vec![json!({"attributes": {"POSITION": 0}}); 400]);
+    let err = refused(&write(&dir, &d), &LoadOptions::default());
+    names(&err, &["scene.gltf", "POSITION (accessor 0)", "16 times"]);
+    // One primitive reads it fine.
+    d["meshes"][0]["primitives"] = json!([{"attributes": {"POSITION": 0}}]);
+    Scene::load(&write(&dir, &d)).unwrap();
 }

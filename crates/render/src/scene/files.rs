@@ -16,11 +16,23 @@
 //!
 //! Decoded data is bounded too: compressed geometry (meshopt, Draco) by
 //! [`LoadOptions::max_decoded_bytes`] over the whole scene, images by
-//! [`streaks_image::input::MAX_PIXELS`] from their headers.
+//! [`streaks_image::input::MAX_PIXELS`] from their headers, and the vertex data read from
+//! accessors by [`EXPANSION`] times the bytes of the scene's files (its JSON or GLB, its
+//! buffers and its decoded geometry) plus [`EXPANSION_SLACK`]: an accessor is checked against
+//! its bufferView, but a thousand primitives or placements can read the same one.
 
 use super::SceneError;
 use std::cell::Cell;
 use std::path::{Component, Path, PathBuf};
+
+/// How many times the bytes of a scene's files its accessors may decode to: 16 (quantized 8-bit
+/// values become 32-bit floats, 4 times larger, and an emissive mesh is read once per
+/// placement).
+pub(super) const EXPANSION: u64 = 16;
+
+/// What a scene's accessors may decode to on top of [`EXPANSION`] times its files' bytes:
+/// 64 MiB, so that small files placing a mesh many times still load.
+pub(super) const EXPANSION_SLACK: u64 = 64 << 20;
 
 /// What loading a scene may read and decode ([`super::Scene::load_with`]).
 #[derive(Clone, Debug)]
@@ -66,6 +78,10 @@ pub(super) struct Files<'a> {
     options: &'a LoadOptions,
     /// Decoded bytes still allowed ([`LoadOptions::max_decoded_bytes`] less what was decoded).
     decode_budget: Cell<u64>,
+    /// Bytes of the scene's files read and of its decoded geometry.
+    backing: Cell<u64>,
+    /// Bytes of vertex data its accessors have decoded.
+    expanded: Cell<u64>,
 }
 
 /// An encoded payload named by a URI: the bytes of a `data:` URI, or a file to read.
@@ -88,6 +104,8 @@ impl<'a> Files<'a> {
             folder,
             options,
             decode_budget: Cell::new(options.max_decoded_bytes),
+            backing: Cell::new(0),
+            expanded: Cell::new(0),
         }
     }
 
@@ -98,13 +116,42 @@ impl<'a> Files<'a> {
 
     /// The scene file itself, whole, within [`LoadOptions::max_file_bytes`].
     pub(super) fn read_scene(&self) -> Result<Vec<u8>, SceneError> {
-        streaks_image::input::read_file(self.scene, self.options.max_file_bytes).map_err(|source| {
-            SceneError::Io {
+        let bytes = streaks_image::input::read_file(self.scene, self.options.max_file_bytes)
+            .map_err(|source| SceneError::Io {
                 path: self.scene.to_path_buf(),
                 element: "the file".into(),
                 source,
-            }
-        })
+            })?;
+        self.add_backing(bytes.len());
+        Ok(bytes)
+    }
+
+    /// Counts `bytes` of the scene's data toward what its accessors may decode to.
+    fn add_backing(&self, bytes: usize) {
+        self.backing
+            .set(self.backing.get().saturating_add(bytes as u64));
+    }
+
+    /// Takes `bytes` of vertex data an accessor is about to decode from what the scene's
+    /// files allow ([`EXPANSION`]), or returns the reason it is exceeded.
+    pub(super) fn charge_expanded(&self, bytes: u64) -> Result<(), String> {
+        let spent = self.expanded.get().saturating_add(bytes);
+        let limit = self
+            .backing
+            .get()
+            .saturating_mul(EXPANSION)
+            .saturating_add(EXPANSION_SLACK);
+        if spent > limit {
+            return Err(format!(
+                "reading it would bring the vertex data decoded from the scene's accessors to \
+                 {spent} bytes, more than {EXPANSION} times the {} bytes of its files plus \
+                 {EXPANSION_SLACK} (is one accessor read by very many primitives or \
+                 placements?)",
+                self.backing.get()
+            ));
+        }
+        self.expanded.set(spent);
+        Ok(())
     }
 
     /// Resolves the relative file name `name` (an OBJ's `mtllib`, an MTL's map, a glTF URI
@@ -194,6 +241,7 @@ impl<'a> Files<'a> {
             };
             let bytes = base64::decode(payload)
                 .map_err(|e| bad(format!("its data URI is not valid base64: {e}")))?;
+            self.add_backing(bytes.len());
             let media = (!media.is_empty()).then(|| media.to_string());
             return Ok(Uri::Data(bytes, media));
         }
@@ -251,11 +299,14 @@ impl<'a> Files<'a> {
                 ),
             ));
         }
-        streaks_image::input::read_file_prefix(path, len).map_err(|source| SceneError::Io {
-            path: self.scene.to_path_buf(),
-            element: element.to_string(),
-            source,
-        })
+        let bytes =
+            streaks_image::input::read_file_prefix(path, len).map_err(|source| SceneError::Io {
+                path: self.scene.to_path_buf(),
+                element: element.to_string(),
+                source,
+            })?;
+        self.add_backing(bytes.len());
+        Ok(bytes)
     }
 
     /// Reads the whole resolved file `path` for `element`, within
@@ -286,6 +337,7 @@ impl<'a> Files<'a> {
             ));
         }
         self.decode_budget.set(left - bytes);
+        self.add_backing(bytes as usize);
         Ok(())
     }
 }

@@ -759,6 +759,11 @@ impl Loader<'_> {
         count: Option<usize>,
     ) -> Result<Vec<[f32; N]>, SceneError> {
         let element = format!("{element}, {name} (accessor {})", accessor.index());
+        // What the values will take, charged before they are read (the accessor itself is
+        // checked against its bufferView by the read).
+        self.files
+            .charge_expanded((accessor.count() as u64).saturating_mul(4 * N as u64))
+            .map_err(|r| self.bad(&element, r))?;
         let values = accessor::read::<N>(accessor, &self.buffers, allowed)
             .map_err(|r| self.bad(&element, r))?;
         match count {
@@ -791,6 +796,10 @@ impl Loader<'_> {
         if count == 0 {
             return Err(self.bad(element, "count is 0"));
         }
+        // The indices will be read as 32-bit values.
+        self.files
+            .charge_expanded((count as u64).saturating_mul(4))
+            .map_err(|r| self.bad(&element, r))?;
         let Some(view) = accessor.view() else {
             return Err(self.bad(element, "has no bufferView"));
         };
