@@ -5,7 +5,6 @@
 use anyhow::Context;
 use std::path::PathBuf;
 use streaks_render::mitsuba::{export, ExportOptions};
-use streaks_render::scene::Scene;
 
 /// Arguments of `streaks export-mitsuba`.
 #[derive(clap::Args, Debug)]
@@ -33,12 +32,14 @@ pub struct Args {
     /// Sampler seed.
     #[arg(long, default_value_t = 0)]
     pub seed: u32,
+    /// Let the scene read files outside its folder (as `streaks render`).
+    #[arg(long)]
+    pub allow_outside_scene: bool,
 }
 
 /// Runs the command.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let scene =
-        Scene::load(&args.scene).with_context(|| format!("loading {}", args.scene.display()))?;
+    let scene = crate::render::load_scene(&args.scene, args.allow_outside_scene)?;
     let opts = ExportOptions {
         width: args.width,
         height: args.height,

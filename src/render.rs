@@ -9,12 +9,29 @@ use streaks_image::GrayImage;
 use streaks_render::camera::Camera;
 use streaks_render::integrator::{self, Layers, RenderOutput, RenderSettings};
 use streaks_render::output;
-use streaks_render::scene::Scene;
+use streaks_render::scene::{LoadOptions, Scene, SceneError};
 use streaks_stereo::render::{road_surface, scene_has_road};
 
 /// Largest image accepted, in pixels (2^26, twice 8K UHD; the film keeps about 72 bytes per
 /// pixel, so 4.5 GiB).
 const MAX_PIXELS: u64 = 1 << 26;
+
+/// Loads a scene for a command; `allow_outside` lets it read files outside its folder
+/// (`--allow-outside-scene`), and a refusal says which flag allows it.
+pub fn load_scene(path: &Path, allow_outside: bool) -> Result<Scene> {
+    let options = LoadOptions {
+        allow_outside,
+        ..LoadOptions::default()
+    };
+    Scene::load_with(path, &options).map_err(|e| {
+        let hint = if matches!(e, SceneError::OutsideFolder { .. }) {
+            " (--allow-outside-scene lets it read files outside its folder)"
+        } else {
+            ""
+        };
+        anyhow::Error::new(e).context(format!("cannot load the scene {}{hint}", path.display()))
+    })
+}
 
 /// Default image height when neither `--width` nor `--height` is given.
 const DEFAULT_HEIGHT: u32 = 480;
@@ -71,6 +88,11 @@ pub struct RenderOpts {
     /// Cycles' "Filter Glossy" does; far fewer fireflies, the first bounce (streaks) unchanged.
     #[arg(long)]
     pub regularize: bool,
+    /// Let the scene read files outside its folder (absolute paths, file: URIs, `..`, links
+    /// out of it). Off by default, so an untrusted scene cannot read other files; FIFOs and
+    /// devices are refused even then.
+    #[arg(long)]
+    pub allow_outside_scene: bool,
 }
 
 /// A scene loaded for rendering, with the chosen camera and the image size.
@@ -110,8 +132,7 @@ impl RenderOpts {
 
     /// Phase 2: loads the scene (printing its warnings), picks the camera and sizes the image.
     pub fn load(&self, path: &Path) -> Result<Loaded> {
-        let scene = Scene::load(path)
-            .with_context(|| format!("cannot load the scene {}", path.display()))?;
+        let scene = load_scene(path, self.allow_outside_scene)?;
         for warning in &scene.warnings {
             eprintln!("warning: {warning}");
         }

@@ -361,3 +361,60 @@ fn noise_target_writes_the_spp_layer_and_is_deterministic() {
     let said = format!("{mean:.1} spp on average (noise target 0.05, cap 64)");
     assert!(stderr[0].contains(&said), "{} (wanted {said})", stderr[0]);
 }
+
+#[test]
+fn scene_files_outside_its_folder_need_the_flag_and_fifos_are_never_read() {
+    let t = TestDir::new();
+    t.write_tiny_gltf();
+    std::fs::create_dir(t.join("sub")).unwrap();
+    let json = std::fs::read_to_string(t.join("scene.gltf")).unwrap();
+    std::fs::write(
+        t.join("sub/up.gltf"),
+        json.replace("\"uri\": \"scene.bin\"", "\"uri\": \"../scene.bin\""),
+    )
+    .unwrap();
+    let render = [
+        "render",
+        "sub/up.gltf",
+        "-o",
+        "x.png",
+        "--spp",
+        "1",
+        "--width",
+        "12",
+    ];
+    t.streaks(&render)
+        .assert_failure_mentioning("--allow-outside-scene")
+        .assert_failure_mentioning("../scene.bin");
+    let mut allowed = render.to_vec();
+    allowed.push("--allow-outside-scene");
+    t.streaks(&allowed).assert_success();
+    // A FIFO as the buffer: refused at once, even with the flag, by render and stereo.
+    let fifo = t.join("sub/pipe.bin");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    assert!(made.is_ok_and(|s| s.success()), "mkfifo failed");
+    std::fs::write(
+        t.join("sub/pipe.gltf"),
+        json.replace("\"uri\": \"scene.bin\"", "\"uri\": \"pipe.bin\""),
+    )
+    .unwrap();
+    let start = std::time::Instant::now();
+    t.streaks(&[
+        "render",
+        "sub/pipe.gltf",
+        "-o",
+        "y.png",
+        "--allow-outside-scene",
+    ])
+    .assert_failure_mentioning("FIFO");
+    t.streaks(&[
+        "stereo",
+        "sub/pipe.gltf",
+        "-o",
+        "pair",
+        "--allow-outside-scene",
+    ])
+    .assert_failure_mentioning("FIFO");
+    assert!(start.elapsed() < std::time::Duration::from_secs(10));
+    assert!(!t.join("y.png").exists() && !t.join("pair").exists());
+}

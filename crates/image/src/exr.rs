@@ -3,7 +3,9 @@
 //! `exrheader` show as layers; the renderer's layout is in `streaks_render::output`).
 
 use crate::atomic::{write_atomically, WriteFailure};
+use crate::input::{check_pixels, open_regular, MAX_IMAGE_BYTES};
 use crate::{ImageError, RgbImage};
+use std::io::Seek;
 use std::path::Path;
 
 /// One channel to write: its full name (`R`, `depth.Z`, ...) and `width * height` values.
@@ -69,16 +71,48 @@ pub fn write_exr_rgb(path: &Path, image: &RgbImage) -> Result<(), ImageError> {
 }
 
 /// The channels of the first EXR part that has all of `names` (any sample type, converted to
-/// f32), in that order, with the part's width and height.
+/// f32), in that order, with the part's width and height. Only a regular file is read, and
+/// its headers are checked against [`crate::input::MAX_PIXELS`] and
+/// [`crate::input::MAX_IMAGE_BYTES`] before any pixel is.
 pub fn read_exr_channels(
     path: &Path,
     names: &[&str],
 ) -> Result<(u32, u32, Vec<Vec<f32>>), ImageError> {
-    let image =
-        exr::prelude::read_all_flat_layers_from_file(path).map_err(|source| ImageError::Exr {
-            path: path.to_path_buf(),
-            source,
-        })?;
+    use exr::prelude::{ReadChannels, ReadLayers};
+    let exr_err = |source| ImageError::Exr {
+        path: path.to_path_buf(),
+        source,
+    };
+    let read_err = |reason: String| ImageError::Read {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let (file, _) = open_regular(path).map_err(|e| read_err(e.to_string()))?;
+    let mut reader = std::io::BufReader::new(file);
+    // The headers first: every part's size against the pixel limit, and the samples the read
+    // will hold against the allocation limit, before any pixel is read.
+    let meta = exr::meta::MetaData::read_from_buffered(&mut reader, false).map_err(exr_err)?;
+    let mut bytes = 0u64;
+    for header in &meta.headers {
+        let (w, h) = (header.layer_size.0 as u64, header.layer_size.1 as u64);
+        check_pixels(w, h).map_err(read_err)?;
+        bytes = bytes.saturating_add(w * h * 4 * header.channels.list.len() as u64);
+    }
+    if bytes > MAX_IMAGE_BYTES {
+        return Err(read_err(format!(
+            "its headers claim {bytes} bytes of samples, more than the limit of \
+             {MAX_IMAGE_BYTES}"
+        )));
+    }
+    reader.rewind().map_err(|e| read_err(e.to_string()))?;
+    let image = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .all_layers()
+        .all_attributes()
+        .from_buffered(reader)
+        .map_err(exr_err)?;
     for layer in &image.layer_data {
         let found: Option<Vec<Vec<f32>>> = names
             .iter()
@@ -196,5 +230,31 @@ mod tests {
         assert!(err.to_string().contains("channel R has 3 values"), "{err}");
         assert!(write_exr(&out, 0, 2, vec![("R", vec![])]).is_err());
         assert!(!out.exists());
+    }
+
+    #[test]
+    fn a_huge_header_is_refused_before_reading_pixels() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("huge.exr");
+        write_exr_rgb(&path, &gradient(4, 4)).unwrap();
+        // Rewrite the dataWindow (box2i: xMin, yMin, xMax, yMax) to 100000 x 100000 pixels.
+        let mut bytes = std::fs::read(&path).unwrap();
+        let key = b"dataWindow\0box2i\0";
+        let at = bytes.windows(key.len()).position(|w| w == key).unwrap() + key.len() + 4;
+        for (i, v) in [0i32, 0, 99_999, 99_999].iter().enumerate() {
+            bytes[at + 4 * i..at + 4 * i + 4].copy_from_slice(&v.to_le_bytes());
+        }
+        std::fs::write(&path, bytes).unwrap();
+        let start = std::time::Instant::now();
+        let err = read_exr_rgb(&path).unwrap_err().to_string();
+        assert!(
+            err.contains("100000x100000") && err.contains("huge.exr"),
+            "{err}"
+        );
+        assert!(start.elapsed() < std::time::Duration::from_secs(1));
+        let err = read_exr_rgb(Path::new("/dev/zero"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("not a regular file"), "{err}");
     }
 }

@@ -2,6 +2,7 @@
 //! (grey levels, disparity and depth maps, masks).
 
 use crate::color::{luminance, srgb_to_linear};
+use crate::input::load_image;
 use crate::png::write_png_buffer;
 use crate::{ImageError, RgbImage};
 use glam::Vec3;
@@ -107,7 +108,8 @@ impl GrayImage {
         Self::from_vec(img.width as usize, img.height as usize, data)
     }
 
-    /// Loads any image the `image` crate reads (PNG, JPEG, EXR; 8/16-bit or float) as its
+    /// Loads any image the `image` crate reads (PNG, JPEG, EXR; 8/16-bit or float; within the
+    /// limits of [`crate::input`]) as its
     /// [`luminance`] (of the stored values: sRGB-encoded for PNG and JPEG, linear for EXR), in
     /// [0, 1] for integer formats.
     pub fn load(path: &Path) -> Result<Self, ImageError> {
@@ -129,10 +131,7 @@ impl GrayImage {
     /// input a detector working on radiance needs; an 8-bit image's clipped highlights stay
     /// clipped.
     pub fn load_linear(path: &Path) -> Result<Self, ImageError> {
-        let img = ::image::open(path).map_err(|e| ImageError::Read {
-            path: path.to_path_buf(),
-            reason: e.to_string(),
-        })?;
+        let img = load_image(path)?;
         let float = matches!(
             img,
             ::image::DynamicImage::ImageRgb32F(_) | ::image::DynamicImage::ImageRgba32F(_)
@@ -154,7 +153,7 @@ pub fn load_rgb_channels(path: &Path) -> Result<[GrayImage; 3], ImageError> {
         path: path.to_path_buf(),
         reason,
     };
-    let img = ::image::open(path).map_err(|e| read_err(e.to_string()))?;
+    let img = load_image(path)?;
     let rgb = img.to_rgb32f();
     let (w, h) = (rgb.width() as usize, rgb.height() as usize);
     let channel = |c: usize| {

@@ -72,12 +72,7 @@ pub fn read_kitti_disparity(path: &Path) -> Result<GrayImage, ImageError> {
         path: path.to_path_buf(),
         reason,
     };
-    let img = image::ImageReader::open(path)
-        .map_err(|e| err(e.to_string()))?
-        .with_guessed_format()
-        .map_err(|e| err(e.to_string()))?
-        .decode()
-        .map_err(|e| err(e.to_string()))?;
+    let img = crate::input::load_image(path)?;
     let image::DynamicImage::ImageLuma16(img) = img else {
         return Err(err(format!(
             "a KITTI disparity map is a 16-bit greyscale PNG, this is {:?}",

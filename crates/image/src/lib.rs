@@ -13,6 +13,8 @@
 //!   (a uniquely named temporary file, then a rename);
 //! - [`exr`], [`png`], [`pfm`]: reading and writing the three formats (EXR with named float
 //!   channels; PNG as 8-bit sRGB or any 8/16-bit buffer; PFM in the Middlebury convention);
+//! - [`input`]: reading files that may be hostile: regular files only, capped reads, images
+//!   checked against a pixel limit from their header ([`input::MAX_PIXELS`]);
 //! - [`kitti`]: disparity maps in the KITTI 2015 encoding (16-bit PNG, disparity x 256);
 //! - [`compare`]: statistics of the difference between two images (relative RMSE, bias, the
 //!   noise test), per region;
@@ -40,6 +42,7 @@ pub mod compare;
 pub mod error;
 pub mod exr;
 pub mod gray;
+pub mod input;
 pub mod kitti;
 pub mod pfm;
 pub mod png;

@@ -2,6 +2,7 @@
 //! (negative scale), rows stored bottom to top, `inf` for "no value". Written atomically.
 
 use crate::atomic::write_bytes_atomically;
+use crate::input::{check_pixels, read_file, MAX_PIXELS};
 use crate::{GrayImage, ImageError};
 use std::path::Path;
 
@@ -17,13 +18,19 @@ pub fn write_pfm(path: &Path, img: &GrayImage) -> Result<(), ImageError> {
     write_bytes_atomically(path, &bytes)
 }
 
-/// Reads a greyscale PFM (either byte order); rows are returned top row first.
+/// The longest PFM header read: the magic, the size and the scale, with room for spaces.
+const MAX_HEADER_BYTES: u64 = 1024;
+
+/// Reads a greyscale PFM (either byte order); rows are returned top row first. Only a regular
+/// file is read, at most [`MAX_PIXELS`] floats and a header; the size in the header is checked
+/// against the limit and against the bytes the file holds before the image is allocated.
 pub fn read_pfm(path: &Path) -> Result<GrayImage, ImageError> {
     let err = |reason: String| ImageError::Read {
         path: path.to_path_buf(),
         reason,
     };
-    let bytes = std::fs::read(path).map_err(|e| err(e.to_string()))?;
+    let bytes =
+        read_file(path, MAX_PIXELS * 4 + MAX_HEADER_BYTES).map_err(|e| err(e.to_string()))?;
     // Header: three whitespace-separated tokens after the magic, then one whitespace byte.
     let mut pos = 0usize;
     let mut token = || -> Result<String, ImageError> {
@@ -52,7 +59,7 @@ pub fn read_pfm(path: &Path) -> Result<GrayImage, ImageError> {
         return Err(err("scale must be a non-zero number".into()));
     }
     let data_start = pos + 1;
-    let mut img = GrayImage::new(width, height, 0.0).map_err(|e| err(e.to_string()))?;
+    check_pixels(width as u64, height as u64).map_err(err)?;
     let need = width * height * 4;
     if bytes.len() < data_start + need {
         return Err(err(format!(
@@ -60,6 +67,7 @@ pub fn read_pfm(path: &Path) -> Result<GrayImage, ImageError> {
             bytes.len().saturating_sub(data_start)
         )));
     }
+    let mut img = GrayImage::new(width, height, 0.0).map_err(|e| err(e.to_string()))?;
     let little = scale < 0.0;
     for (i, chunk) in bytes[data_start..data_start + need]
         .chunks_exact(4)
@@ -107,5 +115,32 @@ mod tests {
         std::fs::write(&p, b"Pf\n4 4\n-1.0\n\0\0").unwrap();
         assert!(read_pfm(&p).unwrap_err().to_string().contains("truncated"));
         assert!(read_pfm(&dir.path().join("missing.pfm")).is_err());
+    }
+
+    #[test]
+    fn a_huge_header_is_refused_before_allocation() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("huge.pfm");
+        let start = std::time::Instant::now();
+        std::fs::write(&p, b"Pf\n100000 100000\n-1.0\n\0\0\0\0").unwrap();
+        let err = read_pfm(&p).unwrap_err().to_string();
+        assert!(
+            err.contains("100000x100000") && err.contains("huge.pfm"),
+            "{err}"
+        );
+        std::fs::write(&p, b"Pf\n40000 40000\n-1.0\n\0\0\0\0").unwrap();
+        let err = read_pfm(&p).unwrap_err().to_string();
+        assert!(
+            err.contains("40000x40000") && err.contains("limit"),
+            "{err}"
+        );
+        // Within the limit but not backed by the file's bytes.
+        std::fs::write(&p, b"Pf\n16384 16384\n-1.0\n\0\0\0\0").unwrap();
+        let err = read_pfm(&p).unwrap_err().to_string();
+        assert!(err.contains("truncated"), "{err}");
+        assert!(start.elapsed() < std::time::Duration::from_secs(1));
+        // A device is not read.
+        let err = read_pfm(Path::new("/dev/zero")).unwrap_err().to_string();
+        assert!(err.contains("not a regular file"), "{err}");
     }
 }

@@ -114,3 +114,25 @@ fn corrupt_compressed_data_is_an_error_naming_the_element() {
         assert!(err.contains(name) && err.contains(element), "{err}");
     }
 }
+
+#[test]
+fn decoded_geometry_is_held_to_the_scenes_budget() {
+    use streaks_render::scene::LoadOptions;
+    for (name, element) in [
+        ("crosscheck_meshopt.glb", "EXT_meshopt_compression"),
+        ("crosscheck_draco.glb", "KHR_draco_mesh_compression"),
+    ] {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/data")
+            .join(name);
+        // The file decodes within the default budget, and not within 1000 bytes.
+        Scene::load(&path).unwrap();
+        let small = LoadOptions {
+            max_decoded_bytes: 1000,
+            ..LoadOptions::default()
+        };
+        let err = Scene::load_with(&path, &small).unwrap_err().to_string();
+        assert!(err.contains(name) && err.contains(element), "{err}");
+        assert!(err.contains("limit") || err.contains("Limit"), "{err}");
+    }
+}

@@ -7,8 +7,11 @@
 //! specification's rules (its section 3.11, "Animations", gives them for all types):
 //! `u8 / 255`, `u16 / 65535`, `max(i8 / 127, -1)`, `max(i16 / 32767, -1)`.
 //!
-//! Every byte range is checked against its bufferView and buffer before it is read, so a
-//! malformed file gives an error naming what is wrong instead of a panic.
+//! Every byte range is checked against its bufferView and buffer before it is read, and every
+//! count against the bytes that back it before anything is reserved (an accessor without a
+//! bufferView may not claim more elements than the file's buffers could hold), so a
+//! malformed file gives an error naming what is wrong instead of a panic or an exhausted
+//! memory.
 
 use gltf::accessor::{DataType, Dimensions};
 use gltf::buffer::Data;
@@ -187,8 +190,21 @@ fn read_flat(
     let size = component_size(ty);
     let element = n * size;
     let mut values = match accessor.view() {
-        // No bufferView: all zeros (then usually replaced by a sparse substitution).
-        None => vec![0.0; count * n],
+        // No bufferView: all zeros (then usually replaced by a sparse substitution). Nothing
+        // in the file backs the zeros, so there may be no more of them than the file's
+        // buffers could hold had they been written out.
+        None => {
+            let held: usize = buffers.iter().map(|b| b.len()).sum();
+            match count.checked_mul(element) {
+                Some(bytes) if bytes <= held => vec![0.0; count * n],
+                _ => {
+                    return Err(format!(
+                        "has no bufferView and claims {count} elements of {element} bytes, more \
+                         than the file's buffers hold ({held} bytes)"
+                    ))
+                }
+            }
+        }
         Some(view) => {
             let stride = view.stride().unwrap_or(element);
             if stride < element {
@@ -226,6 +242,11 @@ fn substitute(
     values: &mut [f32],
 ) -> Result<(), String> {
     let k = sparse.count();
+    if k > count {
+        return Err(format!(
+            "sparse count {k} is more than the accessor's count {count}"
+        ));
+    }
     let indices = sparse.indices();
     let index_type = match indices.index_type() {
         gltf::accessor::sparse::IndexType::U8 => DataType::U8,

@@ -13,7 +13,16 @@
 //!
 //! Each decoded extension is then dropped from `extensionsUsed` and `extensionsRequired`.
 //! Errors name the bufferView or the primitive and the reason.
+//!
+//! Nothing is reserved for a size the file claims before it is checked: a meshopt view's
+//! `count * byteStride` against its byteLength, against the most its compressed bytes can
+//! expand to (1024 times for attributes, from the format: a block of up to 256 vertices
+//! costs at least one control byte per 4 bytes of stride; one byte per triangle or per index
+//! for indices) and against the scene's budget of decoded bytes
+//! ([`super::LoadOptions::max_decoded_bytes`]); a Draco stream is decoded under
+//! `draco-core`'s `DecodeLimits` set to what is left of that budget.
 
+use super::files::Files;
 use super::SceneError;
 use gltf::buffer::Data;
 use serde_json::{json, Value};
@@ -51,9 +60,10 @@ pub(super) fn decode(
     path: &Path,
     raw: &mut Value,
     buffers: &mut Vec<Data>,
+    files: &Files,
 ) -> Result<bool, SceneError> {
-    let meshopt = decode_meshopt(path, raw, buffers)?;
-    let draco = decode_draco(path, raw, buffers)?;
+    let meshopt = decode_meshopt(path, raw, buffers, files)?;
+    let draco = decode_draco(path, raw, buffers, files)?;
     for (done, name) in [(meshopt, MESHOPT), (draco, DRACO)] {
         if done {
             for list in ["extensionsUsed", "extensionsRequired"] {
@@ -98,6 +108,7 @@ fn decode_meshopt(
     path: &Path,
     raw: &mut Value,
     buffers: &mut Vec<Data>,
+    files: &Files,
 ) -> Result<bool, SceneError> {
     let mut new_buffers = Vec::new();
     let Some(Value::Array(views)) = raw.get_mut("bufferViews") else {
@@ -108,20 +119,10 @@ fn decode_meshopt(
             continue;
         };
         let element = format!("bufferView {i} ({MESHOPT})");
-        let bytes = meshopt_view(&ext, buffers)
-            .map_err(|reason| SceneError::invalid(path, &element, reason))?;
         let length = index(view, "byteLength", None)
             .map_err(|reason| SceneError::invalid(path, &element, reason))?;
-        if bytes.len() != length {
-            return Err(SceneError::invalid(
-                path,
-                element,
-                format!(
-                    "decodes to {} bytes but its byteLength is {length}",
-                    bytes.len()
-                ),
-            ));
-        }
+        let bytes = meshopt_view(&ext, buffers, length, files)
+            .map_err(|reason| SceneError::invalid(path, &element, reason))?;
         new_buffers.push(bytes);
         view["buffer"] = json!(buffers.len() + new_buffers.len() - 1);
         view["byteOffset"] = json!(0);
@@ -168,20 +169,53 @@ fn push_buffer(
     Ok(buffers.len() - 1)
 }
 
-/// The decoded bytes of one meshopt-compressed view, from its extension object.
-fn meshopt_view(ext: &Value, buffers: &[Data]) -> Result<Vec<u8>, String> {
+/// The most bytes a meshopt vertex stream of `compressed` bytes can decode to: each block of
+/// at most 256 vertices costs at least one control byte per 4 bytes of stride (version 1;
+/// version 0 costs more), so a stream expands at most 4 x 256 = 1024 times.
+const MESHOPT_MAX_EXPANSION: u64 = 1024;
+
+/// The decoded bytes of one meshopt-compressed view of `length` bytes, from its extension
+/// object; the claimed size is checked against `length`, against what the compressed bytes
+/// can hold and against the budget of `files` before it is reserved.
+fn meshopt_view(
+    ext: &Value,
+    buffers: &[Data],
+    length: usize,
+    files: &Files,
+) -> Result<Vec<u8>, String> {
     let buffer = index(ext, "buffer", None)?;
     let offset = index(ext, "byteOffset", Some(0))?;
-    let length = index(ext, "byteLength", None)?;
+    let compressed = index(ext, "byteLength", None)?;
     let stride = index(ext, "byteStride", None)?;
     let count = index(ext, "count", None)?;
     let mode = ext.get("mode").and_then(Value::as_str).unwrap_or("");
     let filter = ext.get("filter").and_then(Value::as_str).unwrap_or("NONE");
-    let source = slice(buffers, buffer, offset, length)?;
+    let source = slice(buffers, buffer, offset, compressed)?;
     let size = count
         .checked_mul(stride)
         .filter(|&s| s <= isize::MAX as usize)
         .ok_or_else(|| format!("{count} elements of {stride} bytes overflow"))?;
+    if size != length {
+        return Err(format!(
+            "{count} elements of {stride} bytes are {size} bytes but its byteLength is {length}"
+        ));
+    }
+    // What the compressed bytes can hold at most (the decoder's own minimum sizes for
+    // indices: a header byte, one byte per triangle or index, and a tail).
+    let backed = match mode {
+        "ATTRIBUTES" => (source.len() as u64).saturating_mul(MESHOPT_MAX_EXPANSION) >= size as u64,
+        "TRIANGLES" => source.len() >= 1 + count / 3 + 16,
+        "INDICES" => source.len() >= 1 + count + 4,
+        _ => true,
+    };
+    if !backed {
+        return Err(format!(
+            "claims {count} elements ({size} bytes) from {} compressed bytes, more than the \
+             {mode} encoding can hold",
+            source.len()
+        ));
+    }
+    files.charge_decoded(size as u64)?;
     let mut out = vec![0u8; size];
     let code = match mode {
         "ATTRIBUTES" => {
@@ -282,7 +316,12 @@ fn type_components(ty: &str) -> Option<usize> {
 }
 
 /// Decodes the Draco-compressed primitives (see the module documentation).
-fn decode_draco(path: &Path, raw: &mut Value, buffers: &mut Vec<Data>) -> Result<bool, SceneError> {
+fn decode_draco(
+    path: &Path,
+    raw: &mut Value,
+    buffers: &mut Vec<Data>,
+    files: &Files,
+) -> Result<bool, SceneError> {
     let mut any = false;
     let mesh_count = raw
         .get("meshes")
@@ -301,7 +340,7 @@ fn decode_draco(path: &Path, raw: &mut Value, buffers: &mut Vec<Data>) -> Result
             let element = format!("mesh {m}, primitive {p} ({DRACO})");
             let bad = |reason: String| SceneError::invalid(path, &element, reason);
             let prim = prim.clone();
-            let decoded = draco_primitive(raw, &prim, &ext, buffers).map_err(bad)?;
+            let decoded = draco_primitive(raw, &prim, &ext, buffers, files).map_err(bad)?;
             // One new buffer per primitive, one view per decoded accessor, 4-byte aligned.
             let mut bytes = Vec::new();
             let mut placed = Vec::new();
@@ -352,12 +391,14 @@ struct Decoded {
 }
 
 /// The decoded data of one Draco primitive, by accessor index: its attributes as floats and
-/// its indices as 32-bit integers.
+/// its indices as 32-bit integers. The decoder works under limits set to the budget of
+/// `files`, and what is converted is charged to it before it is reserved.
 fn draco_primitive(
     raw: &Value,
     prim: &Value,
     ext: &Value,
     buffers: &[Data],
+    files: &Files,
 ) -> Result<Vec<(usize, Decoded)>, String> {
     let view = index(ext, "bufferView", None)?;
     let v = raw
@@ -371,8 +412,16 @@ fn draco_primitive(
         index(v, "byteLength", None)?,
     )?;
     let mut mesh = draco_core::Mesh::new();
+    let budget = files.decode_budget();
+    let limits = draco_core::DecodeLimits::default()
+        .with_max_decoded_bytes(budget)
+        .with_max_points(budget / 4)
+        .with_max_faces(budget / 12);
     draco_core::MeshDecoder::new()
-        .decode(&mut draco_core::DecoderBuffer::new(source), &mut mesh)
+        .decode(
+            &mut draco_core::DecoderBuffer::new(source).with_limits(limits),
+            &mut mesh,
+        )
         .map_err(|e| format!("the Draco decoder rejects bufferView {view}: {e}"))?;
     let points = mesh.num_points();
     let mut out = Vec::new();
@@ -402,6 +451,7 @@ fn draco_primitive(
         let attr = mesh
             .attribute_by_unique_id(id as u32)
             .ok_or_else(|| format!("the Draco data has no attribute {id} ({semantic})"))?;
+        files.charge_decoded((points as u64).saturating_mul(n as u64 * 4))?;
         let mut values = attr.read_f32s(points, n);
         if a.get("normalized").and_then(Value::as_bool) == Some(true) {
             let scale = match attr.data_type() {
@@ -425,6 +475,7 @@ fn draco_primitive(
         ));
     }
     if let Some(indices) = prim.get("indices").and_then(Value::as_u64) {
+        files.charge_decoded((mesh.num_faces() as u64).saturating_mul(12))?;
         let bytes: Vec<u8> = mesh
             .faces()
             .iter()

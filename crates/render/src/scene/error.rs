@@ -50,6 +50,23 @@ pub enum SceneError {
         /// What is wrong with it.
         reason: String,
     },
+    /// A file the scene names is outside the scene's folder (an absolute path, a `file:` URI,
+    /// a `..` leaving the folder, a symbolic link out of it), and reading outside was not
+    /// allowed ([`super::LoadOptions::allow_outside`]).
+    #[error(
+        "{path}: {element}: refused {uri:?}: {reason}; a scene reads only files inside its \
+         folder unless reading outside is allowed"
+    )]
+    OutsideFolder {
+        /// The scene file.
+        path: PathBuf,
+        /// The element naming the file, e.g. `buffer 0` or `mtllib`.
+        element: String,
+        /// The name or URI as the file gives it.
+        uri: String,
+        /// Why it is outside.
+        reason: String,
+    },
     /// The file requires a glTF extension the loader does not honour.
     #[error("{path}: requires the glTF extension {extension}, which is not supported: {advice}")]
     UnsupportedExtension {

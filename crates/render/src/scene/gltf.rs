@@ -15,6 +15,7 @@
 //! ([`super::Instances`]); every other placement is flattened into world triangles, in the
 //! order of the walk.
 
+use super::files::{Files, Uri};
 use super::{
     accessor, compression, extensions, tangents, Instance, MeshParts, Scene, SceneError, SceneParts,
 };
@@ -192,13 +193,9 @@ impl UvTransform {
     }
 }
 
-/// Loads a `.gltf` or `.glb` file.
-pub(super) fn load(path: &Path) -> Result<Scene, SceneError> {
-    let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
-        path: path.to_path_buf(),
-        element: "the file".into(),
-        source,
-    })?;
+/// Loads a `.gltf` or `.glb` file, reading the files it names through `files`.
+pub(super) fn load(path: &Path, files: &Files) -> Result<Scene, SceneError> {
+    let bytes = files.read_scene()?;
     let gltf_err = |source| SceneError::Gltf {
         path: path.to_path_buf(),
         source,
@@ -237,15 +234,16 @@ pub(super) fn load(path: &Path) -> Result<Scene, SceneError> {
         "asset": raw.get("asset").cloned().unwrap_or_default(),
         "buffers": raw.get("buffers").cloned().unwrap_or_default(),
     });
-    let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+    let base = files.folder().to_path_buf();
     let fallbacks = compression::fallback_buffers(&raw);
-    let mut buffers = load_buffers(path, &base, &read(buffer_list)?, blob, &fallbacks)?;
-    compression::decode(path, &mut raw, &mut buffers)?;
+    let mut buffers = load_buffers(path, files, &read(buffer_list)?, blob, &fallbacks)?;
+    compression::decode(path, &mut raw, &mut buffers, files)?;
     let document = read(raw)?;
     check_views(path, &document, &buffers, &fallbacks)?;
     let mut loader = Loader {
         path,
         base,
+        files,
         buffers,
         parts: SceneParts {
             source: path.to_path_buf(),
@@ -327,36 +325,6 @@ fn mesh_label(mesh: &gltf::Mesh) -> String {
     }
 }
 
-/// Whether the gltf crate can decode `uri` without panicking: it unwraps the UTF-8 decoding
-/// of percent-escaped relative URIs, so a URI whose escapes decode to invalid UTF-8 (`%FF`)
-/// must be rejected first.
-fn uri_is_decodable(uri: &str) -> bool {
-    if uri.contains(':') {
-        return true;
-    }
-    let b = uri.as_bytes();
-    let mut out = Vec::with_capacity(b.len());
-    let mut i = 0;
-    while i < b.len() {
-        let hex = |c: u8| (c as char).to_digit(16);
-        match (
-            b[i],
-            b.get(i + 1).copied().and_then(hex),
-            b.get(i + 2).copied().and_then(hex),
-        ) {
-            (b'%', Some(h), Some(l)) => {
-                out.push((h * 16 + l) as u8);
-                i += 3;
-            }
-            (c, _, _) => {
-                out.push(c);
-                i += 1;
-            }
-        }
-    }
-    std::str::from_utf8(&out).is_ok()
-}
-
 /// Describes where a URI points, for messages.
 fn uri_label(base: &Path, uri: &str) -> String {
     if uri.starts_with("data:") {
@@ -368,9 +336,11 @@ fn uri_label(base: &Path, uri: &str) -> String {
 
 /// Loads every buffer of `document` (external files, data URIs, the GLB binary chunk), except
 /// the meshopt fallback buffers `fallbacks`, which are placeholders without data (left empty).
+/// Each holds exactly its `byteLength` bytes: a file is checked to be at least that long
+/// before they are reserved, and nothing past them is read.
 fn load_buffers(
     path: &Path,
-    base: &Path,
+    files: &Files,
     document: &gltf::Document,
     mut blob: Option<Vec<u8>>,
     fallbacks: &[usize],
@@ -381,42 +351,38 @@ fn load_buffers(
             buffers.push(gltf::buffer::Data(Vec::new()));
             continue;
         }
-        let element = match buffer.source() {
-            gltf::buffer::Source::Bin => format!("buffer {} (GLB binary chunk)", buffer.index()),
+        let length = buffer.length();
+        let (element, data) = match buffer.source() {
+            gltf::buffer::Source::Bin => {
+                let element = format!("buffer {} (GLB binary chunk)", buffer.index());
+                let data = blob.take().ok_or_else(|| {
+                    SceneError::invalid(path, &element, "the GLB file has no binary chunk")
+                })?;
+                (element, data)
+            }
             gltf::buffer::Source::Uri(uri) => {
-                format!("buffer {} ({})", buffer.index(), uri_label(base, uri))
+                let element = format!(
+                    "buffer {} ({})",
+                    buffer.index(),
+                    uri_label(files.folder(), uri)
+                );
+                let data = match files.uri(uri, &format!("buffer {}", buffer.index()))? {
+                    Uri::Data(bytes, _) => bytes,
+                    Uri::File(file) => files.read_prefix(&file, length as u64, &element)?,
+                };
+                (element, data)
             }
         };
-        if let gltf::buffer::Source::Uri(uri) = buffer.source() {
-            if !uri_is_decodable(uri) {
-                return Err(SceneError::invalid(
-                    path,
-                    element,
-                    "URI escapes are not UTF-8",
-                ));
-            }
-        }
-        let data = gltf::buffer::Data::from_source_and_blob(buffer.source(), Some(base), &mut blob)
-            .map_err(|e| match e {
-                gltf::Error::Io(source) => SceneError::Io {
-                    path: path.to_path_buf(),
-                    element: element.clone(),
-                    source,
-                },
-                e => SceneError::invalid(path, &element, e.to_string()),
-            })?;
-        if data.len() < buffer.length() {
+        if data.len() < length {
             return Err(SceneError::invalid(
                 path,
                 element,
-                format!(
-                    "holds {} bytes but byteLength is {}",
-                    data.len(),
-                    buffer.length()
-                ),
+                format!("holds {} bytes but byteLength is {length}", data.len()),
             ));
         }
-        buffers.push(data);
+        let mut data = data;
+        data.truncate(length);
+        buffers.push(gltf::buffer::Data(data));
     }
     Ok(buffers)
 }
@@ -462,6 +428,8 @@ fn check_views(
 struct Loader<'a> {
     path: &'a Path,
     base: PathBuf,
+    /// Reads the files the scene names (images), inside its folder.
+    files: &'a Files<'a>,
     buffers: Vec<gltf::buffer::Data>,
     parts: SceneParts,
     /// Decoded textures by (image index, colour space).
@@ -791,6 +759,11 @@ impl Loader<'_> {
         count: Option<usize>,
     ) -> Result<Vec<[f32; N]>, SceneError> {
         let element = format!("{element}, {name} (accessor {})", accessor.index());
+        // What the values will take, charged before they are read (the accessor itself is
+        // checked against its bufferView by the read).
+        self.files
+            .charge_expanded((accessor.count() as u64).saturating_mul(4 * N as u64))
+            .map_err(|r| self.bad(&element, r))?;
         let values = accessor::read::<N>(accessor, &self.buffers, allowed)
             .map_err(|r| self.bad(&element, r))?;
         match count {
@@ -823,6 +796,10 @@ impl Loader<'_> {
         if count == 0 {
             return Err(self.bad(element, "count is 0"));
         }
+        // The indices will be read as 32-bit values.
+        self.files
+            .charge_expanded((count as u64).saturating_mul(4))
+            .map_err(|r| self.bad(&element, r))?;
         let Some(view) = accessor.view() else {
             return Err(self.bad(element, "has no bufferView"));
         };
@@ -1625,21 +1602,39 @@ impl Loader<'_> {
                 view.index()
             ),
         };
-        if let gltf::image::Source::Uri { uri, .. } = image.source() {
-            if !uri_is_decodable(uri) {
-                return Err(self.bad(element, "URI escapes are not UTF-8"));
+        let (bytes, mime) = match image.source() {
+            gltf::image::Source::Uri { uri, mime_type } => {
+                match self
+                    .files
+                    .uri(uri, &format!("{material}, image {}", image.index()))?
+                {
+                    Uri::Data(bytes, media) => (bytes, media.or(mime_type.map(str::to_string))),
+                    Uri::File(file) => (
+                        self.files.read(&file, &element)?,
+                        mime_type.map(str::to_string),
+                    ),
+                }
             }
-        }
-        let data = gltf::image::Data::from_source(image.source(), Some(&self.base), &self.buffers)
-            .map_err(|e| match e {
-                gltf::Error::Io(source) => SceneError::Io {
-                    path: self.path.to_path_buf(),
-                    element: element.clone(),
-                    source,
-                },
-                e => self.bad(&element, e.to_string()),
-            })?;
-        let texture = decode_image(&data, space)
+            gltf::image::Source::View { view, mime_type } => {
+                let bytes = self
+                    .buffers
+                    .get(view.buffer().index())
+                    .and_then(|b| b.get(view.offset()..view.offset().checked_add(view.length())?))
+                    .ok_or_else(|| self.bad(&element, "its bufferView exceeds its buffer"))?;
+                (bytes.to_vec(), Some(mime_type.to_string()))
+            }
+        };
+        // glTF images are PNG or JPEG: by their content, else by their MIME type.
+        let format = match (image::guess_format(&bytes), mime.as_deref()) {
+            (Ok(f @ (image::ImageFormat::Png | image::ImageFormat::Jpeg)), _) => f,
+            (Err(_), Some("image/png")) => image::ImageFormat::Png,
+            (Err(_), Some("image/jpeg")) => image::ImageFormat::Jpeg,
+            _ => return Err(self.bad(&element, "is not a PNG or JPEG image")),
+        };
+        let decoded = streaks_image::input::decode_image(&bytes, Some(format))
+            .map_err(|reason| self.bad(&element, reason))?;
+        drop(bytes);
+        let texture = decode_image(decoded, space)
             .ok_or_else(|| self.bad(&element, "pixel data does not match its size"))?;
         let id = self.parts.textures.len() as TextureId;
         self.parts.textures.push(texture);
@@ -1688,14 +1683,15 @@ fn triangulate(mode: Mode, idx: &[u32]) -> Vec<[u32; 3]> {
     }
 }
 
-/// Converts decoded glTF image data to a linear RGBA texture.
-fn decode_image(data: &gltf::image::Data, space: ColorSpace) -> Option<Texture> {
-    use gltf::image::Format;
-    let p = &data.pixels;
-    // 8-bit images stay bytes (RGBA8); grey (and grey-alpha) images replicate their value, as
-    // image viewers do.
-    let rgba8 = |channels: usize| -> Vec<u8> {
-        p.chunks_exact(channels)
+/// Converts a decoded image to a linear RGBA texture: 8-bit images stay bytes (RGBA8), others
+/// become floats (16-bit values over 65535); grey (and grey-alpha) images replicate their
+/// value, as image viewers do.
+fn decode_image(image: image::DynamicImage, space: ColorSpace) -> Option<Texture> {
+    use image::DynamicImage as D;
+    let (width, height) = (image.width(), image.height());
+    let rgba8 = |bytes: &[u8], channels: usize| -> Vec<u8> {
+        bytes
+            .chunks_exact(channels)
             .flat_map(|c| match channels {
                 1 => [c[0], c[0], c[0], 255],
                 2 => [c[0], c[0], c[0], c[1]],
@@ -1704,29 +1700,25 @@ fn decode_image(data: &gltf::image::Data, space: ColorSpace) -> Option<Texture> 
             })
             .collect()
     };
-    let u16s = |c: &[u8]| -> Vec<f32> {
-        c.chunks_exact(2)
-            .map(|b| f32::from(u16::from_ne_bytes([b[0], b[1]])) / 65535.0)
-            .collect()
+    let u16s = |v: &[u16]| {
+        v.iter()
+            .map(|&x| f32::from(x) / 65535.0)
+            .collect::<Vec<_>>()
     };
-    let f32s = |c: &[u8]| -> Vec<f32> {
-        c.chunks_exact(4)
-            .map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]))
-            .collect()
+    let (values, channels): (Vec<f32>, usize) = match image {
+        D::ImageLuma8(i) => return Texture::from_rgba8(width, height, &rgba8(&i, 1), space),
+        D::ImageLumaA8(i) => return Texture::from_rgba8(width, height, &rgba8(&i, 2), space),
+        D::ImageRgb8(i) => return Texture::from_rgba8(width, height, &rgba8(&i, 3), space),
+        D::ImageRgba8(i) => return Texture::from_rgba8(width, height, &i, space),
+        D::ImageLuma16(i) => (u16s(&i), 1),
+        D::ImageLumaA16(i) => (u16s(&i), 2),
+        D::ImageRgb16(i) => (u16s(&i), 3),
+        D::ImageRgba16(i) => (u16s(&i), 4),
+        D::ImageRgb32F(i) => (i.into_raw(), 3),
+        D::ImageRgba32F(i) => (i.into_raw(), 4),
+        other => (other.to_rgba32f().into_raw(), 4),
     };
-    let (values, channels): (Vec<f32>, usize) = match data.format {
-        Format::R8 => return Texture::from_rgba8(data.width, data.height, &rgba8(1), space),
-        Format::R8G8 => return Texture::from_rgba8(data.width, data.height, &rgba8(2), space),
-        Format::R8G8B8 => return Texture::from_rgba8(data.width, data.height, &rgba8(3), space),
-        Format::R8G8B8A8 => return Texture::from_rgba8(data.width, data.height, p, space),
-        Format::R16 => (u16s(p), 1),
-        Format::R16G16 => (u16s(p), 2),
-        Format::R16G16B16 => (u16s(p), 3),
-        Format::R16G16B16A16 => (u16s(p), 4),
-        Format::R32G32B32FLOAT => (f32s(p), 3),
-        Format::R32G32B32A32FLOAT => (f32s(p), 4),
-    };
-    let rgba = values
+    let texels = values
         .chunks_exact(channels)
         .map(|c| match channels {
             1 => Vec4::new(c[0], c[0], c[0], 1.0),
@@ -1735,7 +1727,7 @@ fn decode_image(data: &gltf::image::Data, space: ColorSpace) -> Option<Texture> 
             _ => Vec4::new(c[0], c[1], c[2], c[3]),
         })
         .collect();
-    Texture::from_rgba(data.width, data.height, rgba, space)
+    Texture::from_rgba(width, height, texels, space)
 }
 
 #[cfg(test)]
@@ -2077,7 +2069,6 @@ mod tests {
         std::fs::write(&path, serde_json::to_vec(&doc).unwrap()).unwrap();
         let err = Scene::load(&path).unwrap_err().to_string();
         assert!(err.contains("buffer 0") && err.contains("UTF-8"), "{err}");
-        assert!(uri_is_decodable("a%20b.bin") && uri_is_decodable("%zz.bin"));
     }
 
     #[test]

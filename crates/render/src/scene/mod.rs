@@ -109,6 +109,13 @@
 //!   emission. A missing MTL file is a warning (every material becomes grey diffuse). OBJ has no
 //!   cameras or punctual lights, and no normal maps (`map_Bump` is a warning).
 //!
+//! # Files a scene names
+//!
+//! Every buffer, image, material library and texture map a scene names is read through the
+//! `files` module: inside the scene file's folder unless [`LoadOptions::allow_outside`],
+//! regular files only, no more bytes than needed, and counts, decoded sizes and image sizes
+//! checked before memory is reserved (see [`LoadOptions`]).
+//!
 //! # Ray queries
 //!
 //! [`Scene::intersect`] and [`Scene::occluded`] go through [`Accel`] (and, when the scene has
@@ -121,6 +128,7 @@ mod accessor;
 mod compression;
 mod error;
 pub mod extensions;
+mod files;
 mod gltf;
 mod instances;
 mod mesh;
@@ -128,6 +136,7 @@ mod obj;
 mod tangents;
 
 pub use error::SceneError;
+pub use files::LoadOptions;
 pub use instances::{Instance, InstancedMesh, Instances};
 pub use mesh::MeshParts;
 
@@ -232,16 +241,25 @@ pub struct SceneParts {
 }
 
 impl Scene {
-    /// Loads a scene file, choosing the loader by extension: `.gltf` and `.glb` (glTF 2.0) or
-    /// `.obj` (with its MTL), case-insensitively.
+    /// Loads a scene file with the default [`LoadOptions`] (only files inside its folder),
+    /// choosing the loader by extension: `.gltf` and `.glb` (glTF 2.0) or `.obj` (with its
+    /// MTL), case-insensitively.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        Self::load_with(path, &LoadOptions::default())
+    }
+
+    /// Loads a scene file as [`Scene::load`] does, reading what `options` allow: the files it
+    /// names resolve inside its folder unless [`LoadOptions::allow_outside`], only regular
+    /// files are read, and sizes and decoded data are limited (see [`LoadOptions`]).
+    pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
         let ext = path
             .extension()
             .and_then(|e| e.to_str())
             .map(str::to_ascii_lowercase);
+        let files = files::Files::new(path, options);
         match ext.as_deref() {
-            Some("gltf" | "glb") => gltf::load(path),
-            Some("obj") => obj::load(path),
+            Some("gltf" | "glb") => gltf::load(path, &files),
+            Some("obj") => obj::load(path, &files),
             _ => Err(SceneError::UnsupportedFormat {
                 path: path.to_path_buf(),
             }),

@@ -4,47 +4,80 @@
 //! normalised blinn_phong with shininess `Ns` (default 1); otherwise Lambertian `Kd`, with
 //! `map_Kd` (sRGB) multiplying it. `Ke` is emitted radiance. A missing or unreadable MTL file is
 //! a warning: every material becomes the default grey diffuse (albedo 0.5), as do faces without
-//! a material. OBJ texture coordinates have v pointing up; they are stored as `(u, 1 - v)` to
+//! a material. An MTL file or texture map outside the OBJ's folder, or not a regular file, is
+//! an error (see the `files` module). OBJ texture coordinates have v pointing up; they are stored as `(u, 1 - v)` to
 //! match the glTF convention of [`crate::texture::Texture`]. Bump and normal maps (`map_Bump`,
 //! `bump`) are not read: a warning names the material.
 
+use super::files::Files;
 use super::{Scene, SceneError, SceneParts};
 use crate::material::{Alpha, Material, PaperModel, Reflectance};
 use crate::texture::{ColorSpace, Texture, TextureId, TextureRef};
 use glam::{Vec2, Vec3};
+use std::cell::RefCell;
+use std::io::ErrorKind;
 use std::path::Path;
 
 /// Albedo of the material used where the MTL gives none.
 const DEFAULT_GREY: f32 = 0.5;
 
-/// Loads an `.obj` file and its MTL.
-pub(super) fn load(path: &Path) -> Result<Scene, SceneError> {
+/// Loads an `.obj` file and its MTL, reading them through `files`: the MTL and the texture
+/// maps resolve inside the OBJ's folder, and a refused one (outside the folder, not a
+/// regular file, too large) is an error; a missing or unreadable one is a warning.
+pub(super) fn load(path: &Path, files: &Files) -> Result<Scene, SceneError> {
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
         ..Default::default()
     };
-    let (models, mtl) = tobj::load_obj(path, &options).map_err(|source| match source {
-        tobj::LoadError::OpenFileFailed | tobj::LoadError::ReadError => SceneError::Io {
-            path: path.to_path_buf(),
-            element: "the file".into(),
-            source: std::io::Error::other(source.to_string()),
-        },
-        source => SceneError::Obj {
-            path: path.to_path_buf(),
-            source,
-        },
+    let bytes = files.read_scene()?;
+    // What reading the material libraries met: refusals fail the load, the rest are warnings.
+    let refused: RefCell<Option<SceneError>> = RefCell::new(None);
+    let unreadable: RefCell<Vec<String>> = RefCell::new(Vec::new());
+    let loaded = tobj::load_obj_buf(&mut bytes.as_slice(), &options, |name| {
+        let element = format!("mtllib {:?}", name.display().to_string());
+        let read = files
+            .resolve(name, &element)
+            .and_then(|file| files.read(&file, &element));
+        match read {
+            Ok(bytes) => tobj::load_mtl_buf(&mut bytes.as_slice()),
+            Err(SceneError::Io { source, .. })
+                if !matches!(
+                    source.kind(),
+                    ErrorKind::InvalidInput | ErrorKind::InvalidData
+                ) =>
+            {
+                unreadable.borrow_mut().push(format!("{element}: {source}"));
+                Err(tobj::LoadError::OpenFileFailed)
+            }
+            Err(e) => {
+                refused.borrow_mut().get_or_insert(e);
+                Err(tobj::LoadError::OpenFileFailed)
+            }
+        }
+    });
+    if let Some(e) = refused.into_inner() {
+        return Err(e);
+    }
+    let (models, mtl) = loaded.map_err(|source| SceneError::Obj {
+        path: path.to_path_buf(),
+        source,
     })?;
     let mut parts = SceneParts {
         source: path.to_path_buf(),
         ..SceneParts::default()
     };
-    let base = path.parent().unwrap_or(Path::new("."));
     let mtl = match mtl {
         Ok(m) => m,
         Err(e) => {
+            let unreadable = unreadable.into_inner();
+            let why = if unreadable.is_empty() {
+                e.to_string()
+            } else {
+                unreadable.join("; ")
+            };
             parts.warnings.push(format!(
-                "{}: material library not loaded ({e}); using grey diffuse",
+                "{}: material library not loaded ({why}); using grey diffuse",
                 path.display()
             ));
             Vec::new()
@@ -59,7 +92,7 @@ pub(super) fn load(path: &Path) -> Result<Scene, SceneError> {
                 m.name
             ));
         }
-        let material = convert_material(path, base, m, &mut parts.textures)?;
+        let material = convert_material(path, files, m, &mut parts.textures)?;
         parts.materials.push(material);
     }
     let default = parts.materials.len() as u32;
@@ -132,7 +165,7 @@ pub(super) fn load(path: &Path) -> Result<Scene, SceneError> {
 
 fn convert_material(
     path: &Path,
-    base: &Path,
+    files: &Files,
     m: &tobj::Material,
     textures: &mut Vec<Texture>,
 ) -> Result<Material, SceneError> {
@@ -157,7 +190,7 @@ fn convert_material(
     let emission = colour(m.emissive, "Ke")?;
     let kd_texture = match &m.diffuse_texture {
         Some(file) => Some(TextureRef::new(load_texture(
-            path, base, file, &element, textures,
+            path, files, file, &element, textures,
         )?)),
         None => None,
     };
@@ -195,23 +228,20 @@ fn convert_material(
     })
 }
 
+/// Decodes the `map_Kd` texture `file` of `material` (sRGB), read through `files`.
 fn load_texture(
     path: &Path,
-    base: &Path,
+    files: &Files,
     file: &str,
     material: &str,
     textures: &mut Vec<Texture>,
 ) -> Result<TextureId, SceneError> {
-    let file_path = base.join(file);
-    let element = format!("{material}, map_Kd {}", file_path.display());
-    let img = image::open(&file_path).map_err(|e| match e {
-        image::ImageError::IoError(source) => SceneError::Io {
-            path: path.to_path_buf(),
-            element: element.clone(),
-            source,
-        },
-        e => SceneError::invalid(path, &element, e.to_string()),
-    })?;
+    let element = format!("{material}, map_Kd {file:?}");
+    let file_path = files.resolve(Path::new(file), &element)?;
+    let bytes = files.read(&file_path, &element)?;
+    let img = streaks_image::input::decode_image(&bytes, image::ImageFormat::from_path(file).ok())
+        .map_err(|reason| SceneError::invalid(path, &element, reason))?;
+    drop(bytes);
     let rgba = img.to_rgba8();
     let texture = Texture::from_rgba8(rgba.width(), rgba.height(), rgba.as_raw(), ColorSpace::Srgb)
         .ok_or_else(|| SceneError::invalid(path, &element, "empty image"))?;
