@@ -272,21 +272,26 @@ fn supervise(args: &Args, target: &Target) -> Result<Vec<String>, String> {
             std::thread::sleep(Duration::from_millis(20));
         };
         let errors = std::fs::read_to_string(&log).unwrap_or_default();
+        found.extend(
+            errors
+                .lines()
+                .filter_map(|l| l.strip_prefix("found: "))
+                .map(str::to_owned),
+        );
+        let oom = errors.lines().find(|l| l.contains("memory allocation of"));
         let (kind, reason) = match status {
-            Some(s) if s.success() => break,
-            Some(s) if s.code() == Some(FOUND_EXIT) => {
-                found.extend(
-                    errors
-                        .lines()
-                        .filter_map(|l| l.strip_prefix("found: "))
-                        .map(str::to_owned),
-                );
-                break;
-            }
+            Some(s) if s.success() || s.code() == Some(FOUND_EXIT) => break,
             Some(s) if s.code() == Some(HANG_EXIT) => ("hang", last_lines(&errors)),
-            Some(s) if errors.contains("memory allocation of") => {
-                ("oom", format!("{}\n{}", describe(s), last_lines(&errors)))
-            }
+            Some(s) if oom.is_some() => (
+                "oom",
+                format!(
+                    "{} ({}, over the {} MiB limit)\n{}",
+                    oom.unwrap_or_default(),
+                    describe(s),
+                    args.memory_mib,
+                    last_lines(&errors)
+                ),
+            ),
             Some(s) => ("crash", format!("{}\n{}", describe(s), last_lines(&errors))),
             None => (
                 "hang",
@@ -321,9 +326,9 @@ fn describe(status: ExitStatus) -> String {
     format!("exited with {status}")
 }
 
-/// The last 30 lines of `text`.
+/// The last 30 lines of `text` but the findings the child listed.
 fn last_lines(text: &str) -> String {
-    let lines: Vec<&str> = text.lines().collect();
+    let lines: Vec<&str> = text.lines().filter(|l| !l.starts_with("found: ")).collect();
     lines[lines.len().saturating_sub(30)..].join("\n")
 }
 
@@ -470,8 +475,14 @@ fn child(args: &Args, target: &Target) -> Result<i32, String> {
         let place = info
             .location()
             .map_or_else(|| "unknown place".to_owned(), |l| l.to_string());
+        let payload = info.payload();
+        let message = payload
+            .downcast_ref::<&str>()
+            .map(|s| (*s).to_owned())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "a panic".to_owned());
         if let Ok(mut last) = LAST_PANIC.lock() {
-            *last = Some((place, info.to_string()));
+            *last = Some((place, message));
         }
     }));
     let timeout = Duration::from_secs_f64(args.timeout);
@@ -555,9 +566,6 @@ fn child(args: &Args, target: &Target) -> Result<i32, String> {
         corpus.len(),
         run.found.len()
     );
-    for f in &run.found {
-        eprintln!("found: {f}");
-    }
     Ok(if run.found.is_empty() { 0 } else { FOUND_EXIT })
 }
 
@@ -630,10 +638,17 @@ impl Runner<'_> {
                     .unwrap_or_else(|e| e.into_inner())
                     .take()
                     .unwrap_or_else(|| ("unknown place".into(), "a panic".into()));
-                if self.places.insert(place) {
-                    let path = save_artifact(self.target.name, "crash", data, &message);
-                    let line = format!("crash ({}): {}", first_line(&message), path.display());
+                if self.places.insert(place.clone()) {
+                    let reason = format!("panicked at {place}:\n{message}");
+                    let path = save_artifact(self.target.name, "crash", data, &reason);
+                    let line = format!(
+                        "crash (panicked at {place}: {}): {}",
+                        first_line(&message),
+                        path.display()
+                    );
                     println!("fuzz: {}: {line}", self.target.name);
+                    // Now, not at the end: the parent reads these even if this process dies.
+                    eprintln!("found: {line}");
                     self.found.push(line);
                 }
                 (None, false)

@@ -52,14 +52,18 @@ pub fn read_pfm(path: &Path) -> Result<GrayImage, ImageError> {
         return Err(err("scale must be a non-zero number".into()));
     }
     let data_start = pos + 1;
-    let mut img = GrayImage::new(width, height, 0.0).map_err(|e| err(e.to_string()))?;
-    let need = width * height * 4;
-    if bytes.len() < data_start + need {
+    // The pixels must be in the file before memory is reserved for them: a header alone can
+    // claim any size.
+    let have = bytes.len().saturating_sub(data_start);
+    let need = width.checked_mul(height).and_then(|n| n.checked_mul(4));
+    if need.is_none_or(|need| have < need) {
+        let expected = need.map_or_else(|| "more than can be addressed".into(), |n| n.to_string());
         return Err(err(format!(
-            "truncated data: {} bytes for {width}x{height}, expected {need}",
-            bytes.len().saturating_sub(data_start)
+            "truncated data: {have} bytes for {width}x{height}, expected {expected}"
         )));
     }
+    let need = need.unwrap_or_default();
+    let mut img = GrayImage::new(width, height, 0.0).map_err(|e| err(e.to_string()))?;
     let little = scale < 0.0;
     for (i, chunk) in bytes[data_start..data_start + need]
         .chunks_exact(4)
@@ -107,5 +111,18 @@ mod tests {
         std::fs::write(&p, b"Pf\n4 4\n-1.0\n\0\0").unwrap();
         assert!(read_pfm(&p).unwrap_err().to_string().contains("truncated"));
         assert!(read_pfm(&dir.path().join("missing.pfm")).is_err());
+    }
+
+    #[test]
+    fn a_size_the_file_does_not_hold_is_refused_before_allocating() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("x.pfm");
+        // 2^62 pixels: the size overflows any allocation; 40000 x 30000 (4.8 GB): allowed by
+        // the pixel limit but not backed by the 8 bytes that follow.
+        for header in ["Pf\n2147483648 2147483648\n-1.0\n", "Pf\n40000 30000\n-1.0\n"] {
+            std::fs::write(&p, [header.as_bytes(), &[0; 8]].concat()).unwrap();
+            let e = read_pfm(&p).unwrap_err().to_string();
+            assert!(e.contains("truncated data: 8 bytes"), "{e}");
+        }
     }
 }
