@@ -74,11 +74,18 @@ pub fn read_exr_channels(
     path: &Path,
     names: &[&str],
 ) -> Result<(u32, u32, Vec<Vec<f32>>), ImageError> {
-    let image =
-        exr::prelude::read_all_flat_layers_from_file(path).map_err(|source| ImageError::Exr {
+    // The decoder asserts some of its own invariants instead of returning an error, and a
+    // malformed file can break them (a tile whose level differs from the one being read
+    // fails `line should have been filtered`): such a panic is a malformed file too.
+    let read = std::panic::catch_unwind(|| exr::prelude::read_all_flat_layers_from_file(path))
+        .map_err(|panic| ImageError::Read {
             path: path.to_path_buf(),
-            source,
+            reason: format!("malformed EXR (the decoder failed: {})", panic_message(&*panic)),
         })?;
+    let image = read.map_err(|source| ImageError::Exr {
+        path: path.to_path_buf(),
+        source,
+    })?;
     for layer in &image.layer_data {
         let found: Option<Vec<Vec<f32>>> = names
             .iter()
@@ -99,6 +106,15 @@ pub fn read_exr_channels(
         path: path.to_path_buf(),
         what: format!("{} channels", names.join(", ")),
     })
+}
+
+/// The message of a caught panic.
+fn panic_message(panic: &(dyn std::any::Any + Send)) -> String {
+    panic
+        .downcast_ref::<&str>()
+        .map(|s| (*s).to_owned())
+        .or_else(|| panic.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "a panic".to_owned())
 }
 
 /// Reads three channels of an EXR as an RGB image (for example `R`, `G`, `B`).
@@ -196,5 +212,17 @@ mod tests {
         assert!(err.to_string().contains("channel R has 3 values"), "{err}");
         assert!(write_exr(&out, 0, 2, vec![("R", vec![])]).is_err());
         assert!(!out.exists());
+    }
+
+    #[test]
+    fn a_file_that_breaks_the_decoders_assertions_is_an_error() {
+        // Found by the exr fuzz target: a tiled file with a block of another level than the
+        // one read, which fails an assertion of the exr crate (in debug builds).
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("bad.exr");
+        let bytes = include_bytes!("../../../fuzz/regressions/exr/crash-tile-of-another-level");
+        std::fs::write(&p, bytes).unwrap();
+        let e = read_exr_rgb(&p).unwrap_err().to_string();
+        assert!(e.contains("malformed EXR") && e.contains("bad.exr"), "{e}");
     }
 }
