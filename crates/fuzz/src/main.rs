@@ -78,6 +78,13 @@ struct Args {
     /// Write the seed corpus into `corpus/` and exit.
     #[arg(long)]
     write_seeds: bool,
+    /// Shrink FILE, keeping its failure (the same panic place, or an abort or hang), for the
+    /// one target named; writes FILE.min.
+    #[arg(long, value_name = "FILE")]
+    minimize: Option<PathBuf>,
+    /// Seconds the minimisation may take.
+    #[arg(long, default_value_t = 120.0)]
+    minimize_seconds: f64,
     /// Print the folder DIR as one multi-file input whose main file is MAIN, and exit.
     #[arg(long, num_args = 2, value_names = ["DIR", "MAIN"])]
     pack: Vec<PathBuf>,
@@ -90,6 +97,9 @@ struct Args {
     /// Internal: the child skips the replay (a restart after a crash).
     #[arg(long, hide = true)]
     no_replay: bool,
+    /// Internal: the child saves no artifacts (minimisation trials).
+    #[arg(long, hide = true)]
+    no_save: bool,
 }
 
 fn main() {
@@ -149,8 +159,11 @@ fn run(args: Args) -> Result<i32, String> {
             names().join(", ")
         ));
     }
-    if !args.replay.is_empty() && chosen.len() != 1 {
-        return Err("--replay needs exactly one target".into());
+    if (!args.replay.is_empty() || args.minimize.is_some()) && chosen.len() != 1 {
+        return Err("--replay and --minimize need exactly one target".into());
+    }
+    if let Some(path) = &args.minimize {
+        return minimize(&args, chosen[0], path);
     }
     if !(args.seconds.is_finite() && args.seconds >= 0.0 && args.timeout > 0.0) {
         return Err("--seconds and --timeout must be positive numbers".into());
@@ -519,6 +532,7 @@ fn child(args: &Args, target: &Target) -> Result<i32, String> {
         places: HashSet::new(),
         found: Vec::new(),
         executed: 0,
+        save: !args.no_save,
     };
     let mut corpus: Vec<Vec<u8>> = Vec::new();
     for (path, data) in seeds {
@@ -610,6 +624,8 @@ struct Runner<'a> {
     found: Vec<String>,
     /// Inputs run.
     executed: u64,
+    /// Whether findings are saved as artifacts.
+    save: bool,
 }
 
 impl Runner<'_> {
@@ -638,9 +654,16 @@ impl Runner<'_> {
                     .unwrap_or_else(|e| e.into_inner())
                     .take()
                     .unwrap_or_else(|| ("unknown place".into(), "a panic".into()));
-                if self.places.insert(place.clone()) {
+                // One finding per place and kind of message (the dataset target's panics all
+                // come from one place, its message names the command's).
+                let key = format!("{place} {}", kind_of(&first_line(&message)));
+                if self.places.insert(key) {
                     let reason = format!("panicked at {place}:\n{message}");
-                    let path = save_artifact(self.target.name, "crash", data, &reason);
+                    let path = if self.save {
+                        save_artifact(self.target.name, "crash", data, &reason)
+                    } else {
+                        PathBuf::new()
+                    };
                     let line = format!(
                         "crash (panicked at {place}: {}): {}",
                         first_line(&message),
@@ -657,29 +680,120 @@ impl Runner<'_> {
     }
 }
 
-/// An error message without what varies with the input: digits, quoted parts, and anything
-/// past 160 characters.
+/// An error message without what varies with the input: what follows its first quote (a
+/// name or a value from the input), its digits, and anything past 160 characters.
 fn kind_of(message: &str) -> String {
     let mut kind = String::new();
-    let mut quote = None;
     for c in message.chars() {
-        match quote {
-            Some(q) if c == q => quote = None,
-            Some(_) => {}
-            None if matches!(c, '"' | '`' | '\'') => {
-                quote = Some(c);
-                kind.push('…');
-            }
-            None if c.is_ascii_digit() => {
-                if !kind.ends_with('#') {
-                    kind.push('#');
-                }
-            }
-            None => kind.push(c),
-        }
-        if kind.len() >= 160 {
+        if matches!(c, '"' | '`' | '\'') || kind.len() >= 160 {
             break;
+        }
+        if !c.is_ascii_digit() {
+            kind.push(c);
+        } else if !kind.ends_with('#') {
+            kind.push('#');
         }
     }
     kind
+}
+
+/// How an input fails: `crash at PLACE`, `oom`, `hang`, or `None` when it does not.
+fn failure(exe: &Path, args: &Args, target: &Target, scratch: &Path, data: &[u8]) -> Option<String> {
+    let input = scratch.join("input");
+    std::fs::write(&input, data).ok()?;
+    let out = Command::new(exe)
+        .arg("--child")
+        .arg(target.name)
+        .arg("--scratch")
+        .arg(scratch)
+        .args(["--no-save", "--replay"])
+        .arg(&input)
+        .arg("--timeout")
+        .arg(args.timeout.to_string())
+        .arg("--memory-mib")
+        .arg(args.memory_mib.to_string())
+        .stdin(Stdio::null())
+        .output()
+        .ok()?;
+    let errors = String::from_utf8_lossy(&out.stderr);
+    if out.status.success() {
+        return None;
+    }
+    if out.status.code() == Some(HANG_EXIT) {
+        return Some("hang".into());
+    }
+    if errors.contains("memory allocation of") {
+        return Some("oom".into());
+    }
+    let place = errors
+        .lines()
+        .find_map(|l| l.split("panicked at ").nth(1))
+        .and_then(|rest| rest.split(": ").next())
+        .unwrap_or("an abort");
+    Some(format!("crash at {place}"))
+}
+
+/// Shrinks the input at `path` while it fails as it does ([`failure`]): drops the extra
+/// files of a multi-file input one by one, then ranges of bytes from half a file down to one
+/// byte; writes the result beside it as `<path>.min`.
+fn minimize(args: &Args, target: &Target, path: &Path) -> Result<i32, String> {
+    let exe = std::env::current_exe().map_err(|e| format!("cannot find this executable: {e}"))?;
+    let scratch = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let mut best = std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let Some(goal) = failure(&exe, args, target, scratch.path(), &best) else {
+        return Err(format!("{} does not fail in target {}", path.display(), target.name));
+    };
+    println!("fuzz: minimising {} ({} bytes, {goal})", path.display(), best.len());
+    let deadline = Instant::now() + Duration::from_secs_f64(args.minimize_seconds);
+    let keeps = |candidate: &[u8]| {
+        Instant::now() < deadline
+            && failure(&exe, args, target, scratch.path(), candidate).as_ref() == Some(&goal)
+    };
+    let mut parts = if target.multi_file {
+        files::split(&best)
+    } else {
+        vec![files::Part { name: None, bytes: best.clone() }]
+    };
+    let joined = |parts: &[files::Part]| {
+        if target.multi_file {
+            files::join(parts)
+        } else {
+            parts[0].bytes.clone()
+        }
+    };
+    let mut i = 1;
+    while i < parts.len() {
+        let mut fewer = parts.clone();
+        fewer.remove(i);
+        if keeps(&joined(&fewer)) {
+            parts = fewer;
+        } else {
+            i += 1;
+        }
+    }
+    for p in 0..parts.len() {
+        let mut chunk = parts[p].bytes.len().div_ceil(2).max(1);
+        loop {
+            let mut at = 0;
+            while at < parts[p].bytes.len() {
+                let mut shorter = parts.clone();
+                let end = (at + chunk).min(shorter[p].bytes.len());
+                shorter[p].bytes.drain(at..end);
+                if keeps(&joined(&shorter)) {
+                    parts = shorter;
+                } else {
+                    at += chunk;
+                }
+            }
+            if chunk == 1 {
+                break;
+            }
+            chunk = chunk.div_ceil(2);
+        }
+    }
+    best = joined(&parts);
+    let out = PathBuf::from(format!("{}.min", path.display()));
+    std::fs::write(&out, &best).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+    println!("fuzz: {} ({} bytes, {goal})", out.display(), best.len());
+    Ok(0)
 }

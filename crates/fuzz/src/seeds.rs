@@ -318,6 +318,7 @@ pub fn write_seeds(repo: &Path, corpus: &Path) -> io::Result<()> {
     let exr_path = scratch.path().join("a.exr");
     streaks_image::exr::write_exr_rgb(&exr_path, &rgb).map_err(io::Error::other)?;
     put(corpus, "exr", "rgb-3x2", &std::fs::read(&exr_path)?)?;
+    write_exr_seeds(scratch.path(), corpus)?;
     let gray = streaks_image::GrayImage::from_vec(3, 2, vec![0.0, 1.5, f32::INFINITY, 4.0, 5.0, 6.0])
         .map_err(io::Error::other)?;
     let pfm_path = scratch.path().join("a.pfm");
@@ -378,6 +379,53 @@ pub fn write_seeds(repo: &Path, corpus: &Path) -> io::Result<()> {
             put(corpus, "dataset", "dataset-json-only", &info)?;
         }
         Err(e) => eprintln!("no dataset seed: {e}"),
+    }
+    Ok(())
+}
+
+/// EXRs of every compression the `exr` crate writes, in scan lines and in tiles, with half,
+/// float and integer samples.
+fn write_exr_seeds(scratch: &Path, corpus: &Path) -> io::Result<()> {
+    use exr::prelude::*;
+    let compressions = [
+        ("uncompressed", Compression::Uncompressed),
+        ("rle", Compression::RLE),
+        ("zip1", Compression::ZIP1),
+        ("zip16", Compression::ZIP16),
+        ("piz", Compression::PIZ),
+        ("pxr24", Compression::PXR24),
+        ("b44", Compression::B44),
+    ];
+    for (name, compression) in compressions {
+        for (blocks_name, blocks) in [
+            ("lines", Blocks::ScanLines),
+            ("tiles", Blocks::Tiles(Vec2(2, 2))),
+        ] {
+            let encoding = Encoding {
+                compression,
+                blocks,
+                line_order: LineOrder::Increasing,
+            };
+            let layer = Layer::new(
+                (5, 3),
+                LayerAttributes::named("main"),
+                encoding,
+                SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
+                    (f16::from_f32(x as f32 * 0.5), y as f32 * 2.0, (x + y) as u32)
+                }),
+            );
+            let path = scratch.join("seed.exr");
+            Image::from_layer(layer)
+                .write()
+                .to_file(&path)
+                .map_err(io::Error::other)?;
+            put(
+                corpus,
+                "exr",
+                &format!("{name}-{blocks_name}"),
+                &std::fs::read(&path)?,
+            )?;
+        }
     }
     Ok(())
 }

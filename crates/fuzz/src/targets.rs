@@ -453,7 +453,22 @@ pub fn dataset(data: &[u8]) -> Outcome {
         match status.code() {
             Some(0) => Ok(()),
             Some(1) => Err(stderr.lines().last().unwrap_or("").to_owned()),
-            _ => panic!("streaks dataset index failed ({status}):\n{}", tail(&stderr)),
+            _ => {
+                // The command's own panic, if any, first: the runner tells findings apart by it.
+                let lines: Vec<&str> = stderr.lines().collect();
+                let cause = lines
+                    .iter()
+                    .position(|l| l.contains("panicked at "))
+                    .map(|i| {
+                        let place = lines[i].split("panicked at ").nth(1).unwrap_or("");
+                        format!("panicked at {place} {}", lines.get(i + 1).unwrap_or(&""))
+                    })
+                    .unwrap_or_else(|| status.to_string());
+                panic!(
+                    "streaks dataset index {cause}\n{}",
+                    tail(&stderr)
+                )
+            }
         }
     })
 }
