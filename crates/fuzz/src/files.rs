@@ -176,7 +176,16 @@ mod tests {
 
     #[test]
     fn unsafe_names_are_not_written() {
-        for bad in ["", "../x", "/etc/x", "a//b", "./a", "a\\b", "a/../../b", "é"] {
+        for bad in [
+            "",
+            "../x",
+            "/etc/x",
+            "a//b",
+            "./a",
+            "a\\b",
+            "a/../../b",
+            "é",
+        ] {
             assert!(!is_safe_name(bad), "{bad:?}");
         }
         assert!(is_safe_name("textures/wood 2.png"));

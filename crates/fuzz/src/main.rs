@@ -147,9 +147,8 @@ fn run(args: Args) -> Result<i32, String> {
         args.targets
             .iter()
             .map(|n| {
-                targets::find(n).ok_or_else(|| {
-                    format!("no target {n} (the targets: {})", names().join(", "))
-                })
+                targets::find(n)
+                    .ok_or_else(|| format!("no target {n} (the targets: {})", names().join(", ")))
             })
             .collect::<Result<_, _>>()?
     };
@@ -176,6 +175,9 @@ fn names() -> Vec<&'static str> {
     targets::TARGETS.iter().map(|t| t.name).collect()
 }
 
+/// A target's findings (the lines describing them), or why it could not run.
+type Findings = Result<Vec<String>, String>;
+
 /// Runs each target in a child process, `--jobs` at once; the exit status (1 if anything was
 /// found).
 fn parent(args: &Args, chosen: &[&'static Target]) -> Result<i32, String> {
@@ -185,7 +187,7 @@ fn parent(args: &Args, chosen: &[&'static Target]) -> Result<i32, String> {
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
         .clamp(1, chosen.len());
     let next = AtomicUsize::new(0);
-    let results: Mutex<Vec<(&str, Result<Vec<String>, String>)>> = Mutex::new(Vec::new());
+    let results: Mutex<Vec<(&str, Findings)>> = Mutex::new(Vec::new());
     std::thread::scope(|scope| {
         for _ in 0..jobs {
             scope.spawn(|| loop {
@@ -222,7 +224,7 @@ fn parent(args: &Args, chosen: &[&'static Target]) -> Result<i32, String> {
 
 /// Runs one target's child until its time is used, restarting it after a death; the
 /// findings (saved artifacts).
-fn supervise(args: &Args, target: &Target) -> Result<Vec<String>, String> {
+fn supervise(args: &Args, target: &Target) -> Findings {
     let scratch = tempfile::Builder::new()
         .prefix(&format!("streaks-fuzz-{}-", target.name))
         .tempdir()
@@ -237,7 +239,9 @@ fn supervise(args: &Args, target: &Target) -> Result<Vec<String>, String> {
         let seconds = if restart == 0 {
             args.seconds
         } else {
-            deadline.saturating_duration_since(Instant::now()).as_secs_f64()
+            deadline
+                .saturating_duration_since(Instant::now())
+                .as_secs_f64()
         };
         let mut cmd = Command::new(&exe);
         cmd.arg("--child")
@@ -698,7 +702,13 @@ fn kind_of(message: &str) -> String {
 }
 
 /// How an input fails: `crash at PLACE`, `oom`, `hang`, or `None` when it does not.
-fn failure(exe: &Path, args: &Args, target: &Target, scratch: &Path, data: &[u8]) -> Option<String> {
+fn failure(
+    exe: &Path,
+    args: &Args,
+    target: &Target,
+    scratch: &Path,
+    data: &[u8],
+) -> Option<String> {
     let input = scratch.join("input");
     std::fs::write(&input, data).ok()?;
     let out = Command::new(exe)
@@ -739,11 +749,20 @@ fn failure(exe: &Path, args: &Args, target: &Target, scratch: &Path, data: &[u8]
 fn minimize(args: &Args, target: &Target, path: &Path) -> Result<i32, String> {
     let exe = std::env::current_exe().map_err(|e| format!("cannot find this executable: {e}"))?;
     let scratch = tempfile::tempdir().map_err(|e| e.to_string())?;
-    let mut best = std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let mut best =
+        std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
     let Some(goal) = failure(&exe, args, target, scratch.path(), &best) else {
-        return Err(format!("{} does not fail in target {}", path.display(), target.name));
+        return Err(format!(
+            "{} does not fail in target {}",
+            path.display(),
+            target.name
+        ));
     };
-    println!("fuzz: minimising {} ({} bytes, {goal})", path.display(), best.len());
+    println!(
+        "fuzz: minimising {} ({} bytes, {goal})",
+        path.display(),
+        best.len()
+    );
     let deadline = Instant::now() + Duration::from_secs_f64(args.minimize_seconds);
     let keeps = |candidate: &[u8]| {
         Instant::now() < deadline
@@ -752,7 +771,10 @@ fn minimize(args: &Args, target: &Target, path: &Path) -> Result<i32, String> {
     let mut parts = if target.multi_file {
         files::split(&best)
     } else {
-        vec![files::Part { name: None, bytes: best.clone() }]
+        vec![files::Part {
+            name: None,
+            bytes: best.clone(),
+        }]
     };
     let joined = |parts: &[files::Part]| {
         if target.multi_file {

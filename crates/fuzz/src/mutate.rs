@@ -239,8 +239,7 @@ fn number_spans(bytes: &[u8]) -> Vec<(usize, usize)> {
             while end < bytes.len()
                 && (bytes[end].is_ascii_digit()
                     || matches!(bytes[end], b'.' | b'e' | b'E')
-                    || (matches!(bytes[end], b'+' | b'-')
-                        && matches!(bytes[end - 1], b'e' | b'E')))
+                    || (matches!(bytes[end], b'+' | b'-') && matches!(bytes[end - 1], b'e' | b'E')))
             {
                 end += 1;
             }

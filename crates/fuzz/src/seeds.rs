@@ -217,9 +217,10 @@ pub fn write_seeds(repo: &Path, corpus: &Path) -> io::Result<()> {
     let image_offset = glb_bin.len();
     glb_bin.extend(&tex);
     let mut glb_views = views.clone();
-    glb_views.as_array_mut().expect("views").push(
-        json!({"buffer": 0, "byteOffset": image_offset, "byteLength": tex.len()}),
-    );
+    glb_views
+        .as_array_mut()
+        .expect("views")
+        .push(json!({"buffer": 0, "byteOffset": image_offset, "byteLength": tex.len()}));
     let glb_doc = document(
         json!({"byteLength": glb_bin.len()}),
         json!({"bufferView": 6, "mimeType": "image/png"}),
@@ -273,7 +274,9 @@ pub fn write_seeds(repo: &Path, corpus: &Path) -> io::Result<()> {
         corpus,
         "png",
         "gray8",
-        &png(&image::GrayImage::from_fn(4, 1, |x, _| image::Luma([x as u8 * 60]))),
+        &png(&image::GrayImage::from_fn(4, 1, |x, _| {
+            image::Luma([x as u8 * 60])
+        })),
     )?;
     put(
         corpus,
@@ -319,13 +322,18 @@ pub fn write_seeds(repo: &Path, corpus: &Path) -> io::Result<()> {
     streaks_image::exr::write_exr_rgb(&exr_path, &rgb).map_err(io::Error::other)?;
     put(corpus, "exr", "rgb-3x2", &std::fs::read(&exr_path)?)?;
     write_exr_seeds(scratch.path(), corpus)?;
-    let gray = streaks_image::GrayImage::from_vec(3, 2, vec![0.0, 1.5, f32::INFINITY, 4.0, 5.0, 6.0])
-        .map_err(io::Error::other)?;
+    let gray =
+        streaks_image::GrayImage::from_vec(3, 2, vec![0.0, 1.5, f32::INFINITY, 4.0, 5.0, 6.0])
+            .map_err(io::Error::other)?;
     let pfm_path = scratch.path().join("a.pfm");
     streaks_image::pfm::write_pfm(&pfm_path, &gray).map_err(io::Error::other)?;
     put(corpus, "pfm", "gray-3x2", &std::fs::read(&pfm_path)?)?;
     let mut colour = b"PF\n2 1\n1.0\n".to_vec();
-    colour.extend([0.5f32, 1.0, 2.0, 3.0, 4.0, 5.0].iter().flat_map(|f| f.to_be_bytes()));
+    colour.extend(
+        [0.5f32, 1.0, 2.0, 3.0, 4.0, 5.0]
+            .iter()
+            .flat_map(|f| f.to_be_bytes()),
+    );
     put(corpus, "pfm", "colour-big-endian", &colour)?;
 
     // The rig file and calib.txt of a rig looking down the street.
@@ -411,7 +419,11 @@ fn write_exr_seeds(scratch: &Path, corpus: &Path) -> io::Result<()> {
                 LayerAttributes::named("main"),
                 encoding,
                 SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
-                    (f16::from_f32(x as f32 * 0.5), y as f32 * 2.0, (x + y) as u32)
+                    (
+                        f16::from_f32(x as f32 * 0.5),
+                        y as f32 * 2.0,
+                        (x + y) as u32,
+                    )
                 }),
             );
             let path = scratch.join("seed.exr");

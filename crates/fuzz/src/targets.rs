@@ -102,7 +102,17 @@ const OBJ_WORDS: &[&str] = &[
 
 /// Tokens of PNG chunks.
 const PNG_WORDS: &[&str] = &[
-    "IHDR", "IDAT", "IEND", "PLTE", "tRNS", "gAMA", "sRGB", "iCCP", "acTL", "fcTL", "fdAT",
+    "IHDR",
+    "IDAT",
+    "IEND",
+    "PLTE",
+    "tRNS",
+    "gAMA",
+    "sRGB",
+    "iCCP",
+    "acTL",
+    "fcTL",
+    "fdAT",
     "\u{7f}\u{7f}\u{7f}\u{7f}",
 ];
 
@@ -126,7 +136,15 @@ const EXR_WORDS: &[&str] = &[
 ];
 
 /// Tokens of PFM headers.
-const PFM_WORDS: &[&str] = &["PF\n", "Pf\n", "-1.0\n", "1.0\n", "0\n", "65536 65536\n", "nan\n"];
+const PFM_WORDS: &[&str] = &[
+    "PF\n",
+    "Pf\n",
+    "-1.0\n",
+    "1.0\n",
+    "0\n",
+    "65536 65536\n",
+    "nan\n",
+];
 
 /// Tokens of the rig file (JSON).
 const RIG_WORDS: &[&str] = &[
@@ -389,7 +407,8 @@ pub fn pfm(data: &[u8]) -> Outcome {
 /// A stereo pair's rig file (`rig.json`), read and checked.
 pub fn rig(data: &[u8]) -> Outcome {
     with_files(data, "rig.json", false, |dir| {
-        let file = streaks_stereo::rigfile::RigFile::load(&dir.join("rig.json")).map_err(message)?;
+        let file =
+            streaks_stereo::rigfile::RigFile::load(&dir.join("rig.json")).map_err(message)?;
         file.rig().map(|_| ()).map_err(message)
     })
 }
@@ -464,10 +483,7 @@ pub fn dataset(data: &[u8]) -> Outcome {
                         format!("panicked at {place} {}", lines.get(i + 1).unwrap_or(&""))
                     })
                     .unwrap_or_else(|| status.to_string());
-                panic!(
-                    "streaks dataset index {cause}\n{}",
-                    tail(&stderr)
-                )
+                panic!("streaks dataset index {cause}\n{}", tail(&stderr))
             }
         }
     })

@@ -36,7 +36,10 @@ fn the_readers_take_their_corpus_and_regressions() {
 fn the_dataset_index_takes_its_corpus_and_regressions() {
     let runner = std::path::Path::new(env!("CARGO_BIN_EXE_streaks-fuzz"));
     if std::env::var_os("STREAKS").is_none() && !runner.with_file_name("streaks").is_file() {
-        eprintln!("no streaks binary beside {}: not replayed", runner.display());
+        eprintln!(
+            "no streaks binary beside {}: not replayed",
+            runner.display()
+        );
         return;
     }
     replay(&["dataset"]);

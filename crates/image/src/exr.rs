@@ -80,7 +80,10 @@ pub fn read_exr_channels(
     let read = std::panic::catch_unwind(|| exr::prelude::read_all_flat_layers_from_file(path))
         .map_err(|panic| ImageError::Read {
             path: path.to_path_buf(),
-            reason: format!("malformed EXR (the decoder failed: {})", panic_message(&*panic)),
+            reason: format!(
+                "malformed EXR (the decoder failed: {})",
+                panic_message(&*panic)
+            ),
         })?;
     let image = read.map_err(|source| ImageError::Exr {
         path: path.to_path_buf(),

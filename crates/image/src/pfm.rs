@@ -119,7 +119,10 @@ mod tests {
         let p = dir.path().join("x.pfm");
         // 2^62 pixels: the size overflows any allocation; 40000 x 30000 (4.8 GB): allowed by
         // the pixel limit but not backed by the 8 bytes that follow.
-        for header in ["Pf\n2147483648 2147483648\n-1.0\n", "Pf\n40000 30000\n-1.0\n"] {
+        for header in [
+            "Pf\n2147483648 2147483648\n-1.0\n",
+            "Pf\n40000 30000\n-1.0\n",
+        ] {
             std::fs::write(&p, [header.as_bytes(), &[0; 8]].concat()).unwrap();
             let e = read_pfm(&p).unwrap_err().to_string();
             assert!(e.contains("truncated data: 8 bytes"), "{e}");
