@@ -295,21 +295,36 @@ fn supervise(args: &Args, target: &Target) -> Findings {
                 .filter_map(|l| l.strip_prefix("found: "))
                 .map(str::to_owned),
         );
-        let oom = errors.lines().find(|l| l.contains("memory allocation of"));
+        let oom = errors
+            .lines()
+            .position(|l| l.contains("memory allocation of"));
+        let last_panic = errors.lines().rev().find(|l| l.starts_with("panic: "));
         let (kind, reason) = match status {
             Some(s) if s.success() || s.code() == Some(FOUND_EXIT) => break,
             Some(s) if s.code() == Some(HANG_EXIT) => ("hang", last_lines(&errors)),
-            Some(s) if oom.is_some() => (
-                "oom",
+            Some(s) if oom.is_some() => {
+                // The allocation's backtrace, if RUST_BACKTRACE asks for one: its first frames.
+                let lines: Vec<&str> = errors.lines().skip(oom.unwrap_or_default()).collect();
+                (
+                    "oom",
+                    format!(
+                        "{} ({}, over the {} MiB limit)\n{}",
+                        lines[0],
+                        describe(s),
+                        args.memory_mib,
+                        lines[1..lines.len().min(60)].join("\n")
+                    ),
+                )
+            }
+            Some(s) => (
+                "crash",
                 format!(
-                    "{} ({}, over the {} MiB limit)\n{}",
-                    oom.unwrap_or_default(),
+                    "{}{}\n{}",
+                    last_panic.map_or(String::new(), |p| format!("{p}; then ")),
                     describe(s),
-                    args.memory_mib,
                     last_lines(&errors)
                 ),
             ),
-            Some(s) => ("crash", format!("{}\n{}", describe(s), last_lines(&errors))),
             None => (
                 "hang",
                 format!("the child did not end within {} s", limit.as_secs()),
@@ -343,9 +358,12 @@ fn describe(status: ExitStatus) -> String {
     format!("exited with {status}")
 }
 
-/// The last 30 lines of `text` but the findings the child listed.
+/// The last 30 lines of `text` but the findings and panics the child listed.
 fn last_lines(text: &str) -> String {
-    let lines: Vec<&str> = text.lines().filter(|l| !l.starts_with("found: ")).collect();
+    let lines: Vec<&str> = text
+        .lines()
+        .filter(|l| !l.starts_with("found: ") && !l.starts_with("panic: "))
+        .collect();
     lines[lines.len().saturating_sub(30)..].join("\n")
 }
 
@@ -498,6 +516,9 @@ fn child(args: &Args, target: &Target) -> Result<i32, String> {
             .map(|s| (*s).to_owned())
             .or_else(|| payload.downcast_ref::<String>().cloned())
             .unwrap_or_else(|| "a panic".to_owned());
+        // Also on stderr, for the parent: a panic where nothing catches it (a thread pool's
+        // task) aborts the process.
+        eprintln!("panic: {place}: {}", first_line(&message));
         if let Ok(mut last) = LAST_PANIC.lock() {
             *last = Some((place, message));
         }
