@@ -244,6 +244,8 @@ fn supervise(args: &Args, target: &Target) -> Findings {
                 .as_secs_f64()
         };
         let mut cmd = Command::new(&exe);
+        // The targets' own scratch folders go inside this one, which is removed at the end.
+        cmd.env("TMPDIR", scratch.path());
         cmd.arg("--child")
             .arg(target.name)
             .arg("--scratch")
@@ -669,7 +671,7 @@ impl Runner<'_> {
             Ok(outcome) => {
                 let kind = match &outcome {
                     Ok(()) => "ok".to_owned(),
-                    Err(e) => kind_of(e),
+                    Err(e) => kind_of(&first_line(e)),
                 };
                 (Some(outcome), self.kinds.insert(kind))
             }
@@ -733,6 +735,7 @@ fn failure(
     let input = scratch.join("input");
     std::fs::write(&input, data).ok()?;
     let out = Command::new(exe)
+        .env("TMPDIR", scratch)
         .arg("--child")
         .arg(target.name)
         .arg("--scratch")
@@ -839,4 +842,21 @@ fn minimize(args: &Args, target: &Target, path: &Path) -> Result<i32, String> {
     std::fs::write(&out, &best).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
     println!("fuzz: {} ({} bytes, {goal})", out.display(), best.len());
     Ok(0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn kinds_leave_out_numbers_and_quoted_parts() {
+        assert_eq!(
+            kind_of("truncated data: 42 bytes for 7x3, expected 84"),
+            "truncated data: # bytes for #x#, expected #"
+        );
+        assert_eq!(
+            kind_of("unknown key \"xyz\" at line 3"),
+            kind_of("unknown key \"abc\" at line 12")
+        );
+    }
 }

@@ -278,13 +278,15 @@ pub fn find(name: &str) -> Option<&'static Target> {
 }
 
 thread_local! {
-    /// This thread's scratch folder, made on first use and removed at exit.
+    /// This thread's scratch folder, made on first use in the system's temporary folder (the
+    /// stable runner points `TMPDIR` at a folder it removes, since a child that ends with
+    /// `exit` or an abort does not remove its own).
     static SCRATCH: RefCell<Option<tempfile::TempDir>> = const { RefCell::new(None) };
 }
 
 /// Runs `f` on an empty folder `in` inside this thread's scratch folder, holding `data`'s
-/// files (the main one named `main`); `None` for a single-file input (`data` is written as
-/// `main`).
+/// files: those of a multi-file input ([`files`]), the main one named `main`, or else `data`
+/// as the file `main`.
 fn with_files<R>(data: &[u8], main: &str, multi_file: bool, f: impl FnOnce(&Path) -> R) -> R {
     let dir = SCRATCH.with(|s| {
         let mut s = s.borrow_mut();
