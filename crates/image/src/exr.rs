@@ -326,7 +326,7 @@ mod tests {
             .to_vec();
         let header = |w, h| {
             Header::new(
-                "main".try_into().unwrap(),
+                "main".into(),
                 (w, h),
                 exr::prelude::SmallVec::from_vec(channels.clone()),
             )
