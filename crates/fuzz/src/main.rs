@@ -231,7 +231,7 @@ fn supervise(args: &Args, target: &Target) -> Findings {
         .map_err(|e| format!("cannot make a scratch folder: {e}"))?;
     let exe = std::env::current_exe().map_err(|e| format!("cannot find this executable: {e}"))?;
     let deadline = Instant::now() + Duration::from_secs_f64(args.seconds);
-    let mut found = Vec::new();
+    let mut found: Vec<String> = Vec::new();
     for restart in 0..=MAX_RESTARTS {
         let current = scratch.path().join("current");
         let _ = std::fs::remove_file(&current);
@@ -291,12 +291,12 @@ fn supervise(args: &Args, target: &Target) -> Findings {
             std::thread::sleep(Duration::from_millis(20));
         };
         let errors = std::fs::read_to_string(&log).unwrap_or_default();
-        found.extend(
-            errors
-                .lines()
-                .filter_map(|l| l.strip_prefix("found: "))
-                .map(str::to_owned),
-        );
+        // A restarted child finds the same panics again: one line per place.
+        for line in errors.lines().filter_map(|l| l.strip_prefix("found: ")) {
+            if !found.iter().any(|f| finding_key(f) == finding_key(line)) {
+                found.push(line.to_owned());
+            }
+        }
         let oom = errors
             .lines()
             .position(|l| l.contains("memory allocation of"));
@@ -346,6 +346,21 @@ fn supervise(args: &Args, target: &Target) -> Findings {
         }
     }
     Ok(found)
+}
+
+/// What tells a finding's line apart from another's: the places of the panics it names (the
+/// target's, and the `streaks` command's for the dataset target), or the whole line.
+fn finding_key(line: &str) -> String {
+    let places: Vec<&str> = line
+        .split("panicked at ")
+        .skip(1)
+        .map(|rest| rest.split(": ").next().unwrap_or(rest))
+        .collect();
+    if places.is_empty() {
+        line.to_owned()
+    } else {
+        places.join(" ")
+    }
 }
 
 /// An exit status in words (the signal, if one ended the process).
@@ -681,9 +696,9 @@ impl Runner<'_> {
                     .unwrap_or_else(|e| e.into_inner())
                     .take()
                     .unwrap_or_else(|| ("unknown place".into(), "a panic".into()));
-                // One finding per place and kind of message (the dataset target's panics all
-                // come from one place, its message names the command's).
-                let key = format!("{place} {}", kind_of(&first_line(&message)));
+                // One finding per place (the dataset target's panics all come from one place,
+                // its message names the command's own).
+                let key = finding_key(&format!("panicked at {place}: {message}"));
                 if self.places.insert(key) {
                     let reason = format!("panicked at {place}:\n{message}");
                     let path = if self.save {
@@ -847,6 +862,17 @@ fn minimize(args: &Args, target: &Target, path: &Path) -> Result<i32, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn findings_are_told_apart_by_their_panics_places() {
+        let a = "crash (panicked at x.rs:1:2: unwrap on [0.5]): artifacts/obj/crash-1";
+        let b = "crash (panicked at x.rs:1:2: unwrap on [1.0, 2.0]): artifacts/obj/crash-2";
+        assert_eq!(finding_key(a), finding_key(b));
+        let c = "crash (panicked at t.rs:4:1: streaks dataset index panicked at i.rs:9:9: x): p";
+        let d = "crash (panicked at t.rs:4:1: streaks dataset index panicked at i.rs:7:7: x): p";
+        assert_eq!(finding_key(c), "t.rs:4:1 i.rs:9:9");
+        assert_ne!(finding_key(c), finding_key(d));
+    }
 
     #[test]
     fn kinds_leave_out_numbers_and_quoted_parts() {
