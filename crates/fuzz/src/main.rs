@@ -94,9 +94,10 @@ struct Args {
     /// Internal: the child's scratch folder.
     #[arg(long, hide = true)]
     scratch: Option<PathBuf>,
-    /// Internal: the child skips the replay (a restart after a crash).
-    #[arg(long, hide = true)]
-    no_replay: bool,
+    /// Internal: the child skips this many inputs of its replay (a restart after the input
+    /// before them ended the last child).
+    #[arg(long, hide = true, default_value_t = 0)]
+    skip_replay: usize,
     /// Internal: the child saves no artifacts (minimisation trials).
     #[arg(long, hide = true)]
     no_save: bool,
@@ -258,9 +259,13 @@ fn supervise(args: &Args, target: &Target) -> Findings {
             .arg(args.timeout.to_string())
             .arg("--memory-mib")
             .arg(args.memory_mib.to_string());
-        if restart > 0 {
-            cmd.arg("--no-replay");
-        }
+        // The replay goes on after the input that ended the last child (a finding must not
+        // hide the regressions after it).
+        let skip = std::fs::read_to_string(scratch.path().join("replaying"))
+            .ok()
+            .and_then(|n| n.trim().parse::<usize>().ok())
+            .map_or(0, |n| n + 1);
+        cmd.arg("--skip-replay").arg(skip.to_string());
         if args.open {
             cmd.arg("--open");
         }
@@ -341,7 +346,8 @@ fn supervise(args: &Args, target: &Target) -> Findings {
         let line = format!("{kind} ({}): {}", first_line(&reason), path.display());
         println!("fuzz: {}: {line}", target.name);
         found.push(line);
-        if !args.replay.is_empty() || Instant::now() >= deadline {
+        let replayed = scratch.path().join("replay-done").exists();
+        if replayed && Instant::now() >= deadline {
             break;
         }
     }
@@ -577,8 +583,13 @@ fn child(args: &Args, target: &Target) -> Result<i32, String> {
         save: !args.no_save,
     };
     let mut corpus: Vec<Vec<u8>> = Vec::new();
-    for (path, data) in seeds {
-        if !args.no_replay {
+    let replaying = scratch.join("replaying");
+    for (i, (path, data)) in seeds.into_iter().enumerate() {
+        if i >= args.skip_replay {
+            // For the parent: where to go on if this input ends the process.
+            if let Err(e) = std::fs::write(&replaying, i.to_string()) {
+                eprintln!("cannot write {}: {e}", replaying.display());
+            }
             let (outcome, new) = run.input(&data);
             if args.verbose || !args.replay.is_empty() {
                 let what = match &outcome {
@@ -593,6 +604,9 @@ fn child(args: &Args, target: &Target) -> Result<i32, String> {
         corpus.push(data);
     }
     let replayed = run.executed;
+    if let Err(e) = std::fs::write(scratch.join("replay-done"), "") {
+        eprintln!("cannot write {}: {e}", scratch.display());
+    }
     if corpus.is_empty() {
         corpus.push(Vec::new());
     }
