@@ -8,7 +8,8 @@
 //! once (`--memory-mib`, by the global allocator: a larger allocation fails, which aborts) and
 //! an address-space limit (RLIMIT_AS) as a backstop for memory the allocator does not see.
 //! Before each input the child writes it to its scratch folder, so when the child dies (abort,
-//! signal, hang) the parent saves it. Every finding goes to `artifacts/<target>/` with a text
+//! signal, hang) the parent saves it, and starts a new child that goes on with the replay after
+//! that input and then mutates for the rest of the time. Every finding goes to `artifacts/<target>/` with a text
 //! file giving the reason and the command that reproduces it; the runner then exits with
 //! status 1.
 //!
@@ -590,7 +591,7 @@ fn child(args: &Args, target: &Target) -> Result<i32, String> {
             if let Err(e) = std::fs::write(&replaying, i.to_string()) {
                 eprintln!("cannot write {}: {e}", replaying.display());
             }
-            let (outcome, new) = run.input(&data);
+            let (outcome, _) = run.input(&data);
             if args.verbose || !args.replay.is_empty() {
                 let what = match &outcome {
                     Some(Ok(())) => "read".to_owned(),
@@ -599,7 +600,6 @@ fn child(args: &Args, target: &Target) -> Result<i32, String> {
                 };
                 println!("fuzz: {}: {}: {what}", target.name, path.display());
             }
-            let _ = new;
         }
         corpus.push(data);
     }
