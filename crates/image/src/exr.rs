@@ -3,7 +3,7 @@
 //! `exrheader` show as layers; the renderer's layout is in `streaks_render::output`).
 
 use crate::atomic::{write_atomically, WriteFailure};
-use crate::input::{check_pixels, open_regular, MAX_IMAGE_BYTES};
+use crate::input::{check_pixels, open_regular};
 use crate::{ImageError, RgbImage};
 use std::io::Seek;
 use std::path::Path;
@@ -78,7 +78,7 @@ pub fn read_exr_channels(
     path: &Path,
     names: &[&str],
 ) -> Result<(u32, u32, Vec<Vec<f32>>), ImageError> {
-    use exr::prelude::{ReadChannels, ReadLayers};
+    use exr::prelude::traits::*;
     let exr_err = |source| ImageError::Exr {
         path: path.to_path_buf(),
         source,
@@ -89,30 +89,43 @@ pub fn read_exr_channels(
     };
     let (file, _) = open_regular(path).map_err(|e| read_err(e.to_string()))?;
     let mut reader = std::io::BufReader::new(file);
-    // The headers first: every part's size against the pixel limit, and the samples the read
-    // will hold against the allocation limit, before any pixel is read.
-    let meta = exr::meta::MetaData::read_from_buffered(&mut reader, false).map_err(exr_err)?;
-    let mut bytes = 0u64;
-    for header in &meta.headers {
-        let (w, h) = (header.layer_size.0 as u64, header.layer_size.1 as u64);
-        check_pixels(w, h).map_err(read_err)?;
-        bytes = bytes.saturating_add(w * h * 4 * header.channels.list.len() as u64);
-    }
-    if bytes > MAX_IMAGE_BYTES {
-        return Err(read_err(format!(
-            "its headers claim {bytes} bytes of samples, more than the limit of \
-             {MAX_IMAGE_BYTES}"
-        )));
-    }
-    reader.rewind().map_err(|e| read_err(e.to_string()))?;
-    let image = exr::prelude::read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .all_layers()
-        .all_attributes()
-        .from_buffered(reader)
-        .map_err(exr_err)?;
+    // The decoder asserts some of its own invariants instead of returning an error, and a
+    // malformed file can break them (a tile whose level differs from the one being read
+    // fails `line should have been filtered`; B44 blocks overflow its arithmetic in debug
+    // builds): such a panic is a malformed file too. Blocks are decompressed on this thread,
+    // where the panic can be caught (a panic in the decoder's thread pool aborts).
+    let read = std::panic::catch_unwind(move || {
+        // The headers first: every part's size against the pixel limit, the samples the read
+        // will hold and the block sizes against the allocation limits, before any pixel is
+        // read.
+        let meta = exr::meta::MetaData::read_from_buffered(&mut reader, false)?;
+        for header in &meta.headers {
+            let (w, h) = (header.layer_size.0 as u64, header.layer_size.1 as u64);
+            if let Err(reason) = check_pixels(w, h) {
+                return Ok(Err(reason));
+            }
+        }
+        if let Some(reason) = too_large(&meta.headers) {
+            return Ok(Err(reason));
+        }
+        reader.rewind()?;
+        exr::prelude::read()
+            .no_deep_data()
+            .largest_resolution_level()
+            .all_channels()
+            .all_layers()
+            .all_attributes()
+            .non_parallel()
+            .from_buffered(reader)
+            .map(Ok)
+    })
+    .map_err(|panic| {
+        read_err(format!(
+            "malformed EXR (the decoder failed: {})",
+            panic_message(&*panic)
+        ))
+    })?;
+    let image = read.map_err(exr_err)?.map_err(read_err)?;
     for layer in &image.layer_data {
         let found: Option<Vec<Vec<f32>>> = names
             .iter()
@@ -133,6 +146,51 @@ pub fn read_exr_channels(
         path: path.to_path_buf(),
         what: format!("{} channels", names.join(", ")),
     })
+}
+
+/// The most samples (pixels times channels, over all layers) an EXR may hold: 2^28, 1 GiB as
+/// `f32`. The headers say how many there are before any memory is reserved for them.
+pub const MAX_EXR_SAMPLES: u64 = 1 << 28;
+
+/// A block may claim at most this many bytes when its layer's pixels take fewer.
+const MAX_SMALL_LAYER_BLOCK: u64 = 64 << 20;
+
+/// Why the EXR whose headers are `headers` may not be read, if so: more than [`MAX_EXR_SAMPLES`]
+/// samples, or a block size larger than the layer it belongs to (the decoder reserves a
+/// block's claimed size before reading it).
+fn too_large(headers: &[exr::meta::header::Header]) -> Option<String> {
+    let mut samples = 0u64;
+    for (i, header) in headers.iter().enumerate() {
+        let size = header.layer_size;
+        let area = (size.0 as u64).saturating_mul(size.1 as u64);
+        samples = samples.saturating_add(area.saturating_mul(header.channels.list.len() as u64));
+        if samples > MAX_EXR_SAMPLES {
+            return Some(format!(
+                "layer {i} ({}x{}, {} channels) takes the image past {MAX_EXR_SAMPLES} samples",
+                size.0,
+                size.1,
+                header.channels.list.len()
+            ));
+        }
+        let layer_bytes = area.saturating_mul(header.channels.bytes_per_pixel as u64);
+        let block = header.max_block_byte_size() as u64;
+        if block > layer_bytes.max(MAX_SMALL_LAYER_BLOCK) {
+            return Some(format!(
+                "layer {i} ({}x{}) has blocks of {block} bytes, larger than the layer",
+                size.0, size.1
+            ));
+        }
+    }
+    None
+}
+
+/// The message of a caught panic.
+fn panic_message(panic: &(dyn std::any::Any + Send)) -> String {
+    panic
+        .downcast_ref::<&str>()
+        .map(|s| (*s).to_owned())
+        .or_else(|| panic.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "a panic".to_owned())
 }
 
 /// Reads three channels of an EXR as an RGB image (for example `R`, `G`, `B`).
@@ -256,5 +314,67 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.contains("not a regular file"), "{err}");
+    }
+
+    #[test]
+    fn a_file_that_breaks_the_decoders_assertions_is_an_error() {
+        // Found by the exr fuzz target: a tiled file with a block of another level than the
+        // one read, which fails an assertion of the exr crate (in debug builds).
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("bad.exr");
+        let bytes = include_bytes!("../../../fuzz/regressions/exr/crash-tile-of-another-level");
+        std::fs::write(&p, bytes).unwrap();
+        let e = read_exr_rgb(&p).unwrap_err().to_string();
+        assert!(e.contains("malformed EXR") && e.contains("bad.exr"), "{e}");
+    }
+
+    /// Reads the fuzz regression input `name` as an EXR: the error.
+    fn read_regression(name: &str, bytes: &[u8]) -> String {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join(format!("{name}.exr"));
+        std::fs::write(&p, bytes).unwrap();
+        let e = read_exr_rgb(&p).unwrap_err().to_string();
+        assert!(e.contains(name), "{e}");
+        e
+    }
+
+    #[test]
+    fn a_decoder_panic_in_a_block_is_an_error_not_an_abort() {
+        // Found by the exr fuzz target: B44 blocks whose values overflow the decoder's
+        // arithmetic (a panic in debug builds, which aborted the process when blocks were
+        // decompressed in the decoder's thread pool).
+        let bytes =
+            include_bytes!("../../../fuzz/regressions/exr/crash-b44-overflow-in-the-thread-pool");
+        let e = read_regression("b44", bytes);
+        assert!(e.contains("malformed EXR"), "{e}");
+    }
+
+    #[test]
+    fn a_block_larger_than_its_layer_is_refused_before_it_is_allocated() {
+        // Found by the exr fuzz target: a 3x2 layer with 3 GB tiles, whose first block claims
+        // 2 GB, which the decoder reserved before reading it.
+        let bytes = include_bytes!("../../../fuzz/regressions/exr/oom-block-larger-than-its-layer");
+        let e = read_regression("tiles", bytes);
+        assert!(e.contains("larger than the layer"), "{e}");
+    }
+
+    #[test]
+    fn an_image_past_the_sample_limit_is_refused() {
+        use exr::meta::attribute::{ChannelDescription, SampleType};
+        use exr::meta::header::Header;
+        let channels = ["R", "G", "B"]
+            .map(|n| ChannelDescription::named(n, SampleType::F32))
+            .to_vec();
+        let header = |w, h| {
+            Header::new(
+                "main".into(),
+                (w, h),
+                exr::prelude::SmallVec::from_vec(channels.clone()),
+            )
+        };
+        assert_eq!(too_large(&[header(1920, 1080)]), None);
+        // 3 x 10000 x 10000 = 3 x 10^8 samples, 1.2 GB as f32.
+        let e = too_large(&[header(10000, 10000)]).unwrap();
+        assert!(e.contains("10000x10000, 3 channels"), "{e}");
     }
 }

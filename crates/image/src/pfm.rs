@@ -60,13 +60,17 @@ pub fn read_pfm(path: &Path) -> Result<GrayImage, ImageError> {
     }
     let data_start = pos + 1;
     check_pixels(width as u64, height as u64).map_err(err)?;
-    let need = width * height * 4;
-    if bytes.len() < data_start + need {
+    // The pixels must be in the file before memory is reserved for them: a header alone can
+    // claim any size.
+    let have = bytes.len().saturating_sub(data_start);
+    let need = width.checked_mul(height).and_then(|n| n.checked_mul(4));
+    if need.is_none_or(|need| have < need) {
+        let expected = need.map_or_else(|| "more than can be addressed".into(), |n| n.to_string());
         return Err(err(format!(
-            "truncated data: {} bytes for {width}x{height}, expected {need}",
-            bytes.len().saturating_sub(data_start)
+            "truncated data: {have} bytes for {width}x{height}, expected {expected}"
         )));
     }
+    let need = need.unwrap_or_default();
     let mut img = GrayImage::new(width, height, 0.0).map_err(|e| err(e.to_string()))?;
     let little = scale < 0.0;
     for (i, chunk) in bytes[data_start..data_start + need]

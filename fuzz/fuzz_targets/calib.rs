@@ -1,0 +1,6 @@
+//! The `calib` target for cargo-fuzz: `cargo +nightly fuzz run calib`.
+#![no_main]
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| {
+    let _ = streaks_fuzz::targets::calib(data);
+});

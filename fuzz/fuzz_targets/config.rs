@@ -1,0 +1,6 @@
+//! The `config` target for cargo-fuzz: `cargo +nightly fuzz run config`.
+#![no_main]
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| {
+    let _ = streaks_fuzz::targets::config(data);
+});

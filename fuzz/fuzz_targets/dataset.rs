@@ -1,0 +1,6 @@
+//! The `dataset` target for cargo-fuzz: `cargo +nightly fuzz run dataset`.
+#![no_main]
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| {
+    let _ = streaks_fuzz::targets::dataset(data);
+});

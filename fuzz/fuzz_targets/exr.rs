@@ -1,0 +1,6 @@
+//! The `exr` target for cargo-fuzz: `cargo +nightly fuzz run exr`.
+#![no_main]
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| {
+    let _ = streaks_fuzz::targets::exr(data);
+});

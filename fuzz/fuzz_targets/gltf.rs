@@ -1,0 +1,6 @@
+//! The `gltf` target for cargo-fuzz: `cargo +nightly fuzz run gltf`.
+#![no_main]
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| {
+    let _ = streaks_fuzz::targets::gltf(data);
+});

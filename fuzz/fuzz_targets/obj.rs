@@ -1,0 +1,6 @@
+//! The `obj` target for cargo-fuzz: `cargo +nightly fuzz run obj`.
+#![no_main]
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| {
+    let _ = streaks_fuzz::targets::obj(data);
+});

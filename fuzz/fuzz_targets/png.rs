@@ -1,0 +1,6 @@
+//! The `png` target for cargo-fuzz: `cargo +nightly fuzz run png`.
+#![no_main]
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| {
+    let _ = streaks_fuzz::targets::png(data);
+});
