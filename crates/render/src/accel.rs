@@ -1063,16 +1063,14 @@ fn build_cwbvh(aabbs: impl ExactSizeIterator<Item = Aabb>, reinsertion_ratio: f3
             Bvh2Node::new(aabb, 1, i as u32)
         })
         .collect();
-    let mut bvh2 = Bvh2::default();
-    bvh2.reset_for_reuse(count, Some((0..count as u32).collect()));
-    builder.build_ploc_from_leaves::<PLOC_SEARCH_DISTANCE, false>(
-        &mut bvh2,
-        total,
-        BUILD_PARAMS.sort_precision,
-        BUILD_PARAMS.search_depth_threshold,
-    );
+    let leaves = std::mem::take(&mut builder.current_nodes);
+    let mut bvh2 = ploc(&mut builder, &leaves, &total, reinsertion_ratio, false);
+    if tree_depth(&bvh2) > MAX_PLOC_DEPTH {
+        // A pathology the clusters did not catch: a balanced tree in Morton order instead.
+        bvh2 = ploc(&mut builder, &leaves, &total, reinsertion_ratio, true);
+    }
     drop(builder);
-    ReinsertionOptimizer::default().run(&mut bvh2, reinsertion_ratio, None);
+    drop(leaves);
     bvh2.parents = Vec::new();
     let mut cwbvh = bvh2_to_cwbvh(
         &bvh2,
@@ -1082,6 +1080,265 @@ fn build_cwbvh(aabbs: impl ExactSizeIterator<Item = Aabb>, reinsertion_ratio: f3
     );
     cwbvh.nodes.shrink_to_fit();
     cwbvh
+}
+
+/// Deeper BVH2s than this (PLOC's trees of ordinary scenes are well under 100 levels) are
+/// rebuilt as one balanced cluster: obvhs' CWBVH conversion recurses once per level.
+const MAX_PLOC_DEPTH: usize = 1024;
+
+/// The BVH2 over the primitive boxes `leaves` (one primitive each) in the box `total`: PLOC
+/// with [`Clusters`] expanded, or, with `balanced`, one cluster of everything; then the
+/// reinsertion optimiser with `reinsertion_ratio` when there are no clusters.
+fn ploc(
+    builder: &mut PlocBuilder,
+    leaves: &[Bvh2Node],
+    total: &Aabb,
+    reinsertion_ratio: f32,
+    balanced: bool,
+) -> Bvh2 {
+    let count = leaves.len();
+    let mut bvh2 = Bvh2::default();
+    let clusters = Clusters::find(leaves, total, balanced);
+    match &clusters {
+        None => {
+            bvh2.reset_for_reuse(count, Some((0..count as u32).collect()));
+            builder.current_nodes = leaves.to_vec();
+        }
+        Some(c) => {
+            let nodes = c.leaves(leaves);
+            bvh2.reset_for_reuse(nodes.len(), Some(c.order.clone()));
+            builder.current_nodes = nodes;
+        }
+    }
+    if builder.current_nodes.len() == 1 {
+        bvh2.nodes[0] = builder.current_nodes[0];
+    } else {
+        builder.build_ploc_from_leaves::<PLOC_SEARCH_DISTANCE, false>(
+            &mut bvh2,
+            *total,
+            BUILD_PARAMS.sort_precision,
+            BUILD_PARAMS.search_depth_threshold,
+        );
+    }
+    builder.current_nodes = Vec::new();
+    match clusters {
+        None => ReinsertionOptimizer::default().run(&mut bvh2, reinsertion_ratio, None),
+        // Reinsertion searches the whole of a cluster of coincident boxes for each of its
+        // nodes (no bound prunes it): quadratic. The clusters' balanced subtrees are as good
+        // as coincident primitives allow, so it is skipped.
+        Some(c) => c.expand(&mut bvh2),
+    }
+    bvh2
+}
+
+/// The number of levels of `bvh` (1 for a lone leaf), without recursion.
+fn tree_depth(bvh: &Bvh2) -> usize {
+    let mut deepest = 0;
+    let mut stack = vec![(0usize, 1usize)];
+    while let Some((i, depth)) = stack.pop() {
+        deepest = deepest.max(depth);
+        let n = &bvh.nodes[i];
+        if n.prim_count == 0 {
+            let c = n.first_index as usize;
+            stack.extend([(c, depth + 1), (c + 1, depth + 1)]);
+        }
+    }
+    deepest
+}
+
+/// Clusters smaller than this are left to PLOC (see [`Clusters`]).
+const CLUSTER_MIN: usize = 64;
+
+/// Runs of primitives that would stall PLOC, found before it runs: primitives whose boxes'
+/// centres share one cell of PLOC's Morton grid (21 bits per axis over the scene's box:
+/// identical or coincident triangles), and runs of the Morton order in which PLOC's first
+/// pass merges nothing (boxes nested in one another along the curve, as triangles with one
+/// centroid and growing sizes are), each of at least [`CLUSTER_MIN`] primitives.
+///
+/// PLOC merges two nodes only when each is the other's best neighbour. Among nodes with one
+/// box every merge costs the same, each node's best is the farthest in its search window,
+/// and only one pair per pass agrees; along nested boxes each node's best is its smaller
+/// neighbour, and again one pair per pass merges. A run of `k` such primitives takes `k`
+/// passes over all nodes (100,000 coincident triangles: minutes), and its subtree is a chain
+/// `k` deep, on which obvhs' recursive CWBVH conversion overflows the stack. Each run is
+/// instead one PLOC leaf, expanded afterwards into a balanced subtree
+/// ([`Clusters::expand`]). A scene without such runs (every scene we ship) is built exactly
+/// as before.
+struct Clusters {
+    /// The primitives in BVH slot order: those outside clusters first (in input order), then
+    /// each cluster's, contiguously, in Morton order.
+    order: Vec<u32>,
+    /// Each cluster's range in `order`.
+    ranges: Vec<std::ops::Range<u32>>,
+    /// Every primitive's box, by input index.
+    boxes: Vec<Aabb>,
+}
+
+impl Clusters {
+    /// The clusters among the leaves `nodes` (one primitive each, `first_index` = input
+    /// index) in the box `total`; `None` when there are none (the usual case). With
+    /// `everything`, all primitives are one cluster (a balanced tree in Morton order).
+    fn find(nodes: &[Bvh2Node], total: &Aabb, everything: bool) -> Option<Self> {
+        if nodes.len() < CLUSTER_MIN.max(2) && !everything {
+            return None;
+        }
+        // PLOC's own Morton code (obvhs' `sort_nodes_by_morton`, 64-bit precision), ties by
+        // index as its stable radix sort leaves them.
+        let scale = 1.0 / total.diagonal().as_dvec3();
+        let offset = -total.min.as_dvec3() * scale;
+        let mut keys: Vec<(u64, u32)> = nodes
+            .iter()
+            .enumerate()
+            .map(|(i, n)| {
+                let c = n.aabb().center().as_dvec3() * scale + offset;
+                (obvhs::ploc::morton::morton_encode_u64_unorm(c), i as u32)
+            })
+            .collect();
+        keys.sort_unstable();
+        let mut runs: Vec<std::ops::Range<usize>> = Vec::new();
+        if everything {
+            runs.push(0..keys.len());
+        } else {
+            let mut start = 0;
+            for run in keys.chunk_by(|a, b| a.0 == b.0) {
+                if run.len() >= CLUSTER_MIN {
+                    runs.push(start..start + run.len());
+                }
+                start += run.len();
+            }
+            // PLOC's first pass (search distance 1): node i points at i - 1 when the merge
+            // with it is cheaper than the one with i + 1, else at i + 1; two nodes pointing
+            // at each other merge.
+            let aabb = |k: usize| nodes[keys[k].1 as usize].aabb();
+            let cost = |k: usize| aabb(k).union(aabb(k + 1)).half_area();
+            let n = keys.len();
+            let points_left = |k: usize| k + 1 == n || (k > 0 && cost(k - 1) < cost(k));
+            let mut merged = vec![false; n];
+            for k in 0..n - 1 {
+                if !points_left(k) && points_left(k + 1) {
+                    merged[k] = true;
+                    merged[k + 1] = true;
+                }
+            }
+            let mut start = 0;
+            for run in merged.chunk_by(|a, b| a == b) {
+                if !run[0] && run.len() >= CLUSTER_MIN {
+                    runs.push(start..start + run.len());
+                }
+                start += run.len();
+            }
+            if runs.is_empty() {
+                return None;
+            }
+            // Overlapping runs are one cluster.
+            runs.sort_by_key(|r| r.start);
+            let mut joined: Vec<std::ops::Range<usize>> = Vec::with_capacity(runs.len());
+            for r in runs {
+                match joined.last_mut() {
+                    Some(last) if r.start < last.end => last.end = last.end.max(r.end),
+                    _ => joined.push(r),
+                }
+            }
+            runs = joined;
+        }
+        let mut in_cluster = vec![false; nodes.len()];
+        for r in &runs {
+            keys[r.clone()]
+                .iter()
+                .for_each(|&(_, i)| in_cluster[i as usize] = true);
+        }
+        let boxes: Vec<Aabb> = nodes.iter().map(|n| *n.aabb()).collect();
+        let mut order: Vec<u32> = (0..nodes.len() as u32)
+            .filter(|&i| !in_cluster[i as usize])
+            .collect();
+        let mut ranges = Vec::with_capacity(runs.len());
+        for r in runs {
+            let start = order.len() as u32;
+            order.extend(keys[r].iter().map(|&(_, i)| i));
+            ranges.push(start..order.len() as u32);
+        }
+        Some(Self {
+            order,
+            ranges,
+            boxes,
+        })
+    }
+
+    /// The union of the boxes of the primitives in slots `range` of `order`.
+    fn bounds(&self, range: std::ops::Range<u32>) -> Aabb {
+        self.order[range.start as usize..range.end as usize]
+            .iter()
+            .fold(Aabb::empty(), |b, &i| b.union(&self.boxes[i as usize]))
+    }
+
+    /// The PLOC leaves: one per primitive outside the clusters and one per cluster (several
+    /// primitives), indexing `order`.
+    fn leaves(&self, nodes: &[Bvh2Node]) -> Vec<Bvh2Node> {
+        let singles = self.ranges.first().map_or(self.order.len(), |r| r.start as usize);
+        let mut leaves: Vec<Bvh2Node> = self.order[..singles]
+            .iter()
+            .enumerate()
+            .map(|(slot, &i)| Bvh2Node::new(*nodes[i as usize].aabb(), 1, slot as u32))
+            .collect();
+        leaves.extend(
+            self.ranges
+                .iter()
+                .map(|r| Bvh2Node::new(self.bounds(r.clone()), r.end - r.start, r.start)),
+        );
+        leaves
+    }
+
+    /// Replaces each cluster's leaf in `bvh` by a balanced subtree over its primitives (each
+    /// inner node halves its range), one primitive per leaf; children keep following their
+    /// parents in the node array.
+    fn expand(&self, bvh: &mut Bvh2) {
+        let old = std::mem::take(&mut bvh.nodes);
+        let mut nodes = Vec::with_capacity(2 * self.order.len() - 1);
+        nodes.push(old[0]);
+        enum From {
+            Node(usize),
+            Slots(std::ops::Range<u32>),
+        }
+        let mut stack = vec![(0usize, From::Node(0))];
+        let mut deepest = 0u32;
+        while let Some((at, from)) = stack.pop() {
+            let (children, first, second) = match from {
+                From::Node(i) => {
+                    let n = old[i];
+                    if n.prim_count == 0 {
+                        let c = n.first_index as usize;
+                        (*n.aabb(), From::Node(c), From::Node(c + 1))
+                    } else if n.prim_count == 1 {
+                        nodes[at] = n;
+                        continue;
+                    } else {
+                        let r = n.first_index..n.first_index + n.prim_count;
+                        deepest = deepest.max(n.prim_count);
+                        let mid = r.start + (r.end - r.start) / 2;
+                        (*n.aabb(), From::Slots(r.start..mid), From::Slots(mid..r.end))
+                    }
+                }
+                From::Slots(r) if r.end - r.start == 1 => {
+                    nodes[at] = Bvh2Node::new(self.bounds(r.clone()), 1, r.start);
+                    continue;
+                }
+                From::Slots(r) => {
+                    let mid = r.start + (r.end - r.start) / 2;
+                    (self.bounds(r.clone()), From::Slots(r.start..mid), From::Slots(mid..r.end))
+                }
+            };
+            let k = nodes.len();
+            nodes[at] = Bvh2Node::new(children, 0, k as u32);
+            nodes.extend([Bvh2Node::default(); 2]);
+            stack.push((k + 1, second));
+            stack.push((k, first));
+        }
+        debug_assert_eq!(nodes.len(), 2 * self.order.len() - 1);
+        bvh.nodes = nodes;
+        // A cluster of k primitives adds at most ceil(log2 k) levels below its leaf.
+        bvh.max_depth += (u32::BITS - deepest.leading_zeros()) as usize + 1;
+        bvh.children_are_ordered_after_parents = true;
+    }
 }
 
 #[cfg(test)]
@@ -1428,5 +1685,52 @@ mod tests {
         // A ray starting on the surface does not hit it again.
         let r = Ray::new(target, Vec3::new(1.0, 0.0, 1e-3).normalize());
         assert!(a.intersect(&r).is_none());
+    }
+}
+
+#[cfg(test)]
+mod degenerate_timing {
+    use super::*;
+
+    fn time(label: &str, positions: &[Vec3], tris: &[[u32; 3]]) {
+        let t = std::time::Instant::now();
+        let a = Accel::build(positions, tris);
+        eprintln!("{label}: {} tris in {:.3} s", a.triangle_count(), t.elapsed().as_secs_f64());
+    }
+
+    #[test]
+    #[ignore]
+    fn measure() {
+        for n in [20_000u32, 100_000] {
+            let p = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
+            time(&format!("identical {n}"), &p, &vec![[0, 1, 2]; n as usize]);
+            let mut p = Vec::new();
+            let mut t = Vec::new();
+            for i in 0..n {
+                let s = 1.0 + i as f32 * 1e-3;
+                p.extend([Vec3::new(-s, -s, 0.0), Vec3::new(2.0 * s, -s, 0.0), Vec3::new(-s, 2.0 * s, 0.0)]);
+                t.push([3 * i, 3 * i + 1, 3 * i + 2]);
+            }
+            time(&format!("same centroid {n}"), &p, &t);
+            let p = vec![Vec3::ONE];
+            time(&format!("point {n}"), &p, &vec![[0, 0, 0]; n as usize]);
+            let mut p = Vec::new();
+            let mut t = Vec::new();
+            for i in 0..n {
+                p.push(Vec3::new(i as f32 * 0.37 % 11.0, i as f32 * 0.71 % 13.0, i as f32 * 0.13 % 7.0));
+                t.push([i, i, i]);
+            }
+            time(&format!("scattered points {n}"), &p, &t);
+        }
+        for n in [2_000u32, 5_000] {
+            let mut p = Vec::new();
+            let mut t = Vec::new();
+            for i in 0..n {
+                let s = 1.0 + i as f32 * 1e-2;
+                p.extend([Vec3::ZERO, Vec3::new(s, 0.0, 0.0), Vec3::new(0.0, s, s)]);
+                t.push([3 * i, 3 * i + 1, 3 * i + 2]);
+            }
+            time(&format!("nested diagonal {n}"), &p, &t);
+        }
     }
 }
