@@ -1053,7 +1053,6 @@ const PLOC_SEARCH_DISTANCE: usize = 14;
 /// - the converter reserves one CWBVH node per primitive; the unused capacity (about 90% of
 ///   it) is given back.
 fn build_cwbvh(aabbs: impl ExactSizeIterator<Item = Aabb>, reinsertion_ratio: f32) -> CwBvh {
-    let count = aabbs.len();
     let mut total = Aabb::empty();
     let mut builder = PlocBuilder::new();
     builder.current_nodes = aabbs
@@ -1274,7 +1273,10 @@ impl Clusters {
     /// The PLOC leaves: one per primitive outside the clusters and one per cluster (several
     /// primitives), indexing `order`.
     fn leaves(&self, nodes: &[Bvh2Node]) -> Vec<Bvh2Node> {
-        let singles = self.ranges.first().map_or(self.order.len(), |r| r.start as usize);
+        let singles = self
+            .ranges
+            .first()
+            .map_or(self.order.len(), |r| r.start as usize);
         let mut leaves: Vec<Bvh2Node> = self.order[..singles]
             .iter()
             .enumerate()
@@ -1315,7 +1317,11 @@ impl Clusters {
                         let r = n.first_index..n.first_index + n.prim_count;
                         deepest = deepest.max(n.prim_count);
                         let mid = r.start + (r.end - r.start) / 2;
-                        (*n.aabb(), From::Slots(r.start..mid), From::Slots(mid..r.end))
+                        (
+                            *n.aabb(),
+                            From::Slots(r.start..mid),
+                            From::Slots(mid..r.end),
+                        )
                     }
                 }
                 From::Slots(r) if r.end - r.start == 1 => {
@@ -1324,7 +1330,11 @@ impl Clusters {
                 }
                 From::Slots(r) => {
                     let mid = r.start + (r.end - r.start) / 2;
-                    (self.bounds(r.clone()), From::Slots(r.start..mid), From::Slots(mid..r.end))
+                    (
+                        self.bounds(r.clone()),
+                        From::Slots(r.start..mid),
+                        From::Slots(mid..r.end),
+                    )
                 }
             };
             let k = nodes.len();
@@ -1695,7 +1705,11 @@ mod degenerate_timing {
     fn time(label: &str, positions: &[Vec3], tris: &[[u32; 3]]) {
         let t = std::time::Instant::now();
         let a = Accel::build(positions, tris);
-        eprintln!("{label}: {} tris in {:.3} s", a.triangle_count(), t.elapsed().as_secs_f64());
+        eprintln!(
+            "{label}: {} tris in {:.3} s",
+            a.triangle_count(),
+            t.elapsed().as_secs_f64()
+        );
     }
 
     #[test]
@@ -1708,7 +1722,11 @@ mod degenerate_timing {
             let mut t = Vec::new();
             for i in 0..n {
                 let s = 1.0 + i as f32 * 1e-3;
-                p.extend([Vec3::new(-s, -s, 0.0), Vec3::new(2.0 * s, -s, 0.0), Vec3::new(-s, 2.0 * s, 0.0)]);
+                p.extend([
+                    Vec3::new(-s, -s, 0.0),
+                    Vec3::new(2.0 * s, -s, 0.0),
+                    Vec3::new(-s, 2.0 * s, 0.0),
+                ]);
                 t.push([3 * i, 3 * i + 1, 3 * i + 2]);
             }
             time(&format!("same centroid {n}"), &p, &t);
@@ -1717,7 +1735,11 @@ mod degenerate_timing {
             let mut p = Vec::new();
             let mut t = Vec::new();
             for i in 0..n {
-                p.push(Vec3::new(i as f32 * 0.37 % 11.0, i as f32 * 0.71 % 13.0, i as f32 * 0.13 % 7.0));
+                p.push(Vec3::new(
+                    i as f32 * 0.37 % 11.0,
+                    i as f32 * 0.71 % 13.0,
+                    i as f32 * 0.13 % 7.0,
+                ));
                 t.push([i, i, i]);
             }
             time(&format!("scattered points {n}"), &p, &t);

@@ -16,7 +16,8 @@
 //! order of the walk.
 
 use super::{
-    accessor, compression, extensions, tangents, Instance, MeshParts, Scene, SceneError, SceneParts,
+    accessor, compression, extensions, tangents, validate, Instance, MeshParts, Scene, SceneError,
+    SceneParts,
 };
 use crate::camera::Camera;
 use crate::light::{Light, LUMINOUS_EFFICACY};
@@ -269,11 +270,14 @@ pub(super) fn load(path: &Path) -> Result<Scene, SceneError> {
     match scene {
         Some(scene) => {
             // Depth-first in file order with an explicit stack; a depth beyond the node count
-            // can only come from a cycle.
+            // can only come from a cycle. Nodes reached by several paths (a DAG) are visited
+            // once per path, which may be exponentially many: the visits, pending ones
+            // included, are counted against MAX_PLACEMENTS before they are made.
             let node_count = document.nodes().len();
             let mut stack: Vec<(gltf::Node, Mat4, usize)> =
                 scene.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
             stack.reverse();
+            let mut visits = 0usize;
             while let Some((node, parent, depth)) = stack.pop() {
                 if depth > node_count {
                     return Err(SceneError::invalid(
@@ -281,6 +285,10 @@ pub(super) fn load(path: &Path) -> Result<Scene, SceneError> {
                         node_label(&node),
                         "the node hierarchy has a cycle",
                     ));
+                }
+                visits += 1;
+                if visits + stack.len() + node.children().len() > MAX_PLACEMENTS {
+                    return Err(too_many_placements(path, &node));
                 }
                 let world = loader.node(&node, parent, &document)?;
                 let first_child = stack.len();
@@ -299,6 +307,47 @@ pub(super) fn load(path: &Path) -> Result<Scene, SceneError> {
         loader.parts.tangents.resize(n, Vec4::ZERO);
     }
     Scene::from_parts(loader.parts)
+}
+
+/// The most node visits (a node reached by several paths of the hierarchy is visited once per
+/// path) and, separately, mesh placements (node meshes and EXT_mesh_gpu_instancing instances)
+/// a scene may have: a hierarchy in which each node lists the next one twice reaches 2^40
+/// placements in 40 levels, so the walk counts them before it makes them.
+pub const MAX_PLACEMENTS: usize = 1_000_000;
+
+/// The most triangles a scene may hold once its meshes are placed: the flattened placements'
+/// (every placement of a mesh placed once, or with an emissive material) and the instanced
+/// meshes' (stored once); counted from the accessors before any geometry is read. About
+/// 8 GB of scene and BVH; an emissive mesh placed many times would otherwise multiply it.
+pub const MAX_TRIANGLES: usize = 20_000_000;
+
+/// The error for a hierarchy that places more than [`MAX_PLACEMENTS`] nodes or instances,
+/// found at `node`.
+fn too_many_placements(path: &Path, node: &gltf::Node) -> SceneError {
+    SceneError::invalid(
+        path,
+        node_label(node),
+        format!(
+            "the node hierarchy places more than {MAX_PLACEMENTS} nodes or mesh instances \
+             (a node reached by several paths is placed once per path)"
+        ),
+    )
+}
+
+/// The number of triangles primitive `prim` makes (from its index or POSITION count and its
+/// mode; 0 for points and lines, which are skipped).
+fn primitive_triangles(prim: &gltf::Primitive) -> usize {
+    let n = match prim.indices() {
+        Some(a) => a.count(),
+        None => prim
+            .get(&gltf::Semantic::Positions)
+            .map_or(0, |a| a.count()),
+    };
+    match prim.mode() {
+        Mode::Triangles => n / 3,
+        Mode::TriangleStrip | Mode::TriangleFan => n.saturating_sub(2),
+        _ => 0,
+    }
 }
 
 /// Swaps the vertex arrays and triangles of `parts` with those of `mesh`.
@@ -550,7 +599,11 @@ impl Loader<'_> {
         if let Some(mesh) = node.mesh() {
             match node.extension_value("EXT_mesh_gpu_instancing") {
                 Some(ext) => {
-                    for (i, local) in self.gpu_instances(node, ext, document)?.iter().enumerate() {
+                    let locals = self.gpu_instances(node, ext, document)?;
+                    if self.placements.len() + locals.len() > MAX_PLACEMENTS {
+                        return Err(too_many_placements(self.path, node));
+                    }
+                    for (i, local) in locals.iter().enumerate() {
                         let w = world * *local;
                         if Instance::new(0, w).is_none() {
                             return Err(self.bad(
@@ -564,14 +617,19 @@ impl Loader<'_> {
                         self.placements.push((mesh.index(), w));
                     }
                 }
-                None => self.placements.push((mesh.index(), world)),
+                None => {
+                    if self.placements.len() >= MAX_PLACEMENTS {
+                        return Err(too_many_placements(self.path, node));
+                    }
+                    self.placements.push((mesh.index(), world));
+                }
             }
         }
         if let Some(camera) = node.camera() {
             self.camera(node, &camera, world)?;
         }
         if let Some(light) = node.light() {
-            self.light(&light, world);
+            self.light(node, &light, world)?;
         }
         Ok(world)
     }
@@ -661,15 +719,41 @@ impl Loader<'_> {
         for &(m, _) in &self.placements {
             count[m] += 1;
         }
+        let emissive: Vec<bool> = meshes
+            .iter()
+            .map(|mesh| {
+                mesh.primitives().any(|p| {
+                    p.material()
+                        .index()
+                        .is_some_and(|i| self.parts.materials[i].is_emissive())
+                })
+            })
+            .collect();
+        // Triangles stored: a flattened mesh's at each placement, an instanced one's once.
+        let mut stored = 0usize;
+        for (m, mesh) in meshes.iter().enumerate() {
+            let copies = match (count[m], emissive[m]) {
+                (0, _) => 0,
+                (n, true) | (n @ 1, false) => n,
+                (_, false) => 1,
+            };
+            let triangles: usize = mesh.primitives().map(|p| primitive_triangles(&p)).sum();
+            stored = stored.saturating_add(triangles.saturating_mul(copies));
+            if stored > MAX_TRIANGLES {
+                return Err(self.bad(
+                    mesh_label(mesh),
+                    format!(
+                        "the scene would hold more than {MAX_TRIANGLES} triangles once its \
+                         meshes are placed (this mesh: {triangles} triangles, stored {copies} \
+                         times)"
+                    ),
+                ));
+            }
+        }
         let mut instanced: Vec<Option<u32>> = vec![None; meshes.len()];
         for (m, world) in std::mem::take(&mut self.placements) {
             let mesh = &meshes[m];
-            let emissive = mesh.primitives().any(|p| {
-                p.material()
-                    .index()
-                    .is_some_and(|i| self.parts.materials[i].is_emissive())
-            });
-            if count[m] < 2 || emissive {
+            if count[m] < 2 || emissive[m] {
                 self.mesh(mesh, world)?;
                 continue;
             }
@@ -726,10 +810,8 @@ impl Loader<'_> {
         let gltf::camera::Projection::Perspective(p) = camera.projection() else {
             return Err(self.bad(element, "orthographic cameras are not supported"));
         };
+        validate::perspective(&p).map_err(|r| self.bad(&element, r))?;
         let yfov = p.yfov();
-        if !(yfov > 0.0 && yfov < std::f32::consts::PI) {
-            return Err(self.bad(element, format!("yfov {yfov} is not in (0, pi)")));
-        }
         let (_, rotation, translation) = world.to_scale_rotation_translation();
         self.parts.cameras.push(Camera {
             name,
@@ -738,13 +820,23 @@ impl Loader<'_> {
                 translation,
             ),
             yfov,
-            aspect_ratio: p.aspect_ratio().filter(|a| a.is_finite() && *a > 0.0),
+            aspect_ratio: p.aspect_ratio(),
         });
         Ok(())
     }
 
-    fn light(&mut self, light: &gltf::khr_lights_punctual::Light, world: Mat4) {
+    fn light(
+        &mut self,
+        node: &gltf::Node,
+        light: &gltf::khr_lights_punctual::Light,
+        world: Mat4,
+    ) -> Result<(), SceneError> {
         use gltf::khr_lights_punctual::Kind;
+        validate::light(light).map_err(|r| {
+            let name = light.name().map_or(String::new(), |n| format!("{n:?} "));
+            let element = format!("light {name}({}) on {}", light.index(), node_label(node));
+            self.bad(element, r)
+        })?;
         // Photometric (candela, lux) to radiometric (W/sr, W/m^2) unless the file is radiometric.
         let power = match self.light_units {
             LightUnits::Photometric => {
@@ -754,7 +846,7 @@ impl Loader<'_> {
         };
         let position = world.transform_point3(Vec3::ZERO);
         let direction = world.transform_vector3(-Vec3::Z).normalize();
-        let range = light.range().filter(|r| r.is_finite() && *r > 0.0);
+        let range = light.range();
         self.parts.lights.push(match light.kind() {
             Kind::Point => Light::Point {
                 position,
@@ -777,6 +869,7 @@ impl Loader<'_> {
                 irradiance: power,
             },
         });
+        Ok(())
     }
 
     /// Checks that `accessor` has one of the `allowed` layouts and lies within its view.
@@ -981,6 +1074,14 @@ impl Loader<'_> {
                 .iter()
                 .map(|&p| world.transform_point3(p))
                 .collect();
+            if let Some((k, &p)) = positions
+                .iter()
+                .enumerate()
+                .find(|(_, p)| validate::position(**p).is_err())
+            {
+                let why = validate::position(p).unwrap_err();
+                return Err(self.bad(format!("{element}, vertex {k}"), why));
+            }
             let (mut normals, mut uvs) = (normals, uvs);
             let (mut uvs1, mut colors) = (uvs1, colors);
             let tangents = if normal_mapped {
@@ -1138,6 +1239,7 @@ impl Loader<'_> {
             .name()
             .map_or_else(|| format!("material{index}"), str::to_string);
         let element = format!("material {name:?} ({index})");
+        validate::material(m).map_err(|r| self.bad(&element, r))?;
         let pbr = m.pbr_metallic_roughness();
         let base_color_texture = match pbr.base_color_texture() {
             Some(info) => Some(self.texture(&info, ColorSpace::Srgb, &element)?),

@@ -126,6 +126,7 @@ mod instances;
 mod mesh;
 mod obj;
 mod tangents;
+mod validate;
 
 pub use error::SceneError;
 pub use instances::{Instance, InstancedMesh, Instances};
@@ -339,7 +340,8 @@ impl Scene {
                 ),
             ));
         }
-        let instances = Instances::build(meshes, instances);
+        let instances = Instances::build(meshes, instances)
+            .map_err(|(element, reason)| bad(element, reason))?;
         let mut accel = Accel::build_alpha_tested(&positions, &triangles, |t| {
             alpha_tested(triangle_materials[t])
         });

@@ -89,11 +89,12 @@ pub(super) fn load(path: &Path) -> Result<Scene, SceneError> {
             }
             _ => default,
         };
-        parts.positions.extend(
-            mesh.positions
-                .chunks_exact(3)
-                .map(|c| Vec3::new(c[0], c[1], c[2])),
-        );
+        for (k, c) in mesh.positions.chunks_exact(3).enumerate() {
+            let p = Vec3::new(c[0], c[1], c[2]);
+            super::validate::position(p)
+                .map_err(|r| SceneError::invalid(path, format!("{element}, vertex {k}"), r))?;
+            parts.positions.push(p);
+        }
         if mesh.normals.len() == 3 * n {
             parts.normals.extend(
                 mesh.normals
