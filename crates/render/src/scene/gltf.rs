@@ -269,15 +269,15 @@ pub(super) fn load(path: &Path) -> Result<Scene, SceneError> {
         .or_else(|| document.scenes().next());
     match scene {
         Some(scene) => {
+            // Nodes reached by several paths (a DAG) are visited once per path, which may be
+            // exponentially many: they are counted first.
+            count_visits(path, &document, &scene)?;
             // Depth-first in file order with an explicit stack; a depth beyond the node count
-            // can only come from a cycle. Nodes reached by several paths (a DAG) are visited
-            // once per path, which may be exponentially many: the visits, pending ones
-            // included, are counted against MAX_PLACEMENTS before they are made.
+            // can only come from a cycle.
             let node_count = document.nodes().len();
             let mut stack: Vec<(gltf::Node, Mat4, usize)> =
                 scene.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
             stack.reverse();
-            let mut visits = 0usize;
             while let Some((node, parent, depth)) = stack.pop() {
                 if depth > node_count {
                     return Err(SceneError::invalid(
@@ -285,10 +285,6 @@ pub(super) fn load(path: &Path) -> Result<Scene, SceneError> {
                         node_label(&node),
                         "the node hierarchy has a cycle",
                     ));
-                }
-                visits += 1;
-                if visits + stack.len() + node.children().len() > MAX_PLACEMENTS {
-                    return Err(too_many_placements(path, &node));
                 }
                 let world = loader.node(&node, parent, &document)?;
                 let first_child = stack.len();
@@ -332,6 +328,69 @@ fn too_many_placements(path: &Path, node: &gltf::Node) -> SceneError {
              (a node reached by several paths is placed once per path)"
         ),
     )
+}
+
+/// The number of node visits the walk of `scene` makes (each node once per path from a root
+/// to it), counted without walking: a node's count is one plus its children's, each node
+/// computed once (depth-first, without recursion). A cycle, or more than [`MAX_PLACEMENTS`]
+/// visits, is an error naming a node.
+fn count_visits(
+    path: &Path,
+    document: &gltf::Document,
+    scene: &gltf::Scene,
+) -> Result<usize, SceneError> {
+    const UNSEEN: usize = usize::MAX;
+    const OPEN: usize = usize::MAX - 1;
+    let mut visits = vec![UNSEEN; document.nodes().len()];
+    let mut total = 0usize;
+    for root in scene.nodes() {
+        // (node, whether its children have been pushed)
+        let mut stack = vec![(root.clone(), false)];
+        while let Some((node, expanded)) = stack.pop() {
+            let i = node.index();
+            if expanded {
+                let sum = node
+                    .children()
+                    .fold(1usize, |s, c| s.saturating_add(visits[c.index()]));
+                if sum > MAX_PLACEMENTS {
+                    return Err(too_many_placements(path, &node));
+                }
+                visits[i] = sum;
+                continue;
+            }
+            match visits[i] {
+                UNSEEN => {}
+                OPEN => {
+                    return Err(SceneError::invalid(
+                        path,
+                        node_label(&node),
+                        "the node hierarchy has a cycle",
+                    ))
+                }
+                _ => continue,
+            }
+            visits[i] = OPEN;
+            stack.push((node.clone(), true));
+            for c in node.children() {
+                match visits[c.index()] {
+                    OPEN => {
+                        return Err(SceneError::invalid(
+                            path,
+                            node_label(&c),
+                            "the node hierarchy has a cycle",
+                        ))
+                    }
+                    UNSEEN => stack.push((c, false)),
+                    _ => {}
+                }
+            }
+        }
+        total = total.saturating_add(visits[root.index()]);
+        if total > MAX_PLACEMENTS {
+            return Err(too_many_placements(path, &root));
+        }
+    }
+    Ok(total)
 }
 
 /// The number of triangles primitive `prim` makes (from its index or POSITION count and its
@@ -3301,5 +3360,292 @@ mod material_extension_tests {
                 "{ext}: {err}"
             );
         }
+    }
+}
+
+/// Values outside the specification, overflowing positions and exploding node graphs: each
+/// an error naming the file and the element, found before the work it would cause.
+#[cfg(test)]
+mod hostile_tests {
+    use super::tests::{test_doc, write_embedded};
+    use super::*;
+    use serde_json::{json, Value};
+    use std::time::{Duration, Instant};
+
+    /// The error loading `doc` (with buffer `bin`) gives, checked to name the file and to
+    /// come within a second.
+    fn error(doc: Value, bin: &[u8]) -> String {
+        let dir = tempfile::tempdir().unwrap();
+        let path = write_embedded(dir.path(), doc, bin);
+        let start = Instant::now();
+        let err = Scene::load(&path).expect_err("should fail").to_string();
+        assert!(
+            start.elapsed() < Duration::from_secs(1),
+            "{err}: {:?}",
+            start.elapsed()
+        );
+        assert!(err.contains("scene.gltf"), "no file name in: {err}");
+        err
+    }
+
+    /// The test scene with `value` at the JSON pointer `pointer` (its parent must exist).
+    fn with(pointer: &str, value: Value) -> (Value, Vec<u8>) {
+        let (mut doc, bin) = test_doc();
+        let (parent, key) = pointer.rsplit_once('/').unwrap();
+        let parent = doc.pointer_mut(parent).unwrap_or_else(|| panic!("{pointer}"));
+        match key.parse::<usize>() {
+            Ok(i) if parent.is_array() => parent[i] = value,
+            _ => parent[key] = value,
+        }
+        (doc, bin)
+    }
+
+    /// Each `(pointer, value, words)`: the test scene with that value fails naming `words`.
+    fn rejects(cases: &[(&str, Value, &[&str])]) {
+        for (pointer, value, words) in cases {
+            let (doc, bin) = with(pointer, value.clone());
+            let err = error(doc, &bin);
+            for w in *words {
+                assert!(err.contains(w), "{pointer} = {value}: {w:?} not in: {err}");
+            }
+        }
+    }
+
+    const LIGHTS: &str = "/extensions/KHR_lights_punctual/lights";
+
+    #[test]
+    fn lights_outside_the_specification_are_named() {
+        let point = &["light (0) on node \"bulb\" (4)"][..];
+        let spot = &["light (1) on node \"spot\" (5)", "innerConeAngle"][..];
+        rejects(&[
+            (&format!("{LIGHTS}/0/color"), json!([-1, 1, 1]), point),
+            (&format!("{LIGHTS}/0/color"), json!([1e39, 1, 1]), point),
+            (&format!("{LIGHTS}/0/color"), json!([2, 1, 1]), point),
+            (&format!("{LIGHTS}/0/intensity"), json!(-1), point),
+            (&format!("{LIGHTS}/0/intensity"), json!(1e39), point),
+            (&format!("{LIGHTS}/0/range"), json!(0), point),
+            (&format!("{LIGHTS}/0/range"), json!(-5), point),
+            (&format!("{LIGHTS}/0/range"), json!(1e39), point),
+            (&format!("{LIGHTS}/1/spot/innerConeAngle"), json!(0.6), spot),
+            (
+                &format!("{LIGHTS}/1/spot/innerConeAngle"),
+                json!(-0.1),
+                spot,
+            ),
+            (&format!("{LIGHTS}/1/spot/outerConeAngle"), json!(2.0), spot),
+            (
+                &format!("{LIGHTS}/1/spot/outerConeAngle"),
+                json!(1e39),
+                spot,
+            ),
+        ]);
+        // The edges of the ranges load: inner = outer (the project's hard edge), outer =
+        // pi/2, intensity 0.
+        let dir = tempfile::tempdir().unwrap();
+        let (mut doc, bin) = test_doc();
+        doc["extensions"]["KHR_lights_punctual"]["lights"][1]["spot"] =
+            json!({"innerConeAngle": 0.5, "outerConeAngle": 0.5});
+        doc["extensions"]["KHR_lights_punctual"]["lights"][0]["intensity"] = json!(0);
+        Scene::load(&write_embedded(dir.path(), doc, &bin)).unwrap();
+        let (mut doc, bin) = test_doc();
+        doc["extensions"]["KHR_lights_punctual"]["lights"][1]["spot"] =
+            json!({"innerConeAngle": 0, "outerConeAngle": std::f64::consts::FRAC_PI_2});
+        Scene::load(&write_embedded(dir.path(), doc, &bin)).unwrap();
+    }
+
+    #[test]
+    fn cameras_outside_the_specification_are_named() {
+        let named = &["camera \"cam_node\" (0) on node \"cam_node\" (3)"][..];
+        let p = "/cameras/0/perspective";
+        rejects(&[
+            (&format!("{p}/yfov"), json!(4), named),
+            (&format!("{p}/yfov"), json!(0), named),
+            (&format!("{p}/znear"), json!(0), named),
+            (&format!("{p}/znear"), json!(-1), named),
+            (&format!("{p}/znear"), json!(1e39), named),
+            (&format!("{p}/aspectRatio"), json!(0), named),
+            (&format!("{p}/aspectRatio"), json!(1e39), named),
+        ]);
+        let (mut doc, bin) = test_doc();
+        doc["cameras"][0]["perspective"]["zfar"] = json!(0.05);
+        let err = error(doc, &bin);
+        assert!(err.contains("zfar 0.05"), "{err}");
+    }
+
+    #[test]
+    fn materials_outside_the_specification_are_named() {
+        let asphalt = &["material \"asphalt\" (0)"][..];
+        let glow = &["material \"glow\" (1)"][..];
+        rejects(&[
+            (
+                "/materials/0/pbrMetallicRoughness",
+                json!({"baseColorFactor": [-0.5, 0.5, 0.5, 1]}),
+                &["material \"asphalt\" (0)", "baseColorFactor"],
+            ),
+            (
+                "/materials/0/pbrMetallicRoughness",
+                json!({"baseColorFactor": [1e39, 0.5, 0.5, 1]}),
+                asphalt,
+            ),
+            (
+                "/materials/0/pbrMetallicRoughness",
+                json!({"metallicFactor": 1.5}),
+                asphalt,
+            ),
+            (
+                "/materials/0/pbrMetallicRoughness",
+                json!({"roughnessFactor": -0.1}),
+                asphalt,
+            ),
+            ("/materials/0/alphaCutoff", json!(-1), asphalt),
+            ("/materials/1/emissiveFactor", json!([-1, 0, 0]), glow),
+            ("/materials/1/emissiveFactor", json!([2, 0, 0]), glow),
+            ("/materials/1/emissiveFactor", json!([1e39, 0, 0]), glow),
+            (
+                "/materials/1/extensions/KHR_materials_emissive_strength/emissiveStrength",
+                json!(-5),
+                &["material \"glow\" (1)", "emissiveStrength"],
+            ),
+            (
+                "/materials/1/extensions/KHR_materials_emissive_strength/emissiveStrength",
+                json!(1e39),
+                glow,
+            ),
+            ("/materials/0/extras/streaks/kd", json!([-1, 0, 0]), asphalt),
+            (
+                "/materials/0/extras/streaks/ks",
+                json!([1e39, 0, 0]),
+                asphalt,
+            ),
+            ("/materials/0/extras/streaks/alpha", json!(1e39), asphalt),
+        ]);
+        // A negative strength is an error even where the factor is black.
+        let (mut doc, bin) = test_doc();
+        doc["materials"][1]["emissiveFactor"] = json!([0, 0, 0]);
+        doc["materials"][1]["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"] =
+            json!(-1);
+        let err = error(doc, &bin);
+        assert!(err.contains("material \"glow\" (1)"), "{err}");
+    }
+
+    #[test]
+    fn positions_that_overflow_the_bvh_name_the_mesh() {
+        // A finite, invertible node transform that takes a vertex beyond 1e18.
+        let (doc, bin) = with("/nodes/2/scale", json!([1e20, 1, 1e-20]));
+        let err = error(doc, &bin);
+        assert!(
+            err.contains("mesh \"tri\" (1), primitive 0, vertex 1") && err.contains("overflow"),
+            "{err}"
+        );
+        // A finite coordinate beyond 1e18 in the buffer (the last vertex's y).
+        let (doc, mut bin) = test_doc();
+        let n = bin.len();
+        bin[n - 8..n - 4].copy_from_slice(&f32::MAX.to_le_bytes());
+        let err = error(doc, &bin);
+        assert!(
+            err.contains("mesh \"tri\" (1), primitive 0, vertex 2"),
+            "{err}"
+        );
+        // An instanced mesh (placed twice) whose second instance reaches beyond 1e18.
+        let (mut doc, bin) = test_doc();
+        doc["nodes"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!({"mesh": 0, "scale": [1e20, 1, 1e-20]}));
+        doc["scenes"][0]["nodes"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!(7));
+        let err = error(doc, &bin);
+        assert!(err.contains("instance 1 of mesh \"quad\" (0)"), "{err}");
+    }
+
+    /// A chain of `depth` nodes, each listing the next twice, above a node placing mesh
+    /// `mesh`: 2^depth placements of it.
+    fn doubling_dag(doc: &mut Value, depth: usize, mesh: usize) {
+        let base = doc["nodes"].as_array().unwrap().len();
+        let nodes = doc["nodes"].as_array_mut().unwrap();
+        for i in 0..depth {
+            nodes.push(json!({"name": format!("d{i}"), "children": [base + i + 1, base + i + 1]}));
+        }
+        nodes.push(json!({"name": "leaf", "mesh": mesh}));
+        doc["scenes"][0]["nodes"] = json!([base]);
+    }
+
+    #[test]
+    fn exponential_node_graphs_are_refused_before_they_are_walked() {
+        let (mut doc, bin) = test_doc();
+        doubling_dag(&mut doc, 40, 1);
+        let err = error(doc, &bin);
+        assert!(err.contains("more than 1000000"), "{err}");
+        // 2^18 placements of an emissive (so flattened) strip of 100 triangles: 26 million.
+        let (mut doc, mut bin) = test_doc();
+        let at = bin.len();
+        let strip: Vec<u8> = (0..102)
+            .flat_map(|i| [i as f32 * 0.1, (i % 2) as f32, 0.0])
+            .flat_map(f32::to_le_bytes)
+            .collect();
+        bin.extend(&strip);
+        let views = doc["bufferViews"].as_array_mut().unwrap();
+        views.push(json!({"buffer": 0, "byteOffset": at, "byteLength": strip.len()}));
+        let view = views.len() - 1;
+        let accessors = doc["accessors"].as_array_mut().unwrap();
+        accessors.push(
+            json!({"bufferView": view, "componentType": 5126, "count": 102,
+            "type": "VEC3", "min": [0, 0, 0], "max": [10.1, 1, 0]}),
+        );
+        let accessor = accessors.len() - 1;
+        doc["buffers"][0]["byteLength"] = json!(bin.len());
+        doc["meshes"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!({"name": "strip", "primitives":
+            [{"attributes": {"POSITION": accessor}, "mode": 5, "material": 1}]}));
+        doubling_dag(&mut doc, 18, 2);
+        let err = error(doc, &bin);
+        assert!(
+            err.contains("mesh \"strip\" (2)") && err.contains("more than 20000000 triangles"),
+            "{err}"
+        );
+    }
+
+    /// A triangle fan of 200,000 vertices on a circle loads in linear time: 199,998
+    /// triangles sharing the centre vertex.
+    #[test]
+    fn huge_triangle_fans_load_quickly() {
+        let (mut doc, mut bin) = test_doc();
+        let n = 200_000;
+        let at = bin.len();
+        let fan: Vec<u8> = (0..n)
+            .flat_map(|i| {
+                let a = i as f32 / n as f32 * std::f32::consts::TAU;
+                if i == 0 {
+                    [0.0; 3]
+                } else {
+                    [a.cos(), a.sin(), 0.0]
+                }
+            })
+            .flat_map(f32::to_le_bytes)
+            .collect();
+        bin.extend(&fan);
+        doc["bufferViews"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!({"buffer": 0, "byteOffset": at, "byteLength": fan.len()}));
+        doc["accessors"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!({"bufferView": 5,
+            "componentType": 5126, "count": n, "type": "VEC3", "min": [-1, -1, 0],
+            "max": [1, 1, 0]}));
+        doc["buffers"][0]["byteLength"] = json!(bin.len());
+        doc["meshes"][1]["primitives"][0] = json!({"attributes": {"POSITION": 5}, "mode": 6});
+        let dir = tempfile::tempdir().unwrap();
+        let path = write_embedded(dir.path(), doc, &bin);
+        let start = Instant::now();
+        let scene = Scene::load(&path).unwrap();
+        let took = start.elapsed();
+        assert!(took < Duration::from_secs(5), "{took:?}");
+        assert_eq!(scene.triangles.len(), 2 + n - 2);
     }
 }
