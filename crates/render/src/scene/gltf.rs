@@ -3392,7 +3392,9 @@ mod hostile_tests {
     fn with(pointer: &str, value: Value) -> (Value, Vec<u8>) {
         let (mut doc, bin) = test_doc();
         let (parent, key) = pointer.rsplit_once('/').unwrap();
-        let parent = doc.pointer_mut(parent).unwrap_or_else(|| panic!("{pointer}"));
+        let parent = doc
+            .pointer_mut(parent)
+            .unwrap_or_else(|| panic!("{pointer}"));
         match key.parse::<usize>() {
             Ok(i) if parent.is_array() => parent[i] = value,
             _ => parent[key] = value,
