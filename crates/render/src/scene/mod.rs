@@ -104,6 +104,18 @@
 //! `alpha_dry` is the dry shininess and interpolates `shininess`. So black (w = 0) is the wet
 //! value given by `alpha`/`ks` and green (w = 1) is fully dry.
 //!
+//! - Values are checked against the specification and the extensions' schemas (the
+//!   `validate` module): colours and factors in their ranges (baseColorFactor,
+//!   emissiveFactor, metallic, roughness, light colour in [0, 1]; emissiveStrength, intensity
+//!   and the paper models' `kd`, `ks`, `alpha`, `shininess` finite and non-negative), light
+//!   ranges above 0, spot cones with `0 <= inner <= outer <= pi/2` (inner may equal outer: a
+//!   hard edge), cameras' yfov, znear, zfar and aspectRatio, node transforms finite and
+//!   invertible, vertex positions finite and within [`MAX_COORDINATE`] once placed. Anything
+//!   else is an error naming the file and the light, camera, material, node or mesh.
+//! - Limits: a node graph may visit at most [`MAX_PLACEMENTS`] nodes (a node reached by
+//!   several paths counts once per path; counted before the walk) and place as many meshes,
+//!   and the placed meshes may hold at most [`MAX_TRIANGLES`] triangles (counted from the
+//!   accessors before any geometry is read).
 //! - OBJ/MTL (via tobj, triangulated): `Kd` with a non-zero `Ks` (and `illum` not 0 or 1) is
 //!   blinn_phong with shininess `Ns`; otherwise Lambertian `Kd` (times `map_Kd`); `Ke` is
 //!   emission. A missing MTL file is a warning (every material becomes grey diffuse). OBJ has no
@@ -129,8 +141,10 @@ mod tangents;
 mod validate;
 
 pub use error::SceneError;
+pub use gltf::{MAX_PLACEMENTS, MAX_TRIANGLES};
 pub use instances::{Instance, InstancedMesh, Instances};
 pub use mesh::MeshParts;
+pub use validate::MAX_COORDINATE;
 
 use crate::accel::Accel;
 use crate::camera::Camera;

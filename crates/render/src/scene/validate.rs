@@ -67,7 +67,7 @@ pub fn light(l: &gltf::khr_lights_punctual::Light) -> Result<(), String> {
 }
 
 /// A perspective camera: `yfov` in (0, pi), `znear` finite and above 0, `zfar` (if given)
-/// finite or infinite but above `znear`, `aspectRatio` (if given) finite and above 0.
+/// above `znear` (an infinite one is no far plane, as an absent one is), `aspectRatio` (if given) finite and above 0.
 pub fn perspective(p: &gltf::camera::Perspective) -> Result<(), String> {
     let yfov = p.yfov();
     if !(yfov > 0.0 && yfov < std::f32::consts::PI) {
@@ -78,7 +78,7 @@ pub fn perspective(p: &gltf::camera::Perspective) -> Result<(), String> {
         return Err(format!("znear {znear} must be finite and above 0"));
     }
     if let Some(zfar) = p.zfar() {
-        if !(zfar > znear) {
+        if zfar.is_nan() || zfar <= znear {
             return Err(format!("zfar {zfar} must be above znear {znear}"));
         }
     }
