@@ -1133,13 +1133,9 @@ impl Loader<'_> {
                 .iter()
                 .map(|&p| world.transform_point3(p))
                 .collect();
-            if let Some((k, &p)) = positions
-                .iter()
-                .enumerate()
-                .find(|(_, p)| validate::position(**p).is_err())
-            {
-                let why = validate::position(p).unwrap_err();
-                return Err(self.bad(format!("{element}, vertex {k}"), why));
+            // In world space: a finite vertex times a large scale may overflow.
+            for (k, &p) in positions.iter().enumerate() {
+                validate::position(p).map_err(|r| self.bad(format!("{element}, vertex {k}"), r))?;
             }
             let (mut normals, mut uvs) = (normals, uvs);
             let (mut uvs1, mut colors) = (uvs1, colors);
