@@ -1378,7 +1378,7 @@ mod tests {
     use super::*;
 
     /// A xorshift64 generator of floats in [0, 1) from `seed`.
-    fn xorshift(mut seed: u64) -> impl FnMut() -> f32 {
+    pub(super) fn xorshift(mut seed: u64) -> impl FnMut() -> f32 {
         move || {
             seed ^= seed << 13;
             seed ^= seed >> 7;
@@ -1389,7 +1389,10 @@ mod tests {
 
     /// `n` small random triangles (each inside a unit cube) scattered through a 20 m cube:
     /// positions and triangles for [`Accel::build`].
-    fn triangle_soup(n: u32, rnd: &mut impl FnMut() -> f32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    pub(super) fn triangle_soup(
+        n: u32,
+        rnd: &mut impl FnMut() -> f32,
+    ) -> (Vec<Vec3>, Vec<[u32; 3]>) {
         let mut positions = vec![];
         let mut triangles = vec![];
         for i in 0..n {
@@ -1767,6 +1770,20 @@ mod degenerate_tests {
         let a = build("same centroid", &p, &t, 10);
         let ray = Ray::new(Vec3::new(0.1, 0.2, -2.0), Vec3::Z);
         assert!((a.intersect(&ray).unwrap().t - 2.0).abs() < 1e-6);
+        // 50,000 coincident triangles among 50,000 scattered ones: the boxes cover the scene
+        // a few times over on average, so only the cluster finds them.
+        let mut rnd = super::tests::xorshift(5);
+        let (mut p, mut t) = super::tests::triangle_soup(50_000, &mut rnd);
+        let k = p.len() as u32;
+        p.extend([
+            Vec3::new(0.0, 0.0, 30.0),
+            Vec3::new(0.5, 0.0, 30.0),
+            Vec3::new(0.0, 0.5, 30.0),
+        ]);
+        t.extend(std::iter::repeat_n([k, k + 1, k + 2], 50_000));
+        let a = build("coincident among others", &p, &t, 10);
+        let ray = Ray::new(Vec3::new(0.1, 0.1, 31.0), -Vec3::Z);
+        assert!((a.intersect(&ray).unwrap().t - 1.0).abs() < 1e-5);
         // Zero-area triangles: all at one point, or scattered; rays miss them.
         let a = build("points", &[Vec3::ONE], &vec![[0, 0, 0]; n], 10);
         assert!(a.intersect(&Ray::new(Vec3::ZERO, Vec3::X)).is_none());

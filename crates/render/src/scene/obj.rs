@@ -318,14 +318,14 @@ illum 1
         );
     }
 
-    /// One face of 200,000 vertices on a circle (a huge polygon): triangulated as a fan in
+    /// One face of 500,000 vertices on a circle (a huge polygon): triangulated as a fan in
     /// linear time, and its slivers, which all hold the first vertex, get their BVH in about
     /// `n log n` (a million took 68 s before).
     #[test]
     fn huge_polygons_load_quickly() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("disc.obj");
-        let n = 200_000;
+        let n = 500_000;
         let mut text = String::new();
         for i in 0..n {
             let a = i as f32 / n as f32 * std::f32::consts::TAU;
