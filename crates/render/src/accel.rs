@@ -7,6 +7,14 @@
 //! intersection-friendly layout, so traversal reads them contiguously and never goes through
 //! `primitive_indices`; each slot remembers the scene triangle it came from.
 //!
+//! Degenerate input: PLOC stalls on coincident or nested boxes (one merge per pass over all
+//! nodes: quadratic time, and a chain as deep as the boxes are many, which overflowed the
+//! stack in obvhs' recursive CWBVH conversion). Runs of such boxes are found before the build
+//! and given balanced subtrees (`Clusters`), and boxes piled on one another everywhere (a
+//! huge fan's slivers) give a balanced tree in Morton order (`MAX_OVERLAP`); 100,000
+//! coincident triangles or a fan of a million build in well under a second. Other scenes
+//! (all we ship) are built exactly as before.
+//!
 //! Watertight triangles: the triangle test is Woop, Benthin and Wald's (2013), so a ray
 //! through an edge or vertex that triangles share hits one of them (`intersect_triangle`).
 //! The node test is obvhs' slab test, which is not widened for rounding (Ize 2013): a ray that
