@@ -1264,7 +1264,15 @@ impl Loader<'_> {
                  from flat normals, as the glTF specification says"
             ));
         }
-        tangents::generate(positions, normals, uvs, tris)
+        tangents::generate(positions, normals, uvs, tris).unwrap_or_else(|valence| {
+            self.warn(format!(
+                "{element}: a vertex is shared by {valence} triangles, more than MikkTSpace can \
+                 take ({}: it recurses once per triangle around a vertex); rendered without \
+                 the normal map",
+                tangents::MAX_VALENCE
+            ));
+            (vec![Vec4::ZERO; positions.len()], Vec::new())
+        })
     }
 
     /// The glTF default material (white, metallic 1, roughness 1), added once when needed.

@@ -66,7 +66,8 @@
 //!   MikkTSpace tangents generated from the world-space positions, the normals (the face
 //!   normals for flat primitives) and the uvs (vertices whose triangles disagree, as on a uv
 //!   mirror seam, are duplicated). A normal-mapped primitive without TEXCOORD_0 is rendered
-//!   without the map (a warning). A perturbed normal is tilted back toward the geometric
+//!   without the map (a warning), and so is one with a vertex shared by more than 4,096
+//!   triangles (MikkTSpace recurses once per triangle around a vertex). A perturbed normal is tilted back toward the geometric
 //!   normal where the viewer's mirror direction would go below the surface
 //!   ([`crate::normal_map::valid_reflection_normal`]).
 //! - Textures ([`crate::texture`]): every material texture reads its `texCoord` set
