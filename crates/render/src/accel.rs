@@ -7,6 +7,14 @@
 //! intersection-friendly layout, so traversal reads them contiguously and never goes through
 //! `primitive_indices`; each slot remembers the scene triangle it came from.
 //!
+//! Degenerate input: PLOC stalls on coincident or nested boxes (one merge per pass over all
+//! nodes: quadratic time, and a chain as deep as the boxes are many, which overflowed the
+//! stack in obvhs' recursive CWBVH conversion). Runs of such boxes are found before the build
+//! and given balanced subtrees (`Clusters`), and boxes piled on one another everywhere (a
+//! huge fan's slivers) give a balanced tree in Morton order (`MAX_OVERLAP`); 100,000
+//! coincident triangles or a fan of a million build in well under a second. Other scenes
+//! (all we ship) are built exactly as before.
+//!
 //! Watertight triangles: the triangle test is Woop, Benthin and Wald's (2013), so a ray
 //! through an edge or vertex that triangles share hits one of them (`intersect_triangle`).
 //! The node test is obvhs' slab test, which is not widened for rounding (Ize 2013): a ray that
@@ -1053,7 +1061,6 @@ const PLOC_SEARCH_DISTANCE: usize = 14;
 /// - the converter reserves one CWBVH node per primitive; the unused capacity (about 90% of
 ///   it) is given back.
 fn build_cwbvh(aabbs: impl ExactSizeIterator<Item = Aabb>, reinsertion_ratio: f32) -> CwBvh {
-    let count = aabbs.len();
     let mut total = Aabb::empty();
     let mut builder = PlocBuilder::new();
     builder.current_nodes = aabbs
@@ -1063,16 +1070,18 @@ fn build_cwbvh(aabbs: impl ExactSizeIterator<Item = Aabb>, reinsertion_ratio: f3
             Bvh2Node::new(aabb, 1, i as u32)
         })
         .collect();
-    let mut bvh2 = Bvh2::default();
-    bvh2.reset_for_reuse(count, Some((0..count as u32).collect()));
-    builder.build_ploc_from_leaves::<PLOC_SEARCH_DISTANCE, false>(
-        &mut bvh2,
-        total,
-        BUILD_PARAMS.sort_precision,
-        BUILD_PARAMS.search_depth_threshold,
-    );
+    let leaves = std::mem::take(&mut builder.current_nodes);
+    // Boxes piled on one another (a huge fan's slivers, which all hold its centre; coincident
+    // triangles) stall PLOC as the clusters do, but along no Morton run: a balanced tree in
+    // Morton order instead.
+    let piled = overlap(&leaves, &total) > MAX_OVERLAP;
+    let mut bvh2 = ploc(&mut builder, &leaves, &total, reinsertion_ratio, piled);
+    if tree_depth(&bvh2) > MAX_PLOC_DEPTH {
+        // A pathology the clusters did not catch: a balanced tree in Morton order instead.
+        bvh2 = ploc(&mut builder, &leaves, &total, reinsertion_ratio, true);
+    }
     drop(builder);
-    ReinsertionOptimizer::default().run(&mut bvh2, reinsertion_ratio, None);
+    drop(leaves);
     bvh2.parents = Vec::new();
     let mut cwbvh = bvh2_to_cwbvh(
         &bvh2,
@@ -1084,12 +1093,300 @@ fn build_cwbvh(aabbs: impl ExactSizeIterator<Item = Aabb>, reinsertion_ratio: f3
     cwbvh
 }
 
+/// Deeper BVH2s than this (PLOC's trees of ordinary scenes are well under 100 levels) are
+/// rebuilt as one balanced cluster: obvhs' CWBVH conversion recurses once per level.
+const MAX_PLOC_DEPTH: usize = 1024;
+
+/// The BVH2 over the primitive boxes `leaves` (one primitive each) in the box `total`: PLOC
+/// with [`Clusters`] expanded, or, with `balanced`, one cluster of everything; then the
+/// reinsertion optimiser with `reinsertion_ratio` when there are no clusters.
+fn ploc(
+    builder: &mut PlocBuilder,
+    leaves: &[Bvh2Node],
+    total: &Aabb,
+    reinsertion_ratio: f32,
+    balanced: bool,
+) -> Bvh2 {
+    let count = leaves.len();
+    let mut bvh2 = Bvh2::default();
+    let clusters = Clusters::find(leaves, total, balanced);
+    match &clusters {
+        None => {
+            bvh2.reset_for_reuse(count, Some((0..count as u32).collect()));
+            builder.current_nodes = leaves.to_vec();
+        }
+        Some(c) => {
+            let nodes = c.leaves(leaves);
+            bvh2.reset_for_reuse(nodes.len(), Some(c.order.clone()));
+            builder.current_nodes = nodes;
+        }
+    }
+    if builder.current_nodes.len() == 1 {
+        bvh2.nodes[0] = builder.current_nodes[0];
+    } else {
+        builder.build_ploc_from_leaves::<PLOC_SEARCH_DISTANCE, false>(
+            &mut bvh2,
+            *total,
+            BUILD_PARAMS.sort_precision,
+            BUILD_PARAMS.search_depth_threshold,
+        );
+    }
+    builder.current_nodes = Vec::new();
+    match clusters {
+        None => ReinsertionOptimizer::default().run(&mut bvh2, reinsertion_ratio, None),
+        // Reinsertion searches the whole of a cluster of coincident boxes for each of its
+        // nodes (no bound prunes it): quadratic. The clusters' balanced subtrees are as good
+        // as coincident primitives allow, so it is skipped.
+        Some(c) => c.expand(&mut bvh2),
+    }
+    bvh2
+}
+
+/// The most the primitives' boxes may cover the scene's box, on average ([`overlap`]), for
+/// PLOC to build the BVH. The scenes we ship cover it 1.6 to 5.4 times; a fan of 200,000
+/// slivers, whose PLOC build takes seconds and grows with the square of their number
+/// (68 s for a million), 16,000 times.
+const MAX_OVERLAP: f64 = 256.0;
+
+/// How many times, on average, the primitives' boxes cover the scene's box: the sum of their
+/// half areas over the scene box's (1 for a tiling, the count for coincident boxes).
+fn overlap(leaves: &[Bvh2Node], total: &Aabb) -> f64 {
+    let sum: f64 = leaves.iter().map(|n| f64::from(n.aabb().half_area())).sum();
+    let whole = f64::from(total.half_area());
+    if whole > 0.0 {
+        sum / whole
+    } else {
+        leaves.len() as f64
+    }
+}
+
+/// The number of levels of `bvh` (1 for a lone leaf), without recursion.
+fn tree_depth(bvh: &Bvh2) -> usize {
+    let mut deepest = 0;
+    let mut stack = vec![(0usize, 1usize)];
+    while let Some((i, depth)) = stack.pop() {
+        deepest = deepest.max(depth);
+        let n = &bvh.nodes[i];
+        if n.prim_count == 0 {
+            let c = n.first_index as usize;
+            stack.extend([(c, depth + 1), (c + 1, depth + 1)]);
+        }
+    }
+    deepest
+}
+
+/// Clusters smaller than this are left to PLOC (see [`Clusters`]).
+const CLUSTER_MIN: usize = 64;
+
+/// Runs of primitives that would stall PLOC, found before it runs: primitives whose boxes'
+/// centres share one cell of PLOC's Morton grid (21 bits per axis over the scene's box:
+/// identical or coincident triangles), and runs of the Morton order in which PLOC's first
+/// pass merges nothing (boxes nested in one another along the curve, as triangles with one
+/// centroid and growing sizes are), each of at least [`CLUSTER_MIN`] primitives.
+///
+/// PLOC merges two nodes only when each is the other's best neighbour. Among nodes with one
+/// box every merge costs the same, each node's best is the farthest in its search window,
+/// and only one pair per pass agrees; along nested boxes each node's best is its smaller
+/// neighbour, and again one pair per pass merges. A run of `k` such primitives takes `k`
+/// passes over all nodes (100,000 coincident triangles: minutes), and its subtree is a chain
+/// `k` deep, on which obvhs' recursive CWBVH conversion overflows the stack. Each run is
+/// instead one PLOC leaf, expanded afterwards into a balanced subtree
+/// ([`Clusters::expand`]). A scene without such runs (every scene we ship) is built exactly
+/// as before.
+struct Clusters {
+    /// The primitives in BVH slot order: those outside clusters first (in input order), then
+    /// each cluster's, contiguously, in Morton order.
+    order: Vec<u32>,
+    /// Each cluster's range in `order`.
+    ranges: Vec<std::ops::Range<u32>>,
+    /// Every primitive's box, by input index.
+    boxes: Vec<Aabb>,
+}
+
+impl Clusters {
+    /// The clusters among the leaves `nodes` (one primitive each, `first_index` = input
+    /// index) in the box `total`; `None` when there are none (the usual case). With
+    /// `everything`, all primitives are one cluster (a balanced tree in Morton order).
+    fn find(nodes: &[Bvh2Node], total: &Aabb, everything: bool) -> Option<Self> {
+        if nodes.len() < CLUSTER_MIN.max(2) && !everything {
+            return None;
+        }
+        // PLOC's own Morton code (obvhs' `sort_nodes_by_morton`, 64-bit precision), ties by
+        // index as its stable radix sort leaves them.
+        let scale = 1.0 / total.diagonal().as_dvec3();
+        let offset = -total.min.as_dvec3() * scale;
+        let mut keys: Vec<(u64, u32)> = nodes
+            .iter()
+            .enumerate()
+            .map(|(i, n)| {
+                let c = n.aabb().center().as_dvec3() * scale + offset;
+                (obvhs::ploc::morton::morton_encode_u64_unorm(c), i as u32)
+            })
+            .collect();
+        keys.sort_unstable();
+        let mut runs: Vec<std::ops::Range<usize>> = Vec::new();
+        if everything {
+            runs.push(0..keys.len());
+        } else {
+            let mut start = 0;
+            for run in keys.chunk_by(|a, b| a.0 == b.0) {
+                if run.len() >= CLUSTER_MIN {
+                    runs.push(start..start + run.len());
+                }
+                start += run.len();
+            }
+            // PLOC's first pass (search distance 1): node i points at i - 1 when the merge
+            // with it is cheaper than the one with i + 1, else at i + 1; two nodes pointing
+            // at each other merge.
+            let aabb = |k: usize| nodes[keys[k].1 as usize].aabb();
+            let cost = |k: usize| aabb(k).union(aabb(k + 1)).half_area();
+            let n = keys.len();
+            let points_left = |k: usize| k + 1 == n || (k > 0 && cost(k - 1) < cost(k));
+            let mut merged = vec![false; n];
+            for k in 0..n - 1 {
+                if !points_left(k) && points_left(k + 1) {
+                    merged[k] = true;
+                    merged[k + 1] = true;
+                }
+            }
+            let mut start = 0;
+            for run in merged.chunk_by(|a, b| a == b) {
+                if !run[0] && run.len() >= CLUSTER_MIN {
+                    runs.push(start..start + run.len());
+                }
+                start += run.len();
+            }
+            if runs.is_empty() {
+                return None;
+            }
+            // Overlapping runs are one cluster.
+            runs.sort_by_key(|r| r.start);
+            let mut joined: Vec<std::ops::Range<usize>> = Vec::with_capacity(runs.len());
+            for r in runs {
+                match joined.last_mut() {
+                    Some(last) if r.start < last.end => last.end = last.end.max(r.end),
+                    _ => joined.push(r),
+                }
+            }
+            runs = joined;
+        }
+        let mut in_cluster = vec![false; nodes.len()];
+        for r in &runs {
+            keys[r.clone()]
+                .iter()
+                .for_each(|&(_, i)| in_cluster[i as usize] = true);
+        }
+        let boxes: Vec<Aabb> = nodes.iter().map(|n| *n.aabb()).collect();
+        let mut order: Vec<u32> = (0..nodes.len() as u32)
+            .filter(|&i| !in_cluster[i as usize])
+            .collect();
+        let mut ranges = Vec::with_capacity(runs.len());
+        for r in runs {
+            let start = order.len() as u32;
+            order.extend(keys[r].iter().map(|&(_, i)| i));
+            ranges.push(start..order.len() as u32);
+        }
+        Some(Self {
+            order,
+            ranges,
+            boxes,
+        })
+    }
+
+    /// The union of the boxes of the primitives in slots `range` of `order`.
+    fn bounds(&self, range: std::ops::Range<u32>) -> Aabb {
+        self.order[range.start as usize..range.end as usize]
+            .iter()
+            .fold(Aabb::empty(), |b, &i| b.union(&self.boxes[i as usize]))
+    }
+
+    /// The PLOC leaves: one per primitive outside the clusters and one per cluster (several
+    /// primitives), indexing `order`.
+    fn leaves(&self, nodes: &[Bvh2Node]) -> Vec<Bvh2Node> {
+        let singles = self
+            .ranges
+            .first()
+            .map_or(self.order.len(), |r| r.start as usize);
+        let mut leaves: Vec<Bvh2Node> = self.order[..singles]
+            .iter()
+            .enumerate()
+            .map(|(slot, &i)| Bvh2Node::new(*nodes[i as usize].aabb(), 1, slot as u32))
+            .collect();
+        leaves.extend(
+            self.ranges
+                .iter()
+                .map(|r| Bvh2Node::new(self.bounds(r.clone()), r.end - r.start, r.start)),
+        );
+        leaves
+    }
+
+    /// Replaces each cluster's leaf in `bvh` by a balanced subtree over its primitives (each
+    /// inner node halves its range), one primitive per leaf; children keep following their
+    /// parents in the node array.
+    fn expand(&self, bvh: &mut Bvh2) {
+        let old = std::mem::take(&mut bvh.nodes);
+        let mut nodes = Vec::with_capacity(2 * self.order.len() - 1);
+        nodes.push(old[0]);
+        enum From {
+            Node(usize),
+            Slots(std::ops::Range<u32>),
+        }
+        let mut stack = vec![(0usize, From::Node(0))];
+        let mut deepest = 0u32;
+        while let Some((at, from)) = stack.pop() {
+            let (children, first, second) = match from {
+                From::Node(i) => {
+                    let n = old[i];
+                    if n.prim_count == 0 {
+                        let c = n.first_index as usize;
+                        (*n.aabb(), From::Node(c), From::Node(c + 1))
+                    } else if n.prim_count == 1 {
+                        nodes[at] = n;
+                        continue;
+                    } else {
+                        let r = n.first_index..n.first_index + n.prim_count;
+                        deepest = deepest.max(n.prim_count);
+                        let mid = r.start + (r.end - r.start) / 2;
+                        (
+                            *n.aabb(),
+                            From::Slots(r.start..mid),
+                            From::Slots(mid..r.end),
+                        )
+                    }
+                }
+                From::Slots(r) if r.end - r.start == 1 => {
+                    nodes[at] = Bvh2Node::new(self.bounds(r.clone()), 1, r.start);
+                    continue;
+                }
+                From::Slots(r) => {
+                    let mid = r.start + (r.end - r.start) / 2;
+                    (
+                        self.bounds(r.clone()),
+                        From::Slots(r.start..mid),
+                        From::Slots(mid..r.end),
+                    )
+                }
+            };
+            let k = nodes.len();
+            nodes[at] = Bvh2Node::new(children, 0, k as u32);
+            nodes.extend([Bvh2Node::default(); 2]);
+            stack.push((k + 1, second));
+            stack.push((k, first));
+        }
+        debug_assert_eq!(nodes.len(), 2 * self.order.len() - 1);
+        bvh.nodes = nodes;
+        // A cluster of k primitives adds at most ceil(log2 k) levels below its leaf.
+        bvh.max_depth += (u32::BITS - deepest.leading_zeros()) as usize + 1;
+        bvh.children_are_ordered_after_parents = true;
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     /// A xorshift64 generator of floats in [0, 1) from `seed`.
-    fn xorshift(mut seed: u64) -> impl FnMut() -> f32 {
+    pub(super) fn xorshift(mut seed: u64) -> impl FnMut() -> f32 {
         move || {
             seed ^= seed << 13;
             seed ^= seed >> 7;
@@ -1100,7 +1397,10 @@ mod tests {
 
     /// `n` small random triangles (each inside a unit cube) scattered through a 20 m cube:
     /// positions and triangles for [`Accel::build`].
-    fn triangle_soup(n: u32, rnd: &mut impl FnMut() -> f32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    pub(super) fn triangle_soup(
+        n: u32,
+        rnd: &mut impl FnMut() -> f32,
+    ) -> (Vec<Vec3>, Vec<[u32; 3]>) {
         let mut positions = vec![];
         let mut triangles = vec![];
         for i in 0..n {
@@ -1428,5 +1728,129 @@ mod tests {
         // A ray starting on the surface does not hit it again.
         let r = Ray::new(target, Vec3::new(1.0, 0.0, 1e-3).normalize());
         assert!(a.intersect(&r).is_none());
+    }
+}
+
+/// Degenerate and hostile geometry builds in about `n log n` and is hit where it is.
+#[cfg(test)]
+mod degenerate_tests {
+    use super::*;
+    use std::time::{Duration, Instant};
+
+    /// Builds, checks the build took under `seconds` and the BVH is shallow, and returns it.
+    fn build(label: &str, positions: &[Vec3], tris: &[[u32; 3]], seconds: u64) -> Accel {
+        let start = Instant::now();
+        let a = Accel::build(positions, tris);
+        let took = start.elapsed();
+        assert!(took < Duration::from_secs(seconds), "{label}: {took:?}");
+        assert_eq!(a.triangle_count(), tris.len(), "{label}");
+        a
+    }
+
+    /// The triangles `(0,0,0)`-ish of growing size `1 + i/1000`, all with centroid 0.
+    fn same_centroid(n: u32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+        let mut p = Vec::new();
+        let mut t = Vec::new();
+        for i in 0..n {
+            let s = 1.0 + i as f32 * 1e-3;
+            p.extend([
+                Vec3::new(-s, -s, 0.0),
+                Vec3::new(2.0 * s, -s, 0.0),
+                Vec3::new(-s, 2.0 * s, 0.0),
+            ]);
+            t.push([3 * i, 3 * i + 1, 3 * i + 2]);
+        }
+        (p, t)
+    }
+
+    /// Before clusters, 5,000 coincident triangles took 0.9 s, 10,000 took 2.9 s (so 100,000
+    /// about five minutes), and 10,000 coincident points overflowed the stack; 100,000 now
+    /// take well under a second.
+    #[test]
+    fn coincident_triangles_build_quickly_and_are_hit() {
+        let n = 100_000;
+        let p = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
+        let a = build("coincident", &p, &vec![[0, 1, 2]; n], 10);
+        let ray = Ray::new(Vec3::new(0.25, 0.25, 1.0), -Vec3::Z);
+        assert!((a.intersect(&ray).unwrap().t - 1.0).abs() < 1e-6);
+        assert!(a.occluded(&ray));
+        let (p, t) = same_centroid(n as u32);
+        let a = build("same centroid", &p, &t, 10);
+        let ray = Ray::new(Vec3::new(0.1, 0.2, -2.0), Vec3::Z);
+        assert!((a.intersect(&ray).unwrap().t - 2.0).abs() < 1e-6);
+        // 50,000 coincident triangles among 50,000 scattered ones: the boxes cover the scene
+        // a few times over on average, so only the cluster finds them.
+        let mut rnd = super::tests::xorshift(5);
+        let (mut p, mut t) = super::tests::triangle_soup(50_000, &mut rnd);
+        let k = p.len() as u32;
+        p.extend([
+            Vec3::new(0.0, 0.0, 30.0),
+            Vec3::new(0.5, 0.0, 30.0),
+            Vec3::new(0.0, 0.5, 30.0),
+        ]);
+        t.extend(std::iter::repeat_n([k, k + 1, k + 2], 50_000));
+        let a = build("coincident among others", &p, &t, 10);
+        let ray = Ray::new(Vec3::new(0.1, 0.1, 31.0), -Vec3::Z);
+        assert!((a.intersect(&ray).unwrap().t - 1.0).abs() < 1e-5);
+        // Zero-area triangles: all at one point, or scattered; rays miss them.
+        let a = build("points", &[Vec3::ONE], &vec![[0, 0, 0]; n], 10);
+        assert!(a.intersect(&Ray::new(Vec3::ZERO, Vec3::X)).is_none());
+        let p: Vec<Vec3> = (0..n)
+            .map(|i| Vec3::new(i as f32 * 0.37 % 11.0, i as f32 * 0.71 % 13.0, 0.0))
+            .collect();
+        let t: Vec<[u32; 3]> = (0..n as u32).map(|i| [i, i, i]).collect();
+        let a = build("scattered points", &p, &t, 10);
+        assert!(a
+            .intersect(&Ray::new(Vec3::new(0.5, 0.5, 1.0), -Vec3::Z))
+            .is_none());
+    }
+
+    /// A fan of 1,000,000 slivers around one vertex (a huge polygon's triangulation): 68 s
+    /// and growing with the square of the count before, under a second now; hit where it is.
+    #[test]
+    fn huge_fans_build_quickly_and_are_hit() {
+        let n = 1_000_000u32;
+        let mut p = vec![Vec3::ZERO];
+        let mut t = Vec::new();
+        for i in 0..n {
+            let a = i as f32 / n as f32 * std::f32::consts::TAU;
+            p.push(Vec3::new(a.cos(), a.sin(), 0.0));
+            if i > 0 {
+                t.push([0, i, i + 1]);
+            }
+        }
+        let a = build("fan", &p, &t, 10);
+        for target in [Vec3::new(0.3, 0.4, 0.0), Vec3::new(-0.5, -0.1, 0.0)] {
+            let ray = Ray::new(target + Vec3::Z, -Vec3::Z);
+            assert!(
+                (a.intersect(&ray).unwrap().t - 1.0).abs() < 1e-6,
+                "{target}"
+            );
+        }
+        assert!(a
+            .intersect(&Ray::new(Vec3::new(1.5, 0.0, 1.0), -Vec3::Z))
+            .is_none());
+    }
+
+    /// Boxes nested along the Morton curve (one corner shared, growing): PLOC's first pass
+    /// merges one pair per pass; they are one cluster.
+    #[test]
+    fn nested_boxes_build_quickly() {
+        let n = 100_000u32;
+        let mut p = Vec::new();
+        let mut t = Vec::new();
+        for i in 0..n {
+            let s = 1.0 + i as f32 * 1e-2;
+            p.extend([Vec3::ZERO, Vec3::new(s, 0.0, 0.0), Vec3::new(0.0, s, s)]);
+            t.push([3 * i, 3 * i + 1, 3 * i + 2]);
+        }
+        let a = build("nested", &p, &t, 10);
+        // All in the plane y = z; (0.2, 0.1, 0.1) is on every triangle.
+        let ray = Ray::new(
+            Vec3::new(0.2, -0.9, 1.1),
+            Vec3::new(0.0, 1.0, -1.0).normalize(),
+        );
+        let t = a.intersect(&ray).unwrap().t;
+        assert!((t - std::f32::consts::SQRT_2).abs() < 1e-5, "{t}");
     }
 }

@@ -17,7 +17,8 @@
 
 use super::files::{Files, Uri};
 use super::{
-    accessor, compression, extensions, tangents, Instance, MeshParts, Scene, SceneError, SceneParts,
+    accessor, compression, extensions, tangents, validate, Instance, MeshParts, Scene, SceneError,
+    SceneParts,
 };
 use crate::camera::Camera;
 use crate::light::{Light, LUMINOUS_EFFICACY};
@@ -266,6 +267,9 @@ pub(super) fn load(path: &Path, files: &Files) -> Result<Scene, SceneError> {
         .or_else(|| document.scenes().next());
     match scene {
         Some(scene) => {
+            // Nodes reached by several paths (a DAG) are visited once per path, which may be
+            // exponentially many: they are counted first.
+            count_visits(path, &document, &scene)?;
             // Depth-first in file order with an explicit stack; a depth beyond the node count
             // can only come from a cycle.
             let node_count = document.nodes().len();
@@ -297,6 +301,110 @@ pub(super) fn load(path: &Path, files: &Files) -> Result<Scene, SceneError> {
         loader.parts.tangents.resize(n, Vec4::ZERO);
     }
     Scene::from_parts(loader.parts)
+}
+
+/// The most node visits (a node reached by several paths of the hierarchy is visited once per
+/// path) and, separately, mesh placements (node meshes and EXT_mesh_gpu_instancing instances)
+/// a scene may have: a hierarchy in which each node lists the next one twice reaches 2^40
+/// placements in 40 levels, so the walk counts them before it makes them.
+pub const MAX_PLACEMENTS: usize = 1_000_000;
+
+/// The most triangles a scene may hold once its meshes are placed: the flattened placements'
+/// (every placement of a mesh placed once, or with an emissive material) and the instanced
+/// meshes' (stored once); counted from the accessors before any geometry is read. About
+/// 8 GB of scene and BVH; an emissive mesh placed many times would otherwise multiply it.
+pub const MAX_TRIANGLES: usize = 20_000_000;
+
+/// The error for a hierarchy that places more than [`MAX_PLACEMENTS`] nodes or instances,
+/// found at `node`.
+fn too_many_placements(path: &Path, node: &gltf::Node) -> SceneError {
+    SceneError::invalid(
+        path,
+        node_label(node),
+        format!(
+            "the node hierarchy places more than {MAX_PLACEMENTS} nodes or mesh instances \
+             (a node reached by several paths is placed once per path)"
+        ),
+    )
+}
+
+/// The number of node visits the walk of `scene` makes (each node once per path from a root
+/// to it), counted without walking: a node's count is one plus its children's, each node
+/// computed once (depth-first, without recursion). A cycle, or more than [`MAX_PLACEMENTS`]
+/// visits, is an error naming a node.
+fn count_visits(
+    path: &Path,
+    document: &gltf::Document,
+    scene: &gltf::Scene,
+) -> Result<usize, SceneError> {
+    const UNSEEN: usize = usize::MAX;
+    const OPEN: usize = usize::MAX - 1;
+    let mut visits = vec![UNSEEN; document.nodes().len()];
+    let mut total = 0usize;
+    for root in scene.nodes() {
+        // (node, whether its children have been pushed)
+        let mut stack = vec![(root.clone(), false)];
+        while let Some((node, expanded)) = stack.pop() {
+            let i = node.index();
+            if expanded {
+                let sum = node
+                    .children()
+                    .fold(1usize, |s, c| s.saturating_add(visits[c.index()]));
+                if sum > MAX_PLACEMENTS {
+                    return Err(too_many_placements(path, &node));
+                }
+                visits[i] = sum;
+                continue;
+            }
+            match visits[i] {
+                UNSEEN => {}
+                OPEN => {
+                    return Err(SceneError::invalid(
+                        path,
+                        node_label(&node),
+                        "the node hierarchy has a cycle",
+                    ))
+                }
+                _ => continue,
+            }
+            visits[i] = OPEN;
+            stack.push((node.clone(), true));
+            for c in node.children() {
+                match visits[c.index()] {
+                    OPEN => {
+                        return Err(SceneError::invalid(
+                            path,
+                            node_label(&c),
+                            "the node hierarchy has a cycle",
+                        ))
+                    }
+                    UNSEEN => stack.push((c, false)),
+                    _ => {}
+                }
+            }
+        }
+        total = total.saturating_add(visits[root.index()]);
+        if total > MAX_PLACEMENTS {
+            return Err(too_many_placements(path, &root));
+        }
+    }
+    Ok(total)
+}
+
+/// The number of triangles primitive `prim` makes (from its index or POSITION count and its
+/// mode; 0 for points and lines, which are skipped).
+fn primitive_triangles(prim: &gltf::Primitive) -> usize {
+    let n = match prim.indices() {
+        Some(a) => a.count(),
+        None => prim
+            .get(&gltf::Semantic::Positions)
+            .map_or(0, |a| a.count()),
+    };
+    match prim.mode() {
+        Mode::Triangles => n / 3,
+        Mode::TriangleStrip | Mode::TriangleFan => n.saturating_sub(2),
+        _ => 0,
+    }
 }
 
 /// Swaps the vertex arrays and triangles of `parts` with those of `mesh`.
@@ -518,7 +626,11 @@ impl Loader<'_> {
         if let Some(mesh) = node.mesh() {
             match node.extension_value("EXT_mesh_gpu_instancing") {
                 Some(ext) => {
-                    for (i, local) in self.gpu_instances(node, ext, document)?.iter().enumerate() {
+                    let locals = self.gpu_instances(node, ext, document)?;
+                    if self.placements.len() + locals.len() > MAX_PLACEMENTS {
+                        return Err(too_many_placements(self.path, node));
+                    }
+                    for (i, local) in locals.iter().enumerate() {
                         let w = world * *local;
                         if Instance::new(0, w).is_none() {
                             return Err(self.bad(
@@ -532,14 +644,19 @@ impl Loader<'_> {
                         self.placements.push((mesh.index(), w));
                     }
                 }
-                None => self.placements.push((mesh.index(), world)),
+                None => {
+                    if self.placements.len() >= MAX_PLACEMENTS {
+                        return Err(too_many_placements(self.path, node));
+                    }
+                    self.placements.push((mesh.index(), world));
+                }
             }
         }
         if let Some(camera) = node.camera() {
             self.camera(node, &camera, world)?;
         }
         if let Some(light) = node.light() {
-            self.light(&light, world);
+            self.light(node, &light, world)?;
         }
         Ok(world)
     }
@@ -629,15 +746,41 @@ impl Loader<'_> {
         for &(m, _) in &self.placements {
             count[m] += 1;
         }
+        let emissive: Vec<bool> = meshes
+            .iter()
+            .map(|mesh| {
+                mesh.primitives().any(|p| {
+                    p.material()
+                        .index()
+                        .is_some_and(|i| self.parts.materials[i].is_emissive())
+                })
+            })
+            .collect();
+        // Triangles stored: a flattened mesh's at each placement, an instanced one's once.
+        let mut stored = 0usize;
+        for (m, mesh) in meshes.iter().enumerate() {
+            let copies = match (count[m], emissive[m]) {
+                (0, _) => 0,
+                (n, true) | (n @ 1, false) => n,
+                (_, false) => 1,
+            };
+            let triangles: usize = mesh.primitives().map(|p| primitive_triangles(&p)).sum();
+            stored = stored.saturating_add(triangles.saturating_mul(copies));
+            if stored > MAX_TRIANGLES {
+                return Err(self.bad(
+                    mesh_label(mesh),
+                    format!(
+                        "the scene would hold more than {MAX_TRIANGLES} triangles once its \
+                         meshes are placed (this mesh: {triangles} triangles, stored {copies} \
+                         times)"
+                    ),
+                ));
+            }
+        }
         let mut instanced: Vec<Option<u32>> = vec![None; meshes.len()];
         for (m, world) in std::mem::take(&mut self.placements) {
             let mesh = &meshes[m];
-            let emissive = mesh.primitives().any(|p| {
-                p.material()
-                    .index()
-                    .is_some_and(|i| self.parts.materials[i].is_emissive())
-            });
-            if count[m] < 2 || emissive {
+            if count[m] < 2 || emissive[m] {
                 self.mesh(mesh, world)?;
                 continue;
             }
@@ -694,10 +837,8 @@ impl Loader<'_> {
         let gltf::camera::Projection::Perspective(p) = camera.projection() else {
             return Err(self.bad(element, "orthographic cameras are not supported"));
         };
+        validate::perspective(&p).map_err(|r| self.bad(&element, r))?;
         let yfov = p.yfov();
-        if !(yfov > 0.0 && yfov < std::f32::consts::PI) {
-            return Err(self.bad(element, format!("yfov {yfov} is not in (0, pi)")));
-        }
         let (_, rotation, translation) = world.to_scale_rotation_translation();
         self.parts.cameras.push(Camera {
             name,
@@ -706,13 +847,23 @@ impl Loader<'_> {
                 translation,
             ),
             yfov,
-            aspect_ratio: p.aspect_ratio().filter(|a| a.is_finite() && *a > 0.0),
+            aspect_ratio: p.aspect_ratio(),
         });
         Ok(())
     }
 
-    fn light(&mut self, light: &gltf::khr_lights_punctual::Light, world: Mat4) {
+    fn light(
+        &mut self,
+        node: &gltf::Node,
+        light: &gltf::khr_lights_punctual::Light,
+        world: Mat4,
+    ) -> Result<(), SceneError> {
         use gltf::khr_lights_punctual::Kind;
+        validate::light(light).map_err(|r| {
+            let name = light.name().map_or(String::new(), |n| format!("{n:?} "));
+            let element = format!("light {name}({}) on {}", light.index(), node_label(node));
+            self.bad(element, r)
+        })?;
         // Photometric (candela, lux) to radiometric (W/sr, W/m^2) unless the file is radiometric.
         let power = match self.light_units {
             LightUnits::Photometric => {
@@ -722,7 +873,7 @@ impl Loader<'_> {
         };
         let position = world.transform_point3(Vec3::ZERO);
         let direction = world.transform_vector3(-Vec3::Z).normalize();
-        let range = light.range().filter(|r| r.is_finite() && *r > 0.0);
+        let range = light.range();
         self.parts.lights.push(match light.kind() {
             Kind::Point => Light::Point {
                 position,
@@ -745,6 +896,7 @@ impl Loader<'_> {
                 irradiance: power,
             },
         });
+        Ok(())
     }
 
     /// Checks that `accessor` has one of the `allowed` layouts and lies within its view.
@@ -958,6 +1110,10 @@ impl Loader<'_> {
                 .iter()
                 .map(|&p| world.transform_point3(p))
                 .collect();
+            // In world space: a finite vertex times a large scale may overflow.
+            for (k, &p) in positions.iter().enumerate() {
+                validate::position(p).map_err(|r| self.bad(format!("{element}, vertex {k}"), r))?;
+            }
             let (mut normals, mut uvs) = (normals, uvs);
             let (mut uvs1, mut colors) = (uvs1, colors);
             let tangents = if normal_mapped {
@@ -1085,7 +1241,15 @@ impl Loader<'_> {
                  from flat normals, as the glTF specification says"
             ));
         }
-        tangents::generate(positions, normals, uvs, tris)
+        tangents::generate(positions, normals, uvs, tris).unwrap_or_else(|valence| {
+            self.warn(format!(
+                "{element}: a vertex is shared by {valence} triangles, more than MikkTSpace can \
+                 take ({}: it recurses once per triangle around a vertex); rendered without \
+                 the normal map",
+                tangents::MAX_VALENCE
+            ));
+            (vec![Vec4::ZERO; positions.len()], Vec::new())
+        })
     }
 
     /// The glTF default material (white, metallic 1, roughness 1), added once when needed.
@@ -1115,6 +1279,7 @@ impl Loader<'_> {
             .name()
             .map_or_else(|| format!("material{index}"), str::to_string);
         let element = format!("material {name:?} ({index})");
+        validate::material(m).map_err(|r| self.bad(&element, r))?;
         let pbr = m.pbr_metallic_roughness();
         let base_color_texture = match pbr.base_color_texture() {
             Some(info) => Some(self.texture(&info, ColorSpace::Srgb, &element)?),
@@ -3190,5 +3355,294 @@ mod material_extension_tests {
                 "{ext}: {err}"
             );
         }
+    }
+}
+
+/// Values outside the specification, overflowing positions and exploding node graphs: each
+/// an error naming the file and the element, found before the work it would cause.
+#[cfg(test)]
+mod hostile_tests {
+    use super::tests::{test_doc, write_embedded};
+    use super::*;
+    use serde_json::{json, Value};
+    use std::time::{Duration, Instant};
+
+    /// The error loading `doc` (with buffer `bin`) gives, checked to name the file and to
+    /// come within a second.
+    fn error(doc: Value, bin: &[u8]) -> String {
+        let dir = tempfile::tempdir().unwrap();
+        let path = write_embedded(dir.path(), doc, bin);
+        let start = Instant::now();
+        let err = Scene::load(&path).expect_err("should fail").to_string();
+        assert!(
+            start.elapsed() < Duration::from_secs(1),
+            "{err}: {:?}",
+            start.elapsed()
+        );
+        assert!(err.contains("scene.gltf"), "no file name in: {err}");
+        err
+    }
+
+    /// The test scene with `value` at the JSON pointer `pointer` (its parent must exist).
+    fn with(pointer: &str, value: Value) -> (Value, Vec<u8>) {
+        let (mut doc, bin) = test_doc();
+        let (parent, key) = pointer.rsplit_once('/').unwrap();
+        let parent = doc
+            .pointer_mut(parent)
+            .unwrap_or_else(|| panic!("{pointer}"));
+        match key.parse::<usize>() {
+            Ok(i) if parent.is_array() => parent[i] = value,
+            _ => parent[key] = value,
+        }
+        (doc, bin)
+    }
+
+    /// Each `(pointer, value, words)`: the test scene with that value fails naming `words`.
+    fn rejects(cases: &[(&str, Value, &[&str])]) {
+        for (pointer, value, words) in cases {
+            let (doc, bin) = with(pointer, value.clone());
+            let err = error(doc, &bin);
+            for w in *words {
+                assert!(err.contains(w), "{pointer} = {value}: {w:?} not in: {err}");
+            }
+        }
+    }
+
+    const LIGHTS: &str = "/extensions/KHR_lights_punctual/lights";
+
+    #[test]
+    fn lights_outside_the_specification_are_named() {
+        let point = &["light (0) on node \"bulb\" (4)"][..];
+        let spot = &["light (1) on node \"spot\" (5)", "innerConeAngle"][..];
+        rejects(&[
+            (&format!("{LIGHTS}/0/color"), json!([-1, 1, 1]), point),
+            (&format!("{LIGHTS}/0/color"), json!([1e39, 1, 1]), point),
+            (&format!("{LIGHTS}/0/color"), json!([2, 1, 1]), point),
+            (&format!("{LIGHTS}/0/intensity"), json!(-1), point),
+            (&format!("{LIGHTS}/0/intensity"), json!(1e39), point),
+            (&format!("{LIGHTS}/0/range"), json!(0), point),
+            (&format!("{LIGHTS}/0/range"), json!(-5), point),
+            (&format!("{LIGHTS}/0/range"), json!(1e39), point),
+            (&format!("{LIGHTS}/1/spot/innerConeAngle"), json!(0.6), spot),
+            (
+                &format!("{LIGHTS}/1/spot/innerConeAngle"),
+                json!(-0.1),
+                spot,
+            ),
+            (&format!("{LIGHTS}/1/spot/outerConeAngle"), json!(2.0), spot),
+            (
+                &format!("{LIGHTS}/1/spot/outerConeAngle"),
+                json!(1e39),
+                spot,
+            ),
+        ]);
+        // The edges of the ranges load: inner = outer (the project's hard edge), outer =
+        // pi/2, intensity 0.
+        let dir = tempfile::tempdir().unwrap();
+        let (mut doc, bin) = test_doc();
+        doc["extensions"]["KHR_lights_punctual"]["lights"][1]["spot"] =
+            json!({"innerConeAngle": 0.5, "outerConeAngle": 0.5});
+        doc["extensions"]["KHR_lights_punctual"]["lights"][0]["intensity"] = json!(0);
+        Scene::load(&write_embedded(dir.path(), doc, &bin)).unwrap();
+        let (mut doc, bin) = test_doc();
+        doc["extensions"]["KHR_lights_punctual"]["lights"][1]["spot"] =
+            json!({"innerConeAngle": 0, "outerConeAngle": std::f64::consts::FRAC_PI_2});
+        Scene::load(&write_embedded(dir.path(), doc, &bin)).unwrap();
+    }
+
+    #[test]
+    fn cameras_outside_the_specification_are_named() {
+        let named = &["camera \"cam_node\" (0) on node \"cam_node\" (3)"][..];
+        let p = "/cameras/0/perspective";
+        rejects(&[
+            (&format!("{p}/yfov"), json!(4), named),
+            (&format!("{p}/yfov"), json!(0), named),
+            (&format!("{p}/znear"), json!(0), named),
+            (&format!("{p}/znear"), json!(-1), named),
+            (&format!("{p}/znear"), json!(1e39), named),
+            (&format!("{p}/aspectRatio"), json!(0), named),
+            (&format!("{p}/aspectRatio"), json!(1e39), named),
+        ]);
+        let (mut doc, bin) = test_doc();
+        doc["cameras"][0]["perspective"]["zfar"] = json!(0.05);
+        let err = error(doc, &bin);
+        assert!(err.contains("zfar 0.05"), "{err}");
+    }
+
+    #[test]
+    fn materials_outside_the_specification_are_named() {
+        let asphalt = &["material \"asphalt\" (0)"][..];
+        let glow = &["material \"glow\" (1)"][..];
+        rejects(&[
+            (
+                "/materials/0/pbrMetallicRoughness",
+                json!({"baseColorFactor": [-0.5, 0.5, 0.5, 1]}),
+                &["material \"asphalt\" (0)", "baseColorFactor"],
+            ),
+            (
+                "/materials/0/pbrMetallicRoughness",
+                json!({"baseColorFactor": [1e39, 0.5, 0.5, 1]}),
+                asphalt,
+            ),
+            (
+                "/materials/0/pbrMetallicRoughness",
+                json!({"metallicFactor": 1.5}),
+                asphalt,
+            ),
+            (
+                "/materials/0/pbrMetallicRoughness",
+                json!({"roughnessFactor": -0.1}),
+                asphalt,
+            ),
+            ("/materials/0/alphaCutoff", json!(-1), asphalt),
+            ("/materials/1/emissiveFactor", json!([-1, 0, 0]), glow),
+            ("/materials/1/emissiveFactor", json!([2, 0, 0]), glow),
+            ("/materials/1/emissiveFactor", json!([1e39, 0, 0]), glow),
+            (
+                "/materials/1/extensions/KHR_materials_emissive_strength/emissiveStrength",
+                json!(-5),
+                &["material \"glow\" (1)", "emissiveStrength"],
+            ),
+            (
+                "/materials/1/extensions/KHR_materials_emissive_strength/emissiveStrength",
+                json!(1e39),
+                glow,
+            ),
+            ("/materials/0/extras/streaks/kd", json!([-1, 0, 0]), asphalt),
+            (
+                "/materials/0/extras/streaks/ks",
+                json!([1e39, 0, 0]),
+                asphalt,
+            ),
+            ("/materials/0/extras/streaks/alpha", json!(1e39), asphalt),
+        ]);
+        // A negative strength is an error even where the factor is black.
+        let (mut doc, bin) = test_doc();
+        doc["materials"][1]["emissiveFactor"] = json!([0, 0, 0]);
+        doc["materials"][1]["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"] =
+            json!(-1);
+        let err = error(doc, &bin);
+        assert!(err.contains("material \"glow\" (1)"), "{err}");
+    }
+
+    #[test]
+    fn positions_that_overflow_the_bvh_name_the_mesh() {
+        // A finite, invertible node transform that takes a vertex beyond 1e18.
+        let (doc, bin) = with("/nodes/2/scale", json!([1e20, 1, 1e-20]));
+        let err = error(doc, &bin);
+        assert!(
+            err.contains("mesh \"tri\" (1), primitive 0, vertex 1") && err.contains("overflow"),
+            "{err}"
+        );
+        // A finite coordinate beyond 1e18 in the buffer (the last vertex's y).
+        let (doc, mut bin) = test_doc();
+        let n = bin.len();
+        bin[n - 8..n - 4].copy_from_slice(&f32::MAX.to_le_bytes());
+        let err = error(doc, &bin);
+        assert!(
+            err.contains("mesh \"tri\" (1), primitive 0, vertex 2"),
+            "{err}"
+        );
+        // An instanced mesh (placed twice) whose second instance reaches beyond 1e18.
+        let (mut doc, bin) = test_doc();
+        doc["nodes"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!({"mesh": 0, "scale": [1e20, 1, 1e-20]}));
+        doc["scenes"][0]["nodes"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!(7));
+        let err = error(doc, &bin);
+        assert!(err.contains("instance 1 of mesh \"quad\" (0)"), "{err}");
+    }
+
+    /// A chain of `depth` nodes, each listing the next twice, above a node placing mesh
+    /// `mesh`: 2^depth placements of it.
+    fn doubling_dag(doc: &mut Value, depth: usize, mesh: usize) {
+        let base = doc["nodes"].as_array().unwrap().len();
+        let nodes = doc["nodes"].as_array_mut().unwrap();
+        for i in 0..depth {
+            nodes.push(json!({"name": format!("d{i}"), "children": [base + i + 1, base + i + 1]}));
+        }
+        nodes.push(json!({"name": "leaf", "mesh": mesh}));
+        doc["scenes"][0]["nodes"] = json!([base]);
+    }
+
+    #[test]
+    fn exponential_node_graphs_are_refused_before_they_are_walked() {
+        let (mut doc, bin) = test_doc();
+        doubling_dag(&mut doc, 40, 1);
+        let err = error(doc, &bin);
+        assert!(err.contains("more than 1000000"), "{err}");
+        // 2^18 placements of an emissive (so flattened) strip of 100 triangles: 26 million.
+        let (mut doc, mut bin) = test_doc();
+        let at = bin.len();
+        let strip: Vec<u8> = (0..102)
+            .flat_map(|i| [i as f32 * 0.1, (i % 2) as f32, 0.0])
+            .flat_map(f32::to_le_bytes)
+            .collect();
+        bin.extend(&strip);
+        let views = doc["bufferViews"].as_array_mut().unwrap();
+        views.push(json!({"buffer": 0, "byteOffset": at, "byteLength": strip.len()}));
+        let view = views.len() - 1;
+        let accessors = doc["accessors"].as_array_mut().unwrap();
+        accessors.push(
+            json!({"bufferView": view, "componentType": 5126, "count": 102,
+            "type": "VEC3", "min": [0, 0, 0], "max": [10.1, 1, 0]}),
+        );
+        let accessor = accessors.len() - 1;
+        doc["buffers"][0]["byteLength"] = json!(bin.len());
+        doc["meshes"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!({"name": "strip", "primitives":
+            [{"attributes": {"POSITION": accessor}, "mode": 5, "material": 1}]}));
+        doubling_dag(&mut doc, 18, 2);
+        let err = error(doc, &bin);
+        assert!(
+            err.contains("mesh \"strip\" (2)") && err.contains("more than 20000000 triangles"),
+            "{err}"
+        );
+    }
+
+    /// A triangle fan of 500,000 vertices on a circle (slivers that all hold its centre)
+    /// loads in about `n log n`: its BVH took 19 s before (PLOC stalls on such boxes).
+    #[test]
+    fn huge_triangle_fans_load_quickly() {
+        let (mut doc, mut bin) = test_doc();
+        let n = 500_000;
+        let at = bin.len();
+        let fan: Vec<u8> = (0..n)
+            .flat_map(|i| {
+                let a = i as f32 / n as f32 * std::f32::consts::TAU;
+                if i == 0 {
+                    [0.0; 3]
+                } else {
+                    [a.cos(), a.sin(), 0.0]
+                }
+            })
+            .flat_map(f32::to_le_bytes)
+            .collect();
+        bin.extend(&fan);
+        doc["bufferViews"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!({"buffer": 0, "byteOffset": at, "byteLength": fan.len()}));
+        doc["accessors"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!({"bufferView": 5,
+            "componentType": 5126, "count": n, "type": "VEC3", "min": [-1, -1, 0],
+            "max": [1, 1, 0]}));
+        doc["buffers"][0]["byteLength"] = json!(bin.len());
+        doc["meshes"][1]["primitives"][0] = json!({"attributes": {"POSITION": 5}, "mode": 6});
+        let dir = tempfile::tempdir().unwrap();
+        let path = write_embedded(dir.path(), doc, &bin);
+        let start = Instant::now();
+        let scene = Scene::load(&path).unwrap();
+        let took = start.elapsed();
+        assert!(took < Duration::from_secs(5), "{took:?}");
+        assert_eq!(scene.triangles.len(), 2 + n - 2);
     }
 }

@@ -115,36 +115,51 @@ pub(super) struct InstanceHit {
 
 impl Instances {
     /// The meshes (checked) with their BVHs, the instances (whose mesh indices are in range;
-    /// those of meshes without triangles are dropped), their world boxes (the box of each instance's transformed vertices, so as tight as the
-    /// flattened triangles' would be) and the TLAS over them.
-    pub(super) fn build(meshes: Vec<InstancedMesh>, mut instances: Vec<Instance>) -> Self {
+    /// those of meshes without triangles are dropped), their world boxes (the box of each
+    /// instance's transformed vertices, so as tight as the flattened triangles' would be) and
+    /// the TLAS over them. An instance whose box is not finite or reaches beyond
+    /// [`super::validate::MAX_COORDINATE`] (a large scale times a large coordinate) is an
+    /// error: the element (instance and mesh) and the reason.
+    pub(super) fn build(
+        meshes: Vec<InstancedMesh>,
+        mut instances: Vec<Instance>,
+    ) -> Result<Self, (String, String)> {
         // An instance of a mesh without triangles can be hit by nothing (and has no box).
         instances.retain(|i| !meshes[i.mesh as usize].parts.triangles.is_empty());
-        let boxes: Vec<[Vec3; 2]> = instances
-            .iter()
-            .map(|inst| {
-                let m = &meshes[inst.mesh as usize].parts;
-                m.positions.iter().fold(
-                    [Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)],
-                    |[lo, hi], &p| {
-                        let q = inst.world_from_object.transform_point3(p);
-                        [lo.min(q), hi.max(q)]
-                    },
-                )
-            })
-            .collect();
+        let mut boxes: Vec<[Vec3; 2]> = Vec::with_capacity(instances.len());
+        for (i, inst) in instances.iter().enumerate() {
+            let m = &meshes[inst.mesh as usize].parts;
+            let b = m.positions.iter().fold(
+                [Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)],
+                |[lo, hi], &p| {
+                    let q = inst.world_from_object.transform_point3(p);
+                    [lo.min(q), hi.max(q)]
+                },
+            );
+            for corner in b {
+                super::validate::position(corner).map_err(|r| {
+                    let mesh = if m.name.is_empty() {
+                        format!("mesh {}", inst.mesh)
+                    } else {
+                        m.name.clone()
+                    };
+                    (format!("instance {i} of {mesh}"), format!("world box: {r}"))
+                })?;
+            }
+            boxes.push(b);
+        }
         let bounds = boxes.iter().filter(|[lo, hi]| lo.cmple(*hi).all()).fold(
             None,
             |acc: Option<[Vec3; 2]>, &[lo, hi]| {
                 Some(acc.map_or([lo, hi], |[a, b]| [a.min(lo), b.max(hi)]))
             },
         );
-        Self {
+        Ok(Self {
             tlas: Tlas::build(&boxes),
             meshes,
             instances,
             bounds,
-        }
+        })
     }
 
     /// Whether there are no instances.

@@ -48,8 +48,8 @@ impl MeshParts {
             SceneError::invalid(source, format!("{prefix}{element}"), reason)
         };
         let nv = self.positions.len();
-        if let Some(i) = self.positions.iter().position(|p| !p.is_finite()) {
-            return Err(bad(format!("vertex {i}"), "position is not finite".into()));
+        for (i, &p) in self.positions.iter().enumerate() {
+            super::validate::position(p).map_err(|r| bad(format!("vertex {i}"), r))?;
         }
         if self.normals.is_empty() {
             self.normals = vec![Vec3::ZERO; nv];

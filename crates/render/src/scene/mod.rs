@@ -66,7 +66,8 @@
 //!   MikkTSpace tangents generated from the world-space positions, the normals (the face
 //!   normals for flat primitives) and the uvs (vertices whose triangles disagree, as on a uv
 //!   mirror seam, are duplicated). A normal-mapped primitive without TEXCOORD_0 is rendered
-//!   without the map (a warning). A perturbed normal is tilted back toward the geometric
+//!   without the map (a warning), and so is one with a vertex shared by more than 4,096
+//!   triangles (MikkTSpace recurses once per triangle around a vertex). A perturbed normal is tilted back toward the geometric
 //!   normal where the viewer's mirror direction would go below the surface
 //!   ([`crate::normal_map::valid_reflection_normal`]).
 //! - Textures ([`crate::texture`]): every material texture reads its `texCoord` set
@@ -104,6 +105,18 @@
 //! `alpha_dry` is the dry shininess and interpolates `shininess`. So black (w = 0) is the wet
 //! value given by `alpha`/`ks` and green (w = 1) is fully dry.
 //!
+//! - Values are checked against the specification and the extensions' schemas (the
+//!   `validate` module): colours and factors in their ranges (baseColorFactor,
+//!   emissiveFactor, metallic, roughness, light colour in [0, 1]; emissiveStrength, intensity
+//!   and the paper models' `kd`, `ks`, `alpha`, `shininess` finite and non-negative), light
+//!   ranges above 0, spot cones with `0 <= inner <= outer <= pi/2` (inner may equal outer: a
+//!   hard edge), cameras' yfov, znear, zfar and aspectRatio, node transforms finite and
+//!   invertible, vertex positions finite and within [`MAX_COORDINATE`] once placed. Anything
+//!   else is an error naming the file and the light, camera, material, node or mesh.
+//! - Limits: a node graph may visit at most [`MAX_PLACEMENTS`] nodes (a node reached by
+//!   several paths counts once per path; counted before the walk) and place as many meshes,
+//!   and the placed meshes may hold at most [`MAX_TRIANGLES`] triangles (counted from the
+//!   accessors before any geometry is read).
 //! - OBJ/MTL (via tobj, triangulated): `Kd` with a non-zero `Ks` (and `illum` not 0 or 1) is
 //!   blinn_phong with shininess `Ns`; otherwise Lambertian `Kd` (times `map_Kd`); `Ke` is
 //!   emission. A missing MTL file is a warning (every material becomes grey diffuse). OBJ has no
@@ -134,11 +147,14 @@ mod instances;
 mod mesh;
 mod obj;
 mod tangents;
+mod validate;
 
 pub use error::SceneError;
 pub use files::LoadOptions;
+pub use gltf::{MAX_PLACEMENTS, MAX_TRIANGLES};
 pub use instances::{Instance, InstancedMesh, Instances};
 pub use mesh::MeshParts;
+pub use validate::MAX_COORDINATE;
 
 use crate::accel::Accel;
 use crate::camera::Camera;
@@ -357,7 +373,8 @@ impl Scene {
                 ),
             ));
         }
-        let instances = Instances::build(meshes, instances);
+        let instances = Instances::build(meshes, instances)
+            .map_err(|(element, reason)| bad(element, reason))?;
         let mut accel = Accel::build_alpha_tested(&positions, &triangles, |t| {
             alpha_tested(triangle_materials[t])
         });

@@ -122,11 +122,12 @@ pub(super) fn load(path: &Path, files: &Files) -> Result<Scene, SceneError> {
             }
             _ => default,
         };
-        parts.positions.extend(
-            mesh.positions
-                .chunks_exact(3)
-                .map(|c| Vec3::new(c[0], c[1], c[2])),
-        );
+        for (k, c) in mesh.positions.chunks_exact(3).enumerate() {
+            let p = Vec3::new(c[0], c[1], c[2]);
+            super::validate::position(p)
+                .map_err(|r| SceneError::invalid(path, format!("{element}, vertex {k}"), r))?;
+            parts.positions.push(p);
+        }
         if mesh.normals.len() == 3 * n {
             parts.normals.extend(
                 mesh.normals
@@ -344,6 +345,45 @@ illum 1
         assert!(
             matches!(scene.materials[0].reflectance, Reflectance::Diffuse { kd, .. }
             if kd == Vec3::splat(DEFAULT_GREY))
+        );
+    }
+
+    /// One face of 500,000 vertices on a circle (a huge polygon): triangulated as a fan in
+    /// linear time, and its slivers, which all hold the first vertex, get their BVH in about
+    /// `n log n` (a million took 68 s before).
+    #[test]
+    fn huge_polygons_load_quickly() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("disc.obj");
+        let n = 500_000;
+        let mut text = String::new();
+        for i in 0..n {
+            let a = i as f32 / n as f32 * std::f32::consts::TAU;
+            text += &format!("v {} {} 0\n", a.cos(), a.sin());
+        }
+        text += "f";
+        for i in 1..=n {
+            text += &format!(" {i}");
+        }
+        text += "\n";
+        std::fs::write(&path, text).unwrap();
+        let start = std::time::Instant::now();
+        let scene = Scene::load(&path).unwrap();
+        let took = start.elapsed();
+        assert!(took < std::time::Duration::from_secs(5), "{took:?}");
+        assert_eq!(scene.triangles.len(), n - 2);
+    }
+
+    /// A vertex beyond the BVH's range is an error naming the object and the vertex.
+    #[test]
+    fn overflowing_positions_name_the_object() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("far.obj");
+        std::fs::write(&path, "o far\nv 0 0 0\nv 1e30 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+        let err = Scene::load(&path).unwrap_err().to_string();
+        assert!(
+            err.contains("far.obj") && err.contains("object \"far\", vertex 1"),
+            "{err}"
         );
     }
 

@@ -90,17 +90,49 @@ impl Geometry for Mesh<'_> {
     }
 }
 
+/// The most triangles that may share one vertex (as MikkTSpace welds them: same position,
+/// normal and uv) for MikkTSpace to run: it groups the triangles around a vertex by recursing
+/// once per triangle, so a fan of 100,000 overflowed the stack. 4,096 levels take well under
+/// a thread's 2 MB.
+pub(super) const MAX_VALENCE: usize = 4096;
+
+/// The largest number of triangle corners that share one vertex, vertices being welded by
+/// position, normal and uv as MikkTSpace welds them.
+fn max_valence(
+    positions: &[Vec3],
+    normals: &[Vec3],
+    uvs: &[Vec2],
+    triangles: &[[u32; 3]],
+) -> usize {
+    let mut count: HashMap<[u32; 8], usize> = HashMap::new();
+    let mut most = 0;
+    for &v in triangles.iter().flatten() {
+        let i = v as usize;
+        let (p, n, uv) = (positions[i], normals[i], uvs[i]);
+        let key = [p.x, p.y, p.z, n.x, n.y, n.z, uv.x, uv.y].map(f32::to_bits);
+        let c = count.entry(key).or_insert(0);
+        *c += 1;
+        most = most.max(*c);
+    }
+    most
+}
+
 /// MikkTSpace tangents of one primitive (world-space `positions`; unit `normals`, zero where
 /// the face normal is meant; the uvs of the normal texture; `triangles` indexing them): one
 /// tangent per vertex, with vertices whose corners disagree duplicated. Returns the tangents
 /// (one per vertex, the duplicates last) and, for each duplicate, the vertex it copies; the
-/// corners of `triangles` are renumbered to the copies they use.
+/// corners of `triangles` are renumbered to the copies they use. A vertex shared by more than
+/// [`MAX_VALENCE`] triangles is an error giving their number (nothing is generated).
 pub(super) fn generate(
     positions: &[Vec3],
     normals: &[Vec3],
     uvs: &[Vec2],
     triangles: &mut [[u32; 3]],
-) -> (Vec<Vec4>, Vec<u32>) {
+) -> Result<(Vec<Vec4>, Vec<u32>), usize> {
+    let valence = max_valence(positions, normals, uvs, triangles);
+    if valence > MAX_VALENCE {
+        return Err(valence);
+    }
     let mut mesh = Mesh {
         positions,
         normals,
@@ -135,7 +167,7 @@ pub(super) fn generate(
             }
         }
     }
-    (tangents, copies)
+    Ok((tangents, copies))
 }
 
 /// Appends to `values` (one per vertex) a copy of `values[i]` for each `i` in `copies`.
@@ -161,7 +193,7 @@ mod tests {
     fn quad_tangent_is_dp_du_with_the_handedness_of_the_uvs() {
         // glTF uvs: u along +X, v down the image, so the image's up (+Y of a normal map) is +Y.
         let (p, n, uv, mut tris) = quad(|x, y| Vec2::new(x, 1.0 - y));
-        let (t, copies) = generate(&p, &n, &uv, &mut tris);
+        let (t, copies) = generate(&p, &n, &uv, &mut tris).unwrap();
         assert!(copies.is_empty());
         for t in &t {
             assert!((*t - Vec4::new(1.0, 0.0, 0.0, 1.0)).length() < 1e-6, "{t}");
@@ -171,7 +203,7 @@ mod tests {
         // Mirrored in u: the tangent follows dP/du = -X and the handedness flips, so that the
         // bitangent still points up the image.
         let (p, n, uv, mut tris) = quad(|x, y| Vec2::new(1.0 - x, 1.0 - y));
-        let (t, _) = generate(&p, &n, &uv, &mut tris);
+        let (t, _) = generate(&p, &n, &uv, &mut tris).unwrap();
         for t in &t {
             assert!(
                 (*t - Vec4::new(-1.0, 0.0, 0.0, -1.0)).length() < 1e-6,
@@ -181,7 +213,7 @@ mod tests {
         }
         // Rotated uvs (u along +Y): the tangent is +Y.
         let (p, n, uv, mut tris) = quad(|x, y| Vec2::new(y, x));
-        let (t, _) = generate(&p, &n, &uv, &mut tris);
+        let (t, _) = generate(&p, &n, &uv, &mut tris).unwrap();
         assert!((t[0].truncate() - Vec3::Y).length() < 1e-6, "{}", t[0]);
     }
 
@@ -198,7 +230,7 @@ mod tests {
             .collect();
         let n = vec![Vec3::Z; 6];
         let mut tris = vec![[0, 2, 3], [0, 3, 1], [2, 4, 5], [2, 5, 3]];
-        let (t, copies) = generate(&p, &n, &uv, &mut tris);
+        let (t, copies) = generate(&p, &n, &uv, &mut tris).unwrap();
         // The seam's two vertices are copied once each, for the right-hand quad.
         let mut sorted = copies.clone();
         sorted.sort_unstable();
@@ -239,7 +271,7 @@ mod tests {
             Vec2::new(1.0, 0.0),
         ];
         let mut tris = vec![[0, 1, 2], [0, 2, 3], [1, 4, 5], [1, 5, 2]];
-        let (t, copies) = generate(&p, &[Vec3::ZERO; 6], &uv, &mut tris);
+        let (t, copies) = generate(&p, &[Vec3::ZERO; 6], &uv, &mut tris).unwrap();
         // The ridge vertices get one tangent per face: along each face's slope.
         assert_eq!(copies.len(), 2);
         for (k, tri) in tris.iter().enumerate() {
@@ -282,5 +314,30 @@ mod tests {
         let (n2, b2) = (n, mirror.transform_vector3(b));
         assert!((n2.cross(w[0].truncate()) * w[0].w - b2).length() < 1e-6);
         assert!((w[2] - Vec4::new(0.0, 1.0, 0.0, 1.0)).length() < 1e-6);
+    }
+
+    /// A fan of 100,000 triangles around one vertex (which overflowed the stack in
+    /// MikkTSpace's recursion) is refused with the count; one of MAX_VALENCE is generated,
+    /// on a test thread's 2 MB stack.
+    #[test]
+    fn huge_fans_are_refused_and_fans_up_to_the_limit_generate() {
+        let fan = |n: usize| {
+            let mut p = vec![Vec3::ZERO];
+            let mut tris = Vec::new();
+            for i in 0..=n {
+                let a = i as f32 / n as f32 * 6.0;
+                p.push(Vec3::new(a.cos(), a.sin(), 0.0));
+                if i > 0 {
+                    tris.push([0, i as u32, i as u32 + 1]);
+                }
+            }
+            let uv: Vec<Vec2> = p.iter().map(|q| q.truncate() * 0.5 + 0.5).collect();
+            (p.clone(), vec![Vec3::Z; p.len()], uv, tris)
+        };
+        let (p, n, uv, mut tris) = fan(100_000);
+        assert_eq!(generate(&p, &n, &uv, &mut tris).unwrap_err(), 100_000);
+        let (p, n, uv, mut tris) = fan(MAX_VALENCE);
+        let (t, _) = generate(&p, &n, &uv, &mut tris).unwrap();
+        assert!(t.iter().all(|t| t.w.abs() == 1.0), "{:?}", &t[..3]);
     }
 }
