@@ -233,7 +233,8 @@ pub(super) fn load(path: &Path, files: &Files) -> Result<Scene, SceneError> {
     // bufferView until then).
     let buffer_list = serde_json::json!({
         "asset": raw.get("asset").cloned().unwrap_or_default(),
-        "buffers": raw.get("buffers").cloned().unwrap_or_default(),
+        // A file with no geometry (lights and cameras only) may have no buffer list.
+        "buffers": raw.get("buffers").cloned().unwrap_or_else(|| serde_json::json!([])),
     });
     let base = files.folder().to_path_buf();
     let fallbacks = compression::fallback_buffers(&raw);
@@ -3381,6 +3382,23 @@ mod hostile_tests {
         );
         assert!(err.contains("scene.gltf"), "no file name in: {err}");
         err
+    }
+
+    #[test]
+    fn a_file_without_buffers_loads() {
+        // Lights only: no buffers, accessors or meshes, which the specification allows.
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("lights.gltf");
+        let doc = json!({
+            "asset": {"version": "2.0"},
+            "extensionsUsed": ["KHR_lights_punctual"],
+            "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 5.0}]}},
+            "nodes": [{"extensions": {"KHR_lights_punctual": {"light": 0}}}],
+            "scenes": [{"nodes": [0]}]
+        });
+        std::fs::write(&path, doc.to_string()).unwrap();
+        let scene = Scene::load(&path).unwrap();
+        assert_eq!(scene.lights.len(), 1);
     }
 
     /// The test scene with `value` at the JSON pointer `pointer` (its parent must exist).
