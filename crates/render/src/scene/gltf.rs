@@ -2325,7 +2325,10 @@ mod tests {
             }
             std::fs::write(&glb, &bytes).unwrap();
             let err = Scene::load(&glb).unwrap_err().to_string();
-            assert!(err.contains("scene.glb") && err.contains("GLB header"), "{err}");
+            assert!(
+                err.contains("scene.glb") && err.contains("GLB header"),
+                "{err}"
+            );
         }
     }
 
@@ -2334,13 +2337,22 @@ mod tests {
         let (mut doc, bin) = test_doc();
         doc["images"] = json!([{"name": "nothing"}]);
         let err = load_err(doc.clone(), &bin);
-        assert!(err.contains("image 0") && err.contains("neither a uri"), "{err}");
+        assert!(
+            err.contains("image 0") && err.contains("neither a uri"),
+            "{err}"
+        );
         doc["images"] = json!([{"bufferView": 0}]);
         let err = load_err(doc.clone(), &bin);
-        assert!(err.contains("image 0") && err.contains("no mimeType"), "{err}");
+        assert!(
+            err.contains("image 0") && err.contains("no mimeType"),
+            "{err}"
+        );
         doc["images"] = json!([{"bufferView": 99, "mimeType": "image/png"}]);
         let err = load_err(doc, &bin);
-        assert!(err.contains("image 0") && err.contains("bufferView 99"), "{err}");
+        assert!(
+            err.contains("image 0") && err.contains("bufferView 99"),
+            "{err}"
+        );
     }
 
     #[test]
@@ -2355,7 +2367,10 @@ mod tests {
         let (mut doc, bin) = test_doc();
         doc["meshes"][0]["primitives"][0]["indices"] = json!(-1);
         let err = load_err(doc, &bin);
-        assert!(err.contains("indices") && err.contains("accessor -1"), "{err}");
+        assert!(
+            err.contains("indices") && err.contains("accessor -1"),
+            "{err}"
+        );
     }
 
     /// Loads `doc` (embedded) and returns the error message; panics if it loads.

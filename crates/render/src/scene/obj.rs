@@ -397,14 +397,26 @@ illum 1
     fn face_indices_out_of_range_are_errors() {
         let quad = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvn 0 0 1\n";
         for (face, what) in [
-            ("f 1/-3 2/1 3/1", "texcoord index -3 is out of range (2 texcoords declared"),
-            ("f 1//-2 2//1 3//1", "normal index -2 is out of range (1 normals declared"),
+            (
+                "f 1/-3 2/1 3/1",
+                "texcoord index -3 is out of range (2 texcoords declared",
+            ),
+            (
+                "f 1//-2 2//1 3//1",
+                "normal index -2 is out of range (1 normals declared",
+            ),
             ("f -4 -3 -2", "vertex index -4"),
-            ("f 1/9223372036854775807 2/1 3/1", "texcoord index 9223372036854775807"),
+            (
+                "f 1/9223372036854775807 2/1 3/1",
+                "texcoord index 9223372036854775807",
+            ),
             ("f 1/0 2/1 3/1", "texcoord index 0"),
         ] {
             let err = obj_err(&format!("{quad}{face}\n"), "");
-            assert!(err.contains("line 7") && err.contains(what), "{face}: {err}");
+            assert!(
+                err.contains("line 7") && err.contains(what),
+                "{face}: {err}"
+            );
         }
         // Relative indices within range load.
         let dir = tempfile::tempdir().unwrap();
