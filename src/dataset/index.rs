@@ -417,8 +417,7 @@ pub fn index_dir(layout: &Layout) -> Result<IndexReport> {
 fn scene_files(gltf: &Path) -> Result<Vec<String>> {
     // As the renderer would read it: a regular file within its size limit.
     let limit = streaks_render::scene::LoadOptions::default().max_file_bytes;
-    let text =
-        streaks_image::input::read_text(gltf, limit).context("cannot read scene.gltf")?;
+    let text = streaks_image::input::read_text(gltf, limit).context("cannot read scene.gltf")?;
     let json: serde_json::Value = serde_json::from_str(&text).context("scene.gltf is not JSON")?;
     let mut files = Vec::new();
     for key in ["buffers", "images"] {

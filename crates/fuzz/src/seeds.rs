@@ -391,14 +391,24 @@ pub fn write_seeds(repo: &Path, corpus: &Path) -> io::Result<()> {
                     part.bytes = without_scene(&part.bytes)?;
                 }
             }
-            put(corpus, "dataset", "one-sample-verified", &files::join(&verified))?;
+            put(
+                corpus,
+                "dataset",
+                "one-sample-verified",
+                &files::join(&verified),
+            )?;
             // Without a manifest: the first index writes it.
             let unindexed: Vec<Part> = parts
                 .iter()
                 .filter(|p| p.name.as_deref() != Some("manifest.jsonl"))
                 .cloned()
                 .collect();
-            put(corpus, "dataset", "one-sample-no-manifest", &files::join(&unindexed))?;
+            put(
+                corpus,
+                "dataset",
+                "one-sample-no-manifest",
+                &files::join(&unindexed),
+            )?;
             let info = parts[0].bytes.clone();
             put(corpus, "dataset", "dataset-json-only", &info)?;
         }
