@@ -205,7 +205,7 @@ impl Detector {
 
 /// Loads and checks a classifier file.
 pub fn load_classifier(path: &Path) -> Result<StreakClassifier> {
-    let text = std::fs::read_to_string(path)
+    let text = streaks_image::input::read_text(path, streaks_image::input::MAX_TEXT_BYTES)
         .with_context(|| format!("cannot read the classifier {}", path.display()))?;
     StreakClassifier::from_json(&text)
         .with_context(|| format!("{} is not a usable streak classifier", path.display()))

@@ -256,10 +256,13 @@ pub fn run(args: Args) -> Result<()> {
         .datasets
         .iter()
         .map(|d| {
-            let info: serde_json::Value = std::fs::read_to_string(d.join("dataset.json"))
-                .ok()
-                .and_then(|t| serde_json::from_str(&t).ok())
-                .unwrap_or_default();
+            let info: serde_json::Value = streaks_image::input::read_text(
+                &d.join("dataset.json"),
+                streaks_image::input::MAX_TEXT_BYTES,
+            )
+            .ok()
+            .and_then(|t| serde_json::from_str(&t).ok())
+            .unwrap_or_default();
             serde_json::json!({
                 "folder": d.file_name().map(|n| n.to_string_lossy().into_owned()),
                 "seed": info.get("seed"),

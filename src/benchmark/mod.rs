@@ -188,7 +188,7 @@ pub fn run(args: Args) -> Result<()> {
             bar.inc(1);
         }
         if k < args.thumbnails {
-            let left = image::open(&sample.left)
+            let left = streaks_image::input::load_image(&sample.left)
                 .with_context(|| format!("reading {}", sample.left.display()))?
                 .to_rgb8();
             thumbs.push(html::SampleThumbs::new(&sample.id, &left, &maps)?);

@@ -466,7 +466,7 @@ fn check_existing(info: &DatasetInfo, existing: &[u8], path: &std::path::Path) -
 fn prepare_folder(layout: &Layout, info: &DatasetInfo) -> Result<()> {
     let root = layout.root();
     let json = layout.dataset_json();
-    match std::fs::read(&json) {
+    match streaks_image::input::read_file(&json, streaks_image::input::MAX_TEXT_BYTES) {
         Ok(existing) => check_existing(info, &existing, &json)?,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
             // Another shard may be writing dataset.json right now (its temporary file
@@ -487,7 +487,8 @@ fn prepare_folder(layout: &Layout, info: &DatasetInfo) -> Result<()> {
                 .with_context(|| format!("cannot write into {}", root.display()))?;
             // A shard with other settings that wrote at the same time is caught here.
             let written =
-                std::fs::read(&json).with_context(|| format!("cannot read {}", json.display()))?;
+                streaks_image::input::read_file(&json, streaks_image::input::MAX_TEXT_BYTES)
+                    .with_context(|| format!("cannot read {}", json.display()))?;
             check_existing(info, &written, &json)?;
         }
         Err(e) => return Err(e).with_context(|| format!("cannot read {}", json.display())),

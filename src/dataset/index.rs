@@ -415,7 +415,9 @@ pub fn index_dir(layout: &Layout) -> Result<IndexReport> {
 
 /// The files a sample's `scene.gltf` refers to (buffers and images with a relative `uri`).
 fn scene_files(gltf: &Path) -> Result<Vec<String>> {
-    let text = std::fs::read_to_string(gltf).context("cannot read scene.gltf")?;
+    // As the renderer would read it: a regular file within its size limit.
+    let limit = streaks_render::scene::LoadOptions::default().max_file_bytes;
+    let text = streaks_image::input::read_text(gltf, limit).context("cannot read scene.gltf")?;
     let json: serde_json::Value = serde_json::from_str(&text).context("scene.gltf is not JSON")?;
     let mut files = Vec::new();
     for key in ["buffers", "images"] {

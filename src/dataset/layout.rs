@@ -177,13 +177,15 @@ impl Layout {
                     );
                 }
                 let path = self.splits_dir().join(format!("{name}.txt"));
-                let text = std::fs::read_to_string(&path).with_context(|| {
-                    format!(
-                        "cannot read the split {} (run `streaks dataset index {}`)",
-                        path.display(),
-                        self.root.display()
-                    )
-                })?;
+                let text =
+                    streaks_image::input::read_text(&path, streaks_image::input::MAX_TEXT_BYTES)
+                        .with_context(|| {
+                            format!(
+                                "cannot read the split {} (run `streaks dataset index {}`)",
+                                path.display(),
+                                self.root.display()
+                            )
+                        })?;
                 text.lines()
                     .map(str::trim)
                     .filter(|l| !l.is_empty())
@@ -367,7 +369,7 @@ impl DatasetInfo {
                 meta.len()
             );
         }
-        let text = std::fs::read_to_string(path)
+        let text = streaks_image::input::read_text(path, streaks_image::input::MAX_TEXT_BYTES)
             .with_context(|| format!("cannot read {}", path.display()))?;
         let info: Self = serde_json::from_str(&text)
             .with_context(|| format!("{} is not a dataset.json of {FORMAT}", path.display()))?;

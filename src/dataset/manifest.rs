@@ -429,9 +429,10 @@ impl std::fmt::Display for Difference {
     }
 }
 
-/// sha256 of the regular file `path` (read in blocks), lowercase hex.
+/// sha256 of the regular file `path` (read in blocks), lowercase hex; anything else (a FIFO
+/// swapped in since it was listed) is an error rather than a blocking open.
 pub fn sha256_file(path: &Path) -> std::io::Result<String> {
-    let mut file = std::fs::File::open(path)?;
+    let (mut file, _) = streaks_image::input::open_regular(path)?;
     let mut hasher = Sha256::new();
     std::io::copy(&mut file, &mut hasher)?;
     Ok(format!("{:x}", hasher.finalize()))

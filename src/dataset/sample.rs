@@ -160,7 +160,7 @@ pub struct SampleMeta {
 impl SampleMeta {
     /// Reads a sample's `meta.json`.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path)
+        let text = streaks_image::input::read_text(path, streaks_image::input::MAX_TEXT_BYTES)
             .with_context(|| format!("cannot read {}", path.display()))?;
         serde_json::from_str(&text).with_context(|| format!("{} does not parse", path.display()))
     }

@@ -9,4 +9,5 @@ mod dataset;
 mod detect;
 mod measure;
 mod render;
+mod special_files;
 mod stereo;

@@ -383,12 +383,52 @@ pub fn write_seeds(repo: &Path, corpus: &Path) -> io::Result<()> {
                 .filter(|p| !p.name.as_deref().is_some_and(|n| n.contains("/scene")))
                 .collect();
             put(corpus, "dataset", "one-sample", &files::join(&parts))?;
+            // The same with the scene left out of the manifest too: verifying it succeeds,
+            // so mutations reach the comparison of every file with its hash.
+            let mut verified = parts.clone();
+            for part in &mut verified {
+                if part.name.as_deref() == Some("manifest.jsonl") {
+                    part.bytes = without_scene(&part.bytes)?;
+                }
+            }
+            put(
+                corpus,
+                "dataset",
+                "one-sample-verified",
+                &files::join(&verified),
+            )?;
+            // Without a manifest: the first index writes it.
+            let unindexed: Vec<Part> = parts
+                .iter()
+                .filter(|p| p.name.as_deref() != Some("manifest.jsonl"))
+                .cloned()
+                .collect();
+            put(
+                corpus,
+                "dataset",
+                "one-sample-no-manifest",
+                &files::join(&unindexed),
+            )?;
             let info = parts[0].bytes.clone();
             put(corpus, "dataset", "dataset-json-only", &info)?;
         }
         Err(e) => eprintln!("no dataset seed: {e}"),
     }
     Ok(())
+}
+
+/// `manifest.jsonl` without the entries of the samples' scene files.
+fn without_scene(manifest: &[u8]) -> io::Result<Vec<u8>> {
+    let mut out = Vec::new();
+    for line in manifest.split(|&b| b == b'\n').filter(|l| !l.is_empty()) {
+        let mut entry: serde_json::Value = serde_json::from_slice(line)?;
+        if let Some(files) = entry.get_mut("files").and_then(|f| f.as_object_mut()) {
+            files.retain(|name, _| !name.contains("/scene"));
+        }
+        serde_json::to_writer(&mut out, &entry)?;
+        out.push(b'\n');
+    }
+    Ok(out)
 }
 
 /// EXRs of every compression the `exr` crate writes, in scan lines and in tiles, with half,

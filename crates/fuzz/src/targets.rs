@@ -434,61 +434,73 @@ pub fn calib(data: &[u8]) -> Outcome {
     })
 }
 
-/// How long `streaks dataset index` may run on one input before the target reports a hang
-/// (under the runner's per-input limit, so that the child process is always reaped).
+/// How long the two `streaks dataset index` runs on one input may take together before the
+/// target reports a hang (under the runner's per-input limit, so that the child process is
+/// always reaped).
 pub const DATASET_TIME_LIMIT: Duration = Duration::from_millis(1500);
 
 /// A dataset folder (`dataset.json` with any `manifest.jsonl`, `splits/` and `samples/` files),
-/// checked by the `streaks dataset index` command: the dataset readers live in the binary, so
-/// this target runs it (found by [`streaks_binary`]). A panic, a crash or a run longer than
-/// [`DATASET_TIME_LIMIT`] panics here, so the runner reports it.
+/// checked by the `streaks dataset index` command twice: as given (which verifies the files
+/// against `manifest.jsonl`, or writes it the first time) and then with `--rebuild` (which
+/// checks the samples and writes the manifest and splits again). The dataset readers live in
+/// the binary, so this target runs it (found by [`streaks_binary`]). A panic, a crash or a run
+/// longer than [`DATASET_TIME_LIMIT`] panics here, so the runner reports it; the outcome is
+/// the first run's error, else the second's.
 pub fn dataset(data: &[u8]) -> Outcome {
     let binary = streaks_binary().unwrap_or_else(|e| panic!("{e}"));
     with_files(data, "dataset.json", true, |dir| {
-        let log = dir.with_file_name("index.log");
-        let mut child = Command::new(&binary)
-            .args(["dataset", "index"])
-            .arg(dir)
-            .stdin(Stdio::null())
-            .stdout(Stdio::null())
-            .stderr(std::fs::File::create(&log).expect("cannot make the log file"))
-            .spawn()
-            .unwrap_or_else(|e| panic!("cannot run {}: {e}", binary.display()));
-        let start = Instant::now();
-        let status = loop {
-            if let Some(status) = child.try_wait().expect("cannot wait for streaks") {
-                break status;
-            }
-            if start.elapsed() > DATASET_TIME_LIMIT {
-                let _ = child.kill();
-                let _ = child.wait();
-                panic!(
-                    "hang: streaks dataset index ran longer than {:?}",
-                    DATASET_TIME_LIMIT
-                );
-            }
-            std::thread::sleep(Duration::from_millis(2));
-        };
-        let mut stderr = String::new();
-        let _ = std::fs::File::open(&log).and_then(|mut f| f.read_to_string(&mut stderr));
-        match status.code() {
-            Some(0) => Ok(()),
-            Some(1) => Err(stderr.lines().last().unwrap_or("").to_owned()),
-            _ => {
-                // The command's own panic, if any, first: the runner tells findings apart by it.
-                let lines: Vec<&str> = stderr.lines().collect();
-                let cause = lines
-                    .iter()
-                    .position(|l| l.contains("panicked at "))
-                    .map(|i| {
-                        let place = lines[i].split("panicked at ").nth(1).unwrap_or("");
-                        format!("panicked at {place} {}", lines.get(i + 1).unwrap_or(&""))
-                    })
-                    .unwrap_or_else(|| status.to_string());
-                panic!("streaks dataset index {cause}\n{}", tail(&stderr))
-            }
-        }
+        let deadline = Instant::now() + DATASET_TIME_LIMIT;
+        let verified = index(&binary, dir, &[], deadline);
+        let rebuilt = index(&binary, dir, &["--rebuild"], deadline);
+        verified.and(rebuilt)
     })
+}
+
+/// Runs `streaks dataset index EXTRA DIR`: `Ok` if it succeeded, its last line if it failed
+/// with status 1; panics on anything else (a crash, or still running at `deadline`).
+fn index(binary: &Path, dir: &Path, extra: &[&str], deadline: Instant) -> Outcome {
+    let log = dir.with_file_name("index.log");
+    let mut child = Command::new(binary)
+        .args(["dataset", "index"])
+        .args(extra)
+        .arg(dir)
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(std::fs::File::create(&log).expect("cannot make the log file"))
+        .spawn()
+        .unwrap_or_else(|e| panic!("cannot run {}: {e}", binary.display()));
+    let command = format!("streaks dataset index {}", extra.join(" "));
+    let command = command.trim_end();
+    let status = loop {
+        if let Some(status) = child.try_wait().expect("cannot wait for streaks") {
+            break status;
+        }
+        if Instant::now() > deadline {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("hang: {command} ran past the {DATASET_TIME_LIMIT:?} the index runs share");
+        }
+        std::thread::sleep(Duration::from_millis(2));
+    };
+    let mut stderr = String::new();
+    let _ = std::fs::File::open(&log).and_then(|mut f| f.read_to_string(&mut stderr));
+    match status.code() {
+        Some(0) => Ok(()),
+        Some(1) => Err(stderr.lines().last().unwrap_or("").to_owned()),
+        _ => {
+            // The command's own panic, if any, first: the runner tells findings apart by it.
+            let lines: Vec<&str> = stderr.lines().collect();
+            let cause = lines
+                .iter()
+                .position(|l| l.contains("panicked at "))
+                .map(|i| {
+                    let place = lines[i].split("panicked at ").nth(1).unwrap_or("");
+                    format!("panicked at {place} {}", lines.get(i + 1).unwrap_or(&""))
+                })
+                .unwrap_or_else(|| status.to_string());
+            panic!("{command} {cause}\n{}", tail(&stderr))
+        }
+    }
 }
 
 /// The last 20 lines of `text`.

@@ -132,6 +132,18 @@ pub fn read_file(path: &Path, max_bytes: u64) -> io::Result<Vec<u8>> {
     Ok(bytes)
 }
 
+/// The size limit for a text file a user names (a rig, a calibration, a generator config, a
+/// model, a dataset's JSON): far beyond any real one, small enough to read whole.
+pub const MAX_TEXT_BYTES: u64 = 16 << 20;
+
+/// The regular file `path` as UTF-8 text, read as [`read_file`] reads (no FIFO, device or
+/// folder, at most `max_bytes`): a special file given where a text file belongs is a prompt
+/// error rather than a hang or an endless read.
+pub fn read_text(path: &Path, max_bytes: u64) -> io::Result<String> {
+    String::from_utf8(read_file(path, max_bytes)?)
+        .map_err(|e| io::Error::new(io::ErrorKind::InvalidData, format!("not UTF-8 text: {e}")))
+}
+
 /// The first `len` bytes of the regular file `path`: an error, before anything is reserved,
 /// if the file is shorter; nothing past them is read.
 pub fn read_file_prefix(path: &Path, len: u64) -> io::Result<Vec<u8>> {
@@ -286,8 +298,26 @@ pub(crate) mod tests {
             );
             assert!(read_file_prefix(path, 4).is_err());
             assert!(load_image(path).is_err());
+            assert!(read_text(path, MAX_TEXT_BYTES).is_err());
         }
         assert!(start.elapsed() < Duration::from_secs(1));
+    }
+
+    #[test]
+    fn text_is_capped_and_utf8() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("rig.json");
+        std::fs::write(&path, "{}").unwrap();
+        assert_eq!(read_text(&path, 2).unwrap(), "{}");
+        assert!(read_text(&path, 1)
+            .unwrap_err()
+            .to_string()
+            .contains("limit of 1"));
+        std::fs::write(&path, b"\xff{}").unwrap();
+        assert!(read_text(&path, 16)
+            .unwrap_err()
+            .to_string()
+            .contains("UTF-8"));
     }
 
     #[test]

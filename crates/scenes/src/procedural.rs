@@ -339,10 +339,11 @@ impl GeneratorConfig {
 
     /// Reads and checks a TOML config file.
     pub fn from_toml_file(path: &Path) -> Result<Self, Error> {
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Read {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text = streaks_image::input::read_text(path, streaks_image::input::MAX_TEXT_BYTES)
+            .map_err(|source| Error::Read {
+                path: path.to_path_buf(),
+                source,
+            })?;
         Self::from_toml_str(&text, &path.display().to_string())
     }
 

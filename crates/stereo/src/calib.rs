@@ -210,7 +210,8 @@ impl MiddleburyCalib {
             path: path.to_path_buf(),
             reason,
         };
-        let text = std::fs::read_to_string(path).map_err(|e| err(e.to_string()))?;
+        let text = streaks_image::input::read_text(path, streaks_image::input::MAX_TEXT_BYTES)
+            .map_err(|e| err(e.to_string()))?;
         Self::parse(&text).map_err(err)
     }
 }

@@ -250,7 +250,8 @@ impl RigFile {
             path: path.to_path_buf(),
             reason,
         };
-        let text = std::fs::read_to_string(path).map_err(|e| err(e.to_string()))?;
+        let text = streaks_image::input::read_text(path, streaks_image::input::MAX_TEXT_BYTES)
+            .map_err(|e| err(e.to_string()))?;
         let file: RigFile = serde_json::from_str(&text).map_err(|e| err(e.to_string()))?;
         file.rig().map_err(|e| err(e.to_string()))?;
         Ok(file)

@@ -21,6 +21,89 @@ use std::path::Path;
 /// Albedo of the material used where the MTL gives none.
 const DEFAULT_GREY: f32 = 0.5;
 
+/// The lines of an OBJ or MTL file as tobj reads them (split at `\n`, a trailing `\r`
+/// dropped), numbered from 1, up to the first that is not UTF-8 (where tobj stops too).
+fn lines(bytes: &[u8]) -> impl Iterator<Item = (usize, &str)> {
+    bytes
+        .split(|&b| b == b'\n')
+        .map(|line| std::str::from_utf8(line.strip_suffix(b"\r").unwrap_or(line)))
+        .map_while(Result::ok)
+        .enumerate()
+        .map(|(i, line)| (i + 1, line))
+}
+
+/// Checks every index of the OBJ's faces and lines (`f`, `l`) before tobj resolves them: a
+/// negative index must not reach before the first element declared so far, a positive one
+/// must not exceed the elements of the whole file, and 0 is not an OBJ index. tobj turns an
+/// out-of-range relative index into a huge one and overflows multiplying it.
+fn check_obj_indices(path: &Path, bytes: &[u8]) -> Result<(), SceneError> {
+    const KINDS: [(&str, &str); 3] = [("v", "vertex"), ("vt", "texcoord"), ("vn", "normal")];
+    let kind = |word: &str| KINDS.iter().position(|&(k, _)| k == word);
+    let mut total = [0usize; 3];
+    for (_, line) in lines(bytes) {
+        if let Some(k) = line.split_whitespace().next().and_then(kind) {
+            total[k] += 1;
+        }
+    }
+    let mut seen = [0usize; 3];
+    for (number, line) in lines(bytes) {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some(word @ ("f" | "l")) => {
+                for vertex in words {
+                    for (k, index) in vertex.split('/').take(3).enumerate() {
+                        // What does not parse is left to tobj, which rejects it.
+                        let Ok(index) = index.parse::<i64>() else {
+                            continue;
+                        };
+                        let (available, within) = if index < 0 {
+                            (seen[k], "declared before it")
+                        } else {
+                            (total[k], "in the file")
+                        };
+                        if index == 0 || index.unsigned_abs() > available as u64 {
+                            return Err(SceneError::invalid(
+                                path,
+                                format!("line {number} ({word} {vertex:?})"),
+                                format!(
+                                    "{} index {index} is out of range ({available} {}s {within})",
+                                    KINDS[k].1, KINDS[k].1
+                                ),
+                            ));
+                        }
+                    }
+                }
+            }
+            Some(word) => {
+                if let Some(k) = kind(word) {
+                    seen[k] += 1;
+                }
+            }
+            None => {}
+        }
+    }
+    Ok(())
+}
+
+/// Checks that every colour of an MTL file (`Ka`, `Kd`, `Ks`, `Ke`) has three numbers before
+/// tobj reads it: with fewer it panics.
+fn check_mtl_colours(path: &Path, element: &str, bytes: &[u8]) -> Result<(), SceneError> {
+    for (number, line) in lines(bytes) {
+        let mut words = line.split_whitespace();
+        if let Some(key @ ("Ka" | "Kd" | "Ks" | "Ke")) = words.next() {
+            let n = words.count();
+            if n < 3 {
+                return Err(SceneError::invalid(
+                    path,
+                    format!("{element}, line {number} ({key})"),
+                    format!("a colour needs 3 numbers, it has {n}"),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Loads an `.obj` file and its MTL, reading them through `files`: the MTL and the texture
 /// maps resolve inside the OBJ's folder, and a refused one (outside the folder, not a
 /// regular file, too large) is an error; a missing or unreadable one is a warning.
@@ -31,6 +114,7 @@ pub(super) fn load(path: &Path, files: &Files) -> Result<Scene, SceneError> {
         ..Default::default()
     };
     let bytes = files.read_scene()?;
+    check_obj_indices(path, &bytes)?;
     // What reading the material libraries met: refusals fail the load, the rest are warnings.
     let refused: RefCell<Option<SceneError>> = RefCell::new(None);
     let unreadable: RefCell<Vec<String>> = RefCell::new(Vec::new());
@@ -40,7 +124,13 @@ pub(super) fn load(path: &Path, files: &Files) -> Result<Scene, SceneError> {
             .resolve(name, &element)
             .and_then(|file| files.read(&file, &element));
         match read {
-            Ok(bytes) => tobj::load_mtl_buf(&mut bytes.as_slice()),
+            Ok(bytes) => match check_mtl_colours(path, &element, &bytes) {
+                Ok(()) => tobj::load_mtl_buf(&mut bytes.as_slice()),
+                Err(e) => {
+                    refused.borrow_mut().get_or_insert(e);
+                    Err(tobj::LoadError::OpenFileFailed)
+                }
+            },
             Err(SceneError::Io { source, .. })
                 if !matches!(
                     source.kind(),
@@ -291,6 +381,63 @@ Kd 0.7 0.6 0.5
 Ks 0.5 0.5 0.5
 illum 1
 ";
+
+    /// Loads `obj` (with `mtl` as `m.mtl` beside it) and returns the error message.
+    fn obj_err(obj: &str, mtl: &str) -> String {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("bad.obj");
+        std::fs::write(&path, obj).unwrap();
+        std::fs::write(dir.path().join("m.mtl"), mtl).unwrap();
+        let err = Scene::load(&path).unwrap_err().to_string();
+        assert!(err.contains("bad.obj"), "{err}");
+        err
+    }
+
+    #[test]
+    fn face_indices_out_of_range_are_errors() {
+        let quad = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvn 0 0 1\n";
+        for (face, what) in [
+            (
+                "f 1/-3 2/1 3/1",
+                "texcoord index -3 is out of range (2 texcoords declared",
+            ),
+            (
+                "f 1//-2 2//1 3//1",
+                "normal index -2 is out of range (1 normals declared",
+            ),
+            ("f -4 -3 -2", "vertex index -4"),
+            (
+                "f 1/9223372036854775807 2/1 3/1",
+                "texcoord index 9223372036854775807",
+            ),
+            ("f 1/0 2/1 3/1", "texcoord index 0"),
+        ] {
+            let err = obj_err(&format!("{quad}{face}\n"), "");
+            assert!(
+                err.contains("line 7") && err.contains(what),
+                "{face}: {err}"
+            );
+        }
+        // Relative indices within range load.
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("ok.obj");
+        std::fs::write(&path, format!("{quad}f -3/-2/-1 -2/-1/-1 -1/-1/-1\n")).unwrap();
+        assert_eq!(Scene::load(&path).unwrap().triangles.len(), 1);
+    }
+
+    #[test]
+    fn an_mtl_colour_with_fewer_than_three_numbers_is_an_error() {
+        for colour in ["Kd", "Ke 1", "Ks 1 1"] {
+            let err = obj_err(
+                "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+                &format!("newmtl a\n{colour}\n"),
+            );
+            assert!(
+                err.contains("mtllib \"m.mtl\", line 2") && err.contains("needs 3 numbers"),
+                "{colour}: {err}"
+            );
+        }
+    }
 
     #[test]
     fn loads_obj_with_mtl() {
