@@ -12,10 +12,12 @@
 use glam::Vec3;
 use std::f32::consts::FRAC_PI_2;
 
-/// The largest absolute world-space coordinate a vertex may have: twice it, squared and
-/// tripled (a box's half area), stays finite in `f32`, so the BVH's box arithmetic cannot
-/// overflow (about a light-century in metres, far beyond any scene).
-pub const MAX_COORDINATE: f32 = 1e18;
+/// The largest absolute world-space coordinate a vertex may have (a million kilometres, far
+/// beyond any street): the BVH builder's box areas summed over many primitives stay finite in
+/// `f32`, and the watertight triangle test still resolves metre-sized triangles at that
+/// distance (at 1e18 obvhs' tree conversion failed its own assertions on a few hundred
+/// overlapping boxes; at 1e15 rays missed such triangles).
+pub const MAX_COORDINATE: f32 = 1e12;
 
 /// Whether every component of `v` is finite and in `[lo, hi]`.
 fn in_range(v: &[f32], lo: f32, hi: f32) -> bool {
