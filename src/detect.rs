@@ -430,7 +430,7 @@ pub fn score_dataset(
 ) -> Result<DatasetScore> {
     let layout = Layout::new(dir);
     let ids = layout.sample_ids(split)?;
-    let bar = crate::render::progress_bar(ids.len() as u64);
+    let bar = crate::cli::progress_bar(ids.len() as u64);
     let samples = ids
         .par_iter()
         .map(|id| {

@@ -39,7 +39,7 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let scene = crate::render::load_scene(&args.scene, args.allow_outside_scene)?;
+    let scene = crate::cli::load_scene(&args.scene, args.allow_outside_scene)?;
     let opts = ExportOptions {
         width: args.width,
         height: args.height,

@@ -5,6 +5,7 @@
 
 mod analyze;
 mod benchmark;
+mod cli;
 mod compare;
 mod dataset;
 mod detect;

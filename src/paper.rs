@@ -66,7 +66,7 @@ fn fig2_and_3(args: &Args, out: &Path, index: &mut String) -> Result<()> {
         let camera = scene
             .camera(None)
             .with_context(|| format!("in the scene {}", path.display()))?;
-        let (w, h) = crate::render::image_size(Some(args.fig2_width), None, camera.aspect_ratio)?;
+        let (w, h) = crate::cli::image_size(Some(args.fig2_width), None, camera.aspect_ratio)?;
         let rig = rig_from_camera(camera, w, h, Rig::DEFAULT_BASELINE)?;
         let settings = PairSettings {
             spp: args.fig2_spp,
@@ -77,7 +77,7 @@ fn fig2_and_3(args: &Args, out: &Path, index: &mut String) -> Result<()> {
             mask: StreakMaskParams::default(),
             regularize: false,
         };
-        let bar = crate::render::progress_bar(w as u64 * h as u64 * args.fig2_spp as u64);
+        let bar = crate::cli::progress_bar(w as u64 * h as u64 * args.fig2_spp as u64);
         let view = render_eye(&scene, &rig, Eye::Left, &settings, &|n| bar.inc(n))?;
         bar.finish_and_clear();
         let png = out.join(format!("fig2_{name}.png"));
@@ -222,7 +222,7 @@ fn fig6(args: &Args, out: &Path, index: &mut String) -> Result<Report> {
     let camera = scene
         .camera(None)
         .with_context(|| format!("in the scene {}", path.display()))?;
-    let (w, h) = crate::render::image_size(None, Some(args.fig6_size), camera.aspect_ratio)?;
+    let (w, h) = crate::cli::image_size(None, Some(args.fig6_size), camera.aspect_ratio)?;
     let rig = rig_from_camera(camera, w, h, Rig::DEFAULT_BASELINE)?;
     let settings = PairSettings {
         spp: args.fig6_spp,
@@ -233,7 +233,7 @@ fn fig6(args: &Args, out: &Path, index: &mut String) -> Result<Report> {
         mask: StreakMaskParams::default(),
         regularize: false,
     };
-    let bar = crate::render::progress_bar(2 * w as u64 * h as u64 * args.fig6_spp as u64);
+    let bar = crate::cli::progress_bar(2 * w as u64 * h as u64 * args.fig6_spp as u64);
     let views = render_pair(&scene, &rig, &settings, &|n| bar.inc(n))?;
     bar.finish_and_clear();
     let seconds: f64 = views.iter().map(|v| v.output.stats.seconds).sum();

@@ -145,7 +145,7 @@ pub fn run(args: Args) -> Result<()> {
     }
     let t0 = std::time::Instant::now();
     eprintln!("reading {} training samples", train.len());
-    let bar = crate::render::progress_bar(train.len() as u64);
+    let bar = crate::cli::progress_bar(train.len() as u64);
     let parts = train
         .par_iter()
         .enumerate()
@@ -178,7 +178,7 @@ pub fn run(args: Args) -> Result<()> {
         100.0 * positives as f64 / data.rows().max(1) as f64,
         params.rounds
     );
-    let bar = crate::render::progress_bar(params.rounds as u64);
+    let bar = crate::cli::progress_bar(params.rounds as u64);
     let mut last_loss = 0.0;
     let model = gbdt::train(&data, &params, |_, loss| {
         last_loss = loss;

@@ -148,7 +148,7 @@ pub fn run(args: Args) -> Result<()> {
         .prefix("streaks-benchmark-")
         .tempdir()
         .context("cannot create a temporary folder")?;
-    let bar = crate::render::progress_bar((samples.len() * methods.len()) as u64);
+    let bar = crate::cli::progress_bar((samples.len() * methods.len()) as u64);
     let mut sample_reports = Vec::new();
     let mut thumbs = Vec::new();
     for (k, sample) in samples.iter().enumerate() {

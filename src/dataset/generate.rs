@@ -24,7 +24,7 @@ use super::lock::{Lock, Mode};
 use super::manifest::{verify_entry, Difference, Manifest};
 use super::sample::{is_complete, remove_stale_tmp, render_sample, SampleSettings};
 use super::shard::Shard;
-use crate::render::{image_size, progress_bar};
+use crate::cli::{image_size, progress_bar};
 use anyhow::{bail, Context, Result};
 use rayon::prelude::*;
 use sha2::{Digest, Sha256};

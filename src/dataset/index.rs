@@ -25,7 +25,7 @@ use super::layout::{sample_id, DatasetInfo, Layout, ROAD_MASK, SAMPLE_FILES, SCE
 use super::lock::{Lock, LockError, Mode};
 use super::manifest::{verify_batch, Lines};
 use super::sample::{write_kitti, SampleMeta, SampleStats};
-use crate::render::progress_bar;
+use crate::cli::progress_bar;
 use anyhow::{bail, Context, Result};
 use rayon::prelude::*;
 use serde::Serialize;
