@@ -53,7 +53,7 @@ pub struct Args {
     pub pixels: usize,
     /// Boosting rounds. The defaults of these four are the shipped classifier's: small trees
     /// with large leaves, because a street's pixels are far from independent, and deeper
-    /// trees learn the training streets rather than streaks (README, "Streak detection").
+    /// trees learn the training streets rather than streaks (docs/stereo.md, "Streak detection").
     #[arg(long, default_value_t = 150)]
     pub rounds: usize,
     /// Learning rate.

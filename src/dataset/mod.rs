@@ -11,7 +11,7 @@
 //! - [`sample`]: rendering and writing one sample;
 //! - [`shard`]: `--shard K/N`.
 //!
-//! The README's "Datasets" section describes the layout and the conventions for users.
+//! docs/datasets.md describes the layout and the conventions for users.
 
 pub mod generate;
 pub mod index;
