@@ -1,11 +1,14 @@
 //! What the subcommands share: loading a scene with the command's hints, the image size from
-//! `--width`/`--height` and the camera, and the progress bar. Subcommands use these and never
+//! `--width`/`--height` and the camera, the progress bar, and the analysis of a pair folder
+//! with its console summary. Subcommands use these and never
 //! call each other.
 
 use anyhow::{bail, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::Path;
+use std::time::Instant;
+use streaks_analysis::report::{analyze_dir, summary_table, AnalyzeParams, Report};
 use streaks_render::scene::{LoadOptions, Scene, SceneError};
 
 /// Largest image accepted, in pixels (2^26, twice 8K UHD; the film keeps about 72 bytes per
@@ -104,4 +107,20 @@ mod tests {
         assert!(image_size(Some(u32::MAX), Some(u32::MAX), None).is_err());
         assert!(image_size(None, Some(u32::MAX), Some(4.0)).is_err());
     }
+}
+
+/// Analyses the pair in `dir` ([`analyze_dir`]: `dir/analysis/`), prints the summary table
+/// and what was written, and returns the report: `streaks analyze`, and `streaks stereo
+/// --analyze` and `streaks paper` after rendering.
+pub fn analyze_pair(dir: &Path, params: &AnalyzeParams) -> Result<Report> {
+    let start = Instant::now();
+    let done = analyze_dir(dir, params)?;
+    eprint!("{}", summary_table(&done.report));
+    eprintln!(
+        "analysed in {:.1} s; wrote {} files into {}",
+        start.elapsed().as_secs_f64(),
+        done.written.len(),
+        done.out.display()
+    );
+    Ok(done.report)
 }
