@@ -25,7 +25,8 @@
 //! - [`benchmark`]: an estimate scored by region (streak, road, off-road; the phantom-hole
 //!   rate), pooled over samples; the LK streak disparity as a map; signed error maps.
 //! - [`repair`]: streak-robust stereo: the road plane from the pair's own v-disparity, and
-//!   the masking or repair of the pixels streaks and reflections put beneath the road.
+//!   the masking or repair of the pixels streaks and reflections put beneath the road;
+//!   [`repair::estimate`], the dense estimate with or without it.
 //! - [`sgm`]: dense semi-global matching, and its errors against a ground truth (bad-2.0).
 //! - [`report`]: the per-streak analysis of a rendered or photographed pair (Fig. 6, Fig. 8):
 //!   measured against predicted disparity per row, poles and road against their ground truth,
