@@ -24,9 +24,9 @@ use streaks_analysis::streak_classifier::{
 };
 use streaks_image::{write_bytes_atomically, GrayImage};
 
+use crate::cli::{sample_horizon, sample_truths};
 use crate::dataset::layout::Layout;
 use crate::dataset::sample::SampleMeta;
-use crate::detect::{sample_horizon, sample_truths};
 
 /// Train the learned streak detector on datasets.
 #[derive(clap::Args, Debug)]

@@ -40,4 +40,3 @@ pub struct Input {
     /// The dataset split, if one was chosen.
     pub split: Option<String>,
 }
-

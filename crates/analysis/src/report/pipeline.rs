@@ -5,17 +5,17 @@
 use super::dense::{dense_accuracy, disparity_range, summarize_dense};
 use super::input::{RigView, StereoInput};
 use super::lights::match_light;
+use super::output::write_outputs;
 use super::stats::{compare, compare_with, median, span};
 use super::targets::{find_objects, find_road};
-use super::output::write_outputs;
 use super::{Analysis, RegionReport, Report, ReportError, RigSummary, RowRecord, StreakReport};
-use std::path::{Path, PathBuf};
 use crate::centre::CentreModel;
 use crate::detect::{detect_streaks, score_mask, vertical_truth, DetectParams, Streak};
 use crate::lk::{lk_rows, prepare_pair, LkError, LkParams, RowDisparity};
 use crate::model::streak_rows;
 use crate::sgm::{sgm, SgmParams};
 use glam::{DVec3, Vec3};
+use std::path::{Path, PathBuf};
 use streaks_image::{GrayImage, NamedRegion, Region};
 
 /// Parameters of [`analyze`].
