@@ -92,27 +92,6 @@ pub fn progress_bar(total: u64) -> ProgressBar {
     bar
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn sizes_follow_the_aspect_ratio() {
-        assert_eq!(
-            image_size(None, None, Some(16.0 / 9.0)).unwrap(),
-            (853, 480)
-        );
-        assert_eq!(image_size(None, None, None).unwrap(), (640, 480));
-        assert_eq!(image_size(Some(320), None, Some(2.0)).unwrap(), (320, 160));
-        assert_eq!(image_size(None, Some(100), Some(1.5)).unwrap(), (150, 100));
-        assert_eq!(image_size(Some(7), Some(9), Some(2.0)).unwrap(), (7, 9));
-        assert!(image_size(Some(0), None, None).is_err());
-        assert!(image_size(Some(1), None, Some(100.0)).is_err());
-        assert!(image_size(Some(u32::MAX), Some(u32::MAX), None).is_err());
-        assert!(image_size(None, Some(u32::MAX), Some(4.0)).is_err());
-    }
-}
-
 /// Analyses the pair in `dir` ([`analyze_dir`]: `dir/analysis/`), prints the summary table
 /// and what was written, and returns the report: `streaks analyze`, and `streaks stereo
 /// --analyze` and `streaks paper` after rendering.
@@ -160,4 +139,25 @@ pub fn sample_truths(dir: &Path, meta: &SampleMeta) -> Result<(GrayImage, Option
     let road = load_mask(&dir.join("road0.png"), w, h)?;
     let on_road = road_streaks(&truth, &road);
     Ok((truth, Some(on_road)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_follow_the_aspect_ratio() {
+        assert_eq!(
+            image_size(None, None, Some(16.0 / 9.0)).unwrap(),
+            (853, 480)
+        );
+        assert_eq!(image_size(None, None, None).unwrap(), (640, 480));
+        assert_eq!(image_size(Some(320), None, Some(2.0)).unwrap(), (320, 160));
+        assert_eq!(image_size(None, Some(100), Some(1.5)).unwrap(), (150, 100));
+        assert_eq!(image_size(Some(7), Some(9), Some(2.0)).unwrap(), (7, 9));
+        assert!(image_size(Some(0), None, None).is_err());
+        assert!(image_size(Some(1), None, Some(100.0)).is_err());
+        assert!(image_size(Some(u32::MAX), Some(u32::MAX), None).is_err());
+        assert!(image_size(None, Some(u32::MAX), Some(4.0)).is_err());
+    }
 }

@@ -71,10 +71,7 @@ impl Detector {
                 })
             }
             Self::Hand(params) => {
-                let params = DetectParams {
-                    horizon,
-                    ..params.clone()
-                };
+                let params = DetectParams { horizon, ..*params };
                 let det = detect_streaks(image, &params)?;
                 let mut mask = det.mask;
                 for v in &mut mask.data {
