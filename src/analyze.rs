@@ -3,13 +3,10 @@
 //! and predicted (Eq. 4) disparity per row, implied depths below the road, vertical objects
 //! and road (Fig. 8), plots and `DIR/analysis/report.json`.
 
-use anyhow::{Context, Result};
-use std::path::{Path, PathBuf};
-use std::time::Instant;
+use anyhow::Result;
+use std::path::PathBuf;
 use streaks_analysis::lk::LkParams;
-use streaks_analysis::report::{
-    analyze, summary_table, write_outputs, AnalyzeParams, Report, StereoInput,
-};
+use streaks_analysis::report::AnalyzeParams;
 use streaks_image::{ImageError, NamedRegion};
 
 /// Analyse a rendered stereo pair: streak disparities against the virtual light column model.
@@ -70,51 +67,33 @@ impl Args {
         p.detect.horizon = self.horizon;
         p
     }
-
-    /// Default arguments for `dir`.
-    pub fn for_dir(dir: &Path) -> Self {
-        Self {
-            dir: dir.to_path_buf(),
-            regions: Vec::new(),
-            objects: 3,
-            min_ncc: 0.8,
-            window: 21,
-            rows: 5,
-            horizon: None,
-            match_tolerance: 12.0,
-        }
-    }
-}
-
-/// Analyses `dir`, writes `dir/analysis/` and prints the summary table; returns the report.
-pub fn analyze_dir(dir: &Path, params: &AnalyzeParams) -> Result<Report> {
-    let start = Instant::now();
-    let input =
-        StereoInput::load(dir).with_context(|| format!("reading the pair in {}", dir.display()))?;
-    let analysis =
-        analyze(&input, params).with_context(|| format!("analysing {}", dir.display()))?;
-    let out = dir.join("analysis");
-    let written = write_outputs(&out, &analysis, &input)
-        .with_context(|| format!("writing the analysis into {}", out.display()))?;
-    eprint!("{}", summary_table(&analysis.report));
-    eprintln!(
-        "analysed in {:.1} s; wrote {} files into {}",
-        start.elapsed().as_secs_f64(),
-        written.len(),
-        out.display()
-    );
-    Ok(analysis.report)
 }
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<()> {
-    analyze_dir(&args.dir, &args.params()).map(|_| ())
+    crate::cli::analyze_pair(&args.dir, &args.params()).map(|_| ())
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use streaks_image::Region;
+
+    #[test]
+    fn default_arguments_are_the_default_params() {
+        // `streaks stereo --analyze` and `streaks paper` analyse with `AnalyzeParams::default()`:
+        // the same as `streaks analyze DIR` with no flags.
+        #[derive(clap::Parser)]
+        struct Cli {
+            #[command(flatten)]
+            args: Args,
+        }
+        let cli = <Cli as clap::Parser>::try_parse_from(["analyze", "dir"]).unwrap();
+        assert_eq!(
+            format!("{:?}", cli.args.params()),
+            format!("{:?}", AnalyzeParams::default())
+        );
+    }
 
     #[test]
     fn named_regions_parse() {

@@ -1,11 +1,18 @@
 //! What the subcommands share: loading a scene with the command's hints, the image size from
-//! `--width`/`--height` and the camera, and the progress bar. Subcommands use these and never
+//! `--width`/`--height` and the camera, the progress bar, and the analysis of a pair folder
+//! with its console summary; the horizon and streak truths of a dataset sample, which `streaks
+//! detect` and `streaks train-detector` both read. Subcommands use these and never
 //! call each other.
 
-use anyhow::{bail, Result};
+use crate::dataset::sample::SampleMeta;
+use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::Path;
+use std::time::Instant;
+use streaks_analysis::detector::{horizon_row, road_streaks};
+use streaks_analysis::report::{analyze_dir, summary_table, AnalyzeParams, Report};
+use streaks_image::GrayImage;
 use streaks_render::scene::{LoadOptions, Scene, SceneError};
 
 /// Largest image accepted, in pixels (2^26, twice 8K UHD; the film keeps about 72 bytes per
@@ -83,6 +90,55 @@ pub fn progress_bar(total: u64) -> ProgressBar {
         bar.set_style(style.progress_chars("=> "));
     }
     bar
+}
+
+/// Analyses the pair in `dir` ([`analyze_dir`]: `dir/analysis/`), prints the summary table
+/// and what was written, and returns the report: `streaks analyze`, and `streaks stereo
+/// --analyze` and `streaks paper` after rendering.
+pub fn analyze_pair(dir: &Path, params: &AnalyzeParams) -> Result<Report> {
+    let start = Instant::now();
+    let done = analyze_dir(dir, params)?;
+    eprint!("{}", summary_table(&done.report));
+    eprintln!(
+        "analysed in {:.1} s; wrote {} files into {}",
+        start.elapsed().as_secs_f64(),
+        done.written.len(),
+        done.out.display()
+    );
+    Ok(done.report)
+}
+
+/// The horizon row (image y) of a dataset sample's left camera ([`horizon_row`] of its rig).
+pub fn sample_horizon(meta: &SampleMeta) -> f32 {
+    let rig = &meta.rig;
+    horizon_row(&rig.world_from_rig, rig.principal_point[1], rig.focal_px)
+}
+
+/// Loads a 0/255 (or 0/1) mask, checking its size against `w` x `h`.
+fn load_mask(path: &Path, w: usize, h: usize) -> Result<GrayImage> {
+    let m = GrayImage::load(path).with_context(|| format!("cannot read {}", path.display()))?;
+    if (m.width, m.height) != (w, h) {
+        bail!(
+            "{} is {}x{}, the image {w}x{h}",
+            path.display(),
+            m.width,
+            m.height
+        );
+    }
+    Ok(m)
+}
+
+/// The truth masks of the dataset sample in `dir`: `streaks0.png`, and its part on the road
+/// ([`road_streaks`] with `road0.png`), if the scene flags a road.
+pub fn sample_truths(dir: &Path, meta: &SampleMeta) -> Result<(GrayImage, Option<GrayImage>)> {
+    let (w, h) = (meta.rig.width as usize, meta.rig.height as usize);
+    let truth = load_mask(&dir.join("streaks0.png"), w, h)?;
+    if !meta.road_mask {
+        return Ok((truth, None));
+    }
+    let road = load_mask(&dir.join("road0.png"), w, h)?;
+    let on_road = road_streaks(&truth, &road);
+    Ok((truth, Some(on_road)))
 }
 
 #[cfg(test)]

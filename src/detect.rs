@@ -1,5 +1,5 @@
-//! `streaks detect`: specular streak detection ([`streaks_analysis::detect`]) on one image, or
-//! scored over a dataset of `streaks dataset generate` against the renderer's masks.
+//! `streaks detect`: specular streak detection ([`streaks_analysis::detector`]) on one image,
+//! or scored over a dataset of `streaks dataset generate` against the renderer's masks.
 //!
 //! Two detectors: `learned`, the per-pixel classifier of
 //! [`streaks_analysis::streak_classifier`] on linear luminance (the one shipped with the crate,
@@ -23,10 +23,10 @@
 
 use anyhow::{bail, Context, Result};
 use rayon::prelude::*;
-use serde::Serialize;
 use std::path::{Path, PathBuf};
-use streaks_analysis::detect::{detect_streaks, score_mask, DetectParams, MaskScore};
-use streaks_analysis::streak_classifier::{operating_point, StreakClassifier};
+use streaks_analysis::detect::{score_mask, DetectParams};
+use streaks_analysis::detector::{DatasetScore, Detector, Found, SampleScore};
+use streaks_analysis::streak_classifier::StreakClassifier;
 use streaks_image::{write_bytes_atomically, GrayImage};
 
 use crate::dataset::layout::Layout;
@@ -84,25 +84,6 @@ pub enum DetectorKind {
     Hand,
 }
 
-/// A detector ready to run.
-pub enum Detector {
-    /// The learned classifier.
-    Learned(Box<StreakClassifier>),
-    /// The hand-built detector with these settings (the horizon is set per image).
-    Hand(ParamArgs),
-}
-
-/// What a detector found in one image.
-pub struct Found {
-    /// 1 on streak pixels, 0 elsewhere.
-    pub mask: GrayImage,
-    /// The learned detector's smoothed streak probability (the mask is where it reaches the
-    /// threshold).
-    pub probability: Option<GrayImage>,
-    /// The number of streaks (regions), for the hand-built detector.
-    pub streaks: Option<usize>,
-}
-
 /// The detector `args` ask for (see `--detector`), for a dataset (`dataset`) or an image.
 pub fn detector_kind(args: &Args, dataset: bool) -> DetectorKind {
     if let Some(k) = args.detector {
@@ -128,79 +109,59 @@ pub fn detector_kind(args: &Args, dataset: bool) -> DetectorKind {
     }
 }
 
-impl Detector {
-    /// The detector of kind `kind` with the arguments' settings: loads and checks `--model`.
-    pub fn from_args(args: &Args, kind: DetectorKind) -> Result<Self> {
-        match kind {
-            DetectorKind::Hand => {
-                if args.model.is_some() || args.threshold.is_some() {
-                    bail!("--model and --threshold apply to --detector learned");
-                }
-                args.params
-                    .params(None)
-                    .validate()
-                    .context("detector parameters")?;
-                Ok(Self::Hand(args.params.clone()))
+/// The detector of kind `kind` with the arguments' settings: loads and checks `--model`.
+pub fn detector_from_args(args: &Args, kind: DetectorKind) -> Result<Detector> {
+    match kind {
+        DetectorKind::Hand => {
+            if args.model.is_some() || args.threshold.is_some() {
+                bail!("--model and --threshold apply to --detector learned");
             }
-            DetectorKind::Learned => {
-                if args.params != ParamArgs::default() {
-                    bail!("the hand-built detector's settings need --detector hand");
-                }
-                let mut c = match &args.model {
-                    Some(p) => load_classifier(p)?,
-                    None => StreakClassifier::shipped(),
-                };
-                if let Some(t) = args.threshold {
-                    if !(0.0..=1.0).contains(&t) {
-                        bail!("--threshold {t} is not a probability in [0, 1]");
-                    }
-                    c.threshold = t;
-                }
-                Ok(Self::Learned(Box::new(c)))
+            args.params
+                .params(None)
+                .validate()
+                .context("detector parameters")?;
+            Ok(Detector::Hand(args.params.params(None)))
+        }
+        DetectorKind::Learned => {
+            if args.params != ParamArgs::default() {
+                bail!("the hand-built detector's settings need --detector hand");
             }
+            let mut c = match &args.model {
+                Some(p) => load_classifier(p)?,
+                None => StreakClassifier::shipped(),
+            };
+            if let Some(t) = args.threshold {
+                if !(0.0..=1.0).contains(&t) {
+                    bail!("--threshold {t} is not a probability in [0, 1]");
+                }
+                c.threshold = t;
+            }
+            Ok(Detector::Learned(Box::new(c)))
         }
     }
+}
 
-    /// The dataset image this detector reads by default.
-    pub fn default_image(&self) -> ImageKind {
-        match self {
-            Self::Learned(_) => ImageKind::Exr,
-            Self::Hand(_) => ImageKind::Png,
-        }
+/// The dataset image `detector` reads by default.
+fn default_image(detector: &Detector) -> ImageKind {
+    if detector.reads_linear() {
+        ImageKind::Exr
+    } else {
+        ImageKind::Png
     }
+}
 
-    /// Runs on the image at `path` with the horizon at row `horizon` (`None`: the image
-    /// centre).
-    pub fn detect(&self, path: &Path, horizon: Option<f32>) -> Result<Found> {
-        let what = || format!("detecting streaks in {}", path.display());
-        match self {
-            Self::Learned(c) => {
-                let lum = GrayImage::load_linear(path)
-                    .with_context(|| format!("cannot read {}", path.display()))?;
-                let horizon = horizon.unwrap_or(0.5 * lum.height as f32);
-                let p = c.smoothed_probability(&lum, horizon).with_context(what)?;
-                Ok(Found {
-                    mask: c.mask_of(&p),
-                    probability: Some(p),
-                    streaks: None,
-                })
-            }
-            Self::Hand(params) => {
-                let img = GrayImage::load(path)
-                    .with_context(|| format!("cannot read {}", path.display()))?;
-                let det = detect_streaks(&img, &params.params(horizon)).with_context(what)?;
-                let mut mask = det.mask;
-                for v in &mut mask.data {
-                    *v = if *v > 0.5 { 1.0 } else { 0.0 };
-                }
-                Ok(Found {
-                    mask,
-                    probability: None,
-                    streaks: Some(det.streaks.len()),
-                })
-            }
-        }
+/// Runs `detector` on the image at `path` (read as linear or 8-bit luminance, as the detector
+/// wants) with the horizon at row `horizon` (`None`: the image centre).
+pub fn detect_file(detector: &Detector, path: &Path, horizon: Option<f32>) -> Result<Found> {
+    let image = if detector.reads_linear() {
+        GrayImage::load_linear(path)
+    } else {
+        GrayImage::load(path)
     }
+    .with_context(|| format!("cannot read {}", path.display()))?;
+    detector
+        .detect(&image, horizon)
+        .with_context(|| format!("detecting streaks in {}", path.display()))
 }
 
 /// Loads and checks a classifier file.
@@ -280,107 +241,12 @@ impl ParamArgs {
     }
 }
 
-/// The scores of one dataset sample.
-#[derive(Clone, Debug, Serialize)]
-pub struct SampleScore {
-    /// The sample id.
-    pub id: String,
-    /// Its split.
-    pub split: String,
-    /// The horizon row used.
-    pub horizon: f32,
-    /// Streaks the detector found (the hand-built detector; the learned one classifies
-    /// pixels).
-    pub streaks: Option<usize>,
-    /// Against `streaks0.png`.
-    pub all: MaskScore,
-    /// Against the part of `streaks0.png` on the road (`road0.png`); `None` without a road
-    /// mask.
-    pub road: Option<MaskScore>,
-}
-
-/// The scores of a dataset.
-#[derive(Clone, Debug, Serialize)]
-pub struct DatasetScore {
-    /// The dataset folder.
-    pub dataset: PathBuf,
-    /// The split scored (`None`: all samples).
-    pub split: Option<String>,
-    /// The image the detector saw (`im0.png` or `im0.exr`).
-    pub image: String,
-    /// Pixel-pooled score against `streaks0.png`.
-    pub all: MaskScore,
-    /// Pixel-pooled score against the road's streaks (samples with a road mask).
-    pub road: MaskScore,
-    /// The learned detector: the threshold over these samples that gives the highest road
-    /// recall at [`AT_PRECISION`] (chosen on the scored samples themselves: a point of their
-    /// precision-recall curve, not an operating point); `None` for the hand-built detector or
-    /// when no threshold reaches that precision.
-    pub road_at_precision: Option<CurvePoint>,
-    /// Per sample.
-    pub samples: Vec<SampleScore>,
-}
-
-/// The precision at which [`DatasetScore::road_at_precision`] reads the curve (the detector's
-/// target: recall 0.8 at precision 0.9).
-pub const AT_PRECISION: f64 = 0.9;
-
-/// A point of a precision-recall curve.
-#[derive(Clone, Debug, Serialize)]
-pub struct CurvePoint {
-    /// The probability threshold.
-    pub threshold: f32,
-    /// The pooled score at it.
-    pub score: MaskScore,
-}
-
-/// The horizon row (image y) of a sample's left camera: `c_y - f tan(pitch)`, with the pitch
-/// from the rig's pose (its -Z axis, the viewing direction, `asin(z_y)` below the horizontal).
-pub fn sample_horizon(meta: &SampleMeta) -> f32 {
-    let rig = &meta.rig;
-    let zy = rig.world_from_rig.z_axis[1].clamp(-0.999, 0.999);
-    let tan_pitch = zy / (1.0 - zy * zy).sqrt();
-    rig.principal_point[1] - rig.focal_px * tan_pitch
-}
-
-/// Loads a 0/255 (or 0/1) mask, checking its size against `w` x `h`.
-fn load_mask(path: &Path, w: usize, h: usize) -> Result<GrayImage> {
-    let m = GrayImage::load(path).with_context(|| format!("cannot read {}", path.display()))?;
-    if (m.width, m.height) != (w, h) {
-        bail!(
-            "{} is {}x{}, the image {w}x{h}",
-            path.display(),
-            m.width,
-            m.height
-        );
-    }
-    Ok(m)
-}
-
 /// Image file name of a dataset sample's left view.
 fn image_file(kind: ImageKind) -> &'static str {
     match kind {
         ImageKind::Png => "im0.png",
         ImageKind::Exr => "im0.exr",
     }
-}
-
-/// The truth masks of one dataset sample: `streaks0.png`, and its part on the road
-/// (`road0.png`), if the scene flags a road.
-pub fn sample_truths(dir: &Path, meta: &SampleMeta) -> Result<(GrayImage, Option<GrayImage>)> {
-    let (w, h) = (meta.rig.width as usize, meta.rig.height as usize);
-    let truth = load_mask(&dir.join("streaks0.png"), w, h)?;
-    if !meta.road_mask {
-        return Ok((truth, None));
-    }
-    let road = load_mask(&dir.join("road0.png"), w, h)?;
-    let mut on_road = truth.clone();
-    for (t, &r) in on_road.data.iter_mut().zip(&road.data) {
-        if r <= 0.5 {
-            *t = 0.0;
-        }
-    }
-    Ok((truth, Some(on_road)))
 }
 
 /// Scores the detector on one sample folder.
@@ -393,31 +259,11 @@ fn score_sample(
 ) -> Result<(SampleScore, Vec<(f32, bool)>)> {
     let meta = SampleMeta::load(&dir.join("meta.json"))?;
     let image = dir.join(image_file(kind));
-    let horizon = sample_horizon(&meta);
-    let found = detector.detect(&image, Some(horizon))?;
-    let (truth, on_road) = sample_truths(dir, &meta)?;
-    let all = score_mask(&found.mask, &truth)?;
-    let road = match &on_road {
-        Some(t) => Some(score_mask(&found.mask, t)?),
-        None => None,
-    };
-    let pairs = match (&found.probability, &on_road) {
-        (Some(p), Some(t)) => p
-            .data
-            .iter()
-            .zip(&t.data)
-            .map(|(&p, &t)| (p, t > 0.5))
-            .collect(),
-        _ => vec![],
-    };
-    let score = SampleScore {
-        id: id.to_owned(),
-        split: meta.split,
-        horizon,
-        streaks: found.streaks,
-        all,
-        road,
-    };
+    let horizon = crate::cli::sample_horizon(&meta);
+    let found = detect_file(detector, &image, Some(horizon))?;
+    let (truth, on_road) = crate::cli::sample_truths(dir, &meta)?;
+    let (score, pairs) =
+        SampleScore::new(id, &meta.split, horizon, &found, &truth, on_road.as_ref())?;
     Ok((score, pairs))
 }
 
@@ -444,70 +290,23 @@ pub fn score_dataset(
     bar.finish_and_clear();
     let (samples, pairs): (Vec<SampleScore>, Vec<Vec<(f32, bool)>>) = samples.into_iter().unzip();
     let pairs: Vec<(f32, bool)> = pairs.into_iter().flatten().collect();
-    let road_at_precision = if pairs.is_empty() {
-        None
-    } else {
-        operating_point(pairs, AT_PRECISION)
-            .map(|(threshold, score)| CurvePoint { threshold, score })
-    };
-    Ok(DatasetScore {
-        dataset: dir.to_path_buf(),
-        split: split.map(str::to_owned),
-        image: image_file(kind).into(),
-        all: MaskScore::pooled(samples.iter().map(|s| &s.all)),
-        road: MaskScore::pooled(samples.iter().filter_map(|s| s.road.as_ref())),
-        road_at_precision,
+    Ok(DatasetScore::pooled(
+        dir.to_path_buf(),
+        split.map(str::to_owned),
+        image_file(kind).into(),
         samples,
-    })
-}
-
-/// The table `streaks detect DIR` prints.
-fn table(score: &DatasetScore) -> String {
-    let mut out =
-        String::from("sample  split  horizon  streaks  all P/R (true px)    road P/R (true px)\n");
-    let cell = |m: &MaskScore| format!("{:.2}/{:.2} ({:>6})", m.precision, m.recall, m.truth);
-    for s in &score.samples {
-        out.push_str(&format!(
-            "{:<7} {:<6} {:>7.1} {:>8}  {:<20} {}\n",
-            s.id,
-            s.split,
-            s.horizon,
-            s.streaks.map_or("-".into(), |n| n.to_string()),
-            cell(&s.all),
-            s.road
-                .as_ref()
-                .map(cell)
-                .unwrap_or_else(|| "no road mask".into())
-        ));
-    }
-    out.push_str(&format!(
-        "pooled over {} samples: all P {:.3} R {:.3} F1 {:.3}; road P {:.3} R {:.3} F1 {:.3}\n",
-        score.samples.len(),
-        score.all.precision,
-        score.all.recall,
-        score.all.f1,
-        score.road.precision,
-        score.road.recall,
-        score.road.f1
-    ));
-    if let Some(c) = &score.road_at_precision {
-        out.push_str(&format!(
-            "road precision-recall curve: recall {:.3} at precision {:.3} (threshold {:.4}, \
-             chosen on these samples)\n",
-            c.score.recall, c.score.precision, c.threshold
-        ));
-    }
-    out
+        pairs,
+    ))
 }
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<()> {
     let dataset = args.input.join("dataset.json").is_file();
-    let detector = Detector::from_args(&args, detector_kind(&args, dataset))?;
+    let detector = detector_from_args(&args, detector_kind(&args, dataset))?;
     if dataset {
-        let kind = args.image.unwrap_or(detector.default_image());
+        let kind = args.image.unwrap_or(default_image(&detector));
         let score = score_dataset(&args.input, args.split.as_deref(), kind, &detector)?;
-        eprint!("{}", table(&score));
+        eprint!("{}", score.table());
         if let Some(out) = &args.output {
             let json = serde_json::to_vec_pretty(&score)?;
             write_bytes_atomically(out, &json)
@@ -533,7 +332,7 @@ pub fn run(args: Args) -> Result<()> {
         }
         None => None,
     };
-    let found = detector.detect(&args.input, args.horizon)?;
+    let found = detect_file(&detector, &args.input, args.horizon)?;
     let (w, h) = (found.mask.width, found.mask.height);
     if let Some((t, m)) = &truth {
         if (m.width, m.height) != (w, h) {

@@ -7,9 +7,9 @@
 
 use anyhow::{bail, Context};
 use std::path::PathBuf;
-use streaks_analysis::repair::{robust_disparity, RepairParams, RobustDisparity, StreakHandling};
+use streaks_analysis::repair::{estimate, Estimate, StreakHandling};
 use streaks_analysis::sgm::{
-    compare_disparity, compare_disparity_where, sgm, write_disparity_png, Census, Paths, SgmParams,
+    compare_disparity, compare_disparity_where, write_disparity_png, Census, Paths, SgmParams,
 };
 use streaks_image::pfm::{read_pfm, write_pfm};
 use streaks_image::GrayImage;
@@ -78,48 +78,6 @@ pub enum Handling {
     Mask,
     /// Replace them with the road plane's disparity.
     Repair,
-}
-
-/// A dense disparity as `streaks disparity` computes it.
-pub struct Estimate {
-    /// The disparity of the left view (`inf`: no value): SGM's, or the streak-robust one.
-    pub disparity: GrayImage,
-    /// Wall time of the semi-global matching alone, seconds.
-    pub sgm_seconds: f64,
-    /// With a streak handling: what the streak-robust pass did (its `disparity` is
-    /// [`Estimate::disparity`]).
-    pub robust: Option<RobustDisparity>,
-}
-
-/// Semi-global matching of `left` and `right` with `params`, then, given a `handling`, the
-/// streak-robust pass with its default parameters ([`robust_disparity`]): exactly what
-/// `streaks disparity [--streaks mask|repair]` computes (and `streaks benchmark`'s `sgm` and
-/// `sgm-streaks` methods).
-pub fn estimate(
-    left: &GrayImage,
-    right: &GrayImage,
-    params: &SgmParams,
-    handling: Option<StreakHandling>,
-) -> anyhow::Result<Estimate> {
-    let start = std::time::Instant::now();
-    let disp = sgm(left, right, params).context("semi-global matching")?;
-    let sgm_seconds = start.elapsed().as_secs_f64();
-    Ok(match handling {
-        None => Estimate {
-            disparity: disp,
-            sgm_seconds,
-            robust: None,
-        },
-        Some(handling) => {
-            let r = robust_disparity(left, &disp, handling, &RepairParams::default())
-                .context("streak-robust disparity")?;
-            Estimate {
-                disparity: r.disparity.clone(),
-                sgm_seconds,
-                robust: Some(r),
-            }
-        }
-    })
 }
 
 /// Runs the command.

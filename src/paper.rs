@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 use streaks_analysis::figures;
 use streaks_analysis::plot::{Marker, Plot, Series, BLACK_RGB, BLUE, GREY, ORANGE};
-use streaks_analysis::report::{Comparison, Report, RowRecord, StreakReport};
+use streaks_analysis::report::{AnalyzeParams, Comparison, Report, RowRecord, StreakReport};
 use streaks_image::png::write_png;
 use streaks_image::{write_bytes_atomically, GrayImage};
 use streaks_render::scene::Scene;
@@ -242,8 +242,7 @@ fn fig6(args: &Args, out: &Path, index: &mut String) -> Result<Report> {
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
     write_pair(&dir, &scene, &rig, &views, 0.0)?;
     step(5, "Fig. 6: 1D LK along the streak against Eq. 4");
-    let params = crate::analyze::Args::for_dir(&dir).params();
-    let report = crate::analyze::analyze_dir(&dir, &params)?;
+    let report = crate::cli::analyze_pair(&dir, &AnalyzeParams::default())?;
     let streak = report
         .streaks
         .iter()

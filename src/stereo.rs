@@ -4,6 +4,7 @@
 use crate::render::{Loaded, RenderOpts};
 use anyhow::{bail, Context, Result};
 use std::path::PathBuf;
+use streaks_analysis::report::AnalyzeParams;
 use streaks_stereo::render::{render_pair, rig_from_camera, write_pair, PairSettings};
 use streaks_stereo::rig::Rig;
 use streaks_stereo::streak_mask::StreakMaskParams;
@@ -86,8 +87,7 @@ pub fn run(args: Args) -> Result<()> {
         args.output.display()
     );
     if args.analyze {
-        let params = crate::analyze::Args::for_dir(&args.output).params();
-        crate::analyze::analyze_dir(&args.output, &params)?;
+        crate::cli::analyze_pair(&args.output, &AnalyzeParams::default())?;
     }
     Ok(())
 }

@@ -17,16 +17,15 @@
 use anyhow::{bail, Context, Result};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
-use streaks_analysis::detect::MaskScore;
 use streaks_analysis::gbdt::{self, Dataset, TrainParams};
 use streaks_analysis::streak_classifier::{
-    operating_point, smooth_probability, training_rows, StreakClassifier, FEATURES, FORMAT,
+    choose_operating_point, training_rows, OperatingPoint, StreakClassifier, FEATURES,
 };
 use streaks_image::{write_bytes_atomically, GrayImage};
 
+use crate::cli::{sample_horizon, sample_truths};
 use crate::dataset::layout::Layout;
 use crate::dataset::sample::SampleMeta;
-use crate::detect::{sample_horizon, sample_truths};
 
 /// Train the learned streak detector on datasets.
 #[derive(clap::Args, Debug)]
@@ -189,14 +188,7 @@ pub fn run(args: Args) -> Result<()> {
     let train_s = t0.elapsed().as_secs_f64();
     eprintln!("trained in {train_s:.1} s, training log-loss {last_loss:.4}");
 
-    let mut classifier = StreakClassifier {
-        format: FORMAT.into(),
-        features: FEATURES.iter().map(|s| s.to_string()).collect(),
-        threshold: 0.5,
-        smooth: 0,
-        provenance: serde_json::Value::Null,
-        model,
-    };
+    let mut classifier = StreakClassifier::new(model);
     // Threshold and smoothing on every pixel of the validation samples.
     let maps = val
         .par_iter()
@@ -209,34 +201,22 @@ pub fn run(args: Args) -> Result<()> {
         })
         .collect::<Result<Vec<_>>>()?;
     let maps: Vec<(GrayImage, GrayImage)> = maps.into_iter().flatten().collect();
-    let mut best: Option<(usize, f32, MaskScore)> = None;
-    for smooth in 0..=2 {
-        let pairs: Vec<(f32, bool)> = maps
-            .par_iter()
-            .flat_map_iter(|(p, truth)| {
-                let p = smooth_probability(p, smooth);
-                p.data
-                    .into_iter()
-                    .zip(truth.data.iter().map(|&t| t > 0.5))
-                    .collect::<Vec<_>>()
-            })
-            .collect();
-        let Some((threshold, score)) = operating_point(pairs, args.precision) else {
-            eprintln!(
-                "smoothing radius {smooth}: no threshold reaches precision {}",
-                args.precision
-            );
-            continue;
-        };
-        eprintln!(
-            "smoothing radius {smooth}, threshold {threshold:.4}: {} split P {:.3} R {:.3} F1 {:.3}",
-            val_name, score.precision, score.recall, score.f1
-        );
-        if best.as_ref().is_none_or(|b| score.recall > b.2.recall) {
-            best = Some((smooth, threshold, score));
-        }
-    }
-    let Some((smooth, threshold, val_score)) = best else {
+    let best = choose_operating_point(&maps, args.precision, |smooth, point| match point {
+        None => eprintln!(
+            "smoothing radius {smooth}: no threshold reaches precision {}",
+            args.precision
+        ),
+        Some(p) => eprintln!(
+            "smoothing radius {smooth}, threshold {:.4}: {} split P {:.3} R {:.3} F1 {:.3}",
+            p.threshold, val_name, p.score.precision, p.score.recall, p.score.f1
+        ),
+    });
+    let Some(OperatingPoint {
+        smooth,
+        threshold,
+        score: val_score,
+    }) = best
+    else {
         bail!(
             "no threshold reaches precision {} on the {} split: more training data or rounds are needed",
             args.precision,

@@ -1,4 +1,5 @@
-//! The methods `streaks benchmark` runs: the built-ins and external commands.
+//! The methods `streaks benchmark` runs: the built-ins ([`BuiltIn`], the analysis crate's) and
+//! external commands.
 
 use super::command::{self, Ended, Paths, Template};
 use super::input::Sample;
@@ -6,42 +7,15 @@ use super::report::{Failure, FailureKind};
 use anyhow::{bail, Context, Result};
 use std::path::Path;
 use std::time::{Duration, Instant};
-use streaks_analysis::benchmark::{lk_streak_disparity, streak_lk_params};
-use streaks_analysis::detect::DetectParams;
-use streaks_analysis::repair::StreakHandling;
-use streaks_analysis::sgm::SgmParams;
+use streaks_analysis::benchmark::method::{no_value_below_zero, BuiltIn};
 use streaks_image::pfm::read_pfm;
 use streaks_image::GrayImage;
-
-/// The built-in methods, by name.
-pub const BUILT_INS: [(&str, &str); 3] = [
-    (
-        "sgm",
-        "semi-global matching as `streaks disparity` computes it (census 7x7, 8 paths, \
-         disparities 0-63, left-right check, median)",
-    ),
-    (
-        "sgm-streaks",
-        "sgm, then the streak repair: `streaks disparity --streaks repair` (road plane from \
-         the pair's v-disparity; detected streaks and below-the-road pixels given the plane's \
-         disparity)",
-    ),
-    (
-        "lk",
-        "the paper's per-row Lucas-Kanade along each detected streak's centre, as `streaks \
-         analyze` measures it: values only on detected streak rows (a small valid share)",
-    ),
-];
 
 /// One method.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Method {
-    /// `sgm`.
-    Sgm,
-    /// `sgm-streaks`.
-    SgmStreaks,
-    /// `lk`.
-    Lk,
+    /// A built-in method.
+    BuiltIn(BuiltIn),
     /// An external command: a template with `{left}`, `{right}` and `{out}`.
     Command {
         /// The method's name.
@@ -54,12 +28,7 @@ pub enum Method {
 impl Method {
     /// The built-in method `name`.
     pub fn built_in(name: &str) -> Option<Method> {
-        match name {
-            "sgm" => Some(Method::Sgm),
-            "sgm-streaks" => Some(Method::SgmStreaks),
-            "lk" => Some(Method::Lk),
-            _ => None,
-        }
+        BuiltIn::from_name(name).map(Method::BuiltIn)
     }
 
     /// `--method-cmd NAME=TEMPLATE`, checked.
@@ -87,9 +56,7 @@ impl Method {
     /// The method's name.
     pub fn name(&self) -> &str {
         match self {
-            Method::Sgm => "sgm",
-            Method::SgmStreaks => "sgm-streaks",
-            Method::Lk => "lk",
+            Method::BuiltIn(m) => m.name(),
             Method::Command { name, .. } => name,
         }
     }
@@ -100,11 +67,7 @@ impl Method {
             Method::Command { template, .. } => {
                 format!("external command: `{}`", template.text())
             }
-            m => BUILT_INS
-                .iter()
-                .find(|(n, _)| *n == m.name())
-                .map(|(_, d)| d.to_string())
-                .unwrap_or_default(),
+            Method::BuiltIn(m) => m.description().to_string(),
         }
     }
 
@@ -128,9 +91,9 @@ impl Method {
                 let out = work.join(format!("{index:06}-{name}.pfm"));
                 run_command(template, sample, &out, timeout)
             }
-            _ => {
+            Method::BuiltIn(m) => {
                 let start = Instant::now();
-                let result = self.run_built_in(sample).map_err(|e| Failure {
+                let result = run_built_in(*m, sample).map_err(|e| Failure {
                     kind: FailureKind::Error,
                     reason: format!("{e:#}"),
                     stderr_tail: String::new(),
@@ -140,43 +103,15 @@ impl Method {
             }
         }
     }
-
-    /// A built-in method's disparity on `sample`.
-    fn run_built_in(&self, sample: &Sample) -> Result<GrayImage> {
-        let left = GrayImage::load(&sample.left)
-            .with_context(|| format!("reading {}", sample.left.display()))?;
-        let right = GrayImage::load(&sample.right)
-            .with_context(|| format!("reading {}", sample.right.display()))?;
-        let mut disp = match self {
-            Method::Sgm => {
-                crate::disparity::estimate(&left, &right, &SgmParams::default(), None)?.disparity
-            }
-            Method::SgmStreaks => {
-                crate::disparity::estimate(
-                    &left,
-                    &right,
-                    &SgmParams::default(),
-                    Some(StreakHandling::Repair),
-                )?
-                .disparity
-            }
-            Method::Lk => {
-                lk_streak_disparity(&left, &right, &streak_lk_params(), &DetectParams::default())?
-            }
-            Method::Command { name, .. } => bail!("{name} is not a built-in method"),
-        };
-        no_value_below_zero(&mut disp);
-        Ok(disp)
-    }
 }
 
-/// Makes every disparity that is not finite or not positive `inf` (no value).
-fn no_value_below_zero(disp: &mut GrayImage) {
-    for v in &mut disp.data {
-        if !(v.is_finite() && *v > 0.0) {
-            *v = f32::INFINITY;
-        }
-    }
+/// A built-in method's disparity on `sample`: its two PNGs read, then the method.
+fn run_built_in(method: BuiltIn, sample: &Sample) -> Result<GrayImage> {
+    let left = GrayImage::load(&sample.left)
+        .with_context(|| format!("reading {}", sample.left.display()))?;
+    let right = GrayImage::load(&sample.right)
+        .with_context(|| format!("reading {}", sample.right.display()))?;
+    Ok(method.disparity(&left, &right)?)
 }
 
 /// How much of a command's stderr a failure keeps: its last lines and characters.

@@ -4,12 +4,14 @@
 //! self-contained `OUT/index.html` ([`html`]).
 //!
 //! - [`input`]: the samples of DIR;
-//! - [`method`]: the built-in methods (`sgm`, `sgm-streaks`, `lk`) and external commands;
+//! - [`method`]: the built-in methods (`sgm`, `sgm-streaks`, `lk`, the analysis crate's
+//!   [`streaks_analysis::benchmark::method`]) and external commands;
 //! - [`command`]: an external command's template and process, run without a shell;
-//! - [`report`]: the report's schema;
+//! - [`report`]: the report's top level (its parts are
+//!   [`streaks_analysis::benchmark::report`]'s);
 //! - [`html`]: the page.
 //!
-//! Scoring is [`streaks_analysis::benchmark`]. Every method runs on every sample (a progress
+//! Scoring and pooling are [`streaks_analysis::benchmark`]. Every method runs on every sample (a progress
 //! bar over samples x methods). A method that fails on a sample (see [`report::FailureKind`])
 //! is recorded as failed there with its reason and output tails, left out of its summary
 //! ([`report::FAILURE_SCORING`]), and the run goes on; at the end both outputs are written
@@ -94,7 +96,9 @@ fn methods(args: &Args) -> Result<Vec<Method>> {
                 format!(
                     "unknown method {name:?}: the built-in methods are {}; an external one \
                      needs --method-cmd {name}=TEMPLATE",
-                    method::BUILT_INS.map(|(n, _)| n).join(", ")
+                    streaks_analysis::benchmark::method::BUILT_INS
+                        .map(|(n, _)| n)
+                        .join(", ")
                 )
             })?;
         if out.iter().any(|o| o.name() == m.name()) {
@@ -203,16 +207,8 @@ pub fn run(args: Args) -> Result<()> {
         });
     }
     bar.finish_and_clear();
-    let summary = methods
-        .iter()
-        .map(|m| {
-            let parts: Vec<&MethodScore> = sample_reports
-                .iter()
-                .flat_map(|s| s.results.iter().filter(|r| r.method == m.name()))
-                .collect();
-            MethodScore::pooled(m.name(), &parts).context("pooling the samples")
-        })
-        .collect::<Result<Vec<_>>>()?;
+    let summary = report::summary(methods.iter().map(|m| m.name()), &sample_reports)
+        .context("pooling the samples")?;
     let report = Report {
         format: report::FORMAT,
         input: Input {

@@ -22,10 +22,13 @@
 //! - [`streak_classifier`]: learned streak detection on linear luminance: per-pixel features
 //!   and a trained classifier (the shipped one in `models/`), on [`gbdt`]'s gradient-boosted
 //!   trees (training and inference) and [`filter`]'s sliding-window medians, means and maxima.
+//! - [`detector`]: either detector ready to run on a loaded image, and its score over samples
+//!   with known streaks (per sample, pooled, a point of the precision-recall curve).
 //! - [`benchmark`]: an estimate scored by region (streak, road, off-road; the phantom-hole
 //!   rate), pooled over samples; the LK streak disparity as a map; signed error maps.
 //! - [`repair`]: streak-robust stereo: the road plane from the pair's own v-disparity, and
-//!   the masking or repair of the pixels streaks and reflections put beneath the road.
+//!   the masking or repair of the pixels streaks and reflections put beneath the road;
+//!   [`repair::estimate`], the dense estimate with or without it.
 //! - [`sgm`]: dense semi-global matching, and its errors against a ground truth (bad-2.0).
 //! - [`report`]: the per-streak analysis of a rendered or photographed pair (Fig. 6, Fig. 8):
 //!   measured against predicted disparity per row, poles and road against their ground truth,
@@ -58,6 +61,7 @@
 pub mod benchmark;
 pub mod centre;
 pub mod detect;
+pub mod detector;
 pub mod figures;
 pub mod filter;
 pub mod gbdt;

@@ -23,6 +23,9 @@
 //! winners' inliers (within 0.75 px) refines them. It needs no camera calibration, so it
 //! works on photographs.
 //!
+//! [`estimate`] is the whole dense estimate: semi-global matching, then, if asked, the masking
+//! or repair below.
+//!
 //! # Mask and repair ([`robust_disparity`])
 //!
 //! The pixels to distrust are those the streak detector marks (streaks and the wide glows of
@@ -34,6 +37,7 @@
 //! repaired pixels (a model value, not a measurement) and 0 where there is no value.
 
 use crate::detect::{detect_streaks, DetectError, DetectParams};
+use crate::sgm::{sgm, SgmError, SgmParams};
 use streaks_image::{GrayImage, ImageError};
 
 /// What went wrong.
@@ -213,6 +217,59 @@ pub struct RobustDisparity {
     pub repaired_pixels: usize,
     /// Pixels masked (made invalid) that had a value.
     pub masked_pixels: usize,
+}
+
+/// What went wrong in [`estimate`].
+#[derive(Debug, thiserror::Error)]
+pub enum EstimateError {
+    /// Semi-global matching failed (the cause is the source, so a chain prints it once).
+    #[error("semi-global matching")]
+    Sgm(#[from] SgmError),
+    /// The streak-robust pass failed.
+    #[error("streak-robust disparity")]
+    Repair(#[from] RepairError),
+}
+
+/// A dense disparity of the left view: semi-global matching's, or the streak-robust one.
+#[derive(Clone, Debug)]
+pub struct Estimate {
+    /// The disparity of the left view (`inf`: no value): SGM's, or the streak-robust one.
+    pub disparity: GrayImage,
+    /// Wall time of the semi-global matching alone, seconds.
+    pub sgm_seconds: f64,
+    /// With a streak handling: what the streak-robust pass did (its `disparity` is
+    /// [`Estimate::disparity`]).
+    pub robust: Option<RobustDisparity>,
+}
+
+/// Semi-global matching of `left` and `right` with `params`, then, given a `handling`, the
+/// streak-robust pass with its default parameters ([`robust_disparity`]). One function, so
+/// that `streaks disparity [--streaks mask|repair]` and the benchmark's `sgm` and
+/// `sgm-streaks` methods compute exactly the same map.
+pub fn estimate(
+    left: &GrayImage,
+    right: &GrayImage,
+    params: &SgmParams,
+    handling: Option<StreakHandling>,
+) -> Result<Estimate, EstimateError> {
+    let start = std::time::Instant::now();
+    let disp = sgm(left, right, params)?;
+    let sgm_seconds = start.elapsed().as_secs_f64();
+    Ok(match handling {
+        None => Estimate {
+            disparity: disp,
+            sgm_seconds,
+            robust: None,
+        },
+        Some(handling) => {
+            let r = robust_disparity(left, &disp, handling, &RepairParams::default())?;
+            Estimate {
+                disparity: r.disparity.clone(),
+                sgm_seconds,
+                robust: Some(r),
+            }
+        }
+    })
 }
 
 /// `mask` grown by `r` pixels (a square structuring element).

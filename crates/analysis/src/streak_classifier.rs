@@ -35,6 +35,7 @@
 use crate::detect::{quantile, MaskScore};
 use crate::filter::{max, max_above, mean, median, Axis};
 use crate::gbdt::{Dataset, GbdtError, Model};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use streaks_image::GrayImage;
 
@@ -213,6 +214,19 @@ pub struct StreakClassifier {
 }
 
 impl StreakClassifier {
+    /// A classifier of `model` with this version's format and features, threshold 0.5, no
+    /// smoothing and no provenance: what training has before it chooses its operating point.
+    pub fn new(model: Model) -> Self {
+        Self {
+            format: FORMAT.into(),
+            features: FEATURES.iter().map(|s| s.to_string()).collect(),
+            threshold: 0.5,
+            smooth: 0,
+            provenance: serde_json::Value::Null,
+            model,
+        }
+    }
+
     /// Checks a loaded classifier: format, features, the trees.
     pub fn validate(&self) -> Result<(), ClassifierError> {
         if self.format != FORMAT {
@@ -254,7 +268,6 @@ impl StreakClassifier {
 
     /// The streak probability of every pixel of the linear luminance `lum`.
     pub fn probability(&self, lum: &GrayImage, horizon: f32) -> Result<GrayImage, ClassifierError> {
-        use rayon::prelude::*;
         let f = Features::new(lum, horizon)?;
         let data = (0..f.width * f.height)
             .into_par_iter()
@@ -360,9 +373,89 @@ pub fn operating_point(mut pairs: Vec<(f32, bool)>, precision: f64) -> Option<(f
     best
 }
 
+/// The smoothing radii of the probability that [`choose_operating_point`] tries.
+pub const SMOOTHING_RADII: std::ops::RangeInclusive<usize> = 0..=2;
+
+/// A classifier's operating point: a smoothing radius, a threshold and the score they give.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OperatingPoint {
+    /// The smoothing radius ([`StreakClassifier::smooth`]).
+    pub smooth: usize,
+    /// The probability threshold ([`StreakClassifier::threshold`]).
+    pub threshold: f32,
+    /// The pooled score at them.
+    pub score: MaskScore,
+}
+
+/// The operating point of a classifier for a target `precision` over `maps`, pairs of its
+/// (unsmoothed) probability and the truth on samples it was not trained on: for each radius
+/// of [`SMOOTHING_RADII`], the lowest threshold whose pooled precision reaches `precision`
+/// ([`operating_point`]); the radius with the highest recall at its threshold wins (the first
+/// on ties). `each` hears every radius's point (`None`: no threshold reaches the precision).
+pub fn choose_operating_point(
+    maps: &[(GrayImage, GrayImage)],
+    precision: f64,
+    mut each: impl FnMut(usize, Option<&OperatingPoint>),
+) -> Option<OperatingPoint> {
+    let mut best: Option<OperatingPoint> = None;
+    for smooth in SMOOTHING_RADII {
+        let pairs: Vec<(f32, bool)> = maps
+            .par_iter()
+            .flat_map_iter(|(p, truth)| {
+                let p = smooth_probability(p, smooth);
+                p.data
+                    .into_iter()
+                    .zip(truth.data.iter().map(|&t| t > 0.5))
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        let point = operating_point(pairs, precision).map(|(threshold, score)| OperatingPoint {
+            smooth,
+            threshold,
+            score,
+        });
+        each(smooth, point.as_ref());
+        if let Some(point) = point {
+            if best
+                .as_ref()
+                .is_none_or(|b| point.score.recall > b.score.recall)
+            {
+                best = Some(point);
+            }
+        }
+    }
+    best
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_operating_point_is_chosen_over_every_radius() {
+        // A probability that is exact on a 2-pixel streak: radius 0 reaches precision 1 at
+        // full recall; smoothing blurs the streak into its neighbours.
+        let mut p = GrayImage::new(9, 9, 0.0).unwrap();
+        let mut truth = GrayImage::new(9, 9, 0.0).unwrap();
+        for y in 3..5 {
+            p.set(4, y, 1.0);
+            truth.set(4, y, 1.0);
+        }
+        let mut heard = vec![];
+        let best = choose_operating_point(&[(p, truth)], 0.9, |r, point| {
+            heard.push((r, point.is_some()))
+        })
+        .unwrap();
+        assert_eq!(heard.iter().map(|h| h.0).collect::<Vec<_>>(), vec![0, 1, 2]);
+        assert!(heard[0].1);
+        assert_eq!(
+            (best.smooth, best.threshold, best.score.recall),
+            (0, 1.0, 1.0)
+        );
+        // No pixel is true: no threshold reaches any precision.
+        let none = GrayImage::new(3, 3, 0.0).unwrap();
+        assert!(choose_operating_point(&[(none.clone(), none)], 0.9, |_, _| ()).is_none());
+    }
 
     /// A dark road with a diffuse glow and a vertical streak below a lamp, on a black sky:
     /// the streak's pixels, and the luminance.

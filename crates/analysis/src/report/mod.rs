@@ -37,7 +37,8 @@
 //! - `dense.rs`: the dense SGM disparity over the scene's range, its point cloud in the road
 //!   frame ([`DenseSummary`]) and its score against the ground truth ([`dense_accuracy`]).
 //! - `pipeline.rs`: the analysis itself ([`analyze`], [`AnalyzeParams`]): streaks and regions
-//!   measured row by row against their predictions.
+//!   measured row by row against their predictions; [`analyze_dir`], a pair folder read,
+//!   analysed and written into its `analysis/` folder in one call.
 //! - `output.rs`: plots ([`rows_plot`]), `report.json` ([`write_report_json`]), every output
 //!   file ([`write_outputs`]) and the console table ([`summary_table`]).
 
@@ -53,7 +54,7 @@ pub use dense::{dense_accuracy, DenseAccuracy, DenseSummary};
 pub use input::StereoInput;
 pub use lights::MatchedLight;
 pub use output::{rows_plot, summary_table, write_outputs, write_report_json};
-pub use pipeline::{analyze, AnalyzeParams};
+pub use pipeline::{analyze, analyze_dir, AnalyzeParams, DirAnalysis};
 pub use stats::{compare, fit_line, Comparison, LineFit};
 
 use crate::detect::{DetectError, MaskScore};
@@ -115,6 +116,18 @@ pub enum ReportError {
         path: PathBuf,
         /// Why.
         reason: String,
+    },
+    /// A stage of [`analyze_dir`] failed on a pair folder (reading it, analysing it, writing
+    /// the analysis).
+    #[error("{stage} {}", dir.display())]
+    Folder {
+        /// What was being done, e.g. "reading the pair in".
+        stage: &'static str,
+        /// The folder.
+        dir: PathBuf,
+        /// The stage's error.
+        #[source]
+        source: Box<ReportError>,
     },
     /// A parameter is out of range.
     #[error("invalid analysis parameter {name}: {reason}")]

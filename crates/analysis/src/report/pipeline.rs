@@ -5,6 +5,7 @@
 use super::dense::{dense_accuracy, disparity_range, summarize_dense};
 use super::input::{RigView, StereoInput};
 use super::lights::match_light;
+use super::output::write_outputs;
 use super::stats::{compare, compare_with, median, span};
 use super::targets::{find_objects, find_road};
 use super::{Analysis, RegionReport, Report, ReportError, RigSummary, RowRecord, StreakReport};
@@ -14,6 +15,7 @@ use crate::lk::{lk_rows, prepare_pair, LkError, LkParams, RowDisparity};
 use crate::model::streak_rows;
 use crate::sgm::{sgm, SgmParams};
 use glam::{DVec3, Vec3};
+use std::path::{Path, PathBuf};
 use streaks_image::{GrayImage, NamedRegion, Region};
 
 /// Parameters of [`analyze`].
@@ -618,4 +620,39 @@ mod tests {
         let row = &r.rows[10];
         assert!((row.depth_m * row.measured_px - 150.0 * 0.065).abs() < 1e-3);
     }
+}
+
+/// A pair folder analysed by [`analyze_dir`].
+#[derive(Clone, Debug)]
+pub struct DirAnalysis {
+    /// The numbers.
+    pub report: Report,
+    /// The folder the outputs went into (`DIR/analysis`).
+    pub out: PathBuf,
+    /// The files written there.
+    pub written: Vec<PathBuf>,
+}
+
+/// Reads the pair in `dir` ([`StereoInput::load`]), analyses it with `params` ([`analyze`])
+/// and writes every output into `dir/analysis/` ([`write_outputs`]): what `streaks analyze
+/// DIR` does, and `streaks stereo --analyze` and `streaks paper` after rendering a pair.
+pub fn analyze_dir(dir: &Path, params: &AnalyzeParams) -> Result<DirAnalysis, ReportError> {
+    let in_folder = |stage: &'static str, dir: &Path| {
+        let dir = dir.to_path_buf();
+        move |e: ReportError| ReportError::Folder {
+            stage,
+            dir,
+            source: Box::new(e),
+        }
+    };
+    let input = StereoInput::load(dir).map_err(in_folder("reading the pair in", dir))?;
+    let analysis = analyze(&input, params).map_err(in_folder("analysing", dir))?;
+    let out = dir.join("analysis");
+    let written = write_outputs(&out, &analysis, &input)
+        .map_err(in_folder("writing the analysis into", &out))?;
+    Ok(DirAnalysis {
+        report: analysis.report,
+        out,
+        written,
+    })
 }

@@ -1,5 +1,9 @@
 //! Scoring stereo methods against ground truth by region, for `streaks benchmark`.
 //!
+//! - this file: the regions, [`score_regions`], the LK method's map, error maps;
+//! - [`method`]: the built-in methods by name ([`method::BuiltIn`]);
+//! - [`report`]: a method's figures per sample and pooled, its failures.
+//!
 //! # Regions
 //!
 //! Every pixel with a finite ground truth is in `all` and in exactly one of
@@ -25,6 +29,9 @@
 //! 21 x 5 windows) and writes each row's estimate on the row's run of detected streak pixels
 //! through the centre; every other pixel has no value. Its valid share is therefore small and
 //! its scores speak only for the detected streak rows.
+
+pub mod method;
+pub mod report;
 
 use crate::detect::{detect_streaks, DetectError, DetectParams};
 use crate::lk::{lk_rows, prepare_pair, LkError, LkParams};
