@@ -25,7 +25,7 @@
 //! Coordinates follow docs/design.md: `x` is an image coordinate in pixels (pixel `i` covers
 //! `[i, i+1)`, its centre is `i + 0.5`); rows are pixel indices; `d = x_left - x_right`.
 
-use streaks_image::{GrayImage, ImageError, Region};
+use streaks_image::{stats, GrayImage, ImageError, Region};
 
 /// Errors of the Lucas-Kanade estimator (all about user-supplied sizes and parameters).
 #[derive(Debug, thiserror::Error)]
@@ -533,18 +533,7 @@ pub fn log_compress(img: &GrayImage, floor: f32) -> GrayImage {
 /// left image's median, so both eyes get the same curve). `streaks analyze` measures streaks,
 /// poles and road on this, and `streaks lk` does unless told `--raw`.
 pub fn prepare_pair(left: &GrayImage, right: &GrayImage) -> (GrayImage, GrayImage) {
-    let mut v: Vec<f32> = left
-        .data
-        .iter()
-        .copied()
-        .filter(|v| v.is_finite())
-        .collect();
-    let median = if v.is_empty() {
-        0.0
-    } else {
-        let i = v.len() / 2;
-        *v.select_nth_unstable_by(i, f32::total_cmp).1
-    };
+    let median = stats::median(left.data.iter().copied()).unwrap_or(0.0);
     let floor = (0.1 * median).max(1e-6);
     let prep = |img: &GrayImage| log_compress(&despeckle(img, 2.0), floor);
     (prep(left), prep(right))

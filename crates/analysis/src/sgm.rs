@@ -21,6 +21,7 @@
 //! include negative values (photographs aligned by hand).
 
 use rayon::prelude::*;
+use streaks_image::stats::quantile;
 use streaks_image::{GrayImage, ImageError};
 
 /// Errors of the dense matcher (about user-supplied sizes and parameters).
@@ -458,17 +459,6 @@ pub fn median3x3(img: &GrayImage) -> GrayImage {
     out
 }
 
-/// The `p`-quantile (0..1) of the finite values, by sorting a copy.
-fn quantile(values: &[f32], p: f32) -> f32 {
-    let mut v: Vec<f32> = values.iter().copied().filter(|v| v.is_finite()).collect();
-    if v.is_empty() {
-        return 0.0;
-    }
-    let i = ((v.len() - 1) as f32 * p).round() as usize;
-    let (_, q, _) = v.select_nth_unstable_by(i, f32::total_cmp);
-    *q
-}
-
 /// Dense disparity of the left image by semi-global matching; invalid pixels are `inf`.
 pub fn sgm(left: &GrayImage, right: &GrayImage, params: &SgmParams) -> Result<GrayImage, SgmError> {
     if (left.width, left.height) != (right.width, right.height) {
@@ -494,7 +484,8 @@ pub fn sgm(left: &GrayImage, right: &GrayImage, params: &SgmParams) -> Result<Gr
     let left_census = census_transform(left, params.census);
     let right_census = census_transform(right, params.census);
     let left_norm = if params.p2_gradient > 0.0 {
-        let (lo, hi) = (quantile(&left.data, 0.01), quantile(&left.data, 0.99));
+        let q = |p| quantile(left.data.iter().copied(), p).unwrap_or(0.0);
+        let (lo, hi) = (q(0.01), q(0.99));
         let scale = if hi > lo { 1.0 / (hi - lo) } else { 1.0 };
         left.data.iter().map(|&v| v * scale).collect()
     } else {
@@ -687,8 +678,8 @@ pub fn compare_disparity_where(
 /// A colour preview of a disparity map (turbo colour map over `range`, or over the 1-99 %
 /// range of the finite values; invalid pixels black).
 pub fn disparity_preview(disp: &GrayImage, range: Option<(f32, f32)>) -> image::RgbImage {
-    let (lo, hi) =
-        range.unwrap_or_else(|| (quantile(&disp.data, 0.01), quantile(&disp.data, 0.99)));
+    let q = |p| quantile(disp.data.iter().copied(), p).unwrap_or(0.0);
+    let (lo, hi) = range.unwrap_or_else(|| (q(0.01), q(0.99)));
     let span = if hi > lo { hi - lo } else { 1.0 };
     image::RgbImage::from_fn(disp.width as u32, disp.height as u32, |x, y| {
         let d = disp.get(x as usize, y as usize);

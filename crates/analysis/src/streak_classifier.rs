@@ -32,10 +32,11 @@
 //! classifier's threshold. Both are chosen at training on samples the trees never saw, for a
 //! target precision.
 
-use crate::detect::{quantile, MaskScore};
+use crate::detect::MaskScore;
 use crate::filter::{max, max_above, mean, median, Axis};
 use crate::gbdt::{Dataset, GbdtError, Model};
 use serde::{Deserialize, Serialize};
+use streaks_image::stats::quantile_in;
 use streaks_image::GrayImage;
 
 /// The format tag of a saved classifier.
@@ -114,7 +115,8 @@ impl Features {
             )));
         }
         let mut buf = Vec::new();
-        let mut quantile = |v: &[f32], q: f32| quantile(v, q, &mut buf);
+        let mut quantile =
+            |v: &[f32], q: f32| quantile_in(v.iter().copied(), q, &mut buf).unwrap_or(0.0);
         let offset = (quantile(&lum.data, 0.999) + 1e-4).ln();
         // The rows whose centre is below the horizon (at least the bottom row).
         let first_below = ((horizon - 0.5).ceil().max(0.0) as usize).min(h - 1);

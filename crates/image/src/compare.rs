@@ -42,6 +42,7 @@
 //! renders, fireflies are counted on the first render of each, not on the averages.
 
 use crate::png::write_png_buffer;
+use crate::stats::median_midpoint;
 use crate::{luminance, ImageError, NamedRegion, Region, RgbImage};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
@@ -417,15 +418,8 @@ pub fn isolated_bright(img: &RgbImage, ratio: f32, floor: f32) -> Vec<bool> {
                     }
                 }
             }
-            if n == 0 {
+            let Some(median) = median_midpoint(&mut nb[..n]) else {
                 continue;
-            }
-            let v = &mut nb[..n];
-            v.sort_unstable_by(f32::total_cmp);
-            let median = if n % 2 == 1 {
-                v[n / 2]
-            } else {
-                0.5 * (v[n / 2 - 1] + v[n / 2])
             };
             out[y * w + x] = lum[y * w + x] > ratio * median.max(floor);
         }

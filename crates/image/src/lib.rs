@@ -16,6 +16,8 @@
 //! - [`input`]: reading files that may be hostile: regular files only, capped reads, images
 //!   checked against a pixel limit from their header ([`input::MAX_PIXELS`]);
 //! - [`kitti`]: disparity maps in the KITTI 2015 encoding (16-bit PNG, disparity x 256);
+//! - [`stats`]: quantiles and medians of pixel values (nearest rank, and the two other
+//!   definitions the project's numbers depend on);
 //! - [`compare`]: statistics of the difference between two images (relative RMSE, bias, the
 //!   noise test), per region;
 //! - [`error`]: [`ImageError`], which names the file or the region.
@@ -48,6 +50,7 @@ pub mod pfm;
 pub mod png;
 pub mod region;
 pub mod rgb;
+pub mod stats;
 
 pub use atomic::{write_atomically, write_bytes_atomically, WriteFailure};
 pub use color::luminance;

@@ -14,6 +14,7 @@
 //! depend on the exposure. A view without specular radiance has an empty mask (`S > 0` fails).
 
 use crate::error::StereoError;
+use streaks_image::stats::quantile;
 use streaks_image::GrayImage;
 
 /// Parameters of the streak mask (see the module documentation).
@@ -35,17 +36,6 @@ impl Default for StreakMaskParams {
             min_share: 0.5,
         }
     }
-}
-
-/// The `p`-quantile (0..=1) of finite values by the nearest rank; `None` when there are none.
-fn quantile(values: impl Iterator<Item = f32>, p: f32) -> Option<f32> {
-    let mut v: Vec<f32> = values.filter(|x| x.is_finite()).collect();
-    if v.is_empty() {
-        return None;
-    }
-    let k = ((p * (v.len() - 1) as f32).round() as usize).min(v.len() - 1);
-    let (_, x, _) = v.select_nth_unstable_by(k, f32::total_cmp);
-    Some(*x)
 }
 
 /// The streak mask (1 for streak pixels, 0 elsewhere) and the threshold `T` it used, from the
