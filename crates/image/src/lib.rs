@@ -9,6 +9,8 @@
 //! - [`region`]: [`Region`] and [`NamedRegion`], rectangles of pixels, with the one parser of
 //!   `[name=]x0,y0,x1,y1`;
 //! - [`color`]: [`luminance`] and the sRGB transfer functions;
+//! - [`develop`]: [`develop()`], a render through the exposure, the clip and the sRGB tone
+//!   curve to the 8-bit image every PNG of a render holds;
 //! - [`atomic`]: [`write_atomically`], through which every file of the project is written
 //!   (a uniquely named temporary file, then a rename);
 //! - [`exr`], [`png`], [`pfm`]: reading and writing the three formats (EXR with named float
@@ -41,6 +43,7 @@
 pub mod atomic;
 pub mod color;
 pub mod compare;
+pub mod develop;
 pub mod error;
 pub mod exr;
 pub mod gray;
@@ -54,6 +57,7 @@ pub mod stats;
 
 pub use atomic::{write_atomically, write_bytes_atomically, WriteFailure};
 pub use color::luminance;
+pub use develop::develop;
 pub use error::ImageError;
 pub use gray::GrayImage;
 pub use region::{NamedRegion, Region};
