@@ -32,8 +32,8 @@ pub fn develop_srgb8(render: &RgbImage, exposure_ev: f32) -> Vec<u8> {
 }
 
 /// The render developed with exposure `exposure_ev` as an 8-bit sRGB image of the `image`
-/// crate, ready to encode (see the module documentation); an error when the render's pixel
-/// count does not match its size.
+/// crate, ready to encode (see the module documentation); an error when the render has fewer
+/// pixels than its size needs.
 pub fn develop(render: &RgbImage, exposure_ev: f32) -> Result<image::RgbImage, ImageError> {
     image::RgbImage::from_raw(
         render.width,
@@ -43,7 +43,7 @@ pub fn develop(render: &RgbImage, exposure_ev: f32) -> Result<image::RgbImage, I
     .ok_or(ImageError::Size {
         width: u64::from(render.width),
         height: u64::from(render.height),
-        reason: "the pixel count does not match the size",
+        reason: "fewer pixels than the size needs",
     })
 }
 
@@ -72,7 +72,7 @@ mod tests {
         // Linear segment: 0.002 * 12.92 * 255 = 6.6
         assert_eq!(bytes[9], 7);
         assert_eq!(develop(&img, 1.0).unwrap().as_raw(), &bytes);
-        let bad = RgbImage { width: 3, ..img };
+        let bad = RgbImage { width: 5, ..img };
         assert!(develop(&bad, 0.0).is_err());
     }
 }
