@@ -27,7 +27,7 @@
 
 use crate::filter::{median, Axis};
 use streaks_image::stats::quantile_in;
-use streaks_image::GrayImage;
+use streaks_image::{ensure_same_size, GrayImage, SizeMismatch};
 
 /// Errors of streak detection.
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -41,17 +41,8 @@ pub enum DetectError {
         reason: &'static str,
     },
     /// Two masks differ in size.
-    #[error("masks differ in size: {w1}x{h1} and {w2}x{h2}")]
-    SizeMismatch {
-        /// First width.
-        w1: usize,
-        /// First height.
-        h1: usize,
-        /// Second width.
-        w2: usize,
-        /// Second height.
-        h2: usize,
-    },
+    #[error(transparent)]
+    SizeMismatch(#[from] SizeMismatch),
 }
 
 /// Parameters of the detector.
@@ -662,14 +653,12 @@ impl MaskScore {
 
 /// Scores `detected` against `truth` (a pixel is "on" when its value exceeds 0.5).
 pub fn score_mask(detected: &GrayImage, truth: &GrayImage) -> Result<MaskScore, DetectError> {
-    if (detected.width, detected.height) != (truth.width, truth.height) {
-        return Err(DetectError::SizeMismatch {
-            w1: detected.width,
-            h1: detected.height,
-            w2: truth.width,
-            h2: truth.height,
-        });
-    }
+    ensure_same_size(
+        "the detected mask",
+        detected.size(),
+        "the true mask",
+        truth.size(),
+    )?;
     let (mut tp, mut nd, mut nt) = (0usize, 0usize, 0usize);
     for (&d, &t) in detected.data.iter().zip(&truth.data) {
         let (d, t) = (d > 0.5, t > 0.5);

@@ -25,23 +25,14 @@
 //! Coordinates follow docs/design.md: `x` is an image coordinate in pixels (pixel `i` covers
 //! `[i, i+1)`, its centre is `i + 0.5`); rows are pixel indices; `d = x_left - x_right`.
 
-use streaks_image::{stats, GrayImage, ImageError, Region};
+use streaks_image::{ensure_same_size, stats, GrayImage, ImageError, Region, SizeMismatch};
 
 /// Errors of the Lucas-Kanade estimator (all about user-supplied sizes and parameters).
 #[derive(Debug, thiserror::Error)]
 pub enum LkError {
     /// Left and right images differ in size.
-    #[error("left image is {lw}x{lh} but right image is {rw}x{rh}")]
-    SizeMismatch {
-        /// Left width.
-        lw: usize,
-        /// Left height.
-        lh: usize,
-        /// Right width.
-        rw: usize,
-        /// Right height.
-        rh: usize,
-    },
+    #[error(transparent)]
+    SizeMismatch(#[from] SizeMismatch),
     /// A parameter is out of range.
     #[error("invalid Lucas-Kanade parameter {name}: {reason}")]
     Param {
@@ -371,14 +362,12 @@ pub fn lk_row(
 }
 
 fn check(left: &GrayImage, right: &GrayImage, params: &LkParams) -> Result<(), LkError> {
-    if (left.width, left.height) != (right.width, right.height) {
-        return Err(LkError::SizeMismatch {
-            lw: left.width,
-            lh: left.height,
-            rw: right.width,
-            rh: right.height,
-        });
-    }
+    ensure_same_size(
+        "the left image",
+        left.size(),
+        "the right image",
+        right.size(),
+    )?;
     params.validate()
 }
 
@@ -723,7 +712,7 @@ mod tests {
         let small = GrayImage::new(39, 4, 0.5).unwrap();
         assert!(matches!(
             lk_rows(&l, &small, &[], &LkParams::default()),
-            Err(LkError::SizeMismatch { .. })
+            Err(LkError::SizeMismatch(_))
         ));
         let even = LkParams {
             window: 4,

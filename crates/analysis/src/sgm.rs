@@ -22,23 +22,14 @@
 
 use rayon::prelude::*;
 use streaks_image::stats::quantile;
-use streaks_image::{GrayImage, ImageError};
+use streaks_image::{ensure_same_size, GrayImage, ImageError, SizeMismatch};
 
 /// Errors of the dense matcher (about user-supplied sizes and parameters).
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum SgmError {
     /// Left and right images (or an estimate and its ground truth) differ in size.
-    #[error("images differ in size: {lw}x{lh} and {rw}x{rh}")]
-    SizeMismatch {
-        /// First width.
-        lw: usize,
-        /// First height.
-        lh: usize,
-        /// Second width.
-        rw: usize,
-        /// Second height.
-        rh: usize,
-    },
+    #[error(transparent)]
+    SizeMismatch(#[from] SizeMismatch),
     /// A parameter is out of range.
     #[error("invalid semi-global matching parameter {name}: {reason}")]
     Param {
@@ -461,14 +452,12 @@ pub fn median3x3(img: &GrayImage) -> GrayImage {
 
 /// Dense disparity of the left image by semi-global matching; invalid pixels are `inf`.
 pub fn sgm(left: &GrayImage, right: &GrayImage, params: &SgmParams) -> Result<GrayImage, SgmError> {
-    if (left.width, left.height) != (right.width, right.height) {
-        return Err(SgmError::SizeMismatch {
-            lw: left.width,
-            lh: left.height,
-            rw: right.width,
-            rh: right.height,
-        });
-    }
+    ensure_same_size(
+        "the left image",
+        left.size(),
+        "the right image",
+        right.size(),
+    )?;
     params.validate()?;
     let (w, h, nd) = (left.width, left.height, params.disparities());
     let bytes = (w * h) as u64 * nd as u64 * 2;
@@ -625,14 +614,12 @@ pub fn compare_disparity_where(
     threshold: f32,
     select: impl Fn(usize) -> bool,
 ) -> Result<DisparityErrors, SgmError> {
-    if (estimate.width, estimate.height) != (truth.width, truth.height) {
-        return Err(SgmError::SizeMismatch {
-            lw: estimate.width,
-            lh: estimate.height,
-            rw: truth.width,
-            rh: truth.height,
-        });
-    }
+    ensure_same_size(
+        "the estimate",
+        estimate.size(),
+        "the ground truth",
+        truth.size(),
+    )?;
     let (mut n, mut m, mut bad, mut sa, mut ss) = (0usize, 0usize, 0usize, 0.0f64, 0.0f64);
     let (mut below, mut over) = (0usize, [0usize; 3]);
     let mut d1 = 0usize;

@@ -22,6 +22,8 @@
 //!   definitions the project's numbers depend on);
 //! - [`compare`]: statistics of the difference between two images (relative RMSE, bias, the
 //!   noise test), per region;
+//! - [`size`]: [`ensure_same_size`] and its [`SizeMismatch`], the one size check that the
+//!   other crates' errors wrap;
 //! - [`error`]: [`ImageError`], which names the file or the region.
 //!
 //! ```
@@ -53,6 +55,7 @@ pub mod pfm;
 pub mod png;
 pub mod region;
 pub mod rgb;
+pub mod size;
 pub mod stats;
 
 pub use atomic::{write_atomically, write_bytes_atomically, WriteFailure};
@@ -62,3 +65,4 @@ pub use error::ImageError;
 pub use gray::GrayImage;
 pub use region::{NamedRegion, Region};
 pub use rgb::RgbImage;
+pub use size::{ensure_same_size, SizeMismatch};

@@ -15,7 +15,7 @@
 
 use crate::error::StereoError;
 use streaks_image::stats::quantile;
-use streaks_image::GrayImage;
+use streaks_image::{ensure_same_size, GrayImage};
 
 /// Parameters of the streak mask (see the module documentation).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -46,15 +46,12 @@ pub fn streak_mask(
     road: Option<&[bool]>,
     params: &StreakMaskParams,
 ) -> Result<(GrayImage, f32), StereoError> {
-    if (specular.width, specular.height) != (total.width, total.height) {
-        return Err(StereoError::SizeMismatch {
-            what: "streak mask (specular and total luminance)",
-            left_w: specular.width,
-            left_h: specular.height,
-            right_w: total.width,
-            right_h: total.height,
-        });
-    }
+    ensure_same_size(
+        "the specular luminance",
+        specular.size(),
+        "the total luminance",
+        total.size(),
+    )?;
     if let Some(r) = road {
         if r.len() != specular.data.len() {
             return Err(StereoError::Parameter {

@@ -8,7 +8,7 @@ use crate::sgm::{compare_disparity_where, DisparityErrors, SgmError};
 use glam::{DVec2, Vec3};
 use serde::Serialize;
 use streaks_image::stats::quantile_below;
-use streaks_image::GrayImage;
+use streaks_image::{ensure_same_size, GrayImage};
 
 /// Summary of the dense disparity.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -53,15 +53,13 @@ pub fn dense_accuracy(
     streak_mask: &GrayImage,
     mask_name: &'static str,
 ) -> Result<DenseAccuracy, ReportError> {
-    if (streak_mask.width, streak_mask.height) != (truth.width, truth.height) {
-        return Err(SgmError::SizeMismatch {
-            lw: streak_mask.width,
-            lh: streak_mask.height,
-            rw: truth.width,
-            rh: truth.height,
-        }
-        .into());
-    }
+    ensure_same_size(
+        "the streak mask",
+        streak_mask.size(),
+        "the ground truth",
+        truth.size(),
+    )
+    .map_err(SgmError::from)?;
     let on = |i: usize| streak_mask.data[i] > 0.5;
     Ok(DenseAccuracy {
         streak_mask: mask_name,
