@@ -28,7 +28,7 @@
 
 use crate::detect::{detect_streaks, DetectError, DetectParams};
 use crate::lk::{lk_rows, prepare_pair, LkError, LkParams};
-use crate::sgm::{compare_disparity_where, DisparityErrors, SgmError};
+use crate::sgm::{check_against_truth, compare_disparity_where, DisparityErrors, SgmError};
 use streaks_image::{ensure_same_size, GrayImage, ImageError};
 
 /// The threshold of [`DisparityErrors::bad`] in the benchmark (bad-2.0, as `streaks disparity`).
@@ -216,12 +216,7 @@ pub fn error_colour(e: f32) -> [u8; 3] {
 /// estimate minus truth, [`NO_ESTIMATE_RGB`] where only the truth has a value,
 /// [`NO_TRUTH_RGB`] where the truth has none.
 pub fn error_map(estimate: &GrayImage, truth: &GrayImage) -> Result<image::RgbImage, SgmError> {
-    ensure_same_size(
-        "the estimate",
-        estimate.size(),
-        "the ground truth",
-        truth.size(),
-    )?;
+    check_against_truth(estimate, truth)?;
     Ok(image::RgbImage::from_fn(
         truth.width as u32,
         truth.height as u32,

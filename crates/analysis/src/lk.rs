@@ -25,7 +25,7 @@
 //! Coordinates follow docs/design.md: `x` is an image coordinate in pixels (pixel `i` covers
 //! `[i, i+1)`, its centre is `i + 0.5`); rows are pixel indices; `d = x_left - x_right`.
 
-use streaks_image::{ensure_same_size, stats, GrayImage, ImageError, Region, SizeMismatch};
+use streaks_image::{ensure_pair_size, stats, GrayImage, ImageError, Region, SizeMismatch};
 
 /// Errors of the Lucas-Kanade estimator (all about user-supplied sizes and parameters).
 #[derive(Debug, thiserror::Error)]
@@ -362,12 +362,7 @@ pub fn lk_row(
 }
 
 fn check(left: &GrayImage, right: &GrayImage, params: &LkParams) -> Result<(), LkError> {
-    ensure_same_size(
-        "the left image",
-        left.size(),
-        "the right image",
-        right.size(),
-    )?;
+    ensure_pair_size(left.size(), right.size())?;
     params.validate()
 }
 

@@ -22,7 +22,7 @@
 
 use rayon::prelude::*;
 use streaks_image::stats::quantile;
-use streaks_image::{ensure_same_size, GrayImage, ImageError, SizeMismatch};
+use streaks_image::{ensure_pair_size, ensure_same_size, GrayImage, ImageError, SizeMismatch};
 
 /// Errors of the dense matcher (about user-supplied sizes and parameters).
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -450,14 +450,15 @@ pub fn median3x3(img: &GrayImage) -> GrayImage {
     out
 }
 
+/// [`ensure_same_size`] of a disparity estimate and its ground truth.
+pub(crate) fn check_against_truth(estimate: &GrayImage, truth: &GrayImage) -> Result<(), SgmError> {
+    let (e, t) = (estimate.size(), truth.size());
+    Ok(ensure_same_size("the estimate", e, "the ground truth", t)?)
+}
+
 /// Dense disparity of the left image by semi-global matching; invalid pixels are `inf`.
 pub fn sgm(left: &GrayImage, right: &GrayImage, params: &SgmParams) -> Result<GrayImage, SgmError> {
-    ensure_same_size(
-        "the left image",
-        left.size(),
-        "the right image",
-        right.size(),
-    )?;
+    ensure_pair_size(left.size(), right.size())?;
     params.validate()?;
     let (w, h, nd) = (left.width, left.height, params.disparities());
     let bytes = (w * h) as u64 * nd as u64 * 2;
@@ -614,12 +615,7 @@ pub fn compare_disparity_where(
     threshold: f32,
     select: impl Fn(usize) -> bool,
 ) -> Result<DisparityErrors, SgmError> {
-    ensure_same_size(
-        "the estimate",
-        estimate.size(),
-        "the ground truth",
-        truth.size(),
-    )?;
+    check_against_truth(estimate, truth)?;
     let (mut n, mut m, mut bad, mut sa, mut ss) = (0usize, 0usize, 0usize, 0.0f64, 0.0f64);
     let (mut below, mut over) = (0usize, [0usize; 3]);
     let mut d1 = 0usize;

@@ -65,4 +65,4 @@ pub use error::ImageError;
 pub use gray::GrayImage;
 pub use region::{NamedRegion, Region};
 pub use rgb::RgbImage;
-pub use size::{ensure_same_size, SizeMismatch};
+pub use size::{ensure_pair_size, ensure_same_size, SizeMismatch};

@@ -42,6 +42,12 @@ pub fn ensure_same_size(
     }
 }
 
+/// [`ensure_same_size`] of the two views of a stereo pair (width, height), named the left
+/// and the right image.
+pub fn ensure_pair_size(left: (usize, usize), right: (usize, usize)) -> Result<(), SizeMismatch> {
+    ensure_same_size("the left image", left, "the right image", right)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -52,5 +58,9 @@ mod tests {
         let err = ensure_same_size("A", (4, 4), "B", (4, 5)).unwrap_err();
         assert_eq!(err.to_string(), "image sizes differ: A is 4x4, B is 4x5");
         assert!(ensure_same_size("A", (4, 3), "B", (3, 4)).is_err());
+        assert_eq!(ensure_pair_size((2, 1), (2, 1)), Ok(()));
+        let err = ensure_pair_size((2, 1), (1, 2)).unwrap_err();
+        assert_eq!(err.first_size, (2, 1));
+        assert_eq!(err.second, "the right image");
     }
 }

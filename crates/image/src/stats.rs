@@ -39,31 +39,25 @@ pub trait Sample: Copy + sealed::Sealed {
     fn nearest_rank(p: Self, n: usize) -> usize;
 }
 
-impl Sample for f32 {
-    const HALF: f32 = 0.5;
-    fn is_finite(self) -> bool {
-        f32::is_finite(self)
-    }
-    fn total_cmp(&self, other: &f32) -> Ordering {
-        f32::total_cmp(self, other)
-    }
-    fn nearest_rank(p: f32, n: usize) -> usize {
-        ((p * (n - 1) as f32).round() as usize).min(n - 1)
-    }
+/// The one implementation of [`Sample`], for each float type.
+macro_rules! sample {
+    ($t:ty) => {
+        impl Sample for $t {
+            const HALF: $t = 0.5;
+            fn is_finite(self) -> bool {
+                <$t>::is_finite(self)
+            }
+            fn total_cmp(&self, other: &$t) -> Ordering {
+                <$t>::total_cmp(self, other)
+            }
+            fn nearest_rank(p: $t, n: usize) -> usize {
+                ((p * (n - 1) as $t).round() as usize).min(n - 1)
+            }
+        }
+    };
 }
-
-impl Sample for f64 {
-    const HALF: f64 = 0.5;
-    fn is_finite(self) -> bool {
-        f64::is_finite(self)
-    }
-    fn total_cmp(&self, other: &f64) -> Ordering {
-        f64::total_cmp(self, other)
-    }
-    fn nearest_rank(p: f64, n: usize) -> usize {
-        ((p * (n - 1) as f64).round() as usize).min(n - 1)
-    }
-}
+sample!(f32);
+sample!(f64);
 
 /// The `p`-quantile (`p` in 0..=1) of the finite `values` by the nearest rank, with `buf` as
 /// scratch space (cleared first; pass the same one on hot paths to allocate once); `None` when

@@ -6,17 +6,12 @@ use crate::error::StereoError;
 use crate::pair_dir::PairDir;
 use std::path::Path;
 use streaks_image::png::write_png_buffer;
-use streaks_image::{ensure_same_size, GrayImage};
+use streaks_image::{ensure_pair_size, GrayImage};
 
 /// [`ensure_same_size`] of the two views of a developed pair.
 fn check_same_size(left: &image::RgbImage, right: &image::RgbImage) -> Result<(), StereoError> {
     let size = |i: &image::RgbImage| (i.width() as usize, i.height() as usize);
-    Ok(ensure_same_size(
-        "the left image",
-        size(left),
-        "the right image",
-        size(right),
-    )?)
+    Ok(ensure_pair_size(size(left), size(right))?)
 }
 
 /// The pair side by side, the left image on the left (for parallel free-fusing).
@@ -134,12 +129,7 @@ pub fn prepare_pair(
     right: &GrayImage,
     shift: f32,
 ) -> Result<(GrayImage, GrayImage), StereoError> {
-    ensure_same_size(
-        "the left image",
-        left.size(),
-        "the right image",
-        right.size(),
-    )?;
+    ensure_pair_size(left.size(), right.size())?;
     let l = equalize_histogram(left);
     let l = if shift == 0.0 {
         l
