@@ -9,7 +9,7 @@
 //! - [`region`]: [`Region`] and [`NamedRegion`], rectangles of pixels, with the one parser of
 //!   `[name=]x0,y0,x1,y1`;
 //! - [`color`]: [`luminance`] and the sRGB transfer functions;
-//! - [`develop`]: [`develop()`], a render through the exposure, the clip and the sRGB tone
+//! - [`develop`](mod@develop): [`develop()`], a render through the exposure, the clip and the sRGB tone
 //!   curve to the 8-bit image every PNG of a render holds;
 //! - [`atomic`]: [`write_atomically`], through which every file of the project is written
 //!   (a uniquely named temporary file, then a rename);

@@ -12,7 +12,7 @@ use std::io::Write;
 use std::path::Path;
 
 /// Writes a render developed with exposure `exposure_ev` as an 8-bit sRGB PNG (see
-/// [`crate::develop`]).
+/// [`mod@crate::develop`]).
 pub fn write_png(path: &Path, image: &RgbImage, exposure_ev: f32) -> Result<(), ImageError> {
     let bad = || ImageError::BadImage {
         path: path.to_path_buf(),
