@@ -7,7 +7,7 @@ use glam::{Affine3A, Quat, Vec3};
 use streaks_render::camera::Camera;
 use streaks_render::integrator::{render, Layers, RenderSettings};
 use streaks_render::light::Light;
-use streaks_render::material::{Material, PaperModel, Reflectance};
+use streaks_render::material::Material;
 use streaks_render::scene::{Scene, SceneParts};
 
 /// Adds an axis-aligned box (12 triangles, faces pointing out) of material `m`.
@@ -38,24 +38,7 @@ fn add_box(parts: &mut SceneParts, lo: Vec3, hi: Vec3, m: u32) {
 }
 
 fn street() -> Scene {
-    let road = Material {
-        name: "road".into(),
-        reflectance: Reflectance::Paper {
-            model: PaperModel::Ggx,
-            kd: Vec3::splat(0.05),
-            ks: Vec3::splat(0.3),
-            alpha: 0.08,
-            shininess: 0.0,
-            kd_texture: None,
-            wetness: None,
-        },
-        emission: Vec3::ZERO,
-        emission_texture: None,
-        normal_map: None,
-        double_sided: false,
-        alpha: streaks_render::material::Alpha::OPAQUE,
-        road: true,
-    };
+    let road = Material::glossy_road("road", Vec3::splat(0.05), Vec3::splat(0.3), 0.08);
     let mut window = Material::diffuse("window", Vec3::ZERO);
     window.emission = Vec3::new(2.0, 1.8, 1.2);
     let mut parts = SceneParts {

@@ -32,6 +32,7 @@ use std::cell::Cell;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+use streaks_image::stats::quantile_sorted;
 use streaks_image::write_bytes_atomically;
 use streaks_scenes::procedural::{GeneratorConfig, GENERATOR_VERSION};
 
@@ -121,11 +122,6 @@ impl std::str::FromStr for NoiseTarget {
 /// sha256 of bytes, lowercase hex.
 pub fn sha256_hex(bytes: &[u8]) -> String {
     format!("{:x}", Sha256::digest(bytes))
-}
-
-/// The nearest-rank quantile `p` of sorted values.
-fn quantile(sorted: &[f64], p: f64) -> f64 {
-    sorted[((p * (sorted.len() - 1) as f64).round() as usize).min(sorted.len() - 1)]
 }
 
 /// Runs the subcommand.
@@ -346,7 +342,7 @@ pub fn run(args: Args) -> Result<()> {
             " ({:.0} pairs per hour); streak share min {:.3} %, median {:.3} %, max {:.3} %",
             shares.len() as f64 * 3600.0 / seconds.max(1e-9),
             100.0 * shares[0],
-            100.0 * quantile(&shares, 0.5),
+            100.0 * quantile_sorted(&shares, 0.5).unwrap_or(f64::NAN),
             100.0 * shares[shares.len() - 1]
         );
     }

@@ -7,9 +7,10 @@ use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+use streaks_image::develop;
 use streaks_image::kitti::write_kitti_disparity;
 use streaks_image::pfm::write_pfm;
-use streaks_image::png::{to_srgb8_image, write_png_buffer};
+use streaks_image::png::write_png_buffer;
 use streaks_image::{write_bytes_atomically, GrayImage};
 use streaks_render::output::write_exr;
 use streaks_render::scene::Scene;
@@ -319,8 +320,7 @@ fn write_sample(
 
     for (n, view) in views.iter().enumerate() {
         write_exr(&dir.join(format!("im{n}.exr")), &view.output)?;
-        let img = to_srgb8_image(&view.output.image, s.exposure_ev)
-            .context("the image size does not match its pixels")?;
+        let img = develop(&view.output.image, s.exposure_ev)?;
         write_png_buffer(&dir.join(format!("im{n}.png")), &img)?;
         write_pfm(&dir.join(format!("disp{n}.pfm")), &view.disparity)?;
     }

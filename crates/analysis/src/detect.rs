@@ -26,7 +26,8 @@
 //! Coordinates follow docs/design.md: image x and y with pixel centres at `i + 0.5`; rows are indices.
 
 use crate::filter::{median, Axis};
-use streaks_image::GrayImage;
+use streaks_image::stats::quantile_in;
+use streaks_image::{ensure_same_size, GrayImage, SizeMismatch};
 
 /// Errors of streak detection.
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -40,17 +41,8 @@ pub enum DetectError {
         reason: &'static str,
     },
     /// Two masks differ in size.
-    #[error("masks differ in size: {w1}x{h1} and {w2}x{h2}")]
-    SizeMismatch {
-        /// First width.
-        w1: usize,
-        /// First height.
-        h1: usize,
-        /// Second width.
-        w2: usize,
-        /// Second height.
-        h2: usize,
-    },
+    #[error(transparent)]
+    SizeMismatch(#[from] SizeMismatch),
 }
 
 /// Parameters of the detector.
@@ -198,17 +190,6 @@ pub struct Detection {
     pub thresholds: (f32, f32),
 }
 
-/// The `p`-quantile (0..1) of the finite values (nearest rank); `buf` is scratch space.
-pub(crate) fn quantile(values: &[f32], p: f32, buf: &mut Vec<f32>) -> f32 {
-    buf.clear();
-    buf.extend(values.iter().copied().filter(|v| v.is_finite()));
-    if buf.is_empty() {
-        return 0.0;
-    }
-    let i = ((buf.len() - 1) as f32 * p).round() as usize;
-    *buf.select_nth_unstable_by(i, f32::total_cmp).1
-}
-
 /// `img` smoothed with a `(2 r + 1)`-square box filter (clamped at the borders); non-finite
 /// values count as 0.
 fn box_blur(img: &GrayImage, r: usize) -> GrayImage {
@@ -259,7 +240,7 @@ fn local_contrast(img: &GrayImage, share: f32, buf: &mut Vec<f32>) -> Vec<f32> {
     let mut out = vec![0.0f32; w * h];
     if share <= 0.0 {
         for (row, o) in img.data.chunks_exact(w).zip(out.chunks_exact_mut(w)) {
-            let b = quantile(row, 0.5, buf);
+            let b = quantile_in(row.iter().copied(), 0.5, buf).unwrap_or(0.0);
             for (o, &v) in o.iter_mut().zip(row) {
                 *o = v - b;
             }
@@ -295,19 +276,19 @@ pub fn detect_streaks(img: &GrayImage, params: &DetectParams) -> Result<Detectio
     let mut noise = vec![0.0f32; h];
     let mut dev = vec![0.0f32; w];
     for (row, n) in th.contrast.chunks_exact(w).zip(&mut noise) {
-        let m = quantile(row, 0.5, &mut buf);
+        let m = quantile_in(row.iter().copied(), 0.5, &mut buf).unwrap_or(0.0);
         for (d, &c) in dev.iter_mut().zip(row) {
             *d = (c - m).abs();
         }
-        *n = 1.4826 * quantile(&dev, 0.5, &mut buf);
+        *n = 1.4826 * quantile_in(dev.iter().copied(), 0.5, &mut buf).unwrap_or(0.0);
     }
     // The floor: a share of the brightest contrasts below the horizon (lamps above it, however
     // bright, do not raise it).
-    let contrasts: Vec<f32> = (0..w * h)
-        .filter(|&i| below(i / w))
-        .map(|i| th.contrast[i])
-        .collect();
-    let floor = params.noise_floor * quantile(&contrasts, 0.999, &mut buf).max(0.0);
+    let contrasts = (0..w * h).filter(|&i| below(i / w)).map(|i| th.contrast[i]);
+    let floor = params.noise_floor
+        * quantile_in(contrasts, 0.999, &mut buf)
+            .unwrap_or(0.0)
+            .max(0.0);
     for ((n, lo), hi) in noise.iter().zip(&mut th.lo).zip(&mut th.hi) {
         let s = n.max(floor);
         if s > 0.0 {
@@ -317,8 +298,7 @@ pub fn detect_streaks(img: &GrayImage, params: &DetectParams) -> Result<Detectio
     }
     let rows_below: Vec<usize> = (0..h).filter(|&y| below(y)).collect();
     let med_of = |v: &[f32], buf: &mut Vec<f32>| {
-        let sel: Vec<f32> = rows_below.iter().map(|&y| v[y]).collect();
-        quantile(&sel, 0.5, buf)
+        quantile_in(rows_below.iter().map(|&y| v[y]), 0.5, buf).unwrap_or(0.0)
     };
     let thresholds = (med_of(&th.lo, &mut buf), med_of(&th.hi, &mut buf));
     let mut det = Detection {
@@ -673,14 +653,12 @@ impl MaskScore {
 
 /// Scores `detected` against `truth` (a pixel is "on" when its value exceeds 0.5).
 pub fn score_mask(detected: &GrayImage, truth: &GrayImage) -> Result<MaskScore, DetectError> {
-    if (detected.width, detected.height) != (truth.width, truth.height) {
-        return Err(DetectError::SizeMismatch {
-            w1: detected.width,
-            h1: detected.height,
-            w2: truth.width,
-            h2: truth.height,
-        });
-    }
+    ensure_same_size(
+        "the detected mask",
+        detected.size(),
+        "the true mask",
+        truth.size(),
+    )?;
     let (mut tp, mut nd, mut nt) = (0usize, 0usize, 0usize);
     for (&d, &t) in detected.data.iter().zip(&truth.data) {
         let (d, t) = (d > 0.5, t > 0.5);

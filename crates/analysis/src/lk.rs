@@ -25,23 +25,14 @@
 //! Coordinates follow docs/design.md: `x` is an image coordinate in pixels (pixel `i` covers
 //! `[i, i+1)`, its centre is `i + 0.5`); rows are pixel indices; `d = x_left - x_right`.
 
-use streaks_image::{GrayImage, ImageError, Region};
+use streaks_image::{ensure_pair_size, stats, GrayImage, ImageError, Region, SizeMismatch};
 
 /// Errors of the Lucas-Kanade estimator (all about user-supplied sizes and parameters).
 #[derive(Debug, thiserror::Error)]
 pub enum LkError {
     /// Left and right images differ in size.
-    #[error("left image is {lw}x{lh} but right image is {rw}x{rh}")]
-    SizeMismatch {
-        /// Left width.
-        lw: usize,
-        /// Left height.
-        lh: usize,
-        /// Right width.
-        rw: usize,
-        /// Right height.
-        rh: usize,
-    },
+    #[error(transparent)]
+    SizeMismatch(#[from] SizeMismatch),
     /// A parameter is out of range.
     #[error("invalid Lucas-Kanade parameter {name}: {reason}")]
     Param {
@@ -371,14 +362,7 @@ pub fn lk_row(
 }
 
 fn check(left: &GrayImage, right: &GrayImage, params: &LkParams) -> Result<(), LkError> {
-    if (left.width, left.height) != (right.width, right.height) {
-        return Err(LkError::SizeMismatch {
-            lw: left.width,
-            lh: left.height,
-            rw: right.width,
-            rh: right.height,
-        });
-    }
+    ensure_pair_size(left.size(), right.size())?;
     params.validate()
 }
 
@@ -533,18 +517,7 @@ pub fn log_compress(img: &GrayImage, floor: f32) -> GrayImage {
 /// left image's median, so both eyes get the same curve). `streaks analyze` measures streaks,
 /// poles and road on this, and `streaks lk` does unless told `--raw`.
 pub fn prepare_pair(left: &GrayImage, right: &GrayImage) -> (GrayImage, GrayImage) {
-    let mut v: Vec<f32> = left
-        .data
-        .iter()
-        .copied()
-        .filter(|v| v.is_finite())
-        .collect();
-    let median = if v.is_empty() {
-        0.0
-    } else {
-        let i = v.len() / 2;
-        *v.select_nth_unstable_by(i, f32::total_cmp).1
-    };
+    let median = stats::median(left.data.iter().copied()).unwrap_or(0.0);
     let floor = (0.1 * median).max(1e-6);
     let prep = |img: &GrayImage| log_compress(&despeckle(img, 2.0), floor);
     (prep(left), prep(right))
@@ -734,7 +707,7 @@ mod tests {
         let small = GrayImage::new(39, 4, 0.5).unwrap();
         assert!(matches!(
             lk_rows(&l, &small, &[], &LkParams::default()),
-            Err(LkError::SizeMismatch { .. })
+            Err(LkError::SizeMismatch(_))
         ));
         let even = LkParams {
             window: 4,

@@ -38,7 +38,7 @@
 
 use crate::detect::{detect_streaks, DetectError, DetectParams};
 use crate::sgm::{sgm, SgmError, SgmParams};
-use streaks_image::{GrayImage, ImageError};
+use streaks_image::{ensure_same_size, GrayImage, ImageError, SizeMismatch};
 
 /// What went wrong.
 #[derive(Debug, thiserror::Error)]
@@ -50,8 +50,8 @@ pub enum RepairError {
     #[error(transparent)]
     Image(#[from] ImageError),
     /// The left image and the disparity map differ in size.
-    #[error("the left image is {0}x{1} but the disparity map is {2}x{3}")]
-    Size(usize, usize, usize, usize),
+    #[error(transparent)]
+    Size(#[from] SizeMismatch),
 }
 
 /// The road's v-disparity line `d = slope (y - horizon)`.
@@ -304,14 +304,12 @@ pub fn robust_disparity(
     handling: StreakHandling,
     params: &RepairParams,
 ) -> Result<RobustDisparity, RepairError> {
-    if (left.width, left.height) != (disp.width, disp.height) {
-        return Err(RepairError::Size(
-            left.width,
-            left.height,
-            disp.width,
-            disp.height,
-        ));
-    }
+    ensure_same_size(
+        "the left image",
+        left.size(),
+        "the disparity map",
+        disp.size(),
+    )?;
     let (w, h) = (disp.width, disp.height);
     // The plane from all valid pixels first (streaks are few), for the detector's horizon.
     let first = fit_road_plane(disp, None, params.lower_share);

@@ -21,23 +21,15 @@
 //! include negative values (photographs aligned by hand).
 
 use rayon::prelude::*;
-use streaks_image::{GrayImage, ImageError};
+use streaks_image::stats::quantile;
+use streaks_image::{ensure_pair_size, ensure_same_size, GrayImage, ImageError, SizeMismatch};
 
 /// Errors of the dense matcher (about user-supplied sizes and parameters).
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum SgmError {
     /// Left and right images (or an estimate and its ground truth) differ in size.
-    #[error("images differ in size: {lw}x{lh} and {rw}x{rh}")]
-    SizeMismatch {
-        /// First width.
-        lw: usize,
-        /// First height.
-        lh: usize,
-        /// Second width.
-        rw: usize,
-        /// Second height.
-        rh: usize,
-    },
+    #[error(transparent)]
+    SizeMismatch(#[from] SizeMismatch),
     /// A parameter is out of range.
     #[error("invalid semi-global matching parameter {name}: {reason}")]
     Param {
@@ -458,27 +450,15 @@ pub fn median3x3(img: &GrayImage) -> GrayImage {
     out
 }
 
-/// The `p`-quantile (0..1) of the finite values, by sorting a copy.
-fn quantile(values: &[f32], p: f32) -> f32 {
-    let mut v: Vec<f32> = values.iter().copied().filter(|v| v.is_finite()).collect();
-    if v.is_empty() {
-        return 0.0;
-    }
-    let i = ((v.len() - 1) as f32 * p).round() as usize;
-    let (_, q, _) = v.select_nth_unstable_by(i, f32::total_cmp);
-    *q
+/// [`ensure_same_size`] of a disparity estimate and its ground truth.
+pub(crate) fn check_against_truth(estimate: &GrayImage, truth: &GrayImage) -> Result<(), SgmError> {
+    let (e, t) = (estimate.size(), truth.size());
+    Ok(ensure_same_size("the estimate", e, "the ground truth", t)?)
 }
 
 /// Dense disparity of the left image by semi-global matching; invalid pixels are `inf`.
 pub fn sgm(left: &GrayImage, right: &GrayImage, params: &SgmParams) -> Result<GrayImage, SgmError> {
-    if (left.width, left.height) != (right.width, right.height) {
-        return Err(SgmError::SizeMismatch {
-            lw: left.width,
-            lh: left.height,
-            rw: right.width,
-            rh: right.height,
-        });
-    }
+    ensure_pair_size(left.size(), right.size())?;
     params.validate()?;
     let (w, h, nd) = (left.width, left.height, params.disparities());
     let bytes = (w * h) as u64 * nd as u64 * 2;
@@ -494,7 +474,8 @@ pub fn sgm(left: &GrayImage, right: &GrayImage, params: &SgmParams) -> Result<Gr
     let left_census = census_transform(left, params.census);
     let right_census = census_transform(right, params.census);
     let left_norm = if params.p2_gradient > 0.0 {
-        let (lo, hi) = (quantile(&left.data, 0.01), quantile(&left.data, 0.99));
+        let q = |p| quantile(left.data.iter().copied(), p).unwrap_or(0.0);
+        let (lo, hi) = (q(0.01), q(0.99));
         let scale = if hi > lo { 1.0 / (hi - lo) } else { 1.0 };
         left.data.iter().map(|&v| v * scale).collect()
     } else {
@@ -634,14 +615,7 @@ pub fn compare_disparity_where(
     threshold: f32,
     select: impl Fn(usize) -> bool,
 ) -> Result<DisparityErrors, SgmError> {
-    if (estimate.width, estimate.height) != (truth.width, truth.height) {
-        return Err(SgmError::SizeMismatch {
-            lw: estimate.width,
-            lh: estimate.height,
-            rw: truth.width,
-            rh: truth.height,
-        });
-    }
+    check_against_truth(estimate, truth)?;
     let (mut n, mut m, mut bad, mut sa, mut ss) = (0usize, 0usize, 0usize, 0.0f64, 0.0f64);
     let (mut below, mut over) = (0usize, [0usize; 3]);
     let mut d1 = 0usize;
@@ -687,8 +661,8 @@ pub fn compare_disparity_where(
 /// A colour preview of a disparity map (turbo colour map over `range`, or over the 1-99 %
 /// range of the finite values; invalid pixels black).
 pub fn disparity_preview(disp: &GrayImage, range: Option<(f32, f32)>) -> image::RgbImage {
-    let (lo, hi) =
-        range.unwrap_or_else(|| (quantile(&disp.data, 0.01), quantile(&disp.data, 0.99)));
+    let q = |p| quantile(disp.data.iter().copied(), p).unwrap_or(0.0);
+    let (lo, hi) = range.unwrap_or_else(|| (q(0.01), q(0.99)));
     let span = if hi > lo { hi - lo } else { 1.0 };
     image::RgbImage::from_fn(disp.width as u32, disp.height as u32, |x, y| {
         let d = disp.get(x as usize, y as usize);

@@ -32,12 +32,13 @@
 //! classifier's threshold. Both are chosen at training on samples the trees never saw, for a
 //! target precision.
 
-use crate::detect::{quantile, MaskScore};
+use crate::detect::MaskScore;
 use crate::filter::{max, max_above, mean, median, Axis};
 use crate::gbdt::{Dataset, GbdtError, Model};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use streaks_image::GrayImage;
+use streaks_image::stats::quantile_in;
+use streaks_image::{ensure_same_size, GrayImage, SizeMismatch};
 
 /// The format tag of a saved classifier.
 pub const FORMAT: &str = "streaks-classifier/1";
@@ -70,17 +71,8 @@ pub enum ClassifierError {
     #[error("bad image: {0}")]
     Image(String),
     /// A mask and the image differ in size.
-    #[error("the mask is {mw}x{mh}, the image {w}x{h}")]
-    SizeMismatch {
-        /// Mask width.
-        mw: usize,
-        /// Mask height.
-        mh: usize,
-        /// Image width.
-        w: usize,
-        /// Image height.
-        h: usize,
-    },
+    #[error(transparent)]
+    SizeMismatch(#[from] SizeMismatch),
     /// A saved classifier is not one this version reads.
     #[error("not a streak classifier: {0}")]
     Format(String),
@@ -115,7 +107,8 @@ impl Features {
             )));
         }
         let mut buf = Vec::new();
-        let mut quantile = |v: &[f32], q: f32| quantile(v, q, &mut buf);
+        let mut quantile =
+            |v: &[f32], q: f32| quantile_in(v.iter().copied(), q, &mut buf).unwrap_or(0.0);
         let offset = (quantile(&lum.data, 0.999) + 1e-4).ln();
         // The rows whose centre is below the horizon (at least the bottom row).
         let first_below = ((horizon - 0.5).ceil().max(0.0) as usize).min(h - 1);
@@ -332,14 +325,7 @@ pub fn training_rows(
     stride: usize,
     offset: usize,
 ) -> Result<Dataset, ClassifierError> {
-    if (truth.width, truth.height) != (lum.width, lum.height) {
-        return Err(ClassifierError::SizeMismatch {
-            mw: truth.width,
-            mh: truth.height,
-            w: lum.width,
-            h: lum.height,
-        });
-    }
+    ensure_same_size("the mask", truth.size(), "the image", lum.size())?;
     let f = Features::new(lum, horizon)?;
     let stride = stride.max(1);
     let mut d = Dataset::new(FEATURES.len());

@@ -42,7 +42,8 @@
 //! renders, fireflies are counted on the first render of each, not on the averages.
 
 use crate::png::write_png_buffer;
-use crate::{luminance, ImageError, NamedRegion, Region, RgbImage};
+use crate::stats::median_midpoint;
+use crate::{ensure_same_size, luminance, ImageError, NamedRegion, Region, RgbImage, SizeMismatch};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -240,23 +241,15 @@ fn grey(v: Vec3) -> f64 {
     (f64::from(v.x) + f64::from(v.y) + f64::from(v.z)) / 3.0
 }
 
+/// [`ensure_same_size`] of two renders.
 fn check_size(
     first: &'static str,
     a: &RgbImage,
     second: &'static str,
     b: &RgbImage,
 ) -> Result<(), ImageError> {
-    if (a.width, a.height) != (b.width, b.height) {
-        return Err(ImageError::SizeMismatch {
-            first,
-            w0: a.width as usize,
-            h0: a.height as usize,
-            second,
-            w1: b.width as usize,
-            h1: b.height as usize,
-        });
-    }
-    Ok(())
+    let size = |i: &RgbImage| (i.width as usize, i.height as usize);
+    Ok(ensure_same_size(first, size(a), second, size(b))?)
 }
 
 /// Sums over a region, in f64.
@@ -324,15 +317,16 @@ fn region_stats(inputs: &Inputs<'_>, region: NamedRegion, k: f64) -> RegionStats
 /// rectangle.
 fn mask_stats(inputs: &Inputs<'_>, m: &MaskRegion, k: f64) -> Result<RegionStats, ImageError> {
     let (w, h) = (inputs.a.width, inputs.a.height);
-    if (m.width, m.height) != (w, h) || m.mask.len() != w as usize * h as usize {
-        return Err(ImageError::SizeMismatch {
-            first: "A",
-            w0: w as usize,
-            h0: h as usize,
-            second: "the mask",
-            w1: m.width as usize,
-            h1: m.height as usize,
-        });
+    let size = (w as usize, h as usize);
+    let mismatch = SizeMismatch {
+        first: "A",
+        first_size: size,
+        second: "the mask",
+        second_size: (m.width as usize, m.height as usize),
+    };
+    // A mask whose flags do not fill its size fits no image either.
+    if mismatch.first_size != mismatch.second_size || m.mask.len() != size.0 * size.1 {
+        return Err(mismatch.into());
     }
     let mut s = Sums::default();
     let mut bbox: Option<Region> = None;
@@ -417,15 +411,8 @@ pub fn isolated_bright(img: &RgbImage, ratio: f32, floor: f32) -> Vec<bool> {
                     }
                 }
             }
-            if n == 0 {
+            let Some(median) = median_midpoint(&mut nb[..n]) else {
                 continue;
-            }
-            let v = &mut nb[..n];
-            v.sort_unstable_by(f32::total_cmp);
-            let median = if n % 2 == 1 {
-                v[n / 2]
-            } else {
-                0.5 * (v[n / 2 - 1] + v[n / 2])
             };
             out[y * w + x] = lum[y * w + x] > ratio * median.max(floor);
         }

@@ -73,21 +73,8 @@ pub enum ImageError {
         reason: &'static str,
     },
     /// Two images that must have the same size do not.
-    #[error("image sizes differ: {first} is {w0}x{h0}, {second} is {w1}x{h1}")]
-    SizeMismatch {
-        /// Which image (for example A, B, A2, B2).
-        first: &'static str,
-        /// Its width.
-        w0: usize,
-        /// Its height.
-        h0: usize,
-        /// The other image.
-        second: &'static str,
-        /// Its width.
-        w1: usize,
-        /// Its height.
-        h1: usize,
-    },
+    #[error(transparent)]
+    SizeMismatch(#[from] crate::SizeMismatch),
     /// A region does not parse.
     #[error("bad region {text:?}: {reason} (expected {expected})")]
     BadRegion {

@@ -214,14 +214,10 @@ mod tests {
     use glam::Vec3;
 
     fn gradient(w: u32, h: u32) -> RgbImage {
-        let pixels = (0..w * h)
-            .map(|i| Vec3::new(i as f32, 0.5 * i as f32, -(i as f32)))
-            .collect();
-        RgbImage {
-            width: w,
-            height: h,
-            pixels,
-        }
+        RgbImage::from_fn(w, h, |x, y| {
+            let i = (y * w + x) as f32;
+            Vec3::new(i, 0.5 * i, -i)
+        })
     }
 
     /// Many tiles compressed in parallel must still land in one order: the header says

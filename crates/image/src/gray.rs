@@ -47,6 +47,11 @@ impl GrayImage {
         })
     }
 
+    /// Width and height in pixels, the form [`crate::ensure_same_size`] compares.
+    pub fn size(&self) -> (usize, usize) {
+        (self.width, self.height)
+    }
+
     /// The value at (x, y).
     #[inline]
     pub fn get(&self, x: usize, y: usize) -> f32 {

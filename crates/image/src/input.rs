@@ -220,50 +220,52 @@ pub fn load_image(path: &Path) -> Result<DynamicImage, crate::ImageError> {
     decode_from(BufReader::new(file), ImageFormat::from_path(path).ok()).map_err(err)
 }
 
+/// A PNG whose header claims `width` x `height` RGBA pixels of `depth` bits per channel,
+/// with no pixel data: a hostile file's shape, for the tests of every crate that reads images
+/// (this module's pixel limit, the renderer's textures).
+#[doc(hidden)]
+pub fn png_header(width: u32, height: u32, depth: u8) -> Vec<u8> {
+    let chunk = |kind: &[u8], data: &[u8]| {
+        let mut c = (data.len() as u32).to_be_bytes().to_vec();
+        c.extend_from_slice(kind);
+        c.extend_from_slice(data);
+        let crc = crc32(&c[4..]);
+        c.extend_from_slice(&crc.to_be_bytes());
+        c
+    };
+    let mut ihdr = width.to_be_bytes().to_vec();
+    ihdr.extend(height.to_be_bytes());
+    ihdr.extend([depth, 6, 0, 0, 0]);
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    png.extend(chunk(b"IHDR", &ihdr));
+    png.extend(chunk(
+        b"IDAT",
+        &[0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01],
+    ));
+    png.extend(chunk(b"IEND", &[]));
+    png
+}
+
+/// The CRC-32 of PNG chunks.
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut crc = !0u32;
+    for &b in bytes {
+        crc ^= u32::from(b);
+        for _ in 0..8 {
+            crc = if crc & 1 != 0 {
+                (crc >> 1) ^ 0xEDB8_8320
+            } else {
+                crc >> 1
+            };
+        }
+    }
+    !crc
+}
+
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
     use std::time::{Duration, Instant};
-
-    /// A PNG whose header claims `width` x `height` RGBA pixels of `depth` bits per channel,
-    /// with no pixel data.
-    pub(crate) fn png_header(width: u32, height: u32, depth: u8) -> Vec<u8> {
-        let chunk = |kind: &[u8], data: &[u8]| {
-            let mut c = (data.len() as u32).to_be_bytes().to_vec();
-            c.extend_from_slice(kind);
-            c.extend_from_slice(data);
-            let crc = crc32(&c[4..]);
-            c.extend_from_slice(&crc.to_be_bytes());
-            c
-        };
-        let mut ihdr = width.to_be_bytes().to_vec();
-        ihdr.extend(height.to_be_bytes());
-        ihdr.extend([depth, 6, 0, 0, 0]);
-        let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
-        png.extend(chunk(b"IHDR", &ihdr));
-        png.extend(chunk(
-            b"IDAT",
-            &[0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01],
-        ));
-        png.extend(chunk(b"IEND", &[]));
-        png
-    }
-
-    /// The CRC-32 of PNG chunks.
-    fn crc32(bytes: &[u8]) -> u32 {
-        let mut crc = !0u32;
-        for &b in bytes {
-            crc ^= u32::from(b);
-            for _ in 0..8 {
-                crc = if crc & 1 != 0 {
-                    (crc >> 1) ^ 0xEDB8_8320
-                } else {
-                    crc >> 1
-                };
-            }
-        }
-        !crc
-    }
 
     #[test]
     fn a_huge_png_header_is_refused_before_decoding() {

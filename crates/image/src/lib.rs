@@ -9,6 +9,8 @@
 //! - [`region`]: [`Region`] and [`NamedRegion`], rectangles of pixels, with the one parser of
 //!   `[name=]x0,y0,x1,y1`;
 //! - [`color`]: [`luminance`] and the sRGB transfer functions;
+//! - [`develop`](mod@develop): [`develop()`], a render through the exposure, the clip and the sRGB tone
+//!   curve to the 8-bit image every PNG of a render holds;
 //! - [`atomic`]: [`write_atomically`], through which every file of the project is written
 //!   (a uniquely named temporary file, then a rename);
 //! - [`exr`], [`png`], [`pfm`]: reading and writing the three formats (EXR with named float
@@ -16,8 +18,12 @@
 //! - [`input`]: reading files that may be hostile: regular files only, capped reads, images
 //!   checked against a pixel limit from their header ([`input::MAX_PIXELS`]);
 //! - [`kitti`]: disparity maps in the KITTI 2015 encoding (16-bit PNG, disparity x 256);
+//! - [`stats`]: quantiles and medians of pixel values (nearest rank, and the two other
+//!   definitions the project's numbers depend on);
 //! - [`compare`]: statistics of the difference between two images (relative RMSE, bias, the
 //!   noise test), per region;
+//! - [`size`]: [`ensure_same_size`] and its [`SizeMismatch`], the one size check that the
+//!   other crates' errors wrap;
 //! - [`error`]: [`ImageError`], which names the file or the region.
 //!
 //! ```
@@ -39,6 +45,7 @@
 pub mod atomic;
 pub mod color;
 pub mod compare;
+pub mod develop;
 pub mod error;
 pub mod exr;
 pub mod gray;
@@ -48,10 +55,14 @@ pub mod pfm;
 pub mod png;
 pub mod region;
 pub mod rgb;
+pub mod size;
+pub mod stats;
 
 pub use atomic::{write_atomically, write_bytes_atomically, WriteFailure};
 pub use color::luminance;
+pub use develop::develop;
 pub use error::ImageError;
 pub use gray::GrayImage;
 pub use region::{NamedRegion, Region};
 pub use rgb::RgbImage;
+pub use size::{ensure_pair_size, ensure_same_size, SizeMismatch};

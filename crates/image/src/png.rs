@@ -1,37 +1,18 @@
-//! PNG writing: 8-bit sRGB of a linear image with an exposure ([`write_png`]), and any 8- or
+//! PNG writing: a render developed to 8-bit sRGB ([`write_png`], through
+//! [`crate::develop::develop`]), and any 8- or
 //! 16-bit grey or colour buffer of the `image` crate ([`write_png_buffer`]), both atomically and
 //! through the one encoder call, which also gives the bytes in memory ([`png_bytes`]). Reading any image file is [`crate::GrayImage::load`] and
 //! [`crate::gray::load_rgb_channels`].
 
 use crate::atomic::{write_atomically, WriteFailure};
-use crate::color::srgb_oetf;
+use crate::develop::develop;
 use crate::{ImageError, RgbImage};
 use image::ImageEncoder;
 use std::io::Write;
 use std::path::Path;
 
-/// Converts a linear image to 8-bit sRGB, three bytes per pixel: scale by `2^exposure_ev`,
-/// clip to [0, 1] (NaN to 0), apply the sRGB OETF and round.
-pub fn to_srgb8(image: &RgbImage, exposure_ev: f32) -> Vec<u8> {
-    let scale = exposure_ev.exp2();
-    image
-        .pixels
-        .iter()
-        .flat_map(|p| p.to_array())
-        .map(|v| {
-            let v = (v * scale).clamp(0.0, 1.0);
-            let v = if v.is_nan() { 0.0 } else { v };
-            (srgb_oetf(v) * 255.0 + 0.5) as u8
-        })
-        .collect()
-}
-
-/// The linear image as an 8-bit sRGB buffer of the `image` crate (see [`to_srgb8`]).
-pub fn to_srgb8_image(image: &RgbImage, exposure_ev: f32) -> Option<image::RgbImage> {
-    image::RgbImage::from_raw(image.width, image.height, to_srgb8(image, exposure_ev))
-}
-
-/// Writes an 8-bit sRGB PNG of a linear image with exposure `exposure_ev` (see [`to_srgb8`]).
+/// Writes a render developed with exposure `exposure_ev` as an 8-bit sRGB PNG (see
+/// [`mod@crate::develop`]).
 pub fn write_png(path: &Path, image: &RgbImage, exposure_ev: f32) -> Result<(), ImageError> {
     let bad = || ImageError::BadImage {
         path: path.to_path_buf(),
@@ -45,7 +26,7 @@ pub fn write_png(path: &Path, image: &RgbImage, exposure_ev: f32) -> Result<(), 
     if !image.is_well_formed() {
         return Err(bad());
     }
-    write_png_buffer(path, &to_srgb8_image(image, exposure_ev).ok_or_else(bad)?)
+    write_png_buffer(path, &develop(image, exposure_ev).map_err(|_| bad())?)
 }
 
 /// Encodes any `image` crate buffer (8- or 16-bit grey or colour) as PNG into `w`: the one
@@ -112,24 +93,12 @@ mod tests {
     }
 
     #[test]
-    fn png_exposure_clip_and_srgb() {
-        let img = RgbImage {
-            width: 4,
-            height: 1,
-            pixels: vec![
-                Vec3::new(0.0, 1.0, 2.0),
-                Vec3::splat(0.25),
-                Vec3::new(-1.0, f32::NAN, f32::INFINITY),
-                Vec3::splat(0.001),
-            ],
-        };
-        let bytes = to_srgb8(&img, 1.0);
-        assert_eq!(&bytes[0..3], &[0, 255, 255]);
-        // 0.25 * 2 = 0.5 -> sRGB 0.7354 -> 188
-        assert_eq!(&bytes[3..6], &[188, 188, 188]);
-        assert_eq!(&bytes[6..9], &[0, 0, 255]);
-        // Linear segment: 0.002 * 12.92 * 255 = 6.6
-        assert_eq!(bytes[9], 7);
+    fn png_holds_the_developed_render() {
+        let mut img = RgbImage::new(3, 2);
+        img.pixels[1] = Vec3::new(0.25, 2.0, f32::NAN);
+        img.pixels[4] = Vec3::splat(0.001);
+        let bytes = crate::develop::develop_srgb8(&img, 1.0);
+        assert_eq!(&bytes[3..6], &[188, 255, 0]);
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("x.png");
         write_png(&path, &img, 1.0).unwrap();

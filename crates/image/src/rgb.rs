@@ -24,6 +24,19 @@ impl RgbImage {
         }
     }
 
+    /// The image whose pixel in column `x`, row `y` is `f(x, y)`.
+    pub fn from_fn(width: u32, height: u32, mut f: impl FnMut(u32, u32) -> Vec3) -> Self {
+        let pixels = (0..height)
+            .flat_map(|y| (0..width).map(move |x| (x, y)))
+            .map(|(x, y)| f(x, y))
+            .collect();
+        Self {
+            width,
+            height,
+            pixels,
+        }
+    }
+
     /// The pixel in column `x`, row `y` (row 0 at the top).
     #[inline]
     pub fn get(&self, x: u32, y: u32) -> Vec3 {
@@ -73,5 +86,13 @@ mod tests {
         assert_eq!(back, img);
         assert_eq!(img.get(1, 0), Vec3::new(4.0, 5.0, 6.0));
         assert!(img.is_well_formed() && !RgbImage::new(0, 3).is_well_formed());
+    }
+
+    #[test]
+    fn from_fn_is_row_major() {
+        let img = RgbImage::from_fn(3, 2, |x, y| Vec3::new(x as f32, y as f32, 0.0));
+        assert_eq!(img.pixels.len(), 6);
+        assert_eq!(img.get(2, 1), Vec3::new(2.0, 1.0, 0.0));
+        assert_eq!(img.pixels[3], Vec3::new(0.0, 1.0, 0.0));
     }
 }

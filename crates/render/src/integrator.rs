@@ -1035,24 +1035,7 @@ pub(crate) mod tests {
     fn street(kd: Vec3, ks: Vec3) -> Scene {
         let mut sign = Material::diffuse("sign", Vec3::ZERO);
         sign.emission = Vec3::new(4.0, 2.0, 1.0);
-        let road = Material {
-            name: "road".into(),
-            reflectance: crate::material::Reflectance::Paper {
-                model: crate::material::PaperModel::Ggx,
-                kd,
-                ks,
-                alpha: 0.15,
-                shininess: 0.0,
-                kd_texture: None,
-                wetness: None,
-            },
-            emission: Vec3::ZERO,
-            emission_texture: None,
-            normal_map: None,
-            double_sided: false,
-            alpha: crate::material::Alpha::OPAQUE,
-            road: true,
-        };
+        let road = Material::glossy_road("road", kd, ks, 0.15);
         let mut parts = SceneParts {
             materials: vec![road, sign],
             lights: vec![
@@ -1439,17 +1422,7 @@ pub(crate) mod tests {
         // road again after a diffuse bounce.
         let mut sign = Material::diffuse("sign", Vec3::ZERO);
         sign.emission = Vec3::new(40.0, 20.0, 10.0);
-        let mut road = Material::diffuse("road", Vec3::ZERO);
-        road.reflectance = crate::material::Reflectance::Paper {
-            model: crate::material::PaperModel::Ggx,
-            kd: Vec3::splat(0.1),
-            ks: Vec3::splat(0.5),
-            alpha: 0.02,
-            shininess: 0.0,
-            kd_texture: None,
-            wetness: None,
-        };
-        road.road = true;
+        let road = Material::glossy_road("road", Vec3::splat(0.1), Vec3::splat(0.5), 0.02);
         let mut parts = SceneParts {
             materials: vec![road, sign, Material::diffuse("wall", Vec3::splat(0.6))],
             lights: vec![Light::Point {

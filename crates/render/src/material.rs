@@ -298,6 +298,24 @@ impl Material {
         }
     }
 
+    /// An untextured, dry-everywhere GGX road surface (the paper's model) of diffuse albedo
+    /// `kd`, specular reflectance `ks` and roughness `alpha`, marked as road for the road mask.
+    pub fn glossy_road(name: impl Into<String>, kd: Vec3, ks: Vec3, alpha: f32) -> Self {
+        Self {
+            reflectance: Reflectance::Paper {
+                model: PaperModel::Ggx,
+                kd,
+                ks,
+                alpha,
+                shininess: 0.0,
+                kd_texture: None,
+                wetness: None,
+            },
+            road: true,
+            ..Self::diffuse(name, Vec3::ZERO)
+        }
+    }
+
     /// Every texture the material refers to.
     pub fn texture_ids(&self) -> impl Iterator<Item = TextureId> + '_ {
         self.texture_refs().map(|t| t.texture)

@@ -81,14 +81,10 @@ mod tests {
     use streaks_image::exr::read_exr_rgb;
 
     fn gradient(w: u32, h: u32) -> RgbImage {
-        let pixels = (0..w * h)
-            .map(|i| Vec3::new(i as f32, 0.5 * i as f32, -(i as f32)))
-            .collect();
-        RgbImage {
-            width: w,
-            height: h,
-            pixels,
-        }
+        RgbImage::from_fn(w, h, |x, y| {
+            let i = (y * w + x) as f32;
+            Vec3::new(i, 0.5 * i, -i)
+        })
     }
 
     fn output(w: u32, h: u32) -> RenderOutput {

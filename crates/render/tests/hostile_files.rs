@@ -7,6 +7,7 @@
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
+use streaks_image::input::png_header;
 use streaks_render::scene::{LoadOptions, Scene, SceneError};
 
 /// One triangle's positions, as little-endian floats.
@@ -364,48 +365,11 @@ fn a_draco_stream_claiming_huge_counts_is_refused() {
     }
 }
 
-/// A PNG whose header claims `width` x `height` RGBA pixels, with no pixel data.
-fn png_header(width: u32, height: u32) -> Vec<u8> {
-    fn crc32(bytes: &[u8]) -> u32 {
-        let mut crc = !0u32;
-        for &b in bytes {
-            crc ^= u32::from(b);
-            for _ in 0..8 {
-                crc = if crc & 1 != 0 {
-                    (crc >> 1) ^ 0xEDB8_8320
-                } else {
-                    crc >> 1
-                };
-            }
-        }
-        !crc
-    }
-    let chunk = |kind: &[u8], data: &[u8]| {
-        let mut c = (data.len() as u32).to_be_bytes().to_vec();
-        c.extend_from_slice(kind);
-        c.extend_from_slice(data);
-        let crc = crc32(&c[4..]);
-        c.extend_from_slice(&crc.to_be_bytes());
-        c
-    };
-    let mut ihdr = width.to_be_bytes().to_vec();
-    ihdr.extend(height.to_be_bytes());
-    ihdr.extend([8, 6, 0, 0, 0]);
-    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
-    png.extend(chunk(b"IHDR", &ihdr));
-    png.extend(chunk(
-        b"IDAT",
-        &[0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01],
-    ));
-    png.extend(chunk(b"IEND", &[]));
-    png
-}
-
 #[test]
 fn images_claiming_huge_sizes_are_refused_from_their_header() {
     let (_root, dir) = folders();
     std::fs::write(dir.join("tri.bin"), triangle()).unwrap();
-    std::fs::write(dir.join("big.png"), png_header(100_000, 100_000)).unwrap();
+    std::fs::write(dir.join("big.png"), png_header(100_000, 100_000, 8)).unwrap();
     let mut d = doc("tri.bin", 36);
     d["materials"] = json!([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}]);
     d["textures"] = json!([{"source": 0}]);
@@ -416,7 +380,7 @@ fn images_claiming_huge_sizes_are_refused_from_their_header() {
     // The same image embedded as a data URI.
     d["images"][0]["uri"] = json!(format!(
         "data:image/png;base64,{}",
-        base64::encode(png_header(100_000, 100_000))
+        base64::encode(png_header(100_000, 100_000, 8))
     ));
     names(
         &refused(&write(&dir, &d), &LoadOptions::default()),

@@ -9,6 +9,7 @@
 use crate::wetness::{hash, tiling_noise};
 use crate::Error;
 use image::{GrayImage, ImageEncoder};
+use streaks_image::color::srgb_oetf;
 
 /// A grey albedo pattern.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -78,15 +79,10 @@ fn value(pattern: Pattern, i: u32, j: u32, (w, h): (u32, u32), seed: u32) -> f32
     }
 }
 
-/// Linear value to 8-bit sRGB.
+/// Linear value to 8-bit sRGB (a texture's encoding, rounded to nearest: not a render's
+/// development, which [`streaks_image::develop`] does).
 fn encode_srgb(l: f32) -> u8 {
-    let l = l.clamp(0.0, 1.0);
-    let s = if l <= 0.003_130_8 {
-        12.92 * l
-    } else {
-        1.055 * l.powf(1.0 / 2.4) - 0.055
-    };
-    (s * 255.0).round() as u8
+    (srgb_oetf(l.clamp(0.0, 1.0)) * 255.0).round() as u8
 }
 
 /// 8-bit sRGB to linear (the glTF loader's decoding).

@@ -38,19 +38,8 @@ pub enum StereoError {
     #[error("no camera for the rig: {0}")]
     Camera(String),
     /// Two images that must have the same size do not.
-    #[error("{what}: sizes differ ({left_w}x{left_h} and {right_w}x{right_h})")]
-    SizeMismatch {
-        /// Which operation.
-        what: &'static str,
-        /// Width of the first image.
-        left_w: usize,
-        /// Height of the first image.
-        left_h: usize,
-        /// Width of the second image.
-        right_w: usize,
-        /// Height of the second image.
-        right_h: usize,
-    },
+    #[error(transparent)]
+    SizeMismatch(#[from] streaks_image::SizeMismatch),
     /// A parameter out of its range (texture-map ranges, resolution, shift, thresholds).
     #[error("invalid parameter {name}: {reason}")]
     Parameter {

@@ -6,19 +6,12 @@ use crate::error::StereoError;
 use crate::pair_dir::PairDir;
 use std::path::Path;
 use streaks_image::png::write_png_buffer;
-use streaks_image::GrayImage;
+use streaks_image::{ensure_pair_size, GrayImage};
 
-fn check_same_size(what: &'static str, l: (u32, u32), r: (u32, u32)) -> Result<(), StereoError> {
-    if l != r {
-        return Err(StereoError::SizeMismatch {
-            what,
-            left_w: l.0 as usize,
-            left_h: l.1 as usize,
-            right_w: r.0 as usize,
-            right_h: r.1 as usize,
-        });
-    }
-    Ok(())
+/// [`ensure_same_size`] of the two views of a developed pair.
+fn check_same_size(left: &image::RgbImage, right: &image::RgbImage) -> Result<(), StereoError> {
+    let size = |i: &image::RgbImage| (i.width() as usize, i.height() as usize);
+    Ok(ensure_pair_size(size(left), size(right))?)
 }
 
 /// The pair side by side, the left image on the left (for parallel free-fusing).
@@ -26,7 +19,7 @@ pub fn side_by_side(
     left: &image::RgbImage,
     right: &image::RgbImage,
 ) -> Result<image::RgbImage, StereoError> {
-    check_same_size("side-by-side", left.dimensions(), right.dimensions())?;
+    check_same_size(left, right)?;
     let (w, h) = left.dimensions();
     let mut out = image::RgbImage::new(2 * w, h);
     for (x, y, p) in out.enumerate_pixels_mut() {
@@ -46,7 +39,7 @@ pub fn anaglyph(
     left: &image::RgbImage,
     right: &image::RgbImage,
 ) -> Result<image::RgbImage, StereoError> {
-    check_same_size("anaglyph", left.dimensions(), right.dimensions())?;
+    check_same_size(left, right)?;
     let mut out = right.clone();
     for (o, l) in out.pixels_mut().zip(left.pixels()) {
         o[0] = l[0];
@@ -136,11 +129,7 @@ pub fn prepare_pair(
     right: &GrayImage,
     shift: f32,
 ) -> Result<(GrayImage, GrayImage), StereoError> {
-    check_same_size(
-        "stereo pair",
-        (left.width as u32, left.height as u32),
-        (right.width as u32, right.height as u32),
-    )?;
+    ensure_pair_size(left.size(), right.size())?;
     let l = equalize_histogram(left);
     let l = if shift == 0.0 {
         l
@@ -166,7 +155,7 @@ mod tests {
         let small = image::RgbImage::new(1, 1);
         assert!(matches!(
             anaglyph(&l, &small),
-            Err(StereoError::SizeMismatch { .. })
+            Err(StereoError::SizeMismatch(_))
         ));
         assert!(side_by_side(&small, &l).is_err());
     }

@@ -30,8 +30,9 @@ use crate::rig::{Eye, Intrinsics, Rig, RoadFrame};
 use crate::rigfile::{LightRecord, Placed, RigFile};
 use crate::streak_mask::{streak_mask, StreakMaskParams};
 use std::path::Path;
+use streaks_image::develop;
 use streaks_image::pfm::write_pfm;
-use streaks_image::png::{to_srgb8_image, write_png_buffer};
+use streaks_image::png::write_png_buffer;
 use streaks_image::GrayImage;
 use streaks_render::camera::Camera;
 use streaks_render::integrator::{render, Layers, RenderOutput, RenderSettings};
@@ -295,10 +296,6 @@ pub fn light_records(scene: &Scene, road: Option<&RoadFrame>) -> Vec<LightRecord
         .collect()
 }
 
-fn output_err(e: impl std::fmt::Display) -> StereoError {
-    StereoError::Render(e.to_string())
-}
-
 /// Writes a rendered pair and its ground truth into `dir` (which must exist); see the module
 /// documentation for the files.
 pub fn write_pair(
@@ -312,8 +309,7 @@ pub fn write_pair(
     let mut srgb = Vec::with_capacity(2);
     for (eye, view) in Eye::BOTH.into_iter().zip(views) {
         write_exr(&files.exr(eye), &view.output)?;
-        let img = to_srgb8_image(&view.output.image, exposure_ev)
-            .ok_or_else(|| output_err("image size does not match its pixels"))?;
+        let img = develop(&view.output.image, exposure_ev)?;
         write_png_buffer(&files.png(eye), &img)?;
         srgb.push(img);
         write_pfm(&files.disparity(eye), &view.disparity)?;

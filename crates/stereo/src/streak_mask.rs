@@ -14,7 +14,8 @@
 //! depend on the exposure. A view without specular radiance has an empty mask (`S > 0` fails).
 
 use crate::error::StereoError;
-use streaks_image::GrayImage;
+use streaks_image::stats::quantile;
+use streaks_image::{ensure_same_size, GrayImage};
 
 /// Parameters of the streak mask (see the module documentation).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -37,17 +38,6 @@ impl Default for StreakMaskParams {
     }
 }
 
-/// The `p`-quantile (0..=1) of finite values by the nearest rank; `None` when there are none.
-fn quantile(values: impl Iterator<Item = f32>, p: f32) -> Option<f32> {
-    let mut v: Vec<f32> = values.filter(|x| x.is_finite()).collect();
-    if v.is_empty() {
-        return None;
-    }
-    let k = ((p * (v.len() - 1) as f32).round() as usize).min(v.len() - 1);
-    let (_, x, _) = v.select_nth_unstable_by(k, f32::total_cmp);
-    Some(*x)
-}
-
 /// The streak mask (1 for streak pixels, 0 elsewhere) and the threshold `T` it used, from the
 /// specular and total luminance of a view and which pixels are road (`None`: all are).
 pub fn streak_mask(
@@ -56,15 +46,12 @@ pub fn streak_mask(
     road: Option<&[bool]>,
     params: &StreakMaskParams,
 ) -> Result<(GrayImage, f32), StereoError> {
-    if (specular.width, specular.height) != (total.width, total.height) {
-        return Err(StereoError::SizeMismatch {
-            what: "streak mask (specular and total luminance)",
-            left_w: specular.width,
-            left_h: specular.height,
-            right_w: total.width,
-            right_h: total.height,
-        });
-    }
+    ensure_same_size(
+        "the specular luminance",
+        specular.size(),
+        "the total luminance",
+        total.size(),
+    )?;
     if let Some(r) = road {
         if r.len() != specular.data.len() {
             return Err(StereoError::Parameter {

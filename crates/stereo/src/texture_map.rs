@@ -19,7 +19,7 @@ use glam::{Vec2, Vec3};
 use plotters::prelude::*;
 use std::path::Path;
 use streaks_image::png::write_png_buffer;
-use streaks_image::GrayImage;
+use streaks_image::{ensure_same_size, GrayImage};
 
 /// Largest map, in cells.
 const MAX_CELLS: usize = 1 << 26;
@@ -109,15 +109,12 @@ pub fn texture_map(
     let intr = rig.intrinsics();
     let (w, h) = (intr.width() as usize, intr.height() as usize);
     for c in channels {
-        if (c.width, c.height) != (w, h) {
-            return Err(StereoError::SizeMismatch {
-                what: "texture map (image and rig)",
-                left_w: c.width,
-                left_h: c.height,
-                right_w: w,
-                right_h: h,
-            });
-        }
+        ensure_same_size(
+            "the texture-mapped image",
+            c.size(),
+            "the rig's image",
+            (w, h),
+        )?;
     }
     let road = rig.road_frame()?;
     let cam = rig.eye(eye);
@@ -361,7 +358,7 @@ mod tests {
         let img = GrayImage::new(10, 10, 0.0).unwrap();
         assert!(matches!(
             texture_map(&[img], &rig, Eye::Left, &spec),
-            Err(StereoError::SizeMismatch { .. })
+            Err(StereoError::SizeMismatch(_))
         ));
     }
 

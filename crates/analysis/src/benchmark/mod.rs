@@ -35,8 +35,8 @@ pub mod report;
 
 use crate::detect::{detect_streaks, DetectError, DetectParams};
 use crate::lk::{lk_rows, prepare_pair, LkError, LkParams};
-use crate::sgm::{compare_disparity_where, DisparityErrors, SgmError};
-use streaks_image::{GrayImage, ImageError};
+use crate::sgm::{check_against_truth, compare_disparity_where, DisparityErrors, SgmError};
+use streaks_image::{ensure_same_size, GrayImage, ImageError};
 
 /// The threshold of [`DisparityErrors::bad`] in the benchmark (bad-2.0, as `streaks disparity`).
 pub const BAD_THRESHOLD_PX: f32 = 2.0;
@@ -95,14 +95,7 @@ pub fn score_regions(
     road: Option<&GrayImage>,
 ) -> Result<RegionErrors, SgmError> {
     for mask in std::iter::once(streaks).chain(road) {
-        if (mask.width, mask.height) != (truth.width, truth.height) {
-            return Err(SgmError::SizeMismatch {
-                lw: mask.width,
-                lh: mask.height,
-                rw: truth.width,
-                rh: truth.height,
-            });
-        }
+        ensure_same_size("the mask", mask.size(), "the ground truth", truth.size())?;
     }
     let t = BAD_THRESHOLD_PX;
     let streak = |i: usize| streaks.data[i] > 0.0;
@@ -230,14 +223,7 @@ pub fn error_colour(e: f32) -> [u8; 3] {
 /// estimate minus truth, [`NO_ESTIMATE_RGB`] where only the truth has a value,
 /// [`NO_TRUTH_RGB`] where the truth has none.
 pub fn error_map(estimate: &GrayImage, truth: &GrayImage) -> Result<image::RgbImage, SgmError> {
-    if (estimate.width, estimate.height) != (truth.width, truth.height) {
-        return Err(SgmError::SizeMismatch {
-            lw: estimate.width,
-            lh: estimate.height,
-            rw: truth.width,
-            rh: truth.height,
-        });
-    }
+    check_against_truth(estimate, truth)?;
     Ok(image::RgbImage::from_fn(
         truth.width as u32,
         truth.height as u32,

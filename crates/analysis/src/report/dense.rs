@@ -7,7 +7,8 @@ use super::ReportError;
 use crate::sgm::{compare_disparity_where, DisparityErrors, SgmError};
 use glam::{DVec2, Vec3};
 use serde::Serialize;
-use streaks_image::GrayImage;
+use streaks_image::stats::quantile_below;
+use streaks_image::{ensure_same_size, GrayImage};
 
 /// Summary of the dense disparity.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -52,15 +53,13 @@ pub fn dense_accuracy(
     streak_mask: &GrayImage,
     mask_name: &'static str,
 ) -> Result<DenseAccuracy, ReportError> {
-    if (streak_mask.width, streak_mask.height) != (truth.width, truth.height) {
-        return Err(SgmError::SizeMismatch {
-            lw: streak_mask.width,
-            lh: streak_mask.height,
-            rw: truth.width,
-            rh: truth.height,
-        }
-        .into());
-    }
+    ensure_same_size(
+        "the streak mask",
+        streak_mask.size(),
+        "the ground truth",
+        truth.size(),
+    )
+    .map_err(SgmError::from)?;
     let on = |i: usize| streak_mask.data[i] > 0.5;
     Ok(DenseAccuracy {
         streak_mask: mask_name,
@@ -74,15 +73,11 @@ pub fn dense_accuracy(
 /// to the largest ground-truth disparity (or that of the road at the bottom row), plus a
 /// margin, within what the matcher allows.
 pub(super) fn disparity_range(input: &StereoInput, view: &RigView) -> i32 {
-    let truth_max = input.truth_disparity.as_ref().and_then(|t| {
-        let mut v: Vec<f32> = t.data.iter().copied().filter(|d| d.is_finite()).collect();
-        if v.is_empty() {
-            return None;
-        }
-        let i = ((v.len() - 1) as f64 * 0.995) as usize;
-        let (_, q, _) = v.select_nth_unstable_by(i, f32::total_cmp);
-        Some(*q as f64)
-    });
+    let truth_max = input
+        .truth_disparity
+        .as_ref()
+        .and_then(|t| quantile_below(t.data.iter().copied(), 0.995))
+        .map(f64::from);
     let cam = &view.camera;
     let bottom = cam
         .ground_point(DVec2::new(

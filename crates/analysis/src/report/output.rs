@@ -4,12 +4,13 @@
 
 use super::dense::for_each_point;
 use super::input::{RigView, StereoInput};
-use super::stats::{median, span};
+use super::stats::span;
 use super::{Analysis, Report, ReportError, RowRecord};
 use crate::plot::{Marker, Plot, Series, BLACK_RGB, BLUE, GREY, RED};
 use crate::sgm::disparity_preview;
 use std::path::{Path, PathBuf};
 use streaks_image::png::write_png_buffer;
+use streaks_image::stats::median;
 use streaks_image::write_bytes_atomically;
 
 /// The disparity-against-row plot of one region: measured black, predicted blue, and for a
@@ -220,8 +221,8 @@ pub fn summary_table(report: &Report) -> String {
             opt(c.map(|c| c.rms_px)),
             c.map_or("-".into(), |c| format!("{:.5}", c.rms_deg)),
             c.map_or("-", |c| if c.slope_agrees { "yes" } else { "no" }),
-            median(r.rows.iter().map(|x| x.depth_m).collect()),
-            median(r.rows.iter().map(|x| x.road_y_m).collect()),
+            median(r.rows.iter().map(|x| x.depth_m)).unwrap_or(f64::NAN),
+            median(r.rows.iter().map(|x| x.road_y_m)).unwrap_or(f64::NAN),
         ));
     }
     if !report.regions.is_empty() {

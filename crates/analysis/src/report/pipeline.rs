@@ -6,7 +6,7 @@ use super::dense::{dense_accuracy, disparity_range, summarize_dense};
 use super::input::{RigView, StereoInput};
 use super::lights::match_light;
 use super::output::write_outputs;
-use super::stats::{compare, compare_with, median, span};
+use super::stats::{compare, compare_with, span};
 use super::targets::{find_objects, find_road};
 use super::{Analysis, RegionReport, Report, ReportError, RigSummary, RowRecord, StreakReport};
 use crate::centre::CentreModel;
@@ -16,6 +16,7 @@ use crate::model::streak_rows;
 use crate::sgm::{sgm, SgmParams};
 use glam::{DVec3, Vec3};
 use std::path::{Path, PathBuf};
+use streaks_image::stats::median;
 use streaks_image::{GrayImage, NamedRegion, Region};
 
 /// Parameters of [`analyze`].
@@ -178,9 +179,9 @@ fn analyze_streak(
         .collect();
     let off_road = median(
         rows.iter()
-            .filter_map(|r| r.road_px.map(|road| (r.measured_px - road).abs()))
-            .collect(),
-    );
+            .filter_map(|r| r.road_px.map(|road| (r.measured_px - road).abs())),
+    )
+    .unwrap_or(f64::NAN);
     if off_road.is_finite() && off_road < params.road_reject_px as f64 {
         light = None;
         for r in &mut rows {
@@ -198,8 +199,8 @@ fn analyze_streak(
         comparison: compare(&rows),
         centre_comparison: compare_with(&rows, |r| r.centre_px.zip(r.centre_deg)),
         road_span_px: (!road.is_empty()).then(|| span(road.iter().copied())),
-        median_depth_m: median(rows.iter().map(|r| r.depth_m).collect()),
-        median_road_y_m: median(rows.iter().map(|r| r.road_y_m).collect()),
+        median_depth_m: median(rows.iter().map(|r| r.depth_m)).unwrap_or(f64::NAN),
+        median_road_y_m: median(rows.iter().map(|r| r.road_y_m)).unwrap_or(f64::NAN),
         min_road_y_m: rows
             .iter()
             .map(|r| r.road_y_m)

@@ -78,16 +78,6 @@ pub(super) fn span(v: impl Iterator<Item = f64> + Clone) -> f64 {
     v.clone().fold(f64::NEG_INFINITY, f64::max) - v.fold(f64::INFINITY, f64::min)
 }
 
-/// The median of the finite values (the upper one of an even count), NaN for none.
-pub(super) fn median(mut v: Vec<f64>) -> f64 {
-    v.retain(|x| x.is_finite());
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
-
 /// Compares the measured and predicted disparities of `rows`.
 pub fn compare(rows: &[RowRecord]) -> Option<Comparison> {
     compare_with(rows, |r| r.predicted_px.zip(r.predicted_deg))

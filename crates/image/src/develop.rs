@@ -1,0 +1,78 @@
+//! Developing a render: linear radiance through the project's one camera model to the 8-bit
+//! sRGB that every PNG of a render holds (`streaks render`, the pairs of `streaks stereo` and
+//! the dataset's `im0.png`/`im1.png`).
+//!
+//! The camera model is deliberately simple (docs/design.md: no sensor noise, glare or
+//! vignetting): the exposure scales the radiance by `2^exposure_ev`, the sensor clips at 1
+//! (negative values and NaN to 0), and the tone curve is the sRGB transfer function, rounded to
+//! 8 bits.
+
+use crate::color::srgb_oetf;
+use crate::{ImageError, RgbImage};
+
+/// One channel value developed: scaled by `scale` (`2^exposure_ev`), clipped to [0, 1] (NaN to
+/// 0), through the sRGB curve and rounded to 8 bits.
+#[inline]
+fn develop_value(v: f32, scale: f32) -> u8 {
+    let v = (v * scale).clamp(0.0, 1.0);
+    let v = if v.is_nan() { 0.0 } else { v };
+    (srgb_oetf(v) * 255.0 + 0.5) as u8
+}
+
+/// The render developed with exposure `exposure_ev` as 8-bit sRGB bytes, three per pixel,
+/// row-major (see the module documentation).
+pub fn develop_srgb8(render: &RgbImage, exposure_ev: f32) -> Vec<u8> {
+    let scale = exposure_ev.exp2();
+    render
+        .pixels
+        .iter()
+        .flat_map(|p| p.to_array())
+        .map(|v| develop_value(v, scale))
+        .collect()
+}
+
+/// The render developed with exposure `exposure_ev` as an 8-bit sRGB image of the `image`
+/// crate, ready to encode (see the module documentation); an error when the render has fewer
+/// pixels than its size needs.
+pub fn develop(render: &RgbImage, exposure_ev: f32) -> Result<image::RgbImage, ImageError> {
+    image::RgbImage::from_raw(
+        render.width,
+        render.height,
+        develop_srgb8(render, exposure_ev),
+    )
+    .ok_or(ImageError::Size {
+        width: u64::from(render.width),
+        height: u64::from(render.height),
+        reason: "fewer pixels than the size needs",
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    #[test]
+    fn exposure_clip_and_srgb() {
+        let img = RgbImage {
+            width: 4,
+            height: 1,
+            pixels: vec![
+                Vec3::new(0.0, 1.0, 2.0),
+                Vec3::splat(0.25),
+                Vec3::new(-1.0, f32::NAN, f32::INFINITY),
+                Vec3::splat(0.001),
+            ],
+        };
+        let bytes = develop_srgb8(&img, 1.0);
+        assert_eq!(&bytes[0..3], &[0, 255, 255]);
+        // 0.25 * 2 = 0.5 -> sRGB 0.7354 -> 188
+        assert_eq!(&bytes[3..6], &[188, 188, 188]);
+        assert_eq!(&bytes[6..9], &[0, 0, 255]);
+        // Linear segment: 0.002 * 12.92 * 255 = 6.6
+        assert_eq!(bytes[9], 7);
+        assert_eq!(develop(&img, 1.0).unwrap().as_raw(), &bytes);
+        let bad = RgbImage { width: 5, ..img };
+        assert!(develop(&bad, 0.0).is_err());
+    }
+}
