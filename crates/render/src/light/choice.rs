@@ -257,7 +257,6 @@ impl LightSampler {
 mod tests {
     use super::*;
     use crate::bsdf::{Diffuse, Ggx};
-    use glam::Vec3;
     use crate::light::test_scenes::{
         check_tree, cone_emitter, estimate_irradiance, lamp_scene, normal, polygon_irradiance,
         receiver, vertices,
@@ -265,6 +264,7 @@ mod tests {
     use crate::light::BRANCHING;
     use crate::material::Material;
     use crate::scene::{Scene, SceneParts};
+    use glam::Vec3;
     use streaks_image::luminance;
 
     #[test]
