@@ -142,6 +142,7 @@ mod compression;
 mod error;
 pub mod extensions;
 mod files;
+#[path = "gltf/materials.rs"]
 mod gltf;
 mod instances;
 mod mesh;
