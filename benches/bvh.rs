@@ -7,10 +7,9 @@
 //! config, seed 0, sample 0: the scene of `streaks dataset generate --count 1`'s
 //! `samples/000000`, camera `driver`), closest hits traced one at a time in scanline order,
 //! in sorted orders (pixels in Morton and 4x4-tile order; bounce rays by direction octant,
-//! then origin Morton code), and as packets of eight ([`Accel::intersect_packet`]), in 4x2
-//! pixel tiles, in sorted order, or one pixel's eight samples together (the order a renderer
-//! that traces a pixel's samples in turn has). Before timing, every packet's hits are checked
-//! against single-ray traversal, bit for bit.
+//! then origin Morton code), and one pixel's eight samples in turn (the order a renderer that
+//! traces a pixel's samples in turn has). The packet traversal that decision measured against
+//! these is not kept (the decision says where to find it).
 //!
 //! Before the timed runs the bench prints the peak heap memory of one 1M-triangle build (a
 //! counting global allocator wraps the system one), for the "< 300 MB" target in docs/benchmarks.md.
@@ -20,8 +19,8 @@
 //! Instruction counts of the coherent sets: run the bench binary under
 //! `valgrind --tool=callgrind` with `--bench coherent_<street> --profile-time 1` and
 //! `STREAKS_COHERENT_HEIGHT=60` (a smaller image, so that making the rays takes minutes, not
-//! hours); each ray set is traced by its own instance of `trace_single::<SET>` or
-//! `trace_packets::<SET>`, so `callgrind_annotate --inclusive=yes` gives each set's
+//! hours); each ray set is traced by its own instance of `trace_single::<SET>`, so
+//! `callgrind_annotate --inclusive=yes` gives each set's
 //! instructions (divide by the calls and the set's rays).
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
@@ -31,7 +30,7 @@ use std::hint::black_box;
 use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
-use streaks_render::accel::{Accel, AccelHit, PACKET_WIDTH};
+use streaks_render::accel::Accel;
 use streaks_render::camera::Camera;
 use streaks_render::geometry::{offset_ray_origin, Frame, Ray};
 use streaks_render::light::Light;
@@ -259,55 +258,11 @@ fn bench_rays(c: &mut Criterion) {
 /// width follows the camera's aspect ratio.
 const COHERENT_HEIGHT: u32 = 240;
 
-/// Samples per pixel of the "one pixel's samples" sets (one packet per pixel).
-const PIXEL_SAMPLES: u32 = PACKET_WIDTH as u32;
+/// Samples per pixel of the "one pixel's samples" sets (as many as an AVX2 register has lanes).
+const PIXEL_SAMPLES: u32 = 8;
 
 /// GGX alpha of the road's glossy bounce (the wet asphalt of both streets has 0.02-0.04).
 const ROAD_ALPHA: f32 = 0.03;
-
-/// Rays in packets: packet `i` is `rays[starts[i]..starts[i + 1]]`, at most
-/// [`PACKET_WIDTH`] rays each.
-#[derive(Default)]
-struct Packets {
-    rays: Vec<Ray>,
-    starts: Vec<usize>,
-}
-
-impl Packets {
-    /// Starts a new packet (a no-op if the last one is still empty).
-    fn begin(&mut self) {
-        if self.starts.last() != Some(&self.rays.len()) {
-            self.starts.push(self.rays.len());
-        }
-    }
-
-    /// Adds a ray to the current packet, starting a new one when it is full.
-    fn push(&mut self, ray: Ray) {
-        if self.starts.is_empty() || self.rays.len() - self.starts.last().unwrap() == PACKET_WIDTH {
-            self.starts.push(self.rays.len());
-        }
-        self.rays.push(ray);
-    }
-
-    /// Consecutive rays of `rays` in packets of [`PACKET_WIDTH`].
-    fn chunks(rays: &[Ray]) -> Self {
-        let mut p = Self::default();
-        for r in rays {
-            p.push(*r);
-        }
-        p
-    }
-
-    /// The packets, each a slice of rays.
-    fn iter(&self) -> impl Iterator<Item = &[Ray]> + '_ {
-        let ends = self.starts.iter().skip(1).copied().chain([self.rays.len()]);
-        self.starts
-            .iter()
-            .zip(ends)
-            .filter(|&(&a, b)| a < b)
-            .map(|(&a, b)| &self.rays[a..b])
-    }
-}
 
 /// The bits of `x` spread to every `stride`-th bit (`stride` 2 or 3; `bits` of them).
 fn spread(x: u32, bits: u32, stride: u32) -> u64 {
@@ -369,17 +324,13 @@ struct CoherentSets {
     scanline: Vec<Ray>,
     morton: Vec<Ray>,
     tiles: Vec<Ray>,
-    /// Pixel-centre rays in 4x2-pixel packets (tiles in scanline order).
-    tile_packets: Packets,
-    /// [`PIXEL_SAMPLES`] jittered rays per pixel, pixels in scanline order: one packet each.
-    pixel_samples: Packets,
-    /// Glossy bounces off the road from the pixel-centre hits, in scanline order, sorted,
-    /// and in packets of the bounces of a 4x2-pixel tile.
+    /// [`PIXEL_SAMPLES`] jittered rays per pixel, pixels in scanline order.
+    pixel_samples: Vec<Ray>,
+    /// Glossy bounces off the road from the pixel-centre hits, in scanline order and sorted.
     bounce: Vec<Ray>,
     bounce_sorted: Vec<Ray>,
-    bounce_tile_packets: Packets,
-    /// Glossy bounces of the jittered rays that hit the road, one packet per pixel.
-    bounce_pixel_samples: Packets,
+    /// Glossy bounces of the jittered rays that hit the road, pixel by pixel.
+    bounce_pixel_samples: Vec<Ray>,
 }
 
 fn coherent_sets(scene: &Scene, camera: &Camera) -> CoherentSets {
@@ -417,26 +368,9 @@ fn coherent_sets(scene: &Scene, camera: &Camera) -> CoherentSets {
     let morton = pixels.iter().map(|&(x, y)| centre(x, y)).collect();
     pixels.sort_by_key(|&(x, y)| (y / 4, x / 4, y % 4, x % 4));
     let tiles = pixels.iter().map(|&(x, y)| centre(x, y)).collect();
-    let (mut tile_packets, mut bounce_tile_packets) = (Packets::default(), Packets::default());
-    for ty in (0..height).step_by(2) {
-        for tx in (0..width).step_by(4) {
-            tile_packets.begin();
-            bounce_tile_packets.begin();
-            for y in ty..(ty + 2).min(height) {
-                for x in tx..(tx + 4).min(width) {
-                    tile_packets.push(scanline[(y * width + x) as usize]);
-                    if let Some(b) = bounce_of[(y * width + x) as usize] {
-                        bounce_tile_packets.push(b);
-                    }
-                }
-            }
-        }
-    }
-    let (mut pixel_samples, mut bounce_pixel_samples) = (Packets::default(), Packets::default());
+    let (mut pixel_samples, mut bounce_pixel_samples) = (Vec::new(), Vec::new());
     for y in 0..height {
         for x in 0..width {
-            pixel_samples.begin();
-            bounce_pixel_samples.begin();
             for _ in 0..PIXEL_SAMPLES {
                 let film = Vec2::new(x as f32, y as f32) + rng.next_2d();
                 let ray = camera.generate_ray(film, width, height);
@@ -453,11 +387,9 @@ fn coherent_sets(scene: &Scene, camera: &Camera) -> CoherentSets {
         scanline,
         morton,
         tiles,
-        tile_packets,
         pixel_samples,
         bounce_sorted: sorted_by_octant_and_origin(&bounce),
         bounce,
-        bounce_tile_packets,
         bounce_pixel_samples,
     }
 }
@@ -473,46 +405,6 @@ fn trace_single<const SET: u8>(accel: &Accel, rays: &[Ray]) -> u32 {
         hits += u32::from(accel.intersect(black_box(r)).is_some());
     }
     hits
-}
-
-/// Closest hits of `packets`, a packet at a time; how many hit (`SET` as in
-/// [`trace_single`]).
-#[inline(never)]
-fn trace_packets<const SET: u8>(accel: &Accel, packets: &Packets) -> u32 {
-    black_box(SET);
-    let mut found = [None; PACKET_WIDTH];
-    let mut hits = 0u32;
-    for p in packets.iter() {
-        accel.intersect_packet(black_box(p), &mut found);
-        hits += found[..p.len()].iter().filter(|h| h.is_some()).count() as u32;
-    }
-    hits
-}
-
-/// Panics unless every packet finds exactly the single-ray hits; the number of rays checked.
-fn check_packets(accel: &Accel, packets: &Packets) -> usize {
-    let bits = |h: Option<AccelHit>| {
-        h.map(|h| {
-            (
-                h.t.to_bits(),
-                h.triangle,
-                h.barycentrics.x.to_bits(),
-                h.barycentrics.y.to_bits(),
-            )
-        })
-    };
-    let mut found = [None; PACKET_WIDTH];
-    for p in packets.iter() {
-        accel.intersect_packet(p, &mut found);
-        for (r, h) in p.iter().zip(found) {
-            assert_eq!(
-                bits(h),
-                bits(accel.intersect(r)),
-                "packet and single ray differ: {r:?}"
-            );
-        }
-    }
-    packets.rays.len()
 }
 
 /// `rainy_street` (its first camera) and the procedural street (camera `driver`); a street
@@ -550,22 +442,10 @@ fn bench_coherent(c: &mut Criterion) {
         };
         let sets = coherent_sets(&scene, cam);
         let accel = &scene.accel;
-        let checked: usize = [
-            &sets.tile_packets,
-            &sets.pixel_samples,
-            &sets.bounce_tile_packets,
-            &sets.bounce_pixel_samples,
-            &Packets::chunks(&sets.bounce_sorted),
-        ]
-        .into_iter()
-        .map(|p| check_packets(accel, p))
-        .sum();
-        let bounce_sorted = Packets::chunks(&sets.bounce_sorted);
         let hit = |rays: &[Ray]| trace_single::<0>(accel, rays) as f64 / rays.len().max(1) as f64;
         eprintln!(
             "{name}: {} triangles, {} instances, {}x{} pixels, {} road bounces ({:.0}% of the \
-             pixels; {:.0}% of them hit), {} samples' bounces; packets checked against single \
-             rays on {checked} rays: identical hits",
+             pixels; {:.0}% of them hit), {} samples' bounces",
             accel.triangle_count(),
             scene.instances.instances.len(),
             sets.width,
@@ -573,7 +453,7 @@ fn bench_coherent(c: &mut Criterion) {
             sets.bounce.len(),
             100.0 * sets.bounce.len() as f64 / sets.scanline.len() as f64,
             100.0 * hit(&sets.bounce),
-            sets.bounce_pixel_samples.rays.len(),
+            sets.bounce_pixel_samples.len(),
         );
         let mut group = c.benchmark_group(format!("coherent_{name}"));
         group.sample_size(20);
@@ -586,40 +466,15 @@ fn bench_coherent(c: &mut Criterion) {
         single("primary/tiles4x4", &sets.tiles, trace_single::<3>);
         single(
             "primary_spp8/single",
-            &sets.pixel_samples.rays,
+            &sets.pixel_samples,
             trace_single::<4>,
         );
         single("bounce/scanline", &sets.bounce, trace_single::<5>);
         single("bounce/sorted", &sets.bounce_sorted, trace_single::<6>);
         single(
             "bounce_spp8/single",
-            &sets.bounce_pixel_samples.rays,
-            trace_single::<7>,
-        );
-        let mut packets = |id: &str, p: &Packets, trace: fn(&Accel, &Packets) -> u32| {
-            group.throughput(Throughput::Elements(p.rays.len() as u64));
-            group.bench_function(id, |b| b.iter(|| trace(accel, p)));
-        };
-        packets(
-            "primary/packets_tile4x2",
-            &sets.tile_packets,
-            trace_packets::<8>,
-        );
-        packets(
-            "primary_spp8/packets_pixel",
-            &sets.pixel_samples,
-            trace_packets::<9>,
-        );
-        packets(
-            "bounce/packets_tile4x2",
-            &sets.bounce_tile_packets,
-            trace_packets::<10>,
-        );
-        packets("bounce/packets_sorted", &bounce_sorted, trace_packets::<11>);
-        packets(
-            "bounce_spp8/packets_pixel",
             &sets.bounce_pixel_samples,
-            trace_packets::<12>,
+            trace_single::<7>,
         );
         // What sorting the bounce rays costs, per ray.
         group.throughput(Throughput::Elements(sets.bounce.len() as u64));

@@ -1,8 +1,8 @@
 //! The Mitsuba 3 cross-check scene: a wet GGX road, one emissive sphere lamp, one point
 //! light, one diffuse wall and a camera named "cam", all within 20 m.
 
-use crate::doc::{Doc, Light, LightKind, Material, PaperBsdf};
 use crate::estimate::{intensity_for_peak, round_sig2, Brdf};
+use crate::gltf_writer::{Doc, Light, LightKind, Material, PaperBsdf};
 use crate::mesh::Mesh;
 use crate::Error;
 use glam::{DVec3, Vec3};

@@ -3,8 +3,8 @@
 //! cross-check scene. Each scene is written as `NAME.gltf` + `NAME.bin` (+ PNG textures),
 //! byte-for-byte deterministic; `scenes/README.md` describes them and the scene contract.
 //!
-//! The pieces: [`mesh::Mesh`] builds triangle meshes from simple solids, [`doc::Doc`] turns
-//! meshes, [`doc::Material`]s, [`doc::Light`]s and cameras into a glTF document,
+//! The pieces: [`mesh::Mesh`] builds triangle meshes from simple solids, [`gltf_writer::Doc`] turns
+//! meshes, [`gltf_writer::Material`]s, [`gltf_writer::Light`]s and cameras into a glTF document,
 //! [`estimate`] chooses light intensities from the streak's peak radiance, [`wetness`] makes
 //! the road's dryness map, and [`paper`], [`street`] and [`crosscheck`] lay out the scenes.
 //!
@@ -18,8 +18,8 @@
 
 pub mod albedo;
 pub mod crosscheck;
-pub mod doc;
 pub mod estimate;
+pub mod gltf_writer;
 pub mod mesh;
 pub mod paper;
 pub mod procedural;
@@ -73,7 +73,7 @@ pub enum Error {
 }
 
 /// Builds every shipped scene (in memory).
-pub fn build_all() -> Result<Vec<doc::Doc>, Error> {
+pub fn build_all() -> Result<Vec<gltf_writer::Doc>, Error> {
     Ok(vec![
         paper::fig2(paper::Fig2::BlinnPhong)?,
         paper::fig2(paper::Fig2::Ward)?,
@@ -187,7 +187,7 @@ mod tests {
     #[test]
     fn lumens_per_watt_is_the_renderers() {
         assert_eq!(
-            crate::doc::LUMENS_PER_WATT,
+            crate::gltf_writer::LUMENS_PER_WATT,
             f64::from(streaks_render::light::LUMINOUS_EFFICACY)
         );
     }

@@ -4,8 +4,8 @@
 //! The viewer stands at world X = 0, Z = 0 looking along -Z, so the paper's road frame
 //! (Z forward) is world -Z.
 
-use crate::doc::{round7, Doc, Light, LightKind, Material, PaperBsdf};
 use crate::estimate::{intensity_for_peak, round_sig2, Brdf};
+use crate::gltf_writer::{round7, Doc, Light, LightKind, Material, PaperBsdf};
 use crate::mesh::Mesh;
 use crate::Error;
 use glam::{DVec3, Vec3};

@@ -501,7 +501,7 @@ impl std::fmt::Display for Split {
 pub struct SampleScene {
     /// The glTF document, named `scene` (`doc.write(dir)` writes `scene.gltf`, `scene.bin`
     /// and `scene_*.png`).
-    pub doc: crate::doc::Doc,
+    pub doc: crate::gltf_writer::Doc,
     /// The camera node to render: the stereo rig's centre.
     pub camera: String,
     /// Stereo baseline, metres.
@@ -571,7 +571,7 @@ pub fn blackbody_rgb(kelvin: f64) -> [f64; 3] {
     ]
     .map(|c: f64| c.max(0.0));
     let peak = rgb[0].max(rgb[1]).max(rgb[2]);
-    rgb.map(|c| crate::doc::round7(c / peak))
+    rgb.map(|c| crate::gltf_writer::round7(c / peak))
 }
 
 /// Positions along the road from `start` towards `far` every `spacing` metres (at least
@@ -708,7 +708,7 @@ fn random_street(
     };
     let lamp_color = blackbody_rgb(temperature);
     let marker = 40.0 * lamp_intensity / 250.0;
-    let lens_radiance = lamp_color.map(|c| crate::doc::round7(c * marker));
+    let lens_radiance = lamp_color.map(|c| crate::gltf_writer::round7(c * marker));
 
     // Cars: parked ones in the outer lanes by the kerbs, leading ones in the driver's lane,
     // oncoming ones in the lanes left of the centre.
@@ -823,7 +823,7 @@ fn random_street(
     let brightness = uniform(rng, sc.facade_brightness);
     let facade_kd = StreetStyle::SHIPPED
         .facade_kd
-        .map(|c| c.map(|k| crate::doc::round7((k * brightness).min(0.9))));
+        .map(|c| c.map(|k| crate::gltf_writer::round7((k * brightness).min(0.9))));
     let lit = uniform(rng, sc.lit_windows) as f32;
     let cool = uniform(rng, sc.cool_windows) as f32;
     let lit_shops = uniform(rng, sc.lit_shops) as f32;
@@ -835,7 +835,7 @@ fn random_street(
     let wet = (uniform(rng, wc.ks_wet), uniform(rng, wc.alpha_wet));
     let dry = (uniform(rng, wc.ks_dry), uniform(rng, wc.alpha_dry));
     let ripples = rng.random_bool(wc.ripples).then(|| Ripples {
-        strength: crate::doc::round7(uniform(rng, wc.ripple_strength)),
+        strength: crate::gltf_writer::round7(uniform(rng, wc.ripple_strength)),
         tile_m: uniform(rng, wc.ripple_tile) as f32,
         seed: rng.random(),
     });

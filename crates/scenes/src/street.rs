@@ -4,10 +4,10 @@
 //! [`Street::full`] is `rainy_street`; [`Street::small`] is `rainy_street_small` for tests.
 
 use crate::albedo::{albedo_png, Pattern};
-use crate::doc::{
+use crate::estimate::Brdf;
+use crate::gltf_writer::{
     quantise, round7, Doc, Dryness, Light, LightKind, Material, NormalTexture, PaperBsdf,
 };
-use crate::estimate::Brdf;
 use crate::mesh::Mesh;
 use crate::wetness::{dryness_png, ripple_normal_png, Wetness, RIPPLE_TEXELS};
 use crate::Error;

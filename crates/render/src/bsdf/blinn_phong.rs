@@ -1,7 +1,7 @@
 //! Normalised Blinn-Phong [`BlinnPhong`]: its glossy lobe, sampled by `cos^s` of the half
 //! vector.
 
-use super::lanes::{Lanes, Spectrum};
+use super::numbers::{Lanes, Spectrum};
 use super::{glossy_probability, half_vector, reflect_about_half, Lobes, Model, Reflectances};
 use glam::{Vec2, Vec3};
 use std::f32::consts::{PI, TAU};

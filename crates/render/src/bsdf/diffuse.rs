@@ -1,7 +1,7 @@
 //! The Lambertian lobe `kd / pi`, which every model's diffuse part is, and the model that is
 //! only that, [`Diffuse`]. (The lobe mixture in the parent module samples it cosine-weighted.)
 
-use super::lanes::{Lanes, Spectrum};
+use super::numbers::{Lanes, Spectrum};
 use super::{Lobes, Model, Reflectances};
 use glam::{Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;

@@ -5,7 +5,7 @@
 //! model the height-correlated one ([`microfacet_correlated`], as the glTF specification's
 //! appendix B does); both sample the same visible normals.
 
-use super::lanes::{Lanes, Spectrum};
+use super::numbers::{Lanes, Spectrum};
 use super::{glossy_probability, reflect, Lobes, Model, Reflectances, MIN_ALPHA};
 use glam::{Vec2, Vec3};
 use std::f32::consts::{PI, TAU};

@@ -7,7 +7,7 @@
 use super::dielectric::{microfacet_transmission, outside_cos, refract};
 use super::diffuse::lambert;
 use super::ggx;
-use super::lanes::{Lanes, Spectrum};
+use super::numbers::{Lanes, Spectrum};
 use super::{
     glossy_probability, half_vector, reflect, rgb_lobes, BsdfSample, Lobe, LobeValues, Lobes,
     Model, Reflectances, MIN_ALPHA, MIN_LOBE_PROBABILITY,

@@ -6,7 +6,7 @@
 //! [`Bsdf::luminance_at`]; [`AtWo`] holds the model's, one variant per [`Bsdf`] variant, and
 //! no formula.
 
-use super::lanes::Lanes;
+use super::numbers::Lanes;
 use super::{BlinnPhong, Bsdf, Diffuse, Ggx, GltfPbr, Lobes, Model, Reflectances, Ward};
 use glam::Vec3;
 use streaks_image::luminance;
@@ -123,7 +123,7 @@ impl Bsdf {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bsdf::lanes::{Wide, WideLanes};
+    use crate::bsdf::numbers::{Wide, WideLanes};
     use crate::bsdf::tests::{all_models, random_dir};
     use crate::bsdf::{Ggx, MIN_ALPHA};
     use crate::sampling::Pcg32;

@@ -41,7 +41,7 @@
 //!   [`LobeValues`], [`BsdfSample`], [`MIN_ALPHA`], the direction helpers the models share
 //!   (reflection, half vector), and the lobe mixture (the glossy-lobe probability and the
 //!   mixture density);
-//! - `lanes.rs`: the number types every lobe is written in, a scalar or four SIMD lanes
+//! - `numbers.rs`: the number types every lobe is written in, a scalar or four SIMD lanes
 //!   (`Lanes`) and a reflectance as RGB or as its luminance (`Spectrum`);
 //! - `diffuse.rs`: the Lambertian lobe and [`Diffuse`];
 //! - `ggx.rs`: the GGX microfacet lobe (masking, the separable and the height-correlated
@@ -68,8 +68,8 @@ mod dielectric;
 mod diffuse;
 mod ggx;
 mod gltf;
-pub(crate) mod lanes;
 mod luminance;
+pub(crate) mod numbers;
 mod ward;
 
 pub use blinn_phong::BlinnPhong;
@@ -82,7 +82,7 @@ pub use ward::Ward;
 use crate::sampling::{square_to_cosine_hemisphere, square_to_cosine_hemisphere_pdf};
 use diffuse::lambert;
 use glam::{Vec2, Vec3};
-use lanes::{Lanes, Spectrum};
+use numbers::{Lanes, Spectrum};
 use std::f32::consts::TAU;
 
 /// Which part of a model produced a sampled or evaluated contribution.

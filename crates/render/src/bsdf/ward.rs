@@ -1,7 +1,7 @@
 //! The paper's isotropic Ward model [`Ward`]: its glossy lobe, sampled by the Gaussian in
 //! `tan(delta)` (Walter 2005, "Notes on the Ward BRDF").
 
-use super::lanes::{Lanes, Spectrum};
+use super::numbers::{Lanes, Spectrum};
 use super::{glossy_probability, reflect_about_half, Lobes, Model, Reflectances, MIN_ALPHA};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;

@@ -40,20 +40,20 @@
 //!
 //! The choice descends the tree from the root, one child per level, weighing a node's children
 //! once: at most `BRANCHING` (16) BSDF evaluations per level, all of a node's children in SIMD
-//! lanes, 4, 8 or 16 at a time (the crate's `light::lanes`). Every choice is a deterministic
+//! lanes, 4, 8 or 16 at a time (the crate's `light::child_weights`). Every choice is a deterministic
 //! function of the point, so [`LightSampler::sample_li`] and [`LightSampler::pdf_li`] agree
 //! exactly, which MIS needs.
 
+use super::child_weights::{BsdfWeight, TreeLanes, Weights};
 use super::emitter::{Emitter, Emitters, SurfaceMesh};
-use super::lanes::{BsdfWeight, TreeLanes, Weights};
 use super::tree::{LightTree, Node};
-use super::{Light, LightSample};
+use super::{Light, LightSample, Receiver};
 use crate::bsdf::Bsdf;
-use crate::geometry::{Frame, SurfaceHit};
+use crate::geometry::SurfaceHit;
 use crate::material::Material;
 use crate::sampling::ONE_MINUS_EPSILON;
 use crate::texture::Texture;
-use glam::{Vec2, Vec3};
+use glam::Vec2;
 use std::ops::Range;
 
 /// Share of the light choice made by irradiance alone when it is BSDF-aware (defensive
@@ -73,22 +73,6 @@ fn defensive_share(bsdf: &Bsdf) -> f32 {
     } else {
         DEFENSIVE_SHARE
     }
-}
-
-/// What the light choice may know about the shading point: position, geometric normal,
-/// shading frame, outgoing direction and BSDF.
-#[derive(Clone, Copy, Debug)]
-pub struct Receiver {
-    /// Shading point.
-    pub p: Vec3,
-    /// Geometric normal, on the side of `wo`.
-    pub ng: Vec3,
-    /// Shading frame (normal on the side of `wo`).
-    pub frame: Frame,
-    /// Outgoing direction in the shading frame.
-    pub wo_local: Vec3,
-    /// BSDF at the point.
-    pub bsdf: Bsdf,
 }
 
 /// Chooses an emitter and a sample on it for next-event estimation (see the module
@@ -187,7 +171,7 @@ impl LightSampler {
     }
 
     /// The weights `E_c` and `E_c F_c` of the nodes `nodes` (one node's children), with their
-    /// sums, in SIMD lanes ([`super::lanes`]).
+    /// sums, in SIMD lanes ([`super::child_weights`]).
     #[inline]
     fn weights(&self, rx: &Receiver, w: &BsdfWeight, nodes: Range<usize>) -> Weights {
         self.lanes.weights(rx, w, nodes)
@@ -280,6 +264,7 @@ mod tests {
     use crate::light::BRANCHING;
     use crate::material::Material;
     use crate::scene::{Scene, SceneParts};
+    use glam::Vec3;
     use streaks_image::luminance;
 
     #[test]

@@ -7,7 +7,9 @@
 //! - [`tree`]: [`LightTree`], the emitters grouped by position into a flat 16-ary tree;
 //! - [`choice`]: [`LightSampler`], which picks an emitter per shading point by the irradiance
 //!   and the BSDF toward it, down the tree, and samples it; and the density of that choice;
-//! - `lanes`: the weights of a tree node's children, computed in SIMD lanes (4, 8 or 16 at a
+//! - `receiver`: [`Receiver`], the shading point as the choice and the children's weights see
+//!   it;
+//! - `child_weights`: the weights of a tree node's children, computed in SIMD lanes (4, 8 or 16 at a
 //!   time, by [`crate::simd::level`]) from a structure-of-arrays copy of each node's children.
 //!
 //! A [`crate::scene::Scene`] builds its [`LightSampler`] when it is built: every render of the
@@ -21,17 +23,19 @@
 //! (intensity / r^2, or the directional irradiance), so `f * li * cos / pdf` is the estimate
 //! either way.
 
+mod child_weights;
 pub mod choice;
 pub mod emitter;
-mod lanes;
 pub mod punctual;
+mod receiver;
 #[cfg(test)]
 mod test_scenes;
 pub mod tree;
 
-pub use choice::{LightSampler, Receiver};
+pub use choice::LightSampler;
 pub use emitter::{Emitter, Emitters, MeshEmitter, SurfaceMesh};
 pub use punctual::{range_window, spot_falloff, Light, LUMINOUS_EFFICACY};
+pub use receiver::Receiver;
 pub use tree::{LightTree, Node, BRANCHING};
 
 use glam::Vec3;

@@ -140,7 +140,6 @@
 mod accessor;
 mod compression;
 mod error;
-pub mod extensions;
 mod files;
 mod gltf;
 mod instances;
@@ -151,6 +150,7 @@ mod validate;
 
 pub use error::SceneError;
 pub use files::LoadOptions;
+pub use gltf::extensions;
 pub use gltf::{MAX_PLACEMENTS, MAX_TRIANGLES};
 pub use instances::{Instance, InstancedMesh, Instances};
 pub use mesh::MeshParts;

@@ -27,11 +27,11 @@
 //! The sums `sum E` and `sum E F` are taken child by child in order, so the weights and the
 //! choice are bit for bit the same at every width (tested on every width this CPU has).
 
-use super::choice::Receiver;
 use super::emitter::{Emitter, Emitters};
+use super::receiver::Receiver;
 use super::tree::{LightTree, Node, BRANCHING};
 use super::Light;
-use crate::bsdf::lanes::{Wide, WideLanes};
+use crate::bsdf::numbers::{Wide, WideLanes};
 use crate::bsdf::LuminanceEval;
 use crate::simd::{level, SimdLevel};
 use glam::Vec3;

@@ -1,0 +1,913 @@
+//! Materials: glTF metallic-roughness with KHR_materials_specular, _ior, _clearcoat,
+//! _transmission and _volume, the paper's models and the road flag from `extras.streaks`, and
+//! the glTF default material.
+
+use super::*;
+
+/// `extras.streaks` of a material (see the `scene` module documentation).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct StreaksExtras {
+    /// The paper model; absent, the material is glTF metallic-roughness and `extras.streaks`
+    /// may only carry `road`.
+    #[serde(default)]
+    bsdf: Option<StreaksBsdf>,
+    /// Marks the road surface (datasets mask the pixels whose first hit has such a
+    /// material); no effect on shading.
+    #[serde(default)]
+    road: bool,
+    #[serde(default)]
+    kd: Option<[f32; 3]>,
+    #[serde(default)]
+    ks: Option<[f32; 3]>,
+    #[serde(default)]
+    alpha: Option<f32>,
+    #[serde(default)]
+    shininess: Option<f32>,
+    #[serde(default)]
+    alpha_dry: Option<f32>,
+    #[serde(default)]
+    ks_dry: Option<[f32; 3]>,
+}
+
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum StreaksBsdf {
+    Ggx,
+    Ward,
+    BlinnPhong,
+}
+
+/// A material's KHR_materials_specular and KHR_materials_ior parameters.
+pub(super) struct Specular {
+    factor: f32,
+    texture: Option<TextureRef>,
+    color: Vec3,
+    color_texture: Option<TextureRef>,
+    ior: f32,
+}
+
+/// A material's KHR_materials_clearcoat object, as the JSON has it, and its decoded textures.
+#[derive(Debug, Default, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub(super) struct Clearcoat {
+    #[serde(default)]
+    clearcoat_factor: f32,
+    clearcoat_texture: Option<JsonTextureInfo>,
+    #[serde(default)]
+    clearcoat_roughness_factor: f32,
+    clearcoat_roughness_texture: Option<JsonTextureInfo>,
+    clearcoat_normal_texture: Option<serde_json::Value>,
+    #[serde(skip)]
+    texture: Option<TextureRef>,
+    #[serde(skip)]
+    roughness_texture: Option<TextureRef>,
+}
+
+/// A material's KHR_materials_transmission object, as the JSON has it, and its decoded texture.
+#[derive(Debug, Default, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub(super) struct Transmission {
+    #[serde(default)]
+    transmission_factor: f32,
+    transmission_texture: Option<JsonTextureInfo>,
+    #[serde(skip)]
+    texture: Option<TextureRef>,
+}
+
+/// A material's KHR_materials_volume object, as the JSON has it.
+#[derive(Debug, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub(super) struct JsonVolume {
+    #[serde(default)]
+    thickness_factor: f32,
+    thickness_texture: Option<serde_json::Value>,
+    #[serde(default = "infinite")]
+    attenuation_distance: f32,
+    #[serde(default = "white")]
+    attenuation_color: [f32; 3],
+}
+
+/// KHR_materials_volume's default attenuationDistance: no attenuation.
+pub(super) fn infinite() -> f32 {
+    f32::INFINITY
+}
+
+/// KHR_materials_volume's default attenuationColor.
+pub(super) fn white() -> [f32; 3] {
+    [1.0; 3]
+}
+
+impl Loader<'_> {
+    /// The glTF default material (white, metallic 1, roughness 1), added once when needed.
+    pub(super) fn default_material(&mut self) -> u32 {
+        *self.default_material.get_or_insert_with(|| {
+            self.parts.materials.push(Material {
+                name: "default".into(),
+                reflectance: Reflectance::GltfPbr(GltfPbrParams::default()),
+                emission: Vec3::ZERO,
+                emission_texture: None,
+                normal_map: None,
+                double_sided: false,
+                alpha: Alpha::OPAQUE,
+                road: false,
+            });
+            (self.parts.materials.len() - 1) as u32
+        })
+    }
+
+    pub(super) fn material(
+        &mut self,
+        m: &gltf::Material,
+        index: usize,
+        document: &gltf::Document,
+    ) -> Result<Material, SceneError> {
+        let name = m
+            .name()
+            .map_or_else(|| format!("material{index}"), str::to_string);
+        let element = format!("material {name:?} ({index})");
+        validate::material(m).map_err(|r| self.bad(&element, r))?;
+        let pbr = m.pbr_metallic_roughness();
+        let base_color_texture = match pbr.base_color_texture() {
+            Some(info) => Some(self.texture(&info, ColorSpace::Srgb, &element)?),
+            None => None,
+        };
+        let mr_texture = match pbr.metallic_roughness_texture() {
+            Some(info) => Some(self.texture(&info, ColorSpace::Linear, &element)?),
+            None => None,
+        };
+        let emission_texture = match m.emissive_texture() {
+            Some(info) => Some(self.texture(&info, ColorSpace::Srgb, &element)?),
+            None => None,
+        };
+        let normal_map = match m.normal_texture() {
+            Some(info) => {
+                let scale = info.scale();
+                if !scale.is_finite() {
+                    return Err(
+                        self.bad(element, format!("normalTexture.scale {scale} is invalid"))
+                    );
+                }
+                Some(NormalMap {
+                    texture: {
+                        let transform = info
+                            .extension_value("KHR_texture_transform")
+                            .map(UvTransform::from_json)
+                            .transpose()
+                            .map_err(|e| self.bad(format!("{element}, normalTexture"), e))?;
+                        self.texture_of(
+                            &info.texture(),
+                            info.tex_coord(),
+                            transform,
+                            ColorSpace::Linear,
+                            &element,
+                        )?
+                    },
+                    scale,
+                })
+            }
+            None => None,
+        };
+        let emission = Vec3::from(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0);
+        if !emission.is_finite() || emission.min_element() < 0.0 {
+            return Err(self.bad(element, format!("emission {emission} is invalid")));
+        }
+        let base = Vec4::from(pbr.base_color_factor());
+        let mode = match m.alpha_mode() {
+            gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+            gltf::material::AlphaMode::Mask => {
+                let cutoff = m.alpha_cutoff().unwrap_or(0.5);
+                if !cutoff.is_finite() {
+                    return Err(self.bad(element, format!("alphaCutoff {cutoff} is invalid")));
+                }
+                AlphaMode::Mask { cutoff }
+            }
+            gltf::material::AlphaMode::Blend => AlphaMode::Blend,
+        };
+        let alpha = match mode {
+            AlphaMode::Opaque => Alpha::OPAQUE,
+            mode => Alpha {
+                mode,
+                factor: base.w,
+                texture: base_color_texture,
+            },
+        };
+        let extras = self.streaks_extras(m, &element)?;
+        let road = extras.as_ref().is_some_and(|x| x.road);
+        let reflectance = match extras.filter(|x| x.bsdf.is_some()) {
+            Some(x) => self.paper(x, base_color_texture, mr_texture, &element)?,
+            None => {
+                let specular = self.specular(m, &element)?;
+                let clearcoat = self.clearcoat(m, document, &element)?;
+                let transmission = self.transmission(m, document, &element)?;
+                let volume = self.volume(m, &element)?;
+                Reflectance::GltfPbr(GltfPbrParams {
+                    base_color: base.truncate(),
+                    base_color_texture,
+                    metallic: pbr.metallic_factor(),
+                    roughness: pbr.roughness_factor(),
+                    metallic_roughness_texture: mr_texture,
+                    specular: specular.factor,
+                    specular_texture: specular.texture,
+                    specular_color: specular.color,
+                    specular_color_texture: specular.color_texture,
+                    ior: specular.ior,
+                    clearcoat: clearcoat.clearcoat_factor,
+                    clearcoat_texture: clearcoat.texture,
+                    clearcoat_roughness: clearcoat.clearcoat_roughness_factor,
+                    clearcoat_roughness_texture: clearcoat.roughness_texture,
+                    transmission: transmission.transmission_factor,
+                    transmission_texture: transmission.texture,
+                    volume,
+                })
+            }
+        };
+        Ok(Material {
+            name,
+            reflectance,
+            emission,
+            emission_texture,
+            normal_map,
+            double_sided: m.double_sided(),
+            alpha,
+            road,
+        })
+    }
+
+    /// KHR_materials_specular and KHR_materials_ior of a glTF material, with their defaults
+    /// where absent (specular 1, specular colour 1, ior 1.5); out-of-range values are errors.
+    pub(super) fn specular(
+        &mut self,
+        m: &gltf::Material,
+        element: &str,
+    ) -> Result<Specular, SceneError> {
+        let ior = m.ior().unwrap_or(1.5);
+        if !(ior == 0.0 || (ior.is_finite() && ior >= 1.0)) {
+            return Err(self.bad(
+                element,
+                format!("KHR_materials_ior: ior {ior} must be 0 or at least 1"),
+            ));
+        }
+        let Some(sp) = m.specular() else {
+            return Ok(Specular {
+                factor: 1.0,
+                texture: None,
+                color: Vec3::ONE,
+                color_texture: None,
+                ior,
+            });
+        };
+        let (factor, color) = (sp.specular_factor(), Vec3::from(sp.specular_color_factor()));
+        if !(0.0..=1.0).contains(&factor) {
+            return Err(self.bad(
+                element,
+                format!("KHR_materials_specular: specularFactor {factor} is not in [0, 1]"),
+            ));
+        }
+        if !(color.is_finite() && color.min_element() >= 0.0) {
+            return Err(self.bad(
+                element,
+                format!("KHR_materials_specular: specularColorFactor {color} is invalid"),
+            ));
+        }
+        let texture = match sp.specular_texture() {
+            Some(info) => Some(self.texture(&info, ColorSpace::Linear, element)?),
+            None => None,
+        };
+        let color_texture = match sp.specular_color_texture() {
+            Some(info) => Some(self.texture(&info, ColorSpace::Srgb, element)?),
+            None => None,
+        };
+        Ok(Specular {
+            factor,
+            texture,
+            color,
+            color_texture,
+            ior,
+        })
+    }
+
+    /// KHR_materials_clearcoat of a glTF material (no coat where absent), read from the JSON
+    /// (the gltf crate does not know the extension); its textures are decoded, and a
+    /// clearcoatNormalTexture is a warning, as the coat is shaded with the base's normal.
+    pub(super) fn clearcoat(
+        &mut self,
+        m: &gltf::Material,
+        document: &gltf::Document,
+        element: &str,
+    ) -> Result<Clearcoat, SceneError> {
+        let Some(value) = m.extension_value("KHR_materials_clearcoat") else {
+            return Ok(Clearcoat::default());
+        };
+        let reason = |r: String| format!("KHR_materials_clearcoat: {r}");
+        let mut c: Clearcoat = serde_json::from_value(value.clone())
+            .map_err(|e| self.bad(element, reason(e.to_string())))?;
+        for (key, v) in [
+            ("clearcoatFactor", c.clearcoat_factor),
+            ("clearcoatRoughnessFactor", c.clearcoat_roughness_factor),
+        ] {
+            if !(0.0..=1.0).contains(&v) {
+                return Err(self.bad(element, reason(format!("{key} {v} is not in [0, 1]"))));
+            }
+        }
+        if c.clearcoat_normal_texture.is_some() {
+            self.warn(format!(
+                "{element}: KHR_materials_clearcoat clearcoatNormalTexture is not used; the \
+                 clear coat is shaded with the base's normal"
+            ));
+        }
+        for (key, info, space) in [
+            ("clearcoatTexture", c.clearcoat_texture, ColorSpace::Linear),
+            (
+                "clearcoatRoughnessTexture",
+                c.clearcoat_roughness_texture,
+                ColorSpace::Linear,
+            ),
+        ] {
+            let Some(info) = info else { continue };
+            let Some(texture) = document.textures().nth(info.index) else {
+                let why = format!("{key}: texture {} does not exist", info.index);
+                return Err(self.bad(element, reason(why)));
+            };
+            let id = self.texture_of(&texture, info.tex_coord, info.transform, space, element)?;
+            match key {
+                "clearcoatTexture" => c.texture = Some(id),
+                _ => c.roughness_texture = Some(id),
+            }
+        }
+        Ok(c)
+    }
+
+    /// KHR_materials_transmission of a glTF material (none: transmission 0), with its texture;
+    /// a factor outside [0, 1] is an error.
+    pub(super) fn transmission(
+        &mut self,
+        m: &gltf::Material,
+        document: &gltf::Document,
+        element: &str,
+    ) -> Result<Transmission, SceneError> {
+        let Some(value) = m.extension_value("KHR_materials_transmission") else {
+            return Ok(Transmission::default());
+        };
+        let reason = |r: String| format!("KHR_materials_transmission: {r}");
+        let mut t: Transmission = serde_json::from_value(value.clone())
+            .map_err(|e| self.bad(element, reason(e.to_string())))?;
+        let factor = t.transmission_factor;
+        if !(0.0..=1.0).contains(&factor) {
+            let why = format!("transmissionFactor {factor} is not in [0, 1]");
+            return Err(self.bad(element, reason(why)));
+        }
+        if let Some(info) = t.transmission_texture {
+            let Some(texture) = document.textures().nth(info.index) else {
+                let why = format!("transmissionTexture: texture {} does not exist", info.index);
+                return Err(self.bad(element, reason(why)));
+            };
+            t.texture = Some(self.texture_of(
+                &texture,
+                info.tex_coord,
+                info.transform,
+                ColorSpace::Linear,
+                element,
+            )?);
+        }
+        Ok(t)
+    }
+
+    /// KHR_materials_volume of a glTF material: `None` (thin-walled, as the extension says)
+    /// without it or with thicknessFactor 0; out-of-range values are errors, and a
+    /// thicknessTexture is a warning (the path tracer measures the distance travelled inside
+    /// instead of reading it).
+    pub(super) fn volume(
+        &mut self,
+        m: &gltf::Material,
+        element: &str,
+    ) -> Result<Option<Volume>, SceneError> {
+        let Some(value) = m.extension_value("KHR_materials_volume") else {
+            return Ok(None);
+        };
+        let reason = |r: String| format!("KHR_materials_volume: {r}");
+        let v: JsonVolume = serde_json::from_value(value.clone())
+            .map_err(|e| self.bad(element, reason(e.to_string())))?;
+        let colour = Vec3::from(v.attenuation_color);
+        if !(v.thickness_factor.is_finite() && v.thickness_factor >= 0.0) {
+            let why = format!("thicknessFactor {} is invalid", v.thickness_factor);
+            return Err(self.bad(element, reason(why)));
+        }
+        if v.attenuation_distance.is_nan() || v.attenuation_distance <= 0.0 {
+            let why = format!(
+                "attenuationDistance {} must be positive",
+                v.attenuation_distance
+            );
+            return Err(self.bad(element, reason(why)));
+        }
+        if !(colour.is_finite() && colour.min_element() >= 0.0 && colour.max_element() <= 1.0) {
+            let why = format!("attenuationColor {colour} is not in [0, 1]");
+            return Err(self.bad(element, reason(why)));
+        }
+        if v.thickness_factor == 0.0 {
+            return Ok(None);
+        }
+        if v.thickness_texture.is_some() {
+            self.warn(format!(
+                "{element}: KHR_materials_volume thicknessTexture is not used; the volume's \
+                 thickness is the distance the path travels inside the closed mesh"
+            ));
+        }
+        Ok(Some(Volume::new(
+            v.thickness_factor,
+            colour,
+            v.attenuation_distance,
+        )))
+    }
+
+    pub(super) fn streaks_extras(
+        &self,
+        m: &gltf::Material,
+        element: &str,
+    ) -> Result<Option<StreaksExtras>, SceneError> {
+        let Some(raw) = m.extras() else {
+            return Ok(None);
+        };
+        let value: serde_json::Value = serde_json::from_str(raw.get())
+            .map_err(|e| self.bad(element, format!("extras: {e}")))?;
+        let Some(streaks) = value.get("streaks") else {
+            return Ok(None);
+        };
+        let x: StreaksExtras = serde_json::from_value(streaks.clone())
+            .map_err(|e| self.bad(element, format!("extras.streaks: {e}")))?;
+        let paper_keys = [
+            ("kd", x.kd.is_some()),
+            ("ks", x.ks.is_some()),
+            ("alpha", x.alpha.is_some()),
+            ("shininess", x.shininess.is_some()),
+            ("alpha_dry", x.alpha_dry.is_some()),
+            ("ks_dry", x.ks_dry.is_some()),
+        ];
+        if x.bsdf.is_none() {
+            if let Some((key, _)) = paper_keys.iter().find(|(_, given)| *given) {
+                return Err(self.bad(
+                    element,
+                    format!(
+                        "extras.streaks: {key:?} needs \"bsdf\" (\"ggx\", \"ward\" or \"blinn_phong\"); \
+                         without it only \"road\" may be given"
+                    ),
+                ));
+            }
+        }
+        Ok(Some(x))
+    }
+
+    pub(super) fn paper(
+        &self,
+        x: StreaksExtras,
+        kd_texture: Option<TextureRef>,
+        mr_texture: Option<TextureRef>,
+        element: &str,
+    ) -> Result<Reflectance, SceneError> {
+        let bad = |reason: String| self.bad(element, format!("extras.streaks: {reason}"));
+        let colour = |c: Option<[f32; 3]>, key: &str| {
+            let v = Vec3::from(c.unwrap_or([0.0; 3]));
+            if v.is_finite() && v.min_element() >= 0.0 {
+                Ok(v)
+            } else {
+                Err(bad(format!("{key} {v} must be finite and non-negative")))
+            }
+        };
+        let kd = colour(x.kd, "kd")?;
+        let ks = colour(x.ks, "ks")?;
+        let ks_dry = colour(x.ks_dry.or(x.ks), "ks_dry")?;
+        let Some(bsdf) = x.bsdf else {
+            return Err(bad("no \"bsdf\"".into()));
+        };
+        let model = match bsdf {
+            StreaksBsdf::Ggx => PaperModel::Ggx,
+            StreaksBsdf::Ward => PaperModel::Ward,
+            StreaksBsdf::BlinnPhong => PaperModel::BlinnPhong,
+        };
+        let (alpha, shininess) = match model {
+            PaperModel::Ggx | PaperModel::Ward => match x.alpha {
+                Some(a) if a.is_finite() && a > 0.0 => (a, 0.0),
+                Some(a) => return Err(bad(format!("alpha {a} must be positive"))),
+                None => return Err(bad(format!("{model:?} needs \"alpha\""))),
+            },
+            PaperModel::BlinnPhong => match x.shininess {
+                Some(s) if s.is_finite() && s >= 0.0 => (0.0, s),
+                Some(s) => return Err(bad(format!("shininess {s} must be non-negative"))),
+                None => return Err(bad("blinn_phong needs \"shininess\"".into())),
+            },
+        };
+        let wetness = match x.alpha_dry {
+            None => None,
+            Some(a)
+                if !(a.is_finite() && a >= 0.0)
+                    || (a == 0.0 && model != PaperModel::BlinnPhong) =>
+            {
+                return Err(bad(format!("alpha_dry {a} is invalid")));
+            }
+            Some(alpha_dry) => {
+                let Some(texture) = mr_texture else {
+                    return Err(bad(
+                        "alpha_dry needs a metallicRoughnessTexture (the dryness map)".into(),
+                    ));
+                };
+                Some(Wetness {
+                    texture,
+                    alpha_dry,
+                    ks_dry,
+                })
+            }
+        };
+        Ok(Reflectance::Paper {
+            model,
+            kd,
+            ks,
+            alpha,
+            shininess,
+            kd_texture,
+            wetness,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_docs::*;
+
+    use crate::bsdf::Bsdf;
+    use crate::geometry::VertexAttributes;
+    use crate::material::{GltfPbrParams, Reflectance};
+    use crate::scene::Scene;
+    use glam::{Vec2, Vec3};
+    use serde_json::json;
+
+    #[test]
+    fn road_materials_are_flagged_with_or_without_a_paper_model() {
+        let dir = tempfile::tempdir().unwrap();
+        let (doc, bin) = test_doc();
+        let scene = Scene::load(&write_embedded(dir.path(), doc, &bin)).unwrap();
+        assert!(scene.materials.iter().all(|m| !m.road));
+        let (mut doc, bin) = test_doc();
+        doc["materials"][0]["extras"]["streaks"]["road"] = json!(true);
+        // A glTF metallic-roughness material may carry the flag alone.
+        doc["materials"][1]["extras"] = json!({"streaks": {"road": true}});
+        let scene = Scene::load(&write_embedded(dir.path(), doc, &bin)).unwrap();
+        let asphalt = &scene.materials[0];
+        assert!(asphalt.road);
+        assert!(matches!(asphalt.reflectance, Reflectance::Paper { .. }));
+        assert!(scene.materials[1].road);
+        assert!(matches!(
+            scene.materials[1].reflectance,
+            Reflectance::GltfPbr(_)
+        ));
+        // Paper parameters without a model are an error that says what is missing.
+        let (mut doc, bin) = test_doc();
+        doc["materials"][1]["extras"] = json!({"streaks": {"road": true, "alpha": 0.1}});
+        let err = load_err(doc, &bin);
+        assert!(
+            err.contains("material \"glow\" (1)") && err.contains("needs \"bsdf\""),
+            "{err}"
+        );
+        let (mut doc, bin) = test_doc();
+        doc["materials"][0]["extras"]["streaks"]["road"] = json!("yes");
+        let err = load_err(doc, &bin);
+        assert!(err.contains("extras.streaks"), "{err}");
+    }
+
+    #[test]
+    fn bad_materials_and_cameras_are_named() {
+        let (mut doc, bin) = test_doc();
+        doc["materials"][0]["extras"]["streaks"]["bsdf"] = json!("phong");
+        let err = load_err(doc, &bin);
+        assert!(
+            err.contains("material \"asphalt\" (0)") && err.contains("phong"),
+            "{err}"
+        );
+        let (mut doc, bin) = test_doc();
+        doc["materials"][0]["extras"]["streaks"]["alpha"] = json!(-1);
+        let err = load_err(doc, &bin);
+        assert!(
+            err.contains("material \"asphalt\" (0)") && err.contains("alpha"),
+            "{err}"
+        );
+        let (mut doc, bin) = test_doc();
+        doc["materials"][0]["extras"]["streaks"]["alpha_dry"] = json!(0.3);
+        let err = load_err(doc, &bin);
+        assert!(err.contains("metallicRoughnessTexture"), "{err}");
+        let (mut doc, bin) = test_doc();
+        doc["cameras"][0] = json!({"name": "ortho", "type": "orthographic",
+            "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 10}});
+        let err = load_err(doc, &bin);
+        assert!(
+            err.contains("camera \"ortho\"") && err.contains("orthographic"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn wet_dry_material_reads_the_dryness_map() {
+        // A 2x1 PNG: left texel G = 0 (wet), right texel G = 255 (dry).
+        let dir = png_file("dry.png", 2, 1, vec![0, 0, 0, 255, 0, 255, 0, 255]);
+        let (mut doc, bin) = test_doc();
+        doc["images"] = json!([{"uri": "dry.png"}]);
+        doc["textures"] = json!([{"source": 0}]);
+        doc["materials"][0]["pbrMetallicRoughness"] =
+            json!({"metallicRoughnessTexture": {"index": 0}});
+        doc["materials"][0]["extras"]["streaks"]["alpha_dry"] = json!(0.45);
+        doc["materials"][0]["extras"]["streaks"]["ks_dry"] = json!([0.1, 0.1, 0.1]);
+        let scene = Scene::load(&write_embedded(dir.path(), doc.clone(), &bin)).unwrap();
+        assert_eq!(scene.textures.len(), 1);
+        let m = &scene.materials[0];
+        let crate::bsdf::Bsdf::Ggx(wet) = m.bsdf_at(
+            &VertexAttributes::from_uv(Vec2::new(0.25, 0.5)),
+            &scene.textures,
+        ) else {
+            panic!("not ggx")
+        };
+        let crate::bsdf::Bsdf::Ggx(dry) = m.bsdf_at(
+            &VertexAttributes::from_uv(Vec2::new(0.75, 0.5)),
+            &scene.textures,
+        ) else {
+            panic!("not ggx")
+        };
+        assert!((wet.alpha - 0.05).abs() < 1e-6 && (dry.alpha - 0.45).abs() < 1e-6);
+        assert!((dry.ks.x - 0.1).abs() < 1e-6);
+        // A missing image names the material, the image and the file.
+        std::fs::remove_file(dir.path().join("dry.png")).unwrap();
+        let err = Scene::load(&write_embedded(dir.path(), doc, &bin))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("material \"asphalt\" (0), image 0") && err.contains("dry.png"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn plain_material_has_the_extensions_defaults() {
+        let (doc, bin) = test_doc();
+        let dir = tempfile::tempdir().unwrap();
+        let scene = Scene::load(&write_embedded(dir.path(), doc, &bin)).unwrap();
+        let Reflectance::GltfPbr(g) = &scene.materials[1].reflectance else {
+            panic!("glow is not a glTF material")
+        };
+        let defaults = GltfPbrParams {
+            base_color: g.base_color,
+            ..GltfPbrParams::default()
+        };
+        assert_eq!(*g, defaults);
+    }
+
+    #[test]
+    fn specular_ior_and_clearcoat_are_read_with_their_textures() {
+        // One texel: R 255, G 128, B 0, A 64.
+        let dir = png_file("t.png", 1, 1, vec![255, 128, 0, 64]);
+        let (mut doc, bin) = test_doc();
+        doc["extensionsUsed"] = json!([
+            "KHR_lights_punctual",
+            "KHR_materials_emissive_strength",
+            "KHR_materials_specular",
+            "KHR_materials_ior",
+            "KHR_materials_clearcoat"
+        ]);
+        doc["images"] = json!([{"uri": "t.png"}]);
+        doc["textures"] = json!([{"source": 0}]);
+        doc["materials"][1]["extensions"]["KHR_materials_specular"] = json!({
+            "specularFactor": 0.5, "specularTexture": {"index": 0},
+            "specularColorFactor": [2, 1, 0.5], "specularColorTexture": {"index": 0}});
+        doc["materials"][1]["extensions"]["KHR_materials_ior"] = json!({"ior": 1.33});
+        doc["materials"][1]["extensions"]["KHR_materials_clearcoat"] = json!({
+            "clearcoatFactor": 0.8, "clearcoatTexture": {"index": 0},
+            "clearcoatRoughnessFactor": 0.2, "clearcoatRoughnessTexture": {"index": 0},
+            "clearcoatNormalTexture": {"index": 0}});
+        let scene = Scene::load(&write_embedded(dir.path(), doc.clone(), &bin)).unwrap();
+        // Honoured: no "uses KHR_materials_..." warning; the coat's normal map is named.
+        assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+        assert!(
+            scene.warnings[0].contains("material \"glow\" (1)")
+                && scene.warnings[0].contains("clearcoatNormalTexture is not used"),
+            "{:?}",
+            scene.warnings
+        );
+        // The image decoded twice: linear (specular, clearcoat) and sRGB (specular colour).
+        assert_eq!(scene.textures.len(), 2);
+        let Bsdf::GltfPbr(g) = scene.materials[1].bsdf_at(
+            &crate::geometry::VertexAttributes::from_uv(Vec2::ZERO),
+            &scene.textures,
+        ) else {
+            panic!("not a glTF material")
+        };
+        let close = |a: f32, b: f32| (a - b).abs() < 1e-4;
+        assert!(close(g.specular, 0.5 * 64.0 / 255.0), "{g:?}");
+        // sRGB 128/255 is linear 0.2158.
+        assert!(
+            (g.specular_color - Vec3::new(2.0, 0.2158, 0.0))
+                .abs()
+                .max_element()
+                < 1e-3,
+            "{g:?}"
+        );
+        assert_eq!(g.ior, 1.33);
+        assert!(close(g.clearcoat, 0.8), "{g:?}");
+        assert!(close(g.clearcoat_roughness, 0.2 * 128.0 / 255.0), "{g:?}");
+        // Defaults inside the extensions: an empty clear coat is no coat, an empty specular
+        // is the default strength and colour; ior 0 is allowed.
+        let mut d = doc.clone();
+        d["materials"][1]["extensions"] = json!({
+            "KHR_materials_specular": {}, "KHR_materials_clearcoat": {},
+            "KHR_materials_ior": {"ior": 0}});
+        let scene = Scene::load(&write_embedded(dir.path(), d, &bin)).unwrap();
+        let Bsdf::GltfPbr(g) = scene.materials[1].bsdf_at(
+            &crate::geometry::VertexAttributes::from_uv(Vec2::ZERO),
+            &scene.textures,
+        ) else {
+            panic!("not a glTF material")
+        };
+        assert_eq!((g.specular, g.specular_color, g.ior), (1.0, Vec3::ONE, 0.0));
+        assert_eq!((g.clearcoat, g.clearcoat_roughness), (0.0, 0.0));
+        // Out of range: errors naming the material and the extension.
+        for (ext, value, what) in [
+            ("KHR_materials_ior", json!({"ior": 0.5}), "ior 0.5"),
+            (
+                "KHR_materials_clearcoat",
+                json!({"clearcoatFactor": 2}),
+                "clearcoatFactor 2",
+            ),
+            (
+                "KHR_materials_clearcoat",
+                json!({"clearcoatTexture": {"index": 7}}),
+                "texture 7",
+            ),
+            (
+                "KHR_materials_specular",
+                json!({"specularColorFactor": [1, -1, 1]}),
+                "specularColorFactor",
+            ),
+        ] {
+            let mut d = doc.clone();
+            d["materials"][1]["extensions"] = json!({ ext: value });
+            let err = Scene::load(&write_embedded(dir.path(), d, &bin))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                err.contains("material \"glow\" (1)") && err.contains(what),
+                "{ext}: {err}"
+            );
+        }
+    }
+
+    #[test]
+    fn transmission_and_volume_are_read() {
+        // One texel: R 128 (transmission x 0.502), linear.
+        let dir = png_file("t.png", 1, 1, vec![128, 0, 0, 255]);
+        let (mut doc, bin) = test_doc();
+        doc["extensionsUsed"] = json!([
+            "KHR_lights_punctual",
+            "KHR_materials_emissive_strength",
+            "KHR_materials_transmission",
+            "KHR_materials_volume"
+        ]);
+        doc["images"] = json!([{"uri": "t.png"}]);
+        doc["textures"] = json!([{"source": 0}]);
+        doc["materials"][1]["extensions"] = json!({
+            "KHR_materials_transmission": {
+                "transmissionFactor": 0.8, "transmissionTexture": {"index": 0}}});
+        let at = crate::geometry::VertexAttributes::from_uv(Vec2::ZERO);
+        // Thin-walled without KHR_materials_volume; no warning.
+        let scene = Scene::load(&write_embedded(dir.path(), doc.clone(), &bin)).unwrap();
+        assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+        let Bsdf::GltfPbr(g) = scene.materials[1].bsdf_at(&at, &scene.textures) else {
+            panic!("not a glTF material")
+        };
+        assert!((g.transmission - 0.8 * 128.0 / 255.0).abs() < 1e-4, "{g:?}");
+        assert!(g.thin_walled && scene.materials[1].volume().is_none());
+        // A volume: attenuation colour and distance give sigma_a; thicknessTexture warns.
+        let mut d = doc.clone();
+        d["materials"][1]["extensions"]["KHR_materials_volume"] = json!({
+            "thicknessFactor": 0.02, "thicknessTexture": {"index": 0},
+            "attenuationDistance": 0.5, "attenuationColor": [0.5, 1.0, 0.25]});
+        let scene = Scene::load(&write_embedded(dir.path(), d, &bin)).unwrap();
+        assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+        assert!(
+            scene.warnings[0].contains("material \"glow\" (1)")
+                && scene.warnings[0].contains("thicknessTexture is not used"),
+            "{:?}",
+            scene.warnings
+        );
+        let v = scene.materials[1].volume().expect("a volume");
+        let want = Vec3::new(0.5f32.ln(), 0.0, 0.25f32.ln()) / -0.5;
+        assert!((v.sigma_a - want).abs().max_element() < 1e-5, "{v:?}");
+        assert!(
+            (v.transmittance(0.5) - Vec3::new(0.5, 1.0, 0.25))
+                .abs()
+                .max_element()
+                < 1e-5
+        );
+        let Bsdf::GltfPbr(g) = scene.materials[1].bsdf_at(&at, &scene.textures) else {
+            panic!("not a glTF material")
+        };
+        assert!(!g.thin_walled);
+        // Thickness 0 is thin-walled, as the extension says; no attenuation by default.
+        let mut d = doc.clone();
+        d["materials"][1]["extensions"]["KHR_materials_volume"] = json!({});
+        let scene = Scene::load(&write_embedded(dir.path(), d, &bin)).unwrap();
+        assert!(scene.materials[1].volume().is_none() && scene.warnings.is_empty());
+        let mut d = doc.clone();
+        d["materials"][1]["extensions"]["KHR_materials_volume"] = json!({"thicknessFactor": 1});
+        let scene = Scene::load(&write_embedded(dir.path(), d, &bin)).unwrap();
+        assert_eq!(scene.materials[1].volume().unwrap().sigma_a, Vec3::ZERO);
+        // Out of range: errors naming the material and the value.
+        for (ext, value, what) in [
+            (
+                "KHR_materials_transmission",
+                json!({"transmissionFactor": 1.5}),
+                "transmissionFactor 1.5",
+            ),
+            (
+                "KHR_materials_transmission",
+                json!({"transmissionTexture": {"index": 9}}),
+                "texture 9",
+            ),
+            (
+                "KHR_materials_volume",
+                json!({"thicknessFactor": -1}),
+                "thicknessFactor -1",
+            ),
+            (
+                "KHR_materials_volume",
+                json!({"thicknessFactor": 1, "attenuationDistance": 0}),
+                "attenuationDistance 0",
+            ),
+            (
+                "KHR_materials_volume",
+                json!({"attenuationColor": [2, 0, 0]}),
+                "attenuationColor",
+            ),
+        ] {
+            let mut d = doc.clone();
+            d["materials"][1]["extensions"] = json!({ ext: value });
+            let err = Scene::load(&write_embedded(dir.path(), d, &bin))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                err.contains("material \"glow\" (1)") && err.contains(what),
+                "{ext}: {err}"
+            );
+        }
+    }
+
+    #[test]
+    fn materials_outside_the_specification_are_named() {
+        let asphalt = &["material \"asphalt\" (0)"][..];
+        let glow = &["material \"glow\" (1)"][..];
+        rejects(&[
+            (
+                "/materials/0/pbrMetallicRoughness",
+                json!({"baseColorFactor": [-0.5, 0.5, 0.5, 1]}),
+                &["material \"asphalt\" (0)", "baseColorFactor"],
+            ),
+            (
+                "/materials/0/pbrMetallicRoughness",
+                json!({"baseColorFactor": [1e39, 0.5, 0.5, 1]}),
+                asphalt,
+            ),
+            (
+                "/materials/0/pbrMetallicRoughness",
+                json!({"metallicFactor": 1.5}),
+                asphalt,
+            ),
+            (
+                "/materials/0/pbrMetallicRoughness",
+                json!({"roughnessFactor": -0.1}),
+                asphalt,
+            ),
+            ("/materials/0/alphaCutoff", json!(-1), asphalt),
+            ("/materials/1/emissiveFactor", json!([-1, 0, 0]), glow),
+            ("/materials/1/emissiveFactor", json!([2, 0, 0]), glow),
+            ("/materials/1/emissiveFactor", json!([1e39, 0, 0]), glow),
+            (
+                "/materials/1/extensions/KHR_materials_emissive_strength/emissiveStrength",
+                json!(-5),
+                &["material \"glow\" (1)", "emissiveStrength"],
+            ),
+            (
+                "/materials/1/extensions/KHR_materials_emissive_strength/emissiveStrength",
+                json!(1e39),
+                glow,
+            ),
+            ("/materials/0/extras/streaks/kd", json!([-1, 0, 0]), asphalt),
+            (
+                "/materials/0/extras/streaks/ks",
+                json!([1e39, 0, 0]),
+                asphalt,
+            ),
+            ("/materials/0/extras/streaks/alpha", json!(1e39), asphalt),
+        ]);
+        // A negative strength is an error even where the factor is black.
+        let (mut doc, bin) = test_doc();
+        doc["materials"][1]["emissiveFactor"] = json!([0, 0, 0]);
+        doc["materials"][1]["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"] =
+            json!(-1);
+        let err = error(doc, &bin);
+        assert!(err.contains("material \"glow\" (1)"), "{err}");
+    }
+}

@@ -1,0 +1,122 @@
+//! The glTF 2.0 loader (`.gltf` with external or base64-embedded buffers, and `.glb`).
+//!
+//! Every accessor is checked (type, bounds within its buffer view and buffer) before it is
+//! read, so malformed files give a [`SceneError`] naming the element instead of a panic.
+//! Vertex attributes are read by the `accessor` module (every component type of the core
+//! specification and of KHR_mesh_quantization, sparse accessors); meshopt- and
+//! Draco-compressed geometry is decoded first by the `compression` module. Sparse index
+//! accessors are not supported (an error names them).
+//!
+//! Instancing: the scene's nodes are walked first and every placement of a mesh recorded (a
+//! node with a mesh, or each instance of a node's EXT_mesh_gpu_instancing, whose TRANSLATION,
+//! ROTATION and SCALE attributes give `node world * T * R * S`). A mesh placed more than once
+//! and without an emissive material is loaded once in object space (its MikkTSpace tangents,
+//! if generated, from the object-space positions) and becomes instances
+//! ([`super::Instances`]); every other placement is flattened into world triangles, in the
+//! order of the walk.
+//!
+//! One file per concept:
+//!
+//! - `document`: the entry, [`load`]: the GLB header, the references the gltf crate follows
+//!   unchecked, then the steps in order (buffers, compressed geometry, materials, the node
+//!   walk, the meshes' placements);
+//! - `buffers`: buffers and bufferViews, and reading accessors (layouts, bounds, the decoded
+//!   bytes charged against [`super::LoadOptions`]); the accessor formats themselves are
+//!   `scene/accessor.rs`, meshopt and Draco decoding `scene/compression.rs`;
+//! - `nodes`: the node walk, cameras, the limits [`MAX_PLACEMENTS`] and [`MAX_TRIANGLES`],
+//!   and the placement of meshes as world triangles or instances;
+//! - `meshes`: primitives, their attributes in world space, triangulation, tangents;
+//! - `materials`: materials and their KHR_materials_* extensions, `extras.streaks`;
+//! - `textures`: texture infos, KHR_texture_transform, samplers, images;
+//! - [`extensions`]: which extensions are honoured, and the ones that are not a material's
+//!   field: KHR_lights_punctual (and the file's light units), EXT_mesh_gpu_instancing;
+//! - this file: the [`Loader`] state the others add to, and the labels errors name elements by.
+
+mod buffers;
+mod document;
+pub mod extensions;
+mod materials;
+mod meshes;
+mod nodes;
+#[cfg(test)]
+mod test_docs;
+mod textures;
+
+pub(super) use document::load;
+pub use nodes::{MAX_PLACEMENTS, MAX_TRIANGLES};
+
+use super::files::{Files, Uri};
+use super::{
+    accessor, compression, tangents, validate, Instance, MeshParts, Scene, SceneError, SceneParts,
+};
+use crate::camera::Camera;
+use crate::light::{Light, LUMINOUS_EFFICACY};
+use crate::material::{
+    Alpha, AlphaMode, GltfPbrParams, Material, PaperModel, Reflectance, Volume, Wetness,
+};
+use crate::normal_map::NormalMap;
+use crate::texture::{
+    uv_transform, ColorSpace, Filter, Sampler, Texture, TextureId, TextureRef, Wrap,
+};
+use buffers::*;
+use extensions::*;
+use glam::{Affine2, Affine3A, Mat3, Mat4, Quat, Vec2, Vec3, Vec4};
+use gltf::accessor::{DataType, Dimensions};
+use gltf::mesh::Mode;
+use nodes::*;
+use serde::Deserialize;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use textures::*;
+
+fn node_label(node: &gltf::Node) -> String {
+    match node.name() {
+        Some(n) => format!("node {n:?} ({})", node.index()),
+        None => format!("node {}", node.index()),
+    }
+}
+
+fn mesh_label(mesh: &gltf::Mesh) -> String {
+    match mesh.name() {
+        Some(n) => format!("mesh {n:?} ({})", mesh.index()),
+        None => format!("mesh {}", mesh.index()),
+    }
+}
+
+/// Describes where a URI points, for messages.
+fn uri_label(base: &Path, uri: &str) -> String {
+    if uri.starts_with("data:") {
+        "embedded data URI".into()
+    } else {
+        format!("{uri:?} -> {}", base.join(uri).display())
+    }
+}
+
+struct Loader<'a> {
+    path: &'a Path,
+    base: PathBuf,
+    /// Reads the files the scene names (images), inside its folder.
+    files: &'a Files<'a>,
+    buffers: Vec<gltf::buffer::Data>,
+    parts: SceneParts,
+    /// Decoded textures by (image index, colour space).
+    textures: HashMap<(usize, ColorSpace), TextureId>,
+    /// Index of the glTF default material, once a primitive needs it.
+    default_material: Option<u32>,
+    /// What KHR_lights_punctual's intensities are in.
+    light_units: LightUnits,
+    /// Every placement of a mesh in the walk's order: mesh index and world transform.
+    placements: Vec<(usize, Mat4)>,
+}
+
+impl Loader<'_> {
+    fn bad(&self, element: impl Into<String>, reason: impl Into<String>) -> SceneError {
+        SceneError::invalid(self.path, element, reason)
+    }
+
+    fn warn(&mut self, msg: String) {
+        self.parts
+            .warnings
+            .push(format!("{}: {msg}", self.path.display()));
+    }
+}

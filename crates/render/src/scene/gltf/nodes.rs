@@ -1,0 +1,498 @@
+//! The node walk and what it places: node transforms, cameras, the limits on placements and
+//! triangles, and each mesh flattened into world triangles or stored once as instances.
+
+use super::*;
+
+/// The most node visits (a node reached by several paths of the hierarchy is visited once per
+/// path) and, separately, mesh placements (node meshes and EXT_mesh_gpu_instancing instances)
+/// a scene may have: a hierarchy in which each node lists the next one twice reaches 2^40
+/// placements in 40 levels, so the walk counts them before it makes them.
+pub const MAX_PLACEMENTS: usize = 1_000_000;
+
+/// The most triangles a scene may hold once its meshes are placed: the flattened placements'
+/// (every placement of a mesh placed once, or with an emissive material) and the instanced
+/// meshes' (stored once); counted from the accessors before any geometry is read. About
+/// 8 GB of scene and BVH; an emissive mesh placed many times would otherwise multiply it.
+pub const MAX_TRIANGLES: usize = 20_000_000;
+
+/// The error for a hierarchy that places more than [`MAX_PLACEMENTS`] nodes or instances,
+/// found at `node`.
+pub(super) fn too_many_placements(path: &Path, node: &gltf::Node) -> SceneError {
+    SceneError::invalid(
+        path,
+        node_label(node),
+        format!(
+            "the node hierarchy places more than {MAX_PLACEMENTS} nodes or mesh instances \
+             (a node reached by several paths is placed once per path)"
+        ),
+    )
+}
+
+/// The number of node visits the walk of `scene` makes (each node once per path from a root
+/// to it), counted without walking: a node's count is one plus its children's, each node
+/// computed once (depth-first, without recursion). A cycle, or more than [`MAX_PLACEMENTS`]
+/// visits, is an error naming a node.
+pub(super) fn count_visits(
+    path: &Path,
+    document: &gltf::Document,
+    scene: &gltf::Scene,
+) -> Result<usize, SceneError> {
+    const UNSEEN: usize = usize::MAX;
+    const OPEN: usize = usize::MAX - 1;
+    let mut visits = vec![UNSEEN; document.nodes().len()];
+    let mut total = 0usize;
+    for root in scene.nodes() {
+        // (node, whether its children have been pushed)
+        let mut stack = vec![(root.clone(), false)];
+        while let Some((node, expanded)) = stack.pop() {
+            let i = node.index();
+            if expanded {
+                let sum = node
+                    .children()
+                    .fold(1usize, |s, c| s.saturating_add(visits[c.index()]));
+                if sum > MAX_PLACEMENTS {
+                    return Err(too_many_placements(path, &node));
+                }
+                visits[i] = sum;
+                continue;
+            }
+            match visits[i] {
+                UNSEEN => {}
+                OPEN => {
+                    return Err(SceneError::invalid(
+                        path,
+                        node_label(&node),
+                        "the node hierarchy has a cycle",
+                    ))
+                }
+                _ => continue,
+            }
+            visits[i] = OPEN;
+            stack.push((node.clone(), true));
+            for c in node.children() {
+                match visits[c.index()] {
+                    OPEN => {
+                        return Err(SceneError::invalid(
+                            path,
+                            node_label(&c),
+                            "the node hierarchy has a cycle",
+                        ))
+                    }
+                    UNSEEN => stack.push((c, false)),
+                    _ => {}
+                }
+            }
+        }
+        total = total.saturating_add(visits[root.index()]);
+        if total > MAX_PLACEMENTS {
+            return Err(too_many_placements(path, &root));
+        }
+    }
+    Ok(total)
+}
+
+/// The number of triangles primitive `prim` makes (from its index or POSITION count and its
+/// mode; 0 for points and lines, which are skipped).
+pub(super) fn primitive_triangles(prim: &gltf::Primitive) -> usize {
+    let n = match prim.indices() {
+        Some(a) => a.count(),
+        None => prim
+            .get(&gltf::Semantic::Positions)
+            .map_or(0, |a| a.count()),
+    };
+    match prim.mode() {
+        Mode::Triangles => n / 3,
+        Mode::TriangleStrip | Mode::TriangleFan => n.saturating_sub(2),
+        _ => 0,
+    }
+}
+
+/// Swaps the vertex arrays and triangles of `parts` with those of `mesh`.
+pub(super) fn swap_geometry(parts: &mut SceneParts, mesh: &mut MeshParts) {
+    std::mem::swap(&mut parts.positions, &mut mesh.positions);
+    std::mem::swap(&mut parts.normals, &mut mesh.normals);
+    std::mem::swap(&mut parts.uvs, &mut mesh.uvs);
+    std::mem::swap(&mut parts.tangents, &mut mesh.tangents);
+    std::mem::swap(&mut parts.uvs1, &mut mesh.uvs1);
+    std::mem::swap(&mut parts.colors, &mut mesh.colors);
+    std::mem::swap(&mut parts.triangles, &mut mesh.triangles);
+    std::mem::swap(&mut parts.triangle_materials, &mut mesh.triangle_materials);
+}
+
+impl Loader<'_> {
+    /// Adds what `node` carries (camera, light; its mesh's placements are recorded for
+    /// [`Loader::place_meshes`]); returns its world transform.
+    pub(super) fn node(
+        &mut self,
+        node: &gltf::Node,
+        parent: Mat4,
+        document: &gltf::Document,
+    ) -> Result<Mat4, SceneError> {
+        let local = match node.transform() {
+            gltf::scene::Transform::Matrix { matrix } => Mat4::from_cols_array_2d(&matrix),
+            gltf::scene::Transform::Decomposed {
+                translation,
+                rotation,
+                scale,
+            } => Mat4::from_scale_rotation_translation(
+                Vec3::from(scale),
+                // A zero quaternion becomes NaN here and fails the check below.
+                Quat::from_array(rotation).normalize(),
+                Vec3::from(translation),
+            ),
+        };
+        let world = parent * local;
+        let det = world.determinant();
+        if !world.is_finite() || !det.is_finite() || det.abs() < 1e-30 {
+            return Err(self.bad(
+                node_label(node),
+                format!("world transform is not invertible or not finite: {world:?}"),
+            ));
+        }
+        if let Some(mesh) = node.mesh() {
+            match node.extension_value("EXT_mesh_gpu_instancing") {
+                Some(ext) => {
+                    let locals = self.gpu_instances(node, ext, document)?;
+                    if self.placements.len() + locals.len() > MAX_PLACEMENTS {
+                        return Err(too_many_placements(self.path, node));
+                    }
+                    for (i, local) in locals.iter().enumerate() {
+                        let w = world * *local;
+                        if Instance::new(0, w).is_none() {
+                            return Err(self.bad(
+                                format!(
+                                    "{}, EXT_mesh_gpu_instancing instance {i}",
+                                    node_label(node)
+                                ),
+                                format!("world transform is not invertible or not finite: {w:?}"),
+                            ));
+                        }
+                        self.placements.push((mesh.index(), w));
+                    }
+                }
+                None => {
+                    if self.placements.len() >= MAX_PLACEMENTS {
+                        return Err(too_many_placements(self.path, node));
+                    }
+                    self.placements.push((mesh.index(), world));
+                }
+            }
+        }
+        if let Some(camera) = node.camera() {
+            self.camera(node, &camera, world)?;
+        }
+        if let Some(light) = node.light() {
+            self.light(node, &light, world)?;
+        }
+        Ok(world)
+    }
+
+    /// Turns the recorded placements into geometry: a mesh placed more than once and without
+    /// an emissive material is loaded once in object space and placed by instances, every
+    /// other placement is flattened into world triangles (see the module documentation).
+    pub(super) fn place_meshes(&mut self, document: &gltf::Document) -> Result<(), SceneError> {
+        let meshes: Vec<gltf::Mesh> = document.meshes().collect();
+        let mut count = vec![0usize; meshes.len()];
+        for &(m, _) in &self.placements {
+            count[m] += 1;
+        }
+        let emissive: Vec<bool> = meshes
+            .iter()
+            .map(|mesh| {
+                mesh.primitives().any(|p| {
+                    p.material()
+                        .index()
+                        .is_some_and(|i| self.parts.materials[i].is_emissive())
+                })
+            })
+            .collect();
+        // Triangles stored: a flattened mesh's at each placement, an instanced one's once.
+        let mut stored = 0usize;
+        for (m, mesh) in meshes.iter().enumerate() {
+            let copies = match (count[m], emissive[m]) {
+                (0, _) => 0,
+                (n, true) | (n @ 1, false) => n,
+                (_, false) => 1,
+            };
+            let triangles: usize = mesh.primitives().map(|p| primitive_triangles(&p)).sum();
+            stored = stored.saturating_add(triangles.saturating_mul(copies));
+            if stored > MAX_TRIANGLES {
+                return Err(self.bad(
+                    mesh_label(mesh),
+                    format!(
+                        "the scene would hold more than {MAX_TRIANGLES} triangles once its \
+                         meshes are placed (this mesh: {triangles} triangles, stored {copies} \
+                         times)"
+                    ),
+                ));
+            }
+        }
+        let mut instanced: Vec<Option<u32>> = vec![None; meshes.len()];
+        for (m, world) in std::mem::take(&mut self.placements) {
+            let mesh = &meshes[m];
+            if count[m] < 2 || emissive[m] {
+                self.mesh(mesh, world)?;
+                continue;
+            }
+            let index = match instanced[m] {
+                Some(i) => i,
+                None => {
+                    let object = self.object_mesh(mesh)?;
+                    let i = self.parts.instanced_meshes.len() as u32;
+                    self.parts.instanced_meshes.push(object);
+                    instanced[m] = Some(i);
+                    i
+                }
+            };
+            // The walk checked that the transform is invertible.
+            if let Some(instance) = Instance::new(index, world) {
+                self.parts.instances.push(instance);
+            }
+        }
+        Ok(())
+    }
+
+    /// `mesh` loaded in its own (object) space, as [`Loader::mesh`] loads it with the identity
+    /// transform, into its own arrays.
+    pub(super) fn object_mesh(&mut self, mesh: &gltf::Mesh) -> Result<MeshParts, SceneError> {
+        let mut world = MeshParts::default();
+        swap_geometry(&mut self.parts, &mut world);
+        let loaded = self.mesh(mesh, Mat4::IDENTITY);
+        let mut object = MeshParts::default();
+        swap_geometry(&mut self.parts, &mut object);
+        swap_geometry(&mut self.parts, &mut world);
+        loaded?;
+        if !object.tangents.is_empty() {
+            object.tangents.resize(object.positions.len(), Vec4::ZERO);
+        }
+        object.name = mesh_label(mesh);
+        Ok(object)
+    }
+
+    pub(super) fn camera(
+        &mut self,
+        node: &gltf::Node,
+        camera: &gltf::Camera,
+        world: Mat4,
+    ) -> Result<(), SceneError> {
+        let name = camera
+            .name()
+            .or(node.name())
+            .map_or_else(|| format!("camera{}", camera.index()), str::to_string);
+        let element = format!(
+            "camera {name:?} ({}) on {}",
+            camera.index(),
+            node_label(node)
+        );
+        let gltf::camera::Projection::Perspective(p) = camera.projection() else {
+            return Err(self.bad(element, "orthographic cameras are not supported"));
+        };
+        validate::perspective(&p).map_err(|r| self.bad(&element, r))?;
+        let yfov = p.yfov();
+        let (_, rotation, translation) = world.to_scale_rotation_translation();
+        self.parts.cameras.push(Camera {
+            name,
+            world_from_camera: Affine3A::from_rotation_translation(
+                rotation.normalize(),
+                translation,
+            ),
+            yfov,
+            aspect_ratio: p.aspect_ratio(),
+        });
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_docs::*;
+
+    use crate::scene::Scene;
+    use glam::Vec3;
+    use serde_json::{json, Value};
+
+    #[test]
+    fn bad_transforms_name_the_node() {
+        let (mut doc, bin) = test_doc();
+        // JSON has no NaN: a value beyond f32 range becomes infinite.
+        doc["nodes"][1]["matrix"][0] = json!(1e39);
+        let err = load_err(doc, &bin);
+        assert!(
+            err.contains("node \"child\" (1)") && err.contains("not invertible"),
+            "{err}"
+        );
+        let (mut doc, bin) = test_doc();
+        doc["nodes"][0]["scale"] = json!([1, 0, 1]);
+        let err = load_err(doc, &bin);
+        assert!(err.contains("node \"parent\" (0)"), "{err}");
+    }
+
+    #[test]
+    fn scene_zero_is_used_without_a_default_and_cycles_are_errors() {
+        let dir = tempfile::tempdir().unwrap();
+        let (mut doc, bin) = test_doc();
+        doc.as_object_mut().unwrap().remove("scene");
+        check_test_scene(&Scene::load(&write_embedded(dir.path(), doc, &bin)).unwrap());
+        let (mut doc, bin) = test_doc();
+        doc["nodes"][1]["children"] = json!([0]);
+        let err = load_err(doc, &bin);
+        assert!(
+            err.contains("node \"parent\" (0)") && err.contains("cycle"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn mirrored_nodes_keep_the_front_face() {
+        let dir = tempfile::tempdir().unwrap();
+        let (mut doc, bin) = test_doc();
+        doc["nodes"][2]["scale"] = json!([-1, 1, 1]);
+        let scene = Scene::load(&write_embedded(dir.path(), doc, &bin)).unwrap();
+        let hit = scene
+            .intersect(&crate::geometry::Ray::new(
+                Vec3::new(-0.2, 0.2, 1.0),
+                -Vec3::Z,
+            ))
+            .unwrap();
+        assert!(approx(hit.ng, Vec3::Z), "{}", hit.ng);
+    }
+
+    /// One mesh referenced by many nodes (rotations, non-uniform and mirroring scales, a
+    /// parent) is stored once and placed by instances, and every ray hits it as it hits the
+    /// same scene with the triangles copied per node: same hits, normals (normal-mapped),
+    /// uvs, vertex colours and alpha-masked holes.
+    #[test]
+    fn nodes_sharing_a_mesh_are_instances_that_hit_like_copies() {
+        use crate::geometry::Ray;
+        let placements = box_placements();
+        let (doc, bin) = placed_boxes(&placements, true);
+        let instanced = load_doc(doc, &bin);
+        let (doc, bin) = placed_boxes(&placements, false);
+        let flat = load_doc(doc, &bin);
+        assert!(flat.instances.is_empty());
+        assert_eq!(flat.triangles.len(), placements.len() * 14);
+        assert!(instanced.triangles.is_empty() && instanced.positions.is_empty());
+        assert_eq!(instanced.instances.meshes.len(), 1);
+        assert_eq!(instanced.instances.instances.len(), placements.len());
+        assert_eq!(instanced.instances.stored_triangle_count(), 14);
+        assert_eq!(instanced.world_triangle_count(), flat.triangles.len());
+        assert!(
+            instanced
+                .instances
+                .instances
+                .iter()
+                .filter(|i| i.mirrored)
+                .count()
+                == 2
+        );
+        let (ca, ra) = instanced.bounding_sphere();
+        let (cb, rb) = flat.bounding_sphere();
+        assert!((ca - cb).length() < 1e-5 && (ra - rb).abs() < 1e-5);
+        assert!((instanced.accel.t_min() - flat.accel.t_min()).abs() < 1e-9);
+        let hits = assert_same_hits(&instanced, &flat, 6000);
+        assert!(hits > 1000, "{hits} hits");
+        // The mask cuts holes in the instances too: some rays through a fence quad's
+        // transparent half reach a box behind it or miss.
+        let fence = instanced
+            .materials
+            .iter()
+            .position(|m| m.name == "fence")
+            .unwrap() as u32;
+        let mut rng = crate::sampling::Pcg32::new(9, 1);
+        let fence_hits = (0..2000)
+            .filter(|_| {
+                let o = Vec3::new(rng.next_f32() - 0.5, rng.next_f32() - 0.5, 5.0);
+                let r = Ray::new(o, -Vec3::Z);
+                let inst = &instanced.instances.instances[0];
+                let world = Ray::new(
+                    inst.world_from_object.transform_point3(r.origin),
+                    inst.world_from_object
+                        .transform_vector3(r.direction)
+                        .normalize(),
+                );
+                instanced
+                    .intersect(&world)
+                    .is_some_and(|h| h.material == fence)
+            })
+            .count();
+        assert!((700..1300).contains(&fence_hits), "{fence_hits}");
+    }
+
+    /// The triangles stored for a mesh do not grow with the number of nodes placing it.
+    #[test]
+    fn instanced_triangle_storage_does_not_grow_with_the_instances() {
+        let storage = |n: usize| {
+            let locals: Vec<Value> = (0..n)
+                .map(|i| json!({"translation": [i as f32 * 1.5, 0, 0]}))
+                .collect();
+            let (doc, bin) = placed_boxes(&locals, true);
+            let s = load_doc(doc, &bin);
+            assert_eq!(s.world_triangle_count(), 14 * n);
+            let m = &s.instances.meshes[0];
+            (
+                s.triangles.len(),
+                m.parts.triangles.len(),
+                m.parts.positions.len(),
+                m.accel.memory_bytes(),
+            )
+        };
+        assert_eq!(storage(2), storage(300));
+        assert_eq!(storage(2).0, 0);
+    }
+
+    #[test]
+    fn cameras_outside_the_specification_are_named() {
+        let named = &["camera \"cam_node\" (0) on node \"cam_node\" (3)"][..];
+        let p = "/cameras/0/perspective";
+        rejects(&[
+            (&format!("{p}/yfov"), json!(4), named),
+            (&format!("{p}/yfov"), json!(0), named),
+            (&format!("{p}/znear"), json!(0), named),
+            (&format!("{p}/znear"), json!(-1), named),
+            (&format!("{p}/znear"), json!(1e39), named),
+            (&format!("{p}/aspectRatio"), json!(0), named),
+            (&format!("{p}/aspectRatio"), json!(1e39), named),
+        ]);
+        let (mut doc, bin) = test_doc();
+        doc["cameras"][0]["perspective"]["zfar"] = json!(0.05);
+        let err = error(doc, &bin);
+        assert!(err.contains("zfar 0.05"), "{err}");
+    }
+
+    #[test]
+    fn exponential_node_graphs_are_refused_before_they_are_walked() {
+        let (mut doc, bin) = test_doc();
+        doubling_dag(&mut doc, 40, 1);
+        let err = error(doc, &bin);
+        assert!(err.contains("more than 1000000"), "{err}");
+        // 2^18 placements of an emissive (so flattened) strip of 100 triangles: 26 million.
+        let (mut doc, mut bin) = test_doc();
+        let at = bin.len();
+        let strip: Vec<u8> = (0..102)
+            .flat_map(|i| [i as f32 * 0.1, (i % 2) as f32, 0.0])
+            .flat_map(f32::to_le_bytes)
+            .collect();
+        bin.extend(&strip);
+        let views = doc["bufferViews"].as_array_mut().unwrap();
+        views.push(json!({"buffer": 0, "byteOffset": at, "byteLength": strip.len()}));
+        let view = views.len() - 1;
+        let accessors = doc["accessors"].as_array_mut().unwrap();
+        accessors.push(
+            json!({"bufferView": view, "componentType": 5126, "count": 102,
+            "type": "VEC3", "min": [0, 0, 0], "max": [10.1, 1, 0]}),
+        );
+        let accessor = accessors.len() - 1;
+        doc["buffers"][0]["byteLength"] = json!(bin.len());
+        doc["meshes"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!({"name": "strip", "primitives":
+            [{"attributes": {"POSITION": accessor}, "mode": 5, "material": 1}]}));
+        doubling_dag(&mut doc, 18, 2);
+        let err = error(doc, &bin);
+        assert!(
+            err.contains("mesh \"strip\" (2)") && err.contains("more than 20000000 triangles"),
+            "{err}"
+        );
+    }
+}

@@ -1,0 +1,454 @@
+//! Textures: texture infos (with KHR_texture_transform, read by the gltf crate or from the
+//! JSON), samplers, and images decoded once per colour space.
+
+use super::*;
+
+/// A textureInfo read from the JSON: the texture's index and its texCoord set.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub(super) struct JsonTextureInfo {
+    pub(super) index: usize,
+    #[serde(default)]
+    pub(super) tex_coord: u32,
+    /// Its KHR_texture_transform, read from its `extensions`.
+    #[serde(
+        default,
+        rename = "extensions",
+        deserialize_with = "transform_in_extensions"
+    )]
+    pub(super) transform: Option<UvTransform>,
+}
+
+/// The KHR_texture_transform of a texture info's `extensions` object, if it has one.
+pub(super) fn transform_in_extensions<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> Result<Option<UvTransform>, D::Error> {
+    let extensions = serde_json::Map::<String, serde_json::Value>::deserialize(d)?;
+    extensions
+        .get("KHR_texture_transform")
+        .map(UvTransform::from_json)
+        .transpose()
+        .map_err(serde::de::Error::custom)
+}
+
+/// A texture info's KHR_texture_transform, from the gltf crate's accessor or, for the texture
+/// infos it has none for (normalTexture), from the extension's JSON.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct UvTransform {
+    offset: [f32; 2],
+    rotation: f32,
+    scale: [f32; 2],
+    tex_coord: Option<u32>,
+}
+
+impl From<gltf::texture::TextureTransform<'_>> for UvTransform {
+    fn from(t: gltf::texture::TextureTransform<'_>) -> Self {
+        Self {
+            offset: t.offset(),
+            rotation: t.rotation(),
+            scale: t.scale(),
+            tex_coord: t.tex_coord(),
+        }
+    }
+}
+
+impl UvTransform {
+    /// The transform in an `"extensions": {"KHR_texture_transform": ...}` value.
+    pub(super) fn from_json(value: &serde_json::Value) -> Result<Self, String> {
+        let t: gltf::json::extensions::texture::TextureTransform =
+            serde_json::from_value(value.clone())
+                .map_err(|e| format!("KHR_texture_transform: {e}"))?;
+        Ok(Self {
+            offset: t.offset.0,
+            rotation: t.rotation.0,
+            scale: t.scale.0,
+            tex_coord: t.tex_coord,
+        })
+    }
+}
+
+/// What of a glTF sampler the renderer honours: the wrap modes and the magnification filter
+/// (see [`crate::texture`] for why `minFilter` does not change the converged image).
+pub(super) fn sampler(s: &gltf::texture::Sampler) -> Sampler {
+    use gltf::texture::{MagFilter, WrappingMode};
+    let wrap = |w| match w {
+        WrappingMode::Repeat => Wrap::Repeat,
+        WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+        WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+    };
+    Sampler {
+        wrap_s: wrap(s.wrap_s()),
+        wrap_t: wrap(s.wrap_t()),
+        filter: match s.mag_filter() {
+            Some(MagFilter::Nearest) => Filter::Nearest,
+            Some(MagFilter::Linear) | None => Filter::Linear,
+        },
+    }
+}
+
+/// Converts a decoded image to a linear RGBA texture: 8-bit images stay bytes (RGBA8), others
+/// become floats (16-bit values over 65535); grey (and grey-alpha) images replicate their
+/// value, as image viewers do.
+pub(super) fn decode_image(image: image::DynamicImage, space: ColorSpace) -> Option<Texture> {
+    use image::DynamicImage as D;
+    let (width, height) = (image.width(), image.height());
+    let rgba8 = |bytes: &[u8], channels: usize| -> Vec<u8> {
+        bytes
+            .chunks_exact(channels)
+            .flat_map(|c| match channels {
+                1 => [c[0], c[0], c[0], 255],
+                2 => [c[0], c[0], c[0], c[1]],
+                3 => [c[0], c[1], c[2], 255],
+                _ => [c[0], c[1], c[2], c[3]],
+            })
+            .collect()
+    };
+    let u16s = |v: &[u16]| {
+        v.iter()
+            .map(|&x| f32::from(x) / 65535.0)
+            .collect::<Vec<_>>()
+    };
+    let (values, channels): (Vec<f32>, usize) = match image {
+        D::ImageLuma8(i) => return Texture::from_rgba8(width, height, &rgba8(&i, 1), space),
+        D::ImageLumaA8(i) => return Texture::from_rgba8(width, height, &rgba8(&i, 2), space),
+        D::ImageRgb8(i) => return Texture::from_rgba8(width, height, &rgba8(&i, 3), space),
+        D::ImageRgba8(i) => return Texture::from_rgba8(width, height, &i, space),
+        D::ImageLuma16(i) => (u16s(&i), 1),
+        D::ImageLumaA16(i) => (u16s(&i), 2),
+        D::ImageRgb16(i) => (u16s(&i), 3),
+        D::ImageRgba16(i) => (u16s(&i), 4),
+        D::ImageRgb32F(i) => (i.into_raw(), 3),
+        D::ImageRgba32F(i) => (i.into_raw(), 4),
+        other => (other.to_rgba32f().into_raw(), 4),
+    };
+    let texels = values
+        .chunks_exact(channels)
+        .map(|c| match channels {
+            1 => Vec4::new(c[0], c[0], c[0], 1.0),
+            2 => Vec4::new(c[0], c[0], c[0], c[1]),
+            3 => Vec4::new(c[0], c[1], c[2], 1.0),
+            _ => Vec4::new(c[0], c[1], c[2], c[3]),
+        })
+        .collect();
+    Texture::from_rgba(width, height, texels, space)
+}
+
+impl Loader<'_> {
+    /// The reference a material's texture info makes: its image (decoded once per colour
+    /// space), texture coordinate set, sampler and KHR_texture_transform.
+    pub(super) fn texture(
+        &mut self,
+        info: &gltf::texture::Info,
+        space: ColorSpace,
+        material: &str,
+    ) -> Result<TextureRef, SceneError> {
+        let transform = info.texture_transform().map(UvTransform::from);
+        self.texture_of(
+            &info.texture(),
+            info.tex_coord(),
+            transform,
+            space,
+            material,
+        )
+    }
+
+    /// The reference to `texture` read at TEXCOORD_`tex_coord` through its KHR_texture_transform
+    /// `transform`: its image (decoded once per colour space), texture coordinate set, sampler
+    /// and transform.
+    pub(super) fn texture_of(
+        &mut self,
+        texture: &gltf::Texture,
+        tex_coord: u32,
+        transform: Option<UvTransform>,
+        space: ColorSpace,
+        material: &str,
+    ) -> Result<TextureRef, SceneError> {
+        let element = format!("{material}, texture {}", texture.index());
+        // KHR_texture_transform's texCoord overrides the texture info's.
+        let set = transform
+            .as_ref()
+            .and_then(|t| t.tex_coord)
+            .unwrap_or(tex_coord);
+        let texcoord = match set {
+            0 | 1 => set as u8,
+            _ => {
+                self.warn(format!(
+                    "{element} uses TEXCOORD_{set}; only TEXCOORD_0 and TEXCOORD_1 are read, \
+                     TEXCOORD_0 is used instead"
+                ));
+                0
+            }
+        };
+        let transform = match transform {
+            None => None,
+            Some(t) => {
+                let (offset, rotation, scale) =
+                    (Vec2::from(t.offset), t.rotation, Vec2::from(t.scale));
+                if !(offset.is_finite() && rotation.is_finite() && scale.is_finite()) {
+                    return Err(self.bad(
+                        element,
+                        "KHR_texture_transform has a non-finite offset, rotation or scale",
+                    ));
+                }
+                let m = uv_transform(offset, rotation, scale);
+                (m != Affine2::IDENTITY).then_some(m)
+            }
+        };
+        let sampler = sampler(&texture.sampler());
+        let image = self.image(texture, space, material)?;
+        Ok(TextureRef {
+            texture: image,
+            texcoord,
+            sampler,
+            transform,
+        })
+    }
+
+    /// The decoded image of `texture` in colour space `space`, decoded once.
+    pub(super) fn image(
+        &mut self,
+        texture: &gltf::Texture,
+        space: ColorSpace,
+        material: &str,
+    ) -> Result<TextureId, SceneError> {
+        let image = texture.source();
+        let key = (image.index(), space);
+        if let Some(&id) = self.textures.get(&key) {
+            return Ok(id);
+        }
+        let element = match image.source() {
+            gltf::image::Source::Uri { uri, .. } => format!(
+                "{material}, image {} ({})",
+                image.index(),
+                uri_label(&self.base, uri)
+            ),
+            gltf::image::Source::View { view, .. } => format!(
+                "{material}, image {} (bufferView {})",
+                image.index(),
+                view.index()
+            ),
+        };
+        let (bytes, mime) = match image.source() {
+            gltf::image::Source::Uri { uri, mime_type } => {
+                match self
+                    .files
+                    .uri(uri, &format!("{material}, image {}", image.index()))?
+                {
+                    Uri::Data(bytes, media) => (bytes, media.or(mime_type.map(str::to_string))),
+                    Uri::File(file) => (
+                        self.files.read(&file, &element)?,
+                        mime_type.map(str::to_string),
+                    ),
+                }
+            }
+            gltf::image::Source::View { view, mime_type } => {
+                let bytes = self
+                    .buffers
+                    .get(view.buffer().index())
+                    .and_then(|b| b.get(view.offset()..view.offset().checked_add(view.length())?))
+                    .ok_or_else(|| self.bad(&element, "its bufferView exceeds its buffer"))?;
+                (bytes.to_vec(), Some(mime_type.to_string()))
+            }
+        };
+        // glTF images are PNG or JPEG: by their content, else by their MIME type.
+        let format = match (image::guess_format(&bytes), mime.as_deref()) {
+            (Ok(f @ (image::ImageFormat::Png | image::ImageFormat::Jpeg)), _) => f,
+            (Err(_), Some("image/png")) => image::ImageFormat::Png,
+            (Err(_), Some("image/jpeg")) => image::ImageFormat::Jpeg,
+            _ => return Err(self.bad(&element, "is not a PNG or JPEG image")),
+        };
+        let decoded = streaks_image::input::decode_image(&bytes, Some(format))
+            .map_err(|reason| self.bad(&element, reason))?;
+        drop(bytes);
+        let texture = decode_image(decoded, space)
+            .ok_or_else(|| self.bad(&element, "pixel data does not match its size"))?;
+        let id = self.parts.textures.len() as TextureId;
+        self.parts.textures.push(texture);
+        self.textures.insert(key, id);
+        Ok(id)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_docs::*;
+    use super::*;
+
+    use crate::material::{GltfPbrParams, Reflectance};
+    use crate::scene::Scene;
+    use glam::{Vec2, Vec3};
+    use serde_json::json;
+
+    #[test]
+    fn images_without_a_source_or_mime_type_are_errors() {
+        let (mut doc, bin) = test_doc();
+        doc["images"] = json!([{"name": "nothing"}]);
+        let err = load_err(doc.clone(), &bin);
+        assert!(
+            err.contains("image 0") && err.contains("neither a uri"),
+            "{err}"
+        );
+        doc["images"] = json!([{"bufferView": 0}]);
+        let err = load_err(doc.clone(), &bin);
+        assert!(
+            err.contains("image 0") && err.contains("no mimeType"),
+            "{err}"
+        );
+        doc["images"] = json!([{"bufferView": 99, "mimeType": "image/png"}]);
+        let err = load_err(doc, &bin);
+        assert!(
+            err.contains("image 0") && err.contains("bufferView 99"),
+            "{err}"
+        );
+    }
+
+    /// TEXCOORD_1, COLOR_0 (normalized bytes), KHR_texture_transform with its texCoord
+    /// override, a sampler, alphaMode MASK and an emissive texture sharing the image.
+    #[test]
+    fn second_uvs_vertex_colours_transforms_samplers_and_masks() {
+        // 2x2 white PNG, alpha: top row opaque, transparent; bottom row the other way round.
+        let texels = [255, 255, 255, 255, 255, 255, 255, 0]
+            .into_iter()
+            .chain([255, 255, 255, 0, 255, 255, 255, 255])
+            .collect();
+        let dir = png_file("leaf.png", 2, 2, texels);
+        let mut d = Doc::default();
+        // A unit quad in z = 0 facing +Z; uv1 = uv0 / 2; red opaque at y = 0, blue 0.2 at y = 1.
+        let pos = d.floats(&[0., 0., 0., 1., 0., 0., 1., 1., 0., 0., 1., 0.], "VEC3", 3);
+        let uv0 = d.floats(&[0., 0., 1., 0., 1., 1., 0., 1.], "VEC2", 2);
+        let uv1 = d.floats(&[0., 0., 0.5, 0., 0.5, 0.5, 0., 0.5], "VEC2", 2);
+        let colours = d.view(&[255, 0, 0, 255, 255, 0, 0, 255, 0, 0, 255, 51, 0, 0, 255, 51]);
+        d.accessors
+            .push(json!({"bufferView": colours, "componentType": 5121,
+            "normalized": true, "count": 4, "type": "VEC4"}));
+        let col = d.accessors.len() - 1;
+        let idx = d.indices(&[0, 1, 2, 0, 2, 3]);
+        // Behind it, an emissive triangle in z = -1 without uvs or colours.
+        let tri = d.floats(&[0., 0., -1., 1., 0., -1., 0., 1., -1.], "VEC3", 3);
+        let doc = json!({
+            "asset": {"version": "2.0"},
+            "extensionsUsed": ["KHR_texture_transform"],
+            "scenes": [{"nodes": [0]}],
+            "nodes": [{"mesh": 0}],
+            "meshes": [{"primitives": [
+                {"attributes": {"POSITION": pos, "TEXCOORD_0": uv0, "TEXCOORD_1": uv1,
+                    "COLOR_0": col}, "indices": idx, "material": 0},
+                {"attributes": {"POSITION": tri}, "material": 1}]}],
+            "materials": [
+                {"name": "leaf", "alphaMode": "MASK", "pbrMetallicRoughness": {
+                    "baseColorTexture": {"index": 0, "extensions": {"KHR_texture_transform":
+                        {"offset": [0.25, 0], "texCoord": 1}}}}},
+                {"name": "glow", "emissiveFactor": [1, 1, 1], "emissiveTexture": {"index": 1}}
+            ],
+            "images": [{"uri": "leaf.png"}],
+            "samplers": [{"magFilter": 9728, "wrapS": 33071, "wrapT": 33648}],
+            "textures": [{"source": 0, "sampler": 0}, {"source": 0}],
+            "buffers": [{"byteLength": d.bin.len()}],
+            "bufferViews": d.views,
+            "accessors": d.accessors
+        });
+        let scene = Scene::load(&write_embedded(dir.path(), doc, &d.bin)).unwrap();
+        assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+        // One image for both textures (same colour space); the second uv set and the colours
+        // are stored for every vertex, TEXCOORD_0 and white where a primitive has none.
+        assert_eq!(scene.textures.len(), 1);
+        assert_eq!(scene.uvs1.len(), 7);
+        assert_eq!(scene.uvs1[2], Vec2::new(0.5, 0.5));
+        assert_eq!(scene.uvs1[4..], scene.uvs[4..]);
+        assert!((scene.colors[2] - Vec4::new(0.0, 0.0, 1.0, 0.2)).length() < 1e-6);
+        assert_eq!(scene.colors[5], Vec4::ONE);
+        let Reflectance::GltfPbr(GltfPbrParams {
+            base_color_texture: Some(base),
+            ..
+        }) = scene.materials[0].reflectance
+        else {
+            panic!("no base colour texture")
+        };
+        assert_eq!(
+            base,
+            TextureRef {
+                texture: 0,
+                texcoord: 1,
+                sampler: Sampler {
+                    wrap_s: Wrap::ClampToEdge,
+                    wrap_t: Wrap::MirroredRepeat,
+                    filter: Filter::Nearest,
+                },
+                transform: Some(uv_transform(Vec2::new(0.25, 0.0), 0.0, Vec2::ONE)),
+            }
+        );
+        let leaf = &scene.materials[0];
+        assert_eq!(leaf.alpha.mode, AlphaMode::Mask { cutoff: 0.5 });
+        // At x = 0.4 the transformed TEXCOORD_1 (0.45, 0.1) is in the opaque texel (TEXCOORD_0
+        // would be in the transparent one); at x = 0.7 (0.6, 0.1) is in the transparent one,
+        // so the ray goes on to the triangle behind.
+        let down = |x: f32, y: f32| {
+            scene
+                .intersect(&crate::geometry::Ray::new(Vec3::new(x, y, 1.0), -Vec3::Z))
+                .unwrap()
+        };
+        let hit = down(0.4, 0.2);
+        assert!((hit.t - 1.0).abs() < 1e-5 && hit.material == 0);
+        assert!((hit.attributes.uv[1] - Vec2::new(0.2, 0.1)).length() < 1e-6);
+        let c = hit.attributes.color;
+        assert!((c - Vec4::new(0.8, 0.0, 0.2, 0.84)).length() < 1e-5, "{c}");
+        let crate::bsdf::Bsdf::GltfPbr(b) = leaf.bsdf_at(&hit.attributes, &scene.textures) else {
+            panic!("not pbr")
+        };
+        assert!((b.base_color - Vec3::new(0.8, 0.0, 0.2)).length() < 1e-5);
+        let hit = down(0.7, 0.2);
+        assert!((hit.t - 2.0).abs() < 1e-5 && hit.material == 1, "{hit:?}");
+        // The emissive texture is read (white: the emission is the factor).
+        assert!(scene.materials[1].emission_texture.is_some());
+        assert!(approx(scene.emitted_radiance(&hit, Vec3::Z), Vec3::ONE));
+    }
+
+    #[test]
+    fn normal_and_clearcoat_textures_read_their_texture_transform() {
+        let (mut doc, bin) = normal_mapped_doc(0.4, 1.0);
+        // glTF's own material model (the clear coat is one of its layers).
+        doc["materials"][0]
+            .as_object_mut()
+            .unwrap()
+            .remove("extras");
+        doc["extensionsUsed"] = json!(["KHR_texture_transform", "KHR_materials_clearcoat"]);
+        doc["materials"][0]["normalTexture"]["extensions"] =
+            json!({"KHR_texture_transform": {"scale": [2, 2], "texCoord": 1}});
+        doc["materials"][0]["extensions"] = json!({"KHR_materials_clearcoat": {
+            "clearcoatFactor": 1,
+            "clearcoatTexture": {"index": 0, "extensions":
+                {"KHR_texture_transform": {"offset": [0.5, 0]}}}}});
+        let scene = load_doc(doc, &bin);
+        let t = scene.materials[0].normal_map.unwrap().texture;
+        assert_eq!(t.texcoord, 1);
+        let m = t.transform.expect("a transform");
+        assert!((m.transform_point2(Vec2::ONE) - Vec2::splat(2.0)).length() < 1e-6);
+        let Reflectance::GltfPbr(GltfPbrParams {
+            clearcoat_texture: Some(c),
+            ..
+        }) = scene.materials[0].reflectance
+        else {
+            panic!("no clearcoat texture")
+        };
+        let m = c.transform.expect("a transform");
+        assert!((m.transform_point2(Vec2::ZERO) - Vec2::new(0.5, 0.0)).length() < 1e-6);
+        // Tangents follow the normal map's texture space: a quarter turn of its uvs turns the
+        // quad's generated tangents from +X to the Z axis.
+        let (mut doc, bin) = normal_mapped_doc(0.4, 1.0);
+        doc["materials"][0]["normalTexture"]["extensions"] =
+            json!({"KHR_texture_transform": {"rotation": std::f32::consts::FRAC_PI_2}});
+        let scene = load_doc(doc, &bin);
+        for t in &scene.tangents[..4] {
+            assert!(t.x.abs() < 1e-4 && (t.z.abs() - 1.0).abs() < 1e-4, "{t}");
+        }
+        // A malformed transform names the material's normal texture.
+        let (mut doc, bin) = normal_mapped_doc(0.4, 1.0);
+        doc["materials"][0]["normalTexture"]["extensions"] =
+            json!({"KHR_texture_transform": {"scale": "big"}});
+        let err = load_err(doc, &bin);
+        assert!(
+            err.contains("normalTexture") && err.contains("KHR_texture_transform"),
+            "{err}"
+        );
+    }
+}
