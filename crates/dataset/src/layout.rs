@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! DIR/dataset.json                      settings, generator version, config, conventions
-//! DIR/samples/NNNNNN/                   one sample (Middlebury style, see SAMPLE_FILES)
+//! DIR/samples/NNNNNN/                   one sample (Middlebury style, see crate::files)
 //! DIR/samples/.tmp-NNNNNN-PID/          a sample being rendered (renamed when complete)
 //! DIR/samples/.lock-NNNNNN              its lock, while a run checks or renders it
 //! DIR/.lock                             the dataset lock, while a run uses the folder
@@ -13,7 +13,13 @@
 //! DIR/splits/{train,val,test}.txt       sample ids, split by street
 //! ```
 
-use anyhow::{bail, Context, Result};
+use crate::error::DatasetError;
+use crate::files::SampleDir;
+use crate::files::{
+    DATASET_JSON, KITTI_DIR, KITTI_DISP_OCC_0, KITTI_IMAGE_2, KITTI_IMAGE_3, KITTI_SUFFIX, LOCK,
+    MANIFEST, ROAD_MASK, SAMPLES_DIR, SAMPLE_FILES, SAMPLE_LOCK_PREFIX, SCENE_BIN, SCENE_GLTF,
+    SPLITS_DIR, SPLIT_EXTENSION, TMP_PREFIX,
+};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::collections::BTreeMap;
@@ -27,32 +33,6 @@ pub const MAX_COUNT: u64 = 1_000_000;
 
 /// The largest `dataset.json` read (the file holds the settings and the generator config).
 pub const MAX_DATASET_JSON_BYTES: u64 = 16 << 20;
-
-/// The files of every sample folder besides the scene's, sorted.
-pub const SAMPLE_FILES: [&str; 10] = [
-    "calib.txt",
-    "depth0.pfm",
-    "disp0.pfm",
-    "disp1.pfm",
-    "im0.exr",
-    "im0.png",
-    "im1.exr",
-    "im1.png",
-    "meta.json",
-    "streaks0.png",
-];
-
-/// The dataset lock's file name in the dataset folder.
-pub const LOCK: &str = ".lock";
-
-/// The name prefix of the sample locks in `samples/`: `.lock-NNNNNN`.
-pub const SAMPLE_LOCK_PREFIX: &str = ".lock-";
-
-/// The road-surface mask, present when the scene flags a road material.
-pub const ROAD_MASK: &str = "road0.png";
-
-/// The scene's glTF in a sample folder (with `scene.bin` and its `scene_*.png` textures).
-pub const SCENE_GLTF: &str = "scene.gltf";
 
 /// The splits, in the order of `splits/`.
 pub const SPLITS: [&str; 3] = ["train", "val", "test"];
@@ -101,12 +81,12 @@ impl Layout {
 
     /// `dataset.json`.
     pub fn dataset_json(&self) -> PathBuf {
-        self.root.join("dataset.json")
+        self.root.join(DATASET_JSON)
     }
 
     /// `manifest.jsonl`.
     pub fn manifest(&self) -> PathBuf {
-        self.root.join("manifest.jsonl")
+        self.root.join(MANIFEST)
     }
 
     /// Whether `manifest.jsonl` exists (as anything: a symbolic link or folder there is
@@ -115,12 +95,12 @@ impl Layout {
         std::fs::symlink_metadata(self.manifest()).is_ok()
     }
 
-    /// `.lock`: the dataset lock (see [`super::lock`]).
+    /// `.lock`: the dataset lock (see [`crate::lock`]).
     pub fn lock(&self) -> PathBuf {
         self.root.join(LOCK)
     }
 
-    /// `samples/.lock-NNNNNN`: the lock of sample `index` (see [`super::lock`]).
+    /// `samples/.lock-NNNNNN`: the lock of sample `index` (see [`crate::lock`]).
     pub fn sample_lock(&self, index: u64) -> PathBuf {
         self.samples_dir()
             .join(format!("{SAMPLE_LOCK_PREFIX}{}", sample_id(index)))
@@ -128,12 +108,12 @@ impl Layout {
 
     /// `splits/`.
     pub fn splits_dir(&self) -> PathBuf {
-        self.root.join("splits")
+        self.root.join(SPLITS_DIR)
     }
 
     /// `samples/`.
     pub fn samples_dir(&self) -> PathBuf {
-        self.root.join("samples")
+        self.root.join(SAMPLES_DIR)
     }
 
     /// `samples/NNNNNN/`.
@@ -141,9 +121,19 @@ impl Layout {
         self.samples_dir().join(sample_id(index))
     }
 
+    /// The files of `samples/NNNNNN/`.
+    pub fn sample(&self, index: u64) -> SampleDir {
+        SampleDir::new(self.sample_dir(index))
+    }
+
+    /// The files of the sample folder `samples/ID/`.
+    pub fn sample_by_id(&self, id: &str) -> SampleDir {
+        SampleDir::new(self.samples_dir().join(id))
+    }
+
     /// The name prefix of sample `index`'s temporary folders: `.tmp-NNNNNN-`.
     pub fn tmp_prefix(index: u64) -> String {
-        format!(".tmp-{}-", sample_id(index))
+        format!("{TMP_PREFIX}{}-", sample_id(index))
     }
 
     /// This process's temporary folder for sample `index`: `samples/.tmp-NNNNNN-PID/`.
@@ -154,12 +144,12 @@ impl Layout {
 
     /// The KITTI view's files of sample `index`.
     pub fn kitti(&self, index: u64) -> KittiFiles {
-        let dir = self.root.join("kitti").join("training");
-        let name = format!("{}_10.png", sample_id(index));
+        let dir = self.root.join(KITTI_DIR[0]).join(KITTI_DIR[1]);
+        let name = format!("{}{KITTI_SUFFIX}", sample_id(index));
         KittiFiles {
-            image_2: dir.join("image_2").join(&name),
-            image_3: dir.join("image_3").join(&name),
-            disp_occ_0: dir.join("disp_occ_0").join(&name),
+            image_2: dir.join(KITTI_IMAGE_2).join(&name),
+            image_3: dir.join(KITTI_IMAGE_3).join(&name),
+            disp_occ_0: dir.join(KITTI_DISP_OCC_0).join(&name),
         }
     }
 
@@ -167,24 +157,22 @@ impl Layout {
     /// index` listed in `splits/SPLIT.txt`; without, every complete sample folder (six digits;
     /// the `.tmp-` folders of samples in progress are left out). Fails on an unknown split, a
     /// missing split file, or no samples.
-    pub fn sample_ids(&self, split: Option<&str>) -> Result<Vec<String>> {
+    pub fn sample_ids(&self, split: Option<&str>) -> Result<Vec<String>, DatasetError> {
         let mut ids: Vec<String> = match split {
             Some(name) => {
                 if !SPLITS.contains(&name) {
-                    bail!(
-                        "--split {name}: a dataset's splits are {}",
-                        SPLITS.join(", ")
-                    );
+                    return Err(DatasetError::UnknownSplit {
+                        name: name.to_owned(),
+                        known: SPLITS.join(", "),
+                    });
                 }
-                let path = self.splits_dir().join(format!("{name}.txt"));
+                let path = self.split_file(name);
                 let text =
                     streaks_image::input::read_text(&path, streaks_image::input::MAX_TEXT_BYTES)
-                        .with_context(|| {
-                            format!(
-                                "cannot read the split {} (run `streaks dataset index {}`)",
-                                path.display(),
-                                self.root.display()
-                            )
+                        .map_err(|source| DatasetError::Split {
+                            path: path.clone(),
+                            root: self.root.clone(),
+                            source,
                         })?;
                 text.lines()
                     .map(str::trim)
@@ -195,7 +183,7 @@ impl Layout {
             None => {
                 let samples = self.samples_dir();
                 std::fs::read_dir(&samples)
-                    .with_context(|| format!("cannot list {}", samples.display()))?
+                    .map_err(|e| DatasetError::io("list", &samples, e))?
                     .filter_map(|e| e.ok())
                     .map(|e| e.file_name().to_string_lossy().into_owned())
                     .filter(|n| n.len() == 6 && n.bytes().all(|b| b.is_ascii_digit()))
@@ -204,15 +192,17 @@ impl Layout {
         };
         ids.sort();
         if ids.is_empty() {
-            bail!(
-                "the dataset {} has no samples{}",
-                self.root.display(),
-                split
-                    .map(|s| format!(" in its {s} split"))
-                    .unwrap_or_default()
-            );
+            return Err(DatasetError::NoSamples {
+                root: self.root.clone(),
+                split: split.map(String::from),
+            });
         }
         Ok(ids)
+    }
+
+    /// `splits/SPLIT.txt`: the ids of the split `name`.
+    pub fn split_file(&self, name: &str) -> PathBuf {
+        self.splits_dir().join(format!("{name}.{SPLIT_EXTENSION}"))
     }
 
     /// `path` relative to the dataset folder, with `/` separators (for the manifest).
@@ -301,14 +291,12 @@ impl FileList {
             )]),
             scene: vec![
                 SCENE_GLTF.to_owned(),
-                "scene.bin".to_owned(),
+                SCENE_BIN.to_owned(),
                 "scene_*.png (the textures scene.gltf refers to)".to_owned(),
             ],
-            kitti: vec![
-                "kitti/training/image_2/NNNNNN_10.png".to_owned(),
-                "kitti/training/image_3/NNNNNN_10.png".to_owned(),
-                "kitti/training/disp_occ_0/NNNNNN_10.png".to_owned(),
-            ],
+            kitti: [KITTI_IMAGE_2, KITTI_IMAGE_3, KITTI_DISP_OCC_0]
+                .map(|d| format!("{}/{}/{d}/NNNNNN{KITTI_SUFFIX}", KITTI_DIR[0], KITTI_DIR[1]))
+                .to_vec(),
         }
     }
 }
@@ -356,38 +344,42 @@ impl DatasetInfo {
     /// Reads `dataset.json`.
     /// The file must be a regular file of at most [`MAX_DATASET_JSON_BYTES`] (a FIFO or a
     /// device is not opened) and its `count` in `1..=MAX_COUNT`, since commands loop over it.
-    pub fn load(path: &Path) -> Result<Self> {
-        let meta =
-            std::fs::metadata(path).with_context(|| format!("cannot read {}", path.display()))?;
+    pub fn load(path: &Path) -> Result<Self, DatasetError> {
+        let meta = std::fs::metadata(path).map_err(|e| DatasetError::io("read", path, e))?;
+        let invalid = |reason: String| DatasetError::Invalid {
+            path: path.to_path_buf(),
+            reason,
+        };
         if !meta.is_file() {
-            bail!("{} is not a regular file", path.display());
+            return Err(invalid("not a regular file".into()));
         }
         if meta.len() > MAX_DATASET_JSON_BYTES {
-            bail!(
-                "{} is {} bytes, more than a dataset.json has ({MAX_DATASET_JSON_BYTES})",
-                path.display(),
+            return Err(invalid(format!(
+                "{} bytes, more than a dataset.json has ({MAX_DATASET_JSON_BYTES})",
                 meta.len()
-            );
+            )));
         }
         let text = streaks_image::input::read_text(path, streaks_image::input::MAX_TEXT_BYTES)
-            .with_context(|| format!("cannot read {}", path.display()))?;
-        let info: Self = serde_json::from_str(&text)
-            .with_context(|| format!("{} is not a dataset.json of {FORMAT}", path.display()))?;
+            .map_err(|e| DatasetError::io("read", path, e))?;
+        let info: Self = serde_json::from_str(&text).map_err(|source| DatasetError::Json {
+            path: path.to_path_buf(),
+            what: format!("a dataset.json of {FORMAT}"),
+            source,
+        })?;
         if info.count == 0 || info.count > MAX_COUNT {
-            bail!(
-                "{}: count {} is not in 1..={MAX_COUNT}",
-                path.display(),
+            return Err(invalid(format!(
+                "count {} is not in 1..={MAX_COUNT}",
                 info.count
-            );
+            )));
         }
         Ok(info)
     }
 
     /// The file's bytes (pretty JSON, a final newline).
-    pub fn to_bytes(&self) -> Result<Vec<u8>> {
-        let mut text = serde_json::to_string_pretty(self)?;
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut text = serde_json::to_string_pretty(self).expect("dataset.json serialises");
         text.push('\n');
-        Ok(text.into_bytes())
+        text.into_bytes()
     }
 
     /// Fails, naming the first field that differs, unless `existing` (the folder's
@@ -396,7 +388,7 @@ impl DatasetInfo {
     /// path regularisation: it matches a run with `--no-regularize`, and the message for any
     /// other run says so. Likewise one without `noise_target` was rendered at fixed spp: it
     /// matches a run with `--noise-target off`.
-    pub fn check_same(&self, existing: &Value, path: &Path) -> Result<()> {
+    pub fn check_same(&self, existing: &Value, path: &Path) -> Result<(), DatasetError> {
         let mut existing = existing.clone();
         let (mut unrecorded, mut target_unrecorded) = (false, false);
         if let Value::Object(map) = &mut existing {
@@ -409,7 +401,7 @@ impl DatasetInfo {
                 target_unrecorded = true;
             }
         }
-        let new = serde_json::to_value(self)?;
+        let new = serde_json::to_value(self).expect("dataset.json serialises");
         if let Some((field, old, new)) = first_difference("", &existing, &new) {
             let hint = match field.as_str() {
                 "regularize" if unrecorded => {
@@ -425,11 +417,13 @@ impl DatasetInfo {
                 "noise_target" => " (give its --noise-target to continue it)",
                 _ => "",
             };
-            bail!(
-                "{} describes another dataset: its {field} is {old}, this run's is {new}{hint}; \
-                 datasets are not mixed: write into another folder (or remove this one)",
-                path.display()
-            );
+            return Err(DatasetError::OtherDataset {
+                path: path.to_path_buf(),
+                field,
+                old,
+                new,
+                hint,
+            });
         }
         Ok(())
     }
