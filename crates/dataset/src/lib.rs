@@ -13,7 +13,7 @@
 //! - [`manifest`]: reading `manifest.jsonl` back and checking files against it;
 //! - [`lock`]: the advisory locks that make runs on one folder safe or refused;
 //! - [`shard`]: `--shard K/N`;
-//! - [`error`]: [`error::DatasetError`].
+//! - [`error`]: the crate's error type, [`DatasetError`].
 #![deny(missing_docs)]
 
 pub mod error;
