@@ -30,6 +30,7 @@ use streaks_dataset::layout::{
 };
 use streaks_dataset::lock::{Lock, Mode};
 use streaks_dataset::manifest::{sha256_hex, verify_entry, Difference, Manifest};
+use streaks_dataset::settings::Settings;
 use streaks_dataset::shard::Shard;
 use streaks_image::write_bytes_atomically;
 use streaks_scenes::procedural::{GeneratorConfig, GENERATOR_VERSION};
@@ -154,12 +155,14 @@ pub fn run(args: Args) -> Result<()> {
         config_hash: config_hash.clone(),
         count: args.count,
         seed: args.seed,
-        width: args.width,
-        height: args.height,
-        spp: args.spp,
-        max_depth: args.max_depth,
-        regularize: !args.no_regularize,
-        noise_target: args.noise_target.0,
+        settings: Settings {
+            width: args.width,
+            height: args.height,
+            spp: args.spp,
+            max_depth: args.max_depth,
+            regularize: !args.no_regularize,
+            noise_target: args.noise_target.0,
+        },
         files: FileList::current(),
         conventions: Conventions::current(),
     };
@@ -204,12 +207,7 @@ pub fn run(args: Args) -> Result<()> {
         config,
         config_hash,
         seed: args.seed,
-        width: args.width,
-        height: args.height,
-        spp: args.spp,
-        max_depth: args.max_depth,
-        regularize: !args.no_regularize,
-        noise_target: args.noise_target.0,
+        settings: info.settings,
     };
     let check = |index: u64| health(&layout, &info, index, manifest.as_ref());
     let bar = progress_bar(indices.len() as u64);

@@ -534,7 +534,7 @@ pub fn check_sample(
         let list: Vec<&str> = absent.iter().map(|s| s.as_str()).collect();
         bail!("missing files: {}", list.join(", "));
     }
-    let size = (info.width as usize, info.height as usize);
+    let size = (info.settings.width as usize, info.settings.height as usize);
     let mut pngs = vec![
         sample.png(Eye::Left),
         sample.png(Eye::Right),
@@ -567,14 +567,14 @@ pub fn check_sample(
         }
     }
     let calib = MiddleburyCalib::load(&sample.calib())?;
-    if (calib.width, calib.height) != (info.width, info.height) {
+    if (calib.width, calib.height) != (info.settings.width, info.settings.height) {
         bail!(
             "{} is for {}x{}, the dataset's images are {}x{}",
             file_name(&sample.calib()),
             calib.width,
             calib.height,
-            info.width,
-            info.height
+            info.settings.width,
+            info.settings.height
         );
     }
 

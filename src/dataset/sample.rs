@@ -8,6 +8,7 @@ use streaks_dataset::files::{SampleDir, SAMPLE_FILES, SCENE_GLTF};
 use streaks_dataset::kitti::write_kitti;
 use streaks_dataset::layout::{sample_id, Layout};
 pub use streaks_dataset::meta::{render_seed, RenderMeta, RigMeta, SampleMeta, SampleStats};
+use streaks_dataset::settings::Settings;
 use streaks_image::pfm::write_pfm;
 use streaks_image::png::{to_srgb8_image, write_png_buffer};
 use streaks_image::write_bytes_atomically;
@@ -31,18 +32,8 @@ pub struct SampleSettings {
     pub config_hash: String,
     /// The dataset seed.
     pub seed: u64,
-    /// Image width in pixels.
-    pub width: u32,
-    /// Image height in pixels.
-    pub height: u32,
-    /// Samples per pixel per eye.
-    pub spp: u32,
-    /// Longest path.
-    pub max_depth: u32,
-    /// Path regularisation.
-    pub regularize: bool,
-    /// Adaptive sampling's target (`None`: `spp` everywhere).
-    pub noise_target: Option<f64>,
+    /// How the samples are rendered (as `dataset.json` records it).
+    pub settings: Settings,
 }
 
 /// What one rendered sample reports.
@@ -161,17 +152,18 @@ fn write_sample(
     let camera = scene
         .camera(Some(&s.camera))
         .with_context(|| format!("in the scene {}", gltf.display()))?;
-    let rig = rig_from_camera(camera, settings.width, settings.height, s.baseline)
+    let render = &settings.settings;
+    let rig = rig_from_camera(camera, render.width, render.height, s.baseline)
         .with_context(|| format!("the stereo rig of {}", gltf.display()))?;
     let seed = render_seed(settings.seed, index);
     let pair = PairSettings {
-        spp: settings.spp,
-        noise_target: settings.noise_target.map(|rel| rel as f32),
-        max_depth: settings.max_depth,
+        spp: render.spp,
+        noise_target: render.noise_target.map(|rel| rel as f32),
+        max_depth: render.max_depth,
         seed,
         exposure_ev: s.exposure_ev,
         mask: StreakMaskParams::default(),
-        regularize: settings.regularize,
+        regularize: render.regularize,
     };
     let views = render_pair(&scene, &rig, &pair, &|_| {})?;
     let [left, right] = &views;
@@ -246,12 +238,12 @@ fn write_sample(
         lights: light_records(&scene, rig.road_frame().ok().as_ref()),
         stats: stats.clone(),
         render: RenderMeta {
-            spp: settings.spp,
-            max_depth: settings.max_depth,
+            spp: render.spp,
+            max_depth: render.max_depth,
             seed_left: seed,
             seed_right: seed.wrapping_add(1),
-            regularize: settings.regularize,
-            noise_target: settings.noise_target,
+            regularize: render.regularize,
+            noise_target: render.noise_target,
             mean_spp: Some([left, right].map(|v| v.output.stats.samples as f64 / pixels)),
         },
     };

@@ -20,6 +20,7 @@ use crate::files::{
     MANIFEST, ROAD_MASK, SAMPLES_DIR, SAMPLE_FILES, SAMPLE_LOCK_PREFIX, SCENE_BIN, SCENE_GLTF,
     SPLITS_DIR, SPLIT_EXTENSION, TMP_PREFIX,
 };
+use crate::settings::Settings;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::collections::BTreeMap;
@@ -317,23 +318,9 @@ pub struct DatasetInfo {
     pub count: u64,
     /// The dataset seed.
     pub seed: u64,
-    /// Image width in pixels.
-    pub width: u32,
-    /// Image height in pixels.
-    pub height: u32,
-    /// Samples per pixel per eye.
-    pub spp: u32,
-    /// Longest path (Mitsuba's meaning).
-    pub max_depth: u32,
-    /// Path regularisation (`--no-regularize` turns it off). A `dataset.json` written before
-    /// the field existed has none and was rendered without it: it reads as `false`.
-    #[serde(default)]
-    pub regularize: bool,
-    /// Adaptive sampling's target (`--noise-target`; `None`: `spp` samples everywhere). A
-    /// `dataset.json` written before the field existed has none and was rendered at fixed
-    /// spp: it reads as `None`.
-    #[serde(default)]
-    pub noise_target: Option<f64>,
+    /// How the samples are rendered (its fields are fields of `dataset.json` itself).
+    #[serde(flatten)]
+    pub settings: Settings,
     /// The files.
     pub files: FileList,
     /// The conventions.
@@ -408,7 +395,7 @@ impl DatasetInfo {
                     " (it predates the setting and was rendered without path regularisation: \
                      add --no-regularize to continue it)"
                 }
-                "regularize" if self.regularize => " (add --no-regularize to continue it)",
+                "regularize" if self.settings.regularize => " (add --no-regularize to continue it)",
                 "regularize" => " (drop --no-regularize to continue it)",
                 "noise_target" if target_unrecorded => {
                     " (it predates the setting and was rendered at fixed spp: add \
@@ -502,12 +489,14 @@ mod tests {
             config_hash: "h".into(),
             count: 2,
             seed: 0,
-            width: 64,
-            height: 40,
-            spp: 2,
-            max_depth: 8,
-            regularize,
-            noise_target: None,
+            settings: Settings {
+                width: 64,
+                height: 40,
+                spp: 2,
+                max_depth: 8,
+                regularize,
+                noise_target: None,
+            },
             files: FileList::current(),
             conventions: Conventions::current(),
         }
@@ -545,12 +534,10 @@ mod tests {
         let mut old = serde_json::to_value(info(true)).unwrap();
         old.as_object_mut().unwrap().remove("noise_target");
         let back: DatasetInfo = serde_json::from_value(old.clone()).unwrap();
-        assert_eq!(back.noise_target, None);
+        assert_eq!(back.settings.noise_target, None);
         info(true).check_same(&old, path).unwrap();
-        let adaptive = DatasetInfo {
-            noise_target: Some(0.25),
-            ..info(true)
-        };
+        let mut adaptive = info(true);
+        adaptive.settings.noise_target = Some(0.25);
         let err = adaptive.check_same(&old, path).unwrap_err().to_string();
         assert!(
             err.contains("its noise_target is null, this run's is 0.25")

@@ -7,6 +7,7 @@
 //!   the files of a sample folder (a dataset's `samples/NNNNNN/` and a `streaks stereo`
 //!   folder alike, also in the older pair layout);
 //! - [`meta`]: a sample's `meta.json`, and its render seed;
+//! - [`settings`]: the render settings a dataset's samples share ([`settings::Settings`]);
 //! - [`layout`]: the dataset folder, `dataset.json` and the conventions it states, and its
 //!   Middlebury-style sample folders;
 //! - [`kitti`]: the KITTI 2015 view of a sample;
@@ -23,6 +24,7 @@ pub mod layout;
 pub mod lock;
 pub mod manifest;
 pub mod meta;
+pub mod settings;
 pub mod shard;
 
 pub use error::DatasetError;
