@@ -9,10 +9,8 @@ use streaks_dataset::kitti::write_kitti;
 use streaks_dataset::layout::{sample_id, Layout};
 pub use streaks_dataset::meta::{render_seed, RenderMeta, RigMeta, SampleMeta, SampleStats};
 use streaks_dataset::settings::Settings;
-use streaks_image::pfm::write_pfm;
-use streaks_image::png::{to_srgb8_image, write_png_buffer};
+use streaks_dataset::write::{write_views, GroundTruth};
 use streaks_image::write_bytes_atomically;
-use streaks_render::output::write_exr;
 use streaks_render::scene::Scene;
 use streaks_scenes::procedural::{sample, GeneratorConfig, GENERATOR_VERSION};
 use streaks_stereo::calib::MiddleburyCalib;
@@ -169,20 +167,8 @@ fn write_sample(
     let [left, right] = &views;
 
     let files = SampleDir::new(dir);
-    for (eye, view) in Eye::BOTH.into_iter().zip(&views) {
-        write_exr(&files.exr(eye), &view.output)?;
-        let img = to_srgb8_image(&view.output.image, s.exposure_ev)
-            .context("the image size does not match its pixels")?;
-        write_png_buffer(&files.png(eye), &img)?;
-        write_pfm(&files.disparity(eye), &view.disparity)?;
-    }
-    write_pfm(&files.depth(Eye::Left), &left.depth)?;
-    left.streak_mask.save_png(&files.streak_mask(Eye::Left))?;
+    write_views(&files, &scene, &views, s.exposure_ev, GroundTruth::Left)?;
     let has_road = scene_has_road(&scene);
-    if has_road {
-        left.road_surface_mask()?
-            .save_png(&files.road_mask(Eye::Left))?;
-    }
 
     let pixels = left.disparity.data.len().max(1) as f64;
     let finite: Vec<f32> = left

@@ -14,6 +14,8 @@
 //! - [`manifest`]: reading `manifest.jsonl` back and checking files against it;
 //! - [`lock`]: the advisory locks that make runs on one folder safe or refused;
 //! - [`shard`]: `--shard K/N`;
+//! - `write` (feature `render`): writing a rendered pair into a sample folder, the one
+//!   writer of a sample's images and ground truth;
 //! - [`error`]: the crate's error type, [`DatasetError`].
 #![deny(missing_docs)]
 
@@ -26,6 +28,8 @@ pub mod manifest;
 pub mod meta;
 pub mod settings;
 pub mod shard;
+#[cfg(feature = "render")]
+pub mod write;
 
 pub use error::DatasetError;
 pub use files::SampleDir;
