@@ -16,7 +16,7 @@
 //! manifest is written at the end ([`super::index::index_dir`]).
 
 use super::index::{check_sample, dataset_lock, index_dir};
-use super::sample::{is_complete, remove_stale_tmp, render_sample, SampleSettings};
+use super::sample::{render_sample, SampleSettings};
 use crate::cli::{image_size, progress_bar};
 use anyhow::{bail, Context, Result};
 use rayon::prelude::*;
@@ -249,7 +249,7 @@ pub fn run(args: Args) -> Result<()> {
                 bar.suspend(|| eprintln!("sample {id}: {holder} is on it; waiting"));
             },
         )?;
-        for stale in remove_stale_tmp(&layout, index)? {
+        for stale in layout.remove_stale_tmp(index)? {
             bar.suspend(|| {
                 eprintln!(
                     "sample {id}: removed {}, the temporary folder of an interrupted run",
@@ -382,7 +382,7 @@ fn health(layout: &Layout, info: &DatasetInfo, index: u64, manifest: Option<&Man
             let diffs = verify_entry(layout, entry);
             if !diffs.is_empty() {
                 Health::Damaged(describe(&diffs))
-            } else if !is_complete(layout, index) {
+            } else if !layout.is_complete(index) {
                 Health::Damaged("its files match manifest.jsonl, which lists too few".into())
             } else {
                 Health::Good

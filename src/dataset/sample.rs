@@ -2,9 +2,9 @@
 //! publish it with one rename.
 
 use anyhow::{Context, Result};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
-use streaks_dataset::files::{SampleDir, SAMPLE_FILES, SCENE_GLTF};
+use streaks_dataset::files::{SampleDir, SCENE_GLTF};
 use streaks_dataset::kitti::write_kitti;
 use streaks_dataset::layout::{sample_id, Layout};
 pub use streaks_dataset::meta::{render_seed, RenderMeta, RigMeta, SampleMeta, SampleStats};
@@ -17,7 +17,6 @@ use streaks_stereo::calib::MiddleburyCalib;
 use streaks_stereo::render::{
     light_records, render_pair, rig_from_camera, scene_has_road, PairSettings,
 };
-use streaks_stereo::rig::Eye;
 use streaks_stereo::rigfile::PoseRecord;
 use streaks_stereo::streak_mask::StreakMaskParams;
 
@@ -45,49 +44,6 @@ pub struct Rendered {
     pub seconds: f64,
 }
 
-/// Whether sample `index` is published and has all its files (a cheap check: the files are
-/// there; `streaks dataset index` checks their contents).
-pub fn is_complete(layout: &Layout, index: u64) -> bool {
-    let sample = layout.sample(index);
-    let present = |name: &str| sample.file(name).is_file();
-    if !SAMPLE_FILES.iter().all(|f| present(f)) || !present(SCENE_GLTF) {
-        return false;
-    }
-    match sample.load_meta() {
-        Ok(meta) => {
-            meta.index == index && (!meta.road_mask || sample.road_mask(Eye::Left).is_file())
-        }
-        Err(_) => false,
-    }
-}
-
-/// Removes sample `index`'s temporary folders (`.tmp-NNNNNN-*`) and returns them. Call it
-/// only while holding the sample's lock ([`Layout::sample_lock`]): every run renders a sample
-/// under that lock, so then no live run owns such a folder and they are all stale.
-pub fn remove_stale_tmp(layout: &Layout, index: u64) -> Result<Vec<PathBuf>> {
-    let prefix = Layout::tmp_prefix(index);
-    let dir = layout.samples_dir();
-    let Ok(entries) = std::fs::read_dir(&dir) else {
-        return Ok(Vec::new());
-    };
-    let mut removed = Vec::new();
-    for entry in entries {
-        let entry = entry.with_context(|| format!("cannot list {}", dir.display()))?;
-        if entry.file_name().to_string_lossy().starts_with(&prefix) {
-            let path = entry.path();
-            let is_dir = std::fs::symlink_metadata(&path).is_ok_and(|m| m.is_dir());
-            if is_dir {
-                std::fs::remove_dir_all(&path)
-            } else {
-                std::fs::remove_file(&path)
-            }
-            .with_context(|| format!("cannot remove the stale folder {}", path.display()))?;
-            removed.push(path);
-        }
-    }
-    Ok(removed)
-}
-
 /// Renders sample `index` into a temporary folder, writes its KITTI files and publishes it as
 /// `samples/NNNNNN/` (see the module documentation). The caller holds the sample's lock. `warn` receives the scene loader's
 /// warnings. Without a road material in the scene, `road0.png` is not written
@@ -100,7 +56,7 @@ pub fn render_sample(
 ) -> Result<Rendered> {
     let start = Instant::now();
     let id = sample_id(index);
-    remove_stale_tmp(layout, index)?;
+    layout.remove_stale_tmp(index)?;
     let tmp = layout.tmp_dir(index);
     std::fs::create_dir_all(&tmp)
         .with_context(|| format!("cannot create the folder {}", tmp.display()))?;
@@ -116,7 +72,7 @@ pub fn render_sample(
     if let Err(e) = std::fs::rename(&tmp, &dest) {
         let _ = std::fs::remove_dir_all(&tmp);
         // Another writer of the same index published first: its sample is the same.
-        if !is_complete(layout, index) {
+        if !layout.is_complete(index) {
             return Err(e).with_context(|| {
                 format!("cannot publish {} as {}", tmp.display(), dest.display())
             });

@@ -25,6 +25,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use streaks_stereo::rig::Eye;
 
 /// The format of `dataset.json` and of the folder it describes.
 pub const FORMAT: &str = "streaks-dataset/1";
@@ -141,6 +142,49 @@ impl Layout {
     pub fn tmp_dir(&self, index: u64) -> PathBuf {
         self.samples_dir()
             .join(format!("{}{}", Self::tmp_prefix(index), std::process::id()))
+    }
+
+    /// Whether sample `index` is published and has all its files (a cheap check: the files are
+    /// there and `meta.json` names the index; `streaks dataset index` checks their contents).
+    pub fn is_complete(&self, index: u64) -> bool {
+        let sample = self.sample(index);
+        let present = |name: &str| sample.file(name).is_file();
+        if !SAMPLE_FILES.iter().all(|f| present(f)) || !present(SCENE_GLTF) {
+            return false;
+        }
+        match sample.load_meta() {
+            Ok(meta) => {
+                meta.index == index && (!meta.road_mask || sample.road_mask(Eye::Left).is_file())
+            }
+            Err(_) => false,
+        }
+    }
+
+    /// Removes sample `index`'s temporary folders (`.tmp-NNNNNN-*`) and returns them. Call it
+    /// only while holding the sample's lock ([`Layout::sample_lock`]): every run renders a
+    /// sample under that lock, so then no live run owns such a folder and they are all stale.
+    pub fn remove_stale_tmp(&self, index: u64) -> Result<Vec<PathBuf>, DatasetError> {
+        let prefix = Self::tmp_prefix(index);
+        let dir = self.samples_dir();
+        let Ok(entries) = std::fs::read_dir(&dir) else {
+            return Ok(Vec::new());
+        };
+        let mut removed = Vec::new();
+        for entry in entries {
+            let entry = entry.map_err(|e| DatasetError::io("list", &dir, e))?;
+            if entry.file_name().to_string_lossy().starts_with(&prefix) {
+                let path = entry.path();
+                let is_dir = std::fs::symlink_metadata(&path).is_ok_and(|m| m.is_dir());
+                if is_dir {
+                    std::fs::remove_dir_all(&path)
+                } else {
+                    std::fs::remove_file(&path)
+                }
+                .map_err(|e| DatasetError::io("remove the stale folder", &path, e))?;
+                removed.push(path);
+            }
+        }
+        Ok(removed)
     }
 
     /// The KITTI view's files of sample `index`.
