@@ -4,8 +4,10 @@
 
 use anyhow::Context;
 use std::path::PathBuf;
+use streaks_dataset::SampleDir;
 use streaks_image::GrayImage;
 use streaks_stereo::pair::{prepare_pair, write_pair_views};
+use streaks_stereo::rig::Eye;
 
 /// Treat a photographed pair as in the paper's Fig. 7.
 #[derive(clap::Args, Debug)]
@@ -30,11 +32,27 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let (l, r) = prepare_pair(&left, &right, args.shift)?;
     let dir = &args.output;
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    l.save_png(&dir.join("left.png"))?;
-    r.save_png(&dir.join("right.png"))?;
-    write_pair_views(dir, &l.to_rgb8(), &r.to_rgb8())?;
+    let files = SampleDir::new(dir);
+    l.save_png(&files.png(Eye::Left))?;
+    r.save_png(&files.png(Eye::Right))?;
+    write_pair_views(
+        &files.side_by_side(),
+        &files.anaglyph(),
+        &l.to_rgb8(),
+        &r.to_rgb8(),
+    )?;
+    let name = |p: PathBuf| {
+        p.file_name()
+            .unwrap_or_default()
+            .to_string_lossy()
+            .into_owned()
+    };
     eprintln!(
-        "wrote left.png, right.png, side_by_side.png, anaglyph.png to {}",
+        "wrote {}, {}, {}, {} to {}",
+        name(files.png(Eye::Left)),
+        name(files.png(Eye::Right)),
+        name(files.side_by_side()),
+        name(files.anaglyph()),
         dir.display()
     );
     Ok(())

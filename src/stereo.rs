@@ -5,7 +5,8 @@ use crate::render::{Loaded, RenderOpts};
 use anyhow::{bail, Context, Result};
 use std::path::PathBuf;
 use streaks_analysis::report::AnalyzeParams;
-use streaks_stereo::render::{render_pair, rig_from_camera, write_pair, PairSettings};
+use streaks_dataset::write::write_pair;
+use streaks_stereo::render::{render_pair, rig_from_camera, PairSettings};
 use streaks_stereo::rig::Rig;
 use streaks_stereo::streak_mask::StreakMaskParams;
 

@@ -1,10 +1,10 @@
 //! The samples of `streaks benchmark DIR`: a dataset (`streaks dataset generate`), one
 //! `streaks stereo` pair folder, or a folder of pair folders.
 
-use crate::dataset::layout::{Layout, ROAD_MASK};
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
-use streaks_stereo::pair_dir::PairDir;
+use streaks_dataset::files::{SampleDir, PAIR_NAMES, SAMPLE_NAMES};
+use streaks_dataset::layout::Layout;
 use streaks_stereo::rig::Eye;
 
 /// The files of one sample to benchmark on.
@@ -38,57 +38,32 @@ pub enum InputKind {
     Pairs,
 }
 
-/// A dataset sample's files (the dataset layout's names).
-fn dataset_sample(id: &str, dir: PathBuf) -> Result<Sample> {
+/// The files of the sample folder `dir` (a dataset sample or a `streaks stereo` folder, in
+/// either of its layouts, [`SampleDir::open`]); `rerun` says how to make the missing ones.
+fn sample(id: String, dir: &Path, rerun: &str) -> Result<Sample> {
+    let files = SampleDir::open(dir)?;
     let sample = Sample {
-        id: id.to_string(),
-        left: dir.join("im0.png"),
-        right: dir.join("im1.png"),
-        truth: dir.join("disp0.pfm"),
-        streaks: dir.join("streaks0.png"),
-        road: Some(dir.join(ROAD_MASK)).filter(|p| p.exists()),
-        dir,
+        id,
+        left: files.png(Eye::Left),
+        right: files.png(Eye::Right),
+        truth: files.disparity(Eye::Left),
+        streaks: files.streak_mask(Eye::Left),
+        road: Some(files.road_mask(Eye::Left)).filter(|p| p.is_file()),
+        dir: dir.to_path_buf(),
     };
-    for p in [&sample.left, &sample.right, &sample.truth, &sample.streaks] {
-        if !p.is_file() {
-            bail!(
-                "sample {} of the dataset lacks {} (run `streaks dataset index` on the dataset)",
-                sample.dir.display(),
-                p.file_name().unwrap_or_default().to_string_lossy()
-            );
-        }
-    }
+    files
+        .require(&[
+            sample.left.clone(),
+            sample.right.clone(),
+            sample.truth.clone(),
+            sample.streaks.clone(),
+        ])
+        .with_context(|| format!("{} is incomplete ({rerun})", dir.display()))?;
     Ok(sample)
 }
 
-/// Whether `dir` is a `streaks stereo` pair folder (its left and right PNGs and the left
-/// ground truth).
-fn is_pair(dir: &Path) -> bool {
-    let p = PairDir::new(dir);
-    p.png(Eye::Left).is_file() && p.png(Eye::Right).is_file() && p.disparity(Eye::Left).is_file()
-}
-
-/// A pair folder's files ([`PairDir`]'s names).
-fn pair_sample(id: String, dir: &Path) -> Result<Sample> {
-    let p = PairDir::new(dir);
-    let streaks = p.streak_mask(Eye::Left);
-    if !streaks.is_file() {
-        bail!(
-            "the pair folder {} lacks {} (render it again with `streaks stereo`)",
-            dir.display(),
-            streaks.file_name().unwrap_or_default().to_string_lossy()
-        );
-    }
-    Ok(Sample {
-        id,
-        left: p.png(Eye::Left),
-        right: p.png(Eye::Right),
-        truth: p.disparity(Eye::Left),
-        road: Some(p.road_mask(Eye::Left)).filter(|r| r.is_file()),
-        streaks,
-        dir: dir.to_path_buf(),
-    })
-}
+/// How to make a pair folder's missing files.
+const RENDER_AGAIN: &str = "render it again with `streaks stereo`";
 
 /// The samples of `dir`, in order, restricted to `split` for a dataset (see the module
 /// documentation). An error names the folder when it is none of the three.
@@ -101,7 +76,13 @@ pub fn samples(dir: &Path, split: Option<&str>) -> Result<(InputKind, Vec<Sample
         let ids = layout.sample_ids(split)?;
         let samples = ids
             .iter()
-            .map(|id| dataset_sample(id, layout.samples_dir().join(id)))
+            .map(|id| {
+                sample(
+                    id.clone(),
+                    layout.sample_by_id(id).path(),
+                    "run `streaks dataset index` on the dataset",
+                )
+            })
             .collect::<Result<Vec<_>>>()?;
         return Ok((InputKind::Dataset, samples));
     }
@@ -111,26 +92,33 @@ pub fn samples(dir: &Path, split: Option<&str>) -> Result<(InputKind, Vec<Sample
             dir.display()
         );
     }
-    if is_pair(dir) {
+    if SampleDir::is_pair(dir) {
         let id = dir
             .canonicalize()
             .ok()
             .and_then(|d| d.file_name().map(|n| n.to_string_lossy().into_owned()))
             .unwrap_or_else(|| "pair".into());
-        return Ok((InputKind::Pair, vec![pair_sample(id, dir)?]));
+        return Ok((InputKind::Pair, vec![sample(id, dir, RENDER_AGAIN)?]));
     }
     let mut subs: Vec<PathBuf> = std::fs::read_dir(dir)
         .with_context(|| format!("cannot list {}", dir.display()))?
         .filter_map(|e| e.ok())
         .map(|e| e.path())
-        .filter(|p| p.is_dir() && is_pair(p))
+        .filter(|p| p.is_dir() && SampleDir::is_pair(p))
         .collect();
     subs.sort();
     if subs.is_empty() {
         bail!(
-            "{} is neither a dataset (no dataset.json), nor a `streaks stereo` pair folder \
-             (no left.png, right.png and disparity_left.pfm), nor a folder of pair folders",
-            dir.display()
+            "{} is neither a dataset (no {}), nor a `streaks stereo` pair folder \
+             (no {}, {} and {}, nor {}, {} and {}), nor a folder of pair folders",
+            dir.display(),
+            streaks_dataset::files::DATASET_JSON,
+            SAMPLE_NAMES.png[0],
+            SAMPLE_NAMES.png[1],
+            SAMPLE_NAMES.disparity[0],
+            PAIR_NAMES.png[0],
+            PAIR_NAMES.png[1],
+            PAIR_NAMES.disparity[0],
         );
     }
     let samples = subs
@@ -141,7 +129,7 @@ pub fn samples(dir: &Path, split: Option<&str>) -> Result<(InputKind, Vec<Sample
                 .unwrap_or_default()
                 .to_string_lossy()
                 .into_owned();
-            pair_sample(id, p)
+            sample(id, p, RENDER_AGAIN)
         })
         .collect::<Result<Vec<_>>>()?;
     Ok((InputKind::Pairs, samples))

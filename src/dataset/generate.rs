@@ -16,22 +16,22 @@
 //! manifest is written at the end ([`super::index::index_dir`]).
 
 use super::index::{check_sample, dataset_lock, index_dir};
-use super::layout::{
-    sample_id, Conventions, DatasetInfo, FileList, Layout, FORMAT, LOCK, MAX_COUNT,
-    SAMPLE_LOCK_PREFIX,
-};
-use super::lock::{Lock, Mode};
-use super::manifest::{verify_entry, Difference, Manifest};
-use super::sample::{is_complete, remove_stale_tmp, render_sample, SampleSettings};
-use super::shard::Shard;
+use super::sample::{render_sample, SampleSettings};
 use crate::cli::{image_size, progress_bar};
 use anyhow::{bail, Context, Result};
 use rayon::prelude::*;
-use sha2::{Digest, Sha256};
 use std::cell::Cell;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+use streaks_dataset::files::{DATASET_JSON, LOCK, SAMPLE_LOCK_PREFIX};
+use streaks_dataset::layout::{
+    sample_id, Conventions, DatasetInfo, FileList, Layout, FORMAT, MAX_COUNT,
+};
+use streaks_dataset::lock::{Lock, Mode};
+use streaks_dataset::manifest::{sha256_hex, verify_entry, Difference, Manifest};
+use streaks_dataset::settings::Settings;
+use streaks_dataset::shard::Shard;
 use streaks_image::stats::quantile_sorted;
 use streaks_image::write_bytes_atomically;
 use streaks_scenes::procedural::{GeneratorConfig, GENERATOR_VERSION};
@@ -119,11 +119,6 @@ impl std::str::FromStr for NoiseTarget {
     }
 }
 
-/// sha256 of bytes, lowercase hex.
-pub fn sha256_hex(bytes: &[u8]) -> String {
-    format!("{:x}", Sha256::digest(bytes))
-}
-
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<()> {
     // Phase 1: the flags and the config; nothing is written before they are all good.
@@ -156,12 +151,14 @@ pub fn run(args: Args) -> Result<()> {
         config_hash: config_hash.clone(),
         count: args.count,
         seed: args.seed,
-        width: args.width,
-        height: args.height,
-        spp: args.spp,
-        max_depth: args.max_depth,
-        regularize: !args.no_regularize,
-        noise_target: args.noise_target.0,
+        settings: Settings {
+            width: args.width,
+            height: args.height,
+            spp: args.spp,
+            max_depth: args.max_depth,
+            regularize: !args.no_regularize,
+            noise_target: args.noise_target.0,
+        },
         files: FileList::current(),
         conventions: Conventions::current(),
     };
@@ -206,12 +203,7 @@ pub fn run(args: Args) -> Result<()> {
         config,
         config_hash,
         seed: args.seed,
-        width: args.width,
-        height: args.height,
-        spp: args.spp,
-        max_depth: args.max_depth,
-        regularize: !args.no_regularize,
-        noise_target: args.noise_target.0,
+        settings: info.settings,
     };
     let check = |index: u64| health(&layout, &info, index, manifest.as_ref());
     let bar = progress_bar(indices.len() as u64);
@@ -253,7 +245,7 @@ pub fn run(args: Args) -> Result<()> {
                 bar.suspend(|| eprintln!("sample {id}: {holder} is on it; waiting"));
             },
         )?;
-        for stale in remove_stale_tmp(&layout, index)? {
+        for stale in layout.remove_stale_tmp(index)? {
             bar.suspend(|| {
                 eprintln!(
                     "sample {id}: removed {}, the temporary folder of an interrupted run",
@@ -386,7 +378,7 @@ fn health(layout: &Layout, info: &DatasetInfo, index: u64, manifest: Option<&Man
             let diffs = verify_entry(layout, entry);
             if !diffs.is_empty() {
                 Health::Damaged(describe(&diffs))
-            } else if !is_complete(layout, index) {
+            } else if !layout.is_complete(index) {
                 Health::Damaged("its files match manifest.jsonl, which lists too few".into())
             } else {
                 Health::Good
@@ -453,7 +445,7 @@ fn remove_sample(dir: &Path) -> Result<()> {
 fn check_existing(info: &DatasetInfo, existing: &[u8], path: &std::path::Path) -> Result<()> {
     let value: serde_json::Value = serde_json::from_slice(existing)
         .with_context(|| format!("{} is not a dataset.json (not JSON)", path.display()))?;
-    info.check_same(&value, path)
+    Ok(info.check_same(&value, path)?)
 }
 
 /// Writes the dataset folder's `dataset.json`, or checks that the folder holds the same
@@ -471,7 +463,10 @@ fn prepare_folder(layout: &Layout, info: &DatasetInfo) -> Result<()> {
                 .with_context(|| format!("cannot list {}", root.display()))?;
             for entry in entries {
                 let name = entry?.file_name().to_string_lossy().into_owned();
-                if name != "dataset.json" && name != LOCK && !name.starts_with(".dataset.json.") {
+                if name != DATASET_JSON
+                    && name != LOCK
+                    && !name.starts_with(&format!(".{DATASET_JSON}."))
+                {
                     bail!(
                         "{} is not empty (it holds {name}) and has no dataset.json: it is not a \
                          dataset; give an empty or new folder",
@@ -479,7 +474,7 @@ fn prepare_folder(layout: &Layout, info: &DatasetInfo) -> Result<()> {
                     );
                 }
             }
-            write_bytes_atomically(&json, &info.to_bytes()?)
+            write_bytes_atomically(&json, &info.to_bytes())
                 .with_context(|| format!("cannot write into {}", root.display()))?;
             // A shard with other settings that wrote at the same time is caught here.
             let written =

@@ -20,22 +20,26 @@
 //! `split`, `seed`, `render_seed`, `files` (path relative to the dataset folder -> sha256 of
 //! every file of the sample folder and of its KITTI files) and `stats` (from `meta.json`).
 
-use super::generate::sha256_hex;
-use super::layout::{sample_id, DatasetInfo, Layout, ROAD_MASK, SAMPLE_FILES, SCENE_GLTF, SPLITS};
-use super::lock::{Lock, LockError, Mode};
-use super::manifest::{verify_batch, Lines};
-use super::sample::{write_kitti, SampleMeta, SampleStats};
+use super::sample::SampleStats;
 use crate::cli::progress_bar;
 use anyhow::{bail, Context, Result};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use streaks_dataset::files::{
+    SampleDir, SAMPLES_DIR, SAMPLE_FILES, SAMPLE_LOCK_PREFIX, SCENE_GLTF, TMP_PREFIX,
+};
+use streaks_dataset::kitti::write_kitti;
+use streaks_dataset::layout::{sample_id, DatasetInfo, Layout, SPLITS};
+use streaks_dataset::lock::{Lock, LockError, Mode};
+use streaks_dataset::manifest::{sha256_hex, verify_batch, Lines};
 use streaks_image::exr::read_exr_rgb;
 use streaks_image::kitti::read_kitti_disparity;
 use streaks_image::pfm::read_pfm;
 use streaks_image::{write_bytes_atomically, GrayImage};
 use streaks_stereo::calib::MiddleburyCalib;
+use streaks_stereo::rig::Eye;
 
 /// Verify a dataset folder against its manifest.jsonl (or write it the first time).
 #[derive(clap::Args, Debug)]
@@ -164,7 +168,7 @@ pub fn run(args: Args) -> Result<()> {
     pool.install(|| verify(&layout, &info, lines))
 }
 
-/// Takes the dataset lock of `layout` (see [`super::lock`]), or fails naming the folder and
+/// Takes the dataset lock of `layout` (see [`streaks_dataset::lock`]), or fails naming the folder and
 /// the run that holds it.
 pub fn dataset_lock(layout: &Layout, mode: Mode, what: &str) -> Result<Lock> {
     match Lock::acquire(&layout.lock(), mode, what, false, &|_| {}) {
@@ -319,16 +323,16 @@ fn strangers(layout: &Layout, info: &DatasetInfo) -> Result<Vec<(String, String)
     names.sort();
     let mut out = Vec::new();
     for name in &names {
-        if name.starts_with(".tmp-") {
+        if name.starts_with(TMP_PREFIX) {
             out.push((
-                format!("samples/{name}"),
+                format!("{SAMPLES_DIR}/{name}"),
                 "temporary folder of a running or interrupted run (generate removes it when no \
                  run renders that sample)"
                     .into(),
             ));
-        } else if name.starts_with(".lock-") {
+        } else if name.starts_with(SAMPLE_LOCK_PREFIX) {
             out.push((
-                format!("samples/{name}"),
+                format!("{SAMPLES_DIR}/{name}"),
                 "lock file of a running or interrupted run (generate removes it when no run \
                  holds it)"
                     .into(),
@@ -338,7 +342,7 @@ fn strangers(layout: &Layout, info: &DatasetInfo) -> Result<Vec<(String, String)
             && name.parse::<u64>().is_ok_and(|i| i < info.count))
         {
             out.push((
-                format!("samples/{name}"),
+                format!("{SAMPLES_DIR}/{name}"),
                 format!(
                     "not a sample of this dataset (ids 000000 to {})",
                     sample_id(info.count - 1)
@@ -408,7 +412,7 @@ pub fn index_dir(layout: &Layout) -> Result<IndexReport> {
     std::fs::create_dir_all(&dir)
         .with_context(|| format!("cannot create the folder {}", dir.display()))?;
     for (split, ids) in &splits {
-        write_bytes_atomically(&dir.join(format!("{split}.txt")), ids.as_bytes())?;
+        write_bytes_atomically(&layout.split_file(split), ids.as_bytes())?;
     }
     Ok(report)
 }
@@ -467,6 +471,14 @@ fn only_regular_files(layout: &Layout, index: u64, dir: &Path) -> Result<()> {
     Ok(())
 }
 
+/// The file name of `path`, for messages.
+fn file_name(path: &Path) -> String {
+    path.file_name()
+        .unwrap_or_default()
+        .to_string_lossy()
+        .into_owned()
+}
+
 /// Checks that `path` is an image of `w` x `h` pixels.
 fn check_size(
     path: &Path,
@@ -477,7 +489,7 @@ fn check_size(
     if (img.width, img.height) != (w, h) {
         bail!(
             "{} is {}x{}, the dataset's images are {w}x{h}",
-            path.file_name().unwrap_or_default().to_string_lossy(),
+            file_name(path),
             img.width,
             img.height
         );
@@ -496,7 +508,9 @@ pub fn check_sample(
 ) -> Result<(ManifestLine, String)> {
     // Nothing is read through a symbolic link or from a special file (a FIFO would block).
     only_regular_files(layout, index, dir)?;
-    let meta = SampleMeta::load(&dir.join("meta.json"))
+    let sample = SampleDir::new(dir);
+    let meta = sample
+        .load_meta()
         .map_err(|e| anyhow::anyhow!("meta.json: {e:#}"))?;
     if meta.index != index || meta.seed != info.seed || meta.config_hash != info.config_hash {
         bail!(
@@ -507,8 +521,9 @@ pub fn check_sample(
         );
     }
     let mut expected: Vec<String> = SAMPLE_FILES.map(String::from).to_vec();
+    let road_mask = sample.road_mask(Eye::Left);
     if meta.road_mask {
-        expected.push(ROAD_MASK.to_owned());
+        expected.push(file_name(&road_mask));
     }
     expected.push(SCENE_GLTF.to_owned());
     if dir.join(SCENE_GLTF).is_file() {
@@ -519,25 +534,31 @@ pub fn check_sample(
         let list: Vec<&str> = absent.iter().map(|s| s.as_str()).collect();
         bail!("missing files: {}", list.join(", "));
     }
-    let size = (info.width as usize, info.height as usize);
-    let mut pngs = vec!["im0.png", "im1.png", "streaks0.png"];
+    let size = (info.settings.width as usize, info.settings.height as usize);
+    let mut pngs = vec![
+        sample.png(Eye::Left),
+        sample.png(Eye::Right),
+        sample.streak_mask(Eye::Left),
+    ];
     if meta.road_mask {
-        pngs.push(ROAD_MASK);
+        pngs.push(road_mask);
     }
-    for name in pngs {
-        let p = dir.join(name);
+    for p in pngs {
         check_size(&p, size, GrayImage::load(&p))?;
     }
-    for name in ["disp0.pfm", "disp1.pfm", "depth0.pfm"] {
-        let p = dir.join(name);
+    for p in [
+        sample.disparity(Eye::Left),
+        sample.disparity(Eye::Right),
+        sample.depth(Eye::Left),
+    ] {
         check_size(&p, size, read_pfm(&p))?;
     }
-    for name in ["im0.exr", "im1.exr"] {
-        let p = dir.join(name);
+    for p in Eye::BOTH.map(|eye| sample.exr(eye)) {
         let img = read_exr_rgb(&p)?;
         if (img.width as usize, img.height as usize) != size {
             bail!(
-                "{name} is {}x{}, the dataset's images are {}x{}",
+                "{} is {}x{}, the dataset's images are {}x{}",
+                file_name(&p),
                 img.width,
                 img.height,
                 size.0,
@@ -545,14 +566,15 @@ pub fn check_sample(
             );
         }
     }
-    let calib = MiddleburyCalib::load(&dir.join("calib.txt"))?;
-    if (calib.width, calib.height) != (info.width, info.height) {
+    let calib = MiddleburyCalib::load(&sample.calib())?;
+    if (calib.width, calib.height) != (info.settings.width, info.settings.height) {
         bail!(
-            "calib.txt is for {}x{}, the dataset's images are {}x{}",
+            "{} is for {}x{}, the dataset's images are {}x{}",
+            file_name(&sample.calib()),
             calib.width,
             calib.height,
-            info.width,
-            info.height
+            info.settings.width,
+            info.settings.height
         );
     }
 
@@ -568,7 +590,12 @@ pub fn check_sample(
         let Some(repaired) = kitti_repaired else {
             bail!("missing KITTI files: {}", missing.join(", "));
         };
-        write_kitti(layout, index, dir, &read_pfm(&dir.join("disp0.pfm"))?)?;
+        write_kitti(
+            layout,
+            index,
+            &sample,
+            &read_pfm(&sample.disparity(Eye::Left))?,
+        )?;
         *repaired += missing.len();
     }
     check_size(

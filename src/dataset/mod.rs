@@ -5,21 +5,18 @@
 //! - [`index`]: `streaks dataset index DIR` verifies the files against `manifest.jsonl`, or
 //!   (the first time, or with `--rebuild`) checks what is on disk and writes `manifest.jsonl`
 //!   and `splits/`;
-//! - [`layout`]: the folder layout, `dataset.json` and the conventions it states;
-//! - [`lock`]: the advisory locks that make runs on one folder safe or refused;
-//! - [`manifest`]: reading `manifest.jsonl` back and checking files against it;
-//! - [`sample`]: rendering and writing one sample;
-//! - [`shard`]: `--shard K/N`.
+//! - [`sample`]: rendering and writing one sample.
+//!
+//! The folder layout, `dataset.json`, `meta.json`, the manifest, the locks and the shards are
+//! the `streaks-dataset` crate's ([`layout`] is re-exported here).
 //!
 //! docs/datasets.md describes the layout and the conventions for users.
 
 pub mod generate;
 pub mod index;
-pub mod layout;
-pub mod lock;
-pub mod manifest;
 pub mod sample;
-pub mod shard;
+
+pub use streaks_dataset::layout;
 
 use anyhow::Result;
 

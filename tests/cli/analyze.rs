@@ -162,3 +162,31 @@ fn paper_writes_every_figure_and_the_fig6_numbers() {
     let index = std::fs::read_to_string(t.join("paper/index.md")).unwrap();
     assert!(index.contains("RMS difference"), "{index}");
 }
+
+/// `streaks analyze` reads a dataset sample as it reads a `streaks stereo` folder: the images
+/// and ground truth by the sample layout's names, the rig and lights from `meta.json`.
+#[test]
+fn analyze_reads_a_dataset_sample() {
+    let t = TestDir::new();
+    t.streaks(&[
+        "dataset", "generate", "-o", "ds", "--count", "1", "--width", "96", "--height", "64",
+        "--spp", "2",
+    ])
+    .assert_success();
+    let sample = "ds/samples/000000";
+    let run = t.streaks(&["analyze", sample]);
+    run.assert_success();
+    let text = std::fs::read_to_string(t.join(&format!("{sample}/analysis/report.json"))).unwrap();
+    let r: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let meta: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(t.join(&format!("{sample}/{}", streaks_dataset::files::META)))
+            .unwrap(),
+    )
+    .unwrap();
+    assert_eq!(r["rig"]["width"], 96);
+    assert_eq!(r["rig"]["height"], 64);
+    let baseline = |v: &serde_json::Value| v.as_f64().unwrap();
+    assert!(
+        (baseline(&r["rig"]["baseline_m"]) - baseline(&meta["rig"]["baseline_m"])).abs() < 1e-6
+    );
+}

@@ -182,10 +182,10 @@ fn pair_folders_are_benchmarked_with_their_road_masks() {
     road_pair(&t, "pairs/a");
     road_pair(&t, "pairs/b");
     // `streaks stereo` writes the road mask of each eye; the floor is most of the image.
-    let mask = streaks_image::GrayImage::load(&t.join("pairs/a/road_mask_left.png")).unwrap();
+    let mask = streaks_image::GrayImage::load(&t.join("pairs/a/road0.png")).unwrap();
     let road = mask.data.iter().filter(|&&v| v > 0.0).count();
     assert!(road > mask.data.len() / 3, "{road}");
-    assert!(t.join("pairs/a/road_mask_right.png").exists());
+    assert!(t.join("pairs/a/road1.png").exists());
     // One pair folder.
     t.streaks(&["benchmark", "pairs/a", "--method", "sgm", "-o", "one"])
         .assert_success();
@@ -209,6 +209,42 @@ fn pair_folders_are_benchmarked_with_their_road_masks() {
         .map(|s| s["id"].as_str().unwrap())
         .collect();
     assert_eq!(ids, ["a", "b"]);
+}
+
+/// A pair folder that `streaks stereo` wrote before it used the sample layout (`left.png`,
+/// `disparity_left.pfm`, ...) is benchmarked as before, with the same result.
+#[test]
+fn pair_folders_in_the_older_layout_are_still_read() {
+    let t = TestDir::new();
+    road_pair(&t, "new");
+    std::fs::create_dir(t.join("old")).unwrap();
+    let new = streaks_dataset::files::SAMPLE_NAMES;
+    let old = streaks_dataset::files::PAIR_NAMES;
+    for (from, to) in [
+        (new.png, old.png),
+        (new.disparity, old.disparity),
+        (new.streak_mask, old.streak_mask),
+        (new.road_mask, old.road_mask),
+    ] {
+        for i in 0..2 {
+            std::fs::copy(
+                t.join(&format!("new/{}", from[i])),
+                t.join(&format!("old/{}", to[i])),
+            )
+            .unwrap();
+        }
+    }
+    for (dir, out) in [("new", "r_new"), ("old", "r_old")] {
+        t.streaks(&["benchmark", dir, "--method", "sgm", "-o", out])
+            .assert_success();
+    }
+    let (a, b) = (report(&t, "r_new"), report(&t, "r_old"));
+    assert_eq!(b["input"]["kind"], "pair");
+    assert_eq!(b["samples"][0]["road_mask"], true);
+    assert_eq!(
+        a["samples"][0]["results"][0]["errors"],
+        b["samples"][0]["results"][0]["errors"]
+    );
 }
 
 #[test]

@@ -123,7 +123,7 @@ fn disparity_streak_repair_writes_confidence_and_scores_phantom_holes() {
     ])
     .assert_success();
     // The floor is the road: a road mask of the pixels with a ground truth below the horizon.
-    let truth = streaks_image::pfm::read_pfm(&t.join("pair/disparity_left.pfm")).unwrap();
+    let truth = streaks_image::pfm::read_pfm(&t.join("pair/disp0.pfm")).unwrap();
     let road = image::GrayImage::from_fn(truth.width as u32, truth.height as u32, |x, y| {
         let d = truth.get(x as usize, y as usize);
         image::Luma([if d.is_finite() && y as usize > truth.height / 2 {
@@ -135,8 +135,8 @@ fn disparity_streak_repair_writes_confidence_and_scores_phantom_holes() {
     road.save(t.join("road.png")).unwrap();
     let run = t.streaks(&[
         "disparity",
-        "pair/left.png",
-        "pair/right.png",
+        "pair/im0.png",
+        "pair/im1.png",
         "-o",
         "d.pfm",
         "--max-disp",
@@ -144,7 +144,7 @@ fn disparity_streak_repair_writes_confidence_and_scores_phantom_holes() {
         "--streaks",
         "repair",
         "--truth",
-        "pair/disparity_left.pfm",
+        "pair/disp0.pfm",
         "--road",
         "road.png",
     ]);
@@ -163,8 +163,8 @@ fn disparity_streak_repair_writes_confidence_and_scores_phantom_holes() {
     assert!(conf.data.contains(&1.0));
     t.streaks(&[
         "disparity",
-        "pair/left.png",
-        "pair/right.png",
+        "pair/im0.png",
+        "pair/im1.png",
         "-o",
         "e.pfm",
         "--road",
@@ -173,8 +173,8 @@ fn disparity_streak_repair_writes_confidence_and_scores_phantom_holes() {
     .assert_failure_mentioning("--truth");
     t.streaks(&[
         "disparity",
-        "pair/left.png",
-        "pair/right.png",
+        "pair/im0.png",
+        "pair/im1.png",
         "-o",
         "e.pfm",
         "--streaks",

@@ -24,18 +24,18 @@ fn stereo_writes_the_pair_ground_truth_and_rig_then_maps_and_prepares_it() {
         t.files_in("out"),
         [
             "anaglyph.png",
-            "depth_left.pfm",
-            "depth_right.pfm",
-            "disparity_left.pfm",
-            "disparity_right.pfm",
-            "left.exr",
-            "left.png",
+            "depth0.pfm",
+            "depth1.pfm",
+            "disp0.pfm",
+            "disp1.pfm",
+            "im0.exr",
+            "im0.png",
+            "im1.exr",
+            "im1.png",
             "rig.json",
-            "right.exr",
-            "right.png",
             "side_by_side.png",
-            "streak_mask_left.png",
-            "streak_mask_right.png",
+            "streaks0.png",
+            "streaks1.png",
         ]
     );
     let file = RigFile::load(&t.join("out/rig.json")).unwrap();
@@ -66,14 +66,14 @@ fn stereo_writes_the_pair_ground_truth_and_rig_then_maps_and_prepares_it() {
         .expect("the emissive sign");
     assert_eq!(sign.1, 2);
     assert!((glam::Vec3::from(sign.0) - glam::Vec3::new(0.0, 1.75, -3.0)).length() < 1e-5);
-    let disp = streaks_image::pfm::read_pfm(&t.join("out/disparity_left.pfm")).unwrap();
+    let disp = streaks_image::pfm::read_pfm(&t.join("out/disp0.pfm")).unwrap();
     // The floor at the bottom: positive finite disparity; the sky at the top corner: inf.
     assert!(disp.get(15, 19).is_finite() && disp.get(15, 19) > 0.0);
     assert!(disp.get(0, 0).is_infinite());
 
     t.streaks(&[
         "texture-map",
-        "out/left.png",
+        "out/im0.png",
         "--rig",
         "out/rig.json",
         "--x-range",
@@ -89,8 +89,8 @@ fn stereo_writes_the_pair_ground_truth_and_rig_then_maps_and_prepares_it() {
     assert!(image::open(t.join("map.png")).unwrap().width() > 120);
     t.streaks(&[
         "prepare",
-        "out/left.png",
-        "out/right.png",
+        "out/im0.png",
+        "out/im1.png",
         "-o",
         "prep",
         "--shift",
@@ -99,7 +99,7 @@ fn stereo_writes_the_pair_ground_truth_and_rig_then_maps_and_prepares_it() {
     .assert_success();
     assert_eq!(
         t.files_in("prep"),
-        ["anaglyph.png", "left.png", "right.png", "side_by_side.png"]
+        ["anaglyph.png", "im0.png", "im1.png", "side_by_side.png"]
     );
 }
 
@@ -148,9 +148,10 @@ fn bad_inputs_are_clear_errors() {
 use glam::Vec3;
 use std::path::{Path, PathBuf};
 use streaks_analysis::lk::{lk_region, LkParams};
+use streaks_dataset::write::write_pair;
 use streaks_image::{GrayImage, Region, RgbImage};
 use streaks_render::scene::Scene;
-use streaks_stereo::render::{render_pair, rig_from_camera, write_pair, EyeView, PairSettings};
+use streaks_stereo::render::{render_pair, rig_from_camera, EyeView, PairSettings};
 use streaks_stereo::rig::Eye;
 use streaks_stereo::streak_mask::StreakMaskParams;
 
@@ -307,21 +308,21 @@ fn road_plane_disparity_matches_the_analytic_plane() {
     // Write the whole pair and read a few files back.
     write_pair(dir.path(), &scene, &rig, &views, 0.0).unwrap();
     for name in [
-        "left.exr",
-        "right.exr",
-        "left.png",
-        "right.png",
+        "im0.exr",
+        "im1.exr",
+        "im0.png",
+        "im1.png",
         "side_by_side.png",
         "anaglyph.png",
-        "disparity_left.pfm",
-        "depth_left.pfm",
-        "streak_mask_left.png",
-        "streak_mask_right.png",
+        "disp0.pfm",
+        "depth0.pfm",
+        "streaks0.png",
+        "streaks1.png",
         "rig.json",
     ] {
         assert!(dir.path().join(name).exists(), "{name}");
     }
-    let disp = streaks_image::pfm::read_pfm(&dir.path().join("disparity_left.pfm")).unwrap();
+    let disp = streaks_image::pfm::read_pfm(&dir.path().join("disp0.pfm")).unwrap();
     assert_eq!(disp, views[0].disparity);
     let file = RigFile::load(&dir.path().join("rig.json")).unwrap();
     assert_eq!(file.rig().unwrap().intrinsics(), rig.intrinsics());

@@ -14,8 +14,6 @@
 //! - [`rigfile`]: `rig.json` ([`rigfile::RigFile`]), with the scene's lights in world and road
 //!   coordinates.
 //! - [`pair`]: side-by-side and anaglyph views; the paper's Fig. 7 treatment of photographs.
-//! - [`pair_dir`]: the names of a pair folder's files ([`pair_dir::PairDir`]), for its writer
-//!   and its readers.
 //! - [`streak_mask`]: which pixels are specular streaks, from the renderer's specular layer.
 //! - [`texture_map`]: the paper's Fig. 3 ground-plane texture map.
 //! - [`font`]: the bundled plot font (plotters + `ab_glyph`, no system fonts).
@@ -41,7 +39,6 @@ pub mod calib;
 pub mod error;
 pub mod font;
 pub mod pair;
-pub mod pair_dir;
 #[cfg(feature = "render")]
 pub mod render;
 pub mod rig;

@@ -3,7 +3,6 @@
 //! moves a chosen disparity to zero).
 
 use crate::error::StereoError;
-use crate::pair_dir::PairDir;
 use std::path::Path;
 use streaks_image::png::write_png_buffer;
 use streaks_image::{ensure_pair_size, GrayImage};
@@ -47,15 +46,16 @@ pub fn anaglyph(
     Ok(out)
 }
 
-/// Writes `side_by_side.png` and `anaglyph.png` of a pair into `dir`.
+/// Writes the side-by-side view of a pair to `side_by_side_path` and its anaglyph to
+/// `anaglyph_path` (the sample folder's names are the `streaks-dataset` crate's).
 pub fn write_pair_views(
-    dir: &Path,
+    side_by_side_path: &Path,
+    anaglyph_path: &Path,
     left: &image::RgbImage,
     right: &image::RgbImage,
 ) -> Result<(), StereoError> {
-    let files = PairDir::new(dir);
-    write_png_buffer(&files.side_by_side(), &side_by_side(left, right)?)?;
-    write_png_buffer(&files.anaglyph(), &anaglyph(left, right)?)?;
+    write_png_buffer(side_by_side_path, &side_by_side(left, right)?)?;
+    write_png_buffer(anaglyph_path, &anaglyph(left, right)?)?;
     Ok(())
 }
 

@@ -12,32 +12,21 @@
 //! The left eye is rendered with the given seed and the right eye with `seed + 1`, so that
 //! the two views' sampling noise is independent and cannot pull a matcher toward zero disparity.
 //!
-//! Files written by [`write_pair`] into the output folder: `left.exr`, `right.exr` (linear,
-//! with `depth`, `normal` and `specular` layers), `left.png`, `right.png` (sRGB with the
-//! exposure), `side_by_side.png`, `anaglyph.png`, `disparity_left.pfm`, `depth_left.pfm`,
-//! `disparity_right.pfm`, `depth_right.pfm`, `streak_mask_left.png`, `streak_mask_right.png`,
-//! `road_mask_left.png`, `road_mask_right.png` (when the scene flags a road material:
-//! [`EyeView::road_surface`], 0/255) and `rig.json`.
+//! The views are written into a sample folder by the `streaks-dataset` crate (its `write`
+//! module), which names every file.
 //!
 //! The rendered-scene tests (ground truth against an analytic road plane, and the disparity
 //! of a rendered textured plane measured with the project's Lucas-Kanade estimator) are in
 //! `tests/cli/stereo.rs`.
 
 use crate::error::StereoError;
-use crate::pair::write_pair_views;
-use crate::pair_dir::PairDir;
 use crate::rig::{Eye, Intrinsics, Rig, RoadFrame};
-use crate::rigfile::{LightRecord, Placed, RigFile};
+use crate::rigfile::{LightRecord, Placed};
 use crate::streak_mask::{streak_mask, StreakMaskParams};
-use std::path::Path;
-use streaks_image::develop;
-use streaks_image::pfm::write_pfm;
-use streaks_image::png::write_png_buffer;
 use streaks_image::GrayImage;
 use streaks_render::camera::Camera;
 use streaks_render::integrator::{render, Layers, RenderOutput, RenderSettings};
 use streaks_render::light::{Emitter, Light};
-use streaks_render::output::write_exr;
 use streaks_render::scene::Scene;
 
 /// A road pixel's first-hit normal is within this angle's cosine of +Y (10 degrees).
@@ -294,34 +283,6 @@ pub fn light_records(scene: &Scene, road: Option<&RoadFrame>) -> Vec<LightRecord
             }
         })
         .collect()
-}
-
-/// Writes a rendered pair and its ground truth into `dir` (which must exist); see the module
-/// documentation for the files.
-pub fn write_pair(
-    dir: &Path,
-    scene: &Scene,
-    rig: &Rig,
-    views: &[EyeView; 2],
-    exposure_ev: f32,
-) -> Result<(), StereoError> {
-    let files = PairDir::new(dir);
-    let mut srgb = Vec::with_capacity(2);
-    for (eye, view) in Eye::BOTH.into_iter().zip(views) {
-        write_exr(&files.exr(eye), &view.output)?;
-        let img = develop(&view.output.image, exposure_ev)?;
-        write_png_buffer(&files.png(eye), &img)?;
-        srgb.push(img);
-        write_pfm(&files.disparity(eye), &view.disparity)?;
-        write_pfm(&files.depth(eye), &view.depth)?;
-        view.streak_mask.save_png(&files.streak_mask(eye))?;
-        if scene_has_road(scene) {
-            view.road_surface_mask()?.save_png(&files.road_mask(eye))?;
-        }
-    }
-    write_pair_views(dir, &srgb[0], &srgb[1])?;
-    let road = rig.road_frame().ok();
-    RigFile::new(rig, light_records(scene, road.as_ref())).save(&files.rig())
 }
 
 #[cfg(test)]

@@ -3,11 +3,11 @@
 use super::ReportError;
 use glam::{Vec2, Vec3};
 use std::path::{Path, PathBuf};
+use streaks_dataset::SampleDir;
 use streaks_image::pfm::read_pfm;
 use streaks_image::{GrayImage, ImageError};
-use streaks_stereo::pair_dir::PairDir;
 use streaks_stereo::rig::{Eye, EyeCamera, Rig, RoadFrame, RoadRig};
-use streaks_stereo::rigfile::{LightRecord, RigFile};
+use streaks_stereo::rigfile::LightRecord;
 
 /// A pair and what is known about it.
 #[derive(Clone, Debug)]
@@ -24,20 +24,24 @@ pub struct StereoInput {
     pub truth_disparity: Option<GrayImage>,
     /// Ground-truth depth of the left image, if known.
     pub truth_depth: Option<GrayImage>,
-    /// The renderer's streak mask of the left image (`streak_mask_left.png`), if present.
+    /// The renderer's streak mask of the left image, if present.
     pub truth_streak_mask: Option<GrayImage>,
 }
 
 impl StereoInput {
-    /// Loads `dir/{left,right}.exr` (or `.png` when there is no EXR), `dir/rig.json` and the
-    /// ground truth `dir/disparity_left.pfm`, `dir/depth_left.pfm` and the renderer's streak
-    /// mask `dir/streak_mask_left.png` if present.
+    /// Loads the sample folder `dir` ([`SampleDir`]: a `streaks stereo` folder in either
+    /// layout, or a dataset sample): both images (the EXR, or the PNG when there is no EXR),
+    /// the rig and lights (`rig.json`, or a dataset sample's `meta.json`), and the left view's
+    /// ground-truth disparity and depth and the renderer's streak mask if present.
     pub fn load(dir: &Path) -> Result<Self, ReportError> {
-        let files = PairDir::new(dir);
+        let dataset = |e: streaks_dataset::DatasetError| ReportError::Input {
+            path: dir.to_path_buf(),
+            reason: e.to_string(),
+        };
+        let files = SampleDir::open(dir).map_err(dataset)?;
         let left = GrayImage::load(&files.image(Eye::Left))?;
         let right = GrayImage::load(&files.image(Eye::Right))?;
-        let file = RigFile::load(&files.rig())?;
-        let rig = file.rig()?;
+        let (rig, lights) = files.rig().map_err(dataset)?;
         let optional = |p: PathBuf, read: fn(&Path) -> Result<GrayImage, ImageError>| {
             p.exists().then(|| read(&p)).transpose()
         };
@@ -45,19 +49,31 @@ impl StereoInput {
             left,
             right,
             rig,
-            lights: file.lights,
+            lights,
             truth_disparity: optional(files.disparity(Eye::Left), read_pfm)?,
             truth_depth: optional(files.depth(Eye::Left), read_pfm)?,
             truth_streak_mask: optional(files.streak_mask(Eye::Left), GrayImage::load)?,
         };
         let i = input.rig.intrinsics();
         let size = (i.width() as usize, i.height() as usize);
+        let name = |p: PathBuf| {
+            p.file_name()
+                .unwrap_or_default()
+                .to_string_lossy()
+                .into_owned()
+        };
         let named = [
-            ("left image", Some(&input.left)),
-            ("right image", Some(&input.right)),
-            ("disparity_left.pfm", input.truth_disparity.as_ref()),
-            ("depth_left.pfm", input.truth_depth.as_ref()),
-            ("streak_mask_left.png", input.truth_streak_mask.as_ref()),
+            ("left image".to_owned(), Some(&input.left)),
+            ("right image".to_owned(), Some(&input.right)),
+            (
+                name(files.disparity(Eye::Left)),
+                input.truth_disparity.as_ref(),
+            ),
+            (name(files.depth(Eye::Left)), input.truth_depth.as_ref()),
+            (
+                name(files.streak_mask(Eye::Left)),
+                input.truth_streak_mask.as_ref(),
+            ),
         ];
         for (what, img) in named {
             if let Some(img) = img {
@@ -65,7 +81,7 @@ impl StereoInput {
                     return Err(ReportError::Input {
                         path: dir.to_path_buf(),
                         reason: format!(
-                            "the {what} is {}x{}, rig.json says {}x{}",
+                            "the {what} is {}x{}, the rig says {}x{}",
                             img.width, img.height, size.0, size.1
                         ),
                     });

@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! DIR/dataset.json                      settings, generator version, config, conventions
-//! DIR/samples/NNNNNN/                   one sample (Middlebury style, see SAMPLE_FILES)
+//! DIR/samples/NNNNNN/                   one sample (Middlebury style, see crate::files)
 //! DIR/samples/.tmp-NNNNNN-PID/          a sample being rendered (renamed when complete)
 //! DIR/samples/.lock-NNNNNN              its lock, while a run checks or renders it
 //! DIR/.lock                             the dataset lock, while a run uses the folder
@@ -13,11 +13,19 @@
 //! DIR/splits/{train,val,test}.txt       sample ids, split by street
 //! ```
 
-use anyhow::{bail, Context, Result};
+use crate::error::DatasetError;
+use crate::files::SampleDir;
+use crate::files::{
+    DATASET_JSON, KITTI_DIR, KITTI_DISP_OCC_0, KITTI_IMAGE_2, KITTI_IMAGE_3, KITTI_SUFFIX, LOCK,
+    MANIFEST, ROAD_MASK, SAMPLES_DIR, SAMPLE_FILES, SAMPLE_LOCK_PREFIX, SCENE_BIN, SCENE_GLTF,
+    SPLITS_DIR, SPLIT_EXTENSION, TMP_PREFIX,
+};
+use crate::settings::Settings;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use streaks_stereo::rig::Eye;
 
 /// The format of `dataset.json` and of the folder it describes.
 pub const FORMAT: &str = "streaks-dataset/1";
@@ -27,32 +35,6 @@ pub const MAX_COUNT: u64 = 1_000_000;
 
 /// The largest `dataset.json` read (the file holds the settings and the generator config).
 pub const MAX_DATASET_JSON_BYTES: u64 = 16 << 20;
-
-/// The files of every sample folder besides the scene's, sorted.
-pub const SAMPLE_FILES: [&str; 10] = [
-    "calib.txt",
-    "depth0.pfm",
-    "disp0.pfm",
-    "disp1.pfm",
-    "im0.exr",
-    "im0.png",
-    "im1.exr",
-    "im1.png",
-    "meta.json",
-    "streaks0.png",
-];
-
-/// The dataset lock's file name in the dataset folder.
-pub const LOCK: &str = ".lock";
-
-/// The name prefix of the sample locks in `samples/`: `.lock-NNNNNN`.
-pub const SAMPLE_LOCK_PREFIX: &str = ".lock-";
-
-/// The road-surface mask, present when the scene flags a road material.
-pub const ROAD_MASK: &str = "road0.png";
-
-/// The scene's glTF in a sample folder (with `scene.bin` and its `scene_*.png` textures).
-pub const SCENE_GLTF: &str = "scene.gltf";
 
 /// The splits, in the order of `splits/`.
 pub const SPLITS: [&str; 3] = ["train", "val", "test"];
@@ -101,12 +83,12 @@ impl Layout {
 
     /// `dataset.json`.
     pub fn dataset_json(&self) -> PathBuf {
-        self.root.join("dataset.json")
+        self.root.join(DATASET_JSON)
     }
 
     /// `manifest.jsonl`.
     pub fn manifest(&self) -> PathBuf {
-        self.root.join("manifest.jsonl")
+        self.root.join(MANIFEST)
     }
 
     /// Whether `manifest.jsonl` exists (as anything: a symbolic link or folder there is
@@ -115,12 +97,12 @@ impl Layout {
         std::fs::symlink_metadata(self.manifest()).is_ok()
     }
 
-    /// `.lock`: the dataset lock (see [`super::lock`]).
+    /// `.lock`: the dataset lock (see [`crate::lock`]).
     pub fn lock(&self) -> PathBuf {
         self.root.join(LOCK)
     }
 
-    /// `samples/.lock-NNNNNN`: the lock of sample `index` (see [`super::lock`]).
+    /// `samples/.lock-NNNNNN`: the lock of sample `index` (see [`crate::lock`]).
     pub fn sample_lock(&self, index: u64) -> PathBuf {
         self.samples_dir()
             .join(format!("{SAMPLE_LOCK_PREFIX}{}", sample_id(index)))
@@ -128,12 +110,12 @@ impl Layout {
 
     /// `splits/`.
     pub fn splits_dir(&self) -> PathBuf {
-        self.root.join("splits")
+        self.root.join(SPLITS_DIR)
     }
 
     /// `samples/`.
     pub fn samples_dir(&self) -> PathBuf {
-        self.root.join("samples")
+        self.root.join(SAMPLES_DIR)
     }
 
     /// `samples/NNNNNN/`.
@@ -141,9 +123,19 @@ impl Layout {
         self.samples_dir().join(sample_id(index))
     }
 
+    /// The files of `samples/NNNNNN/`.
+    pub fn sample(&self, index: u64) -> SampleDir {
+        SampleDir::new(self.sample_dir(index))
+    }
+
+    /// The files of the sample folder `samples/ID/`.
+    pub fn sample_by_id(&self, id: &str) -> SampleDir {
+        SampleDir::new(self.samples_dir().join(id))
+    }
+
     /// The name prefix of sample `index`'s temporary folders: `.tmp-NNNNNN-`.
     pub fn tmp_prefix(index: u64) -> String {
-        format!(".tmp-{}-", sample_id(index))
+        format!("{TMP_PREFIX}{}-", sample_id(index))
     }
 
     /// This process's temporary folder for sample `index`: `samples/.tmp-NNNNNN-PID/`.
@@ -152,14 +144,57 @@ impl Layout {
             .join(format!("{}{}", Self::tmp_prefix(index), std::process::id()))
     }
 
+    /// Whether sample `index` is published and has all its files (a cheap check: the files are
+    /// there and `meta.json` names the index; `streaks dataset index` checks their contents).
+    pub fn is_complete(&self, index: u64) -> bool {
+        let sample = self.sample(index);
+        let present = |name: &str| sample.file(name).is_file();
+        if !SAMPLE_FILES.iter().all(|f| present(f)) || !present(SCENE_GLTF) {
+            return false;
+        }
+        match sample.load_meta() {
+            Ok(meta) => {
+                meta.index == index && (!meta.road_mask || sample.road_mask(Eye::Left).is_file())
+            }
+            Err(_) => false,
+        }
+    }
+
+    /// Removes sample `index`'s temporary folders (`.tmp-NNNNNN-*`) and returns them. Call it
+    /// only while holding the sample's lock ([`Layout::sample_lock`]): every run renders a
+    /// sample under that lock, so then no live run owns such a folder and they are all stale.
+    pub fn remove_stale_tmp(&self, index: u64) -> Result<Vec<PathBuf>, DatasetError> {
+        let prefix = Self::tmp_prefix(index);
+        let dir = self.samples_dir();
+        let Ok(entries) = std::fs::read_dir(&dir) else {
+            return Ok(Vec::new());
+        };
+        let mut removed = Vec::new();
+        for entry in entries {
+            let entry = entry.map_err(|e| DatasetError::io("list", &dir, e))?;
+            if entry.file_name().to_string_lossy().starts_with(&prefix) {
+                let path = entry.path();
+                let is_dir = std::fs::symlink_metadata(&path).is_ok_and(|m| m.is_dir());
+                if is_dir {
+                    std::fs::remove_dir_all(&path)
+                } else {
+                    std::fs::remove_file(&path)
+                }
+                .map_err(|e| DatasetError::io("remove the stale folder", &path, e))?;
+                removed.push(path);
+            }
+        }
+        Ok(removed)
+    }
+
     /// The KITTI view's files of sample `index`.
     pub fn kitti(&self, index: u64) -> KittiFiles {
-        let dir = self.root.join("kitti").join("training");
-        let name = format!("{}_10.png", sample_id(index));
+        let dir = self.root.join(KITTI_DIR[0]).join(KITTI_DIR[1]);
+        let name = format!("{}{KITTI_SUFFIX}", sample_id(index));
         KittiFiles {
-            image_2: dir.join("image_2").join(&name),
-            image_3: dir.join("image_3").join(&name),
-            disp_occ_0: dir.join("disp_occ_0").join(&name),
+            image_2: dir.join(KITTI_IMAGE_2).join(&name),
+            image_3: dir.join(KITTI_IMAGE_3).join(&name),
+            disp_occ_0: dir.join(KITTI_DISP_OCC_0).join(&name),
         }
     }
 
@@ -167,24 +202,22 @@ impl Layout {
     /// index` listed in `splits/SPLIT.txt`; without, every complete sample folder (six digits;
     /// the `.tmp-` folders of samples in progress are left out). Fails on an unknown split, a
     /// missing split file, or no samples.
-    pub fn sample_ids(&self, split: Option<&str>) -> Result<Vec<String>> {
+    pub fn sample_ids(&self, split: Option<&str>) -> Result<Vec<String>, DatasetError> {
         let mut ids: Vec<String> = match split {
             Some(name) => {
                 if !SPLITS.contains(&name) {
-                    bail!(
-                        "--split {name}: a dataset's splits are {}",
-                        SPLITS.join(", ")
-                    );
+                    return Err(DatasetError::UnknownSplit {
+                        name: name.to_owned(),
+                        known: SPLITS.join(", "),
+                    });
                 }
-                let path = self.splits_dir().join(format!("{name}.txt"));
+                let path = self.split_file(name);
                 let text =
                     streaks_image::input::read_text(&path, streaks_image::input::MAX_TEXT_BYTES)
-                        .with_context(|| {
-                            format!(
-                                "cannot read the split {} (run `streaks dataset index {}`)",
-                                path.display(),
-                                self.root.display()
-                            )
+                        .map_err(|source| DatasetError::Split {
+                            path: path.clone(),
+                            root: self.root.clone(),
+                            source,
                         })?;
                 text.lines()
                     .map(str::trim)
@@ -195,7 +228,7 @@ impl Layout {
             None => {
                 let samples = self.samples_dir();
                 std::fs::read_dir(&samples)
-                    .with_context(|| format!("cannot list {}", samples.display()))?
+                    .map_err(|e| DatasetError::io("list", &samples, e))?
                     .filter_map(|e| e.ok())
                     .map(|e| e.file_name().to_string_lossy().into_owned())
                     .filter(|n| n.len() == 6 && n.bytes().all(|b| b.is_ascii_digit()))
@@ -204,15 +237,17 @@ impl Layout {
         };
         ids.sort();
         if ids.is_empty() {
-            bail!(
-                "the dataset {} has no samples{}",
-                self.root.display(),
-                split
-                    .map(|s| format!(" in its {s} split"))
-                    .unwrap_or_default()
-            );
+            return Err(DatasetError::NoSamples {
+                root: self.root.clone(),
+                split: split.map(String::from),
+            });
         }
         Ok(ids)
+    }
+
+    /// `splits/SPLIT.txt`: the ids of the split `name`.
+    pub fn split_file(&self, name: &str) -> PathBuf {
+        self.splits_dir().join(format!("{name}.{SPLIT_EXTENSION}"))
     }
 
     /// `path` relative to the dataset folder, with `/` separators (for the manifest).
@@ -301,14 +336,12 @@ impl FileList {
             )]),
             scene: vec![
                 SCENE_GLTF.to_owned(),
-                "scene.bin".to_owned(),
+                SCENE_BIN.to_owned(),
                 "scene_*.png (the textures scene.gltf refers to)".to_owned(),
             ],
-            kitti: vec![
-                "kitti/training/image_2/NNNNNN_10.png".to_owned(),
-                "kitti/training/image_3/NNNNNN_10.png".to_owned(),
-                "kitti/training/disp_occ_0/NNNNNN_10.png".to_owned(),
-            ],
+            kitti: [KITTI_IMAGE_2, KITTI_IMAGE_3, KITTI_DISP_OCC_0]
+                .map(|d| format!("{}/{}/{d}/NNNNNN{KITTI_SUFFIX}", KITTI_DIR[0], KITTI_DIR[1]))
+                .to_vec(),
         }
     }
 }
@@ -329,23 +362,9 @@ pub struct DatasetInfo {
     pub count: u64,
     /// The dataset seed.
     pub seed: u64,
-    /// Image width in pixels.
-    pub width: u32,
-    /// Image height in pixels.
-    pub height: u32,
-    /// Samples per pixel per eye.
-    pub spp: u32,
-    /// Longest path (Mitsuba's meaning).
-    pub max_depth: u32,
-    /// Path regularisation (`--no-regularize` turns it off). A `dataset.json` written before
-    /// the field existed has none and was rendered without it: it reads as `false`.
-    #[serde(default)]
-    pub regularize: bool,
-    /// Adaptive sampling's target (`--noise-target`; `None`: `spp` samples everywhere). A
-    /// `dataset.json` written before the field existed has none and was rendered at fixed
-    /// spp: it reads as `None`.
-    #[serde(default)]
-    pub noise_target: Option<f64>,
+    /// How the samples are rendered (its fields are fields of `dataset.json` itself).
+    #[serde(flatten)]
+    pub settings: Settings,
     /// The files.
     pub files: FileList,
     /// The conventions.
@@ -356,38 +375,42 @@ impl DatasetInfo {
     /// Reads `dataset.json`.
     /// The file must be a regular file of at most [`MAX_DATASET_JSON_BYTES`] (a FIFO or a
     /// device is not opened) and its `count` in `1..=MAX_COUNT`, since commands loop over it.
-    pub fn load(path: &Path) -> Result<Self> {
-        let meta =
-            std::fs::metadata(path).with_context(|| format!("cannot read {}", path.display()))?;
+    pub fn load(path: &Path) -> Result<Self, DatasetError> {
+        let meta = std::fs::metadata(path).map_err(|e| DatasetError::io("read", path, e))?;
+        let invalid = |reason: String| DatasetError::Invalid {
+            path: path.to_path_buf(),
+            reason,
+        };
         if !meta.is_file() {
-            bail!("{} is not a regular file", path.display());
+            return Err(invalid("not a regular file".into()));
         }
         if meta.len() > MAX_DATASET_JSON_BYTES {
-            bail!(
-                "{} is {} bytes, more than a dataset.json has ({MAX_DATASET_JSON_BYTES})",
-                path.display(),
+            return Err(invalid(format!(
+                "{} bytes, more than a dataset.json has ({MAX_DATASET_JSON_BYTES})",
                 meta.len()
-            );
+            )));
         }
         let text = streaks_image::input::read_text(path, streaks_image::input::MAX_TEXT_BYTES)
-            .with_context(|| format!("cannot read {}", path.display()))?;
-        let info: Self = serde_json::from_str(&text)
-            .with_context(|| format!("{} is not a dataset.json of {FORMAT}", path.display()))?;
+            .map_err(|e| DatasetError::io("read", path, e))?;
+        let info: Self = serde_json::from_str(&text).map_err(|source| DatasetError::Json {
+            path: path.to_path_buf(),
+            what: format!("a dataset.json of {FORMAT}"),
+            source,
+        })?;
         if info.count == 0 || info.count > MAX_COUNT {
-            bail!(
-                "{}: count {} is not in 1..={MAX_COUNT}",
-                path.display(),
+            return Err(invalid(format!(
+                "count {} is not in 1..={MAX_COUNT}",
                 info.count
-            );
+            )));
         }
         Ok(info)
     }
 
     /// The file's bytes (pretty JSON, a final newline).
-    pub fn to_bytes(&self) -> Result<Vec<u8>> {
-        let mut text = serde_json::to_string_pretty(self)?;
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut text = serde_json::to_string_pretty(self).expect("dataset.json serialises");
         text.push('\n');
-        Ok(text.into_bytes())
+        text.into_bytes()
     }
 
     /// Fails, naming the first field that differs, unless `existing` (the folder's
@@ -396,7 +419,7 @@ impl DatasetInfo {
     /// path regularisation: it matches a run with `--no-regularize`, and the message for any
     /// other run says so. Likewise one without `noise_target` was rendered at fixed spp: it
     /// matches a run with `--noise-target off`.
-    pub fn check_same(&self, existing: &Value, path: &Path) -> Result<()> {
+    pub fn check_same(&self, existing: &Value, path: &Path) -> Result<(), DatasetError> {
         let mut existing = existing.clone();
         let (mut unrecorded, mut target_unrecorded) = (false, false);
         if let Value::Object(map) = &mut existing {
@@ -409,14 +432,14 @@ impl DatasetInfo {
                 target_unrecorded = true;
             }
         }
-        let new = serde_json::to_value(self)?;
+        let new = serde_json::to_value(self).expect("dataset.json serialises");
         if let Some((field, old, new)) = first_difference("", &existing, &new) {
             let hint = match field.as_str() {
                 "regularize" if unrecorded => {
                     " (it predates the setting and was rendered without path regularisation: \
                      add --no-regularize to continue it)"
                 }
-                "regularize" if self.regularize => " (add --no-regularize to continue it)",
+                "regularize" if self.settings.regularize => " (add --no-regularize to continue it)",
                 "regularize" => " (drop --no-regularize to continue it)",
                 "noise_target" if target_unrecorded => {
                     " (it predates the setting and was rendered at fixed spp: add \
@@ -425,11 +448,13 @@ impl DatasetInfo {
                 "noise_target" => " (give its --noise-target to continue it)",
                 _ => "",
             };
-            bail!(
-                "{} describes another dataset: its {field} is {old}, this run's is {new}{hint}; \
-                 datasets are not mixed: write into another folder (or remove this one)",
-                path.display()
-            );
+            return Err(DatasetError::OtherDataset {
+                path: path.to_path_buf(),
+                field,
+                old,
+                new,
+                hint,
+            });
         }
         Ok(())
     }
@@ -508,12 +533,14 @@ mod tests {
             config_hash: "h".into(),
             count: 2,
             seed: 0,
-            width: 64,
-            height: 40,
-            spp: 2,
-            max_depth: 8,
-            regularize,
-            noise_target: None,
+            settings: Settings {
+                width: 64,
+                height: 40,
+                spp: 2,
+                max_depth: 8,
+                regularize,
+                noise_target: None,
+            },
             files: FileList::current(),
             conventions: Conventions::current(),
         }
@@ -551,12 +578,10 @@ mod tests {
         let mut old = serde_json::to_value(info(true)).unwrap();
         old.as_object_mut().unwrap().remove("noise_target");
         let back: DatasetInfo = serde_json::from_value(old.clone()).unwrap();
-        assert_eq!(back.noise_target, None);
+        assert_eq!(back.settings.noise_target, None);
         info(true).check_same(&old, path).unwrap();
-        let adaptive = DatasetInfo {
-            noise_target: Some(0.25),
-            ..info(true)
-        };
+        let mut adaptive = info(true);
+        adaptive.settings.noise_target = Some(0.25);
         let err = adaptive.check_same(&old, path).unwrap_err().to_string();
         assert!(
             err.contains("its noise_target is null, this run's is 0.25")

@@ -6,13 +6,18 @@
 //! files), so nothing outside the dataset folder is ever read. Errors name the line.
 //! Checking never follows a symbolic link and never opens anything but a regular file.
 
-use super::layout::{sample_id, Layout};
+use crate::layout::{sample_id, Layout};
 use rayon::prelude::*;
 use serde::Deserialize;
 use sha2::{Digest, Sha256};
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
+
+/// sha256 of bytes, lowercase hex (as the manifest lists files).
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    format!("{:x}", Sha256::digest(bytes))
+}
 
 /// The longest line accepted (a sample's line is a few kilobytes).
 pub const MAX_LINE_BYTES: usize = 1 << 20;
@@ -558,7 +563,7 @@ mod tests {
             3,
             &|_| true,
             text.as_bytes(),
-            Path::new("manifest.jsonl"),
+            Path::new(crate::files::MANIFEST),
         )
     }
 

@@ -1,0 +1,387 @@
+//! Every file name of a sample folder and of a dataset folder, spelled once, and
+//! [`SampleDir`], the one type that names, reads and checks a sample's files.
+//!
+//! A sample folder (Middlebury style; a dataset's `samples/NNNNNN/`, and the folder of
+//! `streaks stereo -o DIR`):
+//!
+//! ```text
+//! im0.exr, im1.exr        linear float32 RGB with the depth, normal and specular layers
+//! im0.png, im1.png        8-bit sRGB of the render times 2^exposure
+//! disp0.pfm, disp1.pfm    ground-truth disparity of the left and right view
+//! depth0.pfm              ground-truth depth of the left view (depth1.pfm: the right view's)
+//! streaks0.png            streak mask of the left view (streaks1.png: the right view's)
+//! road0.png               road-surface mask of the left view, when the scene flags a road
+//!                         (road1.png: the right view's)
+//! calib.txt               Middlebury 2014 calibration
+//! meta.json               a dataset sample's metadata (rig, lights, seeds, statistics)
+//! rig.json                a pair's rig and lights (`streaks stereo`)
+//! anaglyph.png, side_by_side.png   a pair's viewing aids (`streaks stereo`)
+//! scene.gltf, scene.bin, scene_*.png   a dataset sample's scene
+//! ```
+//!
+//! A dataset sample has the left view's depth and masks only; a `streaks stereo` folder has
+//! both views'. Folders that `streaks stereo` wrote before it used this layout (`left.exr`,
+//! `disparity_left.pfm`, ...: [`PAIR_NAMES`]) are still read: [`SampleDir::open`] finds which
+//! layout a folder has.
+
+use crate::error::DatasetError;
+use crate::meta::SampleMeta;
+use std::path::{Path, PathBuf};
+use streaks_stereo::calib::MiddleburyCalib;
+use streaks_stereo::rig::{Eye, Intrinsics, Rig};
+use streaks_stereo::rigfile::{LightRecord, RigFile};
+
+/// `dataset.json`: a dataset's settings and conventions.
+pub const DATASET_JSON: &str = "dataset.json";
+/// `manifest.jsonl`: one line per good sample of a dataset.
+pub const MANIFEST: &str = "manifest.jsonl";
+/// The dataset lock's file name in the dataset folder.
+pub const LOCK: &str = ".lock";
+/// The name prefix of the sample locks in `samples/`: `.lock-NNNNNN`.
+pub const SAMPLE_LOCK_PREFIX: &str = ".lock-";
+/// The name prefix of the temporary folders in `samples/`: `.tmp-NNNNNN-PID`.
+pub const TMP_PREFIX: &str = ".tmp-";
+/// A dataset's sample folders.
+pub const SAMPLES_DIR: &str = "samples";
+/// A dataset's split lists.
+pub const SPLITS_DIR: &str = "splits";
+/// The extension of a split list (`splits/train.txt`).
+pub const SPLIT_EXTENSION: &str = "txt";
+/// A dataset's KITTI 2015 view (`kitti/training/...`).
+pub const KITTI_DIR: [&str; 2] = ["kitti", "training"];
+/// The KITTI view's left images.
+pub const KITTI_IMAGE_2: &str = "image_2";
+/// The KITTI view's right images.
+pub const KITTI_IMAGE_3: &str = "image_3";
+/// The KITTI view's left disparities.
+pub const KITTI_DISP_OCC_0: &str = "disp_occ_0";
+/// The suffix of a KITTI file name after the sample id (`NNNNNN_10.png`).
+pub const KITTI_SUFFIX: &str = "_10.png";
+
+/// `calib.txt`: the Middlebury 2014 calibration.
+pub const CALIB: &str = "calib.txt";
+/// `meta.json`: a dataset sample's metadata.
+pub const META: &str = "meta.json";
+/// `rig.json`: a pair's rig and lights.
+pub const RIG: &str = "rig.json";
+/// `anaglyph.png`: a pair's red-cyan view.
+pub const ANAGLYPH: &str = "anaglyph.png";
+/// `side_by_side.png`: a pair's two views side by side.
+pub const SIDE_BY_SIDE: &str = "side_by_side.png";
+/// The scene's glTF in a sample folder (with [`SCENE_BIN`] and its `scene_*.png` textures).
+pub const SCENE_GLTF: &str = "scene.gltf";
+/// The scene's buffer in a sample folder.
+pub const SCENE_BIN: &str = "scene.bin";
+/// The road-surface mask of the left view, present when the scene flags a road material.
+pub const ROAD_MASK: &str = "road0.png";
+
+/// The files of every dataset sample folder besides the scene's, sorted.
+pub const SAMPLE_FILES: [&str; 10] = [
+    CALIB,
+    "depth0.pfm",
+    "disp0.pfm",
+    "disp1.pfm",
+    "im0.exr",
+    "im0.png",
+    "im1.exr",
+    "im1.png",
+    META,
+    "streaks0.png",
+];
+
+/// The names of the per-eye files of one layout, left then right.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Names {
+    /// The linear image with its layers.
+    pub exr: [&'static str; 2],
+    /// The 8-bit sRGB image.
+    pub png: [&'static str; 2],
+    /// Ground-truth disparity.
+    pub disparity: [&'static str; 2],
+    /// Ground-truth depth.
+    pub depth: [&'static str; 2],
+    /// The renderer's streak mask.
+    pub streak_mask: [&'static str; 2],
+    /// The road-surface mask.
+    pub road_mask: [&'static str; 2],
+}
+
+/// The sample layout (Middlebury style): `im0.png`, `disp0.pfm`, ...
+pub const SAMPLE_NAMES: Names = Names {
+    exr: ["im0.exr", "im1.exr"],
+    png: ["im0.png", "im1.png"],
+    disparity: ["disp0.pfm", "disp1.pfm"],
+    depth: ["depth0.pfm", "depth1.pfm"],
+    streak_mask: ["streaks0.png", "streaks1.png"],
+    road_mask: [ROAD_MASK, "road1.png"],
+};
+
+/// The older pair layout of `streaks stereo`: `left.png`, `disparity_left.pfm`, ... (read,
+/// never written).
+pub const PAIR_NAMES: Names = Names {
+    exr: ["left.exr", "right.exr"],
+    png: ["left.png", "right.png"],
+    disparity: ["disparity_left.pfm", "disparity_right.pfm"],
+    depth: ["depth_left.pfm", "depth_right.pfm"],
+    streak_mask: ["streak_mask_left.png", "streak_mask_right.png"],
+    road_mask: ["road_mask_left.png", "road_mask_right.png"],
+};
+
+fn eye_index(eye: Eye) -> usize {
+    match eye {
+        Eye::Left => 0,
+        Eye::Right => 1,
+    }
+}
+
+/// A sample folder: the paths of its files in its layout, and reading what they hold.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SampleDir {
+    dir: PathBuf,
+    names: &'static Names,
+}
+
+impl SampleDir {
+    /// The sample folder `dir` in the sample layout (for writing, or reading a folder known
+    /// to have it).
+    pub fn new(dir: impl Into<PathBuf>) -> Self {
+        Self {
+            dir: dir.into(),
+            names: &SAMPLE_NAMES,
+        }
+    }
+
+    /// The layout `dir` has: the sample layout when its left image is there in it, else the
+    /// older pair layout when its is, else `None`.
+    fn detect(dir: &Path) -> Option<&'static Names> {
+        [&SAMPLE_NAMES, &PAIR_NAMES].into_iter().find(|names| {
+            let i = eye_index(Eye::Left);
+            dir.join(names.png[i]).is_file() || dir.join(names.exr[i]).is_file()
+        })
+    }
+
+    /// The sample folder `dir` as it is on disk: the sample layout, or the older pair layout
+    /// of `streaks stereo`. Fails naming the folder when it has neither's left image.
+    pub fn open(dir: impl Into<PathBuf>) -> Result<Self, DatasetError> {
+        let dir = dir.into();
+        match Self::detect(&dir) {
+            Some(names) => Ok(Self { dir, names }),
+            None => Err(DatasetError::NotASample {
+                path: dir,
+                left: SAMPLE_NAMES.png[0],
+                right: SAMPLE_NAMES.png[1],
+                old_left: PAIR_NAMES.png[0],
+                old_right: PAIR_NAMES.png[1],
+            }),
+        }
+    }
+
+    /// Whether `dir` holds a stereo pair to measure, in either layout: both 8-bit images and
+    /// the left view's ground-truth disparity.
+    pub fn is_pair(dir: &Path) -> bool {
+        Self::detect(dir).is_some_and(|n| {
+            n.png.iter().all(|f| dir.join(f).is_file()) && dir.join(n.disparity[0]).is_file()
+        })
+    }
+
+    /// The folder.
+    pub fn path(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Whether the folder has the older pair layout (`left.png`, ...).
+    pub fn is_old_pair_layout(&self) -> bool {
+        *self.names == PAIR_NAMES
+    }
+
+    fn eye_file(&self, names: [&'static str; 2], eye: Eye) -> PathBuf {
+        self.dir.join(names[eye_index(eye)])
+    }
+
+    /// The linear image with its layers (`im0.exr`).
+    pub fn exr(&self, eye: Eye) -> PathBuf {
+        self.eye_file(self.names.exr, eye)
+    }
+
+    /// The 8-bit sRGB image (`im0.png`).
+    pub fn png(&self, eye: Eye) -> PathBuf {
+        self.eye_file(self.names.png, eye)
+    }
+
+    /// The eye's image to measure: the EXR if it exists, else the PNG.
+    pub fn image(&self, eye: Eye) -> PathBuf {
+        let exr = self.exr(eye);
+        if exr.exists() {
+            exr
+        } else {
+            self.png(eye)
+        }
+    }
+
+    /// Ground-truth disparity (`disp0.pfm`).
+    pub fn disparity(&self, eye: Eye) -> PathBuf {
+        self.eye_file(self.names.disparity, eye)
+    }
+
+    /// Ground-truth depth (`depth0.pfm`).
+    pub fn depth(&self, eye: Eye) -> PathBuf {
+        self.eye_file(self.names.depth, eye)
+    }
+
+    /// The renderer's streak mask (`streaks0.png`, 0/255).
+    pub fn streak_mask(&self, eye: Eye) -> PathBuf {
+        self.eye_file(self.names.streak_mask, eye)
+    }
+
+    /// The pixels whose first hit is the road surface (`road0.png`, 0/255; written only when
+    /// the scene flags a road material).
+    pub fn road_mask(&self, eye: Eye) -> PathBuf {
+        self.eye_file(self.names.road_mask, eye)
+    }
+
+    /// `calib.txt`.
+    pub fn calib(&self) -> PathBuf {
+        self.dir.join(CALIB)
+    }
+
+    /// `meta.json`.
+    pub fn meta(&self) -> PathBuf {
+        self.dir.join(META)
+    }
+
+    /// `rig.json`.
+    pub fn rig_json(&self) -> PathBuf {
+        self.dir.join(RIG)
+    }
+
+    /// `anaglyph.png`.
+    pub fn anaglyph(&self) -> PathBuf {
+        self.dir.join(ANAGLYPH)
+    }
+
+    /// `side_by_side.png`.
+    pub fn side_by_side(&self) -> PathBuf {
+        self.dir.join(SIDE_BY_SIDE)
+    }
+
+    /// `scene.gltf`.
+    pub fn scene(&self) -> PathBuf {
+        self.dir.join(SCENE_GLTF)
+    }
+
+    /// A file of the folder by its name (a name of this module).
+    pub fn file(&self, name: &str) -> PathBuf {
+        self.dir.join(name)
+    }
+
+    /// Reads `meta.json`.
+    pub fn load_meta(&self) -> Result<SampleMeta, DatasetError> {
+        SampleMeta::load(&self.meta())
+    }
+
+    /// The rig and the scene's lights: from `rig.json` when the folder has one (a pair),
+    /// else from `meta.json` (a dataset sample).
+    pub fn rig(&self) -> Result<(Rig, Vec<LightRecord>), DatasetError> {
+        let rig_json = self.rig_json();
+        if rig_json.exists() {
+            let file = RigFile::load(&rig_json)?;
+            return Ok((file.rig()?, file.lights));
+        }
+        let meta = self.load_meta()?;
+        let r = &meta.rig;
+        let invalid = |e: streaks_stereo::error::StereoError| DatasetError::Invalid {
+            path: self.meta(),
+            reason: format!("its rig: {e}"),
+        };
+        let rig = Rig::new(
+            Intrinsics::new(r.width, r.height, r.focal_px).map_err(invalid)?,
+            r.baseline_m,
+            r.world_from_rig.to_affine(),
+        )
+        .map_err(invalid)?;
+        Ok((rig, meta.lights))
+    }
+
+    /// Reads `calib.txt`.
+    pub fn load_calib(&self) -> Result<MiddleburyCalib, DatasetError> {
+        Ok(MiddleburyCalib::load(&self.calib())?)
+    }
+
+    /// The first of `files` that is not a regular file in the folder, as an error.
+    pub fn require(&self, files: &[PathBuf]) -> Result<(), DatasetError> {
+        match files.iter().find(|p| !p.is_file()) {
+            Some(p) => Err(DatasetError::Missing {
+                dir: self.dir.clone(),
+                file: p
+                    .file_name()
+                    .unwrap_or_default()
+                    .to_string_lossy()
+                    .into_owned(),
+            }),
+            None => Ok(()),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn name(p: PathBuf) -> String {
+        p.file_name().unwrap().to_string_lossy().into_owned()
+    }
+
+    #[test]
+    fn names_follow_the_sample_layout() {
+        let dir = tempfile::tempdir().unwrap();
+        let s = SampleDir::new(dir.path());
+        assert_eq!(name(s.disparity(Eye::Left)), "disp0.pfm");
+        assert_eq!(name(s.streak_mask(Eye::Right)), "streaks1.png");
+        assert_eq!(name(s.road_mask(Eye::Left)), ROAD_MASK);
+        assert_eq!(name(s.rig_json()), RIG);
+        // The image to measure: the EXR when there is one.
+        assert_eq!(name(s.image(Eye::Left)), "im0.png");
+        std::fs::write(s.exr(Eye::Left), b"").unwrap();
+        assert_eq!(name(s.image(Eye::Left)), "im0.exr");
+        // Every name of SAMPLE_FILES is one of the layout's.
+        for f in SAMPLE_FILES {
+            assert!(
+                [CALIB, META].contains(&f)
+                    || [
+                        SAMPLE_NAMES.exr,
+                        SAMPLE_NAMES.png,
+                        SAMPLE_NAMES.disparity,
+                        SAMPLE_NAMES.depth,
+                        SAMPLE_NAMES.streak_mask
+                    ]
+                    .iter()
+                    .any(|n| n.contains(&f)),
+                "{f}"
+            );
+        }
+    }
+
+    #[test]
+    fn open_finds_the_layout_of_a_folder() {
+        let dir = tempfile::tempdir().unwrap();
+        let err = SampleDir::open(dir.path()).unwrap_err().to_string();
+        assert!(err.contains("im0.png") && err.contains("left.png"), "{err}");
+        for f in ["left.png", "right.png", "disparity_left.pfm"] {
+            std::fs::write(dir.path().join(f), b"").unwrap();
+        }
+        let s = SampleDir::open(dir.path()).unwrap();
+        assert!(s.is_old_pair_layout());
+        assert_eq!(name(s.disparity(Eye::Left)), "disparity_left.pfm");
+        assert_eq!(name(s.streak_mask(Eye::Left)), "streak_mask_left.png");
+        assert!(SampleDir::is_pair(dir.path()));
+        std::fs::write(dir.path().join("im0.exr"), b"").unwrap();
+        let s = SampleDir::open(dir.path()).unwrap();
+        assert!(!s.is_old_pair_layout());
+        assert!(
+            !SampleDir::is_pair(dir.path()),
+            "no im0.png, im1.png, disp0.pfm"
+        );
+        let err = s.require(&[s.png(Eye::Left)]).unwrap_err().to_string();
+        assert!(err.contains("lacks im0.png"), "{err}");
+    }
+}

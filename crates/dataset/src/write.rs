@@ -1,0 +1,75 @@
+//! Writing a rendered pair into a sample folder (feature `render`): the one writer of a
+//! sample's images and ground truth, for `streaks stereo`, `streaks dataset generate` and
+//! `streaks paper` alike.
+
+use crate::error::DatasetError;
+use crate::files::SampleDir;
+use image::RgbImage;
+use streaks_image::develop;
+use streaks_image::pfm::write_pfm;
+use streaks_image::png::write_png_buffer;
+use streaks_render::output::write_exr;
+use streaks_render::scene::Scene;
+use streaks_stereo::pair::write_pair_views;
+use streaks_stereo::render::{light_records, scene_has_road, EyeView};
+use streaks_stereo::rig::{Eye, Rig};
+use streaks_stereo::rigfile::RigFile;
+
+/// Which views get their depth and masks written.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GroundTruth {
+    /// The left view's only (a dataset sample: `depth0.pfm`, `streaks0.png`, `road0.png`).
+    Left,
+    /// Both views' (a `streaks stereo` folder: also `depth1.pfm`, `streaks1.png`,
+    /// `road1.png`).
+    Both,
+}
+
+/// Writes both views of a rendered pair into `files` (whose folder must exist): per eye the
+/// EXR with its layers, the 8-bit sRGB PNG at `exposure_ev` stops and the ground-truth
+/// disparity; the depth, streak mask and (when the scene flags a road material) road-surface
+/// mask of the views `truth` says. Returns the two sRGB images.
+pub fn write_views(
+    files: &SampleDir,
+    scene: &Scene,
+    views: &[EyeView; 2],
+    exposure_ev: f32,
+    truth: GroundTruth,
+) -> Result<[RgbImage; 2], DatasetError> {
+    let has_road = scene_has_road(scene);
+    let mut srgb = Vec::with_capacity(2);
+    for (eye, view) in Eye::BOTH.into_iter().zip(views) {
+        write_exr(&files.exr(eye), &view.output)?;
+        let img = develop(&view.output.image, exposure_ev)?;
+        write_png_buffer(&files.png(eye), &img)?;
+        srgb.push(img);
+        write_pfm(&files.disparity(eye), &view.disparity)?;
+        if eye == Eye::Left || truth == GroundTruth::Both {
+            write_pfm(&files.depth(eye), &view.depth)?;
+            view.streak_mask.save_png(&files.streak_mask(eye))?;
+            if has_road {
+                view.road_surface_mask()?.save_png(&files.road_mask(eye))?;
+            }
+        }
+    }
+    let [left, right]: [RgbImage; 2] = srgb.try_into().expect("two views");
+    Ok([left, right])
+}
+
+/// Writes a rendered pair as `streaks stereo -o DIR` does into `dir` (which must exist): both
+/// views with their ground truth ([`write_views`], [`GroundTruth::Both`]), `side_by_side.png`,
+/// `anaglyph.png` and `rig.json`.
+pub fn write_pair(
+    dir: &std::path::Path,
+    scene: &Scene,
+    rig: &Rig,
+    views: &[EyeView; 2],
+    exposure_ev: f32,
+) -> Result<(), DatasetError> {
+    let files = SampleDir::new(dir);
+    let [left, right] = write_views(&files, scene, views, exposure_ev, GroundTruth::Both)?;
+    write_pair_views(&files.side_by_side(), &files.anaglyph(), &left, &right)?;
+    let road = rig.road_frame().ok();
+    RigFile::new(rig, light_records(scene, road.as_ref())).save(&files.rig_json())?;
+    Ok(())
+}
