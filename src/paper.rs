@@ -151,6 +151,8 @@ fn fmt_fit(c: &Comparison) -> (String, String) {
     (f(c.measured_fit), f(c.predicted_fit))
 }
 
+/// The two Fig. 6 plots, `fig6_deg.png` (disparity in degrees) and `fig6_px.png` (in pixels,
+/// with the matte road's disparity dashed), of the rows where the streak was measured.
 fn fig6_plots(out: &Path, streak: &StreakReport) -> Result<()> {
     let rows: Vec<&RowRecord> = streak
         .rows
@@ -162,55 +164,57 @@ fn fig6_plots(out: &Path, streak: &StreakReport) -> Result<()> {
             .filter_map(|r| f(r).map(|v| (v, r.elevation_deg)))
             .collect()
     };
-    let deg = Plot::new(
-        "Fig. 6: disparity along the streak (degrees)",
-        "disparity (degrees)",
-        "elevation below the horizon (degrees)",
-    )
-    .with(Series::scatter(
-        "measured (1D LK)",
-        BLACK_RGB,
-        Marker::Circle,
-        pts(&|r| Some(r.measured_deg)),
-    ))
-    .with(Series::line(
-        "Eq. 4 + Eq. 5",
-        BLUE,
-        pts(&|r| r.predicted_deg),
-    ))
-    .with(Series::line(
-        "streak-centre model",
-        ORANGE,
-        pts(&|r| r.centre_deg),
-    ));
-    deg.write_png(&out.join("fig6_deg.png"))?;
-    let px = Plot::new(
-        "Fig. 6: disparity along the streak (pixels)",
-        "disparity (px)",
-        "elevation below the horizon (degrees)",
-    )
-    .with(Series::scatter(
-        "measured (1D LK)",
-        BLACK_RGB,
-        Marker::Circle,
-        pts(&|r| Some(r.measured_px)),
-    ))
-    .with(Series::line(
-        "Eq. 4 + Eq. 5",
-        BLUE,
-        pts(&|r| r.predicted_px),
-    ))
-    .with(Series::line(
-        "streak-centre model",
-        ORANGE,
-        pts(&|r| r.centre_px),
-    ))
-    .with(Series::dashed(
-        "road surface (matte road)",
-        GREY,
-        pts(&|r| r.road_px),
-    ));
-    px.write_png(&out.join("fig6_px.png"))?;
+    /// One Fig. 6 plot: its unit, file and the value each series takes from a row.
+    struct Unit {
+        unit: &'static str,
+        file: &'static str,
+        measured: fn(&RowRecord) -> Option<f64>,
+        predicted: fn(&RowRecord) -> Option<f64>,
+        centre: fn(&RowRecord) -> Option<f64>,
+        road: Option<fn(&RowRecord) -> Option<f64>>,
+    }
+    let units = [
+        Unit {
+            unit: "degrees",
+            file: "fig6_deg.png",
+            measured: |r| Some(r.measured_deg),
+            predicted: |r| r.predicted_deg,
+            centre: |r| r.centre_deg,
+            road: None,
+        },
+        Unit {
+            unit: "px",
+            file: "fig6_px.png",
+            measured: |r| Some(r.measured_px),
+            predicted: |r| r.predicted_px,
+            centre: |r| r.centre_px,
+            road: Some(|r| r.road_px),
+        },
+    ];
+    for u in units {
+        let title_unit = if u.unit == "px" { "pixels" } else { u.unit };
+        let mut plot = Plot::new(
+            format!("Fig. 6: disparity along the streak ({title_unit})"),
+            format!("disparity ({})", u.unit),
+            "elevation below the horizon (degrees)",
+        )
+        .with(Series::scatter(
+            "measured (1D LK)",
+            BLACK_RGB,
+            Marker::Circle,
+            pts(&u.measured),
+        ))
+        .with(Series::line("Eq. 4 + Eq. 5", BLUE, pts(&u.predicted)))
+        .with(Series::line("streak-centre model", ORANGE, pts(&u.centre)));
+        if let Some(road) = u.road {
+            plot = plot.with(Series::dashed(
+                "road surface (matte road)",
+                GREY,
+                pts(&road),
+            ));
+        }
+        plot.write_png(&out.join(u.file))?;
+    }
     Ok(())
 }
 
