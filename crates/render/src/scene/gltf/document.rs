@@ -225,9 +225,9 @@ pub(in crate::scene) fn load(path: &Path, files: &Files) -> Result<Scene, SceneE
             .push(format!("{}: the file has no scene", path.display())),
     }
     loader.place_meshes(&document)?;
-    if !loader.parts.tangents.is_empty() {
-        let n = loader.parts.positions.len();
-        loader.parts.tangents.resize(n, Vec4::ZERO);
+    if !loader.parts.mesh.tangents.is_empty() {
+        let n = loader.parts.mesh.positions.len();
+        loader.parts.mesh.tangents.resize(n, Vec4::ZERO);
     }
     Scene::from_parts(loader.parts)
 }

@@ -487,7 +487,7 @@ mod lights_and_instancing_tests {
         let instanced = load_doc(doc.clone(), &bin);
         assert!(instanced.warnings.is_empty(), "{:?}", instanced.warnings);
         assert_eq!(instanced.instances.instances.len(), 4);
-        assert!(instanced.triangles.is_empty());
+        assert!(instanced.mesh.triangles.is_empty());
         // The same placements as nodes, with the values dequantized by the specification's
         // rules (max(c / 32767, -1), max(c / 127, -1)).
         let locals: Vec<Value> = (0..4)

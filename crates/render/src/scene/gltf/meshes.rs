@@ -205,52 +205,54 @@ impl Loader<'_> {
                      have; TEXCOORD_0 is read instead"
                 ));
             }
-            let first = self.parts.positions.len();
+            let first = self.parts.mesh.positions.len();
             if first + positions.len() > u32::MAX as usize {
                 return Err(self.bad(element, "the scene has more than 2^32 - 1 vertices"));
             }
             if let Some(t) = tangents {
-                self.parts.tangents.resize(first, Vec4::ZERO);
-                self.parts.tangents.extend(t);
+                self.parts.mesh.tangents.resize(first, Vec4::ZERO);
+                self.parts.mesh.tangents.extend(t);
             }
             let first = first as u32;
             for t in &mut tris {
                 *t = t.map(|i| i + first);
             }
-            self.parts.positions.extend(positions);
-            self.parts.normals.extend(normals);
+            self.parts.mesh.positions.extend(positions);
+            self.parts.mesh.normals.extend(normals);
             // The second uv set and the colours are stored only once some primitive has them:
             // earlier vertices get TEXCOORD_0 and white, as do later primitives without them.
             let parts = &mut self.parts;
             match uvs1 {
                 Some(uvs1) => {
-                    if parts.uvs1.is_empty() {
-                        parts.uvs1 = parts.uvs.clone();
+                    if parts.mesh.uvs1.is_empty() {
+                        parts.mesh.uvs1 = parts.mesh.uvs.clone();
                     }
-                    parts.uvs1.extend(uvs1);
+                    parts.mesh.uvs1.extend(uvs1);
                 }
-                None if !parts.uvs1.is_empty() => parts.uvs1.extend_from_slice(&uvs),
+                None if !parts.mesh.uvs1.is_empty() => parts.mesh.uvs1.extend_from_slice(&uvs),
                 None => {}
             }
             match colors {
                 Some(colors) => {
-                    if parts.colors.is_empty() {
-                        parts.colors = vec![Vec4::ONE; parts.uvs.len()];
+                    if parts.mesh.colors.is_empty() {
+                        parts.mesh.colors = vec![Vec4::ONE; parts.mesh.uvs.len()];
                     }
-                    parts.colors.extend(colors);
+                    parts.mesh.colors.extend(colors);
                 }
-                None if !parts.colors.is_empty() => {
+                None if !parts.mesh.colors.is_empty() => {
                     parts
+                        .mesh
                         .colors
                         .extend(std::iter::repeat_n(Vec4::ONE, uvs.len()));
                 }
                 None => {}
             }
-            self.parts.uvs.extend(uvs);
+            self.parts.mesh.uvs.extend(uvs);
             self.parts
+                .mesh
                 .triangle_materials
                 .extend(std::iter::repeat_n(material, tris.len()));
-            self.parts.triangles.extend(tris);
+            self.parts.mesh.triangles.extend(tris);
         }
         Ok(())
     }
@@ -326,7 +328,7 @@ mod tests {
         doc["meshes"][1]["primitives"][0]["mode"] = json!(0);
         let path = write_embedded(dir.path(), doc, &bin);
         let scene = Scene::load(&path).unwrap();
-        assert_eq!(scene.triangles.len(), 2);
+        assert_eq!(scene.mesh.triangles.len(), 2);
         assert_eq!(scene.warnings.len(), 1);
         assert!(
             scene.warnings[0].contains("mesh \"tri\" (1), primitive 0"),
@@ -351,7 +353,10 @@ mod tests {
     #[test]
     fn normal_texture_without_tangent_gets_mikktspace_tangents() {
         // No normal map: no tangents stored at all.
-        assert!(load_doc(test_doc().0, &test_doc().1).tangents.is_empty());
+        assert!(load_doc(test_doc().0, &test_doc().1)
+            .mesh
+            .tangents
+            .is_empty());
         let theta = 0.4f32;
         let (doc, bin) = normal_mapped_doc(theta, 1.0);
         let scene = load_doc(doc, &bin);
@@ -359,11 +364,11 @@ mod tests {
         let m = scene.materials[0].normal_map.unwrap();
         assert_eq!((m.texture.texture, m.scale), (0, 1.0));
         // One tangent per vertex; the quad's are +X with w = +1, the unmapped triangle's zero.
-        assert_eq!(scene.tangents.len(), scene.positions.len());
-        for t in &scene.tangents[..4] {
+        assert_eq!(scene.mesh.tangents.len(), scene.mesh.positions.len());
+        for t in &scene.mesh.tangents[..4] {
             assert!((*t - Vec4::new(1.0, 0.0, 0.0, 1.0)).length() < 1e-5, "{t}");
         }
-        assert!(scene.tangents[4..].iter().all(|t| *t == Vec4::ZERO));
+        assert!(scene.mesh.tangents[4..].iter().all(|t| *t == Vec4::ZERO));
         // The texel (8-bit) tilts the normal by theta toward the tangent.
         let ns = quad_normal(&scene);
         assert!((ns.dot(Vec3::Y).acos() - theta).abs() < 0.01, "{ns}");
@@ -383,7 +388,7 @@ mod tests {
         let texel = |x: f32| (255.0 * (x + 1.0) / 2.0).round() as u8;
         doc["images"][0]["uri"] = json!(png_uri([128, texel(theta.sin()), texel(theta.cos())]));
         let scene = load_doc(doc.clone(), &bin);
-        for t in &scene.tangents[..4] {
+        for t in &scene.mesh.tangents[..4] {
             assert!(
                 (*t - Vec4::new(-1.0, 0.0, 0.0, -1.0)).length() < 1e-5,
                 "{t}"
@@ -399,7 +404,7 @@ mod tests {
         // shading normal tilts the same way.
         doc["nodes"][0]["scale"] = json!([-2, 2, 2]);
         let scene = load_doc(doc, &bin);
-        for t in &scene.tangents[..4] {
+        for t in &scene.mesh.tangents[..4] {
             assert!((*t - Vec4::new(1.0, 0.0, 0.0, 1.0)).length() < 1e-5, "{t}");
         }
         let ray = crate::geometry::Ray::new(Vec3::new(-21.0, 5.0, 0.5), -Vec3::Y);
@@ -427,7 +432,7 @@ mod tests {
             "{:?}",
             scene.warnings
         );
-        let t = scene.tangents[0];
+        let t = scene.mesh.tangents[0];
         assert!((t - Vec4::new(1.0, 0.0, 0.0, 1.0)).length() < 1e-5, "{t}");
         assert!((quad_normal(&scene).dot(Vec3::Y).acos() - 0.3).abs() < 0.01);
         // Without TEXCOORD_0 there is nothing to map: a warning, and the plain normal.
@@ -543,6 +548,6 @@ mod tests {
         let scene = Scene::load(&path).unwrap();
         let took = start.elapsed();
         assert!(took < Duration::from_secs(5), "{took:?}");
-        assert_eq!(scene.triangles.len(), 2 + n - 2);
+        assert_eq!(scene.mesh.triangles.len(), 2 + n - 2);
     }
 }

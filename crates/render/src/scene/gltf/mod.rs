@@ -47,7 +47,8 @@ pub use nodes::{MAX_PLACEMENTS, MAX_TRIANGLES};
 
 use super::files::{Files, Uri};
 use super::{
-    accessor, compression, tangents, validate, Instance, MeshParts, Scene, SceneError, SceneParts,
+    accessor, compression, tangents, validate, Instance, Scene, SceneError, SceneParts,
+    TriangleMesh,
 };
 use crate::camera::Camera;
 use crate::light::{Light, LUMINOUS_EFFICACY};

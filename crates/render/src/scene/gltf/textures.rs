@@ -352,11 +352,11 @@ mod tests {
         // One image for both textures (same colour space); the second uv set and the colours
         // are stored for every vertex, TEXCOORD_0 and white where a primitive has none.
         assert_eq!(scene.textures.len(), 1);
-        assert_eq!(scene.uvs1.len(), 7);
-        assert_eq!(scene.uvs1[2], Vec2::new(0.5, 0.5));
-        assert_eq!(scene.uvs1[4..], scene.uvs[4..]);
-        assert!((scene.colors[2] - Vec4::new(0.0, 0.0, 1.0, 0.2)).length() < 1e-6);
-        assert_eq!(scene.colors[5], Vec4::ONE);
+        assert_eq!(scene.mesh.uvs1.len(), 7);
+        assert_eq!(scene.mesh.uvs1[2], Vec2::new(0.5, 0.5));
+        assert_eq!(scene.mesh.uvs1[4..], scene.mesh.uvs[4..]);
+        assert!((scene.mesh.colors[2] - Vec4::new(0.0, 0.0, 1.0, 0.2)).length() < 1e-6);
+        assert_eq!(scene.mesh.colors[5], Vec4::ONE);
         let Reflectance::GltfPbr(GltfPbrParams {
             base_color_texture: Some(base),
             ..
@@ -438,7 +438,7 @@ mod tests {
         doc["materials"][0]["normalTexture"]["extensions"] =
             json!({"KHR_texture_transform": {"rotation": std::f32::consts::FRAC_PI_2}});
         let scene = load_doc(doc, &bin);
-        for t in &scene.tangents[..4] {
+        for t in &scene.mesh.tangents[..4] {
             assert!(t.x.abs() < 1e-4 && (t.z.abs() - 1.0).abs() < 1e-4, "{t}");
         }
         // A malformed transform names the material's normal texture.
