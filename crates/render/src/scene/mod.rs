@@ -137,8 +137,6 @@
 //! self-intersection, on top of the origin offset callers apply with
 //! [`crate::geometry::offset_ray_origin`].
 
-mod accessor;
-mod compression;
 mod error;
 mod files;
 mod gltf;

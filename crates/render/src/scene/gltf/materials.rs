@@ -2,7 +2,16 @@
 //! _transmission and _volume, the paper's models and the road flag from `extras.streaks`, and
 //! the glTF default material.
 
-use super::*;
+use super::textures::{JsonTextureInfo, UvTransform};
+use super::Loader;
+use crate::material::{
+    Alpha, AlphaMode, GltfPbrParams, Material, PaperModel, Reflectance, Volume, Wetness,
+};
+use crate::normal_map::NormalMap;
+use crate::scene::{validate, SceneError};
+use crate::texture::{ColorSpace, TextureRef};
+use glam::{Vec3, Vec4};
+use serde::Deserialize;
 
 /// `extras.streaks` of a material (see the `scene` module documentation).
 #[derive(Debug, Deserialize)]
@@ -531,7 +540,7 @@ impl Loader<'_> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::test_docs::*;
+    use super::super::test_docs::{error, load_err, png_file, rejects, test_doc, write_embedded};
 
     use crate::bsdf::Bsdf;
     use crate::geometry::VertexAttributes;

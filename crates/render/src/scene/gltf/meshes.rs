@@ -1,7 +1,11 @@
 //! Mesh primitives: their vertex attributes taken to world space, triangulation of strips and
 //! fans, and tangents for normal maps (the file's, or MikkTSpace's).
 
-use super::*;
+use super::{accessors, mesh_label, Loader};
+use crate::scene::{tangents, validate, SceneError};
+use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
+use gltf::accessor::{DataType, Dimensions};
+use gltf::mesh::Mode;
 
 /// Triangles (local vertex indices) of a triangle, strip or fan primitive (glTF 2.0 section
 /// 3.7.2.1); degenerate strip and fan triangles are kept (they are never hit).
@@ -53,14 +57,14 @@ impl Loader<'_> {
                 )?;
             }
             let positions: Vec<Vec3> = self
-                .attribute(&pos_acc, &element, "POSITION", accessor::POSITION, None)?
+                .attribute(&pos_acc, &element, "POSITION", accessors::POSITION, None)?
                 .into_iter()
                 .map(Vec3::from)
                 .collect();
             let n = positions.len();
             let normals: Vec<Vec3> = match prim.get(&gltf::Semantic::Normals) {
                 Some(a) => self
-                    .attribute(&a, &element, "NORMAL", accessor::DIRECTION, Some(n))?
+                    .attribute(&a, &element, "NORMAL", accessors::DIRECTION, Some(n))?
                     .into_iter()
                     .map(|v: [f32; 3]| {
                         (normal_matrix * Vec3::from(v))
@@ -72,7 +76,7 @@ impl Loader<'_> {
             };
             let uvs: Vec<Vec2> = match prim.get(&gltf::Semantic::TexCoords(0)) {
                 Some(a) => self
-                    .attribute(&a, &element, "TEXCOORD_0", accessor::TEXCOORD, Some(n))?
+                    .attribute(&a, &element, "TEXCOORD_0", accessors::TEXCOORD, Some(n))?
                     .into_iter()
                     .map(Vec2::from)
                     .collect(),
@@ -89,7 +93,7 @@ impl Loader<'_> {
                 .filter(|_| normal_mapped);
             let file_tangents: Option<Vec<[f32; 4]>> = match &tangent_acc {
                 Some(a) if has_normals => {
-                    Some(self.attribute(a, &element, "TANGENT", accessor::DIRECTION, Some(n))?)
+                    Some(self.attribute(a, &element, "TANGENT", accessors::DIRECTION, Some(n))?)
                 }
                 _ => None,
             };
@@ -97,7 +101,7 @@ impl Loader<'_> {
             let reader = prim.reader(|b| buffers.get(b.index()).map(|d| d.0.as_slice()));
             let uvs1: Option<Vec<Vec2>> = match prim.get(&gltf::Semantic::TexCoords(1)) {
                 Some(a) => Some(
-                    self.attribute(&a, &element, "TEXCOORD_1", accessor::TEXCOORD, Some(n))?
+                    self.attribute(&a, &element, "TEXCOORD_1", accessors::TEXCOORD, Some(n))?
                         .into_iter()
                         .map(Vec2::from)
                         .collect(),
@@ -106,13 +110,13 @@ impl Loader<'_> {
             };
             let colors: Option<Vec<Vec4>> = match prim.get(&gltf::Semantic::Colors(0)) {
                 Some(a) if a.dimensions() == Dimensions::Vec3 => Some(
-                    self.attribute::<3>(&a, &element, "COLOR_0", accessor::COLOR, Some(n))?
+                    self.attribute::<3>(&a, &element, "COLOR_0", accessors::COLOR, Some(n))?
                         .into_iter()
                         .map(|c| Vec3::from(c).extend(1.0))
                         .collect(),
                 ),
                 Some(a) => Some(
-                    self.attribute::<4>(&a, &element, "COLOR_0", accessor::COLOR, Some(n))?
+                    self.attribute::<4>(&a, &element, "COLOR_0", accessors::COLOR, Some(n))?
                         .into_iter()
                         .map(Vec4::from)
                         .collect(),
@@ -300,7 +304,10 @@ impl Loader<'_> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::test_docs::*;
+    use super::super::test_docs::{
+        add_tangent, error, load_doc, load_err, normal_mapped_doc, png_uri, quad_normal, test_doc,
+        with, write_embedded,
+    };
     use super::*;
 
     use crate::scene::Scene;

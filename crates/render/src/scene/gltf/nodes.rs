@@ -1,7 +1,12 @@
 //! The node walk and what it places: node transforms, cameras, the limits on placements and
 //! triangles, and each mesh flattened into world triangles or stored once as instances.
 
-use super::*;
+use super::{mesh_label, node_label, Loader};
+use crate::camera::Camera;
+use crate::scene::{validate, Instance, SceneError, TriangleMesh};
+use glam::{Affine3A, Mat4, Quat, Vec3, Vec4};
+use gltf::mesh::Mode;
+use std::path::Path;
 
 /// The most node visits (a node reached by several paths of the hierarchy is visited once per
 /// path) and, separately, mesh placements (node meshes and EXT_mesh_gpu_instancing instances)
@@ -290,7 +295,10 @@ impl Loader<'_> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::test_docs::*;
+    use super::super::test_docs::{
+        approx, assert_same_hits, box_placements, check_test_scene, doubling_dag, error, load_doc,
+        load_err, placed_boxes, rejects, test_doc, write_embedded,
+    };
 
     use crate::scene::Scene;
     use glam::Vec3;

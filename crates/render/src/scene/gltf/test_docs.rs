@@ -1,12 +1,13 @@
 //! glTF documents for the loader's tests: a builder of buffers and accessors, the test scene,
 //! writers of embedded, external and GLB files, and helpers shared by the tests of several files.
 
-use super::*;
-use crate::material::{GltfPbrParams, Reflectance};
+use crate::light::Light;
+use crate::material::{GltfPbrParams, PaperModel, Reflectance};
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
 use serde_json::{json, Value};
 use std::f32::consts::FRAC_1_SQRT_2;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 /// A glTF document under construction: one binary buffer, views and accessors.

@@ -1,7 +1,14 @@
 //! Textures: texture infos (with KHR_texture_transform, read by the gltf crate or from the
 //! JSON), samplers, and images decoded once per colour space.
 
-use super::*;
+use super::{uri_label, Loader};
+use crate::scene::files::Uri;
+use crate::scene::SceneError;
+use crate::texture::{
+    uv_transform, ColorSpace, Filter, Sampler, Texture, TextureId, TextureRef, Wrap,
+};
+use glam::{Affine2, Vec2, Vec4};
+use serde::Deserialize;
 
 /// A textureInfo read from the JSON: the texture's index and its texCoord set.
 #[derive(Clone, Copy, Debug, Deserialize)]
@@ -271,10 +278,12 @@ impl Loader<'_> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::test_docs::*;
+    use super::super::test_docs::{
+        approx, load_doc, load_err, normal_mapped_doc, png_file, test_doc, write_embedded, Doc,
+    };
     use super::*;
 
-    use crate::material::{GltfPbrParams, Reflectance};
+    use crate::material::{AlphaMode, GltfPbrParams, Reflectance};
     use crate::scene::Scene;
     use glam::{Vec2, Vec3};
     use serde_json::json;
