@@ -175,8 +175,8 @@ pub const INSTANCED_TRIANGLE: u32 = u32::MAX;
 pub struct Scene {
     /// The file it was loaded from.
     pub source: PathBuf,
-    /// The flat triangles in world space, checked: every vertex has a unit (or zero: the face
-    /// normal) normal and a uv.
+    /// The flat triangles in world space, checked (normals unit or zero, uvs filled; see
+    /// [`TriangleMesh`]).
     pub mesh: TriangleMesh,
     /// Materials.
     pub materials: Vec<Material>,
