@@ -189,11 +189,13 @@ pub(super) fn load(path: &Path, files: &Files) -> Result<Scene, SceneError> {
     parts
         .materials
         .push(Material::diffuse("default", Vec3::splat(DEFAULT_GREY)));
+    // The objects, one after another, as the scene's flat triangles.
+    let flat = &mut parts.mesh;
     for model in &models {
         let mesh = &model.mesh;
         let element = format!("object {:?}", model.name);
         let n = mesh.positions.len() / 3;
-        let first = parts.mesh.positions.len();
+        let first = flat.positions.len();
         if first + n > u32::MAX as usize {
             return Err(SceneError::invalid(
                 path,
@@ -216,28 +218,25 @@ pub(super) fn load(path: &Path, files: &Files) -> Result<Scene, SceneError> {
             let p = Vec3::new(c[0], c[1], c[2]);
             super::validate::position(p)
                 .map_err(|r| SceneError::invalid(path, format!("{element}, vertex {k}"), r))?;
-            parts.mesh.positions.push(p);
+            flat.positions.push(p);
         }
         if mesh.normals.len() == 3 * n {
-            parts.mesh.normals.extend(
+            flat.normals.extend(
                 mesh.normals
                     .chunks_exact(3)
                     .map(|c| Vec3::new(c[0], c[1], c[2]).normalize_or_zero()),
             );
         } else {
-            parts
-                .mesh
-                .normals
-                .extend(std::iter::repeat_n(Vec3::ZERO, n));
+            flat.normals.extend(std::iter::repeat_n(Vec3::ZERO, n));
         }
         if mesh.texcoords.len() == 2 * n {
-            parts.mesh.uvs.extend(
+            flat.uvs.extend(
                 mesh.texcoords
                     .chunks_exact(2)
                     .map(|c| Vec2::new(c[0], 1.0 - c[1])),
             );
         } else {
-            parts.mesh.uvs.extend(std::iter::repeat_n(Vec2::ZERO, n));
+            flat.uvs.extend(std::iter::repeat_n(Vec2::ZERO, n));
         }
         for (k, t) in mesh.indices.chunks_exact(3).enumerate() {
             if t.iter().any(|&i| i as usize >= n) {
@@ -248,11 +247,9 @@ pub(super) fn load(path: &Path, files: &Files) -> Result<Scene, SceneError> {
                 ));
             }
             let first = first as u32;
-            parts
-                .mesh
-                .triangles
+            flat.triangles
                 .push([t[0] + first, t[1] + first, t[2] + first]);
-            parts.mesh.triangle_materials.push(material);
+            flat.triangle_materials.push(material);
         }
     }
     Scene::from_parts(parts)

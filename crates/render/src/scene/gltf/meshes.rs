@@ -213,50 +213,45 @@ impl Loader<'_> {
             if first + positions.len() > u32::MAX as usize {
                 return Err(self.bad(element, "the scene has more than 2^32 - 1 vertices"));
             }
+            let out = &mut self.parts.mesh;
             if let Some(t) = tangents {
-                self.parts.mesh.tangents.resize(first, Vec4::ZERO);
-                self.parts.mesh.tangents.extend(t);
+                out.tangents.resize(first, Vec4::ZERO);
+                out.tangents.extend(t);
             }
             let first = first as u32;
             for t in &mut tris {
                 *t = t.map(|i| i + first);
             }
-            self.parts.mesh.positions.extend(positions);
-            self.parts.mesh.normals.extend(normals);
+            out.positions.extend(positions);
+            out.normals.extend(normals);
             // The second uv set and the colours are stored only once some primitive has them:
             // earlier vertices get TEXCOORD_0 and white, as do later primitives without them.
-            let parts = &mut self.parts;
             match uvs1 {
                 Some(uvs1) => {
-                    if parts.mesh.uvs1.is_empty() {
-                        parts.mesh.uvs1 = parts.mesh.uvs.clone();
+                    if out.uvs1.is_empty() {
+                        out.uvs1 = out.uvs.clone();
                     }
-                    parts.mesh.uvs1.extend(uvs1);
+                    out.uvs1.extend(uvs1);
                 }
-                None if !parts.mesh.uvs1.is_empty() => parts.mesh.uvs1.extend_from_slice(&uvs),
+                None if !out.uvs1.is_empty() => out.uvs1.extend_from_slice(&uvs),
                 None => {}
             }
             match colors {
                 Some(colors) => {
-                    if parts.mesh.colors.is_empty() {
-                        parts.mesh.colors = vec![Vec4::ONE; parts.mesh.uvs.len()];
+                    if out.colors.is_empty() {
+                        out.colors = vec![Vec4::ONE; out.uvs.len()];
                     }
-                    parts.mesh.colors.extend(colors);
+                    out.colors.extend(colors);
                 }
-                None if !parts.mesh.colors.is_empty() => {
-                    parts
-                        .mesh
-                        .colors
-                        .extend(std::iter::repeat_n(Vec4::ONE, uvs.len()));
+                None if !out.colors.is_empty() => {
+                    out.colors.extend(std::iter::repeat_n(Vec4::ONE, uvs.len()));
                 }
                 None => {}
             }
-            self.parts.mesh.uvs.extend(uvs);
-            self.parts
-                .mesh
-                .triangle_materials
+            out.uvs.extend(uvs);
+            out.triangle_materials
                 .extend(std::iter::repeat_n(material, tris.len()));
-            self.parts.mesh.triangles.extend(tris);
+            out.triangles.extend(tris);
         }
         Ok(())
     }
