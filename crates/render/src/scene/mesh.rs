@@ -150,7 +150,8 @@ impl TriangleMesh {
     }
 
     /// The mesh's triangles with their vertex attributes and `materials`, as the emitters and
-    /// the alpha test read them (after [`TriangleMesh::check`], which fills the uvs).
+    /// the alpha test read them (once checked by [`super::Scene::from_parts`], which fills the
+    /// uvs).
     #[inline]
     pub fn surface<'a>(&'a self, materials: &'a [Material]) -> SurfaceMesh<'a> {
         SurfaceMesh {
