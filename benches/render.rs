@@ -12,10 +12,10 @@ use streaks_render::scene::{Scene, SceneParts};
 
 /// Adds an axis-aligned box (12 triangles, faces pointing out) of material `m`.
 fn add_box(parts: &mut SceneParts, lo: Vec3, hi: Vec3, m: u32) {
-    let base = parts.positions.len() as u32;
+    let base = parts.mesh.positions.len() as u32;
     for i in 0..8u32 {
         let pick = |bit: u32, a: f32, b: f32| if i & bit == 0 { a } else { b };
-        parts.positions.push(Vec3::new(
+        parts.mesh.positions.push(Vec3::new(
             pick(1, lo.x, hi.x),
             pick(2, lo.y, hi.y),
             pick(4, lo.z, hi.z),
@@ -31,9 +31,9 @@ fn add_box(parts: &mut SceneParts, lo: Vec3, hi: Vec3, m: u32) {
         [4, 5, 7, 6], // +z
     ];
     for [a, b, c, d] in faces {
-        parts.triangles.push([base + a, base + b, base + c]);
-        parts.triangles.push([base + a, base + c, base + d]);
-        parts.triangle_materials.extend([m, m]);
+        parts.mesh.triangles.push([base + a, base + b, base + c]);
+        parts.mesh.triangles.push([base + a, base + c, base + d]);
+        parts.mesh.triangle_materials.extend([m, m]);
     }
 }
 

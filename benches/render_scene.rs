@@ -159,7 +159,7 @@ fn bench_load(c: &mut Criterion) {
     let mut group = c.benchmark_group("scene_load");
     group.sample_size(10);
     group.bench_function("rainy_street", |b| {
-        b.iter(|| Scene::load(black_box(&path)).map(|s| s.triangles.len()))
+        b.iter(|| Scene::load(black_box(&path)).map(|s| s.mesh.triangles.len()))
     });
     group.finish();
 }

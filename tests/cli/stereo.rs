@@ -455,8 +455,9 @@ fn rig_json_lists_the_renderers_emitters() {
                 // The lamp's own triangles, found independently of the renderer's grouping:
                 // those of its material within its bounding sphere.
                 let (mut weighted, mut total) = (glam::Vec3::ZERO, 0.0);
-                for (t, &mat) in scene.triangle_materials.iter().enumerate() {
-                    let [a, b, c] = scene.triangles[t].map(|v| scene.positions[v as usize]);
+                for (t, &mat) in scene.mesh.triangle_materials.iter().enumerate() {
+                    let [a, b, c] =
+                        scene.mesh.triangles[t].map(|v| scene.mesh.positions[v as usize]);
                     let near = [a, b, c]
                         .iter()
                         .all(|v| v.distance(m.centre()) <= m.radius());

@@ -123,13 +123,7 @@ fn write_field(dir: &Path, shared: bool, count: usize) -> std::path::PathBuf {
 
 /// Heap bytes of the scene's geometry and BVHs (flat arrays, flat BVH, instanced meshes).
 fn geometry_bytes(s: &Scene) -> usize {
-    s.accel.memory_bytes()
-        + std::mem::size_of_val(s.positions.as_slice())
-        + std::mem::size_of_val(s.normals.as_slice())
-        + std::mem::size_of_val(s.uvs.as_slice())
-        + std::mem::size_of_val(s.triangles.as_slice())
-        + std::mem::size_of_val(s.triangle_materials.as_slice())
-        + s.instances.memory_bytes()
+    s.accel.memory_bytes() + s.mesh.memory_bytes() + s.instances.memory_bytes()
 }
 
 fn main() {
@@ -167,7 +161,7 @@ fn main() {
              instances), geometry + BVH {:.1} MB, render {}x{} {} spp: {:.2} s ({:.2} M rays/s)",
             if shared { "instanced" } else { "flattened" },
             best,
-            scene.triangles.len() + scene.instances.stored_triangle_count(),
+            scene.mesh.triangles.len() + scene.instances.stored_triangle_count(),
             scene.world_triangle_count(),
             scene.instances.instances.len(),
             geometry_bytes(&scene) as f64 / 1e6,

@@ -741,11 +741,11 @@ pub(crate) mod tests {
 
     /// A quad (two triangles) with the given corners, counter-clockwise seen from its front.
     pub(crate) fn quad(parts: &mut SceneParts, corners: [Vec3; 4], material: u32) {
-        let base = parts.positions.len() as u32;
-        parts.positions.extend_from_slice(&corners);
-        parts.triangles.push([base, base + 1, base + 2]);
-        parts.triangles.push([base, base + 2, base + 3]);
-        parts.triangle_materials.extend([material, material]);
+        let base = parts.mesh.positions.len() as u32;
+        parts.mesh.positions.extend_from_slice(&corners);
+        parts.mesh.triangles.push([base, base + 1, base + 2]);
+        parts.mesh.triangles.push([base, base + 2, base + 3]);
+        parts.mesh.triangle_materials.extend([material, material]);
     }
 
     /// A 200 m floor at Y = 0 facing up, made of material 0.

@@ -33,20 +33,23 @@
 //! use streaks_render::camera::Camera;
 //! use streaks_render::integrator::{render, Layers, RenderSettings};
 //! use streaks_render::material::Material;
-//! use streaks_render::scene::{Scene, SceneParts};
+//! use streaks_render::scene::{Scene, SceneParts, TriangleMesh};
 //!
 //! // An emissive quad of radiance 2 filling the view of a camera at the origin.
 //! let mut glow = Material::diffuse("glow", Vec3::ZERO);
 //! glow.emission = Vec3::splat(2.0);
 //! let scene = Scene::from_parts(SceneParts {
-//!     positions: vec![
-//!         Vec3::new(-9.0, -9.0, -1.0),
-//!         Vec3::new(9.0, -9.0, -1.0),
-//!         Vec3::new(9.0, 9.0, -1.0),
-//!         Vec3::new(-9.0, 9.0, -1.0),
-//!     ],
-//!     triangles: vec![[0, 1, 2], [0, 2, 3]],
-//!     triangle_materials: vec![0, 0],
+//!     mesh: TriangleMesh {
+//!         positions: vec![
+//!             Vec3::new(-9.0, -9.0, -1.0),
+//!             Vec3::new(9.0, -9.0, -1.0),
+//!             Vec3::new(9.0, 9.0, -1.0),
+//!             Vec3::new(-9.0, 9.0, -1.0),
+//!         ],
+//!         triangles: vec![[0, 1, 2], [0, 2, 3]],
+//!         triangle_materials: vec![0, 0],
+//!         ..TriangleMesh::default()
+//!     },
 //!     materials: vec![glow],
 //!     ..SceneParts::default()
 //! })?;

@@ -40,7 +40,7 @@ use crate::bsdf;
 use crate::camera::Camera;
 use crate::light::Light;
 use crate::material::{GltfPbrParams, Material, PaperModel, Reflectance};
-use crate::scene::{Instances, Scene, SceneError};
+use crate::scene::{Instances, Scene, SceneError, TriangleMesh};
 use crate::texture::{Sampler, Texture, TextureId, TextureRef};
 use glam::{Vec2, Vec3};
 use std::collections::HashMap;
@@ -191,11 +191,7 @@ impl MitsubaExport {
 /// The parts of a scene the exporter reads (everything but the BVH).
 pub(crate) struct SceneParts<'a> {
     pub(crate) source: &'a Path,
-    pub(crate) positions: &'a [Vec3],
-    pub(crate) normals: &'a [Vec3],
-    pub(crate) uvs: &'a [Vec2],
-    pub(crate) triangles: &'a [[u32; 3]],
-    pub(crate) triangle_materials: &'a [u32],
+    pub(crate) mesh: &'a TriangleMesh,
     pub(crate) materials: &'a [Material],
     pub(crate) textures: &'a [Texture],
     pub(crate) lights: &'a [Light],
@@ -207,11 +203,7 @@ pub fn export(scene: &Scene, opts: &ExportOptions) -> Result<MitsubaExport, Mits
     export_parts(
         &SceneParts {
             source: &scene.source,
-            positions: &scene.positions,
-            normals: &scene.normals,
-            uvs: &scene.uvs,
-            triangles: &scene.triangles,
-            triangle_materials: &scene.triangle_materials,
+            mesh: &scene.mesh,
             materials: &scene.materials,
             textures: &scene.textures,
             lights: &scene.lights,
@@ -778,7 +770,8 @@ fn sensor_xml(cam: &Camera, opts: &ExportOptions) -> String {
 fn meshes_by_material(parts: &SceneParts<'_>) -> Vec<(usize, PlyMesh)> {
     let mut groups: Vec<Option<(HashMap<u32, u32>, PlyMesh)>> =
         (0..parts.materials.len()).map(|_| None).collect();
-    for (tri, &mat) in parts.triangles.iter().zip(parts.triangle_materials) {
+    let flat = parts.mesh;
+    for (tri, &mat) in flat.triangles.iter().zip(&flat.triangle_materials) {
         let Some(slot) = groups.get_mut(mat as usize) else {
             continue;
         };
@@ -801,11 +794,11 @@ fn meshes_by_material(parts: &SceneParts<'_>) -> Vec<(usize, PlyMesh)> {
         for (k, &v) in tri.iter().enumerate() {
             local[k] = *remap.entry(v).or_insert_with(|| {
                 let i = v as usize;
-                mesh.positions.push(parts.positions[i]);
+                mesh.positions.push(flat.positions[i]);
                 mesh.normals
-                    .push(parts.normals.get(i).copied().unwrap_or(Vec3::ZERO));
+                    .push(flat.normals.get(i).copied().unwrap_or(Vec3::ZERO));
                 mesh.uvs
-                    .push(parts.uvs.get(i).copied().unwrap_or(Vec2::ZERO));
+                    .push(flat.uvs.get(i).copied().unwrap_or(Vec2::ZERO));
                 (mesh.positions.len() - 1) as u32
             });
         }
@@ -893,11 +886,7 @@ pub(crate) fn export_parts(
     }
     for (k, instanced) in parts.instances.meshes.iter().enumerate() {
         let object = SceneParts {
-            positions: &instanced.parts.positions,
-            normals: &instanced.parts.normals,
-            uvs: &instanced.parts.uvs,
-            triangles: &instanced.parts.triangles,
-            triangle_materials: &instanced.parts.triangle_materials,
+            mesh: &instanced.mesh,
             ..*parts
         };
         let _ = write!(xml, "<shape type=\"shapegroup\" id=\"instanced{k}\">");
@@ -958,11 +947,7 @@ mod tests {
     }
 
     struct Fixture {
-        positions: Vec<Vec3>,
-        normals: Vec<Vec3>,
-        uvs: Vec<Vec2>,
-        triangles: Vec<[u32; 3]>,
-        triangle_materials: Vec<u32>,
+        mesh: TriangleMesh,
         materials: Vec<Material>,
         textures: Vec<Texture>,
         lights: Vec<Light>,
@@ -1013,11 +998,14 @@ mod tests {
                 wetness: None,
             };
             Fixture {
-                positions,
-                normals: vec![Vec3::Y; n],
-                uvs: vec![Vec2::new(0.25, 0.75); n],
-                triangles: vec![[0, 2, 1], [0, 3, 2], [4, 6, 5], [7, 8, 9]],
-                triangle_materials: vec![0, 0, 1, 2],
+                mesh: TriangleMesh {
+                    positions,
+                    normals: vec![Vec3::Y; n],
+                    uvs: vec![Vec2::new(0.25, 0.75); n],
+                    triangles: vec![[0, 2, 1], [0, 3, 2], [4, 6, 5], [7, 8, 9]],
+                    triangle_materials: vec![0, 0, 1, 2],
+                    ..TriangleMesh::default()
+                },
                 materials: vec![
                     mat("road & <wet>", ggx, Vec3::ZERO),
                     mat("lamp", lamp, Vec3::new(10.0, 9.0, 8.0)),
@@ -1058,11 +1046,7 @@ mod tests {
         fn parts(&self) -> SceneParts<'_> {
             SceneParts {
                 source: Path::new("test.gltf"),
-                positions: &self.positions,
-                normals: &self.normals,
-                uvs: &self.uvs,
-                triangles: &self.triangles,
-                triangle_materials: &self.triangle_materials,
+                mesh: &self.mesh,
                 materials: &self.materials,
                 textures: &self.textures,
                 lights: &self.lights,
@@ -1091,7 +1075,7 @@ mod tests {
     #[test]
     fn instanced_meshes_are_shapegroups_with_one_instance_per_placement() {
         let fx = Fixture::new();
-        let tri = crate::scene::MeshParts {
+        let tri = TriangleMesh {
             name: "mesh \"tri\" (0)".into(),
             positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
             triangles: vec![[0, 1, 2]],
@@ -1346,11 +1330,11 @@ mod tests {
         back.file_name = road.file_name.clone();
         assert_eq!(&back, road);
         // The compact mesh reproduces the original triangles.
-        for (t, orig) in road.triangles.iter().zip(&fx.triangles[..2]) {
+        for (t, orig) in road.triangles.iter().zip(&fx.mesh.triangles[..2]) {
             for k in 0..3 {
                 assert_eq!(
                     road.positions[t[k] as usize],
-                    fx.positions[orig[k] as usize]
+                    fx.mesh.positions[orig[k] as usize]
                 );
             }
         }

@@ -426,7 +426,8 @@ mod tests {
             add(&mut parts);
             if texel.is_some() {
                 // A tangent not orthogonal to the normal: only its +X part counts.
-                parts.tangents = vec![Vec4::new(1.0, 0.3, 0.0, 1.0); parts.positions.len()];
+                parts.mesh.tangents =
+                    vec![Vec4::new(1.0, 0.3, 0.0, 1.0); parts.mesh.positions.len()];
             }
             Scene::from_parts(parts).unwrap()
         }

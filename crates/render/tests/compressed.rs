@@ -17,10 +17,19 @@ use streaks_render::scene::Scene;
 /// Per material name: total area, area-weighted centroid, area-weighted mean shading normal.
 fn moments(scene: &Scene) -> BTreeMap<String, (f64, Vec3, Vec3)> {
     let mut out: BTreeMap<String, (f64, Vec3, Vec3)> = BTreeMap::new();
-    for (t, &m) in scene.triangles.iter().zip(&scene.triangle_materials) {
-        let [a, b, c] = t.map(|i| scene.positions[i as usize]);
+    for (t, &m) in scene
+        .mesh
+        .triangles
+        .iter()
+        .zip(&scene.mesh.triangle_materials)
+    {
+        let [a, b, c] = t.map(|i| scene.mesh.positions[i as usize]);
         let area = 0.5 * (b - a).cross(c - a).length();
-        let n = t.iter().map(|&i| scene.normals[i as usize]).sum::<Vec3>() / 3.0;
+        let n = t
+            .iter()
+            .map(|&i| scene.mesh.normals[i as usize])
+            .sum::<Vec3>()
+            / 3.0;
         let e = out
             .entry(scene.materials[m as usize].name.clone())
             .or_insert((0.0, Vec3::ZERO, Vec3::ZERO));

@@ -121,7 +121,7 @@ fn uris_outside_the_folder_are_refused_unless_allowed() {
         names(&err, &["scene.gltf", "buffer 0", why]);
         // Allowed explicitly, each is read.
         let scene = Scene::load_with(&path, &allow()).unwrap_or_else(|e| panic!("{uri}: {e}"));
-        assert_eq!(scene.triangles.len(), 1);
+        assert_eq!(scene.mesh.triangles.len(), 1);
     }
     // Inside the folder, `..` that stays inside is fine.
     std::fs::write(dir.join("tri.bin"), triangle()).unwrap();

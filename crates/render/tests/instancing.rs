@@ -91,8 +91,12 @@ fn instanced_posts_render_as_the_flattened_scene() {
         // (three emitters, as in the flattened scene) and so does the ground.
         assert_eq!(scene.instances.instances.len(), 12, "{name}");
         assert_eq!(scene.instances.stored_triangle_count(), 12, "{name}");
-        assert_eq!(scene.triangles.len(), 2 + 3 * 12, "{name}");
-        assert_eq!(scene.world_triangle_count(), flat.triangles.len(), "{name}");
+        assert_eq!(scene.mesh.triangles.len(), 2 + 3 * 12, "{name}");
+        assert_eq!(
+            scene.world_triangle_count(),
+            flat.mesh.triangles.len(),
+            "{name}"
+        );
         assert_eq!(
             scene.light_sampler.emitters().len(),
             flat.light_sampler.emitters().len(),

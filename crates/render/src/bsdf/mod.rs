@@ -47,8 +47,8 @@
 //! - `ggx.rs`: the GGX microfacet lobe (masking, the separable and the height-correlated
 //!   visibility, visible-normal density and sampling), shared by [`Ggx`] and [`GltfPbr`], and
 //!   the paper's [`Ggx`];
-//! - `ward.rs`: [`Ward`]; `blinn_phong.rs`: [`BlinnPhong`]; `gltf.rs`: [`GltfPbr`], with
-//!   its transmission; `dielectric.rs`: refraction and the GGX microfacet transmission (Walter
+//! - `ward.rs`: [`Ward`]; `blinn_phong.rs`: [`BlinnPhong`]; `metallic_roughness.rs`: glTF's
+//!   metallic-roughness model [`GltfPbr`], with its extensions and its transmission; `dielectric.rs`: refraction and the GGX microfacet transmission (Walter
 //!   et al. 2007) it uses for a volume's boundary;
 //! - `luminance.rs`: [`LuminanceEval`], the light choice's `luminance(f(wo, wi))`: the
 //!   luminances of a model's reflectances and its `Model::AtWo`, taken once per `wo`, and
@@ -67,16 +67,16 @@ mod blinn_phong;
 mod dielectric;
 mod diffuse;
 mod ggx;
-mod gltf;
 mod luminance;
+mod metallic_roughness;
 pub(crate) mod numbers;
 mod ward;
 
 pub use blinn_phong::BlinnPhong;
 pub use diffuse::Diffuse;
 pub use ggx::Ggx;
-pub use gltf::{ior_f0, GltfPbr};
 pub use luminance::LuminanceEval;
+pub use metallic_roughness::{ior_f0, GltfPbr};
 pub use ward::Ward;
 
 use crate::sampling::{square_to_cosine_hemisphere, square_to_cosine_hemisphere_pdf};

@@ -263,7 +263,7 @@ mod tests {
     };
     use crate::light::BRANCHING;
     use crate::material::Material;
-    use crate::scene::{Scene, SceneParts};
+    use crate::scene::{Scene, SceneParts, TriangleMesh};
     use glam::Vec3;
     use streaks_image::luminance;
 
@@ -275,7 +275,7 @@ mod tests {
         // Exact: the sum over the sphere triangles that face p (a convex polyhedron: they tile
         // its silhouette once).
         let mut exact = 0.0f64;
-        for (t, &m) in s.triangle_materials.iter().enumerate() {
+        for (t, &m) in s.mesh.triangle_materials.iter().enumerate() {
             if m == 1 {
                 let v = vertices(&s, t);
                 if normal(&s, t).dot(p - v[0]) > 0.0 {
@@ -717,9 +717,12 @@ mod tests {
     fn no_lights_no_samples() {
         let s = Scene::from_parts(SceneParts {
             source: "dark".into(),
-            positions: vec![Vec3::ZERO, Vec3::X, Vec3::Z],
-            triangles: vec![[0, 2, 1]],
-            triangle_materials: vec![0],
+            mesh: TriangleMesh {
+                positions: vec![Vec3::ZERO, Vec3::X, Vec3::Z],
+                triangles: vec![[0, 2, 1]],
+                triangle_materials: vec![0],
+                ..TriangleMesh::default()
+            },
             materials: vec![Material::diffuse("floor", Vec3::splat(0.5))],
             ..SceneParts::default()
         })

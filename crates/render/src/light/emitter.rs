@@ -714,7 +714,7 @@ mod tests {
         }
         // Every emissive triangle maps to a distinct slot of its emitter; nothing else maps.
         let mut slots = Vec::new();
-        for (t, &material) in s.triangle_materials.iter().enumerate() {
+        for (t, &material) in s.mesh.triangle_materials.iter().enumerate() {
             let found = emitters.emitter_of(t as u32);
             assert_eq!(found.is_some(), material != 0, "triangle {t}");
             if let Some((e, k)) = found {
@@ -766,7 +766,7 @@ mod tests {
             }
             let omega = omega / n as f64;
             let mut exact = 0.0f64;
-            for (t, &material) in s.triangle_materials.iter().enumerate() {
+            for (t, &material) in s.mesh.triangle_materials.iter().enumerate() {
                 let v = vertices(&s, t).map(|x| x - p);
                 if material == 1 && normal(&s, t).dot(-v[0]) > 0.0 {
                     exact += solid_angle(v[0], v[1], v[2]) as f64;

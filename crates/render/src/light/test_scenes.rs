@@ -5,7 +5,7 @@ use crate::bsdf::Bsdf;
 use crate::geometry::{Frame, Ray};
 use crate::light::Light;
 use crate::material::Material;
-use crate::scene::{Scene, SceneParts};
+use crate::scene::{Scene, SceneParts, TriangleMesh};
 use glam::Vec3;
 use std::f32::consts::PI;
 
@@ -17,16 +17,19 @@ pub fn triangle_scene(double_sided: bool) -> Scene {
     emitter.double_sided = double_sided;
     Scene::from_parts(SceneParts {
         source: "test".into(),
-        positions: vec![
-            Vec3::new(-0.5, -0.3, 1.0),
-            Vec3::new(0.2, 0.6, 1.0),
-            Vec3::new(0.7, -0.4, 1.0),
-            Vec3::new(-10.0, -5.0, -10.0),
-            Vec3::new(10.0, -5.0, -10.0),
-            Vec3::new(0.0, -5.0, 10.0),
-        ],
-        triangles: vec![[0, 1, 2], [3, 5, 4]],
-        triangle_materials: vec![0, 1],
+        mesh: TriangleMesh {
+            positions: vec![
+                Vec3::new(-0.5, -0.3, 1.0),
+                Vec3::new(0.2, 0.6, 1.0),
+                Vec3::new(0.7, -0.4, 1.0),
+                Vec3::new(-10.0, -5.0, -10.0),
+                Vec3::new(10.0, -5.0, -10.0),
+                Vec3::new(0.0, -5.0, 10.0),
+            ],
+            triangles: vec![[0, 1, 2], [3, 5, 4]],
+            triangle_materials: vec![0, 1],
+            ..TriangleMesh::default()
+        },
         materials: vec![emitter, Material::diffuse("floor", Vec3::splat(0.5))],
         ..Default::default()
     })
@@ -56,12 +59,12 @@ pub fn receiver(p: Vec3, bsdf: Bsdf, wo: Vec3) -> Receiver {
 /// Appends a UV sphere (outward winding) of `material` to `parts`.
 pub fn sphere(parts: &mut SceneParts, centre: Vec3, r: f32, material: u32) {
     let (rings, segments) = (12u32, 16u32);
-    let base = parts.positions.len() as u32;
+    let base = parts.mesh.positions.len() as u32;
     for i in 0..=rings {
         let theta = PI * i as f32 / rings as f32;
         for j in 0..segments {
             let phi = 2.0 * PI * j as f32 / segments as f32;
-            parts.positions.push(
+            parts.mesh.positions.push(
                 centre
                     + r * Vec3::new(
                         theta.sin() * phi.cos(),
@@ -76,7 +79,7 @@ pub fn sphere(parts: &mut SceneParts, centre: Vec3, r: f32, material: u32) {
         for j in 0..segments {
             let (a, b, c, d) = (idx(i, j), idx(i, j + 1), idx(i + 1, j), idx(i + 1, j + 1));
             for t in [[a, b, d], [a, d, c]] {
-                let [p0, p1, p2] = t.map(|v| parts.positions[v as usize]);
+                let [p0, p1, p2] = t.map(|v| parts.mesh.positions[v as usize]);
                 let n = (p1 - p0).cross(p2 - p0);
                 if n.length() > 1e-9 {
                     // Outward: flip if the winding faces the centre.
@@ -85,8 +88,8 @@ pub fn sphere(parts: &mut SceneParts, centre: Vec3, r: f32, material: u32) {
                     } else {
                         t
                     };
-                    parts.triangles.push(t);
-                    parts.triangle_materials.push(material);
+                    parts.mesh.triangles.push(t);
+                    parts.mesh.triangle_materials.push(material);
                 }
             }
         }
@@ -108,8 +111,8 @@ pub fn lamp_scene(centre: Vec3, le: f32, punctual: Vec<Light>) -> Scene {
         ..Default::default()
     };
     let quad = |parts: &mut SceneParts, c: Vec3, h: f32, up: bool, m: u32| {
-        let b = parts.positions.len() as u32;
-        parts.positions.extend([
+        let b = parts.mesh.positions.len() as u32;
+        parts.mesh.positions.extend([
             c + Vec3::new(-h, 0.0, -h),
             c + Vec3::new(h, 0.0, -h),
             c + Vec3::new(h, 0.0, h),
@@ -121,8 +124,8 @@ pub fn lamp_scene(centre: Vec3, le: f32, punctual: Vec<Light>) -> Scene {
         } else {
             ([b, b + 1, b + 2], [b, b + 2, b + 3])
         };
-        parts.triangles.extend([t0, t1]);
-        parts.triangle_materials.extend([m, m]);
+        parts.mesh.triangles.extend([t0, t1]);
+        parts.mesh.triangle_materials.extend([m, m]);
     };
     quad(&mut parts, Vec3::ZERO, 50.0, true, 0);
     sphere(&mut parts, centre, 0.3, 1);
@@ -141,7 +144,7 @@ pub fn cone_emitter(ls: &LightSampler) -> usize {
 
 /// Vertex positions of scene triangle `t`.
 pub fn vertices(s: &Scene, t: usize) -> [Vec3; 3] {
-    s.triangles[t].map(|v| s.positions[v as usize])
+    s.mesh.triangles[t].map(|v| s.mesh.positions[v as usize])
 }
 
 /// Unit normal (from the winding) of scene triangle `t`.

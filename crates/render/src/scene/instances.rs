@@ -15,7 +15,7 @@
 //! triangles): the loader flattens them, and [`super::Scene::from_parts`] rejects an
 //! instanced mesh with an emissive material.
 
-use super::mesh::MeshParts;
+use super::mesh::TriangleMesh;
 use crate::accel::{Accel, AccelHit, Tlas};
 use crate::geometry::Ray;
 use glam::{Affine3A, Mat3A, Mat4, Vec2, Vec3, Vec4};
@@ -86,7 +86,7 @@ impl Instance {
 #[derive(Debug)]
 pub struct InstancedMesh {
     /// The vertex arrays and triangles, in object space.
-    pub parts: MeshParts,
+    pub mesh: TriangleMesh,
     /// The BVH over them (the instance's BLAS).
     pub accel: Accel,
 }
@@ -125,10 +125,10 @@ impl Instances {
         mut instances: Vec<Instance>,
     ) -> Result<Self, (String, String)> {
         // An instance of a mesh without triangles can be hit by nothing (and has no box).
-        instances.retain(|i| !meshes[i.mesh as usize].parts.triangles.is_empty());
+        instances.retain(|i| !meshes[i.mesh as usize].mesh.triangles.is_empty());
         let mut boxes: Vec<[Vec3; 2]> = Vec::with_capacity(instances.len());
         for (i, inst) in instances.iter().enumerate() {
-            let m = &meshes[inst.mesh as usize].parts;
+            let m = &meshes[inst.mesh as usize].mesh;
             let b = m.positions.iter().fold(
                 [Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)],
                 |[lo, hi], &p| {
@@ -175,7 +175,7 @@ impl Instances {
 
     /// The number of triangles stored (each mesh once).
     pub fn stored_triangle_count(&self) -> usize {
-        self.meshes.iter().map(|m| m.parts.triangles.len()).sum()
+        self.meshes.iter().map(|m| m.mesh.triangles.len()).sum()
     }
 
     /// The number of triangles the instances place in the world (what flattening would
@@ -183,7 +183,7 @@ impl Instances {
     pub fn instanced_triangle_count(&self) -> usize {
         self.instances
             .iter()
-            .map(|i| self.meshes[i.mesh as usize].parts.triangles.len())
+            .map(|i| self.meshes[i.mesh as usize].mesh.triangles.len())
             .sum()
     }
 
@@ -192,18 +192,7 @@ impl Instances {
         let meshes: usize = self
             .meshes
             .iter()
-            .map(|m| {
-                let p = &m.parts;
-                m.accel.memory_bytes()
-                    + std::mem::size_of_val(p.positions.as_slice())
-                    + std::mem::size_of_val(p.normals.as_slice())
-                    + std::mem::size_of_val(p.uvs.as_slice())
-                    + std::mem::size_of_val(p.tangents.as_slice())
-                    + std::mem::size_of_val(p.uvs1.as_slice())
-                    + std::mem::size_of_val(p.colors.as_slice())
-                    + std::mem::size_of_val(p.triangles.as_slice())
-                    + std::mem::size_of_val(p.triangle_materials.as_slice())
-            })
+            .map(|m| m.accel.memory_bytes() + m.mesh.memory_bytes())
             .sum();
         meshes
             + std::mem::size_of_val(self.instances.as_slice())

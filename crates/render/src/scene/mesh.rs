@@ -1,6 +1,7 @@
-//! One mesh's vertex arrays and triangles ([`MeshParts`]), checked and completed the same way
-//! for the scene's flat world-space triangles and for each instanced mesh (in object space),
-//! and the points on its triangles that ray hits shade ([`Geometry::surface_at`]).
+//! A triangle mesh's vertex arrays and triangles ([`TriangleMesh`]), defined once for the
+//! scene's flat world-space triangles and for each instanced mesh (in object space), checked
+//! and completed the same way for both, and the points on its triangles that ray hits shade
+//! ([`Geometry::surface_at`]).
 
 use super::SceneError;
 use crate::geometry::VertexAttributes;
@@ -9,24 +10,32 @@ use crate::material::Material;
 use glam::{Vec2, Vec3, Vec4};
 use std::path::Path;
 
-/// The vertex arrays and triangles of a mesh: the scene's flat triangles (world space) or an
-/// instanced mesh (object space, placed by [`super::Instance`]s).
+/// The vertex arrays and triangles of a mesh: the scene's flat triangles (world space,
+/// [`super::Scene::mesh`]) or an instanced mesh (object space, placed by
+/// [`super::Instance`]s). Once checked (by [`super::Scene::from_parts`]) every vertex has a
+/// unit or zero normal and a uv.
 #[derive(Clone, Debug, Default)]
-pub struct MeshParts {
+pub struct TriangleMesh {
     /// A label for messages (`mesh "name" (index)` for a glTF mesh); empty for the flat
     /// triangles.
     pub name: String,
-    /// Vertex positions.
+    /// Vertex positions (world space for the scene's flat triangles, object space for an
+    /// instanced mesh).
     pub positions: Vec<Vec3>,
-    /// One normal per vertex, or empty for face normals everywhere (zero = face normal).
+    /// One normal per vertex, or empty for face normals everywhere; a zero normal means "use
+    /// the face normal" (where the file had none). Unit once checked.
     pub normals: Vec<Vec3>,
-    /// One uv per vertex, or empty for zeros.
+    /// One uv (`TEXCOORD_0`) per vertex, or empty for zeros (filled when checked).
     pub uvs: Vec<Vec2>,
-    /// One tangent per vertex (xyz, w = handedness; zero = none), or empty for none.
+    /// One tangent per vertex for normal maps (xyz: unit tangent, w: handedness +-1), or
+    /// empty when no material has a normal map; a zero tangent means "not normal mapped here"
+    /// (see [`crate::normal_map`]).
     pub tangents: Vec<Vec4>,
-    /// One `TEXCOORD_1` per vertex, or empty for none (`uvs` is read instead).
+    /// One `TEXCOORD_1` per vertex, or empty when no primitive has one (`uvs` is read
+    /// instead).
     pub uvs1: Vec<Vec2>,
-    /// One vertex colour per vertex, or empty for none (white).
+    /// One vertex colour (`COLOR_0`, linear RGBA) per vertex, or empty when no primitive has
+    /// them (white).
     pub colors: Vec<Vec4>,
     /// Vertex indices of each triangle.
     pub triangles: Vec<[u32; 3]>,
@@ -34,7 +43,7 @@ pub struct MeshParts {
     pub triangle_materials: Vec<u32>,
 }
 
-impl MeshParts {
+impl TriangleMesh {
     /// Checks every array length and index against the vertex count and `material_count`,
     /// normalises the normals and fills absent normals and uvs (zeros). Errors name the
     /// element, prefixed by the mesh's name if it has one.
@@ -128,18 +137,39 @@ impl MeshParts {
         Ok(())
     }
 
-    /// The mesh as [`Geometry`] (after [`MeshParts::check`], which fills normals and uvs).
+    /// Approximate heap memory of the arrays.
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of_val(self.positions.as_slice())
+            + std::mem::size_of_val(self.normals.as_slice())
+            + std::mem::size_of_val(self.uvs.as_slice())
+            + std::mem::size_of_val(self.tangents.as_slice())
+            + std::mem::size_of_val(self.uvs1.as_slice())
+            + std::mem::size_of_val(self.colors.as_slice())
+            + std::mem::size_of_val(self.triangles.as_slice())
+            + std::mem::size_of_val(self.triangle_materials.as_slice())
+    }
+
+    /// The mesh's triangles with their vertex attributes and `materials`, as the emitters and
+    /// the alpha test read them (once checked by [`super::Scene::from_parts`], which fills the
+    /// uvs).
+    #[inline]
+    pub fn surface<'a>(&'a self, materials: &'a [Material]) -> SurfaceMesh<'a> {
+        SurfaceMesh {
+            positions: &self.positions,
+            uvs: &self.uvs,
+            uvs1: &self.uvs1,
+            colors: &self.colors,
+            triangles: &self.triangles,
+            triangle_materials: &self.triangle_materials,
+            materials,
+        }
+    }
+
+    /// The mesh as [`Geometry`] (after [`TriangleMesh::check`], which fills normals and uvs).
+    #[inline]
     pub(super) fn geometry<'a>(&'a self, materials: &'a [Material]) -> Geometry<'a> {
         Geometry {
-            mesh: SurfaceMesh {
-                positions: &self.positions,
-                uvs: &self.uvs,
-                uvs1: &self.uvs1,
-                colors: &self.colors,
-                triangles: &self.triangles,
-                triangle_materials: &self.triangle_materials,
-                materials,
-            },
+            mesh: self.surface(materials),
             normals: &self.normals,
             tangents: &self.tangents,
         }

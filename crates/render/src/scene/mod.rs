@@ -59,7 +59,7 @@
 //!   integrator's `material` layer lets datasets mask; it changes no pixel.
 //! - Normal maps ([`crate::normal_map`]): a material's `normalTexture` (linear RGB, `scale`
 //!   multiplying X and Y) perturbs the shading normal in tangent space. Tangents are stored
-//!   per vertex ([`Scene::tangents`], empty when no material has a normal map; zero for the
+//!   per vertex ([`TriangleMesh::tangents`], empty when no material has a normal map; zero for the
 //!   vertices of primitives without one): a primitive's TANGENT (xyz by the model matrix, not
 //!   the inverse transpose; w, the handedness, flipped by a mirroring transform), or, where it
 //!   has none or has no NORMAL (then TANGENT is ignored, as the specification says),
@@ -80,8 +80,8 @@
 //!   An image is decoded once per colour space, whatever samplers read it.
 //! - Vertex colours `COLOR_0` (RGB or RGBA; float, or normalized unsigned byte or short)
 //!   multiply the base colour (`kd` for the paper's models) and its alpha. The second uv set
-//!   and the colours are stored only when some primitive has them ([`Scene::uvs1`],
-//!   [`Scene::colors`]).
+//!   and the colours are stored only when some primitive has them ([`TriangleMesh::uvs1`],
+//!   [`TriangleMesh::colors`]).
 //! - `alphaMode`: alpha is `baseColorFactor.a x baseColorTexture.a x COLOR_0.a`. `MASK`
 //!   (`alphaCutoff`, default 0.5) cuts the surface away where alpha is below the cutoff;
 //!   `BLEND` is stochastic transparency: a ray stops at the surface with probability alpha
@@ -137,8 +137,6 @@
 //! self-intersection, on top of the origin offset callers apply with
 //! [`crate::geometry::offset_ray_origin`].
 
-mod accessor;
-mod compression;
 mod error;
 mod files;
 mod gltf;
@@ -153,7 +151,7 @@ pub use files::LoadOptions;
 pub use gltf::extensions;
 pub use gltf::{MAX_PLACEMENTS, MAX_TRIANGLES};
 pub use instances::{Instance, InstancedMesh, Instances};
-pub use mesh::MeshParts;
+pub use mesh::TriangleMesh;
 pub use validate::MAX_COORDINATE;
 
 use crate::accel::Accel;
@@ -177,27 +175,9 @@ pub const INSTANCED_TRIANGLE: u32 = u32::MAX;
 pub struct Scene {
     /// The file it was loaded from.
     pub source: PathBuf,
-    /// World-space vertex positions.
-    pub positions: Vec<Vec3>,
-    /// World-space unit shading normals, one per vertex; a zero normal means "use the face
-    /// normal" (where the file had none).
-    pub normals: Vec<Vec3>,
-    /// Texture coordinates, one per vertex (zero where the file had none).
-    pub uvs: Vec<Vec2>,
-    /// World-space vertex tangents for normal maps (xyz: unit tangent, w: handedness +-1),
-    /// one per vertex, or empty when no material has a normal map; a zero tangent means "not
-    /// normal mapped here" (see [`crate::normal_map`]).
-    pub tangents: Vec<Vec4>,
-    /// The second texture coordinate set (`TEXCOORD_1`), one per vertex, or empty when no
-    /// primitive has one (the first set is read instead).
-    pub uvs1: Vec<Vec2>,
-    /// Vertex colours (`COLOR_0`, linear RGBA), one per vertex, or empty when no primitive
-    /// has them (white).
-    pub colors: Vec<Vec4>,
-    /// Vertex indices of each triangle.
-    pub triangles: Vec<[u32; 3]>,
-    /// Material index of each triangle.
-    pub triangle_materials: Vec<u32>,
+    /// The flat triangles in world space, checked (normals unit or zero, uvs filled; see
+    /// [`TriangleMesh`]).
+    pub mesh: TriangleMesh,
     /// Materials.
     pub materials: Vec<Material>,
     /// Decoded textures.
@@ -206,7 +186,7 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// Cameras, in file order.
     pub cameras: Vec<Camera>,
-    /// The BVH over `triangles`.
+    /// The BVH over `mesh.triangles`.
     pub accel: Accel,
     /// The instanced meshes (in object space, each stored once), their instances and the
     /// top-level BVH over them; empty for most scenes (see [`Instances`]).
@@ -223,22 +203,8 @@ pub struct Scene {
 pub struct SceneParts {
     /// Where the scene came from (used in messages; may be any label).
     pub source: PathBuf,
-    /// World-space vertex positions.
-    pub positions: Vec<Vec3>,
-    /// One normal per vertex, or empty for face normals everywhere (zero = face normal).
-    pub normals: Vec<Vec3>,
-    /// One uv per vertex, or empty for zeros.
-    pub uvs: Vec<Vec2>,
-    /// One tangent per vertex (xyz, w = handedness; zero = none), or empty for none.
-    pub tangents: Vec<Vec4>,
-    /// One `TEXCOORD_1` per vertex, or empty for none (`uvs` is read instead).
-    pub uvs1: Vec<Vec2>,
-    /// One vertex colour per vertex, or empty for none (white).
-    pub colors: Vec<Vec4>,
-    /// Vertex indices of each triangle.
-    pub triangles: Vec<[u32; 3]>,
-    /// Material index of each triangle.
-    pub triangle_materials: Vec<u32>,
+    /// The flat triangles in world space (a name, if given, prefixes their errors).
+    pub mesh: TriangleMesh,
     /// Materials.
     pub materials: Vec<Material>,
     /// Textures.
@@ -249,7 +215,7 @@ pub struct SceneParts {
     pub cameras: Vec<Camera>,
     /// Meshes stored once in object space and placed by `instances` (none may have an
     /// emissive material: emitters are world triangles).
-    pub instanced_meshes: Vec<MeshParts>,
+    pub instanced_meshes: Vec<TriangleMesh>,
     /// Placements of `instanced_meshes`.
     pub instances: Vec<Instance>,
     /// Warnings to pass on.
@@ -288,14 +254,7 @@ impl Scene {
     pub fn from_parts(parts: SceneParts) -> Result<Scene, SceneError> {
         let SceneParts {
             source,
-            positions,
-            normals,
-            uvs,
-            tangents,
-            uvs1,
-            colors,
-            triangles,
-            triangle_materials,
+            mut mesh,
             materials,
             textures,
             lights,
@@ -305,29 +264,7 @@ impl Scene {
             warnings,
         } = parts;
         let bad = |element: String, reason: String| SceneError::invalid(&source, element, reason);
-        let mut flat = MeshParts {
-            name: String::new(),
-            positions,
-            normals,
-            uvs,
-            tangents,
-            uvs1,
-            colors,
-            triangles,
-            triangle_materials,
-        };
-        flat.check(&source, materials.len())?;
-        let MeshParts {
-            positions,
-            normals,
-            uvs,
-            tangents,
-            uvs1,
-            colors,
-            triangles,
-            triangle_materials,
-            ..
-        } = flat;
+        mesh.check(&source, materials.len())?;
         for m in &materials {
             if let Some(t) = m.texture_ids().find(|&t| t as usize >= textures.len()) {
                 return Err(bad(
@@ -357,7 +294,7 @@ impl Scene {
             let accel = Accel::build_alpha_tested(&m.positions, &m.triangles, |t| {
                 alpha_tested(m.triangle_materials[t])
             });
-            meshes.push(InstancedMesh { parts: m, accel });
+            meshes.push(InstancedMesh { mesh: m, accel });
         }
         if let Some((i, inst)) = instances
             .iter()
@@ -375,34 +312,19 @@ impl Scene {
         }
         let instances = Instances::build(meshes, instances)
             .map_err(|(element, reason)| bad(element, reason))?;
-        let mut accel = Accel::build_alpha_tested(&positions, &triangles, |t| {
-            alpha_tested(triangle_materials[t])
+        let mut accel = Accel::build_alpha_tested(&mesh.positions, &mesh.triangles, |t| {
+            alpha_tested(mesh.triangle_materials[t])
         });
-        let bounds = bounding_box(&positions, &instances);
+        let bounds = bounding_box(&mesh.positions, &instances);
         if let Some([lo, hi]) = bounds.filter(|_| !instances.is_empty()) {
             // One self-intersection distance for all hits, from the extent of everything.
             accel.raise_t_min(16.0 * f32::EPSILON * lo.abs().max(hi.abs()).max_element());
         }
-        let mesh = SurfaceMesh {
-            positions: &positions,
-            uvs: &uvs,
-            uvs1: &uvs1,
-            colors: &colors,
-            triangles: &triangles,
-            triangle_materials: &triangle_materials,
-            materials: &materials,
-        };
-        let light_sampler = LightSampler::new(&lights, mesh, bounding_sphere(bounds).1);
+        let light_sampler =
+            LightSampler::new(&lights, mesh.surface(&materials), bounding_sphere(bounds).1);
         Ok(Scene {
             source,
-            positions,
-            normals,
-            uvs,
-            tangents,
-            uvs1,
-            colors,
-            triangles,
-            triangle_materials,
+            mesh,
             materials,
             textures,
             lights,
@@ -440,12 +362,12 @@ impl Scene {
     /// Centre and radius of a sphere enclosing all vertices, the instances' included (the
     /// centre of their bounding box and its half diagonal); `(0, 0)` for an empty scene.
     pub fn bounding_sphere(&self) -> (Vec3, f32) {
-        bounding_sphere(bounding_box(&self.positions, &self.instances))
+        bounding_sphere(bounding_box(&self.mesh.positions, &self.instances))
     }
 
     /// The number of triangles in the world: the flat ones and every instance's.
     pub fn world_triangle_count(&self) -> usize {
-        self.triangles.len() + self.instances.instanced_triangle_count()
+        self.mesh.triangles.len() + self.instances.instanced_triangle_count()
     }
 
     /// Radiance emitted from `hit` toward `wo` (unit, pointing away from the surface): the
@@ -460,28 +382,16 @@ impl Scene {
         material.emission_at(&hit.attributes, &self.textures)
     }
 
-    /// The scene's triangles with their vertex attributes and materials.
+    /// The scene's (flat, world-space) triangles with their vertex attributes and materials.
     #[inline]
-    pub fn mesh(&self) -> SurfaceMesh<'_> {
-        SurfaceMesh {
-            positions: &self.positions,
-            uvs: &self.uvs,
-            uvs1: &self.uvs1,
-            colors: &self.colors,
-            triangles: &self.triangles,
-            triangle_materials: &self.triangle_materials,
-            materials: &self.materials,
-        }
+    pub fn surface(&self) -> SurfaceMesh<'_> {
+        self.mesh.surface(&self.materials)
     }
 
     /// The scene's own (flat, world-space) triangles as hit shading reads them.
     #[inline]
     fn geometry(&self) -> Geometry<'_> {
-        Geometry {
-            mesh: self.mesh(),
-            normals: &self.normals,
-            tangents: &self.tangents,
-        }
+        self.mesh.geometry(&self.materials)
     }
 
     /// Whether `ray` stops at its hit at barycentrics `b` on triangle `triangle` of
@@ -503,7 +413,7 @@ impl Scene {
     fn instance_stops(&self, ray: &Ray, instance: u32, triangle: u32, b: Vec2) -> bool {
         let mesh = self.instances.instances[instance as usize].mesh;
         let geometry = self.instances.meshes[mesh as usize]
-            .parts
+            .mesh
             .geometry(&self.materials);
         let id = triangle ^ pcg_hash(instance.wrapping_add(1));
         self.stops(geometry, ray, triangle, id, b)
@@ -535,7 +445,7 @@ impl Scene {
             if let Some(h) = instanced {
                 let inst = &self.instances.instances[h.instance as usize];
                 let geometry = self.instances.meshes[inst.mesh as usize]
-                    .parts
+                    .mesh
                     .geometry(&self.materials);
                 let b = h.hit.barycentrics;
                 let local = geometry.surface_at(h.hit.triangle, b);
@@ -698,11 +608,11 @@ mod tests {
         for i in 0..n {
             let c = rng.vec(10.0);
             for _ in 0..3 {
-                parts.positions.push(c + rng.vec(1.0));
+                parts.mesh.positions.push(c + rng.vec(1.0));
             }
             let k = 3 * i as u32;
-            parts.triangles.push([k, k + 1, k + 2]);
-            parts.triangle_materials.push(0);
+            parts.mesh.triangles.push([k, k + 1, k + 2]);
+            parts.mesh.triangle_materials.push(0);
         }
         parts
     }
@@ -736,11 +646,12 @@ mod tests {
                 ray.t_max = 6.0 * rng.next();
             }
             let brute = scene
+                .mesh
                 .triangles
                 .iter()
                 .enumerate()
                 .filter_map(|(i, t)| {
-                    brute_hit(t.map(|v| scene.positions[v as usize]), &ray).map(|h| (i, h))
+                    brute_hit(t.map(|v| scene.mesh.positions[v as usize]), &ray).map(|h| (i, h))
                 })
                 .min_by(|a, b| a.1 .0.total_cmp(&b.1 .0));
             let got = scene.intersect(&ray);
@@ -755,7 +666,7 @@ mod tests {
                         h.t
                     );
                     if h.triangle as usize == i {
-                        let tri = scene.triangles[i].map(|v| scene.positions[v as usize]);
+                        let tri = scene.mesh.triangles[i].map(|v| scene.mesh.positions[v as usize]);
                         let p = tri[0] * (1.0 - b1 - b2) + tri[1] * b1 + tri[2] * b2;
                         assert!((h.p - p).length() < 1e-3, "ray {k}");
                         assert!((h.p - ray.at(h.t)).length() < 1e-3, "ray {k}");
@@ -788,7 +699,7 @@ mod tests {
         let mut glow = Material::diffuse("glow", Vec3::ZERO);
         glow.emission = Vec3::ONE;
         parts.materials.push(glow);
-        parts.triangle_materials[2] = 1;
+        parts.mesh.triangle_materials[2] = 1;
         let scene = Scene::from_parts(parts.clone()).unwrap();
         assert!(scene.lights.is_empty());
         let emitters = scene.light_sampler.emitters();
@@ -799,23 +710,24 @@ mod tests {
             .all(|t| emitters.emitter_of(t).is_none()));
         let (c, r) = scene.bounding_sphere();
         assert!(scene
+            .mesh
             .positions
             .iter()
             .all(|p| (*p - c).length() <= r * 1.0001));
 
         let mut bad = parts.clone();
-        bad.triangles[1][2] = 99;
+        bad.mesh.triangles[1][2] = 99;
         let err = Scene::from_parts(bad).unwrap_err().to_string();
         assert!(err.contains("soup: triangle 1"), "{err}");
         let mut bad = parts.clone();
-        bad.triangle_materials[3] = 5;
+        bad.mesh.triangle_materials[3] = 5;
         let err = Scene::from_parts(bad).unwrap_err().to_string();
         assert!(
             err.contains("triangle 3") && err.contains("material 5"),
             "{err}"
         );
         let mut bad = parts;
-        bad.positions[0].x = f32::NAN;
+        bad.mesh.positions[0].x = f32::NAN;
         assert!(Scene::from_parts(bad).is_err());
     }
 
@@ -828,13 +740,16 @@ mod tests {
             // A triangle in the plane z = 1 facing -Z, toward the origin.
             let s = Scene::from_parts(SceneParts {
                 source: "glow".into(),
-                positions: vec![
-                    Vec3::new(-0.5, -0.3, 1.0),
-                    Vec3::new(0.2, 0.6, 1.0),
-                    Vec3::new(0.7, -0.4, 1.0),
-                ],
-                triangles: vec![[0, 1, 2]],
-                triangle_materials: vec![0],
+                mesh: TriangleMesh {
+                    positions: vec![
+                        Vec3::new(-0.5, -0.3, 1.0),
+                        Vec3::new(0.2, 0.6, 1.0),
+                        Vec3::new(0.7, -0.4, 1.0),
+                    ],
+                    triangles: vec![[0, 1, 2]],
+                    triangle_materials: vec![0],
+                    ..TriangleMesh::default()
+                },
                 materials: vec![glow],
                 ..SceneParts::default()
             })
@@ -848,15 +763,16 @@ mod tests {
 
     /// A unit quad in the plane `z` (x, y in [0, 1], uv = (x, y)) of material `material`.
     fn quad(parts: &mut SceneParts, z: f32, material: u32) {
-        let k = parts.positions.len() as u32;
+        let k = parts.mesh.positions.len() as u32;
         for (x, y) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)] {
-            parts.positions.push(Vec3::new(x, y, z));
-            parts.uvs.push(Vec2::new(x, y));
+            parts.mesh.positions.push(Vec3::new(x, y, z));
+            parts.mesh.uvs.push(Vec2::new(x, y));
         }
         parts
+            .mesh
             .triangles
             .extend([[k, k + 1, k + 2], [k, k + 2, k + 3]]);
-        parts.triangle_materials.extend([material; 2]);
+        parts.mesh.triangle_materials.extend([material; 2]);
     }
 
     /// A material whose alpha is `mode` with factor `factor` and `texture` (an alpha map).
@@ -955,12 +871,15 @@ mod tests {
     fn shading_normal_is_interpolated_and_flipped_to_the_geometric_side() {
         let parts = SceneParts {
             source: "tri".into(),
-            positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
-            // Authored pointing away from the winding's normal (+Z).
-            normals: vec![-Vec3::Z, Vec3::new(0.6, 0.0, -0.8), -Vec3::Z],
-            uvs: vec![Vec2::ZERO, Vec2::X, Vec2::Y],
-            triangles: vec![[0, 1, 2]],
-            triangle_materials: vec![0],
+            mesh: TriangleMesh {
+                positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+                // Authored pointing away from the winding's normal (+Z).
+                normals: vec![-Vec3::Z, Vec3::new(0.6, 0.0, -0.8), -Vec3::Z],
+                uvs: vec![Vec2::ZERO, Vec2::X, Vec2::Y],
+                triangles: vec![[0, 1, 2]],
+                triangle_materials: vec![0],
+                ..TriangleMesh::default()
+            },
             materials: vec![Material::diffuse("m", Vec3::ONE)],
             ..SceneParts::default()
         };

@@ -189,11 +189,13 @@ pub(super) fn load(path: &Path, files: &Files) -> Result<Scene, SceneError> {
     parts
         .materials
         .push(Material::diffuse("default", Vec3::splat(DEFAULT_GREY)));
+    // The objects, one after another, as the scene's flat triangles.
+    let flat = &mut parts.mesh;
     for model in &models {
         let mesh = &model.mesh;
         let element = format!("object {:?}", model.name);
         let n = mesh.positions.len() / 3;
-        let first = parts.positions.len();
+        let first = flat.positions.len();
         if first + n > u32::MAX as usize {
             return Err(SceneError::invalid(
                 path,
@@ -216,25 +218,25 @@ pub(super) fn load(path: &Path, files: &Files) -> Result<Scene, SceneError> {
             let p = Vec3::new(c[0], c[1], c[2]);
             super::validate::position(p)
                 .map_err(|r| SceneError::invalid(path, format!("{element}, vertex {k}"), r))?;
-            parts.positions.push(p);
+            flat.positions.push(p);
         }
         if mesh.normals.len() == 3 * n {
-            parts.normals.extend(
+            flat.normals.extend(
                 mesh.normals
                     .chunks_exact(3)
                     .map(|c| Vec3::new(c[0], c[1], c[2]).normalize_or_zero()),
             );
         } else {
-            parts.normals.extend(std::iter::repeat_n(Vec3::ZERO, n));
+            flat.normals.extend(std::iter::repeat_n(Vec3::ZERO, n));
         }
         if mesh.texcoords.len() == 2 * n {
-            parts.uvs.extend(
+            flat.uvs.extend(
                 mesh.texcoords
                     .chunks_exact(2)
                     .map(|c| Vec2::new(c[0], 1.0 - c[1])),
             );
         } else {
-            parts.uvs.extend(std::iter::repeat_n(Vec2::ZERO, n));
+            flat.uvs.extend(std::iter::repeat_n(Vec2::ZERO, n));
         }
         for (k, t) in mesh.indices.chunks_exact(3).enumerate() {
             if t.iter().any(|&i| i as usize >= n) {
@@ -245,10 +247,9 @@ pub(super) fn load(path: &Path, files: &Files) -> Result<Scene, SceneError> {
                 ));
             }
             let first = first as u32;
-            parts
-                .triangles
+            flat.triangles
                 .push([t[0] + first, t[1] + first, t[2] + first]);
-            parts.triangle_materials.push(material);
+            flat.triangle_materials.push(material);
         }
     }
     Scene::from_parts(parts)
@@ -422,7 +423,7 @@ illum 1
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("ok.obj");
         std::fs::write(&path, format!("{quad}f -3/-2/-1 -2/-1/-1 -1/-1/-1\n")).unwrap();
-        assert_eq!(Scene::load(&path).unwrap().triangles.len(), 1);
+        assert_eq!(Scene::load(&path).unwrap().mesh.triangles.len(), 1);
     }
 
     #[test]
@@ -447,19 +448,19 @@ illum 1
         std::fs::write(dir.path().join("road.mtl"), MTL).unwrap();
         let scene = Scene::load(&path).unwrap();
         assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
-        assert_eq!(scene.triangles.len(), 4);
+        assert_eq!(scene.mesh.triangles.len(), 4);
         assert!(scene.cameras.is_empty());
-        let wet = &scene.materials[scene.triangle_materials[0] as usize];
+        let wet = &scene.materials[scene.mesh.triangle_materials[0] as usize];
         assert_eq!(wet.name, "wet");
         assert!(matches!(wet.reflectance, Reflectance::Paper {
             model: PaperModel::BlinnPhong, shininess, ks, ..
         } if shininess == 200.0 && ks == Vec3::splat(0.6)));
-        let plain = &scene.materials[scene.triangle_materials[3] as usize];
+        let plain = &scene.materials[scene.mesh.triangle_materials[3] as usize];
         assert!(
             matches!(plain.reflectance, Reflectance::Diffuse { kd, kd_texture: None }
             if kd == Vec3::new(0.7, 0.6, 0.5))
         );
-        let glow = &scene.materials[scene.triangle_materials[2] as usize];
+        let glow = &scene.materials[scene.mesh.triangle_materials[2] as usize];
         assert_eq!(glow.emission, Vec3::new(4.0, 3.0, 2.0));
         assert!(scene.lights.is_empty());
         assert_eq!(scene.light_sampler.emitters().emitter_of(2), Some((0, 0)));
@@ -488,7 +489,7 @@ illum 1
         assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
         assert!(scene.warnings[0].contains("street.obj"));
         assert!(scene.lights.is_empty());
-        assert!(scene.triangle_materials.iter().all(|&m| m == 0));
+        assert!(scene.mesh.triangle_materials.iter().all(|&m| m == 0));
         assert!(
             matches!(scene.materials[0].reflectance, Reflectance::Diffuse { kd, .. }
             if kd == Vec3::splat(DEFAULT_GREY))
@@ -518,7 +519,7 @@ illum 1
         let scene = Scene::load(&path).unwrap();
         let took = start.elapsed();
         assert!(took < std::time::Duration::from_secs(5), "{took:?}");
-        assert_eq!(scene.triangles.len(), n - 2);
+        assert_eq!(scene.mesh.triangles.len(), n - 2);
     }
 
     /// A vertex beyond the BVH's range is an error naming the object and the vertex.

@@ -2,7 +2,11 @@
 //! checked against each other, and the Loader's reading of accessors (their layouts, bounds and
 //! the decoded bytes they are charged for).
 
-use super::*;
+use super::{accessors, compression, uri_label, Loader};
+use crate::scene::files::{Files, Uri};
+use crate::scene::SceneError;
+use gltf::accessor::{DataType, Dimensions};
+use std::path::Path;
 
 /// Loads every buffer of `document` (external files, data URIs, the GLB binary chunk), except
 /// the meshopt fallback buffers `fallbacks`, which are placeholders without data (left empty).
@@ -104,7 +108,7 @@ impl Loader<'_> {
         accessor: &gltf::Accessor,
         element: &str,
         name: &str,
-        allowed: &[accessor::Component],
+        allowed: &[accessors::Component],
         count: Option<usize>,
     ) -> Result<Vec<[f32; N]>, SceneError> {
         let element = format!("{element}, {name} (accessor {})", accessor.index());
@@ -113,7 +117,7 @@ impl Loader<'_> {
         self.files
             .charge_expanded((accessor.count() as u64).saturating_mul(4 * N as u64))
             .map_err(|r| self.bad(&element, r))?;
-        let values = accessor::read::<N>(accessor, &self.buffers, allowed)
+        let values = accessors::read::<N>(accessor, &self.buffers, allowed)
             .map_err(|r| self.bad(&element, r))?;
         match count {
             Some(n) if values.len() != n => Err(self.bad(
@@ -182,7 +186,7 @@ impl Loader<'_> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::test_docs::*;
+    use super::super::test_docs::{load_err, test_doc, write_external};
 
     use crate::scene::Scene;
 

@@ -2,7 +2,15 @@
 //! unchecked, then [`load`], which reads the buffers, decodes compressed geometry, reads the
 //! materials, walks the nodes and places the meshes.
 
-use super::*;
+use super::buffers::{check_views, load_buffers};
+use super::extensions::{self, light_units};
+use super::nodes::count_visits;
+use super::{compression, node_label, Loader};
+use crate::scene::files::Files;
+use crate::scene::{Scene, SceneError, SceneParts};
+use glam::{Mat4, Vec4};
+use std::collections::HashMap;
+use std::path::Path;
 
 /// Size of a GLB file's header: magic, version and total length, 4 bytes each.
 pub(super) const GLB_HEADER_SIZE: usize = 12;
@@ -225,16 +233,18 @@ pub(in crate::scene) fn load(path: &Path, files: &Files) -> Result<Scene, SceneE
             .push(format!("{}: the file has no scene", path.display())),
     }
     loader.place_meshes(&document)?;
-    if !loader.parts.tangents.is_empty() {
-        let n = loader.parts.positions.len();
-        loader.parts.tangents.resize(n, Vec4::ZERO);
+    if !loader.parts.mesh.tangents.is_empty() {
+        let n = loader.parts.mesh.positions.len();
+        loader.parts.mesh.tangents.resize(n, Vec4::ZERO);
     }
     Scene::from_parts(loader.parts)
 }
 
 #[cfg(test)]
 mod tests {
-    use super::super::test_docs::*;
+    use super::super::test_docs::{
+        check_test_scene, load_err, test_doc, write_embedded, write_external, write_glb,
+    };
     use super::*;
 
     use crate::scene::Scene;

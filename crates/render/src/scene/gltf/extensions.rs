@@ -11,7 +11,11 @@
 //! The check reads the file's JSON as it is (the `gltf` crate keeps only the extensions it
 //! knows), before the document is validated.
 
-use super::*;
+use super::{accessors, node_label, Loader};
+use crate::light::{Light, LUMINOUS_EFFICACY};
+use crate::scene::{validate, SceneError};
+use glam::{Mat4, Quat, Vec3};
+use serde::Deserialize;
 use serde_json::Value;
 use std::path::Path;
 
@@ -225,7 +229,7 @@ impl Loader<'_> {
         let read3 = |name: &str| -> Result<Option<Vec<Vec3>>, SceneError> {
             accessor(name)?
                 .map(|a| {
-                    self.attribute::<3>(&a, &element, name, accessor::POSITION, None)
+                    self.attribute::<3>(&a, &element, name, accessors::POSITION, None)
                         .map(|v| v.into_iter().map(Vec3::from).collect())
                 })
                 .transpose()
@@ -234,7 +238,7 @@ impl Loader<'_> {
         let scale = read3("SCALE")?;
         let rotation: Option<Vec<Quat>> = accessor("ROTATION")?
             .map(|a| {
-                self.attribute::<4>(&a, &element, "ROTATION", accessor::DIRECTION, None)
+                self.attribute::<4>(&a, &element, "ROTATION", accessors::DIRECTION, None)
                     .map(|v| {
                         v.into_iter()
                             .map(|q| Quat::from_array(q).normalize())
@@ -388,7 +392,10 @@ mod tests {
 
 #[cfg(test)]
 mod lights_and_instancing_tests {
-    use super::super::test_docs::*;
+    use super::super::test_docs::{
+        assert_same_hits, box_mesh, boxes_doc, boxes_parent, load_doc, load_err, placed_boxes,
+        rejects, test_doc, write_embedded, Doc,
+    };
     use super::*;
 
     use crate::scene::Scene;
@@ -487,7 +494,7 @@ mod lights_and_instancing_tests {
         let instanced = load_doc(doc.clone(), &bin);
         assert!(instanced.warnings.is_empty(), "{:?}", instanced.warnings);
         assert_eq!(instanced.instances.instances.len(), 4);
-        assert!(instanced.triangles.is_empty());
+        assert!(instanced.mesh.triangles.is_empty());
         // The same placements as nodes, with the values dequantized by the specification's
         // rules (max(c / 32767, -1), max(c / 127, -1)).
         let locals: Vec<Value> = (0..4)

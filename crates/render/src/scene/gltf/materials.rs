@@ -2,7 +2,17 @@
 //! _transmission and _volume, the paper's models and the road flag from `extras.streaks`, and
 //! the glTF default material.
 
-use super::*;
+use super::textures::{JsonTextureInfo, UvTransform};
+use super::Loader;
+use crate::material::{
+    Alpha, AlphaMode, GltfPbrParams, Material, PaperModel, Reflectance, Volume, Wetness,
+};
+use crate::normal_map::NormalMap;
+use crate::scene::{validate, SceneError};
+use crate::texture::{ColorSpace, TextureRef};
+use glam::{Vec3, Vec4};
+use serde::de::DeserializeOwned;
+use serde::Deserialize;
 
 /// `extras.streaks` of a material (see the `scene` module documentation).
 #[derive(Debug, Deserialize)]
@@ -258,12 +268,11 @@ impl Loader<'_> {
             });
         };
         let (factor, color) = (sp.specular_factor(), Vec3::from(sp.specular_color_factor()));
-        if !(0.0..=1.0).contains(&factor) {
-            return Err(self.bad(
-                element,
-                format!("KHR_materials_specular: specularFactor {factor} is not in [0, 1]"),
-            ));
-        }
+        self.unit_factor(
+            ("KHR_materials_specular", "specularFactor"),
+            factor,
+            element,
+        )?;
         if !(color.is_finite() && color.min_element() >= 0.0) {
             return Err(self.bad(
                 element,
@@ -296,45 +305,26 @@ impl Loader<'_> {
         document: &gltf::Document,
         element: &str,
     ) -> Result<Clearcoat, SceneError> {
-        let Some(value) = m.extension_value("KHR_materials_clearcoat") else {
+        const NAME: &str = "KHR_materials_clearcoat";
+        let Some(mut c) = self.material_extension::<Clearcoat>(m, NAME, element)? else {
             return Ok(Clearcoat::default());
         };
-        let reason = |r: String| format!("KHR_materials_clearcoat: {r}");
-        let mut c: Clearcoat = serde_json::from_value(value.clone())
-            .map_err(|e| self.bad(element, reason(e.to_string())))?;
-        for (key, v) in [
-            ("clearcoatFactor", c.clearcoat_factor),
-            ("clearcoatRoughnessFactor", c.clearcoat_roughness_factor),
-        ] {
-            if !(0.0..=1.0).contains(&v) {
-                return Err(self.bad(element, reason(format!("{key} {v} is not in [0, 1]"))));
-            }
-        }
+        self.unit_factor((NAME, "clearcoatFactor"), c.clearcoat_factor, element)?;
+        let roughness = c.clearcoat_roughness_factor;
+        self.unit_factor((NAME, "clearcoatRoughnessFactor"), roughness, element)?;
         if c.clearcoat_normal_texture.is_some() {
             self.warn(format!(
-                "{element}: KHR_materials_clearcoat clearcoatNormalTexture is not used; the \
-                 clear coat is shaded with the base's normal"
+                "{element}: {NAME} clearcoatNormalTexture is not used; the clear coat is \
+                 shaded with the base's normal"
             ));
         }
-        for (key, info, space) in [
-            ("clearcoatTexture", c.clearcoat_texture, ColorSpace::Linear),
-            (
-                "clearcoatRoughnessTexture",
-                c.clearcoat_roughness_texture,
-                ColorSpace::Linear,
-            ),
-        ] {
-            let Some(info) = info else { continue };
-            let Some(texture) = document.textures().nth(info.index) else {
-                let why = format!("{key}: texture {} does not exist", info.index);
-                return Err(self.bad(element, reason(why)));
-            };
-            let id = self.texture_of(&texture, info.tex_coord, info.transform, space, element)?;
-            match key {
-                "clearcoatTexture" => c.texture = Some(id),
-                _ => c.roughness_texture = Some(id),
-            }
-        }
+        let (info, key) = (c.clearcoat_texture, (NAME, "clearcoatTexture"));
+        c.texture = self.extension_texture(document, key, info, element)?;
+        let (info, key) = (
+            c.clearcoat_roughness_texture,
+            (NAME, "clearcoatRoughnessTexture"),
+        );
+        c.roughness_texture = self.extension_texture(document, key, info, element)?;
         Ok(c)
     }
 
@@ -346,30 +336,13 @@ impl Loader<'_> {
         document: &gltf::Document,
         element: &str,
     ) -> Result<Transmission, SceneError> {
-        let Some(value) = m.extension_value("KHR_materials_transmission") else {
+        const NAME: &str = "KHR_materials_transmission";
+        let Some(mut t) = self.material_extension::<Transmission>(m, NAME, element)? else {
             return Ok(Transmission::default());
         };
-        let reason = |r: String| format!("KHR_materials_transmission: {r}");
-        let mut t: Transmission = serde_json::from_value(value.clone())
-            .map_err(|e| self.bad(element, reason(e.to_string())))?;
-        let factor = t.transmission_factor;
-        if !(0.0..=1.0).contains(&factor) {
-            let why = format!("transmissionFactor {factor} is not in [0, 1]");
-            return Err(self.bad(element, reason(why)));
-        }
-        if let Some(info) = t.transmission_texture {
-            let Some(texture) = document.textures().nth(info.index) else {
-                let why = format!("transmissionTexture: texture {} does not exist", info.index);
-                return Err(self.bad(element, reason(why)));
-            };
-            t.texture = Some(self.texture_of(
-                &texture,
-                info.tex_coord,
-                info.transform,
-                ColorSpace::Linear,
-                element,
-            )?);
-        }
+        self.unit_factor((NAME, "transmissionFactor"), t.transmission_factor, element)?;
+        let (info, key) = (t.transmission_texture, (NAME, "transmissionTexture"));
+        t.texture = self.extension_texture(document, key, info, element)?;
         Ok(t)
     }
 
@@ -382,12 +355,11 @@ impl Loader<'_> {
         m: &gltf::Material,
         element: &str,
     ) -> Result<Option<Volume>, SceneError> {
-        let Some(value) = m.extension_value("KHR_materials_volume") else {
+        let Some(v) = self.material_extension::<JsonVolume>(m, "KHR_materials_volume", element)?
+        else {
             return Ok(None);
         };
         let reason = |r: String| format!("KHR_materials_volume: {r}");
-        let v: JsonVolume = serde_json::from_value(value.clone())
-            .map_err(|e| self.bad(element, reason(e.to_string())))?;
         let colour = Vec3::from(v.attenuation_color);
         if !(v.thickness_factor.is_finite() && v.thickness_factor >= 0.0) {
             let why = format!("thicknessFactor {} is invalid", v.thickness_factor);
@@ -418,6 +390,61 @@ impl Loader<'_> {
             colour,
             v.attenuation_distance,
         )))
+    }
+
+    /// Extension `name` of material `m` as the JSON has it, parsed as `T`; `None` where the
+    /// material does not use it. The gltf crate does not know the extensions read this way;
+    /// a malformed object is an error naming the material and the extension.
+    fn material_extension<T: DeserializeOwned>(
+        &self,
+        m: &gltf::Material,
+        name: &str,
+        element: &str,
+    ) -> Result<Option<T>, SceneError> {
+        m.extension_value(name)
+            .map(|value| {
+                serde_json::from_value(value.clone())
+                    .map_err(|e| self.bad(element, format!("{name}: {e}")))
+            })
+            .transpose()
+    }
+
+    /// Checks that `value`, the factor `key` of material extension `extension`, is in
+    /// [0, 1]; otherwise an error naming the material, the extension and the factor.
+    fn unit_factor(
+        &self,
+        (extension, key): (&str, &str),
+        value: f32,
+        element: &str,
+    ) -> Result<(), SceneError> {
+        if (0.0..=1.0).contains(&value) {
+            return Ok(());
+        }
+        let why = format!("{extension}: {key} {value} is not in [0, 1]");
+        Err(self.bad(element, why))
+    }
+
+    /// The texture `info` names, the textureInfo `key` of material extension `extension`
+    /// (`None` without one), decoded as linear data, which every texture these extensions
+    /// name is; an index past the file's textures is an error naming the material, the
+    /// extension and the key.
+    fn extension_texture(
+        &mut self,
+        document: &gltf::Document,
+        (extension, key): (&str, &str),
+        info: Option<JsonTextureInfo>,
+        element: &str,
+    ) -> Result<Option<TextureRef>, SceneError> {
+        let Some(info) = info else {
+            return Ok(None);
+        };
+        let Some(texture) = document.textures().nth(info.index) else {
+            let why = format!("{extension}: {key}: texture {} does not exist", info.index);
+            return Err(self.bad(element, why));
+        };
+        let space = ColorSpace::Linear;
+        let id = self.texture_of(&texture, info.tex_coord, info.transform, space, element)?;
+        Ok(Some(id))
     }
 
     pub(super) fn streaks_extras(
@@ -531,7 +558,7 @@ impl Loader<'_> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::test_docs::*;
+    use super::super::test_docs::{error, load_err, png_file, rejects, test_doc, write_embedded};
 
     use crate::bsdf::Bsdf;
     use crate::geometry::VertexAttributes;

@@ -1,7 +1,11 @@
 //! Mesh primitives: their vertex attributes taken to world space, triangulation of strips and
 //! fans, and tangents for normal maps (the file's, or MikkTSpace's).
 
-use super::*;
+use super::{accessors, mesh_label, Loader};
+use crate::scene::{tangents, validate, SceneError};
+use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
+use gltf::accessor::{DataType, Dimensions};
+use gltf::mesh::Mode;
 
 /// Triangles (local vertex indices) of a triangle, strip or fan primitive (glTF 2.0 section
 /// 3.7.2.1); degenerate strip and fan triangles are kept (they are never hit).
@@ -53,14 +57,14 @@ impl Loader<'_> {
                 )?;
             }
             let positions: Vec<Vec3> = self
-                .attribute(&pos_acc, &element, "POSITION", accessor::POSITION, None)?
+                .attribute(&pos_acc, &element, "POSITION", accessors::POSITION, None)?
                 .into_iter()
                 .map(Vec3::from)
                 .collect();
             let n = positions.len();
             let normals: Vec<Vec3> = match prim.get(&gltf::Semantic::Normals) {
                 Some(a) => self
-                    .attribute(&a, &element, "NORMAL", accessor::DIRECTION, Some(n))?
+                    .attribute(&a, &element, "NORMAL", accessors::DIRECTION, Some(n))?
                     .into_iter()
                     .map(|v: [f32; 3]| {
                         (normal_matrix * Vec3::from(v))
@@ -72,7 +76,7 @@ impl Loader<'_> {
             };
             let uvs: Vec<Vec2> = match prim.get(&gltf::Semantic::TexCoords(0)) {
                 Some(a) => self
-                    .attribute(&a, &element, "TEXCOORD_0", accessor::TEXCOORD, Some(n))?
+                    .attribute(&a, &element, "TEXCOORD_0", accessors::TEXCOORD, Some(n))?
                     .into_iter()
                     .map(Vec2::from)
                     .collect(),
@@ -89,7 +93,7 @@ impl Loader<'_> {
                 .filter(|_| normal_mapped);
             let file_tangents: Option<Vec<[f32; 4]>> = match &tangent_acc {
                 Some(a) if has_normals => {
-                    Some(self.attribute(a, &element, "TANGENT", accessor::DIRECTION, Some(n))?)
+                    Some(self.attribute(a, &element, "TANGENT", accessors::DIRECTION, Some(n))?)
                 }
                 _ => None,
             };
@@ -97,7 +101,7 @@ impl Loader<'_> {
             let reader = prim.reader(|b| buffers.get(b.index()).map(|d| d.0.as_slice()));
             let uvs1: Option<Vec<Vec2>> = match prim.get(&gltf::Semantic::TexCoords(1)) {
                 Some(a) => Some(
-                    self.attribute(&a, &element, "TEXCOORD_1", accessor::TEXCOORD, Some(n))?
+                    self.attribute(&a, &element, "TEXCOORD_1", accessors::TEXCOORD, Some(n))?
                         .into_iter()
                         .map(Vec2::from)
                         .collect(),
@@ -106,13 +110,13 @@ impl Loader<'_> {
             };
             let colors: Option<Vec<Vec4>> = match prim.get(&gltf::Semantic::Colors(0)) {
                 Some(a) if a.dimensions() == Dimensions::Vec3 => Some(
-                    self.attribute::<3>(&a, &element, "COLOR_0", accessor::COLOR, Some(n))?
+                    self.attribute::<3>(&a, &element, "COLOR_0", accessors::COLOR, Some(n))?
                         .into_iter()
                         .map(|c| Vec3::from(c).extend(1.0))
                         .collect(),
                 ),
                 Some(a) => Some(
-                    self.attribute::<4>(&a, &element, "COLOR_0", accessor::COLOR, Some(n))?
+                    self.attribute::<4>(&a, &element, "COLOR_0", accessors::COLOR, Some(n))?
                         .into_iter()
                         .map(Vec4::from)
                         .collect(),
@@ -205,52 +209,49 @@ impl Loader<'_> {
                      have; TEXCOORD_0 is read instead"
                 ));
             }
-            let first = self.parts.positions.len();
+            let first = self.parts.mesh.positions.len();
             if first + positions.len() > u32::MAX as usize {
                 return Err(self.bad(element, "the scene has more than 2^32 - 1 vertices"));
             }
+            let out = &mut self.parts.mesh;
             if let Some(t) = tangents {
-                self.parts.tangents.resize(first, Vec4::ZERO);
-                self.parts.tangents.extend(t);
+                out.tangents.resize(first, Vec4::ZERO);
+                out.tangents.extend(t);
             }
             let first = first as u32;
             for t in &mut tris {
                 *t = t.map(|i| i + first);
             }
-            self.parts.positions.extend(positions);
-            self.parts.normals.extend(normals);
+            out.positions.extend(positions);
+            out.normals.extend(normals);
             // The second uv set and the colours are stored only once some primitive has them:
             // earlier vertices get TEXCOORD_0 and white, as do later primitives without them.
-            let parts = &mut self.parts;
             match uvs1 {
                 Some(uvs1) => {
-                    if parts.uvs1.is_empty() {
-                        parts.uvs1 = parts.uvs.clone();
+                    if out.uvs1.is_empty() {
+                        out.uvs1 = out.uvs.clone();
                     }
-                    parts.uvs1.extend(uvs1);
+                    out.uvs1.extend(uvs1);
                 }
-                None if !parts.uvs1.is_empty() => parts.uvs1.extend_from_slice(&uvs),
+                None if !out.uvs1.is_empty() => out.uvs1.extend_from_slice(&uvs),
                 None => {}
             }
             match colors {
                 Some(colors) => {
-                    if parts.colors.is_empty() {
-                        parts.colors = vec![Vec4::ONE; parts.uvs.len()];
+                    if out.colors.is_empty() {
+                        out.colors = vec![Vec4::ONE; out.uvs.len()];
                     }
-                    parts.colors.extend(colors);
+                    out.colors.extend(colors);
                 }
-                None if !parts.colors.is_empty() => {
-                    parts
-                        .colors
-                        .extend(std::iter::repeat_n(Vec4::ONE, uvs.len()));
+                None if !out.colors.is_empty() => {
+                    out.colors.extend(std::iter::repeat_n(Vec4::ONE, uvs.len()));
                 }
                 None => {}
             }
-            self.parts.uvs.extend(uvs);
-            self.parts
-                .triangle_materials
+            out.uvs.extend(uvs);
+            out.triangle_materials
                 .extend(std::iter::repeat_n(material, tris.len()));
-            self.parts.triangles.extend(tris);
+            out.triangles.extend(tris);
         }
         Ok(())
     }
@@ -298,7 +299,10 @@ impl Loader<'_> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::test_docs::*;
+    use super::super::test_docs::{
+        add_tangent, error, load_doc, load_err, normal_mapped_doc, png_uri, quad_normal, test_doc,
+        with, write_embedded,
+    };
     use super::*;
 
     use crate::scene::Scene;
@@ -326,7 +330,7 @@ mod tests {
         doc["meshes"][1]["primitives"][0]["mode"] = json!(0);
         let path = write_embedded(dir.path(), doc, &bin);
         let scene = Scene::load(&path).unwrap();
-        assert_eq!(scene.triangles.len(), 2);
+        assert_eq!(scene.mesh.triangles.len(), 2);
         assert_eq!(scene.warnings.len(), 1);
         assert!(
             scene.warnings[0].contains("mesh \"tri\" (1), primitive 0"),
@@ -351,7 +355,10 @@ mod tests {
     #[test]
     fn normal_texture_without_tangent_gets_mikktspace_tangents() {
         // No normal map: no tangents stored at all.
-        assert!(load_doc(test_doc().0, &test_doc().1).tangents.is_empty());
+        assert!(load_doc(test_doc().0, &test_doc().1)
+            .mesh
+            .tangents
+            .is_empty());
         let theta = 0.4f32;
         let (doc, bin) = normal_mapped_doc(theta, 1.0);
         let scene = load_doc(doc, &bin);
@@ -359,11 +366,11 @@ mod tests {
         let m = scene.materials[0].normal_map.unwrap();
         assert_eq!((m.texture.texture, m.scale), (0, 1.0));
         // One tangent per vertex; the quad's are +X with w = +1, the unmapped triangle's zero.
-        assert_eq!(scene.tangents.len(), scene.positions.len());
-        for t in &scene.tangents[..4] {
+        assert_eq!(scene.mesh.tangents.len(), scene.mesh.positions.len());
+        for t in &scene.mesh.tangents[..4] {
             assert!((*t - Vec4::new(1.0, 0.0, 0.0, 1.0)).length() < 1e-5, "{t}");
         }
-        assert!(scene.tangents[4..].iter().all(|t| *t == Vec4::ZERO));
+        assert!(scene.mesh.tangents[4..].iter().all(|t| *t == Vec4::ZERO));
         // The texel (8-bit) tilts the normal by theta toward the tangent.
         let ns = quad_normal(&scene);
         assert!((ns.dot(Vec3::Y).acos() - theta).abs() < 0.01, "{ns}");
@@ -383,7 +390,7 @@ mod tests {
         let texel = |x: f32| (255.0 * (x + 1.0) / 2.0).round() as u8;
         doc["images"][0]["uri"] = json!(png_uri([128, texel(theta.sin()), texel(theta.cos())]));
         let scene = load_doc(doc.clone(), &bin);
-        for t in &scene.tangents[..4] {
+        for t in &scene.mesh.tangents[..4] {
             assert!(
                 (*t - Vec4::new(-1.0, 0.0, 0.0, -1.0)).length() < 1e-5,
                 "{t}"
@@ -399,7 +406,7 @@ mod tests {
         // shading normal tilts the same way.
         doc["nodes"][0]["scale"] = json!([-2, 2, 2]);
         let scene = load_doc(doc, &bin);
-        for t in &scene.tangents[..4] {
+        for t in &scene.mesh.tangents[..4] {
             assert!((*t - Vec4::new(1.0, 0.0, 0.0, 1.0)).length() < 1e-5, "{t}");
         }
         let ray = crate::geometry::Ray::new(Vec3::new(-21.0, 5.0, 0.5), -Vec3::Y);
@@ -427,7 +434,7 @@ mod tests {
             "{:?}",
             scene.warnings
         );
-        let t = scene.tangents[0];
+        let t = scene.mesh.tangents[0];
         assert!((t - Vec4::new(1.0, 0.0, 0.0, 1.0)).length() < 1e-5, "{t}");
         assert!((quad_normal(&scene).dot(Vec3::Y).acos() - 0.3).abs() < 0.01);
         // Without TEXCOORD_0 there is nothing to map: a warning, and the plain normal.
@@ -543,6 +550,6 @@ mod tests {
         let scene = Scene::load(&path).unwrap();
         let took = start.elapsed();
         assert!(took < Duration::from_secs(5), "{took:?}");
-        assert_eq!(scene.triangles.len(), 2 + n - 2);
+        assert_eq!(scene.mesh.triangles.len(), 2 + n - 2);
     }
 }

@@ -2,7 +2,7 @@
 //!
 //! Every accessor is checked (type, bounds within its buffer view and buffer) before it is
 //! read, so malformed files give a [`SceneError`] naming the element instead of a panic.
-//! Vertex attributes are read by the `accessor` module (every component type of the core
+//! Vertex attributes are read by the `accessors` module (every component type of the core
 //! specification and of KHR_mesh_quantization, sparse accessors); meshopt- and
 //! Draco-compressed geometry is decoded first by the `compression` module. Sparse index
 //! accessors are not supported (an error names them).
@@ -21,8 +21,10 @@
 //!   unchecked, then the steps in order (buffers, compressed geometry, materials, the node
 //!   walk, the meshes' placements);
 //! - `buffers`: buffers and bufferViews, and reading accessors (layouts, bounds, the decoded
-//!   bytes charged against [`super::LoadOptions`]); the accessor formats themselves are
-//!   `scene/accessor.rs`, meshopt and Draco decoding `scene/compression.rs`;
+//!   bytes charged against [`super::LoadOptions`]);
+//! - `accessors`: the accessor formats (component types, normalization, sparse accessors);
+//! - `compression`: EXT_meshopt_compression and KHR_draco_mesh_compression, decoded into
+//!   plain buffers and accessors before the document is read;
 //! - `nodes`: the node walk, cameras, the limits [`MAX_PLACEMENTS`] and [`MAX_TRIANGLES`],
 //!   and the placement of meshes as world triangles or instances;
 //! - `meshes`: primitives, their attributes in world space, triangulation, tangents;
@@ -30,9 +32,12 @@
 //! - `textures`: texture infos, KHR_texture_transform, samplers, images;
 //! - [`extensions`]: which extensions are honoured, and the ones that are not a material's
 //!   field: KHR_lights_punctual (and the file's light units), EXT_mesh_gpu_instancing;
+//! - `test_docs` (tests only): the documents the tests build, write and load;
 //! - this file: the [`Loader`] state the others add to, and the labels errors name elements by.
 
+mod accessors;
 mod buffers;
+mod compression;
 mod document;
 pub mod extensions;
 mod materials;
@@ -45,29 +50,13 @@ mod textures;
 pub(super) use document::load;
 pub use nodes::{MAX_PLACEMENTS, MAX_TRIANGLES};
 
-use super::files::{Files, Uri};
-use super::{
-    accessor, compression, tangents, validate, Instance, MeshParts, Scene, SceneError, SceneParts,
-};
-use crate::camera::Camera;
-use crate::light::{Light, LUMINOUS_EFFICACY};
-use crate::material::{
-    Alpha, AlphaMode, GltfPbrParams, Material, PaperModel, Reflectance, Volume, Wetness,
-};
-use crate::normal_map::NormalMap;
-use crate::texture::{
-    uv_transform, ColorSpace, Filter, Sampler, Texture, TextureId, TextureRef, Wrap,
-};
-use buffers::*;
-use extensions::*;
-use glam::{Affine2, Affine3A, Mat3, Mat4, Quat, Vec2, Vec3, Vec4};
-use gltf::accessor::{DataType, Dimensions};
-use gltf::mesh::Mode;
-use nodes::*;
-use serde::Deserialize;
+use super::files::Files;
+use super::{SceneError, SceneParts};
+use crate::texture::{ColorSpace, TextureId};
+use extensions::LightUnits;
+use glam::Mat4;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
-use textures::*;
 
 fn node_label(node: &gltf::Node) -> String {
     match node.name() {

@@ -1,7 +1,12 @@
 //! The node walk and what it places: node transforms, cameras, the limits on placements and
 //! triangles, and each mesh flattened into world triangles or stored once as instances.
 
-use super::*;
+use super::{mesh_label, node_label, Loader};
+use crate::camera::Camera;
+use crate::scene::{validate, Instance, SceneError, TriangleMesh};
+use glam::{Affine3A, Mat4, Quat, Vec3, Vec4};
+use gltf::mesh::Mode;
+use std::path::Path;
 
 /// The most node visits (a node reached by several paths of the hierarchy is visited once per
 /// path) and, separately, mesh placements (node meshes and EXT_mesh_gpu_instancing instances)
@@ -105,18 +110,6 @@ pub(super) fn primitive_triangles(prim: &gltf::Primitive) -> usize {
         Mode::TriangleStrip | Mode::TriangleFan => n.saturating_sub(2),
         _ => 0,
     }
-}
-
-/// Swaps the vertex arrays and triangles of `parts` with those of `mesh`.
-pub(super) fn swap_geometry(parts: &mut SceneParts, mesh: &mut MeshParts) {
-    std::mem::swap(&mut parts.positions, &mut mesh.positions);
-    std::mem::swap(&mut parts.normals, &mut mesh.normals);
-    std::mem::swap(&mut parts.uvs, &mut mesh.uvs);
-    std::mem::swap(&mut parts.tangents, &mut mesh.tangents);
-    std::mem::swap(&mut parts.uvs1, &mut mesh.uvs1);
-    std::mem::swap(&mut parts.colors, &mut mesh.colors);
-    std::mem::swap(&mut parts.triangles, &mut mesh.triangles);
-    std::mem::swap(&mut parts.triangle_materials, &mut mesh.triangle_materials);
 }
 
 impl Loader<'_> {
@@ -254,13 +247,10 @@ impl Loader<'_> {
 
     /// `mesh` loaded in its own (object) space, as [`Loader::mesh`] loads it with the identity
     /// transform, into its own arrays.
-    pub(super) fn object_mesh(&mut self, mesh: &gltf::Mesh) -> Result<MeshParts, SceneError> {
-        let mut world = MeshParts::default();
-        swap_geometry(&mut self.parts, &mut world);
+    pub(super) fn object_mesh(&mut self, mesh: &gltf::Mesh) -> Result<TriangleMesh, SceneError> {
+        let world = std::mem::take(&mut self.parts.mesh);
         let loaded = self.mesh(mesh, Mat4::IDENTITY);
-        let mut object = MeshParts::default();
-        swap_geometry(&mut self.parts, &mut object);
-        swap_geometry(&mut self.parts, &mut world);
+        let mut object = std::mem::replace(&mut self.parts.mesh, world);
         loaded?;
         if !object.tangents.is_empty() {
             object.tangents.resize(object.positions.len(), Vec4::ZERO);
@@ -305,7 +295,10 @@ impl Loader<'_> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::test_docs::*;
+    use super::super::test_docs::{
+        approx, assert_same_hits, box_placements, check_test_scene, doubling_dag, error, load_doc,
+        load_err, placed_boxes, rejects, test_doc, write_embedded,
+    };
 
     use crate::scene::Scene;
     use glam::Vec3;
@@ -370,12 +363,12 @@ mod tests {
         let (doc, bin) = placed_boxes(&placements, false);
         let flat = load_doc(doc, &bin);
         assert!(flat.instances.is_empty());
-        assert_eq!(flat.triangles.len(), placements.len() * 14);
-        assert!(instanced.triangles.is_empty() && instanced.positions.is_empty());
+        assert_eq!(flat.mesh.triangles.len(), placements.len() * 14);
+        assert!(instanced.mesh.triangles.is_empty() && instanced.mesh.positions.is_empty());
         assert_eq!(instanced.instances.meshes.len(), 1);
         assert_eq!(instanced.instances.instances.len(), placements.len());
         assert_eq!(instanced.instances.stored_triangle_count(), 14);
-        assert_eq!(instanced.world_triangle_count(), flat.triangles.len());
+        assert_eq!(instanced.world_triangle_count(), flat.mesh.triangles.len());
         assert!(
             instanced
                 .instances
@@ -430,9 +423,9 @@ mod tests {
             assert_eq!(s.world_triangle_count(), 14 * n);
             let m = &s.instances.meshes[0];
             (
-                s.triangles.len(),
-                m.parts.triangles.len(),
-                m.parts.positions.len(),
+                s.mesh.triangles.len(),
+                m.mesh.triangles.len(),
+                m.mesh.positions.len(),
                 m.accel.memory_bytes(),
             )
         };

@@ -1,12 +1,13 @@
 //! glTF documents for the loader's tests: a builder of buffers and accessors, the test scene,
 //! writers of embedded, external and GLB files, and helpers shared by the tests of several files.
 
-use super::*;
-use crate::material::{GltfPbrParams, Reflectance};
+use crate::light::Light;
+use crate::material::{GltfPbrParams, PaperModel, Reflectance};
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
 use serde_json::{json, Value};
 use std::f32::consts::FRAC_1_SQRT_2;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 /// A glTF document under construction: one binary buffer, views and accessors.
@@ -158,14 +159,14 @@ pub(super) fn approx(a: Vec3, b: Vec3) -> bool {
 pub(super) fn check_test_scene(scene: &Scene) {
     assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
     // Quad: world = T(0,1,0) S(2) T(10,0,0).
-    assert_eq!(scene.triangles.len(), 3);
-    assert!(approx(scene.positions[2], Vec3::new(22.0, 1.0, 2.0)));
-    assert!(approx(scene.positions[0], Vec3::new(20.0, 1.0, 0.0)));
-    assert!(approx(scene.normals[1], Vec3::Y));
-    assert_eq!(scene.uvs[2], Vec2::new(1.0, 1.0));
+    assert_eq!(scene.mesh.triangles.len(), 3);
+    assert!(approx(scene.mesh.positions[2], Vec3::new(22.0, 1.0, 2.0)));
+    assert!(approx(scene.mesh.positions[0], Vec3::new(20.0, 1.0, 0.0)));
+    assert!(approx(scene.mesh.normals[1], Vec3::Y));
+    assert_eq!(scene.mesh.uvs[2], Vec2::new(1.0, 1.0));
     // The emissive triangle has face normals (stored as zero) and sits at z = -3.
-    assert_eq!(scene.normals[5], Vec3::ZERO);
-    assert!(approx(scene.positions[5], Vec3::new(1.0, 0.0, -3.0)));
+    assert_eq!(scene.mesh.normals[5], Vec3::ZERO);
+    assert!(approx(scene.mesh.positions[5], Vec3::new(1.0, 0.0, -3.0)));
     // A ray down onto the quad hits it with the right uv and normal.
     let hit = scene
         .intersect(&crate::geometry::Ray::new(

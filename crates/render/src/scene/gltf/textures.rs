@@ -1,7 +1,14 @@
 //! Textures: texture infos (with KHR_texture_transform, read by the gltf crate or from the
 //! JSON), samplers, and images decoded once per colour space.
 
-use super::*;
+use super::{uri_label, Loader};
+use crate::scene::files::Uri;
+use crate::scene::SceneError;
+use crate::texture::{
+    uv_transform, ColorSpace, Filter, Sampler, Texture, TextureId, TextureRef, Wrap,
+};
+use glam::{Affine2, Vec2, Vec4};
+use serde::Deserialize;
 
 /// A textureInfo read from the JSON: the texture's index and its texCoord set.
 #[derive(Clone, Copy, Debug, Deserialize)]
@@ -271,10 +278,12 @@ impl Loader<'_> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::test_docs::*;
+    use super::super::test_docs::{
+        approx, load_doc, load_err, normal_mapped_doc, png_file, test_doc, write_embedded, Doc,
+    };
     use super::*;
 
-    use crate::material::{GltfPbrParams, Reflectance};
+    use crate::material::{AlphaMode, GltfPbrParams, Reflectance};
     use crate::scene::Scene;
     use glam::{Vec2, Vec3};
     use serde_json::json;
@@ -352,11 +361,11 @@ mod tests {
         // One image for both textures (same colour space); the second uv set and the colours
         // are stored for every vertex, TEXCOORD_0 and white where a primitive has none.
         assert_eq!(scene.textures.len(), 1);
-        assert_eq!(scene.uvs1.len(), 7);
-        assert_eq!(scene.uvs1[2], Vec2::new(0.5, 0.5));
-        assert_eq!(scene.uvs1[4..], scene.uvs[4..]);
-        assert!((scene.colors[2] - Vec4::new(0.0, 0.0, 1.0, 0.2)).length() < 1e-6);
-        assert_eq!(scene.colors[5], Vec4::ONE);
+        assert_eq!(scene.mesh.uvs1.len(), 7);
+        assert_eq!(scene.mesh.uvs1[2], Vec2::new(0.5, 0.5));
+        assert_eq!(scene.mesh.uvs1[4..], scene.mesh.uvs[4..]);
+        assert!((scene.mesh.colors[2] - Vec4::new(0.0, 0.0, 1.0, 0.2)).length() < 1e-6);
+        assert_eq!(scene.mesh.colors[5], Vec4::ONE);
         let Reflectance::GltfPbr(GltfPbrParams {
             base_color_texture: Some(base),
             ..
@@ -438,7 +447,7 @@ mod tests {
         doc["materials"][0]["normalTexture"]["extensions"] =
             json!({"KHR_texture_transform": {"rotation": std::f32::consts::FRAC_PI_2}});
         let scene = load_doc(doc, &bin);
-        for t in &scene.tangents[..4] {
+        for t in &scene.mesh.tangents[..4] {
             assert!(t.x.abs() < 1e-4 && (t.z.abs() - 1.0).abs() < 1e-4, "{t}");
         }
         // A malformed transform names the material's normal texture.

@@ -19,11 +19,11 @@
 //! expand to (1024 times for attributes, from the format: a block of up to 256 vertices
 //! costs at least one control byte per 4 bytes of stride; one byte per triangle or per index
 //! for indices) and against the scene's budget of decoded bytes
-//! ([`super::LoadOptions::max_decoded_bytes`]); a Draco stream is decoded under
+//! ([`crate::scene::LoadOptions::max_decoded_bytes`]); a Draco stream is decoded under
 //! `draco-core`'s `DecodeLimits` set to what is left of that budget.
 
-use super::files::Files;
-use super::SceneError;
+use crate::scene::files::Files;
+use crate::scene::SceneError;
 use gltf::buffer::Data;
 use serde_json::{json, Value};
 use std::path::Path;
