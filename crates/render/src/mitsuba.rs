@@ -188,8 +188,9 @@ impl MitsubaExport {
     }
 }
 
-/// The parts of a scene the exporter reads (everything but the BVH).
-pub(crate) struct SceneParts<'a> {
+/// What the exporter reads of a scene (everything but the BVH): a [`Scene`]'s fields, or an
+/// instanced mesh's as an object of its own.
+pub(crate) struct ExportedScene<'a> {
     pub(crate) source: &'a Path,
     pub(crate) mesh: &'a TriangleMesh,
     pub(crate) materials: &'a [Material],
@@ -201,7 +202,7 @@ pub(crate) struct SceneParts<'a> {
 /// Converts `scene` to Mitsuba 3 with the render settings `opts`.
 pub fn export(scene: &Scene, opts: &ExportOptions) -> Result<MitsubaExport, MitsubaError> {
     export_parts(
-        &SceneParts {
+        &ExportedScene {
             source: &scene.source,
             mesh: &scene.mesh,
             materials: &scene.materials,
@@ -267,7 +268,7 @@ fn rgb(name: &str, v: Vec3) -> String {
 
 /// Context for one material's conversion: collects warnings and baked textures.
 struct MaterialWriter<'a> {
-    parts: &'a SceneParts<'a>,
+    parts: &'a ExportedScene<'a>,
     warnings: &'a mut Vec<String>,
     textures: &'a mut Vec<BakedTexture>,
 }
@@ -767,7 +768,7 @@ fn sensor_xml(cam: &Camera, opts: &ExportOptions) -> String {
 }
 
 /// Splits the triangle soup into one mesh per material, with compact vertex arrays.
-fn meshes_by_material(parts: &SceneParts<'_>) -> Vec<(usize, PlyMesh)> {
+fn meshes_by_material(parts: &ExportedScene<'_>) -> Vec<(usize, PlyMesh)> {
     let mut groups: Vec<Option<(HashMap<u32, u32>, PlyMesh)>> =
         (0..parts.materials.len()).map(|_| None).collect();
     let flat = parts.mesh;
@@ -813,7 +814,7 @@ fn meshes_by_material(parts: &SceneParts<'_>) -> Vec<(usize, PlyMesh)> {
 
 /// [`export`] on the parts of a scene, with the camera already chosen.
 pub(crate) fn export_parts(
-    parts: &SceneParts<'_>,
+    parts: &ExportedScene<'_>,
     camera: &Camera,
     opts: &ExportOptions,
 ) -> Result<MitsubaExport, MitsubaError> {
@@ -885,7 +886,7 @@ pub(crate) fn export_parts(
         );
     }
     for (k, instanced) in parts.instances.meshes.iter().enumerate() {
-        let object = SceneParts {
+        let object = ExportedScene {
             mesh: &instanced.mesh,
             ..*parts
         };
@@ -930,6 +931,7 @@ pub(crate) fn export_parts(
 mod tests {
     use super::*;
     use crate::material::Wetness;
+    use crate::scene::SceneParts;
     use crate::texture::ColorSpace;
     use glam::{Affine3A, Vec4};
 
@@ -1043,8 +1045,8 @@ mod tests {
             }
         }
 
-        fn parts(&self) -> SceneParts<'_> {
-            SceneParts {
+        fn parts(&self) -> ExportedScene<'_> {
+            ExportedScene {
                 source: Path::new("test.gltf"),
                 mesh: &self.mesh,
                 materials: &self.materials,
@@ -1083,7 +1085,7 @@ mod tests {
             ..Default::default()
         };
         let moves = [Vec3::new(0.0, 0.0, -3.0), Vec3::new(2.0, 0.0, -3.0)];
-        let scene = Scene::from_parts(crate::scene::SceneParts {
+        let scene = Scene::from_parts(SceneParts {
             source: "inst.gltf".into(),
             materials: fx.materials.clone(),
             textures: fx.textures.clone(),
