@@ -4,16 +4,18 @@
 //! detect` and `streaks train-detector` both read. Subcommands use these and never
 //! call each other.
 
-use crate::dataset::sample::SampleMeta;
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::Path;
 use std::time::Instant;
 use streaks_analysis::detector::{horizon_row, road_streaks};
 use streaks_analysis::report::{analyze_dir, summary_table, AnalyzeParams, Report};
+use streaks_dataset::files::{load_mask, SampleDir};
+use streaks_dataset::meta::SampleMeta;
 use streaks_image::GrayImage;
 use streaks_render::scene::{LoadOptions, Scene, SceneError};
+use streaks_stereo::rig::Eye;
 
 /// Largest image accepted, in pixels (2^26, twice 8K UHD; the film keeps about 72 bytes per
 /// pixel, so 4.5 GiB).
@@ -114,29 +116,19 @@ pub fn sample_horizon(meta: &SampleMeta) -> f32 {
     horizon_row(&rig.world_from_rig, rig.principal_point[1], rig.focal_px)
 }
 
-/// Loads a 0/255 (or 0/1) mask, checking its size against `w` x `h`.
-fn load_mask(path: &Path, w: usize, h: usize) -> Result<GrayImage> {
-    let m = GrayImage::load(path).with_context(|| format!("cannot read {}", path.display()))?;
-    if (m.width, m.height) != (w, h) {
-        bail!(
-            "{} is {}x{}, the image {w}x{h}",
-            path.display(),
-            m.width,
-            m.height
-        );
-    }
-    Ok(m)
-}
-
-/// The truth masks of the dataset sample in `dir`: `streaks0.png`, and its part on the road
-/// ([`road_streaks`] with `road0.png`), if the scene flags a road.
-pub fn sample_truths(dir: &Path, meta: &SampleMeta) -> Result<(GrayImage, Option<GrayImage>)> {
-    let (w, h) = (meta.rig.width as usize, meta.rig.height as usize);
-    let truth = load_mask(&dir.join("streaks0.png"), w, h)?;
+/// The truth masks of the dataset sample `sample` (with its `meta`): its left streak mask, and
+/// that mask's part on the road ([`road_streaks`] with the road mask), if the scene flags a
+/// road.
+pub fn sample_truths(
+    sample: &SampleDir,
+    meta: &SampleMeta,
+) -> Result<(GrayImage, Option<GrayImage>)> {
+    let size = (meta.rig.width as usize, meta.rig.height as usize);
+    let truth = load_mask(&sample.streak_mask(Eye::Left), size, "the image")?;
     if !meta.road_mask {
         return Ok((truth, None));
     }
-    let road = load_mask(&dir.join("road0.png"), w, h)?;
+    let road = load_mask(&sample.road_mask(Eye::Left), size, "the image")?;
     let on_road = road_streaks(&truth, &road);
     Ok((truth, Some(on_road)))
 }

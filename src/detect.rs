@@ -27,10 +27,11 @@ use std::path::{Path, PathBuf};
 use streaks_analysis::detect::{score_mask, DetectParams};
 use streaks_analysis::detector::{DatasetScore, Detector, Found, SampleScore};
 use streaks_analysis::streak_classifier::StreakClassifier;
+use streaks_dataset::files::{SampleDir, SAMPLE_NAMES};
+use streaks_dataset::layout::Layout;
+use streaks_dataset::DatasetError;
 use streaks_image::{write_bytes_atomically, GrayImage};
-
-use crate::dataset::layout::Layout;
-use crate::dataset::sample::SampleMeta;
+use streaks_stereo::rig::Eye;
 
 /// Detect specular streaks in an image, or score the detector over a dataset.
 #[derive(clap::Args, Debug)]
@@ -243,25 +244,29 @@ impl ParamArgs {
 
 /// Image file name of a dataset sample's left view.
 fn image_file(kind: ImageKind) -> &'static str {
+    let left = 0;
     match kind {
-        ImageKind::Png => "im0.png",
-        ImageKind::Exr => "im0.exr",
+        ImageKind::Png => SAMPLE_NAMES.png[left],
+        ImageKind::Exr => SAMPLE_NAMES.exr[left],
     }
 }
 
 /// Scores the detector on one sample folder.
 /// With the learned detector, also its (probability, road truth) per pixel.
 fn score_sample(
-    dir: &Path,
+    sample: &SampleDir,
     id: &str,
     kind: ImageKind,
     detector: &Detector,
 ) -> Result<(SampleScore, Vec<(f32, bool)>)> {
-    let meta = SampleMeta::load(&dir.join("meta.json"))?;
-    let image = dir.join(image_file(kind));
+    let meta = sample.load_meta()?;
+    let image = match kind {
+        ImageKind::Png => sample.png(Eye::Left),
+        ImageKind::Exr => sample.exr(Eye::Left),
+    };
     let horizon = crate::cli::sample_horizon(&meta);
     let found = detect_file(detector, &image, Some(horizon))?;
-    let (truth, on_road) = crate::cli::sample_truths(dir, &meta)?;
+    let (truth, on_road) = crate::cli::sample_truths(sample, &meta)?;
     let (score, pairs) =
         SampleScore::new(id, &meta.split, horizon, &found, &truth, on_road.as_ref())?;
     Ok((score, pairs))
@@ -280,9 +285,9 @@ pub fn score_dataset(
     let samples = ids
         .par_iter()
         .map(|id| {
-            let sample = layout.samples_dir().join(id);
+            let sample = layout.sample_by_id(id);
             let s = score_sample(&sample, id, kind, detector)
-                .with_context(|| format!("sample {}", sample.display()));
+                .with_context(|| format!("sample {}", sample.path().display()));
             bar.inc(1);
             s
         })
@@ -301,7 +306,7 @@ pub fn score_dataset(
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<()> {
-    let dataset = args.input.join("dataset.json").is_file();
+    let dataset = Layout::new(&args.input).dataset_json().is_file();
     let detector = detector_from_args(&args, detector_kind(&args, dataset))?;
     if dataset {
         let kind = args.image.unwrap_or(default_image(&detector));
@@ -335,14 +340,7 @@ pub fn run(args: Args) -> Result<()> {
     let found = detect_file(&detector, &args.input, args.horizon)?;
     let (w, h) = (found.mask.width, found.mask.height);
     if let Some((t, m)) = &truth {
-        if (m.width, m.height) != (w, h) {
-            bail!(
-                "{} is {}x{}, the image {w}x{h}",
-                t.display(),
-                m.width,
-                m.height
-            );
-        }
+        DatasetError::check_size(t, (m.width, m.height), (w, h), "the image")?;
     }
     let out = args.output.clone().unwrap_or_else(|| {
         let stem = args

@@ -24,8 +24,9 @@ use streaks_analysis::streak_classifier::{
 use streaks_image::{write_bytes_atomically, GrayImage};
 
 use crate::cli::{sample_horizon, sample_truths};
-use crate::dataset::layout::Layout;
-use crate::dataset::sample::SampleMeta;
+use streaks_dataset::files::{SampleDir, SAMPLE_NAMES};
+use streaks_dataset::layout::Layout;
+use streaks_stereo::rig::Eye;
 
 /// Train the learned streak detector on datasets.
 #[derive(clap::Args, Debug)]
@@ -74,12 +75,13 @@ struct Sample {
 }
 
 fn load_sample(dir: &Path) -> Result<Option<Sample>> {
-    let meta = SampleMeta::load(&dir.join("meta.json"))?;
-    let (_, on_road) = sample_truths(dir, &meta)?;
+    let sample = SampleDir::new(dir);
+    let meta = sample.load_meta()?;
+    let (_, on_road) = sample_truths(&sample, &meta)?;
     let Some(truth) = on_road else {
         return Ok(None);
     };
-    let image = dir.join("im0.exr");
+    let image = sample.exr(Eye::Left);
     let lum = GrayImage::load_linear(&image)
         .with_context(|| format!("cannot read {}", image.display()))?;
     if (lum.width, lum.height) != (truth.width, truth.height) {
@@ -96,14 +98,21 @@ fn load_sample(dir: &Path) -> Result<Option<Sample>> {
 fn split_samples(datasets: &[PathBuf], split: &str) -> Result<Vec<PathBuf>> {
     let mut out = vec![];
     for d in datasets {
-        if !d.join("dataset.json").is_file() {
-            bail!("{} is not a dataset folder (no dataset.json)", d.display());
-        }
         let layout = Layout::new(d);
+        if !layout.dataset_json().is_file() {
+            bail!(
+                "{} is not a dataset folder (no {})",
+                d.display(),
+                streaks_dataset::files::DATASET_JSON
+            );
+        }
         let ids = layout
             .sample_ids(Some(split))
             .with_context(|| format!("the {split} split of {}", d.display()))?;
-        out.extend(ids.iter().map(|id| layout.samples_dir().join(id)));
+        out.extend(
+            ids.iter()
+                .map(|id| layout.sample_by_id(id).path().to_path_buf()),
+        );
     }
     Ok(out)
 }
@@ -237,7 +246,7 @@ pub fn run(args: Args) -> Result<()> {
         .iter()
         .map(|d| {
             let info: serde_json::Value = streaks_image::input::read_text(
-                &d.join("dataset.json"),
+                &Layout::new(d).dataset_json(),
                 streaks_image::input::MAX_TEXT_BYTES,
             )
             .ok()
@@ -254,6 +263,8 @@ pub fn run(args: Args) -> Result<()> {
             })
         })
         .collect();
+    // The left view's files of a sample, by their names.
+    let left = 0;
     classifier.provenance = serde_json::json!({
         "trained_by": format!("streaks {} train-detector", env!("CARGO_PKG_VERSION")),
         "datasets": datasets,
@@ -263,8 +274,8 @@ pub fn run(args: Args) -> Result<()> {
         "positive_rows": positives,
         "pixels_per_sample": args.pixels,
         "params": params,
-        "truth": "streaks0.png ∩ road0.png",
-        "image": "im0.exr (linear luminance)",
+        "truth": format!("{} ∩ {}", SAMPLE_NAMES.streak_mask[left], SAMPLE_NAMES.road_mask[left]),
+        "image": format!("{} (linear luminance)", SAMPLE_NAMES.exr[left]),
         "val_split": args.val_split,
         "val_samples": val.len(),
         "target_precision": args.precision,

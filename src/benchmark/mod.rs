@@ -31,6 +31,7 @@ use report::{Input, MethodInfo, MethodScore, Report, SampleReport};
 use std::path::PathBuf;
 use std::time::Duration;
 use streaks_analysis::benchmark::{error_map, score_regions, BAD_THRESHOLD_PX};
+use streaks_dataset::files::load_mask;
 use streaks_image::pfm::read_pfm;
 use streaks_image::{write_bytes_atomically, GrayImage};
 
@@ -120,23 +121,6 @@ fn methods(args: &Args) -> Result<Vec<Method>> {
     Ok(out)
 }
 
-/// Reads a 0/255 mask of `size` (`what` names it in errors).
-fn load_mask(path: &std::path::Path, size: (usize, usize), what: &str) -> Result<GrayImage> {
-    let m =
-        GrayImage::load(path).with_context(|| format!("reading the {what} {}", path.display()))?;
-    if (m.width, m.height) != size {
-        bail!(
-            "the {what} {} is {}x{}, the ground truth {}x{}",
-            path.display(),
-            m.width,
-            m.height,
-            size.0,
-            size.1
-        );
-    }
-    Ok(m)
-}
-
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<()> {
     let methods = methods(&args)?;
@@ -159,9 +143,9 @@ pub fn run(args: Args) -> Result<()> {
         let truth = read_pfm(&sample.truth)
             .with_context(|| format!("reading the ground truth {}", sample.truth.display()))?;
         let size = (truth.width, truth.height);
-        let streaks = load_mask(&sample.streaks, size, "streak mask")?;
+        let streaks = load_mask(&sample.streaks, size, "the ground truth")?;
         let road = match &sample.road {
-            Some(p) => Some(load_mask(p, size, "road mask")?),
+            Some(p) => Some(load_mask(p, size, "the ground truth")?),
             None => None,
         };
         let megapixels = (size.0 * size.1) as f64 / 1e6;

@@ -13,9 +13,9 @@
 //! second one is refused, naming the holder), a shard holds it shared; a sample is cleaned and
 //! rendered under its own lock, so two shards never render one sample at once and temporary
 //! folders are removed only when no live run renders that sample. Without `--shard` the
-//! manifest is written at the end ([`super::index::index_dir`]).
+//! manifest is written at the end ([`super::index::rebuild_dir`]).
 
-use super::index::{check_sample, dataset_lock, index_dir};
+use super::index::{dataset_lock, rebuild_dir};
 use super::sample::{render_sample, SampleSettings};
 use crate::cli::{image_size, progress_bar};
 use anyhow::{bail, Context, Result};
@@ -32,6 +32,7 @@ use streaks_dataset::lock::{Lock, Mode};
 use streaks_dataset::manifest::{sha256_hex, verify_entry, Difference, Manifest};
 use streaks_dataset::settings::Settings;
 use streaks_dataset::shard::Shard;
+use streaks_dataset::verify::check_sample;
 use streaks_image::stats::quantile_sorted;
 use streaks_image::write_bytes_atomically;
 use streaks_scenes::procedural::{GeneratorConfig, GENERATOR_VERSION};
@@ -347,7 +348,7 @@ pub fn run(args: Args) -> Result<()> {
         );
         return Ok(());
     }
-    index_dir(&layout)?.finish(&layout)
+    rebuild_dir(&layout)
 }
 
 /// What the check before rendering found of a sample.

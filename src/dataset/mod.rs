@@ -7,16 +7,14 @@
 //!   and `splits/`;
 //! - [`sample`]: rendering and writing one sample.
 //!
-//! The folder layout, `dataset.json`, `meta.json`, the manifest, the locks and the shards are
-//! the `streaks-dataset` crate's ([`layout`] is re-exported here).
+//! The folder layout, `dataset.json`, `meta.json`, the manifest, the locks, the shards and the
+//! checks of the samples are the `streaks-dataset` crate's.
 //!
 //! docs/datasets.md describes the layout and the conventions for users.
 
 pub mod generate;
 pub mod index;
 pub mod sample;
-
-pub use streaks_dataset::layout;
 
 use anyhow::Result;
 

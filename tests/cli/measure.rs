@@ -2,6 +2,7 @@
 
 use crate::common::TestDir;
 use streaks_analysis::synth::SynthPair;
+use streaks_dataset::files::SAMPLE_NAMES;
 
 /// The constant disparity of the synthetic pair.
 const D: f32 = 3.4;
@@ -10,8 +11,8 @@ const D: f32 = 3.4;
 fn lk_rms(t: &TestDir, extra: &[&str]) -> f64 {
     let mut args = vec![
         "lk",
-        "left.png",
-        "right.png",
+        SAMPLE_NAMES.png[0],
+        SAMPLE_NAMES.png[1],
         "--region",
         "40,2,48,30",
         "--max-disp",

@@ -43,8 +43,8 @@ use streaks_image::{ensure_same_size, GrayImage, ImageError, SizeMismatch};
 /// What went wrong.
 #[derive(Debug, thiserror::Error)]
 pub enum RepairError {
-    /// The streak detector failed.
-    #[error("streak detection: {0}")]
+    /// The streak detector failed (the cause is the source, so a chain prints it once).
+    #[error("streak detection")]
     Detect(#[from] DetectError),
     /// An image could not be made.
     #[error(transparent)]

@@ -10,8 +10,10 @@
 //! their centres; disparity follows docs/design.md: `d = x_left - x_right`.
 
 use std::path::Path;
+use streaks_dataset::SampleDir;
 use streaks_image::pfm::write_pfm;
 use streaks_image::{GrayImage, ImageError};
+use streaks_stereo::rig::Eye;
 
 /// A fronto-parallel rectangle in front of the background, in left-image pixel indices
 /// (half-open `[x0, x1) x [y0, y1)`), with a constant disparity.
@@ -92,11 +94,13 @@ impl SynthPair {
         })
     }
 
-    /// Writes `left.png` and `right.png` (16-bit grey, values clipped to [0, 1]) and
-    /// `disparity_left.pfm` into `dir`, the layout `streaks stereo` writes.
+    /// Writes the two views (`im0.png`, `im1.png`: 16-bit grey, values clipped to [0, 1])
+    /// and the left view's disparity (`disp0.pfm`) into `dir`, in the sample layout
+    /// ([`SampleDir`]) that `streaks stereo` writes.
     pub fn save(&self, dir: &Path) -> Result<(), ImageError> {
-        for (name, img) in [("left.png", &self.left), ("right.png", &self.right)] {
-            let path = dir.join(name);
+        let sample = SampleDir::new(dir);
+        for (eye, img) in [(Eye::Left, &self.left), (Eye::Right, &self.right)] {
+            let path = sample.png(eye);
             let buf = ::image::ImageBuffer::<::image::Luma<u16>, Vec<u16>>::from_fn(
                 img.width as u32,
                 img.height as u32,
@@ -107,7 +111,7 @@ impl SynthPair {
             );
             streaks_image::png::write_png_buffer(&path, &buf)?;
         }
-        write_pfm(&dir.join("disparity_left.pfm"), &self.disparity)
+        write_pfm(&sample.disparity(Eye::Left), &self.disparity)
     }
 }
 
@@ -326,13 +330,16 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let pair = SynthScene::textured(40, 20, 4).render().unwrap();
         pair.save(dir.path()).unwrap();
-        let left = GrayImage::load(&dir.path().join("left.png")).unwrap();
+        let sample = SampleDir::open(dir.path()).unwrap();
+        assert!(!sample.is_old_pair_layout());
+        assert!(SampleDir::is_pair(dir.path()));
+        let left = GrayImage::load(&sample.png(Eye::Left)).unwrap();
         assert!(left
             .data
             .iter()
             .zip(&pair.left.data)
             .all(|(a, b)| (a - b).abs() < 1e-4));
-        let d = streaks_image::pfm::read_pfm(&dir.path().join("disparity_left.pfm")).unwrap();
+        let d = streaks_image::pfm::read_pfm(&sample.disparity(Eye::Left)).unwrap();
         assert_eq!(d, pair.disparity);
         assert!(pair.save(&dir.path().join("missing")).is_err());
     }

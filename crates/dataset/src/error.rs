@@ -1,6 +1,6 @@
 //! The crate's error type.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use streaks_image::ImageError;
 use streaks_stereo::error::StereoError;
 
@@ -63,6 +63,51 @@ pub enum DatasetError {
         dir: PathBuf,
         /// The file's name.
         file: String,
+    },
+    /// Files a sample must have are missing.
+    #[error("missing {what}: {}", files.join(", "))]
+    MissingFiles {
+        /// The sample folder.
+        dir: PathBuf,
+        /// Which files (`files`, `KITTI files`).
+        what: &'static str,
+        /// Their names in the folder (or paths relative to the dataset folder).
+        files: Vec<String>,
+    },
+    /// An entry of a sample that must be a regular file (or the sample's folder) is not.
+    #[error("{file} is {kind}")]
+    NotRegular {
+        /// The entry, relative to the dataset folder.
+        file: String,
+        /// What it is instead (`a symbolic link`, `a folder`, `a special file`, `not a file`).
+        kind: &'static str,
+    },
+    /// A sample's scene refers to a file outside the sample's folder.
+    #[error("{file} refers to {uri:?}, not a file of the sample's folder")]
+    OutsideSample {
+        /// The scene file's name.
+        file: &'static str,
+        /// The reference.
+        uri: String,
+    },
+    /// An image, map or calibration has another size than the one it must have.
+    #[error(
+        "{} is {}x{}, {against} {}x{}",
+        path.display(),
+        size.0,
+        size.1,
+        expected.0,
+        expected.1
+    )]
+    WrongSize {
+        /// The file.
+        path: PathBuf,
+        /// Its width and height in pixels.
+        size: (usize, usize),
+        /// The size it must have.
+        expected: (usize, usize),
+        /// What gives that size, as the message says it (`the dataset's images are`).
+        against: &'static str,
     },
     /// A split name that datasets do not have.
     #[error("--split {name}: a dataset's splits are {known}")]
@@ -133,6 +178,26 @@ impl DatasetError {
             action,
             path: path.into(),
             source,
+        }
+    }
+
+    /// `Ok` when the file `path` of `size` (width, height) has the `expected` size, else
+    /// [`DatasetError::WrongSize`]; `against` says what gives that size.
+    pub fn check_size(
+        path: &Path,
+        size: (usize, usize),
+        expected: (usize, usize),
+        against: &'static str,
+    ) -> Result<(), Self> {
+        if size == expected {
+            Ok(())
+        } else {
+            Err(Self::WrongSize {
+                path: path.to_path_buf(),
+                size,
+                expected,
+                against,
+            })
         }
     }
 }

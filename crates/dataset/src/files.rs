@@ -27,6 +27,7 @@
 use crate::error::DatasetError;
 use crate::meta::SampleMeta;
 use std::path::{Path, PathBuf};
+use streaks_image::GrayImage;
 use streaks_stereo::calib::MiddleburyCalib;
 use streaks_stereo::rig::{Eye, Intrinsics, Rig};
 use streaks_stereo::rigfile::{LightRecord, RigFile};
@@ -323,6 +324,19 @@ impl SampleDir {
     }
 }
 
+/// Reads the 0/255 (or 0/1) mask `path`, a sample's streak or road mask, and checks that it
+/// has the `expected` size (width, height): a mask of another size would score the wrong
+/// pixels. `against` names what gives that size in the error (`the ground truth`).
+pub fn load_mask(
+    path: &Path,
+    expected: (usize, usize),
+    against: &'static str,
+) -> Result<GrayImage, DatasetError> {
+    let mask = GrayImage::load(path)?;
+    DatasetError::check_size(path, (mask.width, mask.height), expected, against)?;
+    Ok(mask)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -383,5 +397,26 @@ mod tests {
         );
         let err = s.require(&[s.png(Eye::Left)]).unwrap_err().to_string();
         assert!(err.contains("lacks im0.png"), "{err}");
+    }
+
+    #[test]
+    fn masks_of_another_size_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let s = SampleDir::new(dir.path());
+        let path = s.streak_mask(Eye::Left);
+        GrayImage::new(4, 3, 1.0).unwrap().save_png(&path).unwrap();
+        let mask = load_mask(&path, (4, 3), "the ground truth").unwrap();
+        assert_eq!((mask.width, mask.height), (4, 3));
+        let err = load_mask(&path, (5, 3), "the ground truth")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.ends_with("streaks0.png is 4x3, the ground truth 5x3"),
+            "{err}"
+        );
+        let err = load_mask(&s.road_mask(Eye::Left), (4, 3), "the ground truth")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("road0.png"), "{err}");
     }
 }

@@ -14,6 +14,8 @@
 //! - [`manifest`]: reading `manifest.jsonl` back and checking files against it;
 //! - [`lock`]: the advisory locks that make runs on one folder safe or refused;
 //! - [`shard`]: `--shard K/N`;
+//! - [`verify`]: checking a dataset's samples on disk and writing its manifest and splits, or
+//!   checking its files against the manifest;
 //! - `write` (feature `render`): writing a rendered pair into a sample folder, the one
 //!   writer of a sample's images and ground truth;
 //! - [`error`]: the crate's error type, [`DatasetError`].
@@ -28,6 +30,7 @@ pub mod manifest;
 pub mod meta;
 pub mod settings;
 pub mod shard;
+pub mod verify;
 #[cfg(feature = "render")]
 pub mod write;
 

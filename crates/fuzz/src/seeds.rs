@@ -10,6 +10,7 @@ use serde_json::{json, Value};
 use std::io;
 use std::path::Path;
 use std::process::Command;
+use streaks_dataset::files::{DATASET_JSON, MANIFEST, RIG};
 
 /// A small PNG of `img`.
 fn png<P, C>(img: &image::ImageBuffer<P, C>) -> Vec<u8>
@@ -342,7 +343,7 @@ pub fn write_seeds(repo: &Path, corpus: &Path) -> io::Result<()> {
     let pose = Affine3A::from_translation(Vec3::new(0.0, 1.5, 0.0));
     let rig = streaks_stereo::rig::Rig::new(intrinsics, 0.065, pose).map_err(io::Error::other)?;
     let rig_file = streaks_stereo::rigfile::RigFile::new(&rig, Vec::new());
-    let rig_path = scratch.path().join("rig.json");
+    let rig_path = scratch.path().join(RIG);
     rig_file.save(&rig_path).map_err(io::Error::other)?;
     put(corpus, "rig", "rig", &std::fs::read(&rig_path)?)?;
     let calib = streaks_stereo::calib::MiddleburyCalib::of_rig(&rig, Some((1.0, 20.0)));
@@ -378,7 +379,7 @@ pub fn write_seeds(repo: &Path, corpus: &Path) -> io::Result<()> {
             }
             // The sample's scene (its textures are most of the bytes) is left out: the index
             // then reports the sample as corrupt, the rest is read as usual.
-            let parts: Vec<Part> = files::split(&files::pack(&dir, "dataset.json")?)
+            let parts: Vec<Part> = files::split(&files::pack(&dir, DATASET_JSON)?)
                 .into_iter()
                 .filter(|p| !p.name.as_deref().is_some_and(|n| n.contains("/scene")))
                 .collect();
@@ -387,7 +388,7 @@ pub fn write_seeds(repo: &Path, corpus: &Path) -> io::Result<()> {
             // so mutations reach the comparison of every file with its hash.
             let mut verified = parts.clone();
             for part in &mut verified {
-                if part.name.as_deref() == Some("manifest.jsonl") {
+                if part.name.as_deref() == Some(MANIFEST) {
                     part.bytes = without_scene(&part.bytes)?;
                 }
             }
@@ -400,7 +401,7 @@ pub fn write_seeds(repo: &Path, corpus: &Path) -> io::Result<()> {
             // Without a manifest: the first index writes it.
             let unindexed: Vec<Part> = parts
                 .iter()
-                .filter(|p| p.name.as_deref() != Some("manifest.jsonl"))
+                .filter(|p| p.name.as_deref() != Some(MANIFEST))
                 .cloned()
                 .collect();
             put(

@@ -8,6 +8,7 @@ use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
+use streaks_dataset::files::{CALIB, DATASET_JSON, RIG};
 
 /// What a target made of an input: `Ok`, or the reader's error message. The stable runner
 /// keeps inputs whose message is of a new kind, a cheap stand-in for coverage.
@@ -408,9 +409,8 @@ pub fn pfm(data: &[u8]) -> Outcome {
 
 /// A stereo pair's rig file (`rig.json`), read and checked.
 pub fn rig(data: &[u8]) -> Outcome {
-    with_files(data, "rig.json", false, |dir| {
-        let file =
-            streaks_stereo::rigfile::RigFile::load(&dir.join("rig.json")).map_err(message)?;
+    with_files(data, RIG, false, |dir| {
+        let file = streaks_stereo::rigfile::RigFile::load(&dir.join(RIG)).map_err(message)?;
         file.rig().map(|_| ()).map_err(message)
     })
 }
@@ -427,8 +427,8 @@ pub fn config(data: &[u8]) -> Outcome {
 
 /// A Middlebury `calib.txt`.
 pub fn calib(data: &[u8]) -> Outcome {
-    with_files(data, "calib.txt", false, |dir| {
-        streaks_stereo::calib::MiddleburyCalib::load(&dir.join("calib.txt"))
+    with_files(data, CALIB, false, |dir| {
+        streaks_stereo::calib::MiddleburyCalib::load(&dir.join(CALIB))
             .map(|_| ())
             .map_err(message)
     })
@@ -448,7 +448,7 @@ pub const DATASET_TIME_LIMIT: Duration = Duration::from_millis(1500);
 /// the first run's error, else the second's.
 pub fn dataset(data: &[u8]) -> Outcome {
     let binary = streaks_binary().unwrap_or_else(|e| panic!("{e}"));
-    with_files(data, "dataset.json", true, |dir| {
+    with_files(data, DATASET_JSON, true, |dir| {
         let deadline = Instant::now() + DATASET_TIME_LIMIT;
         let verified = index(&binary, dir, &[], deadline);
         let rebuilt = index(&binary, dir, &["--rebuild"], deadline);

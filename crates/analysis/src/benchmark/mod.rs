@@ -125,11 +125,11 @@ pub fn score_regions(
 /// What went wrong in [`lk_streak_disparity`].
 #[derive(Debug, thiserror::Error)]
 pub enum StreakLkError {
-    /// The streak detector failed.
-    #[error("streak detection: {0}")]
+    /// The streak detector failed (the cause is the source, so a chain prints it once).
+    #[error("streak detection")]
     Detect(#[from] DetectError),
-    /// The estimator failed.
-    #[error("Lucas-Kanade: {0}")]
+    /// The estimator failed (the cause is the source).
+    #[error("Lucas-Kanade")]
     Lk(#[from] LkError),
     /// An image could not be made.
     #[error(transparent)]
@@ -246,6 +246,50 @@ pub fn error_map(estimate: &GrayImage, truth: &GrayImage) -> Result<image::RgbIm
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::repair::{EstimateError, RepairError};
+    use std::error::Error;
+
+    /// `err` and its causes as `{:#}` of an `anyhow::Error` prints them.
+    fn chain<'a>(err: &'a (dyn Error + 'static)) -> String {
+        let texts: Vec<String> = std::iter::successors(Some(err), |&e: &&'a dyn Error| e.source())
+            .map(|e| e.to_string())
+            .collect();
+        texts.join(": ")
+    }
+
+    #[test]
+    fn a_printed_chain_names_each_cause_once() {
+        let detect = || DetectError::Param {
+            name: "gap",
+            reason: "must be positive",
+        };
+        let lk = || LkError::Param {
+            name: "window",
+            reason: "must be odd".into(),
+        };
+        let cases: [(Box<dyn Error>, String, &str); 3] = [
+            (
+                Box::new(StreakLkError::from(detect())),
+                detect().to_string(),
+                "streak detection: invalid streak detection parameter gap",
+            ),
+            (
+                Box::new(StreakLkError::from(lk())),
+                lk().to_string(),
+                "Lucas-Kanade: invalid Lucas-Kanade parameter window",
+            ),
+            (
+                Box::new(EstimateError::from(RepairError::from(detect()))),
+                detect().to_string(),
+                "streak-robust disparity: streak detection: invalid",
+            ),
+        ];
+        for (err, cause, start) in cases {
+            let text = chain(&*err);
+            assert_eq!(text.matches(&cause).count(), 1, "{text}");
+            assert!(text.starts_with(start), "{text}");
+        }
+    }
 
     #[test]
     fn regions_partition_the_pixels_and_find_phantom_holes() {

@@ -1,8 +1,9 @@
 //! Per-streak analysis of a rectified stereo pair (the paper's Fig. 6 and Fig. 8 measurements).
 //!
-//! [`analyze`] takes a pair written by `streaks stereo` ([`StereoInput::load`]: `left.exr`,
-//! `right.exr`, `rig.json`, and the ground truth `disparity_left.pfm` / `depth_left.pfm` when
-//! present), detects the streaks of the left image ([`crate::detect`]), matches each to the
+//! [`analyze`] takes a pair written by `streaks stereo` or a dataset sample
+//! ([`StereoInput::load`], through [`streaks_dataset::SampleDir`]: the two EXRs, the rig
+//! (`rig.json`, or a sample's `meta.json`), and the left view's ground-truth disparity and
+//! depth when present), detects the streaks of the left image ([`crate::detect`]), matches each to the
 //! scene light whose mirror image `(X_L, -Y_L, Z_L)` projects nearest the streak's axis (below
 //! the light), measures its disparity row by row with the 1D Lucas-Kanade estimator along the
 //! streak's centres ([`crate::lk::lk_rows`]) and predicts it with Eq. 4 and Eq. 5
