@@ -5,10 +5,11 @@
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use glam::{Affine3A, Quat, Vec3};
 use streaks_render::camera::Camera;
-use streaks_render::integrator::{render, Layers, RenderSettings};
+use streaks_render::integrator::{render, Layers, RenderJob};
 use streaks_render::light::Light;
 use streaks_render::material::Material;
 use streaks_render::scene::{Scene, SceneParts};
+use streaks_settings::RenderSettings;
 
 /// Adds an axis-aligned box (12 triangles, faces pointing out) of material `m`.
 fn add_box(parts: &mut SceneParts, lo: Vec3, hi: Vec3, m: u32) {
@@ -118,21 +119,18 @@ fn bench(c: &mut Criterion) {
         yfov: 0.7,
         aspect_ratio: Some(4.0 / 3.0),
     };
-    let settings = RenderSettings {
+    let job = RenderJob {
         width: 160,
         height: 120,
-        spp: 1,
-        noise_target: None,
-        max_depth: 4,
         seed: 0,
         layers: Layers::default(),
-        regularize: false,
+        settings: RenderSettings::new(1, 4),
     };
     let mut group = c.benchmark_group("render");
     group.sample_size(10);
     group.throughput(Throughput::Elements(160 * 120));
     group.bench_function("street_160x120_1spp_depth4", |b| {
-        b.iter(|| render(&scene, &camera, &settings, &|_| {}))
+        b.iter(|| render(&scene, &camera, &job, &|_| {}))
     });
     group.finish();
 }

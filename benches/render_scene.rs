@@ -14,8 +14,9 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
-use streaks_render::integrator::{render, Layers, RenderSettings};
+use streaks_render::integrator::{render, Layers, RenderJob};
 use streaks_render::scene::Scene;
+use streaks_settings::RenderSettings;
 
 /// The system allocator, counting allocations and live/peak heap bytes.
 struct CountingAlloc;
@@ -66,17 +67,14 @@ fn scene_path(name: &str) -> PathBuf {
         .join(name)
 }
 
-/// The race's settings (the Mitsuba measurement): 320x240, max depth 4.
-fn settings(spp: u32) -> RenderSettings {
-    RenderSettings {
+/// The race's image (the Mitsuba measurement): 320x240, max depth 4.
+fn job(spp: u32) -> RenderJob {
+    RenderJob {
         width: 320,
         height: 240,
-        spp,
-        noise_target: None,
-        max_depth: 4,
         seed: 1,
         layers: Layers::default(),
-        regularize: false,
+        settings: RenderSettings::new(spp, 4),
     }
 }
 
@@ -86,7 +84,7 @@ fn render_footprint(scene: &Scene, spp: u32) -> (usize, usize) {
     let before = LIVE.load(Ordering::Relaxed);
     PEAK.store(before, Ordering::Relaxed);
     let count = ALLOCATIONS.load(Ordering::Relaxed);
-    let out = render(scene, camera, &settings(spp), &|_| {});
+    let out = render(scene, camera, &job(spp), &|_| {});
     black_box(&out);
     let allocations = ALLOCATIONS.load(Ordering::Relaxed) - count;
     let peak = PEAK.load(Ordering::Relaxed) - before;
@@ -127,7 +125,7 @@ fn bench_render(c: &mut Criterion) {
     report_footprint(&scene);
     let camera = &scene.cameras[0];
     let spp = 8;
-    let s = settings(spp);
+    let s = job(spp);
     let mut group = c.benchmark_group("render_rainy_street_small");
     group.sample_size(10);
     group.throughput(Throughput::Elements(

@@ -18,6 +18,7 @@ use streaks_dataset::write::write_pair;
 use streaks_image::png::write_png;
 use streaks_image::{write_bytes_atomically, GrayImage};
 use streaks_render::scene::Scene;
+use streaks_settings::RenderSettings;
 use streaks_stereo::render::{render_eye, render_pair, rig_from_camera, PairSettings};
 use streaks_stereo::rig::{Eye, Rig};
 use streaks_stereo::streak_mask::StreakMaskParams;
@@ -70,13 +71,10 @@ fn fig2_and_3(args: &Args, out: &Path, index: &mut String) -> Result<()> {
         let (w, h) = crate::cli::image_size(Some(args.fig2_width), None, camera.aspect_ratio)?;
         let rig = rig_from_camera(camera, w, h, Rig::DEFAULT_BASELINE)?;
         let settings = PairSettings {
-            spp: args.fig2_spp,
-            noise_target: None,
-            max_depth: 8,
+            render: RenderSettings::new(args.fig2_spp, 8),
             seed: 0,
             exposure_ev: 0.0,
             mask: StreakMaskParams::default(),
-            regularize: false,
         };
         let bar = crate::cli::progress_bar(w as u64 * h as u64 * args.fig2_spp as u64);
         let view = render_eye(&scene, &rig, Eye::Left, &settings, &|n| bar.inc(n))?;
@@ -230,13 +228,10 @@ fn fig6(args: &Args, out: &Path, index: &mut String) -> Result<Report> {
     let (w, h) = crate::cli::image_size(None, Some(args.fig6_size), camera.aspect_ratio)?;
     let rig = rig_from_camera(camera, w, h, Rig::DEFAULT_BASELINE)?;
     let settings = PairSettings {
-        spp: args.fig6_spp,
-        noise_target: None,
-        max_depth: 8,
+        render: RenderSettings::new(args.fig6_spp, 8),
         seed: 0,
         exposure_ev: 0.0,
         mask: StreakMaskParams::default(),
-        regularize: false,
     };
     let bar = crate::cli::progress_bar(2 * w as u64 * h as u64 * args.fig6_spp as u64);
     let views = render_pair(&scene, &rig, &settings, &|n| bar.inc(n))?;

@@ -6,9 +6,10 @@ use std::path::{Path, PathBuf};
 use streaks_image::png::write_png;
 use streaks_image::GrayImage;
 use streaks_render::camera::Camera;
-use streaks_render::integrator::{self, Layers, RenderOutput, RenderSettings};
+use streaks_render::integrator::{self, Layers, RenderJob, RenderOutput};
 use streaks_render::output;
 use streaks_render::scene::Scene;
+use streaks_settings::{RenderSettings, SettingsError};
 
 use crate::cli::{image_size, load_scene, progress_bar};
 use streaks_stereo::render::{road_surface, scene_has_road};
@@ -87,24 +88,22 @@ pub struct Loaded {
 impl RenderOpts {
     /// Phase 1: checks the flags that need no scene.
     pub fn check(&self) -> Result<()> {
-        if self.spp == 0 {
-            bail!("--spp must be at least 1");
-        }
-        if self.max_depth == 0 {
-            bail!("--max-depth must be at least 1 (1 renders only emitters seen directly)");
-        }
-        if let Some(rel) = self.noise_target {
-            if !(rel.is_finite() && rel > 0.0) {
-                bail!(
-                    "--noise-target must be a positive, finite relative standard error (such as \
-                     0.05), got {rel}"
-                );
-            }
-        }
+        self.settings().check().map_err(flag_error)?;
         if !self.exposure.is_finite() {
             bail!("--exposure must be a finite number of stops");
         }
         Ok(())
+    }
+
+    /// The render settings of the flags (`--spp`, `--max-depth`, `--regularize`,
+    /// `--noise-target`).
+    pub fn settings(&self) -> RenderSettings {
+        RenderSettings {
+            spp: self.spp,
+            max_depth: self.max_depth,
+            regularize: self.regularize,
+            noise_target: self.noise_target,
+        }
     }
 
     /// Phase 2: loads the scene (printing its warnings), picks the camera and sizes the image.
@@ -141,6 +140,11 @@ impl RenderOpts {
             .context("the number of samples (views x width x height x spp) overflows")?;
         Ok(progress_bar(total))
     }
+}
+
+/// A render setting out of its range as the command line says it: `--spp must be at least 1`.
+pub fn flag_error(e: SettingsError) -> anyhow::Error {
+    anyhow::anyhow!("--{} {}", e.name().replace('_', "-"), e.reason())
 }
 
 /// Path-trace a scene's camera to a linear EXR (and optionally an sRGB PNG).
@@ -239,15 +243,12 @@ pub fn run(args: Args) -> Result<()> {
             args.scene.display()
         );
     }
-    let settings = RenderSettings {
+    let job = RenderJob {
         width,
         height,
-        spp: opts.spp,
-        noise_target: opts.noise_target,
-        max_depth: opts.max_depth,
         seed: opts.seed,
         layers,
-        regularize: opts.regularize,
+        settings: opts.settings(),
     };
     create_parent(&args.output)?;
     for path in args.png.iter().chain(&args.road_mask) {
@@ -258,7 +259,7 @@ pub fn run(args: Args) -> Result<()> {
     let pool = opts.thread_pool()?;
     let bar = opts.progress(1, width, height)?;
     let out: RenderOutput =
-        pool.install(|| integrator::render(&scene, &camera, &settings, &|n| bar.inc(n)));
+        pool.install(|| integrator::render(&scene, &camera, &job, &|n| bar.inc(n)));
     bar.finish_and_clear();
 
     match format {

@@ -52,13 +52,10 @@ pub fn run(args: Args) -> Result<()> {
     std::fs::create_dir_all(&args.output)
         .with_context(|| format!("cannot create the folder {}", args.output.display()))?;
     let settings = PairSettings {
-        spp: opts.spp,
-        noise_target: opts.noise_target,
-        max_depth: opts.max_depth,
+        render: opts.settings(),
         seed: opts.seed,
         exposure_ev: opts.exposure,
         mask: StreakMaskParams::default(),
-        regularize: opts.regularize,
     };
     // Phase 3: render both eyes under one progress bar and write everything.
     let pool = opts.thread_pool()?;

@@ -18,6 +18,7 @@
 use super::index::{dataset_lock, rebuild_dir};
 use super::sample::{render_sample, SampleSettings};
 use crate::cli::{image_size, progress_bar};
+use crate::render::flag_error;
 use anyhow::{bail, Context, Result};
 use rayon::prelude::*;
 use std::cell::Cell;
@@ -36,6 +37,7 @@ use streaks_dataset::verify::check_sample;
 use streaks_image::stats::quantile_sorted;
 use streaks_image::write_bytes_atomically;
 use streaks_scenes::procedural::{GeneratorConfig, GENERATOR_VERSION};
+use streaks_settings::{check_noise_target, RenderSettings};
 
 /// Render the samples of a dataset (all, or one shard) into a folder; resumable.
 #[derive(clap::Args, Debug)]
@@ -86,13 +88,12 @@ pub struct Args {
 pub const DEFAULT_SPP: u32 = 64;
 
 /// The default adaptive-sampling target of a dataset (see docs/benchmarks.md, "Adaptive sampling").
-pub const DEFAULT_NOISE_TARGET: f64 = 0.1;
+pub const DEFAULT_NOISE_TARGET: f32 = 0.1;
 
-/// `--noise-target`: a positive, finite relative standard error, or `off` (`None`). Kept as
-/// the `f64` of its decimal text, so that `dataset.json` records `0.1` and reads back equal (the
-/// renderer gets it as `f32`).
+/// `--noise-target`: a positive, finite relative standard error, or `off` (`None`); the
+/// renderer's `f32`, which `dataset.json` records as its shortest decimal (`0.1`).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct NoiseTarget(pub Option<f64>);
+pub struct NoiseTarget(pub Option<f32>);
 
 impl std::fmt::Display for NoiseTarget {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -110,8 +111,8 @@ impl std::str::FromStr for NoiseTarget {
         if s == "off" {
             return Ok(Self(None));
         }
-        match s.parse::<f64>() {
-            Ok(rel) if rel.is_finite() && rel > 0.0 && (rel as f32) > 0.0 => Ok(Self(Some(rel))),
+        match s.parse::<f32>() {
+            Ok(rel) if check_noise_target(rel).is_ok() => Ok(Self(Some(rel))),
             _ => Err(format!(
                 "expected a positive, finite relative standard error (such as 0.1) or `off`, \
                  got {s:?}"
@@ -133,12 +134,13 @@ pub fn run(args: Args) -> Result<()> {
         );
     }
     image_size(Some(args.width), Some(args.height), None)?;
-    if args.spp == 0 {
-        bail!("--spp must be at least 1");
-    }
-    if args.max_depth == 0 {
-        bail!("--max-depth must be at least 1 (1 renders only emitters seen directly)");
-    }
+    let render = RenderSettings {
+        spp: args.spp,
+        max_depth: args.max_depth,
+        regularize: !args.no_regularize,
+        noise_target: args.noise_target.0,
+    };
+    render.check().map_err(flag_error)?;
     let config = match &args.config {
         Some(path) => GeneratorConfig::from_toml_file(path)
             .with_context(|| format!("cannot use the config {}", path.display()))?,
@@ -155,10 +157,7 @@ pub fn run(args: Args) -> Result<()> {
         settings: Settings {
             width: args.width,
             height: args.height,
-            spp: args.spp,
-            max_depth: args.max_depth,
-            regularize: !args.no_regularize,
-            noise_target: args.noise_target.0,
+            render,
         },
         files: FileList::current(),
         conventions: Conventions::current(),

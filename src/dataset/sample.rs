@@ -111,13 +111,10 @@ fn write_sample(
         .with_context(|| format!("the stereo rig of {}", gltf.display()))?;
     let seed = render_seed(settings.seed, index);
     let pair = PairSettings {
-        spp: render.spp,
-        noise_target: render.noise_target.map(|rel| rel as f32),
-        max_depth: render.max_depth,
+        render: render.render,
         seed,
         exposure_ev: s.exposure_ev,
         mask: StreakMaskParams::default(),
-        regularize: render.regularize,
     };
     let views = render_pair(&scene, &rig, &pair, &|_| {})?;
     let [left, right] = &views;
@@ -180,12 +177,9 @@ fn write_sample(
         lights: light_records(&scene, rig.road_frame().ok().as_ref()),
         stats: stats.clone(),
         render: RenderMeta {
-            spp: render.spp,
-            max_depth: render.max_depth,
+            settings: render.render,
             seed_left: seed,
             seed_right: seed.wrapping_add(1),
-            regularize: render.regularize,
-            noise_target: render.noise_target,
             mean_spp: Some([left, right].map(|v| v.output.stats.samples as f64 / pixels)),
         },
     };

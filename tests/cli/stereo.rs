@@ -151,6 +151,7 @@ use streaks_analysis::lk::{lk_region, LkParams};
 use streaks_dataset::write::write_pair;
 use streaks_image::{GrayImage, Region, RgbImage};
 use streaks_render::scene::Scene;
+use streaks_settings::RenderSettings;
 use streaks_stereo::render::{render_pair, rig_from_camera, EyeView, PairSettings};
 use streaks_stereo::rig::Eye;
 use streaks_stereo::streak_mask::StreakMaskParams;
@@ -244,13 +245,10 @@ fn write_scene(
 
 fn settings(spp: u32) -> PairSettings {
     PairSettings {
-        spp,
-        noise_target: None,
-        max_depth: 2,
+        render: RenderSettings::new(spp, 2),
         seed: 7,
         exposure_ev: 0.0,
         mask: StreakMaskParams::default(),
-        regularize: false,
     }
 }
 

@@ -432,14 +432,18 @@ impl DatasetInfo {
                 target_unrecorded = true;
             }
         }
-        let new = serde_json::to_value(self).expect("dataset.json serialises");
+        // The value of the bytes this run would write (a value made from `self` directly would
+        // hold `noise_target` widened from f32, 0.10000000149011612 for the file's 0.1).
+        let new = serde_json::from_slice(&self.to_bytes()).expect("dataset.json reads back");
         if let Some((field, old, new)) = first_difference("", &existing, &new) {
             let hint = match field.as_str() {
                 "regularize" if unrecorded => {
                     " (it predates the setting and was rendered without path regularisation: \
                      add --no-regularize to continue it)"
                 }
-                "regularize" if self.settings.regularize => " (add --no-regularize to continue it)",
+                "regularize" if self.settings.render.regularize => {
+                    " (add --no-regularize to continue it)"
+                }
                 "regularize" => " (drop --no-regularize to continue it)",
                 "noise_target" if target_unrecorded => {
                     " (it predates the setting and was rendered at fixed spp: add \
@@ -510,6 +514,7 @@ fn short(v: &Value) -> String {
 mod tests {
     use super::*;
     use serde_json::json;
+    use streaks_settings::RenderSettings;
 
     #[test]
     fn differences_are_named_by_path() {
@@ -536,10 +541,10 @@ mod tests {
             settings: Settings {
                 width: 64,
                 height: 40,
-                spp: 2,
-                max_depth: 8,
-                regularize,
-                noise_target: None,
+                render: RenderSettings {
+                    regularize,
+                    ..RenderSettings::new(2, 8)
+                },
             },
             files: FileList::current(),
             conventions: Conventions::current(),
@@ -578,19 +583,19 @@ mod tests {
         let mut old = serde_json::to_value(info(true)).unwrap();
         old.as_object_mut().unwrap().remove("noise_target");
         let back: DatasetInfo = serde_json::from_value(old.clone()).unwrap();
-        assert_eq!(back.settings.noise_target, None);
+        assert_eq!(back.settings.render.noise_target, None);
         info(true).check_same(&old, path).unwrap();
         let mut adaptive = info(true);
-        adaptive.settings.noise_target = Some(0.25);
+        adaptive.settings.render.noise_target = Some(0.1);
         let err = adaptive.check_same(&old, path).unwrap_err().to_string();
         assert!(
-            err.contains("its noise_target is null, this run's is 0.25")
+            err.contains("its noise_target is null, this run's is 0.1")
                 && err.contains("predates the setting")
                 && err.contains("--noise-target off"),
             "{err}"
         );
-        let new = serde_json::to_value(&adaptive).unwrap();
-        assert_eq!(new["noise_target"], serde_json::json!(0.25));
+        let new: Value = serde_json::from_slice(&adaptive.to_bytes()).unwrap();
+        assert_eq!(new["noise_target"], serde_json::json!(0.1));
         adaptive.check_same(&new, path).unwrap();
         let err = info(true).check_same(&new, path).unwrap_err().to_string();
         assert!(err.contains("give its --noise-target"), "{err}");

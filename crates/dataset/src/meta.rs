@@ -5,6 +5,7 @@ use crate::error::DatasetError;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::path::Path;
+use streaks_settings::RenderSettings;
 use streaks_stereo::rigfile::{LightRecord, PoseRecord};
 
 /// The render seed of sample `index` of a dataset of seed `seed` (SplitMix64 of the pair, high
@@ -59,28 +60,81 @@ pub struct SampleStats {
     pub nonfinite_dropped: u64,
 }
 
-/// The render settings of a sample.
+/// How a sample was rendered: the dataset's render settings, the eyes' seeds and the samples
+/// they took.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(from = "RenderRecord", into = "RenderRecord")]
 pub struct RenderMeta {
-    /// Samples per pixel per eye.
-    pub spp: u32,
-    /// Longest path.
-    pub max_depth: u32,
+    /// The render settings (both eyes).
+    pub settings: RenderSettings,
     /// Seed of the left eye.
     pub seed_left: u32,
     /// Seed of the right eye.
     pub seed_right: u32,
+    /// Mean samples per pixel actually taken, left and right eye (`spp` at fixed spp; absent
+    /// in samples written before the field existed).
+    pub mean_spp: Option<[f64; 2]>,
+}
+
+/// `meta.json`'s `render` object as the file holds it: the render settings' fields with the
+/// seeds among them, in this order (a flattened [`RenderSettings`] could not put the seeds
+/// there, and the file's bytes stay as they were).
+#[derive(Serialize, Deserialize)]
+struct RenderRecord {
+    /// Samples per pixel per eye.
+    spp: u32,
+    /// Longest path.
+    max_depth: u32,
+    /// Seed of the left eye.
+    seed_left: u32,
+    /// Seed of the right eye.
+    seed_right: u32,
     /// Path regularisation (absent, `false`, in samples written before the field existed).
     #[serde(default)]
-    pub regularize: bool,
+    regularize: bool,
     /// Adaptive sampling's target (`None`, also in samples written before the field existed:
     /// `spp` samples everywhere).
     #[serde(default)]
-    pub noise_target: Option<f64>,
-    /// Mean samples per pixel actually taken, left and right eye (`spp` at fixed spp; absent
-    /// in samples written before the field existed).
+    noise_target: Option<f32>,
+    /// Mean samples per pixel actually taken, left and right eye.
     #[serde(default)]
-    pub mean_spp: Option<[f64; 2]>,
+    mean_spp: Option<[f64; 2]>,
+}
+
+impl From<RenderRecord> for RenderMeta {
+    fn from(r: RenderRecord) -> Self {
+        Self {
+            settings: RenderSettings {
+                spp: r.spp,
+                max_depth: r.max_depth,
+                regularize: r.regularize,
+                noise_target: r.noise_target,
+            },
+            seed_left: r.seed_left,
+            seed_right: r.seed_right,
+            mean_spp: r.mean_spp,
+        }
+    }
+}
+
+impl From<RenderMeta> for RenderRecord {
+    fn from(m: RenderMeta) -> Self {
+        let RenderSettings {
+            spp,
+            max_depth,
+            regularize,
+            noise_target,
+        } = m.settings;
+        Self {
+            spp,
+            max_depth,
+            seed_left: m.seed_left,
+            seed_right: m.seed_right,
+            regularize,
+            noise_target,
+            mean_spp: m.mean_spp,
+        }
+    }
 }
 
 /// `meta.json` of a sample (no wall time: the file is the same on every run).
@@ -154,5 +208,40 @@ mod tests {
         assert_ne!(render_seed(1, 0), render_seed(0, 0));
         assert_ne!(render_seed(0, 1), render_seed(1, 0));
         assert_eq!(render_seed(5, 7), render_seed(5, 7));
+    }
+
+    /// The `render` object keeps its keys in the file's order (the seeds between the settings)
+    /// and reads back equal; one from before `regularize`, `noise_target` and `mean_spp`
+    /// existed reads as unregularised, fixed spp.
+    #[test]
+    fn render_meta_keeps_the_file_order_and_reads_old_files() {
+        let meta = RenderMeta {
+            settings: RenderSettings {
+                regularize: true,
+                noise_target: Some(0.1),
+                ..RenderSettings::new(64, 8)
+            },
+            seed_left: 7,
+            seed_right: 8,
+            mean_spp: Some([20.5, 21.0]),
+        };
+        let text = serde_json::to_string(&meta).unwrap();
+        assert_eq!(
+            text,
+            r#"{"spp":64,"max_depth":8,"seed_left":7,"seed_right":8,"regularize":true,"noise_target":0.1,"mean_spp":[20.5,21.0]}"#
+        );
+        assert_eq!(serde_json::from_str::<RenderMeta>(&text).unwrap(), meta);
+        let old: RenderMeta =
+            serde_json::from_str(r#"{"spp":4,"max_depth":8,"seed_left":1,"seed_right":2}"#)
+                .unwrap();
+        assert_eq!(
+            old,
+            RenderMeta {
+                settings: RenderSettings::new(4, 8),
+                seed_left: 1,
+                seed_right: 2,
+                mean_spp: None,
+            }
+        );
     }
 }

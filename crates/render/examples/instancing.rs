@@ -11,9 +11,10 @@
 use serde_json::json;
 use std::path::Path;
 use std::time::Instant;
-use streaks_render::integrator::{render, RenderSettings};
+use streaks_render::integrator::{render, RenderJob};
 use streaks_render::sampling::Pcg32;
 use streaks_render::scene::Scene;
+use streaks_settings::RenderSettings;
 
 /// A UV sphere of radius 0.5: `(positions, normals, indices)`.
 fn sphere(rings: u32, segments: u32) -> (Vec<f32>, Vec<f32>, Vec<u32>) {
@@ -133,15 +134,12 @@ fn main() {
         .and_then(|n| n.parse().ok())
         .unwrap_or(3usize);
     let dir = tempfile::tempdir().unwrap();
-    let settings = RenderSettings {
+    let job = RenderJob {
         width: 320,
         height: 240,
-        spp: 4,
-        noise_target: None,
-        max_depth: 3,
         seed: 1,
         layers: Default::default(),
-        regularize: false,
+        settings: RenderSettings::new(4, 3),
     };
     let mut images = Vec::new();
     for shared in [true, false] {
@@ -155,7 +153,7 @@ fn main() {
             best = best.min(t.elapsed().as_secs_f64());
         }
         let scene = scene.unwrap();
-        let out = render(&scene, scene.camera(None).unwrap(), &settings, &|_| {});
+        let out = render(&scene, scene.camera(None).unwrap(), &job, &|_| {});
         println!(
             "{}: load {:.3} s (best of {loads}), {} triangles stored ({} in the world, {} \
              instances), geometry + BVH {:.1} MB, render {}x{} {} spp: {:.2} s ({:.2} M rays/s)",
@@ -165,9 +163,9 @@ fn main() {
             scene.world_triangle_count(),
             scene.instances.instances.len(),
             geometry_bytes(&scene) as f64 / 1e6,
-            settings.width,
-            settings.height,
-            settings.spp,
+            job.width,
+            job.height,
+            job.settings.spp,
             out.stats.seconds,
             out.stats.rays as f64 / out.stats.seconds / 1e6,
         );

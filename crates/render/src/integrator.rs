@@ -148,6 +148,7 @@ use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 use streaks_image::RgbImage;
+use streaks_settings::RenderSettings;
 
 /// Depth from which Russian roulette may end a path (Mitsuba 3's `rr_depth`, whose default is
 /// 5; see the module documentation for why 3).
@@ -174,27 +175,19 @@ pub struct Layers {
     pub spp: bool,
 }
 
-/// What to render.
+/// One image to render: its size, seed and layers, and how to sample it.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RenderSettings {
+pub struct RenderJob {
     /// Image width in pixels.
     pub width: u32,
     /// Image height in pixels.
     pub height: u32,
-    /// Samples per pixel (the cap, with adaptive sampling).
-    pub spp: u32,
-    /// Adaptive sampling: stop a tile of pixels once the estimated relative standard error of
-    /// its pixels' mean luminance is below this (a positive, finite fraction such as 0.1);
-    /// `None` takes `spp` samples everywhere. See the module documentation.
-    pub noise_target: Option<f32>,
-    /// Longest path (Mitsuba's `max_depth`; see the module documentation).
-    pub max_depth: u32,
     /// Seed of the sampler.
     pub seed: u32,
     /// Extra layers.
     pub layers: Layers,
-    /// Path regularisation (Cycles' "Filter Glossy"; biased, see the module documentation).
-    pub regularize: bool,
+    /// Samples, adaptive sampling, path length and regularisation.
+    pub settings: RenderSettings,
 }
 
 /// Adaptive sampling: the side of the square tiles of pixels that stop together (see the
@@ -280,37 +273,36 @@ struct PathResult {
 pub fn render(
     scene: &Scene,
     camera: &Camera,
-    settings: &RenderSettings,
+    job: &RenderJob,
     progress: &(dyn Fn(u64) + Sync),
 ) -> RenderOutput {
     let start = Instant::now();
-    let (width, height) = (settings.width, settings.height);
+    let (width, height) = (job.width, job.height);
     let mut film = Film::new(width, height);
     let rays = AtomicU64::new(0);
     let forward = camera
         .world_from_camera
         .transform_vector3(-Vec3::Z)
         .normalize();
-    let l = settings.layers;
+    let l = job.layers;
     let need_centre = l.depth || l.normal || l.albedo || l.material;
 
-    match settings.noise_target {
+    match job.settings.noise_target {
         None => film.par_rows_mut().enumerate().for_each(|(y, row)| {
             let y = y as u32;
-            let mut sampler = Sampler::new(settings.seed);
+            let mut sampler = Sampler::new(job.seed);
             let mut row_rays = 0u64;
             for (x, pixel) in row.iter_mut().enumerate() {
                 let x = x as u32;
                 if need_centre {
-                    row_rays += centre_ray(scene, camera, settings, forward, (x, y), pixel);
+                    row_rays += centre_ray(scene, camera, job, forward, (x, y), pixel);
                 }
-                for s in 0..settings.spp {
-                    row_rays +=
-                        take_sample(scene, camera, settings, &mut sampler, (x, y), s, pixel);
+                for s in 0..job.settings.spp {
+                    row_rays += take_sample(scene, camera, job, &mut sampler, (x, y), s, pixel);
                 }
             }
             rays.fetch_add(row_rays, Ordering::Relaxed);
-            progress(width as u64 * settings.spp as u64);
+            progress(width as u64 * job.settings.spp as u64);
         }),
         Some(target) => {
             film.par_bands_mut(ADAPTIVE_TILE)
@@ -318,7 +310,7 @@ pub fn render(
                 .for_each(|(band_index, band)| {
                     let y0 = band_index as u32 * ADAPTIVE_TILE;
                     let band_rows = band.len() as u32 / width.max(1);
-                    let mut sampler = Sampler::new(settings.seed);
+                    let mut sampler = Sampler::new(job.seed);
                     let mut band_rays = 0u64;
                     let mut x0 = 0;
                     while x0 < width {
@@ -331,20 +323,19 @@ pub fn render(
                         if need_centre {
                             for (x, y) in tile.pixels() {
                                 let pixel = &mut band[((y - y0) * width + x) as usize];
-                                band_rays +=
-                                    centre_ray(scene, camera, settings, forward, (x, y), pixel);
+                                band_rays += centre_ray(scene, camera, job, forward, (x, y), pixel);
                             }
                         }
                         band_rays += render_tile_adaptive(
                             scene,
                             camera,
-                            settings,
+                            job,
                             target,
                             &mut sampler,
                             tile,
                             band,
                         );
-                        progress(tile.width as u64 * tile.height as u64 * settings.spp as u64);
+                        progress(tile.width as u64 * tile.height as u64 * job.settings.spp as u64);
                         x0 += ADAPTIVE_TILE;
                     }
                     rays.fetch_add(band_rays, Ordering::Relaxed);
@@ -352,7 +343,7 @@ pub fn render(
         }
     }
 
-    let layers = settings.layers;
+    let layers = job.layers;
     RenderOutput {
         image: film.image(),
         depth: layers.depth.then(|| film.depth()),
@@ -416,13 +407,13 @@ fn tile_relative_error(pixels: impl Iterator<Item = Pixel>) -> f64 {
 fn render_tile_adaptive(
     scene: &Scene,
     camera: &Camera,
-    settings: &RenderSettings,
+    job: &RenderJob,
     target: f32,
     sampler: &mut Sampler,
     tile: Tile,
     band: &mut [Pixel],
 ) -> u64 {
-    let (width, cap) = (settings.width, settings.spp);
+    let (width, cap) = (job.width, job.settings.spp);
     let index = |(x, y): (u32, u32)| ((y - tile.y0) * width + x) as usize;
     let mut rays = 0u64;
     let mut taken = 0u32;
@@ -435,7 +426,7 @@ fn render_tile_adaptive(
         for xy in tile.pixels() {
             let pixel = &mut band[index(xy)];
             for s in taken..next {
-                rays += take_sample(scene, camera, settings, sampler, xy, s, pixel);
+                rays += take_sample(scene, camera, job, sampler, xy, s, pixel);
             }
         }
         taken = next;
@@ -453,13 +444,13 @@ fn render_tile_adaptive(
 fn centre_ray(
     scene: &Scene,
     camera: &Camera,
-    settings: &RenderSettings,
+    job: &RenderJob,
     forward: Vec3,
     (x, y): (u32, u32),
     pixel: &mut Pixel,
 ) -> u64 {
     let centre = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
-    let ray = camera.generate_ray(centre, settings.width, settings.height);
+    let ray = camera.generate_ray(centre, job.width, job.height);
     first_hit_layers(scene, &ray, camera.position(), forward, pixel);
     1
 }
@@ -469,7 +460,7 @@ fn centre_ray(
 fn take_sample(
     scene: &Scene,
     camera: &Camera,
-    settings: &RenderSettings,
+    job: &RenderJob,
     sampler: &mut Sampler,
     (x, y): (u32, u32),
     s: u32,
@@ -477,8 +468,8 @@ fn take_sample(
 ) -> u64 {
     sampler.start_pixel_sample((x, y), s);
     let film_pos = Vec2::new(x as f32, y as f32) + sampler.next_2d();
-    let ray = camera.generate_ray(film_pos, settings.width, settings.height);
-    let path = trace_path(scene, ray, sampler, settings);
+    let ray = camera.generate_ray(film_pos, job.width, job.height);
+    let path = trace_path(scene, ray, sampler, job);
     pixel.add_sample(path.radiance, path.specular);
     path.rays
 }
@@ -499,13 +490,8 @@ fn first_hit_layers(scene: &Scene, ray: &Ray, origin: Vec3, forward: Vec3, pixel
 }
 
 /// Traces one camera path (see the module documentation).
-fn trace_path(
-    scene: &Scene,
-    mut ray: Ray,
-    sampler: &mut Sampler,
-    settings: &RenderSettings,
-) -> PathResult {
-    let (max_depth, want_specular) = (settings.max_depth, settings.layers.specular);
+fn trace_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, job: &RenderJob) -> PathResult {
+    let (max_depth, want_specular) = (job.settings.max_depth, job.layers.specular);
     let lights: &LightSampler = &scene.light_sampler;
     let mut out = PathResult::default();
     let mut throughput = Vec3::ONE;
@@ -561,7 +547,7 @@ fn trace_path(
         if !front {
             bsdf = bsdf.seen_from_back();
         }
-        if settings.regularize {
+        if job.settings.regularize {
             if let Some(alpha) = regularized_alpha(min_ray_pdf) {
                 bsdf = bsdf.roughened(alpha);
             }
@@ -763,16 +749,13 @@ pub(crate) mod tests {
         );
     }
 
-    fn settings(width: u32, height: u32, spp: u32, max_depth: u32) -> RenderSettings {
-        RenderSettings {
+    fn settings(width: u32, height: u32, spp: u32, max_depth: u32) -> RenderJob {
+        RenderJob {
             width,
             height,
-            spp,
-            noise_target: None,
-            max_depth,
             seed: 1,
             layers: Layers::default(),
-            regularize: false,
+            settings: RenderSettings::new(spp, max_depth),
         }
     }
 
@@ -1125,12 +1108,7 @@ pub(crate) mod tests {
     }
 
     /// Renders on a pool of `threads` workers.
-    fn render_on(
-        threads: usize,
-        scene: &Scene,
-        cam: &Camera,
-        set: &RenderSettings,
-    ) -> RenderOutput {
+    fn render_on(threads: usize, scene: &Scene, cam: &Camera, set: &RenderJob) -> RenderOutput {
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
@@ -1146,7 +1124,7 @@ pub(crate) mod tests {
         // sees only the black sky (the horizon is near y = 17).
         let (w, h, cap) = (40, 48, 96);
         let mut set = settings(w, h, cap, 4);
-        set.noise_target = Some(0.02);
+        set.settings.noise_target = Some(0.02);
         set.layers.spp = true;
         set.layers.specular = true;
         set.layers.depth = true;
@@ -1194,7 +1172,7 @@ pub(crate) mod tests {
         );
         assert!(one.stats.samples < (w * h * cap) as u64);
         // Not the fixed-spp image, and the fixed-spp render's layer is the cap everywhere.
-        set.noise_target = None;
+        set.settings.noise_target = None;
         let fixed = render_on(2, &scene, &cam, &set);
         assert_ne!(fixed.image, one.image);
         assert!(fixed.spp.unwrap().iter().all(|&n| n == cap));
@@ -1205,14 +1183,14 @@ pub(crate) mod tests {
             .expect("a tile runs to the cap");
         assert_eq!(fixed.image.pixels[full], one.image.pixels[full]);
         // A cap at or below the minimum is fixed-spp sampling, bit for bit.
-        set.spp = ADAPTIVE_MIN_SPP;
+        set.settings.spp = ADAPTIVE_MIN_SPP;
         let fixed = render_on(2, &scene, &cam, &set);
-        set.noise_target = Some(0.05);
+        set.settings.noise_target = Some(0.05);
         let capped = render_on(1, &scene, &cam, &set);
         assert_eq!(fixed.image, capped.image);
         assert_eq!(fixed.stats.samples, capped.stats.samples);
         assert_eq!(fixed.stats.rays, capped.stats.rays);
-        set.spp = 5;
+        set.settings.spp = 5;
         let small = render_on(1, &scene, &cam, &set);
         assert!(small.spp.unwrap().iter().all(|&n| n == 5));
     }
@@ -1249,7 +1227,7 @@ pub(crate) mod tests {
         set.layers.spp = true;
         // Albedo 0: every sample is exactly the emission, zero variance: all stop at the
         // minimum, however tight the target.
-        set.noise_target = Some(1e-6);
+        set.settings.noise_target = Some(1e-6);
         let flat = render(&furnace_box(Vec3::ZERO, le), &cam, &set, &|_| {});
         assert!(flat
             .spp
@@ -1278,7 +1256,7 @@ pub(crate) mod tests {
         let m = lum.iter().sum::<f32>() / lum.len() as f32;
         let r =
             (lum.iter().map(|l| (l - m).powi(2)).sum::<f32>() / (lum.len() - 1) as f32).sqrt() / m;
-        set.noise_target = Some(r / 30f32.sqrt());
+        set.settings.noise_target = Some(r / 30f32.sqrt());
         let mid = render(&noisy_scene, &cam, &set, &|_| {});
         let spp = mid.spp.as_ref().unwrap();
         let mean_spp = spp.iter().map(|&n| n as f64).sum::<f64>() / spp.len() as f64;
@@ -1358,7 +1336,7 @@ pub(crate) mod tests {
         let cap = 512;
         let mut set = settings(w, h, cap, 1);
         set.layers.spp = true;
-        set.noise_target = Some(0.5);
+        set.settings.noise_target = Some(0.5);
         let out = render_on(2, &scene, &cam, &set);
         let p = 1.0 / (k * k);
         let expected = luminance(le) * (1.0 - p) + luminance(bright) * p;
@@ -1458,7 +1436,7 @@ pub(crate) mod tests {
         let mut set = settings(24, 16, 8, 6);
         set.layers.specular = true;
         let plain = render(&scene, &cam, &set, &|_| {});
-        set.regularize = true;
+        set.settings.regularize = true;
         let reg = render(&scene, &cam, &set, &|_| {});
         assert_eq!(plain.specular, reg.specular);
         assert!(plain
@@ -1476,9 +1454,9 @@ pub(crate) mod tests {
             ((a - b) / a).abs().max_element() < 0.2,
             "mean radiance {a} plain, {b} regularised"
         );
-        set.max_depth = 2;
+        set.settings.max_depth = 2;
         let plain2 = render(&scene, &cam, &set, &|_| {});
-        set.regularize = false;
+        set.settings.regularize = false;
         let reg2 = render(&scene, &cam, &set, &|_| {});
         assert_eq!(plain2.image, reg2.image);
         assert_eq!(plain2.specular, reg2.specular);

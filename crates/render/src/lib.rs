@@ -21,7 +21,10 @@
 //! - [`scene`]: loading glTF 2.0 and OBJ into a [`scene::Scene`], with errors that name the file
 //!   and the element.
 //! - [`camera`]: the pinhole camera of docs/design.md (pixel centres at `i + 0.5`, `f = (H/2)/tan(yfov/2)`).
-//! - [`integrator`]: unidirectional path tracing with next-event estimation and MIS.
+//! - [`integrator`]: unidirectional path tracing with next-event estimation and MIS; one image
+//!   is a [`integrator::RenderJob`]: its size, seed and layers, and how to sample it
+//!   ([`streaks_settings::RenderSettings`], the `streaks-settings` crate's one type, which pairs
+//!   and datasets nest too).
 //! - [`film`]: the box-filtered film with its layers; [`output`]: the renderer's EXR layout
 //!   (images, regions, file formats and comparisons are the `streaks-image` crate's).
 //! - [`mitsuba`]: export to Mitsuba 3 (the reference renderer).
@@ -31,9 +34,10 @@
 //! ```
 //! use glam::{Affine3A, Vec3};
 //! use streaks_render::camera::Camera;
-//! use streaks_render::integrator::{render, Layers, RenderSettings};
+//! use streaks_render::integrator::{render, Layers, RenderJob};
 //! use streaks_render::material::Material;
 //! use streaks_render::scene::{Scene, SceneParts, TriangleMesh};
+//! use streaks_settings::RenderSettings;
 //!
 //! // An emissive quad of radiance 2 filling the view of a camera at the origin.
 //! let mut glow = Material::diffuse("glow", Vec3::ZERO);
@@ -61,17 +65,14 @@
 //!     yfov: 0.8,
 //!     aspect_ratio: None,
 //! };
-//! let settings = RenderSettings {
+//! let job = RenderJob {
 //!     width: 8,
 //!     height: 6,
-//!     spp: 4,
-//!     noise_target: None,
-//!     max_depth: 1,
 //!     seed: 0,
 //!     layers: Layers::default(),
-//!     regularize: false,
+//!     settings: RenderSettings::new(4, 1),
 //! };
-//! let out = render(&scene, &camera, &settings, &|_| {});
+//! let out = render(&scene, &camera, &job, &|_| {});
 //! assert!(out.image.pixels.iter().all(|p| (*p - Vec3::splat(2.0)).abs().max_element() < 1e-6));
 //! # Ok::<(), streaks_render::scene::SceneError>(())
 //! ```

@@ -385,8 +385,9 @@ mod tests {
     mod render {
         use super::*;
         use crate::camera::Camera;
-        use crate::integrator::{self, render, Layers, RenderSettings};
+        use crate::integrator::{self, render, Layers, RenderJob};
         use integrator::tests::quad;
+        use streaks_settings::RenderSettings;
 
         fn camera(position: Vec3, pitch: f32) -> Camera {
             integrator::tests::camera(position, pitch, 0.6)
@@ -396,16 +397,13 @@ mod tests {
         use crate::material::Material;
         use crate::scene::{Scene, SceneParts};
 
-        fn settings(spp: u32, max_depth: u32) -> RenderSettings {
-            RenderSettings {
+        fn settings(spp: u32, max_depth: u32) -> RenderJob {
+            RenderJob {
                 width: 12,
                 height: 8,
-                spp,
-                noise_target: None,
-                max_depth,
                 seed: 3,
                 layers: Layers::default(),
-                regularize: false,
+                settings: RenderSettings::new(spp, max_depth),
             }
         }
 

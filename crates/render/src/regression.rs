@@ -30,7 +30,7 @@
 //! regression_references` (about a minute) and stored in [`REFERENCE_DIR`]; remake them only
 //! when a change of the images is intended, and say so in the commit.
 
-use crate::integrator::{render, Layers, RenderSettings};
+use crate::integrator::{render, Layers, RenderJob};
 use crate::scene::{Scene, SceneError};
 use glam::Vec3;
 use statrs::distribution::{ContinuousCDF, Normal};
@@ -38,6 +38,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 use streaks_image::exr::{read_exr_rgb_channels, write_exr};
 use streaks_image::{ImageError, RgbImage};
+use streaks_settings::RenderSettings;
 
 /// How many one-sample renders make a reference.
 pub const REFERENCE_RENDERS: u32 = 16384;
@@ -114,24 +115,21 @@ impl RegressionCase {
         Scene::load(&self.scene_path())
     }
 
-    /// The case's render settings at `spp` samples with `seed`.
-    pub fn settings(&self, spp: u32, seed: u32) -> RenderSettings {
-        RenderSettings {
+    /// The case's image at `spp` samples with `seed`.
+    pub fn job(&self, spp: u32, seed: u32) -> RenderJob {
+        RenderJob {
             width: self.width,
             height: self.height,
-            spp,
-            noise_target: None,
-            max_depth: self.max_depth,
             seed,
             layers: Layers::default(),
-            regularize: false,
+            settings: RenderSettings::new(spp, self.max_depth),
         }
     }
 
     /// Renders the scene's first camera at `spp` samples with `seed`.
     pub fn render(&self, scene: &Scene, spp: u32, seed: u32) -> Result<RgbImage, SceneError> {
         let camera = scene.camera(None)?;
-        Ok(render(scene, camera, &self.settings(spp, seed), &|_| {}).image)
+        Ok(render(scene, camera, &self.job(spp, seed), &|_| {}).image)
     }
 
     /// Makes the reference: the per-pixel mean and per-sample variance of

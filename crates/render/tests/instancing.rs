@@ -9,8 +9,9 @@
 use glam::Vec3;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
-use streaks_render::integrator::{render, RenderSettings};
+use streaks_render::integrator::{render, RenderJob};
 use streaks_render::scene::Scene;
+use streaks_settings::RenderSettings;
 
 fn data(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -42,17 +43,14 @@ fn flattened(dir: &Path, moved: Option<usize>) -> Scene {
 }
 
 fn image(scene: &Scene) -> Vec<Vec3> {
-    let settings = RenderSettings {
+    let job = RenderJob {
         width: 48,
         height: 32,
-        spp: 16,
-        noise_target: None,
-        max_depth: 4,
         seed: 3,
         layers: Default::default(),
-        regularize: false,
+        settings: RenderSettings::new(16, 4),
     };
-    render(scene, scene.camera(None).unwrap(), &settings, &|_| {})
+    render(scene, scene.camera(None).unwrap(), &job, &|_| {})
         .image
         .pixels
 }

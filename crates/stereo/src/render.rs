@@ -25,9 +25,10 @@ use crate::rigfile::{LightRecord, Placed};
 use crate::streak_mask::{streak_mask, StreakMaskParams};
 use streaks_image::GrayImage;
 use streaks_render::camera::Camera;
-use streaks_render::integrator::{render, Layers, RenderOutput, RenderSettings};
+use streaks_render::integrator::{render, Layers, RenderJob, RenderOutput};
 use streaks_render::light::{Emitter, Light};
 use streaks_render::scene::Scene;
+use streaks_settings::RenderSettings;
 
 /// A road pixel's first-hit normal is within this angle's cosine of +Y (10 degrees).
 const ROAD_COS: f32 = 0.984_807_7;
@@ -63,21 +64,14 @@ pub fn eye_camera(rig: &Rig, eye: Eye) -> Camera {
 /// How to render a pair.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PairSettings {
-    /// Samples per pixel (the cap, with adaptive sampling).
-    pub spp: u32,
-    /// Adaptive sampling's target relative standard error per pixel (`None`: `spp`
-    /// everywhere; [`streaks_render::integrator::RenderSettings::noise_target`]).
-    pub noise_target: Option<f32>,
-    /// Longest path (Mitsuba's meaning).
-    pub max_depth: u32,
+    /// How each eye is sampled (the same for both).
+    pub render: RenderSettings,
     /// Seed of the left eye (the right eye uses `seed + 1`).
     pub seed: u32,
     /// Exposure of the PNGs in stops.
     pub exposure_ev: f32,
     /// The streak-mask definition.
     pub mask: StreakMaskParams,
-    /// Path regularisation (biased; [`streaks_render::integrator::RenderSettings::regularize`]).
-    pub regularize: bool,
 }
 
 /// One rendered eye with its ground truth.
@@ -126,20 +120,18 @@ pub fn render_eye(
     settings: &PairSettings,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<EyeView, StereoError> {
-    if settings.spp == 0 || settings.max_depth == 0 {
-        return Err(StereoError::Parameter {
-            name: "spp/max-depth",
-            reason: "both must be at least 1".into(),
-        });
-    }
+    settings
+        .render
+        .check()
+        .map_err(|e| StereoError::Parameter {
+            name: e.name(),
+            reason: e.reason(),
+        })?;
     let i = rig.intrinsics();
     let (w, h) = (i.width(), i.height());
-    let render_settings = RenderSettings {
+    let job = RenderJob {
         width: w,
         height: h,
-        spp: settings.spp,
-        noise_target: settings.noise_target,
-        max_depth: settings.max_depth,
         seed: match eye {
             Eye::Left => settings.seed,
             Eye::Right => settings.seed.wrapping_add(1),
@@ -152,9 +144,9 @@ pub fn render_eye(
             material: true,
             spp: false,
         },
-        regularize: settings.regularize,
+        settings: settings.render,
     };
-    let output = render(scene, &eye_camera(rig, eye), &render_settings, progress);
+    let output = render(scene, &eye_camera(rig, eye), &job, progress);
     let missing =
         |what: &str| StereoError::Render(format!("the renderer returned no {what} layer"));
     let z = output.depth.clone().ok_or_else(|| missing("depth"))?;
