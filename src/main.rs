@@ -17,6 +17,7 @@ mod locus;
 mod paper;
 mod prepare;
 mod render;
+mod render_opts;
 mod stereo;
 mod texture_map;
 mod train_detector;

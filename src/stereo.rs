@@ -1,7 +1,7 @@
 //! `streaks stereo`: render a scene's camera as a rectified stereo pair with ground truth
 //! (disparity and depth maps, streak masks, rig.json), an anaglyph and a side-by-side view.
 
-use crate::render::{Loaded, RenderOpts};
+use crate::render_opts::{Loaded, RenderOpts};
 use anyhow::{bail, Context, Result};
 use std::path::PathBuf;
 use streaks_analysis::report::AnalyzeParams;

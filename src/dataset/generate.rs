@@ -18,14 +18,14 @@
 use super::index::{dataset_lock, rebuild_dir};
 use super::sample::{render_sample, SampleSettings};
 use crate::cli::{image_size, progress_bar};
-use crate::render::flag_error;
+use crate::render_opts::flag_error;
 use anyhow::{bail, Context, Result};
 use rayon::prelude::*;
 use std::cell::Cell;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-use streaks_dataset::files::{DATASET_JSON, LOCK, SAMPLE_LOCK_PREFIX};
+use streaks_dataset::files::{DATASET_JSON, LOCK, SAMPLE_LOCK_PREFIX, TMP_PREFIX};
 use streaks_dataset::layout::{
     sample_id, Conventions, DatasetInfo, FileList, Layout, FORMAT, MAX_COUNT,
 };
@@ -414,7 +414,7 @@ fn leftovers(layout: &Layout) -> Result<BTreeSet<u64>> {
             .file_name();
         let name = name.to_string_lossy();
         let digits = name
-            .strip_prefix(".tmp-")
+            .strip_prefix(TMP_PREFIX)
             .or_else(|| name.strip_prefix(SAMPLE_LOCK_PREFIX))
             .and_then(|rest| rest.get(..6))
             .filter(|d| d.bytes().all(|b| b.is_ascii_digit()));

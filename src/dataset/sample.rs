@@ -7,7 +7,7 @@ use std::time::Instant;
 use streaks_dataset::files::{SampleDir, SCENE_GLTF};
 use streaks_dataset::kitti::write_kitti;
 use streaks_dataset::layout::{sample_id, Layout};
-pub use streaks_dataset::meta::{render_seed, RenderMeta, RigMeta, SampleMeta, SampleStats};
+use streaks_dataset::meta::{render_seed, RenderMeta, RigMeta, SampleMeta, SampleStats};
 use streaks_dataset::settings::Settings;
 use streaks_dataset::write::{write_views, GroundTruth};
 use streaks_image::write_bytes_atomically;

@@ -1,0 +1,129 @@
+//! The rendering flags that `streaks render` and `streaks stereo` share ([`RenderOpts`]), the
+//! scene they load ([`Loaded`]), and how a render setting out of range is reported as a flag.
+
+use anyhow::{bail, Context, Result};
+use indicatif::ProgressBar;
+use std::path::Path;
+use streaks_render::camera::Camera;
+use streaks_render::scene::Scene;
+use streaks_settings::{RenderSettings, SettingsError};
+
+use crate::cli::{image_size, load_scene, progress_bar};
+
+/// The rendering flags that `streaks render` and `streaks stereo` share.
+#[derive(clap::Args, Debug)]
+pub struct RenderOpts {
+    /// Samples per pixel (per eye for a stereo pair); the cap with --noise-target.
+    #[arg(long, default_value_t = 64)]
+    pub spp: u32,
+    /// Adaptive sampling: stop each 16x16 tile of pixels once the estimated relative standard
+    /// error of its pixels' mean luminance is below REL (e.g. 0.1), after at least 16 samples,
+    /// --spp being the cap. Deterministic: the same image for a seed on any number of threads.
+    #[arg(long, value_name = "REL", allow_negative_numbers = true)]
+    pub noise_target: Option<f32>,
+    /// Image width in pixels [default: from the height and the camera's aspect ratio].
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Image height in pixels [default: 480, or from the width and the aspect ratio].
+    #[arg(long)]
+    pub height: Option<u32>,
+    /// Longest path, Mitsuba's meaning: 1 = emitters only, 2 = direct light, 3 = one bounce...
+    #[arg(long, default_value_t = 8)]
+    pub max_depth: u32,
+    /// Sampler seed: the same seed gives the same image on any number of threads (a stereo
+    /// pair's right eye uses seed + 1).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u32,
+    /// Camera name [default: the scene's first camera].
+    #[arg(long)]
+    pub camera: Option<String>,
+    /// Worker threads [default: all cores].
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Exposure of the PNGs in stops (linear * 2^EV before the sRGB curve).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub exposure: f32,
+    /// Path regularisation (biased): roughen glossy lobes after a diffuse or rough bounce, as
+    /// Cycles' "Filter Glossy" does; far fewer fireflies, the first bounce (streaks) unchanged.
+    #[arg(long)]
+    pub regularize: bool,
+    /// Let the scene read files outside its folder (absolute paths, file: URIs, `..`, links
+    /// out of it). Off by default, so an untrusted scene cannot read other files; FIFOs and
+    /// devices are refused even then.
+    #[arg(long)]
+    pub allow_outside_scene: bool,
+}
+
+/// A scene loaded for rendering, with the chosen camera and the image size.
+pub struct Loaded {
+    /// The scene (one BVH, shared by every view).
+    pub scene: Scene,
+    /// The chosen camera.
+    pub camera: Camera,
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+}
+
+impl RenderOpts {
+    /// Phase 1: checks the flags that need no scene.
+    pub fn check(&self) -> Result<()> {
+        self.settings().check().map_err(flag_error)?;
+        if !self.exposure.is_finite() {
+            bail!("--exposure must be a finite number of stops");
+        }
+        Ok(())
+    }
+
+    /// The render settings of the flags (`--spp`, `--max-depth`, `--regularize`,
+    /// `--noise-target`).
+    pub fn settings(&self) -> RenderSettings {
+        RenderSettings {
+            spp: self.spp,
+            max_depth: self.max_depth,
+            regularize: self.regularize,
+            noise_target: self.noise_target,
+        }
+    }
+
+    /// Phase 2: loads the scene (printing its warnings), picks the camera and sizes the image.
+    pub fn load(&self, path: &Path) -> Result<Loaded> {
+        let scene = load_scene(path, self.allow_outside_scene)?;
+        for warning in &scene.warnings {
+            eprintln!("warning: {warning}");
+        }
+        let camera = scene
+            .camera(self.camera.as_deref())
+            .with_context(|| format!("in the scene {}", path.display()))?
+            .clone();
+        let (width, height) = image_size(self.width, self.height, camera.aspect_ratio)?;
+        Ok(Loaded {
+            scene,
+            camera,
+            width,
+            height,
+        })
+    }
+
+    /// The worker pool of `--threads` (all cores by default).
+    pub fn thread_pool(&self) -> Result<rayon::ThreadPool> {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(self.threads.unwrap_or(0))
+            .build()
+            .context("cannot start the worker threads")
+    }
+
+    /// A progress bar over `views` renders of `width` x `height` pixels at `--spp`.
+    pub fn progress(&self, views: u64, width: u32, height: u32) -> Result<ProgressBar> {
+        let total = (views * width as u64 * height as u64)
+            .checked_mul(self.spp as u64)
+            .context("the number of samples (views x width x height x spp) overflows")?;
+        Ok(progress_bar(total))
+    }
+}
+
+/// A render setting out of its range as the command line says it: `--spp must be at least 1`.
+pub fn flag_error(e: SettingsError) -> anyhow::Error {
+    anyhow::anyhow!("--{} {}", e.name().replace('_', "-"), e.reason())
+}
