@@ -112,9 +112,10 @@
 //!   emissiveFactor, metallic, roughness, light colour in [0, 1]; emissiveStrength, intensity
 //!   and the paper models' `kd`, `ks`, `alpha`, `shininess` finite and non-negative), light
 //!   ranges above 0, spot cones with `0 <= inner <= outer <= pi/2` (inner may equal outer: a
-//!   hard edge), cameras' yfov, znear, zfar and aspectRatio, node transforms finite and
-//!   invertible, vertex positions finite and within [`MAX_COORDINATE`] once placed. Anything
-//!   else is an error naming the file and the light, camera, material, node or mesh.
+//!   hard edge), cameras' yfov, xmag, ymag, znear, zfar and aspectRatio, node transforms
+//!   finite and invertible, vertex positions finite and within [`MAX_COORDINATE`] once
+//!   placed. Anything else is an error naming the file and the light, camera, material, node
+//!   or mesh.
 //! - Limits: a node graph may visit at most [`MAX_PLACEMENTS`] nodes (a node reached by
 //!   several paths counts once per path; counted before the walk) and place as many meshes,
 //!   and the placed meshes may hold at most [`MAX_TRIANGLES`] triangles (counted from the
