@@ -104,7 +104,7 @@ impl Camera {
         let centre = 0.5 * (lo + hi);
         let size = hi - lo;
         let mut m = size.x.max(size.y);
-        if !(m > 0.0) {
+        if m.is_nan() || m <= 0.0 {
             m = 1.0;
         }
         let y_zoom = 0.5 * m / (0.5 * FRAMING_YFOV).tan();
