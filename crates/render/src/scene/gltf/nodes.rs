@@ -502,6 +502,40 @@ mod tests {
         }
     }
 
+    /// The default camera's bounds unite one cube per primitive placement, whether the mesh
+    /// is flattened (placed once per mesh copy) or instanced (one mesh placed twice).
+    #[test]
+    fn framing_bounds_unite_the_cubes_of_the_placed_primitives() {
+        let bin: Vec<u8> = [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        let r = std::f32::consts::FRAC_1_SQRT_2;
+        for share in [true, false] {
+            let mesh = |m: usize| if share { 0 } else { m };
+            let doc = json!({
+                "asset": {"version": "2.0"},
+                "scenes": [{"nodes": [0, 1]}],
+                "nodes": [{"mesh": mesh(0)}, {"mesh": mesh(1), "translation": [10, 0, 0]}],
+                "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]},
+                           {"primitives": [{"attributes": {"POSITION": 0}}]}],
+                "buffers": [{"byteLength": 36}],
+                "bufferViews": [{"buffer": 0, "byteLength": 36}],
+                "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3,
+                               "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}]
+            });
+            let scene = load_doc(doc, &bin);
+            assert_eq!(scene.instances.is_empty(), !share);
+            let [lo, hi] = scene.framing_bounds.unwrap();
+            let want_lo = Vec3::new(0.5 - r, 0.5 - r, -r);
+            let want_hi = Vec3::new(10.5 + r, 0.5 + r, r);
+            assert!(
+                (lo - want_lo).length() < 1e-5 && (hi - want_hi).length() < 1e-5,
+                "share {share}: {lo} {hi}"
+            );
+        }
+    }
+
     #[test]
     fn exponential_node_graphs_are_refused_before_they_are_walked() {
         let (mut doc, bin) = test_doc();
