@@ -338,7 +338,7 @@ fn coherent_sets(scene: &Scene, camera: &Camera) -> CoherentSets {
         .ok()
         .and_then(|h| h.parse().ok())
         .unwrap_or(COHERENT_HEIGHT);
-    let width = (height as f32 * camera.aspect_ratio.unwrap_or(4.0 / 3.0)).round() as u32;
+    let width = (height as f32 * camera.aspect_ratio().unwrap_or(4.0 / 3.0)).round() as u32;
     let mut rng = Pcg32::new(23, 0);
     let centre = |x: u32, y: u32| {
         camera.generate_ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5), width, height)

@@ -110,15 +110,15 @@ fn street() -> Scene {
 
 fn bench(c: &mut Criterion) {
     let scene = street();
-    let camera = Camera {
-        name: "cam".into(),
-        world_from_camera: Affine3A::from_rotation_translation(
+    let camera = Camera::perspective(
+        "cam",
+        Affine3A::from_rotation_translation(
             Quat::from_rotation_x(-0.087),
             Vec3::new(1.5, 1.4, 0.0),
         ),
-        yfov: 0.7,
-        aspect_ratio: Some(4.0 / 3.0),
-    };
+        0.7,
+        Some(4.0 / 3.0),
+    );
     let job = RenderJob {
         width: 160,
         height: 120,

@@ -26,7 +26,8 @@ pub struct Args {
     /// Maximum path depth (Mitsuba's meaning: 1 emitters only, 2 direct light, ...).
     #[arg(long, default_value_t = 8)]
     pub max_depth: u32,
-    /// Camera name (default: the scene's first camera).
+    /// Camera name or number, as `streaks render --camera` (default: the scene's first camera;
+    /// a scene without cameras gets the default camera, with a warning).
     #[arg(long)]
     pub camera: Option<String>,
     /// Sampler seed.

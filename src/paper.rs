@@ -68,7 +68,7 @@ fn fig2_and_3(args: &Args, out: &Path, index: &mut String) -> Result<()> {
         let camera = scene
             .camera(None)
             .with_context(|| format!("in the scene {}", path.display()))?;
-        let (w, h) = crate::cli::image_size(Some(args.fig2_width), None, camera.aspect_ratio)?;
+        let (w, h) = crate::cli::image_size(Some(args.fig2_width), None, camera.aspect_ratio())?;
         let rig = rig_from_camera(camera, w, h, Rig::DEFAULT_BASELINE)?;
         let settings = PairSettings {
             render: RenderSettings::new(args.fig2_spp, 8),
@@ -225,7 +225,7 @@ fn fig6(args: &Args, out: &Path, index: &mut String) -> Result<Report> {
     let camera = scene
         .camera(None)
         .with_context(|| format!("in the scene {}", path.display()))?;
-    let (w, h) = crate::cli::image_size(None, Some(args.fig6_size), camera.aspect_ratio)?;
+    let (w, h) = crate::cli::image_size(None, Some(args.fig6_size), camera.aspect_ratio())?;
     let rig = rig_from_camera(camera, w, h, Rig::DEFAULT_BASELINE)?;
     let settings = PairSettings {
         render: RenderSettings::new(args.fig6_spp, 8),

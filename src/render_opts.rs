@@ -4,7 +4,7 @@
 use anyhow::{bail, Context, Result};
 use indicatif::ProgressBar;
 use std::path::Path;
-use streaks_render::camera::Camera;
+use streaks_render::camera::{Camera, FRAMING_WARNING};
 use streaks_render::scene::Scene;
 use streaks_settings::{RenderSettings, SettingsError};
 
@@ -21,7 +21,9 @@ pub struct RenderOpts {
     /// --spp being the cap. Deterministic: the same image for a seed on any number of threads.
     #[arg(long, value_name = "REL", allow_negative_numbers = true)]
     pub noise_target: Option<f32>,
-    /// Image width in pixels [default: from the height and the camera's aspect ratio].
+    /// Image width in pixels [default: from the height and the camera's aspect ratio (an
+    /// orthographic camera's xmag/ymag)]; with both --width and --height an orthographic
+    /// view keeps square pixels and shows more along one axis.
     #[arg(long)]
     pub width: Option<u32>,
     /// Image height in pixels [default: 480, or from the width and the aspect ratio].
@@ -34,7 +36,9 @@ pub struct RenderOpts {
     /// pair's right eye uses seed + 1).
     #[arg(long, default_value_t = 0)]
     pub seed: u32,
-    /// Camera name [default: the scene's first camera].
+    /// Camera name, or its number in the scene's list of cameras (0 is the first; a name
+    /// wins over a number) [default: the scene's first camera; a scene without cameras is
+    /// framed from +Z as the glTF sample viewer frames it, with a warning].
     #[arg(long)]
     pub camera: Option<String>,
     /// Worker threads [default: all cores].
@@ -93,11 +97,21 @@ impl RenderOpts {
         for warning in &scene.warnings {
             eprintln!("warning: {warning}");
         }
-        let camera = scene
-            .camera(self.camera.as_deref())
-            .with_context(|| format!("in the scene {}", path.display()))?
-            .clone();
-        let (width, height) = image_size(self.width, self.height, camera.aspect_ratio)?;
+        let found = scene
+            .find_camera(self.camera.as_deref())
+            .with_context(|| format!("in the scene {}", path.display()))?;
+        let (width, height) = image_size(
+            self.width,
+            self.height,
+            found.and_then(Camera::aspect_ratio),
+        )?;
+        let camera = match found {
+            Some(camera) => camera.clone(),
+            None => {
+                eprintln!("warning: {}: {FRAMING_WARNING}", path.display());
+                scene.default_camera(width as f32 / height as f32)
+            }
+        };
         Ok(Loaded {
             scene,
             camera,

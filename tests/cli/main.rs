@@ -4,6 +4,7 @@
 
 mod analyze;
 mod benchmark;
+mod camera;
 mod common;
 mod dataset;
 mod detect;

@@ -118,7 +118,8 @@ fn bad_inputs_are_clear_errors() {
     );
     assert!(!text.contains("\"camera\": 0"));
     std::fs::write(t.join("nocam.gltf"), text).unwrap();
-    t.streaks(&[
+    // Without a camera the default camera is the rig centre; a named one must exist.
+    let run = t.streaks(&[
         "stereo",
         "nocam.gltf",
         "-o",
@@ -127,8 +128,22 @@ fn bad_inputs_are_clear_errors() {
         "1",
         "--height",
         "8",
+    ]);
+    run.assert_success();
+    assert!(run
+        .stderr()
+        .contains("scene has no camera: framed its bounds"));
+    t.streaks(&[
+        "stereo",
+        "nocam.gltf",
+        "-o",
+        "out3",
+        "--camera",
+        "cam",
+        "--spp",
+        "1",
     ])
-    .assert_failure_mentioning("camera");
+    .assert_failure_mentioning("scene has no camera");
     t.streaks(&[
         "texture-map",
         "scene.gltf",

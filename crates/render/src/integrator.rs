@@ -714,15 +714,12 @@ pub(crate) mod tests {
     use streaks_image::color::luminance;
 
     pub(crate) fn camera(position: Vec3, pitch: f32, yfov: f32) -> Camera {
-        Camera {
-            name: "cam".into(),
-            world_from_camera: Affine3A::from_rotation_translation(
-                Quat::from_rotation_x(pitch),
-                position,
-            ),
+        Camera::perspective(
+            "cam",
+            Affine3A::from_rotation_translation(Quat::from_rotation_x(pitch), position),
             yfov,
-            aspect_ratio: Some(1.5),
-        }
+            Some(1.5),
+        )
     }
 
     /// A quad (two triangles) with the given corners, counter-clockwise seen from its front.

@@ -59,12 +59,7 @@
 //! })?;
 //! // The scene's emitters are built with it: one mesh of two triangles.
 //! assert_eq!(scene.light_sampler.emitters().len(), 1);
-//! let camera = Camera {
-//!     name: "cam".into(),
-//!     world_from_camera: Affine3A::IDENTITY,
-//!     yfov: 0.8,
-//!     aspect_ratio: None,
-//! };
+//! let camera = Camera::perspective("cam", Affine3A::IDENTITY, 0.8, None);
 //! let job = RenderJob {
 //!     width: 8,
 //!     height: 6,

@@ -27,7 +27,9 @@
 //! | double-sided material | BSDF wrapped in `twosided` | yes |
 //! | normal map ([`NormalMap`](crate::normal_map::NormalMap)) | not exported | no (warning) |
 //! | instanced mesh ([`Instances`]) | a `shapegroup` of its object-space meshes (one PLY per material) and an `instance` with its `to_world` matrix per placement | yes |
-//! | camera | `perspective`, `fov_axis` y, `fov` in degrees, `to_world` as a `lookat` | yes |
+//! | perspective camera | `perspective`, `fov_axis` y, `fov` in degrees, `to_world` as a `lookat` | yes |
+//! | orthographic camera | `orthographic`, `to_world` a `scale` by the half-width then a `lookat` moved back by `near_clip` (see [`sensor_xml`]) | yes |
+//! | no camera | the default camera ([`Scene::default_camera`]) as a `perspective` camera | yes (warning) |
 //! | film, filter | `hdrfilm` (rgb, float32) with a `box` filter | yes |
 //! | integrator | `path` with the same `max_depth` | yes (Russian roulette differs: unbiased either way) |
 //! | sampler | `independent` with `sample_count` and `seed` | noise differs, expectation the same |
@@ -37,7 +39,7 @@
 //! (checked by rendering: see tools/mitsuba/README.md).
 
 use crate::bsdf;
-use crate::camera::Camera;
+use crate::camera::{Camera, Projection};
 use crate::light::Light;
 use crate::material::{GltfPbrParams, Material, PaperModel, Reflectance};
 use crate::scene::{Instances, Scene, SceneError, TriangleMesh};
@@ -199,20 +201,34 @@ pub(crate) struct ExportedScene<'a> {
     pub(crate) instances: &'a Instances,
 }
 
-/// Converts `scene` to Mitsuba 3 with the render settings `opts`.
+/// Converts `scene` to Mitsuba 3 with the render settings `opts`. A scene without a camera
+/// is exported with its default camera ([`Scene::default_camera`] for the image's aspect
+/// ratio), and a warning says so.
 pub fn export(scene: &Scene, opts: &ExportOptions) -> Result<MitsubaExport, MitsubaError> {
-    export_parts(
-        &ExportedScene {
-            source: &scene.source,
-            mesh: &scene.mesh,
-            materials: &scene.materials,
-            textures: &scene.textures,
-            lights: &scene.lights,
-            instances: &scene.instances,
-        },
-        scene.camera(opts.camera.as_deref())?,
-        opts,
-    )
+    let parts = ExportedScene {
+        source: &scene.source,
+        mesh: &scene.mesh,
+        materials: &scene.materials,
+        textures: &scene.textures,
+        lights: &scene.lights,
+        instances: &scene.instances,
+    };
+    match scene.find_camera(opts.camera.as_deref())? {
+        Some(camera) => export_parts(&parts, camera, opts),
+        None => {
+            let aspect = opts.width as f32 / opts.height.max(1) as f32;
+            let mut exported = export_parts(&parts, &scene.default_camera(aspect), opts)?;
+            exported.warnings.insert(
+                0,
+                format!(
+                    "{}: {}",
+                    scene.source.display(),
+                    crate::camera::FRAMING_WARNING
+                ),
+            );
+            Ok(exported)
+        }
+    }
 }
 
 /// Escapes text for an XML attribute value.
@@ -736,7 +752,19 @@ fn light_xml(light: &Light, warnings: &mut Vec<String>) -> String {
     }
 }
 
-/// The `<sensor>` element: our camera as a Mitsuba `perspective` camera.
+/// Mitsuba's default `near_clip` of an orthographic sensor, where its rays start (see
+/// [`sensor_xml`]).
+const ORTHO_NEAR_CLIP: f32 = 0.01;
+
+/// The `<sensor>` element: our camera as a Mitsuba `perspective` or `orthographic` camera.
+///
+/// Mitsuba's orthographic sensor (src/sensors/orthographic.cpp and `orthographic_projection`
+/// in include/mitsuba/render/sensor.h) maps the film to local x in [-1, 1] (the width) and
+/// y in [-1/a, 1/a] (a = W/H, so pixels are square), and starts its rays at local
+/// z = `near_clip` along +Z. So `to_world` = `lookat` x `scale(k, k, 1)` with `k` our
+/// half-width `s W / 2` gives our rectangle (`s` the pixel size,
+/// [`Camera::pixel_metres`]), and the lookat origin is moved back by `near_clip` so that
+/// the rays start on our camera plane.
 fn sensor_xml(cam: &Camera, opts: &ExportOptions) -> String {
     let origin = cam.position();
     let forward = cam
@@ -744,11 +772,32 @@ fn sensor_xml(cam: &Camera, opts: &ExportOptions) -> String {
         .transform_vector3(-Vec3::Z)
         .normalize();
     let up = cam.world_from_camera.transform_vector3(Vec3::Y).normalize();
+    // (type, its parameters, a scale before the lookat, the lookat origin)
+    let (kind, projection, scale, origin) = match cam.projection {
+        Projection::Perspective { yfov, .. } => (
+            "perspective",
+            format!(
+                "<string name=\"fov_axis\" value=\"y\"/>\
+                 <float name=\"fov\" value=\"{:?}\"/>",
+                yfov.to_degrees()
+            ),
+            String::new(),
+            origin,
+        ),
+        Projection::Orthographic { .. } => {
+            let pixel = cam.pixel_metres(opts.width, opts.height).unwrap_or(0.0);
+            let k = 0.5 * opts.width as f32 * pixel;
+            (
+                "orthographic",
+                format!("<float name=\"near_clip\" value=\"{ORTHO_NEAR_CLIP:?}\"/>"),
+                format!("<scale x=\"{k:?}\" y=\"{k:?}\"/>"),
+                origin - ORTHO_NEAR_CLIP * forward,
+            )
+        }
+    };
     format!(
-        "<sensor type=\"perspective\">\
-         <string name=\"fov_axis\" value=\"y\"/>\
-         <float name=\"fov\" value=\"{:?}\"/>\
-         <transform name=\"to_world\"><lookat origin=\"{}\" target=\"{}\" up=\"{}\"/></transform>\
+        "<sensor type=\"{kind}\">{projection}\
+         <transform name=\"to_world\">{scale}<lookat origin=\"{}\" target=\"{}\" up=\"{}\"/></transform>\
          <sampler type=\"independent\"><integer name=\"sample_count\" value=\"{}\"/>\
          <integer name=\"seed\" value=\"{}\"/></sampler>\
          <film type=\"hdrfilm\"><integer name=\"width\" value=\"{}\"/>\
@@ -756,7 +805,6 @@ fn sensor_xml(cam: &Camera, opts: &ExportOptions) -> String {
          <string name=\"pixel_format\" value=\"rgb\"/>\
          <string name=\"component_format\" value=\"float32\"/>\
          <rfilter type=\"box\"/></film></sensor>",
-        cam.yfov.to_degrees(),
         v3(origin),
         v3(origin + forward),
         v3(up),
@@ -1035,12 +1083,12 @@ mod tests {
                         range: Some(20.0),
                     },
                 ],
-                cameras: vec![Camera {
-                    name: "cam".into(),
-                    world_from_camera: Affine3A::from_translation(Vec3::new(0.0, 1.5, 4.0)),
-                    yfov: 0.7,
-                    aspect_ratio: None,
-                }],
+                cameras: vec![Camera::perspective(
+                    "cam",
+                    Affine3A::from_translation(Vec3::new(0.0, 1.5, 4.0)),
+                    0.7,
+                    None,
+                )],
                 instances: Instances::default(),
             }
         }

@@ -34,8 +34,9 @@ pub enum StereoError {
         /// Why.
         reason: String,
     },
-    /// The scene has no camera to build the rig from, or not the one asked for.
-    #[error("no camera for the rig: {0}")]
+    /// The camera cannot be a rig's centre (an orthographic camera: a rectified pair needs
+    /// a pinhole); the message says which and why.
+    #[error("{0}")]
     Camera(String),
     /// Two images that must have the same size do not.
     #[error(transparent)]

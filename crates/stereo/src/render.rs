@@ -34,14 +34,21 @@ use streaks_settings::RenderSettings;
 const ROAD_COS: f32 = 0.984_807_7;
 
 /// The rig of a scene camera: the camera is the rig centre, its `yfov` gives the focal length
-/// for an image of `height` pixels (`f = (H/2) / tan(yfov/2)`).
+/// for an image of `height` pixels (`f = (H/2) / tan(yfov/2)`). An orthographic camera is an
+/// error: a rectified pair's disparity `f b / Z` needs a pinhole.
 pub fn rig_from_camera(
     camera: &Camera,
     width: u32,
     height: u32,
     baseline: f32,
 ) -> Result<Rig, StereoError> {
-    let intrinsics = Intrinsics::from_yfov(width, height, camera.yfov)?;
+    let Some(yfov) = camera.yfov() else {
+        return Err(StereoError::Camera(format!(
+            "a stereo pair needs a perspective camera; camera {:?} is orthographic",
+            camera.name
+        )));
+    };
+    let intrinsics = Intrinsics::from_yfov(width, height, yfov)?;
     Rig::new(intrinsics, baseline, camera.world_from_camera).map_err(|e| match e {
         StereoError::Pose(reason) => {
             StereoError::Pose(format!("camera {:?}: {reason}", camera.name))
@@ -53,12 +60,12 @@ pub fn rig_from_camera(
 /// One eye of `rig` as a renderer camera (same pose, field of view and aspect ratio).
 pub fn eye_camera(rig: &Rig, eye: Eye) -> Camera {
     let i = rig.intrinsics();
-    Camera {
-        name: format!("{eye} eye"),
-        world_from_camera: rig.world_from_eye(eye),
-        yfov: i.yfov(),
-        aspect_ratio: Some(i.width() as f32 / i.height() as f32),
-    }
+    Camera::perspective(
+        format!("{eye} eye"),
+        rig.world_from_eye(eye),
+        i.yfov(),
+        Some(i.width() as f32 / i.height() as f32),
+    )
 }
 
 /// How to render a pair.
@@ -284,12 +291,7 @@ mod tests {
 
     #[test]
     fn bad_inputs_are_errors() {
-        let cam = Camera {
-            name: "c".into(),
-            world_from_camera: Affine3A::from_scale(Vec3::splat(2.0)),
-            yfov: 0.5,
-            aspect_ratio: None,
-        };
+        let cam = Camera::perspective("c", Affine3A::from_scale(Vec3::splat(2.0)), 0.5, None);
         let e = rig_from_camera(&cam, 64, 48, 0.065).unwrap_err();
         assert!(e.to_string().contains("\"c\""), "{e}");
         let cam = Camera {
@@ -301,9 +303,17 @@ mod tests {
             Err(StereoError::Baseline(_))
         ));
         assert!(rig_from_camera(&cam, 0, 48, 0.065).is_err());
+        let ortho = Camera::orthographic("flat", Affine3A::IDENTITY, 1.0, 1.0);
+        let e = rig_from_camera(&ortho, 64, 48, 0.065)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("a stereo pair needs a perspective camera; camera \"flat\" is orthographic"),
+            "{e}"
+        );
         let rig = rig_from_camera(&cam, 64, 48, 0.065).unwrap();
         let eye = eye_camera(&rig, Eye::Right);
-        assert!((eye.focal_px(48) - rig.focal_px()).abs() < 1e-3);
+        assert!((eye.focal_px(48).unwrap() - rig.focal_px()).abs() < 1e-3);
         let p = Vec3::new(0.3, -0.2, -4.0);
         let a = eye.project(p, 64, 48).unwrap();
         let b = rig.eye(Eye::Right).project(p).unwrap();

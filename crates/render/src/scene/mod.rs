@@ -23,8 +23,10 @@
 //! - Geometry may be quantized (KHR_mesh_quantization: 8- and 16-bit attributes, normalized
 //!   or not), sparse, or compressed (EXT_meshopt_compression, KHR_draco_mesh_compression,
 //!   decoded when the file is loaded).
-//! - Perspective cameras only; a camera's name is the camera's, else its node's, else
-//!   `camera<i>`; `world_from_camera` is the node's world transform with scale removed.
+//! - Perspective and orthographic cameras ([`Camera`]); a camera's name is the camera's, else
+//!   its node's, else `camera<i>`; `world_from_camera` is the node's world transform with
+//!   scale removed. A scene without a camera is shown by the default camera
+//!   ([`Scene::default_camera`]: the glTF sample viewer's framing of its bounds).
 //! - KHR_lights_punctual: `color * intensity` is in candela (point, spot) or lux
 //!   (directional), as the specification says, and becomes W/sr or W/m^2 divided by 683 lm/W
 //!   ([`crate::light::LUMINOUS_EFFICACY`]), as Blender's importer does. A file written in
@@ -110,9 +112,10 @@
 //!   emissiveFactor, metallic, roughness, light colour in [0, 1]; emissiveStrength, intensity
 //!   and the paper models' `kd`, `ks`, `alpha`, `shininess` finite and non-negative), light
 //!   ranges above 0, spot cones with `0 <= inner <= outer <= pi/2` (inner may equal outer: a
-//!   hard edge), cameras' yfov, znear, zfar and aspectRatio, node transforms finite and
-//!   invertible, vertex positions finite and within [`MAX_COORDINATE`] once placed. Anything
-//!   else is an error naming the file and the light, camera, material, node or mesh.
+//!   hard edge), cameras' yfov, xmag, ymag, znear, zfar and aspectRatio, node transforms
+//!   finite and invertible, vertex positions finite and within [`MAX_COORDINATE`] once
+//!   placed. Anything else is an error naming the file and the light, camera, material, node
+//!   or mesh.
 //! - Limits: a node graph may visit at most [`MAX_PLACEMENTS`] nodes (a node reached by
 //!   several paths counts once per path; counted before the walk) and place as many meshes,
 //!   and the placed meshes may hold at most [`MAX_TRIANGLES`] triangles (counted from the
@@ -184,8 +187,16 @@ pub struct Scene {
     pub textures: Vec<Texture>,
     /// The point, spot and directional lights, in file order.
     pub lights: Vec<Light>,
-    /// Cameras, in file order.
+    /// Cameras, in the order the node walk reaches them (depth-first, children in file
+    /// order); the first is the default.
     pub cameras: Vec<Camera>,
+    /// What the default camera ([`Scene::default_camera`]) frames: the glTF sample viewer's
+    /// bounds ([`crate::camera::cube_bounds`]) of the world-space bounding boxes of the
+    /// loaded primitives (computed from their triangles as loaded, not from the accessors'
+    /// `min` and `max`; an instanced primitive's box is its object-space box's eight corners
+    /// placed by the instance). A scene from OBJ or [`Scene::from_parts`] counts as one
+    /// primitive. `None` for a scene without geometry.
+    pub framing_bounds: Option<[Vec3; 2]>,
     /// The BVH over `mesh.triangles`.
     pub accel: Accel,
     /// The instanced meshes (in object space, each stored once), their instances and the
@@ -329,6 +340,7 @@ impl Scene {
             textures,
             lights,
             cameras,
+            framing_bounds: crate::camera::cube_bounds(bounds),
             accel,
             instances,
             light_sampler,
@@ -336,10 +348,17 @@ impl Scene {
         })
     }
 
-    /// The camera called `name`, or the first camera when `name` is `None`.
+    /// The camera called `name` (else, if `name` is a number `i` and no camera has that name,
+    /// the `i`-th camera of [`Scene::cameras`], from 0), or the first camera when `name` is
+    /// `None`. A scene without cameras is an error here; [`Scene::find_camera`] and
+    /// [`Scene::default_camera`] give it the default camera.
     pub fn camera(&self, name: Option<&str>) -> Result<&Camera, SceneError> {
         let found = match name {
-            Some(n) => self.cameras.iter().find(|c| c.name == n),
+            Some(n) => self
+                .cameras
+                .iter()
+                .find(|c| c.name == n)
+                .or_else(|| n.parse::<usize>().ok().and_then(|i| self.cameras.get(i))),
             None => self.cameras.first(),
         };
         found.ok_or_else(|| match name {
@@ -357,6 +376,26 @@ impl Scene {
                 path: self.source.clone(),
             },
         })
+    }
+
+    /// The camera [`Scene::camera`] chooses, or `None` when the scene has no camera and no
+    /// `name` is asked for (the caller then uses [`Scene::default_camera`], once it knows the
+    /// image size, and says so with [`crate::camera::FRAMING_WARNING`]).
+    pub fn find_camera(&self, name: Option<&str>) -> Result<Option<&Camera>, SceneError> {
+        if name.is_none() && self.cameras.is_empty() {
+            return Ok(None);
+        }
+        self.camera(name).map(Some)
+    }
+
+    /// The default camera for an image of aspect ratio `aspect` (width / height): the glTF
+    /// sample viewer's, [`Camera::framing`] of [`Scene::framing_bounds`] (a scene without
+    /// geometry frames the cube of side 2 around the origin).
+    pub fn default_camera(&self, aspect: f32) -> Camera {
+        let bounds = self
+            .framing_bounds
+            .unwrap_or([Vec3::splat(-1.0), Vec3::splat(1.0)]);
+        Camera::framing(bounds, aspect)
     }
 
     /// Centre and radius of a sphere enclosing all vertices, the instances' included (the
@@ -556,16 +595,21 @@ fn transparency_hash(ray: &Ray, triangle: u32) -> f32 {
 /// The bounding box `[min, max]` of `positions` and the instances; `None` when both are
 /// empty.
 fn bounding_box(positions: &[Vec3], instances: &Instances) -> Option<[Vec3; 2]> {
-    let flat = (!positions.is_empty()).then(|| {
-        positions.iter().fold(
-            [Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)],
-            |[lo, hi], &p| [lo.min(p), hi.max(p)],
-        )
-    });
+    let flat = points_bounds(positions);
     match (flat, instances.bounds()) {
         (Some([a, b]), Some([c, d])) => Some([a.min(c), b.max(d)]),
         (flat, inst) => flat.or(inst),
     }
+}
+
+/// The bounding box `[min, max]` of `points`; `None` without points.
+pub(crate) fn points_bounds(points: &[Vec3]) -> Option<[Vec3; 2]> {
+    (!points.is_empty()).then(|| {
+        points.iter().fold(
+            [Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)],
+            |[lo, hi], &p| [lo.min(p), hi.max(p)],
+        )
+    })
 }
 
 /// Centre and radius of a sphere enclosing the box `bounds` (see [`Scene::bounding_sphere`]).

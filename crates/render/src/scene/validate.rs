@@ -92,6 +92,25 @@ pub fn perspective(p: &gltf::camera::Perspective) -> Result<(), String> {
     Ok(())
 }
 
+/// An orthographic camera: `xmag` and `ymag` finite and above 0 (the schema forbids 0 and
+/// advises against negative values, which would mirror the image), `znear` finite and at
+/// least 0, `zfar` above `znear`.
+pub fn orthographic(o: &gltf::camera::Orthographic) -> Result<(), String> {
+    for (name, v) in [("xmag", o.xmag()), ("ymag", o.ymag())] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(format!("{name} {v} must be finite and above 0"));
+        }
+    }
+    let (znear, zfar) = (o.znear(), o.zfar());
+    if !(znear.is_finite() && znear >= 0.0) {
+        return Err(format!("znear {znear} must be finite and at least 0"));
+    }
+    if zfar.is_nan() || zfar <= znear {
+        return Err(format!("zfar {zfar} must be above znear {znear}"));
+    }
+    Ok(())
+}
+
 /// The core factors of a material: baseColorFactor, metallicFactor, roughnessFactor,
 /// emissiveFactor and occlusionTexture.strength in [0, 1], alphaCutoff at least 0,
 /// normalTexture.scale finite, and KHR_materials_emissive_strength's emissiveStrength finite

@@ -191,6 +191,7 @@ pub(in crate::scene) fn load(path: &Path, files: &Files) -> Result<Scene, SceneE
         default_material: None,
         light_units,
         placements: Vec::new(),
+        primitive_boxes: Vec::new(),
     };
     for w in extension_warnings {
         loader.warn(w);
@@ -237,7 +238,10 @@ pub(in crate::scene) fn load(path: &Path, files: &Files) -> Result<Scene, SceneE
         let n = loader.parts.mesh.positions.len();
         loader.parts.mesh.tangents.resize(n, Vec4::ZERO);
     }
-    Scene::from_parts(loader.parts)
+    let boxes = std::mem::take(&mut loader.primitive_boxes);
+    let mut scene = Scene::from_parts(loader.parts)?;
+    scene.framing_bounds = crate::camera::cube_bounds(boxes);
+    Ok(scene)
 }
 
 #[cfg(test)]

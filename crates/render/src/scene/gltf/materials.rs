@@ -620,14 +620,6 @@ mod tests {
         doc["materials"][0]["extras"]["streaks"]["alpha_dry"] = json!(0.3);
         let err = load_err(doc, &bin);
         assert!(err.contains("metallicRoughnessTexture"), "{err}");
-        let (mut doc, bin) = test_doc();
-        doc["cameras"][0] = json!({"name": "ortho", "type": "orthographic",
-            "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 10}});
-        let err = load_err(doc, &bin);
-        assert!(
-            err.contains("camera \"ortho\"") && err.contains("orthographic"),
-            "{err}"
-        );
     }
 
     #[test]

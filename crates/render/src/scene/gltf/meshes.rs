@@ -2,7 +2,7 @@
 //! fans, and tangents for normal maps (the file's, or MikkTSpace's).
 
 use super::{accessors, mesh_label, Loader};
-use crate::scene::{tangents, validate, SceneError};
+use crate::scene::{points_bounds, tangents, validate, SceneError};
 use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
@@ -213,6 +213,7 @@ impl Loader<'_> {
             if first + positions.len() > u32::MAX as usize {
                 return Err(self.bad(element, "the scene has more than 2^32 - 1 vertices"));
             }
+            self.primitive_boxes.extend(points_bounds(&positions));
             let out = &mut self.parts.mesh;
             if let Some(t) = tangents {
                 out.tangents.resize(first, Vec4::ZERO);

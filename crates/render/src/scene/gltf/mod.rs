@@ -54,7 +54,7 @@ use super::files::Files;
 use super::{SceneError, SceneParts};
 use crate::texture::{ColorSpace, TextureId};
 use extensions::LightUnits;
-use glam::Mat4;
+use glam::{Mat4, Vec3};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -96,6 +96,9 @@ struct Loader<'a> {
     light_units: LightUnits,
     /// Every placement of a mesh in the walk's order: mesh index and world transform.
     placements: Vec<(usize, Mat4)>,
+    /// The bounding box of each primitive loaded so far, in the space it was loaded in (world,
+    /// or object space while an instanced mesh is loaded), for the default camera.
+    primitive_boxes: Vec<[Vec3; 2]>,
 }
 
 impl Loader<'_> {

@@ -3,7 +3,7 @@
 
 use super::{mesh_label, node_label, Loader};
 use crate::camera::Camera;
-use crate::scene::{validate, Instance, SceneError, TriangleMesh};
+use crate::scene::{points_bounds, validate, Instance, SceneError, TriangleMesh};
 use glam::{Affine3A, Mat4, Quat, Vec3, Vec4};
 use gltf::mesh::Mode;
 use std::path::Path;
@@ -221,6 +221,8 @@ impl Loader<'_> {
             }
         }
         let mut instanced: Vec<Option<u32>> = vec![None; meshes.len()];
+        // The object-space boxes of each instanced mesh's primitives.
+        let mut object_boxes: Vec<Vec<[Vec3; 2]>> = Vec::new();
         for (m, world) in std::mem::take(&mut self.placements) {
             let mesh = &meshes[m];
             if count[m] < 2 || emissive[m] {
@@ -230,13 +232,23 @@ impl Loader<'_> {
             let index = match instanced[m] {
                 Some(i) => i,
                 None => {
+                    let first_box = self.primitive_boxes.len();
                     let object = self.object_mesh(mesh)?;
+                    object_boxes.push(self.primitive_boxes.split_off(first_box));
                     let i = self.parts.instanced_meshes.len() as u32;
                     self.parts.instanced_meshes.push(object);
                     instanced[m] = Some(i);
                     i
                 }
             };
+            for &[lo, hi] in &object_boxes[index as usize] {
+                let corners = std::array::from_fn::<Vec3, 8, _>(|k| {
+                    let corner =
+                        Vec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), hi, lo);
+                    world.transform_point3(corner)
+                });
+                self.primitive_boxes.extend(points_bounds(&corners));
+            }
             // The walk checked that the transform is invertible.
             if let Some(instance) = Instance::new(index, world) {
                 self.parts.instances.push(instance);
@@ -274,21 +286,20 @@ impl Loader<'_> {
             camera.index(),
             node_label(node)
         );
-        let gltf::camera::Projection::Perspective(p) = camera.projection() else {
-            return Err(self.bad(element, "orthographic cameras are not supported"));
-        };
-        validate::perspective(&p).map_err(|r| self.bad(&element, r))?;
-        let yfov = p.yfov();
         let (_, rotation, translation) = world.to_scale_rotation_translation();
-        self.parts.cameras.push(Camera {
-            name,
-            world_from_camera: Affine3A::from_rotation_translation(
-                rotation.normalize(),
-                translation,
-            ),
-            yfov,
-            aspect_ratio: p.aspect_ratio(),
-        });
+        let world_from_camera =
+            Affine3A::from_rotation_translation(rotation.normalize(), translation);
+        let camera = match camera.projection() {
+            gltf::camera::Projection::Perspective(p) => {
+                validate::perspective(&p).map_err(|r| self.bad(&element, r))?;
+                Camera::perspective(name, world_from_camera, p.yfov(), p.aspect_ratio())
+            }
+            gltf::camera::Projection::Orthographic(o) => {
+                validate::orthographic(&o).map_err(|r| self.bad(&element, r))?;
+                Camera::orthographic(name, world_from_camera, o.xmag(), o.ymag())
+            }
+        };
+        self.parts.cameras.push(camera);
         Ok(())
     }
 }
@@ -450,6 +461,79 @@ mod tests {
         doc["cameras"][0]["perspective"]["zfar"] = json!(0.05);
         let err = error(doc, &bin);
         assert!(err.contains("zfar 0.05"), "{err}");
+    }
+
+    #[test]
+    fn orthographic_cameras_load_and_bad_ones_are_named() {
+        let (mut doc, bin) = test_doc();
+        doc["cameras"][0] = json!({"name": "ortho", "type": "orthographic",
+            "orthographic": {"xmag": 2, "ymag": 0.5, "znear": 0.1, "zfar": 10}});
+        let scene = load_doc(doc, &bin);
+        let cam = scene.camera(Some("ortho")).unwrap();
+        assert_eq!(
+            cam.projection,
+            crate::camera::Projection::Orthographic {
+                xmag: 2.0,
+                ymag: 0.5
+            }
+        );
+        assert_eq!(cam.aspect_ratio(), Some(4.0));
+        let named = &["camera \"ortho\" (0) on node \"cam_node\" (3)"][..];
+        let o = "/cameras/0/orthographic";
+        let base = |doc: &mut Value| {
+            doc["cameras"][0] = json!({"name": "ortho", "type": "orthographic",
+                "orthographic": {"xmag": 2, "ymag": 0.5, "znear": 0.1, "zfar": 10}});
+        };
+        for (field, value, says) in [
+            ("xmag", json!(0), "xmag 0"),
+            ("ymag", json!(-1), "ymag -1"),
+            ("xmag", json!(1e39), "xmag inf"),
+            ("znear", json!(-0.5), "znear -0.5"),
+            ("zfar", json!(0.05), "zfar 0.05"),
+        ] {
+            let (mut doc, bin) = test_doc();
+            base(&mut doc);
+            doc["cameras"][0]["orthographic"][field] = value;
+            let err = error(doc, &bin);
+            assert!(
+                err.contains(named[0]) && err.contains(says),
+                "{o}/{field}: {err}"
+            );
+        }
+    }
+
+    /// The default camera's bounds unite one cube per primitive placement, whether the mesh
+    /// is flattened (placed once per mesh copy) or instanced (one mesh placed twice).
+    #[test]
+    fn framing_bounds_unite_the_cubes_of_the_placed_primitives() {
+        let bin: Vec<u8> = [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        let r = std::f32::consts::FRAC_1_SQRT_2;
+        for share in [true, false] {
+            let mesh = |m: usize| if share { 0 } else { m };
+            let doc = json!({
+                "asset": {"version": "2.0"},
+                "scenes": [{"nodes": [0, 1]}],
+                "nodes": [{"mesh": mesh(0)}, {"mesh": mesh(1), "translation": [10, 0, 0]}],
+                "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]},
+                           {"primitives": [{"attributes": {"POSITION": 0}}]}],
+                "buffers": [{"byteLength": 36}],
+                "bufferViews": [{"buffer": 0, "byteLength": 36}],
+                "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3,
+                               "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}]
+            });
+            let scene = load_doc(doc, &bin);
+            assert_eq!(scene.instances.is_empty(), !share);
+            let [lo, hi] = scene.framing_bounds.unwrap();
+            let want_lo = Vec3::new(0.5 - r, 0.5 - r, -r);
+            let want_hi = Vec3::new(10.5 + r, 0.5 + r, r);
+            assert!(
+                (lo - want_lo).length() < 1e-5 && (hi - want_hi).length() < 1e-5,
+                "share {share}: {lo} {hi}"
+            );
+        }
     }
 
     #[test]

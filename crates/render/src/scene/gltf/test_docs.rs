@@ -208,7 +208,7 @@ pub(super) fn check_test_scene(scene: &Scene) {
     let cam = scene.camera(None).unwrap();
     assert_eq!(cam.name, "cam_node");
     assert_eq!(scene.camera(Some("cam_node")).unwrap().name, "cam_node");
-    assert!((cam.yfov - 0.7).abs() < 1e-6 && cam.aspect_ratio == Some(1.5));
+    assert!((cam.yfov().unwrap() - 0.7).abs() < 1e-6 && cam.aspect_ratio() == Some(1.5));
     assert!(approx(cam.position(), Vec3::new(0.0, 2.0, 5.0)));
     let fwd = cam.world_from_camera.transform_vector3(-Vec3::Z);
     assert!(approx(fwd, -Vec3::X), "{fwd}");
