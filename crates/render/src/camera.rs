@@ -87,18 +87,18 @@ impl Camera {
         }
     }
 
-    /// The sample viewer's default camera for a scene of bounding box `bounds` (`[min, max]`,
-    /// as [`cube_bounds`] makes it), for an image of aspect ratio `aspect` (width / height).
+    /// The default camera for a scene of bounding box `bounds` (`[min, max]`, as
+    /// [`cube_bounds`] makes it), for an image of aspect ratio `aspect` (width / height): the
+    /// glTF sample viewer's, moved back so that all of the box is in view.
     ///
-    /// A perspective camera of [`FRAMING_YFOV`] looking along -Z with +Y up, aimed at the
-    /// centre `c` of the box from `c + (0, 0, D)`, with the viewer's distance (which ignores
-    /// the depth of the box): `m = max(size.x, size.y)`, `D = max(m/2 / tan(yfov/2),
-    /// m/2 / tan(xfov/2))` where `xfov = yfov * aspect` (the viewer's approximation, not
-    /// `2 atan(aspect tan(yfov/2))`; a negative tangent when `xfov` passes pi leaves `D` to
-    /// the first term). When the box reaches past that point (a scene deeper along Z than
-    /// wide), the camera moves back to `max.z + m/10`, so that it is always outside the
-    /// geometry and everything is in front of it. A degenerate box (a point) is framed as a
-    /// box of size 1.
+    /// A perspective camera of [`FRAMING_YFOV`] looking along -Z with +Y up, on the axis
+    /// through the centre `c` of the box, at `(c.x, c.y, max.z + D)`: `m = max(size.x,
+    /// size.y)`, `D = max(m/2 / tan(yfov/2), m/2 / tan(xfov/2))`, `xfov = 2 atan(aspect
+    /// tan(yfov/2))`. The viewer takes the same `D` from the box's centre, with `xfov = yfov *
+    /// aspect`, which ignores the box's depth and cuts the front of deep scenes at the image's
+    /// edge; measured from the front face, the front face fills the limiting axis exactly and
+    /// everything behind it is smaller, so every point of the box is in view and in front of
+    /// the camera. A degenerate box (a point) is framed as a box of size 1.
     pub fn framing(bounds: [Vec3; 2], aspect: f32) -> Camera {
         let [lo, hi] = bounds;
         let centre = 0.5 * (lo + hi);
@@ -107,10 +107,10 @@ impl Camera {
         if m.is_nan() || m <= 0.0 {
             m = 1.0;
         }
-        let y_zoom = 0.5 * m / (0.5 * FRAMING_YFOV).tan();
-        let x_zoom = 0.5 * m / (0.5 * FRAMING_YFOV * aspect).tan();
-        let distance = y_zoom.max(x_zoom);
-        let z = (centre.z + distance).max(hi.z + 0.1 * m);
+        let tan_half_y = (0.5 * FRAMING_YFOV).tan();
+        let tan_half_x = aspect * tan_half_y;
+        let distance = (0.5 * m / tan_half_y).max(0.5 * m / tan_half_x);
+        let z = hi.z + distance;
         Camera::perspective(
             FRAMING_NAME,
             Affine3A::from_translation(Vec3::new(centre.x, centre.y, z)),
@@ -365,24 +365,19 @@ mod tests {
                     "aspect {aspect}: corner {p} at {px}"
                 );
             }
-            // The bounds' centre plane (the one the distance is computed for) spans exactly
-            // the image height when the height is the limiting axis (aspect >= 1), and the
-            // width at xfov = yfov * aspect otherwise.
+            // The bounds' front face (the one the distance is computed for) spans exactly
+            // the image height when the height is the limiting axis (aspect >= 1), and
+            // exactly the width otherwise.
             let [blo, bhi] = bounds;
             let centre = 0.5 * (blo + bhi);
+            let front = Vec3::new(centre.x, centre.y, bhi.z);
             let m = (bhi - blo).x;
-            let top = cam.project(centre + Vec3::Y * (0.5 * m), w, h).unwrap();
-            let bottom = cam.project(centre - Vec3::Y * (0.5 * m), w, h).unwrap();
-            let frac = (bottom.y - top.y) / h as f32;
-            let expect = if aspect >= 1.0 {
-                1.0
-            } else {
-                (0.5 * FRAMING_YFOV * aspect).tan() / (0.5 * FRAMING_YFOV).tan()
-            };
-            assert!(
-                (frac - expect).abs() < 1e-4,
-                "aspect {aspect}: {frac} vs {expect}"
-            );
+            let top = cam.project(front + Vec3::Y * (0.5 * m), w, h).unwrap();
+            let bottom = cam.project(front - Vec3::Y * (0.5 * m), w, h).unwrap();
+            let left = cam.project(front - Vec3::X * (0.5 * m), w, h).unwrap();
+            let right = cam.project(front + Vec3::X * (0.5 * m), w, h).unwrap();
+            let frac = ((bottom.y - top.y) / h as f32).max((right.x - left.x) / w as f32);
+            assert!((frac - 1.0).abs() < 1e-4, "aspect {aspect}: fills {frac}");
         }
     }
 
