@@ -147,14 +147,16 @@ pub(in crate::scene) fn load(path: &Path, files: &Files) -> Result<Scene, SceneE
         (serde_json::from_slice(&bytes), None)
     };
     let mut raw: serde_json::Value = raw.map_err(|e| gltf_err(gltf::Error::Deserialize(e)))?;
-    let extension_warnings = extensions::check(path, &raw)?;
+    let mut warnings = super::warnings::Warnings::default();
+    extensions::check(path, &raw, &mut warnings)?;
     let light_units = light_units(path, &raw)?;
-    // The extensions the loader honours have been checked; the gltf crate's validation would
-    // reject the required ones it does not implement itself.
+    // The extensions the loader honours or renders without have been checked; the gltf
+    // crate's validation would reject the required ones it does not implement itself.
     if let Some(serde_json::Value::Array(required)) = raw.get_mut("extensionsRequired") {
         required.retain(|e| {
-            !e.as_str()
-                .is_some_and(|e| extensions::HONOURED.contains(&e))
+            !e.as_str().is_some_and(|e| {
+                extensions::HONOURED.contains(&e) || extensions::RENDERED_WITHOUT.contains(&e)
+            })
         });
     }
     let read = |raw: serde_json::Value| {
@@ -191,10 +193,8 @@ pub(in crate::scene) fn load(path: &Path, files: &Files) -> Result<Scene, SceneE
         default_material: None,
         light_units,
         placements: Vec::new(),
+        warnings,
     };
-    for w in extension_warnings {
-        loader.warn(w);
-    }
     for (i, m) in document.materials().enumerate() {
         let material = loader.material(&m, i, &document)?;
         loader.parts.materials.push(material);
@@ -227,16 +227,15 @@ pub(in crate::scene) fn load(path: &Path, files: &Files) -> Result<Scene, SceneE
                 stack[first_child..].reverse();
             }
         }
-        None => loader
-            .parts
-            .warnings
-            .push(format!("{}: the file has no scene", path.display())),
+        None => loader.warnings.note("the file has no scene".into()),
     }
     loader.place_meshes(&document)?;
     if !loader.parts.mesh.tangents.is_empty() {
         let n = loader.parts.mesh.positions.len();
         loader.parts.mesh.tangents.resize(n, Vec4::ZERO);
     }
+    let lines = loader.warnings.lines(path);
+    loader.parts.warnings.extend(lines);
     Scene::from_parts(loader.parts)
 }
 
@@ -356,10 +355,10 @@ mod tests {
             json!({"KHR_materials_sheen": {"sheenColorFactor": [1, 1, 1]}});
         let scene = Scene::load(&write_embedded(dir.path(), doc, &bin)).unwrap();
         assert!(
-            scene
-                .warnings
-                .iter()
-                .any(|w| w.contains("material \"asphalt\" (0) uses KHR_materials_sheen")),
+            scene.warnings.iter().any(|w| w.contains(
+                "KHR_materials_sheen on 1 material: rendered without sheen \
+                                     (material \"asphalt\" (0))"
+            )),
             "{:?}",
             scene.warnings
         );

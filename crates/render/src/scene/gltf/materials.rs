@@ -313,10 +313,13 @@ impl Loader<'_> {
         let roughness = c.clearcoat_roughness_factor;
         self.unit_factor((NAME, "clearcoatRoughnessFactor"), roughness, element)?;
         if c.clearcoat_normal_texture.is_some() {
-            self.warn(format!(
-                "{element}: {NAME} clearcoatNormalTexture is not used; the clear coat is \
-                 shaded with the base's normal"
-            ));
+            let without = "the clear coat is shaded with the base's normal";
+            self.warn(
+                "KHR_materials_clearcoat clearcoatNormalTexture",
+                "material",
+                element,
+                without,
+            );
         }
         let (info, key) = (c.clearcoat_texture, (NAME, "clearcoatTexture"));
         c.texture = self.extension_texture(document, key, info, element)?;
@@ -380,10 +383,14 @@ impl Loader<'_> {
             return Ok(None);
         }
         if v.thickness_texture.is_some() {
-            self.warn(format!(
-                "{element}: KHR_materials_volume thicknessTexture is not used; the volume's \
-                 thickness is the distance the path travels inside the closed mesh"
-            ));
+            let without =
+                "the volume's thickness is the distance the path travels inside the closed mesh";
+            self.warn(
+                "KHR_materials_volume thicknessTexture",
+                "material",
+                element,
+                without,
+            );
         }
         Ok(Some(Volume::new(
             v.thickness_factor,
@@ -711,7 +718,7 @@ mod tests {
         assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
         assert!(
             scene.warnings[0].contains("material \"glow\" (1)")
-                && scene.warnings[0].contains("clearcoatNormalTexture is not used"),
+                && scene.warnings[0].contains("clearcoatNormalTexture on 1 material"),
             "{:?}",
             scene.warnings
         );
@@ -816,7 +823,7 @@ mod tests {
         assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
         assert!(
             scene.warnings[0].contains("material \"glow\" (1)")
-                && scene.warnings[0].contains("thicknessTexture is not used"),
+                && scene.warnings[0].contains("thicknessTexture on 1 material"),
             "{:?}",
             scene.warnings
         );

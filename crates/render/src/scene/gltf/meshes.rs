@@ -39,7 +39,13 @@ impl Loader<'_> {
                 mode,
                 Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
             ) {
-                self.warn(format!("{element}: skipped {mode:?} primitive"));
+                let what = format!("mode {mode:?}");
+                self.warn(
+                    &what,
+                    "primitive",
+                    &element,
+                    "skipped: only triangles are rendered",
+                );
                 continue;
             }
             let Some(pos_acc) = prim.get(&gltf::Semantic::Positions) else {
@@ -141,10 +147,12 @@ impl Loader<'_> {
             }
             let mut tris = triangulate(mode, &indices);
             if mode == Mode::Triangles && indices.len() % 3 != 0 {
-                self.warn(format!(
-                    "{element}: {} indices is not a multiple of 3; the rest is ignored",
-                    indices.len()
-                ));
+                self.warn(
+                    "a triangle index count that is not a multiple of 3",
+                    "primitive",
+                    &element,
+                    "the indices after the last whole triangle are ignored",
+                );
             }
             let material = match prim.material().index() {
                 Some(i) => i as u32,
@@ -204,10 +212,12 @@ impl Loader<'_> {
                     .texture_refs()
                     .any(|t| t.texcoord == 1)
             {
-                self.warn(format!(
-                    "{element}: its material reads TEXCOORD_1, which the primitive does not \
-                     have; TEXCOORD_0 is read instead"
-                ));
+                self.warn(
+                    "a material reading TEXCOORD_1 the primitive does not have",
+                    "primitive",
+                    &element,
+                    "TEXCOORD_0 is read instead",
+                );
             }
             let first = self.parts.mesh.positions.len();
             if first + positions.len() > u32::MAX as usize {
@@ -273,25 +283,35 @@ impl Loader<'_> {
     ) -> (Vec<Vec4>, Vec<u32>) {
         let (has_tangents, has_uvs) = has;
         if !has_uvs {
-            self.warn(format!(
-                "{element}: its material has a normal texture but the primitive has no \
-                 TEXCOORD_0; rendered without the normal map"
-            ));
+            self.warn(
+                "a normal texture on a primitive without TEXCOORD_0",
+                "primitive",
+                element,
+                "rendered without the normal map",
+            );
             return (vec![Vec4::ZERO; positions.len()], Vec::new());
         }
         if has_tangents {
-            self.warn(format!(
-                "{element}: has TANGENT but no NORMAL; the tangents are ignored and generated \
-                 from flat normals, as the glTF specification says"
-            ));
+            self.warn(
+                "TANGENT without NORMAL",
+                "primitive",
+                element,
+                "the tangents are ignored and generated from flat normals, as the glTF \
+                 specification says",
+            );
         }
         tangents::generate(positions, normals, uvs, tris).unwrap_or_else(|valence| {
-            self.warn(format!(
-                "{element}: a vertex is shared by {valence} triangles, more than MikkTSpace can \
-                 take ({}: it recurses once per triangle around a vertex); rendered without \
-                 the normal map",
+            let what = format!(
+                "a vertex shared by more triangles than MikkTSpace can take ({}: it recurses \
+                 once per triangle around a vertex; here {valence})",
                 tangents::MAX_VALENCE
-            ));
+            );
+            self.warn(
+                &what,
+                "primitive",
+                element,
+                "rendered without the normal map",
+            );
             (vec![Vec4::ZERO; positions.len()], Vec::new())
         })
     }
@@ -337,7 +357,7 @@ mod tests {
             "{:?}",
             scene.warnings
         );
-        assert!(scene.warnings[0].contains("Points"));
+        assert!(scene.warnings[0].contains("mode Points on 1 primitive: skipped"));
     }
 
     #[test]
@@ -430,7 +450,7 @@ mod tests {
             scene
                 .warnings
                 .iter()
-                .any(|w| w.contains("TANGENT but no NORMAL")),
+                .any(|w| w.contains("TANGENT without NORMAL")),
             "{:?}",
             scene.warnings
         );
@@ -443,7 +463,10 @@ mod tests {
         attributes.as_object_mut().unwrap().remove("TANGENT");
         let scene = load_doc(doc, &bin);
         assert!(
-            scene.warnings.iter().any(|w| w.contains("no TEXCOORD_0")),
+            scene
+                .warnings
+                .iter()
+                .any(|w| w.contains("without TEXCOORD_0")),
             "{:?}",
             scene.warnings
         );

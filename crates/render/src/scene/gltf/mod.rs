@@ -32,6 +32,7 @@
 //! - `textures`: texture infos, KHR_texture_transform, samplers, images;
 //! - [`extensions`]: which extensions are honoured, and the ones that are not a material's
 //!   field: KHR_lights_punctual (and the file's light units), EXT_mesh_gpu_instancing;
+//! - `warnings`: the warnings, gathered by feature so that each is named once per file;
 //! - `test_docs` (tests only): the documents the tests build, write and load;
 //! - this file: the [`Loader`] state the others add to, and the labels errors name elements by.
 
@@ -46,6 +47,7 @@ mod nodes;
 #[cfg(test)]
 mod test_docs;
 mod textures;
+mod warnings;
 
 pub(super) use document::load;
 pub use nodes::{MAX_PLACEMENTS, MAX_TRIANGLES};
@@ -57,6 +59,7 @@ use extensions::LightUnits;
 use glam::Mat4;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use warnings::Warnings;
 
 fn node_label(node: &gltf::Node) -> String {
     match node.name() {
@@ -96,6 +99,8 @@ struct Loader<'a> {
     light_units: LightUnits,
     /// Every placement of a mesh in the walk's order: mesh index and world transform.
     placements: Vec<(usize, Mat4)>,
+    /// What the file uses that is skipped or rendered differently, by feature.
+    warnings: Warnings,
 }
 
 impl Loader<'_> {
@@ -103,9 +108,9 @@ impl Loader<'_> {
         SceneError::invalid(self.path, element, reason)
     }
 
-    fn warn(&mut self, msg: String) {
-        self.parts
-            .warnings
-            .push(format!("{}: {msg}", self.path.display()));
+    /// Records that `element`, of kind `kind` (`material`, `primitive`), uses `what`, which is
+    /// rendered `without`; see [`Warnings::add`].
+    fn warn(&mut self, what: &str, kind: &'static str, element: &str, without: &str) {
+        self.warnings.add(what, kind, element, without);
     }
 }

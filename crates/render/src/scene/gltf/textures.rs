@@ -179,10 +179,9 @@ impl Loader<'_> {
         let texcoord = match set {
             0 | 1 => set as u8,
             _ => {
-                self.warn(format!(
-                    "{element} uses TEXCOORD_{set}; only TEXCOORD_0 and TEXCOORD_1 are read, \
-                     TEXCOORD_0 is used instead"
-                ));
+                let what = format!("TEXCOORD_{set}");
+                let without = "only TEXCOORD_0 and TEXCOORD_1 are read; TEXCOORD_0 is used";
+                self.warn(&what, "texture", &element, without);
                 0
             }
         };
