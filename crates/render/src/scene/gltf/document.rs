@@ -149,6 +149,7 @@ pub(in crate::scene) fn load(path: &Path, files: &Files) -> Result<Scene, SceneE
     let mut raw: serde_json::Value = raw.map_err(|e| gltf_err(gltf::Error::Deserialize(e)))?;
     let mut warnings = super::warnings::Warnings::default();
     extensions::check(path, &raw, &mut warnings)?;
+    super::textures::basisu_sources(&mut raw);
     let light_units = light_units(path, &raw)?;
     // The extensions the loader honours or renders without have been checked; the gltf
     // crate's validation would reject the required ones it does not implement itself.

@@ -48,7 +48,11 @@ fn without(extension: &str) -> &'static str {
         "KHR_materials_pbrSpecularGlossiness" => {
             "its specular-glossiness parameters are ignored (metallic-roughness defaults)"
         }
-        "KHR_texture_basisu" | "EXT_texture_webp" | "EXT_texture_avif" | "MSFT_texture_dds" => {
+        "KHR_texture_basisu" => {
+            "the KTX2 images are not decoded: each texture's fallback image (its core source) \
+             is read, and a texture without one is left out"
+        }
+        "EXT_texture_webp" | "EXT_texture_avif" | "MSFT_texture_dds" => {
             "its textures in that format are not decoded"
         }
         "KHR_materials_variants" => "rendered with its default material",

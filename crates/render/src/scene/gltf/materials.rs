@@ -139,15 +139,15 @@ impl Loader<'_> {
         validate::material(m).map_err(|r| self.bad(&element, r))?;
         let pbr = m.pbr_metallic_roughness();
         let base_color_texture = match pbr.base_color_texture() {
-            Some(info) => Some(self.texture(&info, ColorSpace::Srgb, &element)?),
+            Some(info) => self.texture(&info, ColorSpace::Srgb, &element)?,
             None => None,
         };
         let mr_texture = match pbr.metallic_roughness_texture() {
-            Some(info) => Some(self.texture(&info, ColorSpace::Linear, &element)?),
+            Some(info) => self.texture(&info, ColorSpace::Linear, &element)?,
             None => None,
         };
         let emission_texture = match m.emissive_texture() {
-            Some(info) => Some(self.texture(&info, ColorSpace::Srgb, &element)?),
+            Some(info) => self.texture(&info, ColorSpace::Srgb, &element)?,
             None => None,
         };
         let normal_map = match m.normal_texture() {
@@ -158,23 +158,19 @@ impl Loader<'_> {
                         self.bad(element, format!("normalTexture.scale {scale} is invalid"))
                     );
                 }
-                Some(NormalMap {
-                    texture: {
-                        let transform = info
-                            .extension_value("KHR_texture_transform")
-                            .map(UvTransform::from_json)
-                            .transpose()
-                            .map_err(|e| self.bad(format!("{element}, normalTexture"), e))?;
-                        self.texture_of(
-                            &info.texture(),
-                            info.tex_coord(),
-                            transform,
-                            ColorSpace::Linear,
-                            &element,
-                        )?
-                    },
-                    scale,
-                })
+                let transform = info
+                    .extension_value("KHR_texture_transform")
+                    .map(UvTransform::from_json)
+                    .transpose()
+                    .map_err(|e| self.bad(format!("{element}, normalTexture"), e))?;
+                let texture = self.texture_of(
+                    &info.texture(),
+                    info.tex_coord(),
+                    transform,
+                    ColorSpace::Linear,
+                    &element,
+                )?;
+                texture.map(|texture| NormalMap { texture, scale })
             }
             None => None,
         };
@@ -280,11 +276,11 @@ impl Loader<'_> {
             ));
         }
         let texture = match sp.specular_texture() {
-            Some(info) => Some(self.texture(&info, ColorSpace::Linear, element)?),
+            Some(info) => self.texture(&info, ColorSpace::Linear, element)?,
             None => None,
         };
         let color_texture = match sp.specular_color_texture() {
-            Some(info) => Some(self.texture(&info, ColorSpace::Srgb, element)?),
+            Some(info) => self.texture(&info, ColorSpace::Srgb, element)?,
             None => None,
         };
         Ok(Specular {
@@ -450,8 +446,7 @@ impl Loader<'_> {
             return Err(self.bad(element, why));
         };
         let space = ColorSpace::Linear;
-        let id = self.texture_of(&texture, info.tex_coord, info.transform, space, element)?;
-        Ok(Some(id))
+        self.texture_of(&texture, info.tex_coord, info.transform, space, element)
     }
 
     pub(super) fn streaks_extras(

@@ -91,8 +91,9 @@ struct Loader<'a> {
     files: &'a Files<'a>,
     buffers: Vec<gltf::buffer::Data>,
     parts: SceneParts,
-    /// Decoded textures by (image index, colour space).
-    textures: HashMap<(usize, ColorSpace), TextureId>,
+    /// Decoded textures by (image index, colour space); `None` for an image that is not
+    /// decoded (KTX2).
+    textures: HashMap<(usize, ColorSpace), Option<TextureId>>,
     /// Index of the glTF default material, once a primitive needs it.
     default_material: Option<u32>,
     /// What KHR_lights_punctual's intensities are in.
