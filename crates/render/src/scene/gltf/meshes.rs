@@ -29,7 +29,14 @@ pub(super) fn triangulate(mode: Mode, idx: &[u32]) -> Vec<[u32; 3]> {
 }
 
 impl Loader<'_> {
-    pub(super) fn mesh(&mut self, mesh: &gltf::Mesh, world: Mat4) -> Result<(), SceneError> {
+    /// Adds `mesh` placed by `world` to the scene's world triangles, in the pose of the morph
+    /// `weights` (weight i scales target i's deltas; missing weights are 0).
+    pub(super) fn mesh(
+        &mut self,
+        mesh: &gltf::Mesh,
+        world: Mat4,
+        weights: &[f32],
+    ) -> Result<(), SceneError> {
         let normal_matrix = Mat3::from_mat4(world).inverse().transpose();
         let flip = world.determinant() < 0.0;
         for prim in mesh.primitives() {
@@ -62,24 +69,25 @@ impl Loader<'_> {
                     ],
                 )?;
             }
-            let positions: Vec<Vec3> = self
+            let mut positions: Vec<Vec3> = self
                 .attribute(&pos_acc, &element, "POSITION", accessors::POSITION, None)?
                 .into_iter()
                 .map(Vec3::from)
                 .collect();
             let n = positions.len();
-            let normals: Vec<Vec3> = match prim.get(&gltf::Semantic::Normals) {
+            let mut normals: Vec<Vec3> = match prim.get(&gltf::Semantic::Normals) {
                 Some(a) => self
                     .attribute(&a, &element, "NORMAL", accessors::DIRECTION, Some(n))?
                     .into_iter()
-                    .map(|v: [f32; 3]| {
-                        (normal_matrix * Vec3::from(v))
-                            .try_normalize()
-                            .unwrap_or(Vec3::ZERO)
-                    })
+                    .map(Vec3::from)
                     .collect(),
                 None => vec![Vec3::ZERO; n],
             };
+            let tangent_deltas =
+                self.morph(&prim, &element, weights, &mut positions, &mut normals)?;
+            for v in &mut normals {
+                *v = (normal_matrix * *v).try_normalize().unwrap_or(Vec3::ZERO);
+            }
             let uvs: Vec<Vec2> = match prim.get(&gltf::Semantic::TexCoords(0)) {
                 Some(a) => self
                     .attribute(&a, &element, "TEXCOORD_0", accessors::TEXCOORD, Some(n))?
@@ -99,7 +107,13 @@ impl Loader<'_> {
                 .filter(|_| normal_mapped);
             let file_tangents: Option<Vec<[f32; 4]>> = match &tangent_acc {
                 Some(a) if has_normals => {
-                    Some(self.attribute(a, &element, "TANGENT", accessors::DIRECTION, Some(n))?)
+                    let mut t: Vec<[f32; 4]> =
+                        self.attribute(a, &element, "TANGENT", accessors::DIRECTION, Some(n))?;
+                    for (t, d) in t.iter_mut().zip(tangent_deltas.iter().flatten()) {
+                        let moved = Vec3::new(t[0], t[1], t[2]) + *d;
+                        (t[0], t[1], t[2]) = (moved.x, moved.y, moved.z);
+                    }
+                    Some(t)
                 }
                 _ => None,
             };
@@ -266,6 +280,59 @@ impl Loader<'_> {
         Ok(())
     }
 
+    /// Moves a primitive's object-space `positions` and `normals` to the pose of the morph
+    /// `weights`: each target i adds weight i times its POSITION and NORMAL deltas (glTF 2.0,
+    /// "Morph Targets"; normals are renormalised later). Returns the sum of the weighted
+    /// TANGENT deltas, for the file's tangents, where a target has them. A target without a
+    /// weight, or with weight 0, is not read; a non-finite weight is an error.
+    fn morph(
+        &self,
+        prim: &gltf::Primitive,
+        element: &str,
+        weights: &[f32],
+        positions: &mut [Vec3],
+        normals: &mut [Vec3],
+    ) -> Result<Option<Vec<Vec3>>, SceneError> {
+        let n = positions.len();
+        let mut tangents: Option<Vec<Vec3>> = None;
+        for (i, target) in prim.morph_targets().enumerate() {
+            let w = weights.get(i).copied().unwrap_or(0.0);
+            if !w.is_finite() {
+                let why = format!("morph target {i}'s weight {w} is not finite");
+                return Err(self.bad(element, why));
+            }
+            if w == 0.0 {
+                continue;
+            }
+            let add = |out: &mut [Vec3], deltas: Vec<[f32; 3]>| {
+                for (v, d) in out.iter_mut().zip(deltas) {
+                    *v += w * Vec3::from(d);
+                }
+            };
+            let name = |attribute: &str| format!("morph target {i} {attribute}");
+            if let Some(a) = target.positions() {
+                let name = name("POSITION");
+                add(
+                    positions,
+                    self.attribute(&a, element, &name, accessors::POSITION, Some(n))?,
+                );
+            }
+            if let Some(a) = target.normals() {
+                let name = name("NORMAL");
+                add(
+                    normals,
+                    self.attribute(&a, element, &name, accessors::DIRECTION, Some(n))?,
+                );
+            }
+            if let Some(a) = target.tangents() {
+                let name = name("TANGENT");
+                let deltas = self.attribute(&a, element, &name, accessors::DIRECTION, Some(n))?;
+                add(tangents.get_or_insert_with(|| vec![Vec3::ZERO; n]), deltas);
+            }
+        }
+        Ok(tangents)
+    }
+
     /// The generated tangents of a normal-mapped primitive without usable TANGENT (see
     /// [`tangents`]): MikkTSpace's from the world-space `positions`, `normals` (zero: the face
     /// normal) and `uvs`, which may renumber `tris` to duplicated vertices (the second value
@@ -327,9 +394,76 @@ mod tests {
 
     use crate::scene::Scene;
     use glam::Vec3;
-    use serde_json::json;
+    use serde_json::{json, Value};
 
     use std::time::{Duration, Instant};
+
+    /// Appends `values` to the buffer as a float VEC3 accessor; returns its index.
+    fn add_vec3s(doc: &mut Value, bin: &mut Vec<u8>, values: &[f32]) -> usize {
+        let offset = bin.len();
+        bin.extend(values.iter().flat_map(|f| f.to_le_bytes()));
+        let views = doc["bufferViews"].as_array_mut().unwrap();
+        views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": values.len() * 4}));
+        let view = views.len() - 1;
+        let accessors = doc["accessors"].as_array_mut().unwrap();
+        accessors.push(json!({"bufferView": view, "componentType": 5126,
+            "count": values.len() / 3, "type": "VEC3"}));
+        let index = accessors.len() - 1;
+        doc["buffers"][0]["byteLength"] = json!(bin.len());
+        index
+    }
+
+    /// Morph targets in the specification's default pose: each vertex moves by the sum of
+    /// the weights times the targets' deltas, the weights being the node's, else the mesh's;
+    /// two nodes placing one morphed mesh each get their own pose.
+    #[test]
+    fn morph_targets_take_the_default_weights() {
+        let (mut doc, mut bin) = test_doc();
+        // The lamp's triangle (0,0,0), (1,0,0), (0,1,0) at z = -3: target 0 lifts every vertex
+        // by +Z, target 1 moves vertex 0 by +X and has NORMAL deltas.
+        let up = add_vec3s(&mut doc, &mut bin, &[0., 0., 1.].repeat(3));
+        let side = add_vec3s(&mut doc, &mut bin, &[1., 0., 0., 0., 0., 0., 0., 0., 0.]);
+        let nrm = add_vec3s(&mut doc, &mut bin, &[0.; 9]);
+        doc["meshes"][1]["primitives"][0]["targets"] =
+            json!([{"POSITION": up}, {"POSITION": side, "NORMAL": nrm}]);
+        doc["meshes"][1]["weights"] = json!([0.5, 0.25]);
+        // A second placement of the same mesh whose node has its own weights.
+        doc["nodes"].as_array_mut().unwrap().push(
+            json!({"name": "lamp2", "mesh": 1, "translation": [0, 0, -10], "weights": [1, 0]}),
+        );
+        doc["scenes"][0]["nodes"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!(7));
+        let scene = load_doc(doc.clone(), &bin);
+        assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+        // The quad's 4 vertices first, then the lamp's 3, then lamp2's 3.
+        let p = &scene.mesh.positions;
+        assert_eq!(p.len(), 10);
+        let expected = [
+            Vec3::new(0.25, 0.0, -2.5),
+            Vec3::new(1.0, 0.0, -2.5),
+            Vec3::new(0.0, 1.0, -2.5),
+            Vec3::new(0.0, 0.0, -9.0),
+            Vec3::new(1.0, 0.0, -9.0),
+            Vec3::new(0.0, 1.0, -9.0),
+        ];
+        for (got, want) in p[4..].iter().zip(expected) {
+            assert!((*got - want).length() < 1e-6, "{got} != {want}");
+        }
+        // No weights anywhere: the base shape.
+        let mut rest = doc.clone();
+        rest["meshes"][1].as_object_mut().unwrap().remove("weights");
+        let scene = load_doc(rest, &bin);
+        assert!((scene.mesh.positions[4] - Vec3::new(0.0, 0.0, -3.0)).length() < 1e-6);
+        // A weight beyond f32's range is an error naming the primitive.
+        doc["meshes"][1]["weights"] = json!([1e39, 0]);
+        let err = load_err(doc, &bin);
+        assert!(
+            err.contains("mesh \"tri\" (1), primitive 0") && err.contains("weight"),
+            "{err}"
+        );
+    }
 
     #[test]
     fn index_out_of_range_is_an_error() {

@@ -98,8 +98,9 @@ struct Loader<'a> {
     default_material: Option<u32>,
     /// What KHR_lights_punctual's intensities are in.
     light_units: LightUnits,
-    /// Every placement of a mesh in the walk's order: mesh index and world transform.
-    placements: Vec<(usize, Mat4)>,
+    /// Every placement of a mesh in the walk's order: mesh index, world transform and the
+    /// index of the node that places it (whose morph weights apply).
+    placements: Vec<(usize, Mat4, usize)>,
     /// What the file uses that is skipped or rendered differently, by feature.
     warnings: Warnings,
 }

@@ -160,14 +160,14 @@ impl Loader<'_> {
                                 format!("world transform is not invertible or not finite: {w:?}"),
                             ));
                         }
-                        self.placements.push((mesh.index(), w));
+                        self.placements.push((mesh.index(), w, node.index()));
                     }
                 }
                 None => {
                     if self.placements.len() >= MAX_PLACEMENTS {
                         return Err(too_many_placements(self.path, node));
                     }
-                    self.placements.push((mesh.index(), world));
+                    self.placements.push((mesh.index(), world, node.index()));
                 }
             }
         }
@@ -180,22 +180,27 @@ impl Loader<'_> {
         Ok(world)
     }
 
-    /// Turns the recorded placements into geometry: a mesh placed more than once and without
-    /// an emissive material is loaded once in object space and placed by instances, every
-    /// other placement is flattened into world triangles (see the module documentation).
+    /// Turns the recorded placements into geometry: a mesh placed more than once, without an
+    /// emissive material and without morph targets is loaded once in object space and placed
+    /// by instances, every other placement is flattened into world triangles (see the module
+    /// documentation); a mesh with morph targets takes the weights of the node that places it,
+    /// else its own (the specification's default pose).
     pub(super) fn place_meshes(&mut self, document: &gltf::Document) -> Result<(), SceneError> {
         let meshes: Vec<gltf::Mesh> = document.meshes().collect();
         let mut count = vec![0usize; meshes.len()];
-        for &(m, _) in &self.placements {
+        for &(m, _, _) in &self.placements {
             count[m] += 1;
         }
+        // Meshes flattened at every placement: emissive ones (emitters are world triangles) and
+        // morphed ones (each placement may have its own weights).
         let emissive: Vec<bool> = meshes
             .iter()
             .map(|mesh| {
                 mesh.primitives().any(|p| {
-                    p.material()
-                        .index()
-                        .is_some_and(|i| self.parts.materials[i].is_emissive())
+                    p.morph_targets().len() > 0
+                        || p.material()
+                            .index()
+                            .is_some_and(|i| self.parts.materials[i].is_emissive())
                 })
             })
             .collect();
@@ -221,10 +226,12 @@ impl Loader<'_> {
             }
         }
         let mut instanced: Vec<Option<u32>> = vec![None; meshes.len()];
-        for (m, world) in std::mem::take(&mut self.placements) {
+        for (m, world, node) in std::mem::take(&mut self.placements) {
             let mesh = &meshes[m];
             if count[m] < 2 || emissive[m] {
-                self.mesh(mesh, world)?;
+                let node_weights = document.nodes().nth(node).and_then(|n| n.weights());
+                let weights = node_weights.or(mesh.weights()).unwrap_or_default();
+                self.mesh(mesh, world, weights)?;
                 continue;
             }
             let index = match instanced[m] {
@@ -249,7 +256,8 @@ impl Loader<'_> {
     /// transform, into its own arrays.
     pub(super) fn object_mesh(&mut self, mesh: &gltf::Mesh) -> Result<TriangleMesh, SceneError> {
         let world = std::mem::take(&mut self.parts.mesh);
-        let loaded = self.mesh(mesh, Mat4::IDENTITY);
+        // Meshes with morph targets are never instanced: no weights here.
+        let loaded = self.mesh(mesh, Mat4::IDENTITY, &[]);
         let mut object = std::mem::replace(&mut self.parts.mesh, world);
         loaded?;
         if !object.tangents.is_empty() {
