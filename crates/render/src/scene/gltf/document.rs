@@ -196,6 +196,14 @@ pub(in crate::scene) fn load(path: &Path, files: &Files) -> Result<Scene, SceneE
         placements: Vec::new(),
         warnings,
     };
+    for animation in document.animations() {
+        let label = match animation.name() {
+            Some(n) => format!("animation {n:?} ({})", animation.index()),
+            None => format!("animation {}", animation.index()),
+        };
+        let without = "not played: the nodes' rest pose is rendered";
+        loader.warn("animations", "animation", &label, without);
+    }
     for (i, m) in document.materials().enumerate() {
         let material = loader.material(&m, i, &document)?;
         loader.parts.materials.push(material);
@@ -372,6 +380,69 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.contains("road.glb"), "{err}");
+    }
+
+    /// What the loader leaves out without a word otherwise: an occlusion texture, animations
+    /// and skins are each named once for the file, with the elements counted.
+    #[test]
+    fn occlusion_animations_and_skins_warn_once() {
+        let (mut doc, mut bin) = test_doc();
+        doc["images"] = json!([{"uri": super::super::test_docs::png_uri([255, 255, 255])}]);
+        doc["textures"] = json!([{"source": 0}]);
+        let mut glow2 = doc["materials"][1].clone();
+        glow2["name"] = json!("glow2");
+        doc["materials"].as_array_mut().unwrap().push(glow2);
+        for m in [1, 2] {
+            doc["materials"][m]["occlusionTexture"] = json!({"index": 0, "strength": 0.5});
+        }
+        // Two animations of the lamp's translation (keyframe times 0 and 1).
+        let offset = bin.len();
+        let values = [0f32, 1., 0., 0., 0., 1., 0., 0.];
+        bin.extend(values.iter().flat_map(|f| f.to_le_bytes()));
+        doc["buffers"][0]["byteLength"] = json!(bin.len());
+        let views = doc["bufferViews"].as_array_mut().unwrap();
+        views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": 8}));
+        views.push(json!({"buffer": 0, "byteOffset": offset + 8, "byteLength": 24}));
+        let v = views.len();
+        let accessors = doc["accessors"].as_array_mut().unwrap();
+        accessors.push(
+            json!({"bufferView": v - 2, "componentType": 5126, "count": 2,
+            "type": "SCALAR", "min": [0], "max": [1]}),
+        );
+        accessors.push(
+            json!({"bufferView": v - 1, "componentType": 5126, "count": 2,
+            "type": "VEC3"}),
+        );
+        let a = accessors.len();
+        let animation = json!({"channels": [{"sampler": 0, "target": {"node": 2, "path": "translation"}}],
+            "samplers": [{"input": a - 2, "output": a - 1}]});
+        let mut named = animation.clone();
+        named["name"] = json!("sway");
+        doc["animations"] = json!([animation, named]);
+        doc["skins"] = json!([{"joints": [2]}]);
+        doc["nodes"][2]["skin"] = json!(0);
+        let dir = tempfile::tempdir().unwrap();
+        let scene = Scene::load(&write_embedded(dir.path(), doc, &bin)).unwrap();
+        let w = &scene.warnings;
+        assert_eq!(w.len(), 3, "{w:?}");
+        assert!(
+            w[0].ends_with(
+                "animations on 2 animations: not played: the nodes' rest pose is rendered \
+                 (animation 0; animation \"sway\" (1))"
+            ),
+            "{w:?}"
+        );
+        assert!(
+            w[1].ends_with(
+                "occlusionTexture on 2 materials: ignored: the path tracer computes occlusion \
+                 itself (material \"glow\" (1); material \"glow2\" (2))"
+            ),
+            "{w:?}"
+        );
+        assert!(
+            w[2].contains("skins on 1 node") && w[2].contains("(node \"lamp\" (2))"),
+            "{w:?}"
+        );
     }
 
     #[test]

@@ -174,6 +174,10 @@ impl Loader<'_> {
             }
             None => None,
         };
+        if m.occlusion_texture().is_some() {
+            let without = "ignored: the path tracer computes occlusion itself";
+            self.warn("occlusionTexture", "material", &element, without);
+        }
         let emission = Vec3::from(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0);
         if !emission.is_finite() || emission.min_element() < 0.0 {
             return Err(self.bad(element, format!("emission {emission} is invalid")));

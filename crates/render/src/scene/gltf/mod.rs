@@ -9,11 +9,13 @@
 //!
 //! Instancing: the scene's nodes are walked first and every placement of a mesh recorded (a
 //! node with a mesh, or each instance of a node's EXT_mesh_gpu_instancing, whose TRANSLATION,
-//! ROTATION and SCALE attributes give `node world * T * R * S`). A mesh placed more than once
-//! and without an emissive material is loaded once in object space (its MikkTSpace tangents,
+//! ROTATION and SCALE attributes give `node world * T * R * S`). A mesh placed more than once,
+//! without an emissive material and without morph targets is loaded once in object space (its
+//! MikkTSpace tangents,
 //! if generated, from the object-space positions) and becomes instances
 //! ([`super::Instances`]); every other placement is flattened into world triangles, in the
-//! order of the walk.
+//! order of the walk. Morph targets are applied with the default weights (the placing node's
+//! `weights`, else the mesh's), as the specification's default pose.
 //!
 //! One file per concept:
 //!

@@ -15,8 +15,8 @@ use std::path::Path;
 pub const MAX_PLACEMENTS: usize = 1_000_000;
 
 /// The most triangles a scene may hold once its meshes are placed: the flattened placements'
-/// (every placement of a mesh placed once, or with an emissive material) and the instanced
-/// meshes' (stored once); counted from the accessors before any geometry is read. About
+/// (every placement of a mesh placed once, or with an emissive material or morph targets) and
+/// the instanced meshes' (stored once); counted from the accessors before any geometry is read. About
 /// 8 GB of scene and BVH; an emissive mesh placed many times would otherwise multiply it.
 pub const MAX_TRIANGLES: usize = 20_000_000;
 
@@ -143,6 +143,10 @@ impl Loader<'_> {
             ));
         }
         if let Some(mesh) = node.mesh() {
+            if node.skin().is_some() {
+                let without = "not applied: the mesh is rendered as stored, placed by its node";
+                self.warn("skins", "node", &node_label(node), without);
+            }
             match node.extension_value("EXT_mesh_gpu_instancing") {
                 Some(ext) => {
                     let locals = self.gpu_instances(node, ext, document)?;
@@ -193,7 +197,7 @@ impl Loader<'_> {
         }
         // Meshes flattened at every placement: emissive ones (emitters are world triangles) and
         // morphed ones (each placement may have its own weights).
-        let emissive: Vec<bool> = meshes
+        let flattened: Vec<bool> = meshes
             .iter()
             .map(|mesh| {
                 mesh.primitives().any(|p| {
@@ -207,7 +211,7 @@ impl Loader<'_> {
         // Triangles stored: a flattened mesh's at each placement, an instanced one's once.
         let mut stored = 0usize;
         for (m, mesh) in meshes.iter().enumerate() {
-            let copies = match (count[m], emissive[m]) {
+            let copies = match (count[m], flattened[m]) {
                 (0, _) => 0,
                 (n, true) | (n @ 1, false) => n,
                 (_, false) => 1,
@@ -228,7 +232,7 @@ impl Loader<'_> {
         let mut instanced: Vec<Option<u32>> = vec![None; meshes.len()];
         for (m, world, node) in std::mem::take(&mut self.placements) {
             let mesh = &meshes[m];
-            if count[m] < 2 || emissive[m] {
+            if count[m] < 2 || flattened[m] {
                 let node_weights = document.nodes().nth(node).and_then(|n| n.weights());
                 let weights = node_weights.or(mesh.weights()).unwrap_or_default();
                 self.mesh(mesh, world, weights)?;
