@@ -522,6 +522,11 @@ impl<'a> MaterialWriter<'a> {
                 let refl = self.colour(m, &stem, "reflectance", *kd, *kd_texture)?;
                 let _ = write!(out, "<bsdf type=\"diffuse\">{refl}</bsdf>");
             }
+            // Black: an unlit surface is seen by its emission, exported as an area emitter.
+            Reflectance::Unlit => {
+                let black = rgb("reflectance", Vec3::ZERO);
+                let _ = write!(out, "<bsdf type=\"diffuse\">{black}</bsdf>");
+            }
             Reflectance::Paper {
                 model,
                 kd,

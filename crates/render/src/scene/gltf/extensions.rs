@@ -35,6 +35,7 @@ pub const HONOURED: &[&str] = &[
     "KHR_materials_transmission",
     "KHR_materials_volume",
     "EXT_mesh_gpu_instancing",
+    "KHR_materials_unlit",
 ];
 
 /// How an element that uses `extension` is rendered when the extension is not honoured.
@@ -44,7 +45,6 @@ fn without(extension: &str) -> &'static str {
         "KHR_materials_iridescence" => "rendered without iridescence",
         "KHR_materials_anisotropy" => "rendered as an isotropic surface",
         "KHR_materials_dispersion" => "rendered without dispersion",
-        "KHR_materials_unlit" => "shaded as a lit surface, not as unlit",
         "KHR_materials_pbrSpecularGlossiness" => {
             "its specular-glossiness parameters are ignored (metallic-roughness defaults)"
         }
@@ -158,7 +158,6 @@ pub const RENDERED_WITHOUT: &[&str] = &[
     "KHR_materials_iridescence",
     "KHR_materials_anisotropy",
     "KHR_materials_dispersion",
-    "KHR_materials_unlit",
     "KHR_materials_diffuse_transmission",
     "KHR_materials_pbrSpecularGlossiness",
     "KHR_materials_variants",
@@ -422,7 +421,7 @@ mod tests {
     #[test]
     fn required_shading_extensions_are_warnings() {
         let doc = json!({
-            "extensionsUsed": ["KHR_materials_unlit"],
+            "extensionsUsed": ["KHR_materials_dispersion"],
             "extensionsRequired": ["KHR_materials_iridescence"],
             "materials": [
                 {"extensions": {"KHR_materials_iridescence": {}}},
@@ -431,7 +430,7 @@ mod tests {
         });
         let w = lines("s.gltf", &doc).unwrap();
         assert_eq!(w.len(), 2, "{w:?}");
-        assert!(w[0].contains("KHR_materials_unlit is listed"), "{w:?}");
+        assert!(w[0].contains("KHR_materials_dispersion is listed"), "{w:?}");
         assert!(
             w[1].starts_with(
                 "s.gltf: KHR_materials_iridescence (required by the file, which is loaded \

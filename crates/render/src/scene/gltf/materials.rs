@@ -204,6 +204,19 @@ impl Loader<'_> {
         };
         let extras = self.streaks_extras(m, &element)?;
         let road = extras.as_ref().is_some_and(|x| x.road);
+        if m.extension_value("KHR_materials_unlit").is_some() {
+            // Seen as its base colour: an emitter of that radiance that reflects nothing.
+            return Ok(Material {
+                name,
+                reflectance: Reflectance::Unlit,
+                emission: base.truncate(),
+                emission_texture: base_color_texture,
+                normal_map: None,
+                double_sided: m.double_sided(),
+                alpha,
+                road,
+            });
+        }
         let reflectance = match extras.filter(|x| x.bsdf.is_some()) {
             Some(x) => self.paper(x, base_color_texture, mr_texture, &element)?,
             None => {
@@ -572,6 +585,64 @@ mod tests {
     use crate::scene::Scene;
     use glam::{Vec2, Vec3};
     use serde_json::json;
+
+    /// KHR_materials_unlit (required by the file): the camera sees the base colour times the
+    /// vertex colour, exactly, whatever the lights; the surface reflects nothing.
+    #[test]
+    fn unlit_pixels_are_the_base_colour() {
+        use super::super::test_docs::Doc;
+        use crate::integrator::{render, Layers, RenderJob};
+        use streaks_settings::RenderSettings;
+        let mut d = Doc::default();
+        // A quad of side 4 in z = 0 facing +Z, COLOR_0 grey 0.5; the camera 1 m in front.
+        let pos = d.floats(
+            &[-2., -2., 0., 2., -2., 0., 2., 2., 0., -2., 2., 0.],
+            "VEC3",
+            3,
+        );
+        let col = d.floats(&[0.5, 0.5, 0.5].repeat(4), "VEC3", 3);
+        let idx = d.indices(&[0, 1, 2, 0, 2, 3]);
+        let base = [1.0, 0.217_637_64, 0.0];
+        let doc = json!({
+            "asset": {"version": "2.0"},
+            "extensionsUsed": ["KHR_materials_unlit", "KHR_lights_punctual"],
+            "extensionsRequired": ["KHR_materials_unlit"],
+            "scenes": [{"nodes": [0, 1, 2]}],
+            "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, 1]},
+                {"translation": [0, 0, 0.5], "extensions": {"KHR_lights_punctual": {"light": 0}}}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": pos, "COLOR_0": col},
+                "indices": idx, "material": 0}]}],
+            "materials": [{"name": "orange", "emissiveFactor": [1, 1, 1],
+                "pbrMetallicRoughness": {"baseColorFactor": [base[0], base[1], base[2], 1]},
+                "extensions": {"KHR_materials_unlit": {}}}],
+            "cameras": [{"type": "perspective", "perspective": {"yfov": 0.5, "znear": 0.1}}],
+            "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 1e5}]}},
+            "buffers": [{"byteLength": d.bin.len()}],
+            "bufferViews": d.views,
+            "accessors": d.accessors
+        });
+        let dir = tempfile::tempdir().unwrap();
+        let scene = Scene::load(&write_embedded(dir.path(), doc, &d.bin)).unwrap();
+        assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+        assert_eq!(scene.materials[0].reflectance, Reflectance::Unlit);
+        let expected = Vec3::from(base) * 0.5;
+        for max_depth in [1, 8] {
+            let job = RenderJob {
+                width: 6,
+                height: 4,
+                seed: 1,
+                layers: Layers::default(),
+                settings: RenderSettings::new(4, max_depth),
+            };
+            let out = render(&scene, scene.camera(None).unwrap(), &job, &|_| {});
+            for p in &out.image.pixels {
+                assert!(
+                    (*p - expected).abs().max_element() < 1e-5,
+                    "{p} vs {expected}"
+                );
+            }
+        }
+    }
 
     #[test]
     fn road_materials_are_flagged_with_or_without_a_paper_model() {
