@@ -28,14 +28,23 @@ pub(super) fn triangulate(mode: Mode, idx: &[u32]) -> Vec<[u32; 3]> {
     }
 }
 
+/// The pose a mesh is placed in: the morph weights (weight i scales target i's deltas;
+/// missing weights are 0) and, for a skinned placement, the skin's joint matrices (each
+/// joint's world transform times its inverse bind matrix; empty: unskinned).
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Pose<'a> {
+    pub(super) weights: &'a [f32],
+    pub(super) joints: &'a [Mat4],
+}
+
 impl Loader<'_> {
-    /// Adds `mesh` placed by `world` to the scene's world triangles, in the pose of the morph
-    /// `weights` (weight i scales target i's deltas; missing weights are 0).
+    /// Adds `mesh` placed by `world` to the scene's world triangles, in `pose`: its morph
+    /// weights first, then its skin.
     pub(super) fn mesh(
         &mut self,
         mesh: &gltf::Mesh,
         world: Mat4,
-        weights: &[f32],
+        pose: Pose,
     ) -> Result<(), SceneError> {
         let normal_matrix = Mat3::from_mat4(world).inverse().transpose();
         let flip = world.determinant() < 0.0;
@@ -84,7 +93,14 @@ impl Loader<'_> {
                 None => vec![Vec3::ZERO; n],
             };
             let tangent_deltas =
-                self.morph(&prim, &element, weights, &mut positions, &mut normals)?;
+                self.morph(&prim, &element, pose.weights, &mut positions, &mut normals)?;
+            let skin = self.skin(&prim, &element, pose.joints, n)?;
+            if let Some(skin) = &skin {
+                for ((p, v), m) in positions.iter_mut().zip(&mut normals).zip(skin) {
+                    *p = m.transform_point3(*p);
+                    *v = Mat3::from_mat4(*m).inverse().transpose() * *v;
+                }
+            }
             for v in &mut normals {
                 *v = (normal_matrix * *v).try_normalize().unwrap_or(Vec3::ZERO);
             }
@@ -111,6 +127,10 @@ impl Loader<'_> {
                         self.attribute(a, &element, "TANGENT", accessors::DIRECTION, Some(n))?;
                     for (t, d) in t.iter_mut().zip(tangent_deltas.iter().flatten()) {
                         let moved = Vec3::new(t[0], t[1], t[2]) + *d;
+                        (t[0], t[1], t[2]) = (moved.x, moved.y, moved.z);
+                    }
+                    for (t, m) in t.iter_mut().zip(skin.iter().flatten()) {
+                        let moved = m.transform_vector3(Vec3::new(t[0], t[1], t[2]));
                         (t[0], t[1], t[2]) = (moved.x, moved.y, moved.z);
                     }
                     Some(t)
@@ -333,6 +353,48 @@ impl Loader<'_> {
         Ok(tangents)
     }
 
+    /// The skinning matrix of each of a primitive's `n` vertices, `sum_k w_k * joints[j_k]`
+    /// over its JOINTS_s / WEIGHTS_s sets (glTF 2.0, "Skins"; `joints` are the skin's joint
+    /// matrices, world times inverse bind matrix); `None` for an unskinned placement (no
+    /// joints). A joint index past the skin's joints, or a skinned placement of a primitive
+    /// without JOINTS_0 and WEIGHTS_0, is an error.
+    fn skin(
+        &self,
+        prim: &gltf::Primitive,
+        element: &str,
+        joints: &[Mat4],
+        n: usize,
+    ) -> Result<Option<Vec<Mat4>>, SceneError> {
+        if joints.is_empty() {
+            return Ok(None);
+        }
+        let mut skin = vec![Mat4::ZERO; n];
+        let mut set = 0;
+        while let (Some(j), Some(w)) = (
+            prim.get(&gltf::Semantic::Joints(set)),
+            prim.get(&gltf::Semantic::Weights(set)),
+        ) {
+            let (jn, wn) = (format!("JOINTS_{set}"), format!("WEIGHTS_{set}"));
+            let indices = self.attribute::<4>(&j, element, &jn, accessors::JOINTS, Some(n))?;
+            let weights = self.attribute::<4>(&w, element, &wn, accessors::COLOR, Some(n))?;
+            for ((m, js), ws) in skin.iter_mut().zip(indices).zip(weights) {
+                for (j, w) in js.into_iter().zip(ws).filter(|&(_, w)| w != 0.0) {
+                    let Some(joint) = joints.get(j as usize) else {
+                        let why = format!("joint {j} is not one of the skin's {}", joints.len());
+                        return Err(self.bad(format!("{element}, {jn}"), why));
+                    };
+                    *m += *joint * w;
+                }
+            }
+            set += 1;
+        }
+        if set == 0 {
+            let why = "is skinned (its node has a skin) but has no JOINTS_0 and WEIGHTS_0";
+            return Err(self.bad(element, why));
+        }
+        Ok(Some(skin))
+    }
+
     /// The generated tangents of a normal-mapped primitive without usable TANGENT (see
     /// [`tangents`]): MikkTSpace's from the world-space `positions`, `normals` (zero: the face
     /// normal) and `uvs`, which may renumber `tris` to duplicated vertices (the second value
@@ -393,24 +455,102 @@ mod tests {
     use super::*;
 
     use crate::scene::Scene;
-    use glam::Vec3;
+    use glam::{Mat4, Vec3};
     use serde_json::{json, Value};
 
     use std::time::{Duration, Instant};
 
-    /// Appends `values` to the buffer as a float VEC3 accessor; returns its index.
-    fn add_vec3s(doc: &mut Value, bin: &mut Vec<u8>, values: &[f32]) -> usize {
+    /// Appends `bytes` to the buffer as an accessor of `count` elements of `kind` ("VEC3") and
+    /// `component_type` (5126: float); returns its index.
+    fn add_accessor(
+        doc: &mut Value,
+        bin: &mut Vec<u8>,
+        bytes: &[u8],
+        (component_type, count, kind): (u32, usize, &str),
+    ) -> usize {
         let offset = bin.len();
-        bin.extend(values.iter().flat_map(|f| f.to_le_bytes()));
+        bin.extend(bytes);
+        // Each view starts on a 4-byte boundary.
+        bin.resize(bin.len().next_multiple_of(4), 0);
         let views = doc["bufferViews"].as_array_mut().unwrap();
-        views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": values.len() * 4}));
+        views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": bytes.len()}));
         let view = views.len() - 1;
         let accessors = doc["accessors"].as_array_mut().unwrap();
-        accessors.push(json!({"bufferView": view, "componentType": 5126,
-            "count": values.len() / 3, "type": "VEC3"}));
+        accessors.push(json!({"bufferView": view, "componentType": component_type,
+            "count": count, "type": kind}));
         let index = accessors.len() - 1;
         doc["buffers"][0]["byteLength"] = json!(bin.len());
         index
+    }
+
+    /// Appends `values` to the buffer as a float VEC3 accessor; returns its index.
+    fn add_vec3s(doc: &mut Value, bin: &mut Vec<u8>, values: &[f32]) -> usize {
+        let bytes: Vec<u8> = values.iter().flat_map(|f| f.to_le_bytes()).collect();
+        add_accessor(doc, bin, &bytes, (5126, values.len() / 3, "VEC3"))
+    }
+
+    /// Skins in the rest pose: each vertex is moved by its weighted joint matrices (the
+    /// joints' world transforms times their inverse bind matrices), and the skinned mesh
+    /// node's own transform is ignored.
+    #[test]
+    fn skins_place_vertices_by_their_joints() {
+        let (mut doc, mut bin) = test_doc();
+        // The lamp's triangle (0,0,0), (1,0,0), (0,1,0): vertex 0 on joint 0, vertex 1 on
+        // joint 1, vertex 2 half on each.
+        let joints: Vec<u8> = [0, 1, 0, 0].repeat(3);
+        let j = add_accessor(&mut doc, &mut bin, &joints, (5121, 3, "VEC4"));
+        let weights = [1f32, 0., 0., 0., 0., 1., 0., 0., 0.5, 0.5, 0., 0.];
+        let bytes: Vec<u8> = weights.iter().flat_map(|f| f.to_le_bytes()).collect();
+        let w = add_accessor(&mut doc, &mut bin, &bytes, (5126, 3, "VEC4"));
+        // Joint 0's inverse bind matrix is the identity, joint 1's a translation by +X.
+        let ibm: Vec<f32> = Mat4::IDENTITY
+            .to_cols_array()
+            .into_iter()
+            .chain(Mat4::from_translation(Vec3::X).to_cols_array())
+            .collect();
+        let bytes: Vec<u8> = ibm.iter().flat_map(|f| f.to_le_bytes()).collect();
+        let m = add_accessor(&mut doc, &mut bin, &bytes, (5126, 2, "MAT4"));
+        let attributes = &mut doc["meshes"][1]["primitives"][0]["attributes"];
+        attributes["JOINTS_0"] = json!(j);
+        attributes["WEIGHTS_0"] = json!(w);
+        // Joint 0 at (0, 5, 0) under the node "bulb" (1, 2, 3): (1, 7, 3); joint 1 at the
+        // origin. The lamp node's translation (0, 0, -3) is ignored.
+        let nodes = doc["nodes"].as_array_mut().unwrap();
+        nodes.push(json!({"name": "bone0", "translation": [0, 5, 0]}));
+        nodes.push(json!({"name": "bone1"}));
+        nodes[4]["children"] = json!([7]);
+        doc["scenes"][0]["nodes"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!(8));
+        doc["nodes"][2]["skin"] = json!(0);
+        doc["skins"] = json!([{"joints": [7, 8], "inverseBindMatrices": m}]);
+        let scene = load_doc(doc.clone(), &bin);
+        assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+        let expected = [
+            Vec3::new(1.0, 7.0, 3.0),
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(1.0, 4.5, 1.5),
+        ];
+        for (got, want) in scene.mesh.positions[4..].iter().zip(expected) {
+            assert!((*got - want).length() < 1e-5, "{got} != {want}");
+        }
+        // A joint index past the skin's joints names the attribute.
+        doc["skins"][0]["joints"] = json!([7]);
+        doc["skins"][0]
+            .as_object_mut()
+            .unwrap()
+            .remove("inverseBindMatrices");
+        let err = load_err(doc.clone(), &bin);
+        assert!(err.contains("JOINTS_0") && err.contains("joint 1"), "{err}");
+        // A joint outside the scene names the skin.
+        doc["skins"][0]["joints"] = json!([7, 6]);
+        doc["scenes"][0]["nodes"] = json!([0, 2, 3, 4, 5]);
+        let err = load_err(doc, &bin);
+        assert!(
+            err.contains("skin 0 of node \"lamp\" (2)") && err.contains("\"sun\""),
+            "{err}"
+        );
     }
 
     /// Morph targets in the specification's default pose: each vertex moves by the sum of

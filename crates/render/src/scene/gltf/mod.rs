@@ -105,6 +105,8 @@ struct Loader<'a> {
     placements: Vec<(usize, Mat4, usize)>,
     /// What the file uses that is skipped or rendered differently, by feature.
     warnings: Warnings,
+    /// Each node's world transform, once the walk has reached it (joints of skins).
+    node_worlds: Vec<Option<Mat4>>,
 }
 
 impl Loader<'_> {

@@ -1,7 +1,8 @@
 //! The node walk and what it places: node transforms, cameras, the limits on placements and
 //! triangles, and each mesh flattened into world triangles or stored once as instances.
 
-use super::{mesh_label, node_label, Loader};
+use super::meshes::Pose;
+use super::{accessors, mesh_label, node_label, Loader};
 use crate::camera::Camera;
 use crate::scene::{validate, Instance, SceneError, TriangleMesh};
 use glam::{Affine3A, Mat4, Quat, Vec3, Vec4};
@@ -142,11 +143,12 @@ impl Loader<'_> {
                 format!("world transform is not invertible or not finite: {world:?}"),
             ));
         }
+        // A node reached by several paths keeps its first world transform for the skins whose
+        // joint it is.
+        if let Some(w) = self.node_worlds.get_mut(node.index()) {
+            w.get_or_insert(world);
+        }
         if let Some(mesh) = node.mesh() {
-            if node.skin().is_some() {
-                let without = "not applied: the mesh is rendered as stored, placed by its node";
-                self.warn("skins", "node", &node_label(node), without);
-            }
             match node.extension_value("EXT_mesh_gpu_instancing") {
                 Some(ext) => {
                     let locals = self.gpu_instances(node, ext, document)?;
@@ -195,9 +197,9 @@ impl Loader<'_> {
         for &(m, _, _) in &self.placements {
             count[m] += 1;
         }
-        // Meshes flattened at every placement: emissive ones (emitters are world triangles) and
-        // morphed ones (each placement may have its own weights).
-        let flattened: Vec<bool> = meshes
+        // Meshes flattened at every placement: emissive ones (emitters are world triangles),
+        // morphed ones (each placement may have its own weights) and skinned ones.
+        let mut flattened: Vec<bool> = meshes
             .iter()
             .map(|mesh| {
                 mesh.primitives().any(|p| {
@@ -208,6 +210,10 @@ impl Loader<'_> {
                 })
             })
             .collect();
+        let nodes: Vec<gltf::Node> = document.nodes().collect();
+        for &(m, _, node) in &self.placements {
+            flattened[m] |= nodes[node].skin().is_some();
+        }
         // Triangles stored: a flattened mesh's at each placement, an instanced one's once.
         let mut stored = 0usize;
         for (m, mesh) in meshes.iter().enumerate() {
@@ -233,9 +239,19 @@ impl Loader<'_> {
         for (m, world, node) in std::mem::take(&mut self.placements) {
             let mesh = &meshes[m];
             if count[m] < 2 || flattened[m] {
-                let node_weights = document.nodes().nth(node).and_then(|n| n.weights());
-                let weights = node_weights.or(mesh.weights()).unwrap_or_default();
-                self.mesh(mesh, world, weights)?;
+                let node = &nodes[node];
+                let weights = node.weights().or(mesh.weights()).unwrap_or_default();
+                // A skinned mesh is placed by its joints alone: the specification says its
+                // node's own transform is ignored.
+                let (world, joints) = match node.skin() {
+                    Some(skin) => (Mat4::IDENTITY, self.joint_matrices(node, &skin)?),
+                    None => (world, Vec::new()),
+                };
+                let pose = Pose {
+                    weights,
+                    joints: &joints,
+                };
+                self.mesh(mesh, world, pose)?;
                 continue;
             }
             let index = match instanced[m] {
@@ -260,8 +276,8 @@ impl Loader<'_> {
     /// transform, into its own arrays.
     pub(super) fn object_mesh(&mut self, mesh: &gltf::Mesh) -> Result<TriangleMesh, SceneError> {
         let world = std::mem::take(&mut self.parts.mesh);
-        // Meshes with morph targets are never instanced: no weights here.
-        let loaded = self.mesh(mesh, Mat4::IDENTITY, &[]);
+        // Meshes with morph targets or skins are never instanced: the rest pose here.
+        let loaded = self.mesh(mesh, Mat4::IDENTITY, Pose::default());
         let mut object = std::mem::replace(&mut self.parts.mesh, world);
         loaded?;
         if !object.tangents.is_empty() {
@@ -269,6 +285,47 @@ impl Loader<'_> {
         }
         object.name = mesh_label(mesh);
         Ok(object)
+    }
+
+    /// The joint matrices of `skin`, used by `node`'s mesh: each joint's world transform (from
+    /// the walk) times its inverse bind matrix (identity without inverseBindMatrices). A joint
+    /// outside the scene, or a non-finite matrix, is an error naming the skin.
+    fn joint_matrices(
+        &self,
+        node: &gltf::Node,
+        skin: &gltf::Skin,
+    ) -> Result<Vec<Mat4>, SceneError> {
+        let element = match skin.name() {
+            Some(n) => format!("skin {n:?} ({}) of {}", skin.index(), node_label(node)),
+            None => format!("skin {} of {}", skin.index(), node_label(node)),
+        };
+        let joints: Vec<gltf::Node> = skin.joints().collect();
+        let inverse_binds: Vec<Mat4> = match skin.inverse_bind_matrices() {
+            Some(a) => {
+                let name = "inverseBindMatrices";
+                self.attribute::<16>(&a, &element, name, accessors::MATRIX, Some(joints.len()))?
+                    .iter()
+                    .map(Mat4::from_cols_array)
+                    .collect()
+            }
+            None => vec![Mat4::IDENTITY; joints.len()],
+        };
+        joints
+            .iter()
+            .zip(inverse_binds)
+            .map(|(joint, inverse_bind)| {
+                let Some(world) = self.node_worlds.get(joint.index()).copied().flatten() else {
+                    let why = format!("its joint {} is not in the scene", node_label(joint));
+                    return Err(self.bad(&element, why));
+                };
+                let m = world * inverse_bind;
+                if !m.is_finite() {
+                    let why = format!("joint {} has a non-finite matrix", node_label(joint));
+                    return Err(self.bad(&element, why));
+                }
+                Ok(m)
+            })
+            .collect()
     }
 
     pub(super) fn camera(
