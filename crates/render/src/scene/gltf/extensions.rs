@@ -192,7 +192,9 @@ pub(super) fn check(path: &Path, json: &Value, warnings: &mut Warnings) -> Resul
             extension.to_owned()
         };
         let users = users(json, extension);
-        if users.is_empty() {
+        // KTX2 images named by a texture's core source use KHR_texture_basisu without its
+        // object; the image loader names them (see textures.rs).
+        if users.is_empty() && extension != "KHR_texture_basisu" {
             warnings.note(format!(
                 "{extension} is listed in extensionsUsed but nothing uses it"
             ));

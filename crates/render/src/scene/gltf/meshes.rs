@@ -55,13 +55,9 @@ impl Loader<'_> {
                 mode,
                 Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
             ) {
-                let what = format!("mode {mode:?}");
-                self.warn(
-                    &what,
-                    "primitive",
-                    &element,
-                    "skipped: only triangles are rendered",
-                );
+                let element = format!("{element} ({mode:?})");
+                let without = "skipped: only triangles are rendered";
+                self.warn("point and line primitives", "primitive", &element, without);
                 continue;
             }
             let Some(pos_acc) = prim.get(&gltf::Semantic::Positions) else {
@@ -627,11 +623,11 @@ mod tests {
         assert_eq!(scene.mesh.triangles.len(), 2);
         assert_eq!(scene.warnings.len(), 1);
         assert!(
-            scene.warnings[0].contains("mesh \"tri\" (1), primitive 0"),
+            scene.warnings[0].contains("(mesh \"tri\" (1), primitive 0 (Points))"),
             "{:?}",
             scene.warnings
         );
-        assert!(scene.warnings[0].contains("mode Points on 1 primitive: skipped"));
+        assert!(scene.warnings[0].contains("point and line primitives on 1 primitive: skipped"));
     }
 
     #[test]

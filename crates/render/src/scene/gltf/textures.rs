@@ -372,6 +372,7 @@ mod tests {
             .iter()
             .filter(|w| w.contains("KTX2"))
             .collect();
+        assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
         assert_eq!(ktx2.len(), 1, "{:?}", scene.warnings);
         assert!(
             ktx2[0].contains("on 2 images")
