@@ -252,7 +252,8 @@ pub(in crate::scene) fn load(path: &Path, files: &Files) -> Result<Scene, SceneE
 #[cfg(test)]
 mod tests {
     use super::super::test_docs::{
-        check_test_scene, load_err, test_doc, write_embedded, write_external, write_glb,
+        add_accessor, add_vec3s, check_test_scene, load_err, test_doc, write_embedded,
+        write_external, write_glb,
     };
     use super::*;
 
@@ -397,26 +398,13 @@ mod tests {
             doc["materials"][m]["occlusionTexture"] = json!({"index": 0, "strength": 0.5});
         }
         // Two animations of the lamp's translation (keyframe times 0 and 1).
-        let offset = bin.len();
-        let values = [0f32, 1., 0., 0., 0., 1., 0., 0.];
-        bin.extend(values.iter().flat_map(|f| f.to_le_bytes()));
-        doc["buffers"][0]["byteLength"] = json!(bin.len());
-        let views = doc["bufferViews"].as_array_mut().unwrap();
-        views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": 8}));
-        views.push(json!({"buffer": 0, "byteOffset": offset + 8, "byteLength": 24}));
-        let v = views.len();
-        let accessors = doc["accessors"].as_array_mut().unwrap();
-        accessors.push(
-            json!({"bufferView": v - 2, "componentType": 5126, "count": 2,
-            "type": "SCALAR", "min": [0], "max": [1]}),
-        );
-        accessors.push(
-            json!({"bufferView": v - 1, "componentType": 5126, "count": 2,
-            "type": "VEC3"}),
-        );
-        let a = accessors.len();
+        let times: Vec<u8> = [0f32, 1.].iter().flat_map(|f| f.to_le_bytes()).collect();
+        let input = add_accessor(&mut doc, &mut bin, &times, (5126, 2, "SCALAR"));
+        doc["accessors"][input]["min"] = json!([0]);
+        doc["accessors"][input]["max"] = json!([1]);
+        let output = add_vec3s(&mut doc, &mut bin, &[0., 0., 0., 1., 0., 0.]);
         let animation = json!({"channels": [{"sampler": 0, "target": {"node": 2, "path": "translation"}}],
-            "samplers": [{"input": a - 2, "output": a - 1}]});
+            "samplers": [{"input": input, "output": output}]});
         let mut named = animation.clone();
         named["name"] = json!("sway");
         doc["animations"] = json!([animation, named]);
