@@ -333,7 +333,11 @@ impl Loader<'_> {
                     self.attribute(&a, element, &name, accessors::POSITION, Some(n))?,
                 );
             }
-            if let Some(a) = target.normals() {
+            // Normal deltas only where the primitive has normals (else they are the face's).
+            if let Some(a) = target
+                .normals()
+                .filter(|_| prim.get(&gltf::Semantic::Normals).is_some())
+            {
                 let name = name("NORMAL");
                 add(
                     normals,

@@ -420,6 +420,12 @@ mod tests {
             "{:?}",
             scene.warnings
         );
+        // An extension source that is no image is an error, not a panic.
+        let mut bad = doc.clone();
+        bad["textures"][1]["extensions"]["KHR_texture_basisu"]["source"] = json!(99);
+        let err = Scene::load(&write_embedded(dir.path(), bad, &bin)).unwrap_err();
+        let err = format!("{err}: {:?}", std::error::Error::source(&err));
+        assert!(err.contains("textures[1].source"), "{err}");
         doc["extensionsRequired"] = json!(["KHR_texture_basisu"]);
         let err = Scene::load(&write_embedded(dir.path(), doc, &bin))
             .unwrap_err()
