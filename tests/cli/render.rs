@@ -418,3 +418,73 @@ fn scene_files_outside_its_folder_need_the_flag_and_fifos_are_never_read() {
     assert!(start.elapsed() < std::time::Duration::from_secs(10));
     assert!(!t.join("y.png").exists() && !t.join("pair").exists());
 }
+
+/// A glTF sample-model's kind of file: 5 materials using an extension the renderer does not
+/// honour, a required KHR_materials_unlit and a morph target. The command renders it and
+/// names the unhonoured extension once, with the materials counted (not once per material).
+#[test]
+fn gltf_warnings_name_each_feature_once() {
+    let dir = TestDir::new();
+    // One triangle in z = -2 in front of the camera; its morph target moves it by +Y.
+    let floats: [f32; 18] = [
+        -1., -1., -2., 1., -1., -2., 0., 1., -2., 0., 1., 0., 0., 1., 0., 0., 1., 0.,
+    ];
+    let bin: Vec<u8> = floats.iter().flat_map(|f| f.to_le_bytes()).collect();
+    std::fs::write(dir.join("model.bin"), &bin).unwrap();
+    let aniso = serde_json::json!({"KHR_materials_anisotropy": {"anisotropyStrength": 0.5}});
+    let mut materials: Vec<serde_json::Value> = (0..5)
+        .map(|i| serde_json::json!({"name": format!("m{i}"), "extensions": aniso}))
+        .collect();
+    materials.push(
+        serde_json::json!({"name": "flat", "extensions": {"KHR_materials_unlit": {}},
+        "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}}),
+    );
+    let primitives: Vec<serde_json::Value> = (0..6)
+        .map(|m| {
+            serde_json::json!({"attributes": {"POSITION": 0}, "material": m,
+            "targets": [{"POSITION": 1}]})
+        })
+        .collect();
+    let doc = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_materials_anisotropy", "KHR_materials_unlit"],
+        "extensionsRequired": ["KHR_materials_unlit"],
+        "scenes": [{"nodes": [0, 1]}],
+        "nodes": [{"mesh": 0}, {"camera": 0}],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 1.0, "znear": 0.1}}],
+        "meshes": [{"primitives": primitives, "weights": [0.5]}],
+        "materials": materials,
+        "buffers": [{"uri": "model.bin", "byteLength": bin.len()}],
+        "bufferViews": [{"buffer": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 36}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+             "min": [-1, -1, -2], "max": [1, 1, -2]},
+            {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC3"}
+        ]
+    });
+    let scene = dir.join("model.gltf");
+    std::fs::write(&scene, doc.to_string()).unwrap();
+    let out = dir.join("model.exr");
+    let run = dir.streaks(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--spp",
+        "1",
+    ]);
+    run.assert_success();
+    let stderr = run.stderr();
+    let lines: Vec<&str> = stderr.lines().filter(|l| l.contains("warning")).collect();
+    assert_eq!(lines.len(), 1, "{stderr}");
+    assert!(
+        lines[0]
+            .contains("KHR_materials_anisotropy on 5 materials: rendered as an isotropic surface")
+            && lines[0].contains("and 2 more"),
+        "{stderr}"
+    );
+}

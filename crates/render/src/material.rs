@@ -70,6 +70,10 @@ pub enum Reflectance {
     },
     /// glTF metallic-roughness with its extensions' parameters.
     GltfPbr(GltfPbrParams),
+    /// KHR_materials_unlit: reflects nothing; what is seen is the material's emission, which
+    /// the loader sets to the base colour (factor, texture), and which the vertex colour
+    /// multiplies ([`Material::emission_at`]). Like any emitter it lights other surfaces.
+    Unlit,
 }
 
 /// The parameters of a glTF metallic-roughness material and of the material extensions the
@@ -340,6 +344,7 @@ impl Material {
                 None,
                 None,
             ],
+            Reflectance::Unlit => [None; 7],
             Reflectance::GltfPbr(g) => [
                 g.base_color_texture,
                 g.metallic_roughness_texture,
@@ -422,17 +427,23 @@ impl Material {
                     inside: false,
                 })
             }
+            Reflectance::Unlit => Bsdf::Diffuse(bsdf::Diffuse { kd: Vec3::ZERO }),
         }
     }
 
     /// Emitted radiance at a point with vertex attributes `at` (front face; the caller checks
-    /// sidedness). The vertex colour does not change it (glTF's COLOR_0 is a base colour).
+    /// sidedness). The vertex colour does not change it (glTF's COLOR_0 is a base colour),
+    /// except on an unlit material, whose emission is its base colour.
     #[inline]
     pub fn emission_at(&self, at: &VertexAttributes, textures: &[Texture]) -> Vec3 {
-        if self.emission_texture.is_none() {
-            return self.emission;
+        let emission = match self.emission_texture {
+            None => self.emission,
+            texture => self.emission * sample_or_one(texture, at, textures).truncate(),
+        };
+        match self.reflectance {
+            Reflectance::Unlit => emission * at.color.truncate(),
+            _ => emission,
         }
-        self.emission * sample_or_one(self.emission_texture, at, textures).truncate()
     }
 
     /// The medium inside the material's surface (KHR_materials_volume), if it bounds one.

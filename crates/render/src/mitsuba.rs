@@ -22,6 +22,7 @@
 //! | the same, thin-walled and smooth | `thindielectric` | no: a slab with two interfaces and its inter-reflections, ours one interface (warning) |
 //! | other transmissive materials | `principled` (a volume) or `principledthin` (thin-walled) with `spec_trans` = transmission | no (warning) |
 //! | diffuse | `diffuse` | yes |
+//! | KHR_materials_unlit ([`Reflectance::Unlit`]) | `diffuse` of reflectance 0 and an `area` emitter of the base colour | yes (vertex colours are not exported, as for every material) |
 //! | kd / base colour / emission texture | `bitmap` (an EXR of texture x factor, so the factor is baked in) | yes (bilinear, repeat) |
 //! | wet/dry map ([`Wetness`](crate::material::Wetness)) | `alpha` and `specular_reflectance` as `bitmap`s baked per texel of the dryness map (`mix(wet, dry, w)`) | yes for `ggx` and `ward`'s alpha (linear in `w`, so bilinear filtering commutes); blinn_phong's alpha is not linear in the shininess (approximation already) |
 //! | double-sided material | BSDF wrapped in `twosided` | yes |
@@ -537,6 +538,11 @@ impl<'a> MaterialWriter<'a> {
             Reflectance::Diffuse { kd, kd_texture } => {
                 let refl = self.colour(m, &stem, "reflectance", *kd, *kd_texture)?;
                 let _ = write!(out, "<bsdf type=\"diffuse\">{refl}</bsdf>");
+            }
+            // Black: an unlit surface is seen by its emission, exported as an area emitter.
+            Reflectance::Unlit => {
+                let black = rgb("reflectance", Vec3::ZERO);
+                let _ = write!(out, "<bsdf type=\"diffuse\">{black}</bsdf>");
             }
             Reflectance::Paper {
                 model,
@@ -1190,6 +1196,19 @@ mod tests {
                 .descendants()
                 .any(|n| n.attribute("id") == Some("instanced0")));
         }
+    }
+
+    /// An unlit material exports as the fixture's lamp does: a black diffuse BSDF and an area
+    /// emitter of its emission (the base colour).
+    #[test]
+    fn unlit_materials_are_black_with_an_area_emitter() {
+        let fx = Fixture::new();
+        let lamp = export_parts(&fx.parts(), &fx.cameras[0], &opts()).unwrap();
+        let mut unlit = Fixture::new();
+        unlit.materials[1].reflectance = Reflectance::Unlit;
+        let ex = export_parts(&unlit.parts(), &unlit.cameras[0], &opts()).unwrap();
+        assert_eq!(ex.xml, lamp.xml);
+        assert!(ex.xml.contains("<emitter type=\"area\">"), "{}", ex.xml);
     }
 
     #[test]

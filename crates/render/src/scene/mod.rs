@@ -16,10 +16,21 @@
 //!   has none the shading normal is the face normal (stored as a zero vertex normal). A node
 //!   whose world transform has a negative determinant has its winding reversed, as the glTF
 //!   specification says, so the geometric normal from the winding stays the front side.
+//! - Morph targets and skins are in the specification's default pose: a primitive's
+//!   POSITION, NORMAL and TANGENT get the sum of the weights times the targets' deltas (the
+//!   placing node's `weights`, else the mesh's); a skinned mesh's vertices are moved by the
+//!   weighted sum of its joints' matrices (each joint's world transform times its inverse bind
+//!   matrix; JOINTS_n and WEIGHTS_n), and the skinned node's own transform is ignored, as the
+//!   specification says. Such meshes are flattened, never instanced. Animations are not
+//!   played (a warning): the rest pose is rendered.
 //! - Extensions ([`extensions`]): the ones the loader honours are listed in
-//!   [`extensions::HONOURED`]; any other extension in `extensionsUsed` is a warning for each
-//!   element that uses it (naming the element and what is rendered without it), and in
-//!   `extensionsRequired` an error naming it.
+//!   [`extensions::HONOURED`]; any other extension in `extensionsUsed` is one warning for the
+//!   file, which says what is rendered without it, counts the elements that use it and names
+//!   the first of them. One in `extensionsRequired` is an error naming it, unless it only
+//!   changes the shading ([`extensions::RENDERED_WITHOUT`]: sheen, iridescence, anisotropy,
+//!   dispersion, ...), where the file loads with that warning (docs/decisions/0025). Every
+//!   other warning of the loader (skipped primitives, an `occlusionTexture`, which a path
+//!   tracer does not need, animations) is likewise one per file and feature.
 //! - Geometry may be quantized (KHR_mesh_quantization: 8- and 16-bit attributes, normalized
 //!   or not), sparse, or compressed (EXT_meshopt_compression, KHR_draco_mesh_compression,
 //!   decoded when the file is loaded).
@@ -79,7 +90,12 @@
 //!   its sampler's `wrapS`/`wrapT` (repeat, clamp to edge, mirrored repeat) and `magFilter`
 //!   (nearest or linear). `minFilter` is ignored: each pixel is supersampled, which filters
 //!   the texture over the pixel footprint as a mipmap approximates (see [`crate::texture`]).
-//!   An image is decoded once per colour space, whatever samplers read it.
+//!   An image is decoded once per colour space, whatever samplers read it. Images are PNG or
+//!   JPEG; a KTX2 image (KHR_texture_basisu), recognised by its content whatever its MIME
+//!   type or name, is not decoded: the texture's fallback image (its core `source`) is read
+//!   where it has one, and otherwise the texture is left out (the material keeps its factor),
+//!   with one warning naming the images; a file that requires KHR_texture_basisu is an error
+//!   (docs/decisions/0026). A missing image file is an error naming it and the material.
 //! - Vertex colours `COLOR_0` (RGB or RGBA; float, or normalized unsigned byte or short)
 //!   multiply the base colour (`kd` for the paper's models) and its alpha. The second uv set
 //!   and the colours are stored only when some primitive has them ([`TriangleMesh::uvs1`],
@@ -97,6 +113,10 @@
 //!   is radiance; the triangles of an emissive material are area lights, grouped into the
 //!   scene's emitters ([`crate::light::Emitters`]) when it is built. Emission is one-sided (the
 //!   winding's front face) unless the material is `doubleSided`.
+//! - KHR_materials_unlit ([`crate::material::Reflectance::Unlit`]): the surface reflects
+//!   nothing and emits its base colour (factor, texture, times COLOR_0) as radiance, so the
+//!   camera sees exactly the base colour; like any emitter it lights the rest of the scene
+//!   (docs/decisions/0027).
 //!
 //! ## Wet and dry patches (an extension of the contract)
 //!

@@ -44,7 +44,14 @@ pub(super) const DIRECTION: &[Component] = &[FLOAT, (DataType::I8, true), (DataT
 /// KHR_mesh_quantization adds the signed ones and the unnormalized ones).
 pub(super) const TEXCOORD: &[Component] = POSITION;
 
-/// Component types of COLOR_0 (core: float, normalized unsigned 8- and 16-bit integers).
+/// Component types of JOINTS_n (unsigned 8- and 16-bit integers, not normalized).
+pub(super) const JOINTS: &[Component] = &[(DataType::U8, false), (DataType::U16, false)];
+
+/// Component types of a skin's inverseBindMatrices (float).
+pub(super) const MATRIX: &[Component] = &[FLOAT];
+
+/// Component types of COLOR_0 and WEIGHTS_n (core: float, normalized unsigned 8- and 16-bit
+/// integers).
 pub(super) const COLOR: &[Component] = &[FLOAT, (DataType::U8, true), (DataType::U16, true)];
 
 /// The number of components of an accessor type.

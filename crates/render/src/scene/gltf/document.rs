@@ -147,14 +147,17 @@ pub(in crate::scene) fn load(path: &Path, files: &Files) -> Result<Scene, SceneE
         (serde_json::from_slice(&bytes), None)
     };
     let mut raw: serde_json::Value = raw.map_err(|e| gltf_err(gltf::Error::Deserialize(e)))?;
-    let extension_warnings = extensions::check(path, &raw)?;
+    let mut warnings = super::warnings::Warnings::default();
+    extensions::check(path, &raw, &mut warnings)?;
+    super::textures::basisu_sources(&mut raw);
     let light_units = light_units(path, &raw)?;
-    // The extensions the loader honours have been checked; the gltf crate's validation would
-    // reject the required ones it does not implement itself.
+    // The extensions the loader honours or renders without have been checked; the gltf
+    // crate's validation would reject the required ones it does not implement itself.
     if let Some(serde_json::Value::Array(required)) = raw.get_mut("extensionsRequired") {
         required.retain(|e| {
-            !e.as_str()
-                .is_some_and(|e| extensions::HONOURED.contains(&e))
+            !e.as_str().is_some_and(|e| {
+                extensions::HONOURED.contains(&e) || extensions::RENDERED_WITHOUT.contains(&e)
+            })
         });
     }
     let read = |raw: serde_json::Value| {
@@ -192,9 +195,16 @@ pub(in crate::scene) fn load(path: &Path, files: &Files) -> Result<Scene, SceneE
         light_units,
         placements: Vec::new(),
         primitive_boxes: Vec::new(),
+        warnings,
+        node_worlds: vec![None; document.nodes().len()],
     };
-    for w in extension_warnings {
-        loader.warn(w);
+    for animation in document.animations() {
+        let label = match animation.name() {
+            Some(n) => format!("animation {n:?} ({})", animation.index()),
+            None => format!("animation {}", animation.index()),
+        };
+        let without = "not played: the nodes' rest pose is rendered";
+        loader.warn("animations", "animation", &label, without);
     }
     for (i, m) in document.materials().enumerate() {
         let material = loader.material(&m, i, &document)?;
@@ -228,16 +238,15 @@ pub(in crate::scene) fn load(path: &Path, files: &Files) -> Result<Scene, SceneE
                 stack[first_child..].reverse();
             }
         }
-        None => loader
-            .parts
-            .warnings
-            .push(format!("{}: the file has no scene", path.display())),
+        None => loader.warnings.note("the file has no scene".into()),
     }
     loader.place_meshes(&document)?;
     if !loader.parts.mesh.tangents.is_empty() {
         let n = loader.parts.mesh.positions.len();
         loader.parts.mesh.tangents.resize(n, Vec4::ZERO);
     }
+    let lines = loader.warnings.lines(path);
+    loader.parts.warnings.extend(lines);
     let boxes = std::mem::take(&mut loader.primitive_boxes);
     let mut scene = Scene::from_parts(loader.parts)?;
     scene.framing_bounds = crate::camera::cube_bounds(boxes);
@@ -247,7 +256,8 @@ pub(in crate::scene) fn load(path: &Path, files: &Files) -> Result<Scene, SceneE
 #[cfg(test)]
 mod tests {
     use super::super::test_docs::{
-        check_test_scene, load_err, test_doc, write_embedded, write_external, write_glb,
+        add_accessor, add_vec3s, check_test_scene, load_err, test_doc, write_embedded,
+        write_external, write_glb,
     };
     use super::*;
 
@@ -360,10 +370,10 @@ mod tests {
             json!({"KHR_materials_sheen": {"sheenColorFactor": [1, 1, 1]}});
         let scene = Scene::load(&write_embedded(dir.path(), doc, &bin)).unwrap();
         assert!(
-            scene
-                .warnings
-                .iter()
-                .any(|w| w.contains("material \"asphalt\" (0) uses KHR_materials_sheen")),
+            scene.warnings.iter().any(|w| w.contains(
+                "KHR_materials_sheen on 1 material: rendered without sheen \
+                                     (material \"asphalt\" (0))"
+            )),
             "{:?}",
             scene.warnings
         );
@@ -376,6 +386,50 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.contains("road.glb"), "{err}");
+    }
+
+    /// What the loader leaves out without a word otherwise: an occlusion texture and
+    /// animations are each named once for the file, with the elements counted.
+    #[test]
+    fn occlusion_and_animations_warn_once() {
+        let (mut doc, mut bin) = test_doc();
+        doc["images"] = json!([{"uri": super::super::test_docs::png_uri([255, 255, 255])}]);
+        doc["textures"] = json!([{"source": 0}]);
+        let mut glow2 = doc["materials"][1].clone();
+        glow2["name"] = json!("glow2");
+        doc["materials"].as_array_mut().unwrap().push(glow2);
+        for m in [1, 2] {
+            doc["materials"][m]["occlusionTexture"] = json!({"index": 0, "strength": 0.5});
+        }
+        // Two animations of the lamp's translation (keyframe times 0 and 1).
+        let times: Vec<u8> = [0f32, 1.].iter().flat_map(|f| f.to_le_bytes()).collect();
+        let input = add_accessor(&mut doc, &mut bin, &times, (5126, 2, "SCALAR"));
+        doc["accessors"][input]["min"] = json!([0]);
+        doc["accessors"][input]["max"] = json!([1]);
+        let output = add_vec3s(&mut doc, &mut bin, &[0., 0., 0., 1., 0., 0.]);
+        let animation = json!({"channels": [{"sampler": 0, "target": {"node": 2, "path": "translation"}}],
+            "samplers": [{"input": input, "output": output}]});
+        let mut named = animation.clone();
+        named["name"] = json!("sway");
+        doc["animations"] = json!([animation, named]);
+        let dir = tempfile::tempdir().unwrap();
+        let scene = Scene::load(&write_embedded(dir.path(), doc, &bin)).unwrap();
+        let w = &scene.warnings;
+        assert_eq!(w.len(), 2, "{w:?}");
+        assert!(
+            w[0].ends_with(
+                "animations on 2 animations: not played: the nodes' rest pose is rendered \
+                 (animation 0; animation \"sway\" (1))"
+            ),
+            "{w:?}"
+        );
+        assert!(
+            w[1].ends_with(
+                "occlusionTexture on 2 materials: ignored: the path tracer computes occlusion \
+                 itself (material \"glow\" (1); material \"glow2\" (2))"
+            ),
+            "{w:?}"
+        );
     }
 
     #[test]

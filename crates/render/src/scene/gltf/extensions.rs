@@ -3,14 +3,16 @@
 //!
 //! - An extension in `extensionsRequired` that the loader does not honour is an error
 //!   ([`SceneError::UnsupportedExtension`]) that names it and, for the ones street assets and
-//!   Blender's exporter use, says what to do instead.
-//! - An extension in `extensionsUsed` that the loader does not honour is a warning for every
-//!   material, node, mesh, texture or other element that uses it, naming the element and
-//!   saying how it is rendered without it.
+//!   Blender's exporter use, says what to do instead; except the ones in [`RENDERED_WITHOUT`]
+//!   (shading only), which are warnings as used ones are.
+//! - An extension in `extensionsUsed` that the loader does not honour is one warning per file,
+//!   saying how it is rendered without it, how many materials, nodes, meshes, textures or
+//!   other elements use it and naming the first of them.
 //!
 //! The check reads the file's JSON as it is (the `gltf` crate keeps only the extensions it
 //! knows), before the document is validated.
 
+use super::warnings::Warnings;
 use super::{accessors, node_label, Loader};
 use crate::light::{Light, LUMINOUS_EFFICACY};
 use crate::scene::{validate, SceneError};
@@ -33,6 +35,7 @@ pub const HONOURED: &[&str] = &[
     "KHR_materials_transmission",
     "KHR_materials_volume",
     "EXT_mesh_gpu_instancing",
+    "KHR_materials_unlit",
 ];
 
 /// How an element that uses `extension` is rendered when the extension is not honoured.
@@ -42,11 +45,14 @@ fn without(extension: &str) -> &'static str {
         "KHR_materials_iridescence" => "rendered without iridescence",
         "KHR_materials_anisotropy" => "rendered as an isotropic surface",
         "KHR_materials_dispersion" => "rendered without dispersion",
-        "KHR_materials_unlit" => "shaded as a lit surface, not as unlit",
         "KHR_materials_pbrSpecularGlossiness" => {
             "its specular-glossiness parameters are ignored (metallic-roughness defaults)"
         }
-        "KHR_texture_basisu" | "EXT_texture_webp" | "EXT_texture_avif" | "MSFT_texture_dds" => {
+        "KHR_texture_basisu" => {
+            "the KTX2 images are not decoded: each texture's fallback image (its core source) \
+             is read, and a texture without one is left out"
+        }
+        "EXT_texture_webp" | "EXT_texture_avif" | "MSFT_texture_dds" => {
             "its textures in that format are not decoded"
         }
         "KHR_materials_variants" => "rendered with its default material",
@@ -65,8 +71,9 @@ fn advice(extension: &str) -> &'static str {
     }
 }
 
-/// A label for element `index` of the top-level array `array` (`"materials"`, ...).
-fn label(array: &str, index: usize, element: &Value) -> String {
+/// The kind (`material`) and the label for messages of element `index` of the top-level
+/// array `array` (`"materials"`, ...).
+fn label(array: &str, index: usize, element: &Value) -> (&'static str, String) {
     let kind = match array {
         "materials" => "material",
         "meshes" => "mesh",
@@ -81,12 +88,14 @@ fn label(array: &str, index: usize, element: &Value) -> String {
         "accessors" => "accessor",
         "bufferViews" => "buffer view",
         "buffers" => "buffer",
-        other => other,
+        _ => "element",
     };
-    match element.get("name").and_then(Value::as_str) {
-        Some(name) => format!("{kind} {name:?} ({index})"),
-        None => format!("{kind} {index}"),
-    }
+    let noun = if kind == "element" { array } else { kind };
+    let label = match element.get("name").and_then(Value::as_str) {
+        Some(name) => format!("{noun} {name:?} ({index})"),
+        None => format!("{noun} {index}"),
+    };
+    (kind, label)
 }
 
 /// Whether `value` (an element or anything inside it) has `"extensions": {extension: ...}`.
@@ -103,9 +112,9 @@ fn uses(value: &Value, extension: &str) -> bool {
     }
 }
 
-/// The elements of the document that use `extension`, labelled for messages; the root itself
-/// when only it does.
-fn users(json: &Value, extension: &str) -> Vec<String> {
+/// The elements of the document that use `extension`, as kinds and labels for messages; the
+/// root itself when only it does.
+fn users(json: &Value, extension: &str) -> Vec<(&'static str, String)> {
     let mut found = Vec::new();
     if let Some(root) = json.as_object() {
         for (array, items) in root {
@@ -123,7 +132,7 @@ fn users(json: &Value, extension: &str) -> Vec<String> {
             .and_then(Value::as_object)
             .is_some_and(|e| e.contains_key(extension));
         if at_root && found.is_empty() {
-            found.push("the file".into());
+            found.push(("file", "the file".into()));
         }
     }
     found
@@ -138,32 +147,63 @@ fn names<'a>(json: &'a Value, key: &str) -> impl Iterator<Item = &'a str> {
         .filter_map(Value::as_str)
 }
 
+/// The extensions that change only how surfaces are shaded, or what of a file is shown
+/// (variants, animation), and that the renderer can leave out and still show the model: a file
+/// that *requires* one of them loads, with the warning of a used one, which says that the file
+/// requires it. The glTF specification says a client must not load such a file; users asked
+/// to see the model (docs/decisions/0025 has the reasons). Extensions that geometry or images
+/// need are not here: without them there is nothing right to show.
+pub const RENDERED_WITHOUT: &[&str] = &[
+    "KHR_materials_sheen",
+    "KHR_materials_iridescence",
+    "KHR_materials_anisotropy",
+    "KHR_materials_dispersion",
+    "KHR_materials_diffuse_transmission",
+    "KHR_materials_pbrSpecularGlossiness",
+    "KHR_materials_variants",
+    "KHR_animation_pointer",
+];
+
 /// Checks the file's extensions (see the module documentation): an error for the first
-/// required one that is not honoured, else the warnings for the used ones that are not.
-pub fn check(path: &Path, json: &Value) -> Result<Vec<String>, SceneError> {
-    if let Some(extension) = names(json, "extensionsRequired").find(|e| !HONOURED.contains(e)) {
+/// required one that is neither honoured nor in [`RENDERED_WITHOUT`]; a warning in `warnings`
+/// for each used one that is not honoured, counting the elements that use it.
+pub(super) fn check(path: &Path, json: &Value, warnings: &mut Warnings) -> Result<(), SceneError> {
+    let required: Vec<&str> = names(json, "extensionsRequired").collect();
+    if let Some(extension) = required
+        .iter()
+        .find(|e| !HONOURED.contains(e) && !RENDERED_WITHOUT.contains(e))
+    {
         return Err(SceneError::UnsupportedExtension {
             path: path.to_path_buf(),
-            extension: extension.to_owned(),
+            extension: (*extension).to_owned(),
             advice: advice(extension).to_owned(),
         });
     }
-    let mut warnings = Vec::new();
-    for extension in names(json, "extensionsUsed").filter(|e| !HONOURED.contains(e)) {
+    let used = names(json, "extensionsUsed").chain(required.iter().copied());
+    let mut seen: Vec<&str> = Vec::new();
+    for extension in used.filter(|e| !HONOURED.contains(e)) {
+        if seen.contains(&extension) {
+            continue;
+        }
+        seen.push(extension);
+        let what = if required.contains(&extension) {
+            format!("{extension} (required by the file, which is loaded without it)")
+        } else {
+            extension.to_owned()
+        };
         let users = users(json, extension);
-        if users.is_empty() {
-            warnings.push(format!(
+        // KTX2 images named by a texture's core source use KHR_texture_basisu without its
+        // object; the image loader names them (see textures.rs).
+        if users.is_empty() && extension != "KHR_texture_basisu" {
+            warnings.note(format!(
                 "{extension} is listed in extensionsUsed but nothing uses it"
             ));
         }
-        for user in users {
-            warnings.push(format!(
-                "{user} uses {extension}, which is not supported: {}",
-                without(extension)
-            ));
+        for (kind, user) in users {
+            warnings.add(&what, kind, &user, without(extension));
         }
     }
-    Ok(warnings)
+    Ok(())
 }
 
 /// The units of a file's KHR_lights_punctual intensities: the specification's photometric ones
@@ -333,7 +373,7 @@ mod tests {
     fn required_and_unsupported_is_an_error_naming_the_extension() {
         let doc = json!({"extensionsRequired": ["KHR_lights_punctual", "KHR_texture_basisu"],
                          "extensionsUsed": ["KHR_lights_punctual", "KHR_texture_basisu"]});
-        let err = check(Path::new("car.glb"), &doc).unwrap_err().to_string();
+        let err = lines("car.glb", &doc).unwrap_err().to_string();
         assert!(
             err.contains("car.glb")
                 && err.contains("KHR_texture_basisu")
@@ -341,52 +381,87 @@ mod tests {
             "{err}"
         );
         let ok = json!({"extensionsRequired": ["KHR_lights_punctual"]});
-        assert!(check(Path::new("a.gltf"), &ok).unwrap().is_empty());
+        assert!(lines("a.gltf", &ok).unwrap().is_empty());
+    }
+
+    /// The warnings `check` gives for `doc` read from `path`.
+    fn lines(path: &str, doc: &Value) -> Result<Vec<String>, SceneError> {
+        let mut warnings = Warnings::default();
+        check(Path::new(path), doc, &mut warnings)?;
+        Ok(warnings.lines(Path::new(path)))
     }
 
     #[test]
-    fn used_and_unsupported_warns_for_every_user_by_name() {
+    fn used_and_unsupported_warns_once_counting_the_users() {
         let doc = json!({
             "extensionsUsed": ["KHR_materials_iridescence", "KHR_materials_sheen",
                                "KHR_materials_emissive_strength", "EXT_unknown"],
             "materials": [
                 {"name": "glass", "extensions": {"KHR_materials_iridescence": {"iridescenceFactor": 1}}},
                 {"name": "road", "extensions": {"KHR_materials_sheen": {"sheenColorFactor": [1, 1, 1]}}},
-                {"extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 5}}}
+                {"extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 5}}},
+                {"extensions": {"KHR_materials_iridescence": {}}},
+                {"extensions": {"KHR_materials_iridescence": {}}},
+                {"extensions": {"KHR_materials_iridescence": {}}}
             ]
         });
-        let w = check(Path::new("street.gltf"), &doc).unwrap();
-        assert_eq!(w.len(), 3, "{w:?}");
+        let w = lines("street.gltf", &doc).unwrap();
+        assert_eq!(
+            w,
+            [
+                "street.gltf: EXT_unknown is listed in extensionsUsed but nothing uses it",
+                "street.gltf: KHR_materials_iridescence on 4 materials: rendered without \
+                 iridescence (material \"glass\" (0); material 3; material 4 and 1 more)",
+                "street.gltf: KHR_materials_sheen on 1 material: rendered without sheen \
+                 (material \"road\" (1))",
+            ]
+        );
+    }
+
+    /// A required extension that changes only the shading loads with the warning a used one
+    /// gets, saying the file requires it; one the images need is still an error.
+    #[test]
+    fn required_shading_extensions_are_warnings() {
+        let doc = json!({
+            "extensionsUsed": ["KHR_materials_dispersion"],
+            "extensionsRequired": ["KHR_materials_iridescence"],
+            "materials": [
+                {"extensions": {"KHR_materials_iridescence": {}}},
+                {"extensions": {"KHR_materials_iridescence": {}}}
+            ]
+        });
+        let w = lines("s.gltf", &doc).unwrap();
+        assert_eq!(w.len(), 2, "{w:?}");
+        assert!(w[0].contains("KHR_materials_dispersion is listed"), "{w:?}");
         assert!(
-            w[0].contains("material \"glass\" (0) uses KHR_materials_iridescence"),
+            w[1].starts_with(
+                "s.gltf: KHR_materials_iridescence (required by the file, which is loaded \
+                 without it) on 2 materials: rendered without iridescence"
+            ),
             "{w:?}"
         );
-        assert!(w[0].contains("without iridescence"), "{w:?}");
-        assert!(
-            w[1].contains("material \"road\" (1) uses KHR_materials_sheen"),
-            "{w:?}"
-        );
-        assert!(
-            w[2].contains("EXT_unknown") && w[2].contains("nothing uses it"),
-            "{w:?}"
-        );
+        let doc = json!({"extensionsRequired": ["KHR_materials_sheen", "EXT_texture_webp"]});
+        let err = lines("s.gltf", &doc).unwrap_err().to_string();
+        assert!(err.contains("EXT_texture_webp"), "{err}");
     }
 
     #[test]
     fn labels_name_the_element_kind() {
         let doc = json!({"extensionsUsed": ["EXT_node_thing"],
             "nodes": [{"mesh": 0}, {"name": "trees", "extensions": {"EXT_node_thing": {}}}]});
-        let w = check(Path::new("s.gltf"), &doc).unwrap();
-        assert_eq!(w.len(), 1);
-        assert!(
-            w[0].starts_with("node \"trees\" (1) uses EXT_node_thing"),
-            "{w:?}"
+        let w = lines("s.gltf", &doc).unwrap();
+        assert_eq!(
+            w,
+            ["s.gltf: EXT_node_thing on 1 node: the extension is ignored (node \"trees\" (1))"]
         );
-        assert!(w[0].contains("ignored"), "{w:?}");
         let root = json!({"extensionsUsed": ["KHR_x"], "extensions": {"KHR_x": {}}});
-        assert!(check(Path::new("s.gltf"), &root).unwrap()[0].starts_with("the file uses"));
+        assert!(lines("s.gltf", &root).unwrap()[0]
+            .contains("KHR_x on 1 file: the extension is ignored (the file)"));
         let mesh = json!({"extensionsUsed": ["KHR_x"], "meshes": [{"primitives": [{"extensions": {"KHR_x": {}}}]}]});
-        assert!(check(Path::new("s.gltf"), &mesh).unwrap()[0].starts_with("mesh 0 uses"));
+        assert!(lines("s.gltf", &mesh).unwrap()[0].ends_with("(mesh 0)"));
+        let other = json!({"extensionsUsed": ["KHR_x"], "things": [{"extensions": {"KHR_x": {}}}]});
+        assert!(lines("s.gltf", &other).unwrap()[0]
+            .contains("on 1 element: the extension is ignored (things 0)"));
     }
 }
 

@@ -139,15 +139,15 @@ impl Loader<'_> {
         validate::material(m).map_err(|r| self.bad(&element, r))?;
         let pbr = m.pbr_metallic_roughness();
         let base_color_texture = match pbr.base_color_texture() {
-            Some(info) => Some(self.texture(&info, ColorSpace::Srgb, &element)?),
+            Some(info) => self.texture(&info, ColorSpace::Srgb, &element)?,
             None => None,
         };
         let mr_texture = match pbr.metallic_roughness_texture() {
-            Some(info) => Some(self.texture(&info, ColorSpace::Linear, &element)?),
+            Some(info) => self.texture(&info, ColorSpace::Linear, &element)?,
             None => None,
         };
         let emission_texture = match m.emissive_texture() {
-            Some(info) => Some(self.texture(&info, ColorSpace::Srgb, &element)?),
+            Some(info) => self.texture(&info, ColorSpace::Srgb, &element)?,
             None => None,
         };
         let normal_map = match m.normal_texture() {
@@ -158,26 +158,26 @@ impl Loader<'_> {
                         self.bad(element, format!("normalTexture.scale {scale} is invalid"))
                     );
                 }
-                Some(NormalMap {
-                    texture: {
-                        let transform = info
-                            .extension_value("KHR_texture_transform")
-                            .map(UvTransform::from_json)
-                            .transpose()
-                            .map_err(|e| self.bad(format!("{element}, normalTexture"), e))?;
-                        self.texture_of(
-                            &info.texture(),
-                            info.tex_coord(),
-                            transform,
-                            ColorSpace::Linear,
-                            &element,
-                        )?
-                    },
-                    scale,
-                })
+                let transform = info
+                    .extension_value("KHR_texture_transform")
+                    .map(UvTransform::from_json)
+                    .transpose()
+                    .map_err(|e| self.bad(format!("{element}, normalTexture"), e))?;
+                let texture = self.texture_of(
+                    &info.texture(),
+                    info.tex_coord(),
+                    transform,
+                    ColorSpace::Linear,
+                    &element,
+                )?;
+                texture.map(|texture| NormalMap { texture, scale })
             }
             None => None,
         };
+        if m.occlusion_texture().is_some() {
+            let without = "ignored: the path tracer computes occlusion itself";
+            self.warn("occlusionTexture", "material", &element, without);
+        }
         let emission = Vec3::from(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0);
         if !emission.is_finite() || emission.min_element() < 0.0 {
             return Err(self.bad(element, format!("emission {emission} is invalid")));
@@ -204,6 +204,19 @@ impl Loader<'_> {
         };
         let extras = self.streaks_extras(m, &element)?;
         let road = extras.as_ref().is_some_and(|x| x.road);
+        if m.extension_value("KHR_materials_unlit").is_some() {
+            // Seen as its base colour: an emitter of that radiance that reflects nothing.
+            return Ok(Material {
+                name,
+                reflectance: Reflectance::Unlit,
+                emission: base.truncate(),
+                emission_texture: base_color_texture,
+                normal_map: None,
+                double_sided: m.double_sided(),
+                alpha,
+                road,
+            });
+        }
         let reflectance = match extras.filter(|x| x.bsdf.is_some()) {
             Some(x) => self.paper(x, base_color_texture, mr_texture, &element)?,
             None => {
@@ -280,11 +293,11 @@ impl Loader<'_> {
             ));
         }
         let texture = match sp.specular_texture() {
-            Some(info) => Some(self.texture(&info, ColorSpace::Linear, element)?),
+            Some(info) => self.texture(&info, ColorSpace::Linear, element)?,
             None => None,
         };
         let color_texture = match sp.specular_color_texture() {
-            Some(info) => Some(self.texture(&info, ColorSpace::Srgb, element)?),
+            Some(info) => self.texture(&info, ColorSpace::Srgb, element)?,
             None => None,
         };
         Ok(Specular {
@@ -313,10 +326,13 @@ impl Loader<'_> {
         let roughness = c.clearcoat_roughness_factor;
         self.unit_factor((NAME, "clearcoatRoughnessFactor"), roughness, element)?;
         if c.clearcoat_normal_texture.is_some() {
-            self.warn(format!(
-                "{element}: {NAME} clearcoatNormalTexture is not used; the clear coat is \
-                 shaded with the base's normal"
-            ));
+            let without = "the clear coat is shaded with the base's normal";
+            self.warn(
+                "KHR_materials_clearcoat clearcoatNormalTexture",
+                "material",
+                element,
+                without,
+            );
         }
         let (info, key) = (c.clearcoat_texture, (NAME, "clearcoatTexture"));
         c.texture = self.extension_texture(document, key, info, element)?;
@@ -380,10 +396,14 @@ impl Loader<'_> {
             return Ok(None);
         }
         if v.thickness_texture.is_some() {
-            self.warn(format!(
-                "{element}: KHR_materials_volume thicknessTexture is not used; the volume's \
-                 thickness is the distance the path travels inside the closed mesh"
-            ));
+            let without =
+                "the volume's thickness is the distance the path travels inside the closed mesh";
+            self.warn(
+                "KHR_materials_volume thicknessTexture",
+                "material",
+                element,
+                without,
+            );
         }
         Ok(Some(Volume::new(
             v.thickness_factor,
@@ -443,8 +463,7 @@ impl Loader<'_> {
             return Err(self.bad(element, why));
         };
         let space = ColorSpace::Linear;
-        let id = self.texture_of(&texture, info.tex_coord, info.transform, space, element)?;
-        Ok(Some(id))
+        self.texture_of(&texture, info.tex_coord, info.transform, space, element)
     }
 
     pub(super) fn streaks_extras(
@@ -566,6 +585,64 @@ mod tests {
     use crate::scene::Scene;
     use glam::{Vec2, Vec3};
     use serde_json::json;
+
+    /// KHR_materials_unlit (required by the file): the camera sees the base colour times the
+    /// vertex colour, exactly, whatever the lights; the surface reflects nothing.
+    #[test]
+    fn unlit_pixels_are_the_base_colour() {
+        use super::super::test_docs::Doc;
+        use crate::integrator::{render, Layers, RenderJob};
+        use streaks_settings::RenderSettings;
+        let mut d = Doc::default();
+        // A quad of side 4 in z = 0 facing +Z, COLOR_0 grey 0.5; the camera 1 m in front.
+        let pos = d.floats(
+            &[-2., -2., 0., 2., -2., 0., 2., 2., 0., -2., 2., 0.],
+            "VEC3",
+            3,
+        );
+        let col = d.floats(&[0.5, 0.5, 0.5].repeat(4), "VEC3", 3);
+        let idx = d.indices(&[0, 1, 2, 0, 2, 3]);
+        let base = [1.0, 0.217_637_64, 0.0];
+        let doc = json!({
+            "asset": {"version": "2.0"},
+            "extensionsUsed": ["KHR_materials_unlit", "KHR_lights_punctual"],
+            "extensionsRequired": ["KHR_materials_unlit"],
+            "scenes": [{"nodes": [0, 1, 2]}],
+            "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, 1]},
+                {"translation": [0, 0, 0.5], "extensions": {"KHR_lights_punctual": {"light": 0}}}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": pos, "COLOR_0": col},
+                "indices": idx, "material": 0}]}],
+            "materials": [{"name": "orange", "emissiveFactor": [1, 1, 1],
+                "pbrMetallicRoughness": {"baseColorFactor": [base[0], base[1], base[2], 1]},
+                "extensions": {"KHR_materials_unlit": {}}}],
+            "cameras": [{"type": "perspective", "perspective": {"yfov": 0.5, "znear": 0.1}}],
+            "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 1e5}]}},
+            "buffers": [{"byteLength": d.bin.len()}],
+            "bufferViews": d.views,
+            "accessors": d.accessors
+        });
+        let dir = tempfile::tempdir().unwrap();
+        let scene = Scene::load(&write_embedded(dir.path(), doc, &d.bin)).unwrap();
+        assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+        assert_eq!(scene.materials[0].reflectance, Reflectance::Unlit);
+        let expected = Vec3::from(base) * 0.5;
+        for max_depth in [1, 8] {
+            let job = RenderJob {
+                width: 6,
+                height: 4,
+                seed: 1,
+                layers: Layers::default(),
+                settings: RenderSettings::new(4, max_depth),
+            };
+            let out = render(&scene, scene.camera(None).unwrap(), &job, &|_| {});
+            for p in &out.image.pixels {
+                assert!(
+                    (*p - expected).abs().max_element() < 1e-5,
+                    "{p} vs {expected}"
+                );
+            }
+        }
+    }
 
     #[test]
     fn road_materials_are_flagged_with_or_without_a_paper_model() {
@@ -703,7 +780,7 @@ mod tests {
         assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
         assert!(
             scene.warnings[0].contains("material \"glow\" (1)")
-                && scene.warnings[0].contains("clearcoatNormalTexture is not used"),
+                && scene.warnings[0].contains("clearcoatNormalTexture on 1 material"),
             "{:?}",
             scene.warnings
         );
@@ -808,7 +885,7 @@ mod tests {
         assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
         assert!(
             scene.warnings[0].contains("material \"glow\" (1)")
-                && scene.warnings[0].contains("thicknessTexture is not used"),
+                && scene.warnings[0].contains("thicknessTexture on 1 material"),
             "{:?}",
             scene.warnings
         );

@@ -28,8 +28,24 @@ pub(super) fn triangulate(mode: Mode, idx: &[u32]) -> Vec<[u32; 3]> {
     }
 }
 
+/// The pose a mesh is placed in: the morph weights (weight i scales target i's deltas;
+/// missing weights are 0) and, for a skinned placement, the skin's joint matrices (each
+/// joint's world transform times its inverse bind matrix; empty: unskinned).
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Pose<'a> {
+    pub(super) weights: &'a [f32],
+    pub(super) joints: &'a [Mat4],
+}
+
 impl Loader<'_> {
-    pub(super) fn mesh(&mut self, mesh: &gltf::Mesh, world: Mat4) -> Result<(), SceneError> {
+    /// Adds `mesh` placed by `world` to the scene's world triangles, in `pose`: its morph
+    /// weights first, then its skin.
+    pub(super) fn mesh(
+        &mut self,
+        mesh: &gltf::Mesh,
+        world: Mat4,
+        pose: Pose,
+    ) -> Result<(), SceneError> {
         let normal_matrix = Mat3::from_mat4(world).inverse().transpose();
         let flip = world.determinant() < 0.0;
         for prim in mesh.primitives() {
@@ -39,7 +55,9 @@ impl Loader<'_> {
                 mode,
                 Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
             ) {
-                self.warn(format!("{element}: skipped {mode:?} primitive"));
+                let element = format!("{element} ({mode:?})");
+                let without = "skipped: only triangles are rendered";
+                self.warn("point and line primitives", "primitive", &element, without);
                 continue;
             }
             let Some(pos_acc) = prim.get(&gltf::Semantic::Positions) else {
@@ -56,24 +74,32 @@ impl Loader<'_> {
                     ],
                 )?;
             }
-            let positions: Vec<Vec3> = self
+            let mut positions: Vec<Vec3> = self
                 .attribute(&pos_acc, &element, "POSITION", accessors::POSITION, None)?
                 .into_iter()
                 .map(Vec3::from)
                 .collect();
             let n = positions.len();
-            let normals: Vec<Vec3> = match prim.get(&gltf::Semantic::Normals) {
+            let mut normals: Vec<Vec3> = match prim.get(&gltf::Semantic::Normals) {
                 Some(a) => self
                     .attribute(&a, &element, "NORMAL", accessors::DIRECTION, Some(n))?
                     .into_iter()
-                    .map(|v: [f32; 3]| {
-                        (normal_matrix * Vec3::from(v))
-                            .try_normalize()
-                            .unwrap_or(Vec3::ZERO)
-                    })
+                    .map(Vec3::from)
                     .collect(),
                 None => vec![Vec3::ZERO; n],
             };
+            let tangent_deltas =
+                self.morph(&prim, &element, pose.weights, &mut positions, &mut normals)?;
+            let skin = self.skin(&prim, &element, pose.joints, n)?;
+            if let Some(skin) = &skin {
+                for ((p, v), m) in positions.iter_mut().zip(&mut normals).zip(skin) {
+                    *p = m.transform_point3(*p);
+                    *v = Mat3::from_mat4(*m).inverse().transpose() * *v;
+                }
+            }
+            for v in &mut normals {
+                *v = (normal_matrix * *v).try_normalize().unwrap_or(Vec3::ZERO);
+            }
             let uvs: Vec<Vec2> = match prim.get(&gltf::Semantic::TexCoords(0)) {
                 Some(a) => self
                     .attribute(&a, &element, "TEXCOORD_0", accessors::TEXCOORD, Some(n))?
@@ -93,7 +119,17 @@ impl Loader<'_> {
                 .filter(|_| normal_mapped);
             let file_tangents: Option<Vec<[f32; 4]>> = match &tangent_acc {
                 Some(a) if has_normals => {
-                    Some(self.attribute(a, &element, "TANGENT", accessors::DIRECTION, Some(n))?)
+                    let mut t: Vec<[f32; 4]> =
+                        self.attribute(a, &element, "TANGENT", accessors::DIRECTION, Some(n))?;
+                    for (t, d) in t.iter_mut().zip(tangent_deltas.iter().flatten()) {
+                        let moved = Vec3::new(t[0], t[1], t[2]) + *d;
+                        (t[0], t[1], t[2]) = (moved.x, moved.y, moved.z);
+                    }
+                    for (t, m) in t.iter_mut().zip(skin.iter().flatten()) {
+                        let moved = m.transform_vector3(Vec3::new(t[0], t[1], t[2]));
+                        (t[0], t[1], t[2]) = (moved.x, moved.y, moved.z);
+                    }
+                    Some(t)
                 }
                 _ => None,
             };
@@ -141,10 +177,12 @@ impl Loader<'_> {
             }
             let mut tris = triangulate(mode, &indices);
             if mode == Mode::Triangles && indices.len() % 3 != 0 {
-                self.warn(format!(
-                    "{element}: {} indices is not a multiple of 3; the rest is ignored",
-                    indices.len()
-                ));
+                self.warn(
+                    "a triangle index count that is not a multiple of 3",
+                    "primitive",
+                    &element,
+                    "the indices after the last whole triangle are ignored",
+                );
             }
             let material = match prim.material().index() {
                 Some(i) => i as u32,
@@ -204,10 +242,12 @@ impl Loader<'_> {
                     .texture_refs()
                     .any(|t| t.texcoord == 1)
             {
-                self.warn(format!(
-                    "{element}: its material reads TEXCOORD_1, which the primitive does not \
-                     have; TEXCOORD_0 is read instead"
-                ));
+                self.warn(
+                    "a material reading TEXCOORD_1 the primitive does not have",
+                    "primitive",
+                    &element,
+                    "TEXCOORD_0 is read instead",
+                );
             }
             let first = self.parts.mesh.positions.len();
             if first + positions.len() > u32::MAX as usize {
@@ -257,6 +297,105 @@ impl Loader<'_> {
         Ok(())
     }
 
+    /// Moves a primitive's object-space `positions` and `normals` to the pose of the morph
+    /// `weights`: each target i adds weight i times its POSITION and NORMAL deltas (glTF 2.0,
+    /// "Morph Targets"; normals are renormalised later). Returns the sum of the weighted
+    /// TANGENT deltas, for the file's tangents, where a target has them. A target without a
+    /// weight, or with weight 0, is not read; a non-finite weight is an error.
+    fn morph(
+        &self,
+        prim: &gltf::Primitive,
+        element: &str,
+        weights: &[f32],
+        positions: &mut [Vec3],
+        normals: &mut [Vec3],
+    ) -> Result<Option<Vec<Vec3>>, SceneError> {
+        let n = positions.len();
+        let mut tangents: Option<Vec<Vec3>> = None;
+        for (i, target) in prim.morph_targets().enumerate() {
+            let w = weights.get(i).copied().unwrap_or(0.0);
+            if !w.is_finite() {
+                let why = format!("morph target {i}'s weight {w} is not finite");
+                return Err(self.bad(element, why));
+            }
+            if w == 0.0 {
+                continue;
+            }
+            let add = |out: &mut [Vec3], deltas: Vec<[f32; 3]>| {
+                for (v, d) in out.iter_mut().zip(deltas) {
+                    *v += w * Vec3::from(d);
+                }
+            };
+            let name = |attribute: &str| format!("morph target {i} {attribute}");
+            if let Some(a) = target.positions() {
+                let name = name("POSITION");
+                add(
+                    positions,
+                    self.attribute(&a, element, &name, accessors::POSITION, Some(n))?,
+                );
+            }
+            // Normal deltas only where the primitive has normals (else they are the face's).
+            if let Some(a) = target
+                .normals()
+                .filter(|_| prim.get(&gltf::Semantic::Normals).is_some())
+            {
+                let name = name("NORMAL");
+                add(
+                    normals,
+                    self.attribute(&a, element, &name, accessors::DIRECTION, Some(n))?,
+                );
+            }
+            if let Some(a) = target.tangents() {
+                let name = name("TANGENT");
+                let deltas = self.attribute(&a, element, &name, accessors::DIRECTION, Some(n))?;
+                add(tangents.get_or_insert_with(|| vec![Vec3::ZERO; n]), deltas);
+            }
+        }
+        Ok(tangents)
+    }
+
+    /// The skinning matrix of each of a primitive's `n` vertices, `sum_k w_k * joints[j_k]`
+    /// over its JOINTS_s / WEIGHTS_s sets (glTF 2.0, "Skins"; `joints` are the skin's joint
+    /// matrices, world times inverse bind matrix); `None` for an unskinned placement (no
+    /// joints). A joint index past the skin's joints, or a skinned placement of a primitive
+    /// without JOINTS_0 and WEIGHTS_0, is an error.
+    fn skin(
+        &self,
+        prim: &gltf::Primitive,
+        element: &str,
+        joints: &[Mat4],
+        n: usize,
+    ) -> Result<Option<Vec<Mat4>>, SceneError> {
+        if joints.is_empty() {
+            return Ok(None);
+        }
+        let mut skin = vec![Mat4::ZERO; n];
+        let mut set = 0;
+        while let (Some(j), Some(w)) = (
+            prim.get(&gltf::Semantic::Joints(set)),
+            prim.get(&gltf::Semantic::Weights(set)),
+        ) {
+            let (jn, wn) = (format!("JOINTS_{set}"), format!("WEIGHTS_{set}"));
+            let indices = self.attribute::<4>(&j, element, &jn, accessors::JOINTS, Some(n))?;
+            let weights = self.attribute::<4>(&w, element, &wn, accessors::COLOR, Some(n))?;
+            for ((m, js), ws) in skin.iter_mut().zip(indices).zip(weights) {
+                for (j, w) in js.into_iter().zip(ws).filter(|&(_, w)| w != 0.0) {
+                    let Some(joint) = joints.get(j as usize) else {
+                        let why = format!("joint {j} is not one of the skin's {}", joints.len());
+                        return Err(self.bad(format!("{element}, {jn}"), why));
+                    };
+                    *m += *joint * w;
+                }
+            }
+            set += 1;
+        }
+        if set == 0 {
+            let why = "is skinned (its node has a skin) but has no JOINTS_0 and WEIGHTS_0";
+            return Err(self.bad(element, why));
+        }
+        Ok(Some(skin))
+    }
+
     /// The generated tangents of a normal-mapped primitive without usable TANGENT (see
     /// [`tangents`]): MikkTSpace's from the world-space `positions`, `normals` (zero: the face
     /// normal) and `uvs`, which may renumber `tris` to duplicated vertices (the second value
@@ -274,25 +413,35 @@ impl Loader<'_> {
     ) -> (Vec<Vec4>, Vec<u32>) {
         let (has_tangents, has_uvs) = has;
         if !has_uvs {
-            self.warn(format!(
-                "{element}: its material has a normal texture but the primitive has no \
-                 TEXCOORD_0; rendered without the normal map"
-            ));
+            self.warn(
+                "a normal texture on a primitive without TEXCOORD_0",
+                "primitive",
+                element,
+                "rendered without the normal map",
+            );
             return (vec![Vec4::ZERO; positions.len()], Vec::new());
         }
         if has_tangents {
-            self.warn(format!(
-                "{element}: has TANGENT but no NORMAL; the tangents are ignored and generated \
-                 from flat normals, as the glTF specification says"
-            ));
+            self.warn(
+                "TANGENT without NORMAL",
+                "primitive",
+                element,
+                "the tangents are ignored and generated from flat normals, as the glTF \
+                 specification says",
+            );
         }
         tangents::generate(positions, normals, uvs, tris).unwrap_or_else(|valence| {
-            self.warn(format!(
-                "{element}: a vertex is shared by {valence} triangles, more than MikkTSpace can \
-                 take ({}: it recurses once per triangle around a vertex); rendered without \
-                 the normal map",
+            let what = format!(
+                "a vertex shared by more triangles than MikkTSpace can take ({}: it recurses \
+                 once per triangle around a vertex; here {valence})",
                 tangents::MAX_VALENCE
-            ));
+            );
+            self.warn(
+                &what,
+                "primitive",
+                element,
+                "rendered without the normal map",
+            );
             (vec![Vec4::ZERO; positions.len()], Vec::new())
         })
     }
@@ -301,16 +450,132 @@ impl Loader<'_> {
 #[cfg(test)]
 mod tests {
     use super::super::test_docs::{
-        add_tangent, error, load_doc, load_err, normal_mapped_doc, png_uri, quad_normal, test_doc,
-        with, write_embedded,
+        add_accessor, add_tangent, add_vec3s, error, load_doc, load_err, normal_mapped_doc,
+        png_uri, quad_normal, test_doc, with, write_embedded,
     };
     use super::*;
 
     use crate::scene::Scene;
-    use glam::Vec3;
+    use glam::{Mat4, Vec3};
     use serde_json::json;
 
     use std::time::{Duration, Instant};
+
+    /// Skins in the rest pose: each vertex is moved by its weighted joint matrices (the
+    /// joints' world transforms times their inverse bind matrices), and the skinned mesh
+    /// node's own transform is ignored.
+    #[test]
+    fn skins_place_vertices_by_their_joints() {
+        let (mut doc, mut bin) = test_doc();
+        // The lamp's triangle (0,0,0), (1,0,0), (0,1,0): vertex 0 on joint 0, vertex 1 on
+        // joint 1, vertex 2 half on each.
+        let joints: Vec<u8> = [0, 1, 0, 0].repeat(3);
+        let j = add_accessor(&mut doc, &mut bin, &joints, (5121, 3, "VEC4"));
+        let weights = [1f32, 0., 0., 0., 0., 1., 0., 0., 0.5, 0.5, 0., 0.];
+        let bytes: Vec<u8> = weights.iter().flat_map(|f| f.to_le_bytes()).collect();
+        let w = add_accessor(&mut doc, &mut bin, &bytes, (5126, 3, "VEC4"));
+        // Joint 0's inverse bind matrix is the identity, joint 1's a translation by +X.
+        let ibm: Vec<f32> = Mat4::IDENTITY
+            .to_cols_array()
+            .into_iter()
+            .chain(Mat4::from_translation(Vec3::X).to_cols_array())
+            .collect();
+        let bytes: Vec<u8> = ibm.iter().flat_map(|f| f.to_le_bytes()).collect();
+        let m = add_accessor(&mut doc, &mut bin, &bytes, (5126, 2, "MAT4"));
+        let attributes = &mut doc["meshes"][1]["primitives"][0]["attributes"];
+        attributes["JOINTS_0"] = json!(j);
+        attributes["WEIGHTS_0"] = json!(w);
+        // Joint 0 at (0, 5, 0) under the node "bulb" (1, 2, 3): (1, 7, 3); joint 1 at the
+        // origin. The lamp node's translation (0, 0, -3) is ignored.
+        let nodes = doc["nodes"].as_array_mut().unwrap();
+        nodes.push(json!({"name": "bone0", "translation": [0, 5, 0]}));
+        nodes.push(json!({"name": "bone1"}));
+        nodes[4]["children"] = json!([7]);
+        doc["scenes"][0]["nodes"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!(8));
+        doc["nodes"][2]["skin"] = json!(0);
+        doc["skins"] = json!([{"joints": [7, 8], "inverseBindMatrices": m}]);
+        let scene = load_doc(doc.clone(), &bin);
+        assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+        let expected = [
+            Vec3::new(1.0, 7.0, 3.0),
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(1.0, 4.5, 1.5),
+        ];
+        for (got, want) in scene.mesh.positions[4..].iter().zip(expected) {
+            assert!((*got - want).length() < 1e-5, "{got} != {want}");
+        }
+        // A joint index past the skin's joints names the attribute.
+        doc["skins"][0]["joints"] = json!([7]);
+        doc["skins"][0]
+            .as_object_mut()
+            .unwrap()
+            .remove("inverseBindMatrices");
+        let err = load_err(doc.clone(), &bin);
+        assert!(err.contains("JOINTS_0") && err.contains("joint 1"), "{err}");
+        // A joint outside the scene names the skin.
+        doc["skins"][0]["joints"] = json!([7, 6]);
+        doc["scenes"][0]["nodes"] = json!([0, 2, 3, 4, 5]);
+        let err = load_err(doc, &bin);
+        assert!(
+            err.contains("skin 0 of node \"lamp\" (2)") && err.contains("\"sun\""),
+            "{err}"
+        );
+    }
+
+    /// Morph targets in the specification's default pose: each vertex moves by the sum of
+    /// the weights times the targets' deltas, the weights being the node's, else the mesh's;
+    /// two nodes placing one morphed mesh each get their own pose.
+    #[test]
+    fn morph_targets_take_the_default_weights() {
+        let (mut doc, mut bin) = test_doc();
+        // The lamp's triangle (0,0,0), (1,0,0), (0,1,0) at z = -3: target 0 lifts every vertex
+        // by +Z, target 1 moves vertex 0 by +X and has NORMAL deltas.
+        let up = add_vec3s(&mut doc, &mut bin, &[0., 0., 1.].repeat(3));
+        let side = add_vec3s(&mut doc, &mut bin, &[1., 0., 0., 0., 0., 0., 0., 0., 0.]);
+        let nrm = add_vec3s(&mut doc, &mut bin, &[0.; 9]);
+        doc["meshes"][1]["primitives"][0]["targets"] =
+            json!([{"POSITION": up}, {"POSITION": side, "NORMAL": nrm}]);
+        doc["meshes"][1]["weights"] = json!([0.5, 0.25]);
+        // A second placement of the same mesh whose node has its own weights.
+        doc["nodes"].as_array_mut().unwrap().push(
+            json!({"name": "lamp2", "mesh": 1, "translation": [0, 0, -10], "weights": [1, 0]}),
+        );
+        doc["scenes"][0]["nodes"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!(7));
+        let scene = load_doc(doc.clone(), &bin);
+        assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+        // The quad's 4 vertices first, then the lamp's 3, then lamp2's 3.
+        let p = &scene.mesh.positions;
+        assert_eq!(p.len(), 10);
+        let expected = [
+            Vec3::new(0.25, 0.0, -2.5),
+            Vec3::new(1.0, 0.0, -2.5),
+            Vec3::new(0.0, 1.0, -2.5),
+            Vec3::new(0.0, 0.0, -9.0),
+            Vec3::new(1.0, 0.0, -9.0),
+            Vec3::new(0.0, 1.0, -9.0),
+        ];
+        for (got, want) in p[4..].iter().zip(expected) {
+            assert!((*got - want).length() < 1e-6, "{got} != {want}");
+        }
+        // No weights anywhere: the base shape.
+        let mut rest = doc.clone();
+        rest["meshes"][1].as_object_mut().unwrap().remove("weights");
+        let scene = load_doc(rest, &bin);
+        assert!((scene.mesh.positions[4] - Vec3::new(0.0, 0.0, -3.0)).length() < 1e-6);
+        // A weight beyond f32's range is an error naming the primitive.
+        doc["meshes"][1]["weights"] = json!([1e39, 0]);
+        let err = load_err(doc, &bin);
+        assert!(
+            err.contains("mesh \"tri\" (1), primitive 0") && err.contains("weight"),
+            "{err}"
+        );
+    }
 
     #[test]
     fn index_out_of_range_is_an_error() {
@@ -334,11 +599,11 @@ mod tests {
         assert_eq!(scene.mesh.triangles.len(), 2);
         assert_eq!(scene.warnings.len(), 1);
         assert!(
-            scene.warnings[0].contains("mesh \"tri\" (1), primitive 0"),
+            scene.warnings[0].contains("(mesh \"tri\" (1), primitive 0 (Points))"),
             "{:?}",
             scene.warnings
         );
-        assert!(scene.warnings[0].contains("Points"));
+        assert!(scene.warnings[0].contains("point and line primitives on 1 primitive: skipped"));
     }
 
     #[test]
@@ -431,7 +696,7 @@ mod tests {
             scene
                 .warnings
                 .iter()
-                .any(|w| w.contains("TANGENT but no NORMAL")),
+                .any(|w| w.contains("TANGENT without NORMAL")),
             "{:?}",
             scene.warnings
         );
@@ -444,7 +709,10 @@ mod tests {
         attributes.as_object_mut().unwrap().remove("TANGENT");
         let scene = load_doc(doc, &bin);
         assert!(
-            scene.warnings.iter().any(|w| w.contains("no TEXCOORD_0")),
+            scene
+                .warnings
+                .iter()
+                .any(|w| w.contains("without TEXCOORD_0")),
             "{:?}",
             scene.warnings
         );

@@ -9,11 +9,13 @@
 //!
 //! Instancing: the scene's nodes are walked first and every placement of a mesh recorded (a
 //! node with a mesh, or each instance of a node's EXT_mesh_gpu_instancing, whose TRANSLATION,
-//! ROTATION and SCALE attributes give `node world * T * R * S`). A mesh placed more than once
-//! and without an emissive material is loaded once in object space (its MikkTSpace tangents,
+//! ROTATION and SCALE attributes give `node world * T * R * S`). A mesh placed more than once,
+//! without an emissive material and without morph targets is loaded once in object space (its
+//! MikkTSpace tangents,
 //! if generated, from the object-space positions) and becomes instances
 //! ([`super::Instances`]); every other placement is flattened into world triangles, in the
-//! order of the walk.
+//! order of the walk. Morph targets are applied with the default weights (the placing node's
+//! `weights`, else the mesh's), as the specification's default pose.
 //!
 //! One file per concept:
 //!
@@ -32,6 +34,7 @@
 //! - `textures`: texture infos, KHR_texture_transform, samplers, images;
 //! - [`extensions`]: which extensions are honoured, and the ones that are not a material's
 //!   field: KHR_lights_punctual (and the file's light units), EXT_mesh_gpu_instancing;
+//! - `warnings`: the warnings, gathered by feature so that each is named once per file;
 //! - `test_docs` (tests only): the documents the tests build, write and load;
 //! - this file: the [`Loader`] state the others add to, and the labels errors name elements by.
 
@@ -46,6 +49,7 @@ mod nodes;
 #[cfg(test)]
 mod test_docs;
 mod textures;
+mod warnings;
 
 pub(super) use document::load;
 pub use nodes::{MAX_PLACEMENTS, MAX_TRIANGLES};
@@ -57,6 +61,7 @@ use extensions::LightUnits;
 use glam::{Mat4, Vec3};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use warnings::Warnings;
 
 fn node_label(node: &gltf::Node) -> String {
     match node.name() {
@@ -88,14 +93,20 @@ struct Loader<'a> {
     files: &'a Files<'a>,
     buffers: Vec<gltf::buffer::Data>,
     parts: SceneParts,
-    /// Decoded textures by (image index, colour space).
-    textures: HashMap<(usize, ColorSpace), TextureId>,
+    /// Decoded textures by (image index, colour space); `None` for an image that is not
+    /// decoded (KTX2).
+    textures: HashMap<(usize, ColorSpace), Option<TextureId>>,
     /// Index of the glTF default material, once a primitive needs it.
     default_material: Option<u32>,
     /// What KHR_lights_punctual's intensities are in.
     light_units: LightUnits,
-    /// Every placement of a mesh in the walk's order: mesh index and world transform.
-    placements: Vec<(usize, Mat4)>,
+    /// Every placement of a mesh in the walk's order: mesh index, world transform and the
+    /// index of the node that places it (whose morph weights apply).
+    placements: Vec<(usize, Mat4, usize)>,
+    /// What the file uses that is skipped or rendered differently, by feature.
+    warnings: Warnings,
+    /// Each node's world transform, once the walk has reached it (joints of skins).
+    node_worlds: Vec<Option<Mat4>>,
     /// The bounding box of each primitive loaded so far, in the space it was loaded in (world,
     /// or object space while an instanced mesh is loaded), for the default camera.
     primitive_boxes: Vec<[Vec3; 2]>,
@@ -106,9 +117,9 @@ impl Loader<'_> {
         SceneError::invalid(self.path, element, reason)
     }
 
-    fn warn(&mut self, msg: String) {
-        self.parts
-            .warnings
-            .push(format!("{}: {msg}", self.path.display()));
+    /// Records that `element`, of kind `kind` (`material`, `primitive`), uses `what`, which is
+    /// rendered `without`; see [`Warnings::add`].
+    fn warn(&mut self, what: &str, kind: &'static str, element: &str, without: &str) {
+        self.warnings.add(what, kind, element, without);
     }
 }

@@ -1,7 +1,8 @@
 //! The node walk and what it places: node transforms, cameras, the limits on placements and
 //! triangles, and each mesh flattened into world triangles or stored once as instances.
 
-use super::{mesh_label, node_label, Loader};
+use super::meshes::Pose;
+use super::{accessors, mesh_label, node_label, Loader};
 use crate::camera::Camera;
 use crate::scene::{points_bounds, validate, Instance, SceneError, TriangleMesh};
 use glam::{Affine3A, Mat4, Quat, Vec3, Vec4};
@@ -15,8 +16,8 @@ use std::path::Path;
 pub const MAX_PLACEMENTS: usize = 1_000_000;
 
 /// The most triangles a scene may hold once its meshes are placed: the flattened placements'
-/// (every placement of a mesh placed once, or with an emissive material) and the instanced
-/// meshes' (stored once); counted from the accessors before any geometry is read. About
+/// (every placement of a mesh placed once, or with an emissive material or morph targets) and
+/// the instanced meshes' (stored once); counted from the accessors before any geometry is read. About
 /// 8 GB of scene and BVH; an emissive mesh placed many times would otherwise multiply it.
 pub const MAX_TRIANGLES: usize = 20_000_000;
 
@@ -142,6 +143,11 @@ impl Loader<'_> {
                 format!("world transform is not invertible or not finite: {world:?}"),
             ));
         }
+        // A node reached by several paths keeps its first world transform for the skins whose
+        // joint it is.
+        if let Some(w) = self.node_worlds.get_mut(node.index()) {
+            w.get_or_insert(world);
+        }
         if let Some(mesh) = node.mesh() {
             match node.extension_value("EXT_mesh_gpu_instancing") {
                 Some(ext) => {
@@ -160,14 +166,14 @@ impl Loader<'_> {
                                 format!("world transform is not invertible or not finite: {w:?}"),
                             ));
                         }
-                        self.placements.push((mesh.index(), w));
+                        self.placements.push((mesh.index(), w, node.index()));
                     }
                 }
                 None => {
                     if self.placements.len() >= MAX_PLACEMENTS {
                         return Err(too_many_placements(self.path, node));
                     }
-                    self.placements.push((mesh.index(), world));
+                    self.placements.push((mesh.index(), world, node.index()));
                 }
             }
         }
@@ -180,29 +186,38 @@ impl Loader<'_> {
         Ok(world)
     }
 
-    /// Turns the recorded placements into geometry: a mesh placed more than once and without
-    /// an emissive material is loaded once in object space and placed by instances, every
-    /// other placement is flattened into world triangles (see the module documentation).
+    /// Turns the recorded placements into geometry: a mesh placed more than once, without an
+    /// emissive material and without morph targets is loaded once in object space and placed
+    /// by instances, every other placement is flattened into world triangles (see the module
+    /// documentation); a mesh with morph targets takes the weights of the node that places it,
+    /// else its own (the specification's default pose).
     pub(super) fn place_meshes(&mut self, document: &gltf::Document) -> Result<(), SceneError> {
         let meshes: Vec<gltf::Mesh> = document.meshes().collect();
         let mut count = vec![0usize; meshes.len()];
-        for &(m, _) in &self.placements {
+        for &(m, _, _) in &self.placements {
             count[m] += 1;
         }
-        let emissive: Vec<bool> = meshes
+        // Meshes flattened at every placement: emissive ones (emitters are world triangles),
+        // morphed ones (each placement may have its own weights) and skinned ones.
+        let mut flattened: Vec<bool> = meshes
             .iter()
             .map(|mesh| {
                 mesh.primitives().any(|p| {
-                    p.material()
-                        .index()
-                        .is_some_and(|i| self.parts.materials[i].is_emissive())
+                    p.morph_targets().len() > 0
+                        || p.material()
+                            .index()
+                            .is_some_and(|i| self.parts.materials[i].is_emissive())
                 })
             })
             .collect();
+        let nodes: Vec<gltf::Node> = document.nodes().collect();
+        for &(m, _, node) in &self.placements {
+            flattened[m] |= nodes[node].skin().is_some();
+        }
         // Triangles stored: a flattened mesh's at each placement, an instanced one's once.
         let mut stored = 0usize;
         for (m, mesh) in meshes.iter().enumerate() {
-            let copies = match (count[m], emissive[m]) {
+            let copies = match (count[m], flattened[m]) {
                 (0, _) => 0,
                 (n, true) | (n @ 1, false) => n,
                 (_, false) => 1,
@@ -223,10 +238,22 @@ impl Loader<'_> {
         let mut instanced: Vec<Option<u32>> = vec![None; meshes.len()];
         // The object-space boxes of each instanced mesh's primitives.
         let mut object_boxes: Vec<Vec<[Vec3; 2]>> = Vec::new();
-        for (m, world) in std::mem::take(&mut self.placements) {
+        for (m, world, node) in std::mem::take(&mut self.placements) {
             let mesh = &meshes[m];
-            if count[m] < 2 || emissive[m] {
-                self.mesh(mesh, world)?;
+            if count[m] < 2 || flattened[m] {
+                let node = &nodes[node];
+                let weights = node.weights().or(mesh.weights()).unwrap_or_default();
+                // A skinned mesh is placed by its joints alone: the specification says its
+                // node's own transform is ignored.
+                let (world, joints) = match node.skin() {
+                    Some(skin) => (Mat4::IDENTITY, self.joint_matrices(node, &skin)?),
+                    None => (world, Vec::new()),
+                };
+                let pose = Pose {
+                    weights,
+                    joints: &joints,
+                };
+                self.mesh(mesh, world, pose)?;
                 continue;
             }
             let index = match instanced[m] {
@@ -261,7 +288,8 @@ impl Loader<'_> {
     /// transform, into its own arrays.
     pub(super) fn object_mesh(&mut self, mesh: &gltf::Mesh) -> Result<TriangleMesh, SceneError> {
         let world = std::mem::take(&mut self.parts.mesh);
-        let loaded = self.mesh(mesh, Mat4::IDENTITY);
+        // Meshes with morph targets or skins are never instanced: the rest pose here.
+        let loaded = self.mesh(mesh, Mat4::IDENTITY, Pose::default());
         let mut object = std::mem::replace(&mut self.parts.mesh, world);
         loaded?;
         if !object.tangents.is_empty() {
@@ -269,6 +297,47 @@ impl Loader<'_> {
         }
         object.name = mesh_label(mesh);
         Ok(object)
+    }
+
+    /// The joint matrices of `skin`, used by `node`'s mesh: each joint's world transform (from
+    /// the walk) times its inverse bind matrix (identity without inverseBindMatrices). A joint
+    /// outside the scene, or a non-finite matrix, is an error naming the skin.
+    fn joint_matrices(
+        &self,
+        node: &gltf::Node,
+        skin: &gltf::Skin,
+    ) -> Result<Vec<Mat4>, SceneError> {
+        let element = match skin.name() {
+            Some(n) => format!("skin {n:?} ({}) of {}", skin.index(), node_label(node)),
+            None => format!("skin {} of {}", skin.index(), node_label(node)),
+        };
+        let joints: Vec<gltf::Node> = skin.joints().collect();
+        let inverse_binds: Vec<Mat4> = match skin.inverse_bind_matrices() {
+            Some(a) => {
+                let name = "inverseBindMatrices";
+                self.attribute::<16>(&a, &element, name, accessors::MATRIX, Some(joints.len()))?
+                    .iter()
+                    .map(Mat4::from_cols_array)
+                    .collect()
+            }
+            None => vec![Mat4::IDENTITY; joints.len()],
+        };
+        joints
+            .iter()
+            .zip(inverse_binds)
+            .map(|(joint, inverse_bind)| {
+                let Some(world) = self.node_worlds.get(joint.index()).copied().flatten() else {
+                    let why = format!("its joint {} is not in the scene", node_label(joint));
+                    return Err(self.bad(&element, why));
+                };
+                let m = world * inverse_bind;
+                if !m.is_finite() {
+                    let why = format!("joint {} has a non-finite matrix", node_label(joint));
+                    return Err(self.bad(&element, why));
+                }
+                Ok(m)
+            })
+            .collect()
     }
 
     pub(super) fn camera(

@@ -306,6 +306,35 @@ pub(super) fn quad_normal(scene: &Scene) -> Vec3 {
     scene.intersect(&ray).unwrap().ns
 }
 
+/// Appends `bytes` to the buffer as an accessor of `count` elements of `kind` ("VEC3") and
+/// `component_type` (5126: float); returns its index.
+pub(super) fn add_accessor(
+    doc: &mut Value,
+    bin: &mut Vec<u8>,
+    bytes: &[u8],
+    (component_type, count, kind): (u32, usize, &str),
+) -> usize {
+    let offset = bin.len();
+    bin.extend(bytes);
+    // Each view starts on a 4-byte boundary.
+    bin.resize(bin.len().next_multiple_of(4), 0);
+    let views = doc["bufferViews"].as_array_mut().unwrap();
+    views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": bytes.len()}));
+    let view = views.len() - 1;
+    let accessors = doc["accessors"].as_array_mut().unwrap();
+    accessors.push(json!({"bufferView": view, "componentType": component_type,
+        "count": count, "type": kind}));
+    let index = accessors.len() - 1;
+    doc["buffers"][0]["byteLength"] = json!(bin.len());
+    index
+}
+
+/// Appends `values` to the buffer as a float VEC3 accessor; returns its index.
+pub(super) fn add_vec3s(doc: &mut Value, bin: &mut Vec<u8>, values: &[f32]) -> usize {
+    let bytes: Vec<u8> = values.iter().flat_map(|f| f.to_le_bytes()).collect();
+    add_accessor(doc, bin, &bytes, (5126, values.len() / 3, "VEC3"))
+}
+
 /// Gives the quad a TANGENT attribute of `t` at every vertex.
 pub(super) fn add_tangent(doc: &mut Value, bin: &mut Vec<u8>, t: [f32; 4]) {
     let offset = bin.len();

@@ -74,6 +74,39 @@ impl UvTransform {
     }
 }
 
+/// The first 12 bytes of every KTX2 file: `«KTX 20»\r\n\x1A\n`.
+pub(super) const KTX2_MAGIC: [u8; 12] = [
+    0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A,
+];
+
+/// The warning for KTX2 images: the feature, and how the materials are rendered without them.
+const KTX2_WHAT: &str = "KTX2 (KHR_texture_basisu, not decoded)";
+/// How the materials that use a KTX2 image are rendered (see [`KTX2_WHAT`]).
+const KTX2_WITHOUT: &str =
+    "their textures are left out; the materials are rendered with their factors alone";
+
+/// Gives every texture of the file's JSON that has a KHR_texture_basisu `source` but no core
+/// `source` the extension's, so that its image is found (and, being KTX2, left out with the
+/// KTX2 warning) instead of failing validation. The extension's image is the preferred one and
+/// the core `source` its fallback (the extension's specification); without a decoder the
+/// fallback is what is read, where there is one. Only files that do not require the extension
+/// get here (see [`super::extensions::check`]).
+pub(super) fn basisu_sources(raw: &mut serde_json::Value) {
+    let Some(textures) = raw.get_mut("textures").and_then(|t| t.as_array_mut()) else {
+        return;
+    };
+    for texture in textures.iter_mut().filter_map(|t| t.as_object_mut()) {
+        let source = texture
+            .get("extensions")
+            .and_then(|e| e.get("KHR_texture_basisu"))
+            .and_then(|b| b.get("source"))
+            .cloned();
+        if let Some(source) = source.filter(|_| !texture.contains_key("source")) {
+            texture.insert("source".into(), source);
+        }
+    }
+}
+
 /// What of a glTF sampler the renderer honours: the wrap modes and the magnification filter
 /// (see [`crate::texture`] for why `minFilter` does not change the converged image).
 pub(super) fn sampler(s: &gltf::texture::Sampler) -> Sampler {
@@ -142,13 +175,14 @@ pub(super) fn decode_image(image: image::DynamicImage, space: ColorSpace) -> Opt
 
 impl Loader<'_> {
     /// The reference a material's texture info makes: its image (decoded once per colour
-    /// space), texture coordinate set, sampler and KHR_texture_transform.
+    /// space), texture coordinate set, sampler and KHR_texture_transform; `None` where the
+    /// image is not decoded (KTX2, with a warning: the material keeps its factor).
     pub(super) fn texture(
         &mut self,
         info: &gltf::texture::Info,
         space: ColorSpace,
         material: &str,
-    ) -> Result<TextureRef, SceneError> {
+    ) -> Result<Option<TextureRef>, SceneError> {
         let transform = info.texture_transform().map(UvTransform::from);
         self.texture_of(
             &info.texture(),
@@ -161,7 +195,7 @@ impl Loader<'_> {
 
     /// The reference to `texture` read at TEXCOORD_`tex_coord` through its KHR_texture_transform
     /// `transform`: its image (decoded once per colour space), texture coordinate set, sampler
-    /// and transform.
+    /// and transform; `None` where the image is not decoded (see [`Loader::image`]).
     pub(super) fn texture_of(
         &mut self,
         texture: &gltf::Texture,
@@ -169,7 +203,7 @@ impl Loader<'_> {
         transform: Option<UvTransform>,
         space: ColorSpace,
         material: &str,
-    ) -> Result<TextureRef, SceneError> {
+    ) -> Result<Option<TextureRef>, SceneError> {
         let element = format!("{material}, texture {}", texture.index());
         // KHR_texture_transform's texCoord overrides the texture info's.
         let set = transform
@@ -179,10 +213,9 @@ impl Loader<'_> {
         let texcoord = match set {
             0 | 1 => set as u8,
             _ => {
-                self.warn(format!(
-                    "{element} uses TEXCOORD_{set}; only TEXCOORD_0 and TEXCOORD_1 are read, \
-                     TEXCOORD_0 is used instead"
-                ));
+                let what = format!("TEXCOORD_{set}");
+                let without = "only TEXCOORD_0 and TEXCOORD_1 are read; TEXCOORD_0 is used";
+                self.warn(&what, "texture", &element, without);
                 0
             }
         };
@@ -203,38 +236,39 @@ impl Loader<'_> {
         };
         let sampler = sampler(&texture.sampler());
         let image = self.image(texture, space, material)?;
-        Ok(TextureRef {
-            texture: image,
+        Ok(image.map(|texture| TextureRef {
+            texture,
             texcoord,
             sampler,
             transform,
-        })
+        }))
     }
 
-    /// The decoded image of `texture` in colour space `space`, decoded once.
+    /// The decoded image of `texture` in colour space `space`, decoded once; `None` for a KTX2
+    /// image (found by its content, whatever its MIME type or name say), which is not decoded:
+    /// one warning names every such image, and the materials keep their factors. A KTX2 image
+    /// in a file that requires KHR_texture_basisu never gets here (the extension check fails
+    /// the file).
     pub(super) fn image(
         &mut self,
         texture: &gltf::Texture,
         space: ColorSpace,
         material: &str,
-    ) -> Result<TextureId, SceneError> {
+    ) -> Result<Option<TextureId>, SceneError> {
         let image = texture.source();
         let key = (image.index(), space);
         if let Some(&id) = self.textures.get(&key) {
             return Ok(id);
         }
-        let element = match image.source() {
-            gltf::image::Source::Uri { uri, .. } => format!(
-                "{material}, image {} ({})",
-                image.index(),
-                uri_label(&self.base, uri)
-            ),
-            gltf::image::Source::View { view, .. } => format!(
-                "{material}, image {} (bufferView {})",
-                image.index(),
-                view.index()
-            ),
+        let image_label = match image.source() {
+            gltf::image::Source::Uri { uri, .. } => {
+                format!("image {} ({})", image.index(), uri_label(&self.base, uri))
+            }
+            gltf::image::Source::View { view, .. } => {
+                format!("image {} (bufferView {})", image.index(), view.index())
+            }
         };
+        let element = format!("{material}, {image_label}");
         let (bytes, mime) = match image.source() {
             gltf::image::Source::Uri { uri, mime_type } => {
                 match self
@@ -257,6 +291,11 @@ impl Loader<'_> {
                 (bytes.to_vec(), Some(mime_type.to_string()))
             }
         };
+        if bytes.starts_with(&KTX2_MAGIC) {
+            self.warn(KTX2_WHAT, "image", &image_label, KTX2_WITHOUT);
+            self.textures.insert(key, None);
+            return Ok(None);
+        }
         // glTF images are PNG or JPEG: by their content, else by their MIME type.
         let format = match (image::guess_format(&bytes), mime.as_deref()) {
             (Ok(f @ (image::ImageFormat::Png | image::ImageFormat::Jpeg)), _) => f,
@@ -271,8 +310,8 @@ impl Loader<'_> {
             .ok_or_else(|| self.bad(&element, "pixel data does not match its size"))?;
         let id = self.parts.textures.len() as TextureId;
         self.parts.textures.push(texture);
-        self.textures.insert(key, id);
-        Ok(id)
+        self.textures.insert(key, Some(id));
+        Ok(Some(id))
     }
 }
 
@@ -287,6 +326,132 @@ mod tests {
     use crate::scene::Scene;
     use glam::{Vec2, Vec3};
     use serde_json::json;
+
+    /// A KTX2 file: the magic, then bytes that are no image (the loader never decodes them).
+    fn ktx2_bytes() -> Vec<u8> {
+        let mut bytes = KTX2_MAGIC.to_vec();
+        bytes.extend([0u8; 68]);
+        bytes
+    }
+
+    /// The base colour texture of material `m` of `scene`, if it has one.
+    fn base_texture(scene: &Scene, m: usize) -> Option<TextureRef> {
+        match scene.materials[m].reflectance {
+            Reflectance::GltfPbr(GltfPbrParams {
+                base_color_texture, ..
+            }) => base_color_texture,
+            _ => panic!("not a glTF material"),
+        }
+    }
+
+    /// KTX2 images are found by their content, whatever their name and MIME type say, and
+    /// left out with one warning for the file naming them; the material keeps its factor.
+    #[test]
+    fn ktx2_images_are_sniffed_and_left_out_with_one_warning() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("lamp.png"), ktx2_bytes()).unwrap();
+        std::fs::write(dir.path().join("lamp_n.ktx2"), ktx2_bytes()).unwrap();
+        let (mut doc, bin) = test_doc();
+        doc["extensionsUsed"] = json!(["KHR_lights_punctual", "KHR_texture_basisu"]);
+        doc["images"] =
+            json!([{"uri": "lamp.png", "mimeType": "image/png"}, {"uri": "lamp_n.ktx2"}]);
+        doc["textures"] = json!([{"source": 0}, {"source": 1}]);
+        doc["materials"][1]["pbrMetallicRoughness"] = json!({"baseColorFactor": [0.5, 0.25, 1, 1], "baseColorTexture": {"index": 0},
+                   "metallicRoughnessTexture": {"index": 0}});
+        doc["materials"][1]["normalTexture"] = json!({"index": 1});
+        let scene = Scene::load(&write_embedded(dir.path(), doc, &bin)).unwrap();
+        assert!(scene.textures.is_empty());
+        assert!(base_texture(&scene, 1).is_none());
+        assert!(scene.materials[1].normal_map.is_none());
+        let Reflectance::GltfPbr(p) = &scene.materials[1].reflectance else {
+            panic!()
+        };
+        assert_eq!(p.base_color, Vec3::new(0.5, 0.25, 1.0));
+        let ktx2: Vec<&String> = scene
+            .warnings
+            .iter()
+            .filter(|w| w.contains("KTX2"))
+            .collect();
+        assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+        assert_eq!(ktx2.len(), 1, "{:?}", scene.warnings);
+        assert!(
+            ktx2[0].contains("on 2 images")
+                && ktx2[0].contains("image 0 (\"lamp.png\"")
+                && ktx2[0].contains("image 1 (\"lamp_n.ktx2\"")
+                && ktx2[0].contains("factors alone"),
+            "{ktx2:?}"
+        );
+    }
+
+    /// KHR_texture_basisu: the texture's core source is the fallback and is read, with one
+    /// warning; without a fallback the KTX2 image is left out; a file that requires the
+    /// extension is an error naming it.
+    #[test]
+    fn basisu_textures_use_their_fallback_image() {
+        let dir = png_file("lamp.png", 1, 1, vec![255, 0, 0, 255]);
+        std::fs::write(dir.path().join("lamp.ktx2"), ktx2_bytes()).unwrap();
+        let (mut doc, bin) = test_doc();
+        doc["extensionsUsed"] = json!(["KHR_lights_punctual", "KHR_texture_basisu"]);
+        doc["images"] =
+            json!([{"uri": "lamp.png"}, {"uri": "lamp.ktx2", "mimeType": "image/ktx2"}]);
+        let basisu = json!({"KHR_texture_basisu": {"source": 1}});
+        doc["textures"] = json!([{"source": 0, "extensions": basisu}, {"extensions": basisu}]);
+        doc["materials"][1]["pbrMetallicRoughness"] = json!({"baseColorTexture": {"index": 0}});
+        let scene = Scene::load(&write_embedded(dir.path(), doc.clone(), &bin)).unwrap();
+        let base = base_texture(&scene, 1).expect("the fallback PNG");
+        let red = scene.textures[base.texture as usize].texel(0);
+        assert!((red.truncate() - Vec3::X).length() < 1e-6, "{red}");
+        assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+        assert!(
+            scene.warnings[0].contains("KHR_texture_basisu on 2 textures")
+                && scene.warnings[0].contains("fallback image"),
+            "{:?}",
+            scene.warnings
+        );
+        // The texture without a fallback: left out, its KTX2 image named.
+        doc["materials"][1]["pbrMetallicRoughness"] = json!({"baseColorTexture": {"index": 1}});
+        let scene = Scene::load(&write_embedded(dir.path(), doc.clone(), &bin)).unwrap();
+        assert!(base_texture(&scene, 1).is_none());
+        assert!(
+            scene
+                .warnings
+                .iter()
+                .any(|w| w.contains("KTX2") && w.contains("image 1 (\"lamp.ktx2\"")),
+            "{:?}",
+            scene.warnings
+        );
+        // An extension source that is no image is an error, not a panic.
+        let mut bad = doc.clone();
+        bad["textures"][1]["extensions"]["KHR_texture_basisu"]["source"] = json!(99);
+        let err = Scene::load(&write_embedded(dir.path(), bad, &bin)).unwrap_err();
+        let err = format!("{err}: {:?}", std::error::Error::source(&err));
+        assert!(err.contains("textures[1].source"), "{err}");
+        doc["extensionsRequired"] = json!(["KHR_texture_basisu"]);
+        let err = Scene::load(&write_embedded(dir.path(), doc, &bin))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("requires the glTF extension KHR_texture_basisu")
+                && err.contains("export PNG or JPEG"),
+            "{err}"
+        );
+    }
+
+    /// A texture whose file is missing is an error naming the file and the material.
+    #[test]
+    fn a_missing_texture_file_is_an_error_naming_it() {
+        let (mut doc, bin) = test_doc();
+        doc["images"] = json!([{"uri": "textures/asphalt_albedo.png"}]);
+        doc["textures"] = json!([{"source": 0}]);
+        doc["materials"][1]["pbrMetallicRoughness"] = json!({"baseColorTexture": {"index": 0}});
+        let err = load_err(doc, &bin);
+        assert!(
+            err.contains("material \"glow\" (1)")
+                && err.contains("asphalt_albedo.png")
+                && err.contains("image 0"),
+            "{err}"
+        );
+    }
 
     #[test]
     fn images_without_a_source_or_mime_type_are_errors() {
