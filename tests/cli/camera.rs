@@ -162,7 +162,7 @@ fn a_scene_without_a_camera_is_framed_with_one_warning() {
     let (img, err) = render(&t, "nocam.gltf", "out.exr", &["--height", "60"]);
     // 4:3 by default.
     assert_eq!((img.width, img.height), (80, 60));
-    let warning = "scene has no camera: framed its bounds from +Z with a 45 degree field of view";
+    let warning = "scene has no camera: framed its bounds from +Z, 25 degrees above the horizon, with a 45 degree field of view";
     assert_eq!(err.matches(warning).count(), 1, "{err}");
     // The square is seen whole, centred, and not cut by the border.
     let lit: Vec<(u32, u32)> = (0..60)

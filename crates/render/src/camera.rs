@@ -16,7 +16,7 @@
 //! - The default camera ([`Camera::framing`]) is the glTF sample viewer's: see there.
 
 use crate::geometry::Ray;
-use glam::{Affine3A, Vec2, Vec3};
+use glam::{Affine3A, BVec3, Quat, Vec2, Vec3};
 
 /// How a camera maps film positions to rays: the closed set of glTF's camera types.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -54,9 +54,14 @@ pub const FRAMING_YFOV: f32 = std::f32::consts::FRAC_PI_4;
 /// The name of the default camera ([`Camera::framing`]).
 pub const FRAMING_NAME: &str = "default";
 
+/// How far above the horizon the default camera looks down at the scene: 25 degrees, so that
+/// a flat model lying in the XZ plane (the ground of a street, TwoSidedPlane) is seen and not
+/// edge-on, while a model facing +Z is foreshortened by only cos 25 = 0.91.
+pub const FRAMING_ELEVATION: f32 = 25.0 * std::f32::consts::PI / 180.0;
+
 /// What the command says when it uses the default camera.
-pub const FRAMING_WARNING: &str =
-    "scene has no camera: framed its bounds from +Z with a 45 degree field of view";
+pub const FRAMING_WARNING: &str = "scene has no camera: framed its bounds from +Z, 25 degrees \
+     above the horizon, with a 45 degree field of view";
 
 impl Camera {
     /// A perspective camera.
@@ -89,31 +94,45 @@ impl Camera {
 
     /// The default camera for a scene of bounding box `bounds` (`[min, max]`, as
     /// [`cube_bounds`] makes it), for an image of aspect ratio `aspect` (width / height): the
-    /// glTF sample viewer's, moved back so that all of the box is in view.
+    /// glTF sample viewer's distance rule, seen from [`FRAMING_ELEVATION`] above the horizon
+    /// and moved back so that all of the box is in view.
     ///
-    /// A perspective camera of [`FRAMING_YFOV`] looking along -Z with +Y up, on the axis
-    /// through the centre `c` of the box, at `(c.x, c.y, max.z + D)`: `m = max(size.x,
-    /// size.y)`, `D = max(m/2 / tan(yfov/2), m/2 / tan(xfov/2))`, `xfov = 2 atan(aspect
-    /// tan(yfov/2))`. The viewer takes the same `D` from the box's centre, with `xfov = yfov *
-    /// aspect`, which ignores the box's depth and cuts the front of deep scenes at the image's
-    /// edge; measured from the front face, the front face fills the limiting axis exactly and
-    /// everything behind it is smaller, so every point of the box is in view and in front of
-    /// the camera. A degenerate box (a point) is framed as a box of size 1.
+    /// A perspective camera of [`FRAMING_YFOV`] with +Y up in the plane of its view, looking
+    /// along `-Z` pitched down by the elevation (from `+Z` and above). In the camera's axes
+    /// the box's eight corners span `m = max(extent x, extent y)` across the view; the camera
+    /// sits on the axis through the box's centre at `D = max(m/2 / tan(yfov/2),
+    /// m/2 / tan(xfov/2))` (`xfov = 2 atan(aspect tan(yfov/2))`) in front of the plane that
+    /// touches the box's nearest corner. The viewer takes the same `D` from the box's centre,
+    /// looking straight along -Z with `xfov = yfov * aspect`: that cuts the front of deep
+    /// scenes at the image's edge and sees a flat model lying in the XZ plane edge-on.
+    /// Measured from the nearest plane, that plane's square of side `m` fills the limiting
+    /// axis exactly and everything behind it is smaller, so every point of the box is in
+    /// view and in front of the camera. A degenerate box (a point) is framed as a box of
+    /// size 1.
     pub fn framing(bounds: [Vec3; 2], aspect: f32) -> Camera {
         let [lo, hi] = bounds;
         let centre = 0.5 * (lo + hi);
-        let size = hi - lo;
-        let mut m = size.x.max(size.y);
-        if m.is_nan() || m <= 0.0 {
+        let rotation = Quat::from_rotation_x(-FRAMING_ELEVATION);
+        let to_camera = rotation.inverse();
+        // The box's corners about its centre, in the camera's axes.
+        let (mut span, mut near) = (Vec2::ZERO, 0.0f32);
+        for k in 0..8 {
+            let corner = Vec3::select(BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), hi, lo);
+            let c = to_camera * (corner - centre);
+            span = span.max(c.truncate().abs());
+            near = near.max(c.z);
+        }
+        let mut m = 2.0 * span.x.max(span.y);
+        if !m.is_finite() || m <= 0.0 {
             m = 1.0;
         }
         let tan_half_y = (0.5 * FRAMING_YFOV).tan();
         let tan_half_x = aspect * tan_half_y;
         let distance = (0.5 * m / tan_half_y).max(0.5 * m / tan_half_x);
-        let z = hi.z + distance;
+        let position = centre + rotation * Vec3::new(0.0, 0.0, near + distance);
         Camera::perspective(
             FRAMING_NAME,
-            Affine3A::from_translation(Vec3::new(centre.x, centre.y, z)),
+            Affine3A::from_rotation_translation(rotation, position),
             FRAMING_YFOV,
             Some(aspect),
         )
@@ -252,7 +271,6 @@ pub fn cube_bounds(boxes: impl IntoIterator<Item = [Vec3; 2]>) -> Option<[Vec3; 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::Quat;
 
     #[test]
     fn centre_ray_looks_down_minus_z_and_projection_round_trips() {
@@ -343,42 +361,58 @@ mod tests {
         assert!((b[0] - Vec3::new(0.0, -1.0, -1.0)).length() < 1e-6);
     }
 
-    /// The default camera frames a known box: every corner projects inside the image, and
-    /// the cube it is framed by fills the fraction of the image height the formula predicts.
+    /// The default camera frames known boxes: every corner of the bounds projects inside the
+    /// image, the corners' projections fill most of the limiting axis (the box is not lost in
+    /// the distance), the camera looks down at the elevation, and a flat square lying in the
+    /// XZ plane covers a good part of the image instead of being seen edge-on.
     #[test]
-    fn framing_sees_the_whole_box_and_fills_the_expected_fraction() {
-        for (aspect, w, h) in [(4.0 / 3.0, 640, 480), (0.5, 200, 400), (3.0, 600, 200)] {
-            let lo = Vec3::new(-1.0, 2.0, -3.0);
-            let hi = Vec3::new(1.0, 3.0, -2.0);
-            let bounds = cube_bounds([[lo, hi]]).unwrap();
-            let cam = Camera::framing(bounds, aspect);
-            assert_eq!(cam.yfov(), Some(FRAMING_YFOV));
-            for i in 0..8 {
-                let p = Vec3::new(
-                    if i & 1 == 0 { lo.x } else { hi.x },
-                    if i & 2 == 0 { lo.y } else { hi.y },
-                    if i & 4 == 0 { lo.z } else { hi.z },
-                );
-                let px = cam.project(p, w, h).expect("in front");
+    fn framing_sees_the_whole_box_and_fills_the_image() {
+        let boxes = [
+            [Vec3::new(-1.0, 2.0, -3.0), Vec3::new(1.0, 3.0, -2.0)],
+            [Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 0.0, 1.0)],
+            [Vec3::new(5.0, -1.0, -40.0), Vec3::new(6.0, 1.0, 2.0)],
+        ];
+        for [lo, hi] in boxes {
+            for (aspect, w, h) in [(4.0 / 3.0, 640, 480), (0.5, 200, 400), (3.0, 600, 200)] {
+                let bounds = cube_bounds([[lo, hi]]).unwrap();
+                let cam = Camera::framing(bounds, aspect);
+                assert_eq!(cam.yfov(), Some(FRAMING_YFOV));
+                let forward = cam.world_from_camera.transform_vector3(-Vec3::Z);
                 assert!(
-                    (0.0..=w as f32).contains(&px.x) && (0.0..=h as f32).contains(&px.y),
-                    "aspect {aspect}: corner {p} at {px}"
+                    (forward.y + FRAMING_ELEVATION.sin()).abs() < 1e-5,
+                    "{forward}"
                 );
+                let [blo, bhi] = bounds;
+                let (mut min, mut max) = (Vec2::splat(f32::MAX), Vec2::splat(f32::MIN));
+                for k in 0..8 {
+                    let p = Vec3::select(BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), bhi, blo);
+                    let px = cam.project(p, w, h).expect("in front");
+                    assert!(
+                        (0.0..=w as f32).contains(&px.x) && (0.0..=h as f32).contains(&px.y),
+                        "{lo} {hi}, aspect {aspect}: corner {p} at {px}"
+                    );
+                    (min, max) = (min.min(px), max.max(px));
+                }
+                let fill = ((max.x - min.x) / w as f32).max((max.y - min.y) / h as f32);
+                assert!(fill > 0.6, "{lo} {hi}, aspect {aspect}: fills {fill}");
             }
-            // The bounds' front face (the one the distance is computed for) spans exactly
-            // the image height when the height is the limiting axis (aspect >= 1), and
-            // exactly the width otherwise.
-            let [blo, bhi] = bounds;
-            let centre = 0.5 * (blo + bhi);
-            let front = Vec3::new(centre.x, centre.y, bhi.z);
-            let m = (bhi - blo).x;
-            let top = cam.project(front + Vec3::Y * (0.5 * m), w, h).unwrap();
-            let bottom = cam.project(front - Vec3::Y * (0.5 * m), w, h).unwrap();
-            let left = cam.project(front - Vec3::X * (0.5 * m), w, h).unwrap();
-            let right = cam.project(front + Vec3::X * (0.5 * m), w, h).unwrap();
-            let frac = ((bottom.y - top.y) / h as f32).max((right.x - left.x) / w as f32);
-            assert!((frac - 1.0).abs() < 1e-4, "aspect {aspect}: fills {frac}");
         }
+        // The flat square (the second box) is seen from above.
+        let [lo, hi] = boxes[1];
+        let cam = Camera::framing(cube_bounds([[lo, hi]]).unwrap(), 4.0 / 3.0);
+        let corners = [
+            lo,
+            Vec3::new(hi.x, 0.0, lo.z),
+            hi,
+            Vec3::new(lo.x, 0.0, hi.z),
+        ];
+        let px: Vec<Vec2> = corners
+            .iter()
+            .map(|&p| cam.project(p, 640, 480).unwrap())
+            .collect();
+        let far_edge = px[0].y.max(px[1].y);
+        let near_edge = px[2].y.min(px[3].y);
+        assert!(near_edge - far_edge > 0.1 * 480.0, "{px:?}");
     }
 
     #[test]
