@@ -38,6 +38,15 @@
 //!   a rough lens seen at grazing send its shadow rays to groups rather than to its bulb 0.1 m
 //!   away; docs/decisions/0016-sharp-lobes-see-past-the-anchor.md.)
 //!
+//! The environment light ([`Environment`]), when the scene has one, is one more choice beside
+//! the tree, made first: it is chosen with probability `E_env / (E_env + E_tree)`, held within
+//! [`ENVIRONMENT_SHARE_BOUNDS`], where `E_env` is `pi` times its mean luminance (the irradiance
+//! it gives a surface open to the whole sky) and `E_tree` the sum of the `E` of the tree's root
+//! children at the point (everything when the tree is empty or gives nothing there). The
+//! bounds keep either side sampled however wrong the estimate is (neither counts occlusion):
+//! a lamp under a bright sky, the sky in a lamp's shadow. The tree's choices are then scaled
+//! by the rest. Without an environment nothing changes.
+//!
 //! The choice descends the tree from the root, one child per level, weighing a node's children
 //! once: at most `BRANCHING` (16) BSDF evaluations per level, all of a node's children in SIMD
 //! lanes, 4, 8 or 16 at a time (the crate's `light::child_weights`). Every choice is a deterministic
@@ -46,15 +55,21 @@
 
 use super::child_weights::{BsdfWeight, TreeLanes, Weights};
 use super::emitter::{Emitter, Emitters, SurfaceMesh};
+use super::environment::Environment;
 use super::tree::{LightTree, Node};
-use super::{Light, LightSample, Receiver};
+use super::{Light, LightSample, Receiver, Visibility};
 use crate::bsdf::Bsdf;
 use crate::geometry::SurfaceHit;
 use crate::material::Material;
 use crate::sampling::ONE_MINUS_EPSILON;
 use crate::texture::Texture;
-use glam::Vec2;
+use glam::{Vec2, Vec3};
+use std::f32::consts::PI;
 use std::ops::Range;
+
+/// The least and the most of the light choice the environment gets when the scene has other
+/// lights too (see the module documentation): the defensive share either way.
+pub const ENVIRONMENT_SHARE_BOUNDS: (f32, f32) = (DEFENSIVE_SHARE, 1.0 - DEFENSIVE_SHARE);
 
 /// Share of the light choice made by irradiance alone when it is BSDF-aware (defensive
 /// sampling, see the module documentation).
@@ -83,6 +98,8 @@ pub struct LightSampler {
     tree: LightTree,
     /// The tree's sibling sets in lanes, for the weights.
     lanes: TreeLanes,
+    /// The environment light, if any: one more choice beside the tree.
+    environment: Option<Environment>,
 }
 
 /// Chooses index `i` with probability `w_i / sum` by inverting the cumulative sum at `u sum`
@@ -155,6 +172,56 @@ impl LightSampler {
             emitters,
             tree,
             lanes,
+            environment: None,
+        }
+    }
+
+    /// Sets (or removes) the environment light; the emitters and the tree stay as they are.
+    pub fn set_environment(&mut self, environment: Option<Environment>) {
+        self.environment = environment;
+    }
+
+    /// The environment light, if any.
+    #[inline]
+    pub fn environment(&self) -> Option<&Environment> {
+        self.environment.as_ref()
+    }
+
+    /// The probability that the choice at the receiver is the environment: 0 without one (see
+    /// the module documentation).
+    #[inline]
+    fn environment_share(&self, rx: &Receiver) -> f32 {
+        let Some(env) = &self.environment else {
+            return 0.0;
+        };
+        let e_env = PI * env.mean_luminance();
+        if !(e_env > 0.0 && e_env.is_finite()) {
+            return 0.0;
+        }
+        if self.emitters.is_empty() {
+            return 1.0;
+        }
+        let (_, _, e_tree, _) = self.weights(rx, &BsdfWeight::new(rx), self.tree.root());
+        if !(e_tree > 0.0 && e_tree.is_finite()) {
+            return 1.0;
+        }
+        let (lo, hi) = ENVIRONMENT_SHARE_BOUNDS;
+        (e_env / (e_env + e_tree)).clamp(lo, hi)
+    }
+
+    /// The density (choice included) with which [`LightSampler::sample_li`] at the receiver
+    /// returns direction `wi` toward the environment; 0 without one.
+    pub fn pdf_environment(&self, rx: &Receiver, wi: Vec3) -> f32 {
+        match &self.environment {
+            Some(env) => {
+                let share = self.environment_share(rx);
+                if share > 0.0 {
+                    share * env.pdf(wi)
+                } else {
+                    0.0
+                }
+            }
+            None => 0.0,
         }
     }
 
@@ -205,7 +272,11 @@ impl LightSampler {
         };
         let f = BsdfWeight::new(rx);
         let share = defensive_share(&rx.bsdf);
-        let mut pmf = 1.0f32;
+        let mut pmf = if self.environment.is_some() {
+            1.0 - self.environment_share(rx)
+        } else {
+            1.0
+        };
         loop {
             let siblings = self.tree.siblings(node);
             let slot = node - siblings.start;
@@ -218,10 +289,11 @@ impl LightSampler {
         }
     }
 
-    /// Chooses an emitter with `u_light` and samples it with `u` (see the module
-    /// documentation); `materials` and `textures` are the scene's, for the emission of an
-    /// area sample. The returned `pdf` includes the probability of the choice; `None` when
-    /// nothing was sampled.
+    /// Chooses an emitter (or the environment) with `u_light` and samples it with `u` (see the
+    /// module documentation); `materials` and `textures` are the scene's, for the emission of
+    /// an area sample. The returned `pdf` includes the probability of the choice; `None` when
+    /// nothing was sampled. An environment sample is a direction: `dist` is infinite, and its
+    /// shadow ray must escape the scene.
     pub fn sample_li(
         &self,
         materials: &[Material],
@@ -230,7 +302,25 @@ impl LightSampler {
         u_light: f32,
         u: Vec2,
     ) -> Option<LightSample> {
+        let (mut u_light, mut rest) = (u_light, 1.0f32);
+        if let Some(env) = &self.environment {
+            let share = self.environment_share(rx);
+            if u_light < share {
+                let (wi, li, pdf) = env.sample(u)?;
+                return Some(LightSample {
+                    wi,
+                    dist: f32::INFINITY,
+                    li,
+                    pdf: pdf * share,
+                    delta: false,
+                    visibility: Visibility::ShadowRay,
+                });
+            }
+            u_light = ((u_light - share) / (1.0 - share)).min(ONE_MINUS_EPSILON);
+            rest = 1.0 - share;
+        }
         let (e, pmf, reused) = self.choose(rx, u_light)?;
+        let pmf = pmf * rest;
         let mut ls = match self.emitters.get(e) {
             Emitter::Punctual(light) => light.sample_li(rx.p)?,
             Emitter::Mesh(m) => m.sample_li(materials, textures, e as u32, rx.p, reused, u)?,
@@ -738,5 +828,56 @@ mod tests {
                 .sample_li(&s.materials, &s.textures, &rx, 0.5, Vec2::splat(0.5));
         assert!(sample.is_none());
         assert_eq!(s.light_sampler.emitter_pmf(&rx, 0), 0.0);
+    }
+
+    /// With an environment, the choice is a distribution over the emitters and the
+    /// environment: the emitters' probabilities and the environment's share sum to 1, an
+    /// environment sample's density is `pdf_environment` of its direction, and its share
+    /// follows the estimate `pi L / (pi L + E_tree)` within the bounds.
+    #[test]
+    fn the_environment_is_one_more_choice() {
+        use crate::light::Environment;
+        let mut s = lamp_scene(Vec3::new(-3.0, 2.0, -10.0), 50.0, vec![]);
+        let rx = receiver(Vec3::ZERO, Bsdf::Diffuse(Diffuse { kd: Vec3::splat(0.5) }), Vec3::Y);
+        for radiance in [1e-3f32, 0.3, 1e3] {
+            s.set_environment(Environment::constant(Vec3::splat(radiance), 1.0).unwrap());
+            let ls = &s.light_sampler;
+            let share = ls.environment_share(&rx);
+            let (lo, hi) = ENVIRONMENT_SHARE_BOUNDS;
+            assert!((lo..=hi).contains(&share), "{share}");
+            let emitters: f32 = (0..ls.emitters().len()).map(|e| ls.emitter_pmf(&rx, e)).sum();
+            assert!((emitters + share - 1.0).abs() < 1e-5, "{emitters} + {share}");
+            let n = 4000;
+            let mut env_samples = 0;
+            for k in 0..n {
+                let u_light = (k as f32 + 0.5) / n as f32;
+                let u = Vec2::new((k as f32 * 0.618_034).fract(), 0.3);
+                if let Some(l) = ls.sample_li(&s.materials, &s.textures, &rx, u_light, u) {
+                    if l.dist == f32::INFINITY {
+                        env_samples += 1;
+                        assert_eq!(l.pdf, ls.pdf_environment(&rx, l.wi));
+                        assert!((l.pdf - share / (4.0 * PI)).abs() < 1e-6 * l.pdf.max(1.0));
+                        assert_eq!(l.visibility, Visibility::ShadowRay);
+                    }
+                }
+            }
+            assert!((env_samples as f32 / n as f32 - share).abs() < 2e-3, "{env_samples}");
+        }
+        // A brighter sky takes a larger share.
+        let share_of = |s: &mut Scene, l: f32| {
+            s.set_environment(Environment::constant(Vec3::splat(l), 1.0).unwrap());
+            s.light_sampler.environment_share(&rx)
+        };
+        assert!(share_of(&mut s, 0.01) < share_of(&mut s, 0.1));
+        // Alone, the environment is the whole choice.
+        let mut parts = SceneParts {
+            materials: vec![Material::diffuse("floor", Vec3::splat(0.5))],
+            ..Default::default()
+        };
+        parts.mesh.positions = vec![Vec3::ZERO, Vec3::X, Vec3::Z];
+        parts.mesh.triangles = vec![[0, 2, 1]];
+        parts.mesh.triangle_materials = vec![0];
+        let alone = Scene::from_parts(parts).unwrap();
+        assert_eq!(alone.light_sampler.environment_share(&rx), 1.0);
     }
 }
