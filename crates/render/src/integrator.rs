@@ -1691,7 +1691,10 @@ pub(crate) mod tests {
         let cam = camera(Vec3::new(0.0, 1.5, 2.0), -0.6, 0.6);
         let out = render(&scene, &cam, &settings(24, 16, 64, 8), &|_| {});
         let mean = mean_pixel(&out);
-        assert!((mean - kd).abs().max_element() < 0.01 * kd.max_element(), "{mean} vs {kd}");
+        assert!(
+            (mean - kd).abs().max_element() < 0.01 * kd.max_element(),
+            "{mean} vs {kd}"
+        );
         // Looking up: the sky only, exactly.
         let up = camera(Vec3::new(0.0, 1.5, 2.0), 1.2, 0.6);
         let mut set = settings(8, 6, 4, 8);
@@ -1725,10 +1728,18 @@ pub(crate) mod tests {
         let cam = camera(Vec3::new(0.0, 1.5, 2.0), -0.4, 0.6);
         let mut set = settings(24, 16, 256, 3);
         set.layers.specular = true;
-        let a = render(&floor_under(road.clone(), constant, lamp.clone()), &cam, &set, &|_| {});
+        let a = render(
+            &floor_under(road.clone(), constant, lamp.clone()),
+            &cam,
+            &set,
+            &|_| {},
+        );
         let b = render(&floor_under(road, map, lamp), &cam, &set, &|_| {});
         let (ma, mb) = (mean_pixel(&a), mean_pixel(&b));
-        assert!((ma - mb).abs().max_element() < 0.01 * ma.max_element(), "{ma} vs {mb}");
+        assert!(
+            (ma - mb).abs().max_element() < 0.01 * ma.max_element(),
+            "{ma} vs {mb}"
+        );
         let spec = a.specular.unwrap();
         let spec_mean = spec.pixels.iter().copied().sum::<Vec3>() / spec.pixels.len() as f32;
         assert!(spec_mean.min_element() > 0.0 && spec_mean.max_element() < ma.max_element());

@@ -838,15 +838,26 @@ mod tests {
     fn the_environment_is_one_more_choice() {
         use crate::light::Environment;
         let mut s = lamp_scene(Vec3::new(-3.0, 2.0, -10.0), 50.0, vec![]);
-        let rx = receiver(Vec3::ZERO, Bsdf::Diffuse(Diffuse { kd: Vec3::splat(0.5) }), Vec3::Y);
+        let rx = receiver(
+            Vec3::ZERO,
+            Bsdf::Diffuse(Diffuse {
+                kd: Vec3::splat(0.5),
+            }),
+            Vec3::Y,
+        );
         for radiance in [1e-3f32, 0.3, 1e3] {
             s.set_environment(Environment::constant(Vec3::splat(radiance), 1.0).unwrap());
             let ls = &s.light_sampler;
             let share = ls.environment_share(&rx);
             let (lo, hi) = ENVIRONMENT_SHARE_BOUNDS;
             assert!((lo..=hi).contains(&share), "{share}");
-            let emitters: f32 = (0..ls.emitters().len()).map(|e| ls.emitter_pmf(&rx, e)).sum();
-            assert!((emitters + share - 1.0).abs() < 1e-5, "{emitters} + {share}");
+            let emitters: f32 = (0..ls.emitters().len())
+                .map(|e| ls.emitter_pmf(&rx, e))
+                .sum();
+            assert!(
+                (emitters + share - 1.0).abs() < 1e-5,
+                "{emitters} + {share}"
+            );
             let n = 4000;
             let mut env_samples = 0;
             for k in 0..n {
@@ -861,7 +872,10 @@ mod tests {
                     }
                 }
             }
-            assert!((env_samples as f32 / n as f32 - share).abs() < 2e-3, "{env_samples}");
+            assert!(
+                (env_samples as f32 / n as f32 - share).abs() < 2e-3,
+                "{env_samples}"
+            );
         }
         // A brighter sky takes a larger share.
         let share_of = |s: &mut Scene, l: f32| {

@@ -40,7 +40,9 @@
 //!
 //! Building the map's distributions allocates; looking up, sampling and the density do not.
 
-use crate::sampling::{square_to_uniform_sphere, square_to_uniform_sphere_pdf, DiscreteDistribution};
+use crate::sampling::{
+    square_to_uniform_sphere, square_to_uniform_sphere_pdf, DiscreteDistribution,
+};
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, PI, TAU};
 use std::path::{Path, PathBuf};
@@ -316,8 +318,7 @@ impl EnvironmentMap {
         let rows = DiscreteDistribution::new(&row_weights);
         // The weights sum the mean luminance over each cell's solid angle: over 4 pi, the mean
         // over the sphere.
-        let mean_luminance =
-            (total / (4.0 * std::f64::consts::PI) * f64::from(strength)) as f32;
+        let mean_luminance = (total / (4.0 * std::f64::consts::PI) * f64::from(strength)) as f32;
         Ok(Self {
             path: path.to_path_buf(),
             strength,
@@ -345,6 +346,15 @@ impl EnvironmentMap {
     /// `(width, height)` of the map as used (a single row or column counts twice).
     pub fn size(&self) -> (u32, u32) {
         (self.width, self.height)
+    }
+
+    /// The texels as an image (without the strength), as the lookup uses them.
+    pub fn texels(&self) -> RgbImage {
+        RgbImage {
+            width: self.width,
+            height: self.height,
+            pixels: self.texels.clone(),
+        }
     }
 
     #[inline]
@@ -424,7 +434,11 @@ mod tests {
         map_of(w, h, |x, y| {
             let (dx, dy) = (x as f32 - 0.3 * w as f32, y as f32 - 0.25 * h as f32);
             let sun = 50.0 * (-(dx * dx + dy * dy) / 4.0).exp();
-            let sky = if y == h / 2 { 0.0 } else { 0.2 + 0.8 * y as f32 / h as f32 };
+            let sky = if y == h / 2 {
+                0.0
+            } else {
+                0.2 + 0.8 * y as f32 / h as f32
+            };
             Vec3::new(sun + sky, sun + 0.5 * sky, sun + 0.2 + 0.1 * (x % 3) as f32)
         })
     }
@@ -440,7 +454,10 @@ mod tests {
         assert!(direction_to_uv(Vec3::Y).y == 0.0);
         assert!(direction_to_uv(-Vec3::Y).y == 1.0);
         for k in 0..50 {
-            let uv = Vec2::new((k as f32 + 0.3) / 50.0, (k as f32 * 7.0 % 49.0 + 0.5) / 50.0);
+            let uv = Vec2::new(
+                (k as f32 + 0.3) / 50.0,
+                (k as f32 * 7.0 % 49.0 + 0.5) / 50.0,
+            );
             let back = direction_to_uv(uv_to_direction(uv));
             assert!((back - uv).abs().max_element() < 1e-4, "{uv} {back}");
         }
@@ -559,7 +576,11 @@ mod tests {
         // rows and bilinear interpolation, the radiance is a tent in theta from pi/8 to 3pi/8.
         let (w, h) = (16u32, 9u32);
         let l = 3.0f32;
-        let m = map_of(w, h, |_, y| if y == 2 { Vec3::splat(l) } else { Vec3::ZERO });
+        let m = map_of(
+            w,
+            h,
+            |_, y| if y == 2 { Vec3::splat(l) } else { Vec3::ZERO },
+        );
         let env = Environment::Map(Box::new(m));
         // Exact: E = 2 pi int L(theta) cos sin dtheta, L a tent of height l on [pi/8, 3pi/8].
         let step = std::f64::consts::PI / 8.0;
@@ -586,7 +607,10 @@ mod tests {
         // The mean luminance counts each cell at the mean of its corners times its solid
         // angle: an estimate (for the light choice), here 1.3 % low.
         let mean = f64::from(env.mean_luminance());
-        assert!((mean - exact_mean).abs() < 0.02 * exact_mean, "{mean} vs {exact_mean}");
+        assert!(
+            (mean - exact_mean).abs() < 0.02 * exact_mean,
+            "{mean} vs {exact_mean}"
+        );
     }
 
     #[test]
@@ -617,9 +641,14 @@ mod tests {
         let png = dir.path().join("sky.png");
         std::fs::write(&png, b"\x89PNG\r\n\x1a\nnot really").unwrap();
         let err = Environment::load_map(&png, 1.0).unwrap_err().to_string();
-        assert!(err.contains("sky.png") && err.contains("not an OpenEXR"), "{err}");
+        assert!(
+            err.contains("sky.png") && err.contains("not an OpenEXR"),
+            "{err}"
+        );
         let missing = dir.path().join("none.exr");
-        let err = Environment::load_map(&missing, 1.0).unwrap_err().to_string();
+        let err = Environment::load_map(&missing, 1.0)
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("none.exr"), "{err}");
         // A real EXR round-trips.
         let exr = dir.path().join("sky.exr");
@@ -627,7 +656,12 @@ mod tests {
         streaks_image::exr::write_exr_rgb(&exr, &img).unwrap();
         let env = Environment::load_map(&exr, 2.0).unwrap();
         let d = uv_to_direction(Vec2::new(3.0 / 8.0, 0.5));
-        assert!((env.le(d) - 2.0 * Vec3::new(1.0, 1.0, 0.5)).abs().max_element() < 1e-5);
+        assert!(
+            (env.le(d) - 2.0 * Vec3::new(1.0, 1.0, 0.5))
+                .abs()
+                .max_element()
+                < 1e-5
+        );
         assert_eq!(env.map().unwrap().path(), exr.as_path());
     }
 

@@ -57,8 +57,7 @@ impl Loader<'_> {
             (None, Some(c)) => Environment::constant(Vec3::from_array(c), strength),
             _ => {
                 return Err(bad(
-                    "give either \"uri\" (an equirectangular .exr) or \"color\" ([r, g, b])"
-                        .into(),
+                    "give either \"uri\" (an equirectangular .exr) or \"color\" ([r, g, b])".into(),
                 ))
             }
         };
@@ -123,17 +122,26 @@ mod tests {
         // A PNG under that name is refused as not an EXR.
         std::fs::write(dir.path().join("sky.exr"), b"\x89PNG\r\n\x1a\n").unwrap();
         let err = crate::scene::Scene::load(&path).unwrap_err().to_string();
-        assert!(err.contains("sky.exr") && err.contains("not an OpenEXR"), "{err}");
+        assert!(
+            err.contains("sky.exr") && err.contains("not an OpenEXR"),
+            "{err}"
+        );
     }
 
     #[test]
     fn bad_environments_are_errors_naming_the_element() {
         for (env, needle) in [
             (json!({"color": [1.0, -1.0, 0.0]}), "color"),
-            (json!({"color": [1.0, 1.0, 1.0], "strength": -2.0}), "strength"),
+            (
+                json!({"color": [1.0, 1.0, 1.0], "strength": -2.0}),
+                "strength",
+            ),
             (json!({"colour": [1.0, 1.0, 1.0]}), "colour"),
             (json!({}), "either"),
-            (json!({"uri": "sky.exr", "color": [1.0, 1.0, 1.0]}), "either"),
+            (
+                json!({"uri": "sky.exr", "color": [1.0, 1.0, 1.0]}),
+                "either",
+            ),
             (json!({"uri": "missing.exr"}), "missing.exr"),
             (json!({"uri": "../outside.exr"}), "outside"),
         ] {
