@@ -823,11 +823,13 @@ mod tests {
             Bsdf::Diffuse(Diffuse { kd: Vec3::ONE }),
             Vec3::Y,
         );
-        let sample =
-            s.light_sampler
-                .sample_li(&s.materials, &s.textures, &rx, 0.5, Vec2::splat(0.5));
+        // Without its default environment (a scene without lights gets one), nothing.
+        let mut ls = s.light_sampler.clone();
+        assert!(ls.environment().is_some());
+        ls.set_environment(None);
+        let sample = ls.sample_li(&s.materials, &s.textures, &rx, 0.5, Vec2::splat(0.5));
         assert!(sample.is_none());
-        assert_eq!(s.light_sampler.emitter_pmf(&rx, 0), 0.0);
+        assert_eq!(ls.emitter_pmf(&rx, 0), 0.0);
     }
 
     /// With an environment, the choice is a distribution over the emitters and the
