@@ -560,18 +560,19 @@ fn trace_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, job: &RenderJo
 
     while depth < max_depth {
         out.rays += 1;
+        // Where the path stands, for light arriving along this ray.
+        let arrival = Arrival {
+            depth,
+            prev_delta,
+            prev_bsdf_pdf,
+            first_bsdf,
+        };
         let Some(hit) = scene.intersect(&ray) else {
             // 1'. The environment, for a ray that escapes (not from inside a volume, whose
             // closed surface a ray cannot leave unseen).
             if let (Some(env), None) = (lights.environment(), medium) {
                 let le = env.le(ray.direction);
                 if le.max_element() > 0.0 {
-                    let arrival = Arrival {
-                        depth,
-                        prev_delta,
-                        prev_bsdf_pdf,
-                        first_bsdf,
-                    };
                     arrival.add(&mut out, throughput, le, ray.direction, || {
                         prev.map_or(0.0, |rx| lights.pdf_environment(&rx, ray.direction))
                     });
@@ -587,12 +588,6 @@ fn trace_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, job: &RenderJo
         // 1. Emission of the surface hit.
         let le = scene.emitted_radiance(&hit, wo);
         if le.max_element() > 0.0 {
-            let arrival = Arrival {
-                depth,
-                prev_delta,
-                prev_bsdf_pdf,
-                first_bsdf,
-            };
             arrival.add(&mut out, throughput, le, ray.direction, || {
                 prev.map_or(0.0, |rx| lights.pdf_li(&rx, &hit))
             });
