@@ -2,7 +2,7 @@
 # CI check: streaks render against Mitsuba 3 on scenes/crosscheck.gltf, with the noise test of
 # tools/mitsuba/README.md, then on the same scene with the glass pane of glass_pane.py
 # (KHR_materials_transmission with a volume: Mitsuba's dielectric) at max depth 8, then on its
-# road and wall lit by the environment map of env_scene.py only (Mitsuba's envmap; ~3 s).
+# road and wall lit by the environment map of env_scene.py only (Mitsuba's envmap; about 5 s).
 # Exits 0 on agreement, 1 on disagreement, 2 when it cannot run.
 # Environment: STREAKS (the binary; default target/debug/streaks, built with cargo build),
 # CROSSCHECK_SPP (default 64), CROSSCHECK_WIDTH/HEIGHT (default 160x120), CROSSCHECK_K (4).
