@@ -102,6 +102,14 @@ pub struct LightSampler {
     environment: Option<Environment>,
 }
 
+/// What [`LightSampler`]'s choice chose.
+enum Choice {
+    /// The environment, with this probability.
+    Environment(f32),
+    /// Emitter `.0` with probability `.1`, and `u` rescaled within it (`.2`).
+    Emitter(usize, f32, f32),
+}
+
 /// Chooses index `i` with probability `w_i / sum` by inverting the cumulative sum at `u sum`
 /// (`u` in [0, 1)): the first positive weight whose cumulative sum exceeds it (else the last
 /// positive one), with `u` rescaled to [0, 1) within that weight.
@@ -191,6 +199,21 @@ impl LightSampler {
     /// the module documentation).
     #[inline]
     fn environment_share(&self, rx: &Receiver) -> f32 {
+        if self.environment.is_none() {
+            return 0.0;
+        }
+        let e_tree = if self.emitters.is_empty() {
+            0.0
+        } else {
+            self.weights(rx, &BsdfWeight::new(rx), self.tree.root()).2
+        };
+        self.environment_share_given(e_tree)
+    }
+
+    /// [`LightSampler::environment_share`] given `e_tree`, the sum of the `E` of the tree's
+    /// root children at the point (0 when the tree is empty).
+    #[inline]
+    fn environment_share_given(&self, e_tree: f32) -> f32 {
         let Some(env) = &self.environment else {
             return 0.0;
         };
@@ -198,10 +221,6 @@ impl LightSampler {
         if !(e_env > 0.0 && e_env.is_finite()) {
             return 0.0;
         }
-        if self.emitters.is_empty() {
-            return 1.0;
-        }
-        let (_, _, e_tree, _) = self.weights(rx, &BsdfWeight::new(rx), self.tree.root());
         if !(e_tree > 0.0 && e_tree.is_finite()) {
             return 1.0;
         }
@@ -247,18 +266,35 @@ impl LightSampler {
     /// Chooses an emitter for the receiver: `(emitter, probability, u rescaled within it)`.
     /// From the root down, a child of each node by the mixture of `E` and `E F`.
     #[inline]
-    fn choose(&self, rx: &Receiver, u: f32) -> Option<(usize, f32, f32)> {
+    fn choose(&self, rx: &Receiver, u: f32) -> Option<Choice> {
+        if self.environment.is_some() && self.emitters.is_empty() {
+            let share = self.environment_share_given(0.0);
+            return (share > 0.0).then_some(Choice::Environment(share));
+        }
         let f = BsdfWeight::new(rx);
         let share = defensive_share(&rx.bsdf);
         let (mut nodes, mut u, mut pmf) = (self.tree.root(), u, 1.0f32);
+        let mut at_root = self.environment.is_some();
         loop {
             let (e_w, ef_w, e_sum, ef_sum) = self.weights(rx, &f, nodes.clone());
+            if at_root {
+                // The environment first, from the root's weights.
+                at_root = false;
+                let env = self.environment_share_given(e_sum);
+                if u < env {
+                    return Some(Choice::Environment(env));
+                }
+                u = ((u - env) / (1.0 - env)).min(ONE_MINUS_EPSILON);
+                pmf = 1.0 - env;
+            }
             let n = nodes.len();
             let (c, u_c) = choose_mixture(&e_w[..n], &ef_w[..n], e_sum, ef_sum, u, share)?;
             pmf *= mixture_pmf(e_w[c], ef_w[c], e_sum, ef_sum, share);
             u = u_c;
             match self.tree.nodes()[nodes.start + c] {
-                Node::Emitter(e) => return (pmf > 0.0).then_some((e as usize, pmf, u)),
+                Node::Emitter(e) => {
+                    return (pmf > 0.0).then_some(Choice::Emitter(e as usize, pmf, u));
+                }
                 Node::Group(g) => nodes = g.children(),
             }
         }
@@ -272,11 +308,7 @@ impl LightSampler {
         };
         let f = BsdfWeight::new(rx);
         let share = defensive_share(&rx.bsdf);
-        let mut pmf = if self.environment.is_some() {
-            1.0 - self.environment_share(rx)
-        } else {
-            1.0
-        };
+        let mut pmf = 1.0f32;
         loop {
             let siblings = self.tree.siblings(node);
             let slot = node - siblings.start;
@@ -284,6 +316,10 @@ impl LightSampler {
             pmf *= mixture_pmf(e_w[slot], ef_w[slot], e_sum, ef_sum, share);
             match self.tree.parent(node) {
                 Some(parent) if pmf > 0.0 => node = parent,
+                // At the root: what the environment leaves (its share from the same weights).
+                None if self.environment.is_some() => {
+                    return pmf * (1.0 - self.environment_share_given(e_sum));
+                }
                 _ => return pmf,
             }
         }
@@ -302,11 +338,9 @@ impl LightSampler {
         u_light: f32,
         u: Vec2,
     ) -> Option<LightSample> {
-        let (mut u_light, mut rest) = (u_light, 1.0f32);
-        if let Some(env) = &self.environment {
-            let share = self.environment_share(rx);
-            if u_light < share {
-                let (wi, li, pdf) = env.sample(u)?;
+        let (e, pmf, reused) = match self.choose(rx, u_light)? {
+            Choice::Environment(share) => {
+                let (wi, li, pdf) = self.environment.as_ref()?.sample(u)?;
                 return Some(LightSample {
                     wi,
                     dist: f32::INFINITY,
@@ -316,11 +350,8 @@ impl LightSampler {
                     visibility: Visibility::ShadowRay,
                 });
             }
-            u_light = ((u_light - share) / (1.0 - share)).min(ONE_MINUS_EPSILON);
-            rest = 1.0 - share;
-        }
-        let (e, pmf, reused) = self.choose(rx, u_light)?;
-        let pmf = pmf * rest;
+            Choice::Emitter(e, pmf, reused) => (e, pmf, reused),
+        };
         let mut ls = match self.emitters.get(e) {
             Emitter::Punctual(light) => light.sample_li(rx.p)?,
             Emitter::Mesh(m) => m.sample_li(materials, textures, e as u32, rx.p, reused, u)?,
@@ -462,7 +493,9 @@ mod tests {
             let mut counts = vec![0usize; n_e];
             for k in 0..n {
                 let u = (k as f32 + 0.5) / n as f32;
-                let (e, pmf, reused) = ls.choose(&rx, u).unwrap();
+                let Some(Choice::Emitter(e, pmf, reused)) = ls.choose(&rx, u) else {
+                    panic!("no emitter chosen")
+                };
                 assert!((pmf - pmfs[e]).abs() < 1e-6 && (0.0..1.0).contains(&reused));
                 counts[e] += 1;
             }
@@ -549,7 +582,9 @@ mod tests {
         let mut counts = vec![0usize; n_e];
         for k in 0..n {
             let u = (k as f32 + 0.5) / n as f32;
-            let (e, pmf, reused) = ls.choose(rx, u).unwrap();
+            let Some(Choice::Emitter(e, pmf, reused)) = ls.choose(rx, u) else {
+                panic!("no emitter chosen")
+            };
             assert!(
                 (pmf - pmfs[e]).abs() <= 1e-6 * pmfs[e].max(1.0),
                 "{e}: {pmf} {}",
