@@ -36,11 +36,14 @@ pub struct Args {
     /// Let the scene read files outside its folder (as `streaks render`).
     #[arg(long)]
     pub allow_outside_scene: bool,
+    /// The environment light flags.
+    #[command(flatten)]
+    pub env: crate::render_opts::EnvOpts,
 }
 
 /// Runs the command.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let scene = crate::cli::load_scene(&args.scene, args.allow_outside_scene)?;
+    let scene = args.env.load_scene(&args.scene, args.allow_outside_scene)?;
     let opts = ExportOptions {
         width: args.width,
         height: args.height,

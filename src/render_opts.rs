@@ -2,9 +2,11 @@
 //! scene they load ([`Loaded`]), and how a render setting out of range is reported as a flag.
 
 use anyhow::{bail, Context, Result};
+use glam::Vec3;
 use indicatif::ProgressBar;
 use std::path::Path;
 use streaks_render::camera::{Camera, FRAMING_WARNING};
+use streaks_render::light::Environment;
 use streaks_render::scene::Scene;
 use streaks_settings::{RenderSettings, SettingsError};
 
@@ -56,6 +58,80 @@ pub struct RenderOpts {
     /// devices are refused even then.
     #[arg(long)]
     pub allow_outside_scene: bool,
+    /// The environment light flags.
+    #[command(flatten)]
+    pub env: EnvOpts,
+}
+
+/// The environment light flags of `streaks render`, `streaks stereo` and `streaks
+/// export-mitsuba`: they replace the scene's environment.
+#[derive(clap::Args, Debug, Default)]
+pub struct EnvOpts {
+    /// Light the scene with this equirectangular linear-RGB OpenEXR map (Mitsuba's envmap
+    /// mapping: top row +Y, left edge -Z, centre +Z), replacing the scene's environment.
+    #[arg(long, value_name = "SKY.exr")]
+    pub env: Option<std::path::PathBuf>,
+    /// Light the scene with a constant environment of this linear RGB radiance instead.
+    #[arg(
+        long,
+        value_name = "R,G,B",
+        value_delimiter = ',',
+        conflicts_with = "env",
+        allow_negative_numbers = true
+    )]
+    pub env_color: Option<Vec<f32>>,
+    /// Factor on --env or --env-color [default: 1].
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    pub env_strength: Option<f32>,
+}
+
+impl EnvOpts {
+    /// Phase 1: checks the strength and the colour.
+    pub fn check(&self) -> Result<()> {
+        if self.env_strength.is_some() && self.env.is_none() && self.env_color.is_none() {
+            bail!("--env-strength needs --env or --env-color");
+        }
+        let colour = match self.env_color.as_deref() {
+            Some(&[r, g, b]) => Vec3::new(r, g, b),
+            Some(other) => bail!(
+                "--env-color takes three numbers, R,G,B (got {})",
+                other.len()
+            ),
+            None => Vec3::ONE,
+        };
+        Environment::constant(colour, self.strength())
+            .map_err(|e| anyhow::anyhow!("--env-color/--env-strength: {e}"))?;
+        Ok(())
+    }
+
+    /// `--env-strength`, 1 by default.
+    fn strength(&self) -> f32 {
+        self.env_strength.unwrap_or(1.0)
+    }
+
+    /// The environment of `--env` or `--env-color` (with `--env-strength`), if either is given.
+    pub fn environment(&self) -> Result<Option<Environment>> {
+        self.check()?;
+        if let Some(path) = &self.env {
+            let env = Environment::load_map(path, self.strength())
+                .with_context(|| format!("--env {}", path.display()))?;
+            return Ok(Some(env));
+        }
+        Ok(match self.env_color.as_deref() {
+            Some(&[r, g, b]) => Some(Environment::constant(Vec3::new(r, g, b), self.strength())?),
+            _ => None,
+        })
+    }
+
+    /// Loads the scene at `path` as [`load_scene`] does, with the environment of the flags.
+    pub fn load_scene(&self, path: &Path, allow_outside: bool) -> Result<Scene> {
+        let environment = self.environment()?;
+        let mut scene = load_scene(path, allow_outside)?;
+        if let Some(env) = environment {
+            scene.set_environment(env);
+        }
+        Ok(scene)
+    }
 }
 
 /// A scene loaded for rendering, with the chosen camera and the image size.
@@ -77,7 +153,7 @@ impl RenderOpts {
         if !self.exposure.is_finite() {
             bail!("--exposure must be a finite number of stops");
         }
-        Ok(())
+        self.env.check()
     }
 
     /// The render settings of the flags (`--spp`, `--max-depth`, `--regularize`,
@@ -91,9 +167,10 @@ impl RenderOpts {
         }
     }
 
-    /// Phase 2: loads the scene (printing its warnings), picks the camera and sizes the image.
+    /// Phase 2: loads the scene (with the environment of `--env` or `--env-color`, if given;
+    /// printing its warnings), picks the camera and sizes the image.
     pub fn load(&self, path: &Path) -> Result<Loaded> {
-        let scene = load_scene(path, self.allow_outside_scene)?;
+        let scene = self.env.load_scene(path, self.allow_outside_scene)?;
         for warning in &scene.warnings {
             eprintln!("warning: {warning}");
         }

@@ -488,3 +488,110 @@ fn gltf_warnings_name_each_feature_once() {
         "{stderr}"
     );
 }
+
+/// `--env`, `--env-color` and `--env-strength` light the scene from the sky: a pixel that sees
+/// only the sky shows the environment's radiance there; bad values are errors naming the flag
+/// or the file; a scene with no light gets the default environment and one warning, which a
+/// flag takes away; the Mitsuba export writes the environment.
+#[test]
+fn environment_flags_light_the_sky() {
+    use glam::Vec3;
+    let t = TestDir::new();
+    t.write_tiny_gltf();
+    let base = ["render", "scene.gltf", "--spp", "2", "--height", "20"];
+    let render = |extra: &[&str], out: &str| {
+        let mut args: Vec<&str> = base.to_vec();
+        args.extend_from_slice(&["-o", out]);
+        args.extend_from_slice(extra);
+        t.streaks(&args)
+    };
+    // A constant sky: the top-left pixel sees only it.
+    render(
+        &["--env-color", "0.2,0.3,0.4", "--env-strength", "2"],
+        "c.exr",
+    )
+    .assert_success();
+    let img = read_exr_rgb(&t.join("c.exr")).unwrap();
+    assert!(
+        (img.get(0, 0) - Vec3::new(0.4, 0.6, 0.8))
+            .abs()
+            .max_element()
+            < 1e-6
+    );
+    // A map of one colour per column band: every texel 0.5 but the +Z half bright.
+    let sky = streaks_image::RgbImage::from_fn(8, 4, |x, _| {
+        if (2..6).contains(&x) {
+            Vec3::splat(4.0)
+        } else {
+            Vec3::splat(0.5)
+        }
+    });
+    streaks_image::exr::write_exr_rgb(&t.join("sky.exr"), &sky).unwrap();
+    render(&["--env", "sky.exr"], "m.exr").assert_success();
+    let img = read_exr_rgb(&t.join("m.exr")).unwrap();
+    // The camera looks along -Z: the dim half, exactly 0.5 near the image's top centre.
+    assert!(
+        (img.get(15, 0) - Vec3::splat(0.5)).abs().max_element() < 1e-5,
+        "{}",
+        img.get(15, 0)
+    );
+
+    render(&["--env", "missing.exr"], "x.exr").assert_failure_mentioning("missing.exr");
+    std::fs::write(t.join("sky.png"), b"\x89PNG\r\n\x1a\n").unwrap();
+    render(&["--env", "sky.png"], "x.exr").assert_failure_mentioning("not an OpenEXR");
+    render(&["--env", "sky.exr", "--env-strength", "-1"], "x.exr")
+        .assert_failure_mentioning("strength");
+    render(&["--env-color", "1,2"], "x.exr").assert_failure_mentioning("three numbers");
+    render(&["--env-strength", "2"], "x.exr").assert_failure_mentioning("--env-strength needs");
+    render(&["--env-color", "1,nan,1"], "x.exr").assert_failure_mentioning("env-color");
+
+    // Without its lamp and with a black sign, the scene has no light.
+    let mut doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(t.join("scene.gltf")).unwrap()).unwrap();
+    doc["scenes"][0]["nodes"] = serde_json::json!([0, 1, 2]);
+    doc["materials"][1]["emissiveFactor"] = serde_json::json!([0, 0, 0]);
+    std::fs::write(t.join("dark.gltf"), doc.to_string()).unwrap();
+    let dark = [
+        "render",
+        "dark.gltf",
+        "--spp",
+        "2",
+        "--height",
+        "20",
+        "-o",
+        "d.exr",
+    ];
+    let run = t.streaks(&dark);
+    run.assert_success();
+    let warning = "scene has no light: lit by a uniform white environment of radiance 1";
+    assert_eq!(run.stderr().matches(warning).count(), 1, "{}", run.stderr());
+    let img = read_exr_rgb(&t.join("d.exr")).unwrap();
+    assert_eq!(img.get(0, 0), Vec3::ONE);
+    assert!(img.get(15, 19).min_element() > 0.05);
+    let mut with_env = dark.to_vec();
+    with_env.extend_from_slice(&["--env-color", "1,1,1"]);
+    let run = t.streaks(&with_env);
+    run.assert_success();
+    assert!(!run.stderr().contains(warning), "{}", run.stderr());
+
+    // The export writes the environment map beside the XML.
+    t.streaks(&[
+        "export-mitsuba",
+        "scene.gltf",
+        "-o",
+        "mi",
+        "--env",
+        "sky.exr",
+    ])
+    .assert_success();
+    let xml = std::fs::read_to_string(t.join("mi/scene.xml")).unwrap();
+    assert!(xml.contains("<emitter type=\"envmap\">"), "{xml}");
+    assert!(t.join("mi/textures/environment.exr").exists());
+    // And stereo takes the same flags.
+    let help = t.streaks(&["stereo", "--help"]);
+    let text = String::from_utf8_lossy(&help.output.stdout);
+    assert!(
+        text.contains("--env <SKY.exr>") && text.contains("--env-color"),
+        "{text}"
+    );
+}

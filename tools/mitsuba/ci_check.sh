@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # CI check: streaks render against Mitsuba 3 on scenes/crosscheck.gltf, with the noise test of
 # tools/mitsuba/README.md, then on the same scene with the glass pane of glass_pane.py
-# (KHR_materials_transmission with a volume: Mitsuba's dielectric) at max depth 8.
+# (KHR_materials_transmission with a volume: Mitsuba's dielectric) at max depth 8, then on its
+# road and wall lit by the environment map of env_scene.py only (Mitsuba's envmap; about 5 s).
 # Exits 0 on agreement, 1 on disagreement, 2 when it cannot run.
 # Environment: STREAKS (the binary; default target/debug/streaks, built with cargo build),
 # CROSSCHECK_SPP (default 64), CROSSCHECK_WIDTH/HEIGHT (default 160x120), CROSSCHECK_K (4).
@@ -23,11 +24,20 @@ python3 "$here/crosscheck.py" --ci --streaks "$streaks" \
     --spp "${CROSSCHECK_SPP:-64}" --width "${CROSSCHECK_WIDTH:-160}" \
     --height "${CROSSCHECK_HEIGHT:-120}" --k "${CROSSCHECK_K:-4}" \
     --out "$repo/target/crosscheck/ci" "$@" || status=$?
+# One more scene at CI's size, spp and k: SCENE MAX_DEPTH OUT then regions.
+check_scene() {
+    local scene="$1" depth="$2" out="$3"
+    shift 3
+    python3 "$here/crosscheck.py" "$scene" --camera cam --streaks "$streaks" \
+        --max-depth "$depth" --spp "${CROSSCHECK_SPP:-64}" --width "${CROSSCHECK_WIDTH:-160}" \
+        --height "${CROSSCHECK_HEIGHT:-120}" --k "${CROSSCHECK_K:-4}" \
+        --out "$repo/target/crosscheck/$out" "$@" || status=$?
+}
 python3 "$here/glass_pane.py" "$repo/target/crosscheck/glass" >&2
-python3 "$here/crosscheck.py" "$repo/target/crosscheck/glass/glass_crosscheck.gltf" \
-    --camera cam --streaks "$streaks" --max-depth 8 \
-    --spp "${CROSSCHECK_SPP:-64}" --width "${CROSSCHECK_WIDTH:-160}" \
-    --height "${CROSSCHECK_HEIGHT:-120}" --k "${CROSSCHECK_K:-4}" \
-    --region pane=0.2,0.22,0.52,0.6 --region road=0,0.7,1,1 --region wall=0.6,0.1,0.95,0.5 \
-    --out "$repo/target/crosscheck/ci_glass" || status=$?
+check_scene "$repo/target/crosscheck/glass/glass_crosscheck.gltf" 8 ci_glass \
+    --region pane=0.2,0.22,0.52,0.6 --region road=0,0.7,1,1 --region wall=0.6,0.1,0.95,0.5
+python3 "$here/env_scene.py" "$repo/target/crosscheck/env" >&2
+check_scene "$repo/target/crosscheck/env/env_crosscheck.gltf" 4 ci_env \
+    --region top=0,0,1,0.06 --region wall=0.1,0.1,0.9,0.45 --region road=0,0.62,1,1 \
+    --region streak=0.35,0.7,0.65,1
 exit "$status"

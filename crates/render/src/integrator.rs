@@ -11,6 +11,12 @@
 //!    lights (point, spot, directional) cannot be hit by BSDF samples and are added unweighted,
 //! 3. samples the BSDF for the next direction.
 //!
+//! A ray that escapes the scene adds the environment light's radiance
+//! ([`crate::light::Environment`]) the way a hit emitter adds its emission: in full for a
+//! camera ray or after a delta lobe, else weighted against the light choice's density of that
+//! direction; next-event estimation samples the environment as one more choice of the
+//! [`LightSampler`], with a shadow ray that must escape. A ray inside a volume adds nothing.
+//!
 //! `max_depth` has Mitsuba 3's meaning (`path.cpp`): the longest path, counted in segments
 //! from the camera; 1 renders only emitters seen directly, 2 direct illumination, 3 one
 //! indirect bounce, and so on; `u32::MAX` means no limit. Russian roulette uses Mitsuba's
@@ -124,7 +130,8 @@
 //!   ([`crate::film::NO_MATERIAL`] on a miss); with [`crate::material::Material::road`] it tells
 //!   which pixels see the road surface first.
 //! - `specular`: the part of the pixel's radiance that reached the camera by exactly one
-//!   reflection of an emitter off the glossy lobe at the first surface hit: the glossy part
+//!   reflection of an emitter off the glossy lobe at the first surface hit (the environment
+//!   counts as an emitter: a glossy road's reflection of the sky is a streak too): the glossy part
 //!   (`eval_lobes(..).glossy`) of the next-event estimate at the first hit, plus, for the BSDF
 //!   sample from the first hit that hits an emitter directly, `L_e * glossy(wi) * cos / pdf`
 //!   with the same MIS weight as in the beauty image. Using the glossy part of `f` at the
@@ -489,6 +496,47 @@ fn first_hit_layers(scene: &Scene, ray: &Ray, origin: Vec3, forward: Vec3, pixel
     }
 }
 
+/// Where the path stands when light arrives along its current ray (an emitter hit, or the
+/// environment as the ray escapes), for [`Arrival::add`].
+struct Arrival {
+    /// Segments before the current one.
+    depth: u32,
+    /// Whether the current direction came from a delta lobe.
+    prev_delta: bool,
+    /// The BSDF-sampling density of the current direction.
+    prev_bsdf_pdf: f32,
+    /// The first hit's BSDF, frame and `wo`, for the specular layer.
+    first_bsdf: Option<(Bsdf, Frame, Vec3)>,
+}
+
+impl Arrival {
+    /// Adds radiance `le` arriving along direction `dir`: in full when seen by the camera or
+    /// through a delta lobe, else weighted by the power heuristic against the light choice's
+    /// density `light_pdf()` of the same direction; light reached by one BSDF sample from the
+    /// first hit also goes, with the glossy part of that BSDF, to the specular layer.
+    #[inline]
+    fn add(
+        &self,
+        out: &mut PathResult,
+        throughput: Vec3,
+        le: Vec3,
+        dir: Vec3,
+        light_pdf: impl FnOnce() -> f32,
+    ) {
+        if self.depth == 0 || self.prev_delta {
+            out.radiance += throughput * le;
+        } else {
+            let weight = power_heuristic(1.0, self.prev_bsdf_pdf, 1.0, light_pdf());
+            out.radiance += throughput * le * weight;
+            if let (1, Some((bsdf, frame, wo_local))) = (self.depth, self.first_bsdf) {
+                let wi_local = frame.to_local(dir);
+                let glossy = bsdf.eval_lobes(wo_local, wi_local).glossy;
+                out.specular += le * glossy * (wi_local.z * weight / self.prev_bsdf_pdf);
+            }
+        }
+    }
+}
+
 /// Traces one camera path (see the module documentation).
 fn trace_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, job: &RenderJob) -> PathResult {
     let (max_depth, want_specular) = (job.settings.max_depth, job.layers.specular);
@@ -512,7 +560,24 @@ fn trace_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, job: &RenderJo
 
     while depth < max_depth {
         out.rays += 1;
+        // Where the path stands, for light arriving along this ray.
+        let arrival = Arrival {
+            depth,
+            prev_delta,
+            prev_bsdf_pdf,
+            first_bsdf,
+        };
         let Some(hit) = scene.intersect(&ray) else {
+            // 1'. The environment, for a ray that escapes (not from inside a volume, whose
+            // closed surface a ray cannot leave unseen).
+            if let (Some(env), None) = (lights.environment(), medium) {
+                let le = env.le(ray.direction);
+                if le.max_element() > 0.0 {
+                    arrival.add(&mut out, throughput, le, ray.direction, || {
+                        prev.map_or(0.0, |rx| lights.pdf_environment(&rx, ray.direction))
+                    });
+                }
+            }
             break;
         };
         let wo = -ray.direction;
@@ -523,18 +588,9 @@ fn trace_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, job: &RenderJo
         // 1. Emission of the surface hit.
         let le = scene.emitted_radiance(&hit, wo);
         if le.max_element() > 0.0 {
-            if depth == 0 || prev_delta {
-                out.radiance += throughput * le;
-            } else {
-                let light_pdf = prev.map_or(0.0, |rx| lights.pdf_li(&rx, &hit));
-                let weight = power_heuristic(1.0, prev_bsdf_pdf, 1.0, light_pdf);
-                out.radiance += throughput * le * weight;
-                if let (1, Some((bsdf, frame, wo_local))) = (depth, first_bsdf) {
-                    let wi_local = frame.to_local(ray.direction);
-                    let glossy = bsdf.eval_lobes(wo_local, wi_local).glossy;
-                    out.specular += le * glossy * (wi_local.z * weight / prev_bsdf_pdf);
-                }
-            }
+            arrival.add(&mut out, throughput, le, ray.direction, || {
+                prev.map_or(0.0, |rx| lights.pdf_li(&rx, &hit))
+            });
         }
         if depth + 1 >= max_depth {
             break;
@@ -1591,5 +1647,132 @@ pub(crate) mod tests {
             (mean - want).abs().max_element() < (4.0 * err as f32).max(2e-3),
             "{mean} vs {want} (standard error {err})"
         );
+    }
+
+    /// The floor of [`floor`] made of `material` under `environment`, with `lights`.
+    fn floor_under(
+        material: Material,
+        environment: crate::light::Environment,
+        lights: Vec<Light>,
+    ) -> Scene {
+        let mut parts = SceneParts {
+            materials: vec![material],
+            lights,
+            environment: Some(environment),
+            ..Default::default()
+        };
+        floor(&mut parts);
+        Scene::from_parts(parts).unwrap()
+    }
+
+    /// The mean pixel of a render.
+    fn mean_pixel(out: &RenderOutput) -> Vec3 {
+        out.image.pixels.iter().copied().sum::<Vec3>() / out.image.pixels.len() as f32
+    }
+
+    /// The furnace under the sky: a white-ish diffuse floor under a uniform environment of
+    /// radiance 1 sees the whole upper hemisphere of it, so its radiance is its albedo; the
+    /// sky seen directly is exactly 1, and the AOVs keep their miss values there.
+    #[test]
+    fn diffuse_floor_under_a_constant_environment_has_its_albedo() {
+        use crate::light::Environment;
+        let kd = Vec3::new(0.8, 0.5, 0.2);
+        let env = Environment::constant(Vec3::ONE, 1.0).unwrap();
+        let scene = floor_under(Material::diffuse("floor", kd), env, vec![]);
+        assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+        let cam = camera(Vec3::new(0.0, 1.5, 2.0), -0.6, 0.6);
+        let out = render(&scene, &cam, &settings(24, 16, 64, 8), &|_| {});
+        let mean = mean_pixel(&out);
+        assert!(
+            (mean - kd).abs().max_element() < 0.01 * kd.max_element(),
+            "{mean} vs {kd}"
+        );
+        // Looking up: the sky only, exactly.
+        let up = camera(Vec3::new(0.0, 1.5, 2.0), 1.2, 0.6);
+        let mut set = settings(8, 6, 4, 8);
+        set.layers.depth = true;
+        set.layers.normal = true;
+        let out = render(&scene, &up, &set, &|_| {});
+        assert!(out.image.pixels.iter().all(|p| *p == Vec3::ONE));
+        assert!(out.depth.unwrap().iter().all(|d| *d == f32::INFINITY));
+        assert!(out.normal.unwrap().pixels.iter().all(|n| *n == Vec3::ZERO));
+    }
+
+    /// A map of one colour is the constant environment sampled another way (in proportion to
+    /// sin theta): the same image within the noise, on a glossy floor (MIS of the map's
+    /// sampling with the GGX lobe's) with a point light beside it (the share between the
+    /// environment and the tree). The specular layer holds the sky's streak.
+    #[test]
+    fn a_uniform_map_lights_as_the_constant_environment_does() {
+        use crate::light::{Environment, EnvironmentMap};
+        let road = Material::glossy_road("road", Vec3::splat(0.1), Vec3::splat(0.5), 0.1);
+        let lamp = vec![Light::Point {
+            position: Vec3::new(0.5, 3.0, -3.0),
+            intensity: Vec3::splat(3.0),
+            range: None,
+        }];
+        let colour = Vec3::new(0.3, 0.4, 0.6);
+        let constant = Environment::constant(colour, 1.0).unwrap();
+        let image = RgbImage::from_fn(16, 9, |_, _| colour);
+        let map = Environment::Map(Box::new(
+            EnvironmentMap::new(std::path::Path::new("sky.exr"), &image, 1.0).unwrap(),
+        ));
+        let cam = camera(Vec3::new(0.0, 1.5, 2.0), -0.4, 0.6);
+        let mut set = settings(24, 16, 256, 3);
+        set.layers.specular = true;
+        let a = render(
+            &floor_under(road.clone(), constant, lamp.clone()),
+            &cam,
+            &set,
+            &|_| {},
+        );
+        let b = render(&floor_under(road, map, lamp), &cam, &set, &|_| {});
+        let (ma, mb) = (mean_pixel(&a), mean_pixel(&b));
+        assert!(
+            (ma - mb).abs().max_element() < 0.01 * ma.max_element(),
+            "{ma} vs {mb}"
+        );
+        let spec = a.specular.unwrap();
+        let spec_mean = spec.pixels.iter().copied().sum::<Vec3>() / spec.pixels.len() as f32;
+        assert!(spec_mean.min_element() > 0.0 && spec_mean.max_element() < ma.max_element());
+        // The sky's reflection is bluish, like the sky.
+        assert!(spec_mean.z > spec_mean.x, "{spec_mean}");
+    }
+
+    /// Without any light the scene gets the default environment and one warning, which an
+    /// environment set afterwards (a command's `--env`) takes away.
+    #[test]
+    fn a_scene_without_lights_is_lit_by_the_default_environment() {
+        use crate::light::Environment;
+        use crate::scene::{DEFAULT_ENVIRONMENT_RADIANCE, NO_LIGHT_WARNING};
+        let mut parts = SceneParts {
+            source: "dark.gltf".into(),
+            materials: vec![Material::diffuse("floor", Vec3::splat(0.5))],
+            ..Default::default()
+        };
+        floor(&mut parts);
+        let mut scene = Scene::from_parts(parts.clone()).unwrap();
+        assert_eq!(
+            scene.warnings,
+            vec![format!("dark.gltf: {NO_LIGHT_WARNING}")]
+        );
+        assert_eq!(
+            scene.environment(),
+            Some(&Environment::Constant {
+                radiance: Vec3::splat(DEFAULT_ENVIRONMENT_RADIANCE)
+            })
+        );
+        let cam = camera(Vec3::new(0.0, 1.5, 2.0), -0.6, 0.6);
+        let out = render(&scene, &cam, &settings(12, 8, 16, 2), &|_| {});
+        assert!(mean_pixel(&out).min_element() > 0.45);
+        scene.set_environment(Environment::constant(Vec3::ONE, 0.5).unwrap());
+        assert!(scene.warnings.is_empty());
+        // A light of any kind is enough to go without.
+        parts.lights.push(Light::Directional {
+            direction: -Vec3::Y,
+            irradiance: Vec3::ONE,
+        });
+        let lit = Scene::from_parts(parts).unwrap();
+        assert!(lit.warnings.is_empty() && lit.environment().is_none());
     }
 }

@@ -31,6 +31,8 @@
 //! | perspective camera | `perspective`, `fov_axis` y, `fov` in degrees, `to_world` as a `lookat` | yes |
 //! | orthographic camera | `orthographic`, `to_world` a `scale` by the half-width then a `lookat` moved back by `near_clip` (see [`sensor_xml`]) | yes |
 //! | no camera | the default camera ([`Scene::default_camera`]) as a `perspective` camera | yes (warning) |
+//! | constant environment ([`Environment::Constant`], also the default of a scene without lights) | `constant` with the same `radiance` | yes |
+//! | environment map ([`Environment::Map`]) | `envmap` of the map's texels (written to `textures/environment.exr`), `scale` = strength, no `to_world` | yes: the same direction mapping, texel centres and bilinear lookup (a map of one row or column is written with it repeated) |
 //! | film, filter | `hdrfilm` (rgb, float32) with a `box` filter | yes |
 //! | integrator | `path` with the same `max_depth` | yes (Russian roulette differs: unbiased either way) |
 //! | sampler | `independent` with `sample_count` and `seed` | noise differs, expectation the same |
@@ -41,7 +43,7 @@
 
 use crate::bsdf;
 use crate::camera::{Camera, Projection};
-use crate::light::Light;
+use crate::light::{Environment, Light};
 use crate::material::{GltfPbrParams, Material, PaperModel, Reflectance};
 use crate::scene::{Instances, Scene, SceneError, TriangleMesh};
 use crate::texture::{Sampler, Texture, TextureId, TextureRef};
@@ -200,6 +202,7 @@ pub(crate) struct ExportedScene<'a> {
     pub(crate) textures: &'a [Texture],
     pub(crate) lights: &'a [Light],
     pub(crate) instances: &'a Instances,
+    pub(crate) environment: Option<&'a Environment>,
 }
 
 /// Converts `scene` to Mitsuba 3 with the render settings `opts`. A scene without a camera
@@ -213,6 +216,7 @@ pub fn export(scene: &Scene, opts: &ExportOptions) -> Result<MitsubaExport, Mits
         textures: &scene.textures,
         lights: &scene.lights,
         instances: &scene.instances,
+        environment: scene.environment(),
     };
     match scene.find_camera(opts.camera.as_deref())? {
         Some(camera) => export_parts(&parts, camera, opts),
@@ -896,6 +900,30 @@ pub(crate) fn export_parts(
     for light in parts.lights {
         let _ = writeln!(xml, "{}", light_xml(light, &mut warnings));
     }
+    match parts.environment {
+        None => {}
+        Some(Environment::Constant { radiance }) => {
+            let _ = writeln!(
+                xml,
+                "<emitter type=\"constant\">{}</emitter>",
+                rgb("radiance", *radiance)
+            );
+        }
+        Some(Environment::Map(map)) => {
+            let file_name = "textures/environment.exr".to_string();
+            let _ = writeln!(
+                xml,
+                "<emitter type=\"envmap\"><string name=\"filename\" value=\"{}\"/>\
+                 <float name=\"scale\" value=\"{}\"/></emitter>",
+                esc(&file_name),
+                map.strength()
+            );
+            textures.push(BakedTexture {
+                file_name,
+                image: map.texels(),
+            });
+        }
+    }
     let mut meshes = meshes_by_material(parts);
     let mut mw = MaterialWriter {
         parts,
@@ -1107,6 +1135,7 @@ mod tests {
                 textures: &self.textures,
                 lights: &self.lights,
                 instances: &self.instances,
+                environment: None,
             }
         }
     }
@@ -1514,5 +1543,54 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// A constant environment (the default one of a scene without lights included) becomes
+    /// `constant` with its radiance, a map `envmap` of its texels with `scale` the strength.
+    #[test]
+    fn environments_are_exported() {
+        use crate::light::{Environment, EnvironmentMap};
+        let build = |environment: Option<Environment>| {
+            let mut parts = crate::scene::SceneParts {
+                materials: vec![Material::diffuse("floor", Vec3::splat(0.5))],
+                cameras: vec![Camera::perspective(
+                    "cam",
+                    Affine3A::from_translation(Vec3::new(0.0, 1.5, 4.0)),
+                    0.7,
+                    None,
+                )],
+                environment,
+                ..Default::default()
+            };
+            parts.mesh.positions = vec![Vec3::ZERO, Vec3::X, Vec3::Z];
+            parts.mesh.triangles = vec![[0, 2, 1]];
+            parts.mesh.triangle_materials = vec![0];
+            export(&Scene::from_parts(parts).unwrap(), &opts()).unwrap()
+        };
+        let default = build(None);
+        assert!(
+            default.xml.contains(
+                "<emitter type=\"constant\"><rgb name=\"radiance\" value=\"1.0, 1.0, 1.0\"/></emitter>"
+            ),
+            "{}",
+            default.xml
+        );
+        let image = RgbImage::from_fn(4, 3, |x, y| Vec3::new(x as f32, y as f32, 0.5));
+        let map = EnvironmentMap::new(Path::new("/elsewhere/sky.exr"), &image, 2.5).unwrap();
+        let e = build(Some(Environment::Map(Box::new(map))));
+        assert!(
+            e.xml.contains(
+                "<emitter type=\"envmap\"><string name=\"filename\" value=\"textures/environment.exr\"/><float name=\"scale\" value=\"2.5\"/></emitter>"
+            ),
+            "{}",
+            e.xml
+        );
+        let baked = e
+            .textures
+            .iter()
+            .find(|t| t.file_name == "textures/environment.exr");
+        assert_eq!(baked.unwrap().image, image);
+        // The XML parses.
+        roxmltree::Document::parse(&e.xml).unwrap();
     }
 }

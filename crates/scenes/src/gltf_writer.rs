@@ -242,6 +242,8 @@ pub struct Doc {
     textures_used: Vec<usize>,
     triangles: usize,
     description: String,
+    /// `scenes[0].extras.streaks.environment`, if any.
+    environment: Option<serde_json::Value>,
 }
 
 impl std::fmt::Debug for Doc {
@@ -273,7 +275,14 @@ impl Doc {
             textures_used: Vec::new(),
             triangles: 0,
             description: description.to_owned(),
+            environment: None,
         }
+    }
+
+    /// Sets the scene's environment light, `scenes[0].extras.streaks.environment` (for
+    /// example `{"color": [r, g, b]}`).
+    pub fn set_environment(&mut self, environment: serde_json::Value) {
+        self.environment = Some(environment);
     }
 
     /// Number of triangles added so far.
@@ -593,6 +602,9 @@ impl Doc {
         });
         if !self.cameras.is_empty() {
             root["cameras"] = json!(self.cameras);
+        }
+        if let Some(env) = &self.environment {
+            root["scenes"][0]["extras"]["streaks"] = json!({ "environment": env });
         }
         let mut used = Vec::new();
         if !self.lights.is_empty() {

@@ -317,6 +317,30 @@ pub struct GeneratorConfig {
     pub exposure: ExposureConfig,
     /// Streets and splits.
     pub dataset: DatasetConfig,
+    /// The night sky's glow, an environment light; none by default (the sky is black).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sky: Option<SkyConfig>,
+}
+
+/// The night sky's glow: a constant environment light of radiance `color * glow` (W/(m^2 sr)),
+/// written in each sample's `scene.gltf` as `scenes[0].extras.streaks.environment`, so that
+/// the sample is rendered with it and the file says so.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SkyConfig {
+    /// The glow's radiance, drawn per street.
+    pub glow: Range,
+    /// Its linear RGB colour (a city's sodium-orange or a moonlit blue).
+    pub color: [f64; 3],
+}
+
+impl Default for SkyConfig {
+    fn default() -> Self {
+        Self {
+            glow: [0.002, 0.02],
+            color: [1.0, 0.75, 0.55],
+        }
+    }
 }
 
 /// The documented default config, with comments (the same values as
@@ -460,6 +484,19 @@ impl GeneratorConfig {
                 sp.train, sp.val, sp.test
             ));
         }
+        if let Some(sky) = &self.sky {
+            real("sky.glow", sky.glow, 0.0, 100.0)?;
+            if !sky
+                .color
+                .iter()
+                .all(|c| c.is_finite() && (0.0..=1.0).contains(c))
+            {
+                return Err(format!(
+                    "sky.color = {:?} must lie within [0, 1]",
+                    sky.color
+                ));
+            }
+        }
         Ok(())
     }
 }
@@ -532,6 +569,7 @@ fn mix(seed: u64, tag: u64, n: u64) -> u64 {
 const STREET_STREAM: u64 = 1;
 const RIG_STREAM: u64 = 2;
 const SPLIT_STREAM: u64 = 3;
+const SKY_STREAM: u64 = 4;
 
 fn uniform(rng: &mut ChaCha8Rng, r: Range) -> f64 {
     if r[1] > r[0] {
@@ -633,7 +671,15 @@ pub fn sample(config: &GeneratorConfig, seed: u64, index: u64) -> Result<SampleS
     street.style.eye = eye;
     street.style.pitch_tan = pitch_deg.to_radians().tan() as f32;
     street.style.yfov_deg = yfov_deg;
-    let doc = street.build()?;
+    let mut doc = street.build()?;
+    if let Some(sky) = &config.sky {
+        // Its own stream: a config with a sky draws every other parameter as one without.
+        let mut sky_rng = ChaCha8Rng::seed_from_u64(mix(seed, SKY_STREAM, street_id));
+        let glow = uniform(&mut sky_rng, sky.glow);
+        let color = sky.color.map(|c| crate::gltf_writer::round7(c * glow));
+        doc.set_environment(json!({ "color": color }));
+        params["sky"] = json!({ "glow": glow, "color": color });
+    }
     let split = split_of(config, seed, street_id);
     params["rig"] = json!({
         "eye": eye.to_array(),
@@ -1072,5 +1118,54 @@ mod tests {
         assert!(sodium[2] < 0.15 && sodium[1] < 0.6, "{sodium:?}");
         assert!(led[2] > sodium[2] && led[1] > sodium[1], "{led:?}");
         assert!(d65.iter().all(|&c| c > 0.85), "{d65:?}");
+    }
+
+    /// A config with a `[sky]` writes the glow in the scene's extras and draws everything
+    /// else as the config without it; the default writes no environment; bad skies say why.
+    #[test]
+    fn a_sky_glow_is_written_in_the_scene_and_changes_nothing_else() {
+        let read = |config: &GeneratorConfig| {
+            let s = sample(config, 7, 3).unwrap();
+            let dir = tempfile::tempdir().unwrap();
+            let files = s.doc.write(dir.path()).unwrap();
+            let gltf = files
+                .iter()
+                .find(|f| f.extension().is_some_and(|e| e == "gltf"));
+            let json: serde_json::Value =
+                serde_json::from_slice(&std::fs::read(gltf.unwrap()).unwrap()).unwrap();
+            (json, s.params)
+        };
+        let (plain, plain_params) = read(&GeneratorConfig::default());
+        assert!(plain["scenes"][0]["extras"].get("streaks").is_none());
+        assert!(plain_params.get("sky").is_none());
+        let sky = GeneratorConfig::from_toml_str(
+            "[sky]\nglow = [0.01, 0.01]\ncolor = [1.0, 0.5, 0.25]\n",
+            "sky.toml",
+        )
+        .unwrap();
+        let (glowing, params) = read(&sky);
+        assert_eq!(
+            glowing["scenes"][0]["extras"]["streaks"]["environment"],
+            json!({"color": [0.01, 0.005, 0.0025]})
+        );
+        assert_eq!(params["sky"]["glow"], json!(0.01));
+        let mut without = glowing.clone();
+        without["scenes"][0]["extras"]
+            .as_object_mut()
+            .unwrap()
+            .remove("streaks");
+        assert_eq!(without, plain);
+        // The default config's serialised forms name no sky (dataset.json keeps its bytes).
+        assert!(!GeneratorConfig::default().to_toml().contains("sky"));
+        assert!(GeneratorConfig::default().to_json().get("sky").is_none());
+        for (text, needle) in [
+            ("[sky]\nglow = [-1, 0.1]\n", "sky.glow"),
+            ("[sky]\ncolor = [2, 0, 0]\n", "sky.color"),
+        ] {
+            let e = GeneratorConfig::from_toml_str(text, "x.toml")
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(needle), "{text:?}: {e}");
+        }
     }
 }

@@ -38,6 +38,15 @@
 //!   a rough lens seen at grazing send its shadow rays to groups rather than to its bulb 0.1 m
 //!   away; docs/decisions/0016-sharp-lobes-see-past-the-anchor.md.)
 //!
+//! The environment light ([`Environment`]), when the scene has one, is one more choice beside
+//! the tree, made first: it is chosen with probability `E_env / (E_env + E_tree)`, held within
+//! [`ENVIRONMENT_SHARE_BOUNDS`], where `E_env` is `pi` times its mean luminance (the irradiance
+//! it gives a surface open to the whole sky) and `E_tree` the sum of the `E` of the tree's root
+//! children at the point (everything when the tree is empty or gives nothing there). The
+//! bounds keep either side sampled however wrong the estimate is (neither counts occlusion):
+//! a lamp under a bright sky, the sky in a lamp's shadow. The tree's choices are then scaled
+//! by the rest. Without an environment nothing changes.
+//!
 //! The choice descends the tree from the root, one child per level, weighing a node's children
 //! once: at most `BRANCHING` (16) BSDF evaluations per level, all of a node's children in SIMD
 //! lanes, 4, 8 or 16 at a time (the crate's `light::child_weights`). Every choice is a deterministic
@@ -46,15 +55,21 @@
 
 use super::child_weights::{BsdfWeight, TreeLanes, Weights};
 use super::emitter::{Emitter, Emitters, SurfaceMesh};
+use super::environment::Environment;
 use super::tree::{LightTree, Node};
-use super::{Light, LightSample, Receiver};
+use super::{Light, LightSample, Receiver, Visibility};
 use crate::bsdf::Bsdf;
 use crate::geometry::SurfaceHit;
 use crate::material::Material;
 use crate::sampling::ONE_MINUS_EPSILON;
 use crate::texture::Texture;
-use glam::Vec2;
+use glam::{Vec2, Vec3};
+use std::f32::consts::PI;
 use std::ops::Range;
+
+/// The least and the most of the light choice the environment gets when the scene has other
+/// lights too (see the module documentation): the defensive share either way.
+pub const ENVIRONMENT_SHARE_BOUNDS: (f32, f32) = (DEFENSIVE_SHARE, 1.0 - DEFENSIVE_SHARE);
 
 /// Share of the light choice made by irradiance alone when it is BSDF-aware (defensive
 /// sampling, see the module documentation).
@@ -83,6 +98,16 @@ pub struct LightSampler {
     tree: LightTree,
     /// The tree's sibling sets in lanes, for the weights.
     lanes: TreeLanes,
+    /// The environment light, if any: one more choice beside the tree.
+    environment: Option<Environment>,
+}
+
+/// What [`LightSampler`]'s choice chose.
+enum Choice {
+    /// The environment, with this probability.
+    Environment(f32),
+    /// Emitter `.0` with probability `.1`, and `u` rescaled within it (`.2`).
+    Emitter(usize, f32, f32),
 }
 
 /// Chooses index `i` with probability `w_i / sum` by inverting the cumulative sum at `u sum`
@@ -155,6 +180,67 @@ impl LightSampler {
             emitters,
             tree,
             lanes,
+            environment: None,
+        }
+    }
+
+    /// Sets (or removes) the environment light; the emitters and the tree stay as they are.
+    pub fn set_environment(&mut self, environment: Option<Environment>) {
+        self.environment = environment;
+    }
+
+    /// The environment light, if any.
+    #[inline]
+    pub fn environment(&self) -> Option<&Environment> {
+        self.environment.as_ref()
+    }
+
+    /// The probability that the choice at the receiver is the environment: 0 without one (see
+    /// the module documentation).
+    #[inline]
+    fn environment_share(&self, rx: &Receiver) -> f32 {
+        if self.environment.is_none() {
+            return 0.0;
+        }
+        let e_tree = if self.emitters.is_empty() {
+            0.0
+        } else {
+            self.weights(rx, &BsdfWeight::new(rx), self.tree.root()).2
+        };
+        self.environment_share_given(e_tree)
+    }
+
+    /// [`LightSampler::environment_share`] given `e_tree`, the sum of the `E` of the tree's
+    /// root children at the point (0 when the tree is empty).
+    #[inline]
+    fn environment_share_given(&self, e_tree: f32) -> f32 {
+        let Some(env) = &self.environment else {
+            return 0.0;
+        };
+        let e_env = PI * env.mean_luminance();
+        if !(e_env > 0.0 && e_env.is_finite()) {
+            return 0.0;
+        }
+        if !(e_tree > 0.0 && e_tree.is_finite()) {
+            return 1.0;
+        }
+        let (lo, hi) = ENVIRONMENT_SHARE_BOUNDS;
+        (e_env / (e_env + e_tree)).clamp(lo, hi)
+    }
+
+    /// The density (choice included) with which [`LightSampler::sample_li`] at the receiver
+    /// returns direction `wi` toward the environment; 0 without one.
+    pub fn pdf_environment(&self, rx: &Receiver, wi: Vec3) -> f32 {
+        match &self.environment {
+            Some(env) => {
+                let share = self.environment_share(rx);
+                if share > 0.0 {
+                    share * env.pdf(wi)
+                } else {
+                    0.0
+                }
+            }
+            None => 0.0,
         }
     }
 
@@ -180,18 +266,35 @@ impl LightSampler {
     /// Chooses an emitter for the receiver: `(emitter, probability, u rescaled within it)`.
     /// From the root down, a child of each node by the mixture of `E` and `E F`.
     #[inline]
-    fn choose(&self, rx: &Receiver, u: f32) -> Option<(usize, f32, f32)> {
+    fn choose(&self, rx: &Receiver, u: f32) -> Option<Choice> {
+        if self.environment.is_some() && self.emitters.is_empty() {
+            let share = self.environment_share_given(0.0);
+            return (share > 0.0).then_some(Choice::Environment(share));
+        }
         let f = BsdfWeight::new(rx);
         let share = defensive_share(&rx.bsdf);
         let (mut nodes, mut u, mut pmf) = (self.tree.root(), u, 1.0f32);
+        let mut at_root = self.environment.is_some();
         loop {
             let (e_w, ef_w, e_sum, ef_sum) = self.weights(rx, &f, nodes.clone());
+            if at_root {
+                // The environment first, from the root's weights.
+                at_root = false;
+                let env = self.environment_share_given(e_sum);
+                if u < env {
+                    return Some(Choice::Environment(env));
+                }
+                u = ((u - env) / (1.0 - env)).min(ONE_MINUS_EPSILON);
+                pmf = 1.0 - env;
+            }
             let n = nodes.len();
             let (c, u_c) = choose_mixture(&e_w[..n], &ef_w[..n], e_sum, ef_sum, u, share)?;
             pmf *= mixture_pmf(e_w[c], ef_w[c], e_sum, ef_sum, share);
             u = u_c;
             match self.tree.nodes()[nodes.start + c] {
-                Node::Emitter(e) => return (pmf > 0.0).then_some((e as usize, pmf, u)),
+                Node::Emitter(e) => {
+                    return (pmf > 0.0).then_some(Choice::Emitter(e as usize, pmf, u));
+                }
                 Node::Group(g) => nodes = g.children(),
             }
         }
@@ -213,15 +316,20 @@ impl LightSampler {
             pmf *= mixture_pmf(e_w[slot], ef_w[slot], e_sum, ef_sum, share);
             match self.tree.parent(node) {
                 Some(parent) if pmf > 0.0 => node = parent,
+                // At the root: what the environment leaves (its share from the same weights).
+                None if self.environment.is_some() => {
+                    return pmf * (1.0 - self.environment_share_given(e_sum));
+                }
                 _ => return pmf,
             }
         }
     }
 
-    /// Chooses an emitter with `u_light` and samples it with `u` (see the module
-    /// documentation); `materials` and `textures` are the scene's, for the emission of an
-    /// area sample. The returned `pdf` includes the probability of the choice; `None` when
-    /// nothing was sampled.
+    /// Chooses an emitter (or the environment) with `u_light` and samples it with `u` (see the
+    /// module documentation); `materials` and `textures` are the scene's, for the emission of
+    /// an area sample. The returned `pdf` includes the probability of the choice; `None` when
+    /// nothing was sampled. An environment sample is a direction: `dist` is infinite, and its
+    /// shadow ray must escape the scene.
     pub fn sample_li(
         &self,
         materials: &[Material],
@@ -230,7 +338,20 @@ impl LightSampler {
         u_light: f32,
         u: Vec2,
     ) -> Option<LightSample> {
-        let (e, pmf, reused) = self.choose(rx, u_light)?;
+        let (e, pmf, reused) = match self.choose(rx, u_light)? {
+            Choice::Environment(share) => {
+                let (wi, li, pdf) = self.environment.as_ref()?.sample(u)?;
+                return Some(LightSample {
+                    wi,
+                    dist: f32::INFINITY,
+                    li,
+                    pdf: pdf * share,
+                    delta: false,
+                    visibility: Visibility::ShadowRay,
+                });
+            }
+            Choice::Emitter(e, pmf, reused) => (e, pmf, reused),
+        };
         let mut ls = match self.emitters.get(e) {
             Emitter::Punctual(light) => light.sample_li(rx.p)?,
             Emitter::Mesh(m) => m.sample_li(materials, textures, e as u32, rx.p, reused, u)?,
@@ -372,7 +493,9 @@ mod tests {
             let mut counts = vec![0usize; n_e];
             for k in 0..n {
                 let u = (k as f32 + 0.5) / n as f32;
-                let (e, pmf, reused) = ls.choose(&rx, u).unwrap();
+                let Some(Choice::Emitter(e, pmf, reused)) = ls.choose(&rx, u) else {
+                    panic!("no emitter chosen")
+                };
                 assert!((pmf - pmfs[e]).abs() < 1e-6 && (0.0..1.0).contains(&reused));
                 counts[e] += 1;
             }
@@ -459,7 +582,9 @@ mod tests {
         let mut counts = vec![0usize; n_e];
         for k in 0..n {
             let u = (k as f32 + 0.5) / n as f32;
-            let (e, pmf, reused) = ls.choose(rx, u).unwrap();
+            let Some(Choice::Emitter(e, pmf, reused)) = ls.choose(rx, u) else {
+                panic!("no emitter chosen")
+            };
             assert!(
                 (pmf - pmfs[e]).abs() <= 1e-6 * pmfs[e].max(1.0),
                 "{e}: {pmf} {}",
@@ -733,10 +858,77 @@ mod tests {
             Bsdf::Diffuse(Diffuse { kd: Vec3::ONE }),
             Vec3::Y,
         );
-        let sample =
-            s.light_sampler
-                .sample_li(&s.materials, &s.textures, &rx, 0.5, Vec2::splat(0.5));
+        // Without its default environment (a scene without lights gets one), nothing.
+        let mut ls = s.light_sampler.clone();
+        assert!(ls.environment().is_some());
+        ls.set_environment(None);
+        let sample = ls.sample_li(&s.materials, &s.textures, &rx, 0.5, Vec2::splat(0.5));
         assert!(sample.is_none());
-        assert_eq!(s.light_sampler.emitter_pmf(&rx, 0), 0.0);
+        assert_eq!(ls.emitter_pmf(&rx, 0), 0.0);
+    }
+
+    /// With an environment, the choice is a distribution over the emitters and the
+    /// environment: the emitters' probabilities and the environment's share sum to 1, an
+    /// environment sample's density is `pdf_environment` of its direction, and its share
+    /// follows the estimate `pi L / (pi L + E_tree)` within the bounds.
+    #[test]
+    fn the_environment_is_one_more_choice() {
+        use crate::light::Environment;
+        let mut s = lamp_scene(Vec3::new(-3.0, 2.0, -10.0), 50.0, vec![]);
+        let rx = receiver(
+            Vec3::ZERO,
+            Bsdf::Diffuse(Diffuse {
+                kd: Vec3::splat(0.5),
+            }),
+            Vec3::Y,
+        );
+        for radiance in [1e-3f32, 0.3, 1e3] {
+            s.set_environment(Environment::constant(Vec3::splat(radiance), 1.0).unwrap());
+            let ls = &s.light_sampler;
+            let share = ls.environment_share(&rx);
+            let (lo, hi) = ENVIRONMENT_SHARE_BOUNDS;
+            assert!((lo..=hi).contains(&share), "{share}");
+            let emitters: f32 = (0..ls.emitters().len())
+                .map(|e| ls.emitter_pmf(&rx, e))
+                .sum();
+            assert!(
+                (emitters + share - 1.0).abs() < 1e-5,
+                "{emitters} + {share}"
+            );
+            let n = 4000;
+            let mut env_samples = 0;
+            for k in 0..n {
+                let u_light = (k as f32 + 0.5) / n as f32;
+                let u = Vec2::new((k as f32 * 0.618_034).fract(), 0.3);
+                if let Some(l) = ls.sample_li(&s.materials, &s.textures, &rx, u_light, u) {
+                    if l.dist == f32::INFINITY {
+                        env_samples += 1;
+                        assert_eq!(l.pdf, ls.pdf_environment(&rx, l.wi));
+                        assert!((l.pdf - share / (4.0 * PI)).abs() < 1e-6 * l.pdf.max(1.0));
+                        assert_eq!(l.visibility, Visibility::ShadowRay);
+                    }
+                }
+            }
+            assert!(
+                (env_samples as f32 / n as f32 - share).abs() < 2e-3,
+                "{env_samples}"
+            );
+        }
+        // A brighter sky takes a larger share.
+        let share_of = |s: &mut Scene, l: f32| {
+            s.set_environment(Environment::constant(Vec3::splat(l), 1.0).unwrap());
+            s.light_sampler.environment_share(&rx)
+        };
+        assert!(share_of(&mut s, 0.01) < share_of(&mut s, 0.1));
+        // Alone, the environment is the whole choice.
+        let mut parts = SceneParts {
+            materials: vec![Material::diffuse("floor", Vec3::splat(0.5))],
+            ..Default::default()
+        };
+        parts.mesh.positions = vec![Vec3::ZERO, Vec3::X, Vec3::Z];
+        parts.mesh.triangles = vec![[0, 2, 1]];
+        parts.mesh.triangle_materials = vec![0];
+        let alone = Scene::from_parts(parts).unwrap();
+        assert_eq!(alone.light_sampler.environment_share(&rx), 1.0);
     }
 }

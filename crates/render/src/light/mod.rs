@@ -4,6 +4,9 @@
 //! - [`emitter`]: [`Emitter`], what the light choice chooses between: a punctual light, or an
 //!   emitter mesh ([`MeshEmitter`], connected emissive triangles of one material, which are
 //!   area lights); [`Emitters`] builds the list once, with the scene;
+//! - [`environment`]: [`Environment`], the light from directions that escape the scene (a
+//!   constant or an equirectangular map), looked up by escaping rays and sampled as one more
+//!   choice beside the tree;
 //! - [`tree`]: [`LightTree`], the emitters grouped by position into a flat 16-ary tree;
 //! - [`choice`]: [`LightSampler`], which picks an emitter per shading point by the irradiance
 //!   and the BSDF toward it, down the tree, and samples it; and the density of that choice;
@@ -26,6 +29,7 @@
 mod child_weights;
 pub mod choice;
 pub mod emitter;
+pub mod environment;
 pub mod punctual;
 mod receiver;
 #[cfg(test)]
@@ -34,6 +38,7 @@ pub mod tree;
 
 pub use choice::LightSampler;
 pub use emitter::{Emitter, Emitters, MeshEmitter, SurfaceMesh};
+pub use environment::{Environment, EnvironmentError, EnvironmentMap};
 pub use punctual::{range_window, spot_falloff, Light, LUMINOUS_EFFICACY};
 pub use receiver::Receiver;
 pub use tree::{LightTree, Node, BRANCHING};
@@ -45,7 +50,7 @@ use glam::Vec3;
 pub struct LightSample {
     /// Unit direction from the shading point toward the light.
     pub wi: Vec3,
-    /// Distance to the light point (`inf` for directional lights).
+    /// Distance to the light point (`inf` for directional lights and the environment).
     pub dist: f32,
     /// Incident radiance (area lights) or irradiance (delta lights).
     pub li: Vec3,
@@ -61,7 +66,8 @@ pub struct LightSample {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Visibility {
     /// The sample is a point at `dist`: trace a shadow ray (any hit) up to it; `li` is the
-    /// light's radiance there.
+    /// light's radiance there. With `dist` infinite (a directional light, the environment)
+    /// the ray is unbounded and must escape the scene.
     ShadowRay,
     /// The sample is only a direction toward emitter `emitter` (sampled uniformly in the cone
     /// that bounds it): trace a closest-hit ray; the light arrives if the ray first hits one of

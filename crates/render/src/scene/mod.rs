@@ -180,7 +180,7 @@ pub use validate::MAX_COORDINATE;
 use crate::accel::Accel;
 use crate::camera::Camera;
 use crate::geometry::{Ray, SurfaceHit};
-use crate::light::{Light, LightSampler, SurfaceMesh};
+use crate::light::{Environment, Light, LightSampler, SurfaceMesh};
 use crate::material::Material;
 use crate::normal_map::{self, MappedNormal};
 use crate::sampling::{pcg_hash, u32_to_unit_f32};
@@ -192,6 +192,16 @@ use std::path::{Path, PathBuf};
 /// [`SurfaceHit::triangle`] of a hit on an instanced mesh: no triangle of the flat soup (and
 /// never an emitter's; see [`Instances`]).
 pub const INSTANCED_TRIANGLE: u32 = u32::MAX;
+
+/// The radiance of the environment a scene with no light at all is lit by: a uniform white
+/// of 1, Mitsuba's `constant` emitter's default, so that the Mitsuba export of such a scene is
+/// lit the same way (docs/decisions/0028-default-environment-light.md).
+pub const DEFAULT_ENVIRONMENT_RADIANCE: f32 = 1.0;
+
+/// The warning (after the scene's file name) of a scene that has no light: no punctual light,
+/// no emissive triangle and no environment.
+pub const NO_LIGHT_WARNING: &str = "scene has no light: lit by a uniform white environment of \
+                                    radiance 1; --env or extras.streaks.environment sets one";
 
 /// A loaded scene, shared read-only by all render threads (never copied per thread).
 #[derive(Debug)]
@@ -223,7 +233,8 @@ pub struct Scene {
     /// top-level BVH over them; empty for most scenes (see [`Instances`]).
     pub instances: Instances,
     /// The emitters (`lights` and the emissive triangles) and the light tree over them, built
-    /// with the scene from its triangles, materials and lights.
+    /// with the scene from its triangles, materials and lights, and the environment light
+    /// ([`Scene::environment`]).
     pub light_sampler: LightSampler,
     /// Things in the file that were skipped or defaulted, for the command to print.
     pub warnings: Vec<String>,
@@ -249,6 +260,10 @@ pub struct SceneParts {
     pub instanced_meshes: Vec<TriangleMesh>,
     /// Placements of `instanced_meshes`.
     pub instances: Vec<Instance>,
+    /// The environment light (`scenes[i].extras.streaks.environment` in glTF); with none,
+    /// and no punctual light or emissive triangle either, the scene gets a uniform white
+    /// environment ([`DEFAULT_ENVIRONMENT_RADIANCE`]) and a warning ([`NO_LIGHT_WARNING`]).
+    pub environment: Option<Environment>,
     /// Warnings to pass on.
     pub warnings: Vec<String>,
 }
@@ -292,7 +307,8 @@ impl Scene {
             cameras,
             instanced_meshes,
             instances,
-            warnings,
+            environment,
+            mut warnings,
         } = parts;
         let bad = |element: String, reason: String| SceneError::invalid(&source, element, reason);
         mesh.check(&source, materials.len())?;
@@ -351,8 +367,18 @@ impl Scene {
             // One self-intersection distance for all hits, from the extent of everything.
             accel.raise_t_min(16.0 * f32::EPSILON * lo.abs().max(hi.abs()).max_element());
         }
-        let light_sampler =
+        let mut light_sampler =
             LightSampler::new(&lights, mesh.surface(&materials), bounding_sphere(bounds).1);
+        let environment = match environment {
+            None if light_sampler.emitters().is_empty() => {
+                warnings.push(format!("{}: {NO_LIGHT_WARNING}", source.display()));
+                Some(Environment::Constant {
+                    radiance: Vec3::splat(DEFAULT_ENVIRONMENT_RADIANCE),
+                })
+            }
+            other => other,
+        };
+        light_sampler.set_environment(environment);
         Ok(Scene {
             source,
             mesh,
@@ -366,6 +392,20 @@ impl Scene {
             light_sampler,
             warnings,
         })
+    }
+
+    /// The environment light, if any (the scene's, the default one of a scene without
+    /// lights, or the one [`Scene::set_environment`] gave).
+    #[inline]
+    pub fn environment(&self) -> Option<&Environment> {
+        self.light_sampler.environment()
+    }
+
+    /// Replaces the scene's environment light (a command's `--env`); the warning that a
+    /// scene without lights got the default one goes with it.
+    pub fn set_environment(&mut self, environment: Environment) {
+        self.light_sampler.set_environment(Some(environment));
+        self.warnings.retain(|w| !w.ends_with(NO_LIGHT_WARNING));
     }
 
     /// The camera called `name` (else, if `name` is a number `i` and no camera has that name,

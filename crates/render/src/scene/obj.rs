@@ -486,8 +486,10 @@ illum 1
         let path = dir.path().join("street.obj");
         std::fs::write(&path, OBJ).unwrap();
         let scene = Scene::load(&path).unwrap();
-        assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+        // The missing library, and (nothing emits) the default environment.
+        assert_eq!(scene.warnings.len(), 2, "{:?}", scene.warnings);
         assert!(scene.warnings[0].contains("street.obj"));
+        assert!(scene.warnings[1].ends_with(crate::scene::NO_LIGHT_WARNING));
         assert!(scene.lights.is_empty());
         assert!(scene.mesh.triangle_materials.iter().all(|&m| m == 0));
         assert!(

@@ -567,7 +567,15 @@ mod lights_and_instancing_tests {
         doc["extensionsUsed"] = used.clone();
         doc["extensionsRequired"] = used;
         let instanced = load_doc(doc.clone(), &bin);
-        assert!(instanced.warnings.is_empty(), "{:?}", instanced.warnings);
+        // Unlit: only the default environment's warning.
+        assert!(
+            instanced
+                .warnings
+                .iter()
+                .all(|w| w.ends_with(crate::scene::NO_LIGHT_WARNING)),
+            "{:?}",
+            instanced.warnings
+        );
         assert_eq!(instanced.instances.instances.len(), 4);
         assert!(instanced.mesh.triangles.is_empty());
         // The same placements as nodes, with the values dequantized by the specification's

@@ -31,6 +31,7 @@
 //!   and the placement of meshes as world triangles or instances;
 //! - `meshes`: primitives, their attributes in world space, triangulation, tangents;
 //! - `materials`: materials and their KHR_materials_* extensions, `extras.streaks`;
+//! - `environment`: the scene's environment light, `scenes[i].extras.streaks.environment`;
 //! - `textures`: texture infos, KHR_texture_transform, samplers, images;
 //! - [`extensions`]: which extensions are honoured, and the ones that are not a material's
 //!   field: KHR_lights_punctual (and the file's light units), EXT_mesh_gpu_instancing;
@@ -42,6 +43,7 @@ mod accessors;
 mod buffers;
 mod compression;
 mod document;
+mod environment;
 pub mod extensions;
 mod materials;
 mod meshes;
