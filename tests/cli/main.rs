@@ -8,6 +8,7 @@ mod camera;
 mod common;
 mod dataset;
 mod detect;
+mod khronos;
 mod measure;
 mod render;
 mod special_files;

@@ -93,22 +93,22 @@ impl Camera {
     }
 
     /// The default camera for a scene of bounding box `bounds` (`[min, max]`, as
-    /// [`cube_bounds`] makes it), for an image of aspect ratio `aspect` (width / height): the
+    /// [`union_bounds`] makes it), for an image of aspect ratio `aspect` (width / height): the
     /// glTF sample viewer's distance rule, seen from [`FRAMING_ELEVATION`] above the horizon
     /// and moved back so that all of the box is in view.
     ///
     /// A perspective camera of [`FRAMING_YFOV`] with +Y up in the plane of its view, looking
     /// along `-Z` pitched down by the elevation (from `+Z` and above). In the camera's axes
-    /// the box's eight corners span `m = max(extent x, extent y)` across the view; the camera
-    /// sits on the axis through the box's centre at `D = max(m/2 / tan(yfov/2),
-    /// m/2 / tan(xfov/2))` (`xfov = 2 atan(aspect tan(yfov/2))`) in front of the plane that
-    /// touches the box's nearest corner. The viewer takes the same `D` from the box's centre,
-    /// looking straight along -Z with `xfov = yfov * aspect`: that cuts the front of deep
-    /// scenes at the image's edge and sees a flat model lying in the XZ plane edge-on.
-    /// Measured from the nearest plane, that plane's square of side `m` fills the limiting
-    /// axis exactly and everything behind it is smaller, so every point of the box is in
-    /// view and in front of the camera. A degenerate box (a point) is framed as a box of
-    /// size 1.
+    /// the box's eight corners span `w` across and `h` up the view; the camera sits on the
+    /// axis through the box's centre at `D = max(h/2 / tan(yfov/2), w/2 / tan(xfov/2))`
+    /// (`xfov = 2 atan(aspect tan(yfov/2))`) in front of the plane that touches the box's
+    /// nearest corner. The viewer takes `D` from the box's centre, with `m = max(w, h)` for
+    /// both terms, looking straight along -Z with `xfov = yfov * aspect`: that cuts the front
+    /// of deep scenes at the image's edge and sees a flat model lying in the XZ plane
+    /// edge-on. Measured from the nearest plane, that plane's `w` x `h` rectangle fills the
+    /// limiting axis exactly and everything behind it is smaller, so every point of the box
+    /// is in view and in front of the camera. A degenerate box (a point) is framed as a box
+    /// of size 1.
     pub fn framing(bounds: [Vec3; 2], aspect: f32) -> Camera {
         let [lo, hi] = bounds;
         let centre = 0.5 * (lo + hi);
@@ -122,13 +122,12 @@ impl Camera {
             span = span.max(c.truncate().abs());
             near = near.max(c.z);
         }
-        let mut m = 2.0 * span.x.max(span.y);
-        if !m.is_finite() || m <= 0.0 {
-            m = 1.0;
+        if !span.is_finite() || span.max_element() <= 0.0 {
+            span = Vec2::splat(0.5);
         }
         let tan_half_y = (0.5 * FRAMING_YFOV).tan();
         let tan_half_x = aspect * tan_half_y;
-        let distance = (0.5 * m / tan_half_y).max(0.5 * m / tan_half_x);
+        let distance = (span.y / tan_half_y).max(span.x / tan_half_x);
         let position = centre + rotation * Vec3::new(0.0, 0.0, near + distance);
         Camera::perspective(
             FRAMING_NAME,
@@ -253,18 +252,15 @@ fn ortho_pixel(xmag: f32, ymag: f32, width: u32, height: u32) -> f32 {
     (2.0 * xmag / width as f32).max(2.0 * ymag / height as f32)
 }
 
-/// The bounds the default camera frames, the glTF sample viewer's: each box `[min, max]` (a
-/// primitive's world-space bounding box) is replaced by the cube around its centre whose
-/// half-size is the box's half-diagonal, and the cubes are united. `None` without boxes.
-pub fn cube_bounds(boxes: impl IntoIterator<Item = [Vec3; 2]>) -> Option<[Vec3; 2]> {
+/// The bounds the default camera frames: the union of the boxes `[min, max]` (the loaded
+/// primitives' world-space bounding boxes). The glTF sample viewer first replaces each box by
+/// the cube of half-size its half-diagonal, which keeps a model in view while the user orbits
+/// it; a camera that does not orbit frames the boxes themselves, and a tall or flat model
+/// fills the image instead of a third of it. `None` without boxes.
+pub fn union_bounds(boxes: impl IntoIterator<Item = [Vec3; 2]>) -> Option<[Vec3; 2]> {
     boxes
         .into_iter()
         .filter(|[lo, hi]| lo.cmple(*hi).all())
-        .map(|[lo, hi]| {
-            let centre = 0.5 * (lo + hi);
-            let r = Vec3::splat(0.5 * (hi - lo).length());
-            [centre - r, centre + r]
-        })
         .reduce(|[a, b], [c, d]| [a.min(c), b.max(d)])
 }
 
@@ -347,18 +343,15 @@ mod tests {
     }
 
     #[test]
-    fn cube_bounds_unite_the_cubes_of_the_boxes() {
-        assert_eq!(cube_bounds([]), None);
-        let b = cube_bounds([[Vec3::ZERO, Vec3::new(2.0, 0.0, 0.0)]]).unwrap();
-        assert!((b[0] - Vec3::new(0.0, -1.0, -1.0)).length() < 1e-6);
-        assert!((b[1] - Vec3::new(2.0, 1.0, 1.0)).length() < 1e-6);
-        let b = cube_bounds([
+    fn union_bounds_unite_the_boxes() {
+        assert_eq!(union_bounds([]), None);
+        let b = union_bounds([
             [Vec3::ZERO, Vec3::new(2.0, 0.0, 0.0)],
             [Vec3::splat(10.0), Vec3::splat(10.0)],
+            [Vec3::ONE, Vec3::ZERO],
         ])
         .unwrap();
-        assert!((b[1] - Vec3::splat(10.0)).length() < 1e-6);
-        assert!((b[0] - Vec3::new(0.0, -1.0, -1.0)).length() < 1e-6);
+        assert_eq!(b, [Vec3::ZERO, Vec3::splat(10.0)]);
     }
 
     /// The default camera frames known boxes: every corner of the bounds projects inside the
@@ -374,7 +367,7 @@ mod tests {
         ];
         for [lo, hi] in boxes {
             for (aspect, w, h) in [(4.0 / 3.0, 640, 480), (0.5, 200, 400), (3.0, 600, 200)] {
-                let bounds = cube_bounds([[lo, hi]]).unwrap();
+                let bounds = union_bounds([[lo, hi]]).unwrap();
                 let cam = Camera::framing(bounds, aspect);
                 assert_eq!(cam.yfov(), Some(FRAMING_YFOV));
                 let forward = cam.world_from_camera.transform_vector3(-Vec3::Z);
@@ -399,7 +392,7 @@ mod tests {
         }
         // The flat square (the second box) is seen from above.
         let [lo, hi] = boxes[1];
-        let cam = Camera::framing(cube_bounds([[lo, hi]]).unwrap(), 4.0 / 3.0);
+        let cam = Camera::framing(union_bounds([[lo, hi]]).unwrap(), 4.0 / 3.0);
         let corners = [
             lo,
             Vec3::new(hi.x, 0.0, lo.z),
@@ -419,7 +412,7 @@ mod tests {
     fn framing_stays_outside_a_deep_scene() {
         // Two small boxes 100 m apart along Z: the viewer's distance would put the camera
         // between them.
-        let bounds = cube_bounds([
+        let bounds = union_bounds([
             [Vec3::splat(-0.5), Vec3::splat(0.5)],
             [Vec3::new(-0.5, -0.5, -100.5), Vec3::new(0.5, 0.5, -99.5)],
         ])

@@ -220,8 +220,8 @@ pub struct Scene {
     /// Cameras, in the order the node walk reaches them (depth-first, children in file
     /// order); the first is the default.
     pub cameras: Vec<Camera>,
-    /// What the default camera ([`Scene::default_camera`]) frames: the glTF sample viewer's
-    /// bounds ([`crate::camera::cube_bounds`]) of the world-space bounding boxes of the
+    /// What the default camera ([`Scene::default_camera`]) frames: the union
+    /// ([`crate::camera::union_bounds`]) of the world-space bounding boxes of the
     /// loaded primitives (computed from their triangles as loaded, not from the accessors'
     /// `min` and `max`; an instanced primitive's box is its object-space box's eight corners
     /// placed by the instance). A scene from OBJ or [`Scene::from_parts`] counts as one
@@ -386,7 +386,7 @@ impl Scene {
             textures,
             lights,
             cameras,
-            framing_bounds: crate::camera::cube_bounds(bounds),
+            framing_bounds: crate::camera::union_bounds(bounds),
             accel,
             instances,
             light_sampler,

@@ -250,7 +250,7 @@ pub(in crate::scene) fn load(path: &Path, files: &Files) -> Result<Scene, SceneE
     loader.parts.warnings.extend(lines);
     let boxes = std::mem::take(&mut loader.primitive_boxes);
     let mut scene = Scene::from_parts(loader.parts)?;
-    scene.framing_bounds = crate::camera::cube_bounds(boxes);
+    scene.framing_bounds = crate::camera::union_bounds(boxes);
     Ok(scene)
 }
 
