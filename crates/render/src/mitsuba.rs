@@ -21,6 +21,7 @@
 //! | KHR_materials_transmission 1, metallic 0, with KHR_materials_volume | `dielectric` (roughness 0) or `roughdielectric` (ggx, alpha = roughness^2), `int_ior` = ior, `specular_transmittance` = base colour | no: exact Fresnel instead of Schlick's (warning); the volume's attenuation needs an interior medium, not exported (warning) |
 //! | the same, thin-walled and smooth | `thindielectric` | no: a slab with two interfaces and its inter-reflections, ours one interface (warning) |
 //! | other transmissive materials | `principled` (a volume) or `principledthin` (thin-walled) with `spec_trans` = transmission | no (warning) |
+//! | KHR_materials_sheen (opaque glTF) | principled `sheen` = max3(sheenColor), `sheen_tint` 0 | no: Disney's white, Schlick-weighted sheen, not the Charlie lobe; sheenColor's hue, sheenRoughness and the textures are lost (warning); not exported on transmissive materials (warning) |
 //! | diffuse | `diffuse` | yes |
 //! | kd / base colour / emission texture | `bitmap` (an EXR of texture x factor, so the factor is baked in) | yes (bilinear, repeat) |
 //! | wet/dry map ([`Wetness`](crate::material::Wetness)) | `alpha` and `specular_reflectance` as `bitmap`s baked per texel of the dryness map (`mix(wet, dry, w)`) | yes for `ggx` and `ward`'s alpha (linear in `w`, so bilinear filtering commutes); blinn_phong's alpha is not linear in the shininess (approximation already) |
@@ -368,6 +369,8 @@ impl<'a> MaterialWriter<'a> {
             ("specularColorTexture", g.specular_color_texture),
             ("clearcoatTexture", g.clearcoat_texture),
             ("clearcoatRoughnessTexture", g.clearcoat_roughness_texture),
+            ("sheenColorTexture", g.sheen_color_texture),
+            ("sheenRoughnessTexture", g.sheen_roughness_texture),
         ];
         for (name, texture) in unexported {
             if texture.is_some() {
@@ -407,10 +410,20 @@ impl<'a> MaterialWriter<'a> {
         } else {
             String::new()
         };
+        let sheen = g.sheen_color.max_element();
+        let sheen = if sheen > 0.0 {
+            self.warnings.push(format!(
+                "material {:?}: KHR_materials_sheen (colour {}, roughness {}) exported as                  principled sheen {sheen:?} (Disney's white sheen, Schlick-weighted, not the                  Charlie lobe; the colour's hue and the roughness are lost): approximation",
+                m.name, g.sheen_color, g.sheen_roughness
+            ));
+            format!("<float name=\"sheen\" value=\"{sheen:?}\"/>")
+        } else {
+            String::new()
+        };
         Ok(format!(
             "<bsdf type=\"principled\">{base}\
              <float name=\"metallic\" value=\"{:?}\"/>\
-             <float name=\"roughness\" value=\"{:?}\"/>{}{coat}</bsdf>",
+             <float name=\"roughness\" value=\"{:?}\"/>{}{sheen}{coat}</bsdf>",
             g.metallic, g.roughness, dielectric.xml
         ))
     }
@@ -439,6 +452,12 @@ impl<'a> MaterialWriter<'a> {
             self.warnings.push(format!(
                 "material {name:?}: transmissionTexture is not exported; its factor is used \
                  everywhere"
+            ));
+        }
+        if g.sheen_color.max_element() > 0.0 {
+            self.warnings.push(format!(
+                "material {name:?}: KHR_materials_sheen is not exported on a transmissive \
+                 material; rendered without sheen"
             ));
         }
         if let Some(v) = g.volume {

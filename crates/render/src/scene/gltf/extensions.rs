@@ -28,6 +28,7 @@ pub const HONOURED: &[&str] = &[
     "KHR_draco_mesh_compression",
     "KHR_materials_specular",
     "KHR_materials_ior",
+    "KHR_materials_sheen",
     "KHR_materials_clearcoat",
     "KHR_texture_transform",
     "KHR_materials_transmission",
@@ -347,11 +348,11 @@ mod tests {
     #[test]
     fn used_and_unsupported_warns_for_every_user_by_name() {
         let doc = json!({
-            "extensionsUsed": ["KHR_materials_iridescence", "KHR_materials_sheen",
+            "extensionsUsed": ["KHR_materials_iridescence", "KHR_materials_anisotropy",
                                "KHR_materials_emissive_strength", "EXT_unknown"],
             "materials": [
                 {"name": "glass", "extensions": {"KHR_materials_iridescence": {"iridescenceFactor": 1}}},
-                {"name": "road", "extensions": {"KHR_materials_sheen": {"sheenColorFactor": [1, 1, 1]}}},
+                {"name": "road", "extensions": {"KHR_materials_anisotropy": {"anisotropyStrength": 1}}},
                 {"extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 5}}}
             ]
         });
@@ -363,7 +364,7 @@ mod tests {
         );
         assert!(w[0].contains("without iridescence"), "{w:?}");
         assert!(
-            w[1].contains("material \"road\" (1) uses KHR_materials_sheen"),
+            w[1].contains("material \"road\" (1) uses KHR_materials_anisotropy"),
             "{w:?}"
         );
         assert!(
