@@ -26,7 +26,7 @@
 //! | kd / base colour / emission texture | `bitmap` (an EXR of texture x factor, so the factor is baked in) | yes (bilinear, repeat) |
 //! | wet/dry map ([`Wetness`](crate::material::Wetness)) | `alpha` and `specular_reflectance` as `bitmap`s baked per texel of the dryness map (`mix(wet, dry, w)`) | yes for `ggx` and `ward`'s alpha (linear in `w`, so bilinear filtering commutes); blinn_phong's alpha is not linear in the shininess (approximation already) |
 //! | double-sided material | BSDF wrapped in `twosided` | yes |
-//! | normal map ([`NormalMap`](crate::normal_map::NormalMap)) | not exported | no (warning) |
+//! | normal map ([`NormalMap`](crate::normal_map::NormalMap)), clearcoatNormalTexture | not exported | no (warning) |
 //! | instanced mesh ([`Instances`]) | a `shapegroup` of its object-space meshes (one PLY per material) and an `instance` with its `to_world` matrix per placement | yes |
 //! | camera | `perspective`, `fov_axis` y, `fov` in degrees, `to_world` as a `lookat` | yes |
 //! | film, filter | `hdrfilm` (rgb, float32) with a `box` filter | yes |
@@ -372,6 +372,13 @@ impl<'a> MaterialWriter<'a> {
             ("sheenColorTexture", g.sheen_color_texture),
             ("sheenRoughnessTexture", g.sheen_roughness_texture),
         ];
+        if g.clearcoat > 0.0 && g.clearcoat_normal_map.is_some() {
+            self.warnings.push(format!(
+                "material {:?}: clearcoatNormalTexture is not exported; the coat is shaded \
+                 with the interpolated normal",
+                m.name
+            ));
+        }
         for (name, texture) in unexported {
             if texture.is_some() {
                 self.warnings.push(format!(

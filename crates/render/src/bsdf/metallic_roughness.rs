@@ -495,13 +495,13 @@ pub(super) struct CoatFrame {
 impl CoatFrame {
     /// Directions in lanes from the shading frame to the coat's.
     #[inline(always)]
-    fn to_coat<L: Lanes>(&self, w: [L; 3]) -> [L; 3] {
+    fn coat_from_shading<L: Lanes>(&self, w: [L; 3]) -> [L; 3] {
         [self.s, self.t, self.n].map(|a| w[0] * a.x + w[1] * a.y + w[2] * a.z)
     }
 
     /// A direction from the coat's frame to the shading frame.
     #[inline]
-    fn to_shading(&self, w: Vec3) -> Vec3 {
+    fn shading_from_coat(&self, w: Vec3) -> Vec3 {
         self.s * w.x + self.t * w.y + self.n * w.z
     }
 }
@@ -620,7 +620,7 @@ impl Model for GltfPbr {
             let (coat, coat_pdf) = match &at.coat_frame {
                 None => ggx::microfacet_correlated(&at.coat, wo, wi),
                 Some(c) => {
-                    let wi_c = c.to_coat(wi);
+                    let wi_c = c.coat_from_shading(wi);
                     let (coat, pdf) = ggx::microfacet_correlated(&at.coat, c.wo, wi_c);
                     // A BRDF about the coat's normal (see the type's documentation); the
                     // visible normals' density is zero where the half vector is below it.
@@ -658,7 +658,7 @@ impl Model for GltfPbr {
             let u = Vec2::new(u.x / q, u.y);
             if let Some(c) = self.coat_frame(wo) {
                 let h = ggx::sample_visible_normal(c.wo, self.coat_alpha(), u)?;
-                return Some(c.to_shading(reflect(c.wo, h)));
+                return Some(c.shading_from_coat(reflect(c.wo, h)));
             }
             (self.coat_alpha(), u)
         } else {

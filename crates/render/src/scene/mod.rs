@@ -39,8 +39,10 @@
 //!   sheenRoughnessFactor and sheenRoughnessTexture's alpha: the Charlie sheen lobe over the
 //!   base by the extension's albedo scaling, see `bsdf/sheen.rs`) and
 //!   KHR_materials_clearcoat (clearcoatFactor and clearcoatTexture's red channel,
-//!   clearcoatRoughnessFactor and clearcoatRoughnessTexture's green channel; a
-//!   clearcoatNormalTexture is a warning, the coat uses the base's normal), with those
+//!   clearcoatRoughnessFactor and clearcoatRoughnessTexture's green channel, and
+//!   clearcoatNormalTexture, the coat's own normal map in the base's tangent space; without
+//!   it the coat is shaded with the interpolated normal, not the base's mapped one, as the
+//!   extension says: [`crate::geometry::SurfaceHit::coat_normal`]), with those
 //!   extensions' formulas; values outside the schemas' ranges are errors naming the material.
 //!   KHR_materials_transmission (transmissionFactor and transmissionTexture's red channel)
 //!   makes that share of the dielectric's diffuse part a specular transmission tinted by the
