@@ -1474,4 +1474,60 @@ mod tests {
             }
         }
     }
+    /// KHR_materials_sheen becomes principled `sheen` (its colour's largest channel) with a
+    /// warning on an opaque material, and is dropped with a warning on a transmissive one;
+    /// a clear coat's normal map is named as not exported.
+    #[test]
+    fn sheen_and_coat_normal_are_approximated_with_warnings() {
+        use crate::material::GltfPbrParams;
+        use crate::normal_map::NormalMap;
+        let velvet = |transmission: f32| {
+            Reflectance::GltfPbr(GltfPbrParams {
+                base_color: Vec3::splat(0.05),
+                metallic: 0.0,
+                roughness: 0.7,
+                sheen_color: Vec3::new(0.2, 0.6, 0.4),
+                sheen_roughness: 0.5,
+                clearcoat: 0.5,
+                clearcoat_normal_map: Some(NormalMap {
+                    texture: TextureRef::new(0),
+                    scale: 1.0,
+                }),
+                transmission,
+                ..GltfPbrParams::default()
+            })
+        };
+        let mut fx = Fixture::new();
+        fx.materials[2].reflectance = velvet(0.0);
+        let ex = export_parts(&fx.parts(), &fx.cameras[0], &opts()).unwrap();
+        let doc = roxmltree::Document::parse(&ex.xml).unwrap();
+        let sheen = doc
+            .descendants()
+            .find(|n| n.attribute("name") == Some("sheen"))
+            .and_then(|n| n.attribute("value"))
+            .unwrap_or_else(|| panic!("no sheen in {}", ex.xml));
+        assert_eq!(sheen, "0.6");
+        for needle in [
+            "KHR_materials_sheen",
+            "clearcoatNormalTexture is not exported",
+        ] {
+            assert!(
+                ex.warnings
+                    .iter()
+                    .any(|w| w.contains("\"wall\"") && w.contains(needle)),
+                "no warning about {needle}: {:?}",
+                ex.warnings
+            );
+        }
+        fx.materials[2].reflectance = velvet(0.5);
+        let ex = export_parts(&fx.parts(), &fx.cameras[0], &opts()).unwrap();
+        assert!(!ex.xml.contains("name=\"sheen\""), "{}", ex.xml);
+        assert!(
+            ex.warnings
+                .iter()
+                .any(|w| w.contains("KHR_materials_sheen is not exported")),
+            "{:?}",
+            ex.warnings
+        );
+    }
 }
