@@ -11,7 +11,9 @@
 //!   specular texture's alpha multiplies `specular` and the specular colour texture's RGB
 //!   `specular_color` (KHR_materials_specular); the sheen colour texture's RGB multiplies
 //!   `sheen_color` and the sheen roughness texture's alpha `sheen_roughness`
-//!   (KHR_materials_sheen); the clearcoat texture's red channel multiplies
+//!   (KHR_materials_sheen); the iridescence texture's red channel multiplies `iridescence`
+//!   and the thickness texture's green channel blends the film's thickness from its minimum
+//!   to its maximum (KHR_materials_iridescence); the clearcoat texture's red channel multiplies
 //!   `clearcoat` and the clearcoat roughness texture's green channel `clearcoat_roughness`
 //!   (KHR_materials_clearcoat); the transmission texture's red channel multiplies
 //!   `transmission` (KHR_materials_transmission).
@@ -43,7 +45,7 @@ pub enum PaperModel {
 }
 
 /// How a material reflects light.
-// The glTF variant holds nine texture references; a scene has few materials and `bsdf_at`
+// The glTF variant holds eleven texture references; a scene has few materials and `bsdf_at`
 // reads them by reference, so boxing it would only add an indirection per hit.
 #[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug, PartialEq)]
@@ -109,6 +111,17 @@ pub struct GltfPbrParams {
     pub sheen_roughness: f32,
     /// KHR_materials_sheen sheenRoughnessTexture (A = sheen roughness).
     pub sheen_roughness_texture: Option<TextureRef>,
+    /// KHR_materials_iridescence iridescenceFactor in [0, 1] (0: no thin film).
+    pub iridescence: f32,
+    /// KHR_materials_iridescence iridescenceTexture (R = iridescence).
+    pub iridescence_texture: Option<TextureRef>,
+    /// KHR_materials_iridescence iridescenceIor (1.3 by default).
+    pub iridescence_ior: f32,
+    /// KHR_materials_iridescence iridescenceThicknessMinimum and Maximum, in nanometres.
+    pub iridescence_thickness: [f32; 2],
+    /// KHR_materials_iridescence iridescenceThicknessTexture (G blends from the minimum to
+    /// the maximum thickness; without it the thickness is the maximum).
+    pub iridescence_thickness_texture: Option<TextureRef>,
     /// KHR_materials_clearcoat clearcoatFactor (0: no coat).
     pub clearcoat: f32,
     /// KHR_materials_clearcoat clearcoatTexture (R = clearcoat).
@@ -148,6 +161,11 @@ impl Default for GltfPbrParams {
             sheen_color_texture: None,
             sheen_roughness: 0.0,
             sheen_roughness_texture: None,
+            iridescence: 0.0,
+            iridescence_texture: None,
+            iridescence_ior: 1.3,
+            iridescence_thickness: [100.0, 400.0],
+            iridescence_thickness_texture: None,
             clearcoat: 0.0,
             clearcoat_texture: None,
             clearcoat_roughness: 0.0,
@@ -345,9 +363,19 @@ impl Material {
     /// Every texture reference the material holds.
     pub fn texture_refs(&self) -> impl Iterator<Item = TextureRef> + '_ {
         let r = match &self.reflectance {
-            Reflectance::Diffuse { kd_texture, .. } => {
-                [*kd_texture, None, None, None, None, None, None, None, None]
-            }
+            Reflectance::Diffuse { kd_texture, .. } => [
+                *kd_texture,
+                None,
+                None,
+                None,
+                None,
+                None,
+                None,
+                None,
+                None,
+                None,
+                None,
+            ],
             Reflectance::Paper {
                 kd_texture,
                 wetness,
@@ -355,6 +383,8 @@ impl Material {
             } => [
                 *kd_texture,
                 wetness.as_ref().map(|w| w.texture),
+                None,
+                None,
                 None,
                 None,
                 None,
@@ -370,6 +400,8 @@ impl Material {
                 g.specular_color_texture,
                 g.sheen_color_texture,
                 g.sheen_roughness_texture,
+                g.iridescence_texture,
+                g.iridescence_thickness_texture,
                 g.clearcoat_texture,
                 g.clearcoat_roughness_texture,
                 g.transmission_texture,
@@ -443,6 +475,19 @@ impl Material {
                     },
                     sheen_roughness: (g.sheen_roughness * sample(g.sheen_roughness_texture).w)
                         .clamp(0.0, 1.0),
+                    iridescence: if g.iridescence > 0.0 {
+                        (g.iridescence * sample(g.iridescence_texture).x).clamp(0.0, 1.0)
+                    } else {
+                        0.0
+                    },
+                    iridescence_ior: g.iridescence_ior,
+                    iridescence_thickness: {
+                        let [min, max] = g.iridescence_thickness;
+                        match g.iridescence_thickness_texture {
+                            Some(t) => min + (max - min) * sample(Some(t)).y,
+                            None => max,
+                        }
+                    },
                     clearcoat: (g.clearcoat * sample(g.clearcoat_texture).x).clamp(0.0, 1.0),
                     clearcoat_roughness: (g.clearcoat_roughness
                         * sample(g.clearcoat_roughness_texture).y)

@@ -21,6 +21,7 @@
 //! | KHR_materials_transmission 1, metallic 0, with KHR_materials_volume | `dielectric` (roughness 0) or `roughdielectric` (ggx, alpha = roughness^2), `int_ior` = ior, `specular_transmittance` = base colour | no: exact Fresnel instead of Schlick's (warning); the volume's attenuation needs an interior medium, not exported (warning) |
 //! | the same, thin-walled and smooth | `thindielectric` | no: a slab with two interfaces and its inter-reflections, ours one interface (warning) |
 //! | other transmissive materials | `principled` (a volume) or `principledthin` (thin-walled) with `spec_trans` = transmission | no (warning) |
+//! | KHR_materials_iridescence | not exported | no (warning) |
 //! | KHR_materials_sheen (opaque glTF) | principled `sheen` = max3(sheenColor), `sheen_tint` 0 | no: Disney's white, Schlick-weighted sheen, not the Charlie lobe; sheenColor's hue, sheenRoughness and the textures are lost (warning); not exported on transmissive materials (warning) |
 //! | diffuse | `diffuse` | yes |
 //! | kd / base colour / emission texture | `bitmap` (an EXR of texture x factor, so the factor is baked in) | yes (bilinear, repeat) |
@@ -417,6 +418,13 @@ impl<'a> MaterialWriter<'a> {
         } else {
             String::new()
         };
+        if g.iridescence > 0.0 {
+            self.warnings.push(format!(
+                "material {:?}: KHR_materials_iridescence is not exported (Mitsuba's principled \
+                 BSDF has no thin film); rendered without iridescence",
+                m.name
+            ));
+        }
         let sheen = g.sheen_color.max_element();
         let sheen = if sheen > 0.0 {
             self.warnings.push(format!(
@@ -465,6 +473,12 @@ impl<'a> MaterialWriter<'a> {
             self.warnings.push(format!(
                 "material {name:?}: KHR_materials_sheen is not exported on a transmissive \
                  material; rendered without sheen"
+            ));
+        }
+        if g.iridescence > 0.0 {
+            self.warnings.push(format!(
+                "material {name:?}: KHR_materials_iridescence is not exported; rendered \
+                 without iridescence"
             ));
         }
         if let Some(v) = g.volume {

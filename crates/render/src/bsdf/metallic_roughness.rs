@@ -7,6 +7,7 @@
 use super::dielectric::{microfacet_transmission, outside_cos, refract};
 use super::diffuse::lambert;
 use super::ggx;
+use super::iridescence;
 use super::numbers::{Lanes, Spectrum};
 use super::sheen::SheenAtWo;
 use super::{
@@ -29,6 +30,11 @@ use streaks_image::luminance;
 ///   `f0 = specular_color`, clamped) and `fr = f0 + (1 - f0) s`,
 ///   `dielectric_brdf = (1 - specular max_value(fr)) base / pi + specular fr specular_brdf`;
 /// - `material = mix(dielectric_brdf, metal_brdf, metallic)`;
+/// - iridescence (KHR_materials_iridescence): both Fresnel terms, the dielectric's `fr` and
+///   the metal's `base + (1 - base) s`, become `mix(F, F_film(wo.h, F0), iridescence)` with
+///   `F_film` the thin film's reflectance over a base of that F0 (see `iridescence.rs`), in
+///   the specular lobe and in the dielectric's diffuse weight `1 - specular max_value(fr)`;
+///   not from inside a volume, and the transmission keeps Schlick's weight;
 /// - sheen (KHR_materials_sheen's albedo scaling, see `sheen.rs`): `sheen_material =
 ///   sheen_color f_sheen + material (1 - max3(sheen_color) max(E(n.wo), E(n.wi)))`, with
 ///   `f_sheen` the Charlie lobe of `alpha = sheen_roughness^2` and `E` its directional
@@ -101,6 +107,12 @@ pub struct GltfPbr {
     pub sheen_color: Vec3,
     /// KHR_materials_sheen `sheenRoughness` in [0, 1].
     pub sheen_roughness: f32,
+    /// KHR_materials_iridescence `iridescence` in [0, 1] (0: no thin film).
+    pub iridescence: f32,
+    /// KHR_materials_iridescence `iridescenceIor`, the film's index (1.3 by default).
+    pub iridescence_ior: f32,
+    /// The film's thickness in nanometres (KHR_materials_iridescence; 0: no film).
+    pub iridescence_thickness: f32,
     /// KHR_materials_clearcoat `clearcoat` in [0, 1] (0: no coat).
     pub clearcoat: f32,
     /// KHR_materials_clearcoat `clearcoatRoughness` in [0, 1].
@@ -132,6 +144,9 @@ impl Default for GltfPbr {
             ior: 1.5,
             sheen_color: Vec3::ZERO,
             sheen_roughness: 0.0,
+            iridescence: 0.0,
+            iridescence_ior: 1.3,
+            iridescence_thickness: 400.0,
             clearcoat: 0.0,
             clearcoat_roughness: 0.0,
             coat_normal: Vec3::Z,
@@ -541,6 +556,53 @@ pub(super) struct GltfAtWo {
     sheen_max: f32,
     /// The transmission's weight under the sheen, `1 - max3(sheen_color) E(cos_o)`.
     sheen_transmission: f32,
+    /// The thin film (`None` without one).
+    film: Option<Film>,
+}
+
+/// A [`GltfPbr`]'s thin film (KHR_materials_iridescence) and the Fresnel terms it changes.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Film {
+    iridescence: f32,
+    ior: f32,
+    thickness: f32,
+    /// The dielectric's F0 ([`GltfPbr::dielectric_f0`]) and the metal's (the base colour).
+    dielectric_f0: Vec3,
+    metal_f0: Vec3,
+    specular: f32,
+    metallic: f32,
+}
+
+impl Film {
+    /// The dielectric's Fresnel term `mix(f0 + (1 - f0) s, F_film, iridescence)` at the
+    /// cosine `cos` of `wo` with the microfacet normal.
+    #[inline]
+    fn dielectric(&self, cos: f32) -> Vec3 {
+        self.mixed(cos, self.dielectric_f0)
+    }
+
+    /// `mix(f0 + (1 - f0) s, F_film(f0), iridescence)`.
+    #[inline]
+    fn mixed(&self, cos: f32, f0: Vec3) -> Vec3 {
+        let cos = cos.abs();
+        let s = schlick_weight(cos);
+        let schlick = f0 + (Vec3::ONE - f0) * s;
+        let film = iridescence::fresnel(cos, self.ior, self.thickness, f0);
+        schlick + (film - schlick) * self.iridescence
+    }
+
+    /// The glossy colour `(1 - metallic) specular F_dielectric + metallic F_metal`.
+    #[inline]
+    fn glossy_colour(&self, cos: f32) -> Vec3 {
+        (1.0 - self.metallic) * self.specular * self.dielectric(cos)
+            + self.metallic * self.mixed(cos, self.metal_f0)
+    }
+
+    /// The dielectric's diffuse weight `1 - specular max_value(F_dielectric)`.
+    #[inline]
+    fn diffuse_weight(&self, cos: f32) -> f32 {
+        1.0 - self.specular * self.dielectric(cos).max_element()
+    }
 }
 
 impl Model for GltfPbr {
@@ -567,6 +629,16 @@ impl Model for GltfPbr {
             sheen,
             sheen_max: self.sheen_color.max_element(),
             sheen_transmission: self.sheen_base_weight(&sheen),
+            film: (self.iridescence > 0.0 && self.iridescence_thickness > 0.0 && !self.inside)
+                .then(|| Film {
+                    iridescence: self.iridescence,
+                    ior: self.iridescence_ior,
+                    thickness: self.iridescence_thickness,
+                    dielectric_f0: self.dielectric_f0(),
+                    metal_f0: self.base_color,
+                    specular: self.specular,
+                    metallic: self.metallic,
+                }),
         }
     }
 
@@ -605,8 +677,16 @@ impl Model for GltfPbr {
         } else {
             schlick_weight(cos)
         };
-        let mut diffuse_weight = (L::splat(at.diffuse_a) - s * at.diffuse_b) * at.base_weight;
-        let colour = r.glossy * s.one_minus() + S::grey(s * at.f90);
+        let (mut diffuse_weight, colour) = match &at.film {
+            None => (
+                (L::splat(at.diffuse_a) - s * at.diffuse_b) * at.base_weight,
+                r.glossy * s.one_minus() + S::grey(s * at.f90),
+            ),
+            Some(film) => (
+                cos.lanewise(|c| film.diffuse_weight(c)) * at.base_weight,
+                S::from_rgb(cos, |c| film.glossy_colour(c)),
+            ),
+        };
         let mut glossy = colour * (spec * at.base_weight);
         let mut sheen = None;
         if let Some(sh) = &at.sheen {
@@ -843,9 +923,24 @@ mod tests {
         let w = (1.0 - v_h).powi(5);
         let ior = g.ior as f64;
         let ior_f0 = ((1.0 - ior) / (1.0 + ior)).powi(2);
+        // KHR_materials_iridescence: each Fresnel term mixed with the thin film's.
+        let k = if g.iridescence_thickness > 0.0 {
+            g.iridescence as f64
+        } else {
+            0.0
+        };
+        let film = |f0: [f64; 3]| {
+            let (ior, d) = (g.iridescence_ior as f64, g.iridescence_thickness as f64);
+            super::super::iridescence::tests::reference(v_h, ior, d, f0)
+        };
+        let f0_d: [f64; 3] =
+            std::array::from_fn(|c| (ior_f0 * g.specular_color[c] as f64).min(1.0));
+        let film_d = film(f0_d);
+        let film_m = film(g.base_color.to_array().map(f64::from));
         let fr: [f64; 3] = std::array::from_fn(|c| {
-            let f0 = (ior_f0 * g.specular_color[c] as f64).min(1.0);
-            f0 + (1.0 - f0) * w
+            let f0 = f0_d[c];
+            let schlick = f0 + (1.0 - f0) * w;
+            schlick + (film_d[c] - schlick) * k
         });
         let fr_max = fr[0].max(fr[1]).max(fr[2]);
         let (weight, metallic) = (g.specular as f64, g.metallic as f64);
@@ -859,7 +954,8 @@ mod tests {
         std::array::from_fn(|c| {
             let base = g.base_color[c] as f64;
             let dielectric = (1.0 - weight * fr_max) * base / PI64 + weight * fr[c] * specular_brdf;
-            let metal = (base + (1.0 - base) * w) * specular_brdf;
+            let metal_f = base + (1.0 - base) * w;
+            let metal = (metal_f + (film_m[c] - metal_f) * k) * specular_brdf;
             let mut material = (1.0 - metallic) * dielectric + metallic * metal;
             if sheen_max > 0.0 {
                 material = g.sheen_color[c] as f64 * sheen_brdf + material * scaling;

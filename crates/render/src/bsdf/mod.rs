@@ -53,7 +53,8 @@
 //!   metallic-roughness model [`GltfPbr`], with its extensions and its transmission; `dielectric.rs`: refraction and the GGX microfacet transmission (Walter
 //!   et al. 2007) it uses for a volume's boundary; `sheen.rs`: KHR_materials_sheen's lobe
 //!   (Charlie distribution, fitted visibility, directional albedo) that [`GltfPbr`] layers
-//!   over its base, with its albedo table in `sheen_table.rs`;
+//!   over its base, with its albedo table in `sheen_table.rs`; `iridescence.rs`:
+//!   KHR_materials_iridescence's thin-film Fresnel term;
 //! - `luminance.rs`: [`LuminanceEval`], the light choice's `luminance(f(wo, wi))`: the
 //!   luminances of a model's reflectances and its `Model::AtWo`, taken once per `wo`, and
 //!   its lobes.
@@ -71,6 +72,7 @@ mod blinn_phong;
 mod dielectric;
 mod diffuse;
 mod ggx;
+mod iridescence;
 mod luminance;
 mod metallic_roughness;
 pub(crate) mod numbers;
@@ -573,7 +575,7 @@ mod tests {
     pub(super) const GLTF_ROUGHNESS: [f32; 3] = [0.15, 0.5, 1.0];
     pub(super) const GLTF_ANGLES: [f32; 4] = [0.0, 45.0, 85.0, 88.0];
     pub(super) const GLTF_VARIANT_ANGLES: [f32; 4] = [0.0, 60.0, 85.0, 88.0];
-    const GLTF_VARIANTS: usize = 7;
+    const GLTF_VARIANTS: usize = 8;
     /// Every chi-square test in the module, for the Sidak correction.
     const NUM_TESTS: usize = 2 * ALPHAS.len() * (ANGLES.len() + MIXED_ANGLES.len())
         + SHININESS.len() * (ANGLES.len() + MIXED_ANGLES.len())
@@ -592,7 +594,8 @@ mod tests {
     /// glTF materials with the extensions' parameters: KHR_materials_specular with a coloured
     /// F0 and KHR_materials_ior (1.33, and 0 as the specular-glossiness conversion uses),
     /// KHR_materials_clearcoat over a dark dielectric, a metal and a pure diffuse base, and
-    /// KHR_materials_sheen over a dark dielectric (velvet) and under a coat over a metal.
+    /// KHR_materials_sheen over a dark dielectric (velvet), KHR_materials_iridescence over a
+    /// dielectric, and both under a coat over a metal.
     pub(super) fn gltf_variants() -> [GltfPbr; GLTF_VARIANTS] {
         let base = GltfPbr {
             base_color: Vec3::new(0.8, 0.5, 0.2),
@@ -642,8 +645,18 @@ mod tests {
                 ..base
             },
             GltfPbr {
+                roughness: 0.25,
+                iridescence: 0.8,
+                iridescence_ior: 1.3,
+                iridescence_thickness: 350.0,
+                ..base
+            },
+            GltfPbr {
                 metallic: 1.0,
                 roughness: 0.3,
+                iridescence: 1.0,
+                iridescence_ior: 1.8,
+                iridescence_thickness: 250.0,
                 sheen_color: Vec3::new(0.2, 0.4, 1.0),
                 sheen_roughness: 0.35,
                 clearcoat: 0.5,

@@ -418,6 +418,9 @@ pub(crate) trait Spectrum<L: Lanes>:
     fn one_minus(self) -> Self;
     /// The grey reflectance `x` in every channel (whose luminance is `x`).
     fn grey(x: L) -> Self;
+    /// The reflectance `f(x)` of each lane's `x`, `f` giving linear RGB (its luminance for
+    /// luminance lanes), one lane at a time.
+    fn from_rgb(x: L, f: impl Fn(f32) -> Vec3) -> Self;
 }
 
 impl Spectrum<f32> for Vec3 {
@@ -429,6 +432,10 @@ impl Spectrum<f32> for Vec3 {
     fn grey(x: f32) -> Self {
         Vec3::splat(x)
     }
+    #[inline(always)]
+    fn from_rgb(x: f32, f: impl Fn(f32) -> Vec3) -> Self {
+        f(x)
+    }
 }
 
 impl<L: Lanes> Spectrum<L> for L {
@@ -439,5 +446,9 @@ impl<L: Lanes> Spectrum<L> for L {
     #[inline(always)]
     fn grey(x: L) -> Self {
         x
+    }
+    #[inline(always)]
+    fn from_rgb(x: L, f: impl Fn(f32) -> Vec3) -> Self {
+        x.lanewise(|c| streaks_image::luminance(f(c)))
     }
 }

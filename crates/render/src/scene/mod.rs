@@ -37,7 +37,10 @@
 //!   specularColorTexture), KHR_materials_ior (ior, 1.5 by default, 0 or at least 1),
 //!   KHR_materials_sheen (sheenColorFactor and the sRGB sheenColorTexture's RGB,
 //!   sheenRoughnessFactor and sheenRoughnessTexture's alpha: the Charlie sheen lobe over the
-//!   base by the extension's albedo scaling, see `bsdf/sheen.rs`) and
+//!   base by the extension's albedo scaling, see `bsdf/sheen.rs`), KHR_materials_iridescence
+//!   (iridescenceFactor and iridescenceTexture's red channel, iridescenceIor, the thickness
+//!   range blended by iridescenceThicknessTexture's green channel: the thin-film Fresnel of
+//!   `bsdf/iridescence.rs`) and
 //!   KHR_materials_clearcoat (clearcoatFactor and clearcoatTexture's red channel,
 //!   clearcoatRoughnessFactor and clearcoatRoughnessTexture's green channel, and
 //!   clearcoatNormalTexture, the coat's own normal map in the base's tangent space; without

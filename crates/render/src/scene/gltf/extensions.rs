@@ -29,6 +29,7 @@ pub const HONOURED: &[&str] = &[
     "KHR_materials_specular",
     "KHR_materials_ior",
     "KHR_materials_sheen",
+    "KHR_materials_iridescence",
     "KHR_materials_clearcoat",
     "KHR_texture_transform",
     "KHR_materials_transmission",
@@ -40,7 +41,6 @@ pub const HONOURED: &[&str] = &[
 fn without(extension: &str) -> &'static str {
     match extension {
         "KHR_materials_sheen" => "rendered without sheen",
-        "KHR_materials_iridescence" => "rendered without iridescence",
         "KHR_materials_anisotropy" => "rendered as an isotropic surface",
         "KHR_materials_dispersion" => "rendered without dispersion",
         "KHR_materials_unlit" => "shaded as a lit surface, not as unlit",
@@ -348,10 +348,10 @@ mod tests {
     #[test]
     fn used_and_unsupported_warns_for_every_user_by_name() {
         let doc = json!({
-            "extensionsUsed": ["KHR_materials_iridescence", "KHR_materials_anisotropy",
+            "extensionsUsed": ["KHR_materials_dispersion", "KHR_materials_anisotropy",
                                "KHR_materials_emissive_strength", "EXT_unknown"],
             "materials": [
-                {"name": "glass", "extensions": {"KHR_materials_iridescence": {"iridescenceFactor": 1}}},
+                {"name": "glass", "extensions": {"KHR_materials_dispersion": {"dispersion": 1}}},
                 {"name": "road", "extensions": {"KHR_materials_anisotropy": {"anisotropyStrength": 1}}},
                 {"extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 5}}}
             ]
@@ -359,10 +359,10 @@ mod tests {
         let w = check(Path::new("street.gltf"), &doc).unwrap();
         assert_eq!(w.len(), 3, "{w:?}");
         assert!(
-            w[0].contains("material \"glass\" (0) uses KHR_materials_iridescence"),
+            w[0].contains("material \"glass\" (0) uses KHR_materials_dispersion"),
             "{w:?}"
         );
-        assert!(w[0].contains("without iridescence"), "{w:?}");
+        assert!(w[0].contains("without dispersion"), "{w:?}");
         assert!(
             w[1].contains("material \"road\" (1) uses KHR_materials_anisotropy"),
             "{w:?}"

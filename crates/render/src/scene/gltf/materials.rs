@@ -1,5 +1,5 @@
-//! Materials: glTF metallic-roughness with KHR_materials_specular, _ior, _sheen, _clearcoat,
-//! _transmission and _volume, the paper's models and the road flag from `extras.streaks`, and
+//! Materials: glTF metallic-roughness with KHR_materials_specular, _ior, _sheen,
+//! _iridescence, _clearcoat, _transmission and _volume, the paper's models and the road flag from `extras.streaks`, and
 //! the glTF default material.
 
 use super::textures::{JsonTextureInfo, UvTransform};
@@ -105,6 +105,53 @@ pub(super) struct Sheen {
     color_texture: Option<TextureRef>,
     #[serde(skip)]
     roughness_texture: Option<TextureRef>,
+}
+
+/// A material's KHR_materials_iridescence object, as the JSON has it, and its decoded
+/// textures.
+#[derive(Debug, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub(super) struct Iridescence {
+    #[serde(default)]
+    iridescence_factor: f32,
+    iridescence_texture: Option<JsonTextureInfo>,
+    #[serde(default = "film_ior")]
+    iridescence_ior: f32,
+    #[serde(default = "film_min")]
+    iridescence_thickness_minimum: f32,
+    #[serde(default = "film_max")]
+    iridescence_thickness_maximum: f32,
+    iridescence_thickness_texture: Option<JsonTextureInfo>,
+    #[serde(skip)]
+    texture: Option<TextureRef>,
+    #[serde(skip)]
+    thickness_texture: Option<TextureRef>,
+}
+
+/// KHR_materials_iridescence's defaults: the film's index, its thickness range in nm.
+fn film_ior() -> f32 {
+    1.3
+}
+fn film_min() -> f32 {
+    100.0
+}
+fn film_max() -> f32 {
+    400.0
+}
+
+impl Default for Iridescence {
+    fn default() -> Self {
+        Iridescence {
+            iridescence_factor: 0.0,
+            iridescence_texture: None,
+            iridescence_ior: film_ior(),
+            iridescence_thickness_minimum: film_min(),
+            iridescence_thickness_maximum: film_max(),
+            iridescence_thickness_texture: None,
+            texture: None,
+            thickness_texture: None,
+        }
+    }
 }
 
 /// A material's KHR_materials_transmission object, as the JSON has it, and its decoded texture.
@@ -242,6 +289,7 @@ impl Loader<'_> {
             None => {
                 let specular = self.specular(m, &element)?;
                 let sheen = self.sheen(m, document, &element)?;
+                let film = self.iridescence(m, document, &element)?;
                 let clearcoat = self.clearcoat(m, document, &element)?;
                 let transmission = self.transmission(m, document, &element)?;
                 let volume = self.volume(m, document, &element)?;
@@ -260,6 +308,14 @@ impl Loader<'_> {
                     sheen_color_texture: sheen.color_texture,
                     sheen_roughness: sheen.sheen_roughness_factor,
                     sheen_roughness_texture: sheen.roughness_texture,
+                    iridescence: film.iridescence_factor,
+                    iridescence_texture: film.texture,
+                    iridescence_ior: film.iridescence_ior,
+                    iridescence_thickness: [
+                        film.iridescence_thickness_minimum,
+                        film.iridescence_thickness_maximum,
+                    ],
+                    iridescence_thickness_texture: film.thickness_texture,
                     clearcoat: clearcoat.clearcoat_factor,
                     clearcoat_texture: clearcoat.texture,
                     clearcoat_roughness: clearcoat.clearcoat_roughness_factor,
@@ -401,6 +457,52 @@ impl Loader<'_> {
         let (info, key) = (sh.sheen_roughness_texture, (NAME, "sheenRoughnessTexture"));
         sh.roughness_texture = self.extension_texture(document, key, info, element)?;
         Ok(sh)
+    }
+
+    /// KHR_materials_iridescence of a glTF material (none: iridescence 0), with its textures;
+    /// a factor outside [0, 1], an index below 1 or a negative or non-finite thickness is an
+    /// error.
+    pub(super) fn iridescence(
+        &mut self,
+        m: &gltf::Material,
+        document: &gltf::Document,
+        element: &str,
+    ) -> Result<Iridescence, SceneError> {
+        const NAME: &str = "KHR_materials_iridescence";
+        let Some(mut f) = self.material_extension::<Iridescence>(m, NAME, element)? else {
+            return Ok(Iridescence::default());
+        };
+        self.unit_factor((NAME, "iridescenceFactor"), f.iridescence_factor, element)?;
+        if !(f.iridescence_ior.is_finite() && f.iridescence_ior >= 1.0) {
+            let why = format!(
+                "{NAME}: iridescenceIor {} must be at least 1",
+                f.iridescence_ior
+            );
+            return Err(self.bad(element, why));
+        }
+        for (key, d) in [
+            (
+                "iridescenceThicknessMinimum",
+                f.iridescence_thickness_minimum,
+            ),
+            (
+                "iridescenceThicknessMaximum",
+                f.iridescence_thickness_maximum,
+            ),
+        ] {
+            if !(d.is_finite() && d >= 0.0) {
+                let why = format!("{NAME}: {key} {d} must be finite and not negative");
+                return Err(self.bad(element, why));
+            }
+        }
+        let (info, key) = (f.iridescence_texture, (NAME, "iridescenceTexture"));
+        f.texture = self.extension_texture(document, key, info, element)?;
+        let (info, key) = (
+            f.iridescence_thickness_texture,
+            (NAME, "iridescenceThicknessTexture"),
+        );
+        f.thickness_texture = self.extension_texture(document, key, info, element)?;
+        Ok(f)
     }
 
     /// KHR_materials_transmission of a glTF material (none: transmission 0), with its texture;
