@@ -881,6 +881,53 @@ mod tests {
     }
 
     #[test]
+    fn iridescence_is_read_with_its_textures() {
+        // One texel: R 255, G 128, B 0, A 64.
+        let dir = png_file("t.png", 1, 1, vec![255, 128, 0, 64]);
+        let (mut doc, bin) = test_doc();
+        doc["extensionsRequired"] = json!(["KHR_materials_iridescence"]);
+        doc["extensionsUsed"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!("KHR_materials_iridescence"));
+        doc["images"] = json!([{"uri": "t.png"}]);
+        doc["textures"] = json!([{"source": 0}]);
+        doc["materials"][1]["extensions"]["KHR_materials_iridescence"] = json!({
+            "iridescenceFactor": 0.5, "iridescenceTexture": {"index": 0},
+            "iridescenceIor": 1.8, "iridescenceThicknessMinimum": 200,
+            "iridescenceThicknessMaximum": 600, "iridescenceThicknessTexture": {"index": 0}});
+        let scene = Scene::load(&write_embedded(dir.path(), doc.clone(), &bin)).unwrap();
+        assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+        let Bsdf::GltfPbr(g) = scene.materials[1].bsdf_at(
+            &crate::geometry::VertexAttributes::from_uv(Vec2::ZERO),
+            &scene.textures,
+        ) else {
+            panic!("not a glTF material")
+        };
+        assert_eq!((g.iridescence, g.iridescence_ior), (0.5, 1.8));
+        let want = 200.0 + 400.0 * 128.0 / 255.0;
+        assert!((g.iridescence_thickness - want).abs() < 1e-3, "{g:?}");
+        for (value, what) in [
+            (json!({"iridescenceIor": 0.5}), "iridescenceIor 0.5"),
+            (
+                json!({"iridescenceThicknessMaximum": -1}),
+                "iridescenceThicknessMaximum -1",
+            ),
+            (json!({"iridescenceFactor": 2}), "iridescenceFactor 2"),
+        ] {
+            let mut d = doc.clone();
+            d["materials"][1]["extensions"] = json!({ "KHR_materials_iridescence": value });
+            let err = Scene::load(&write_embedded(dir.path(), d, &bin))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                err.contains("material \"glow\" (1)") && err.contains(what),
+                "{err}"
+            );
+        }
+    }
+
+    #[test]
     fn sheen_is_read_with_its_textures() {
         // One texel: R 255, G 128, B 0, A 64.
         let dir = png_file("t.png", 1, 1, vec![255, 128, 0, 64]);
