@@ -111,10 +111,6 @@ const EXPECTED_WARNINGS: &[(&str, &str)] = &[
     ("AnimatedMorphCube", "animations on 1 animation"),
     ("AnisotropyStrengthTest", "KHR_materials_anisotropy on"),
     (
-        "IridescenceSuzanne",
-        "KHR_materials_iridescence (required by the file",
-    ),
-    (
         "MeshPrimitiveModes",
         "point and line primitives on 4 primitives",
     ),

@@ -70,6 +70,10 @@ pub struct SurfaceHit {
     /// Where a normal map set `ns`: the smooth and the mapped normal, for the diffuse lobe
     /// ([`crate::normal_map::MappedNormal`]); `None` elsewhere.
     pub mapped: Option<MappedNormal>,
+    /// A clear-coated material's coat normal (unit, world space, on the side of `ng`) where it
+    /// is not `ns`: through the coat's normal map (clearcoatNormalTexture), or the
+    /// interpolated normal where only the base is normal mapped; `None` elsewhere.
+    pub coat_normal: Option<Vec3>,
     /// Texture coordinates and vertex colour.
     pub attributes: VertexAttributes,
     /// Index of the scene's flat triangle, or [`crate::scene::INSTANCED_TRIANGLE`] for a

@@ -624,6 +624,10 @@ fn trace_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, job: &RenderJo
         // A normal-mapped hit's diffuse lobe follows the mapped normal (crate::normal_map).
         let mapped = hit.mapped.map(|m| if front { m } else { m.flipped() });
         let frame = Frame::from_normal(ns);
+        if let Some(n) = hit.coat_normal {
+            // A clear coat with its own normal: flipped toward the viewer as `ns` is.
+            bsdf = bsdf.with_coat_normal(frame.to_local(if front { n } else { -n }));
+        }
         let wo_local = frame.to_local(wo);
         if wo_local.z <= 0.0 {
             // The interpolated normal faces away from the viewer: no BSDF value either way.

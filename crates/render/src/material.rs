@@ -9,7 +9,11 @@
 //! - [`Reflectance::GltfPbr`]: RGB multiplies the base colour; the metallic-roughness texture's
 //!   blue channel multiplies `metallic` and its green channel `roughness` (glTF 2.0); the
 //!   specular texture's alpha multiplies `specular` and the specular colour texture's RGB
-//!   `specular_color` (KHR_materials_specular); the clearcoat texture's red channel multiplies
+//!   `specular_color` (KHR_materials_specular); the sheen colour texture's RGB multiplies
+//!   `sheen_color` and the sheen roughness texture's alpha `sheen_roughness`
+//!   (KHR_materials_sheen); the iridescence texture's red channel multiplies `iridescence`
+//!   and the thickness texture's green channel blends the film's thickness from its minimum
+//!   to its maximum (KHR_materials_iridescence); the clearcoat texture's red channel multiplies
 //!   `clearcoat` and the clearcoat roughness texture's green channel `clearcoat_roughness`
 //!   (KHR_materials_clearcoat); the transmission texture's red channel multiplies
 //!   `transmission` (KHR_materials_transmission).
@@ -19,7 +23,9 @@
 //! Each texture is read through its [`TextureRef`] (coordinate set, sampler, uv transform).
 //! A material's [`Alpha`] says how much of its surface is there (glTF `alphaMode`, see
 //! [`Alpha::stop_probability`]). A normal map ([`Material::normal_map`]) changes the shading
-//! normal, not the BSDF: the scene applies it at the hit ([`crate::normal_map`]).
+//! normal, not the BSDF: the scene applies it at the hit ([`crate::normal_map`]), and so
+//! does a clear coat's normal map ([`Material::coat_normal_map`]), whose normal the
+//! integrator gives the BSDF ([`Bsdf::with_coat_normal`]).
 
 use crate::bsdf::{self, Bsdf};
 use crate::geometry::VertexAttributes;
@@ -39,7 +45,7 @@ pub enum PaperModel {
 }
 
 /// How a material reflects light.
-// The glTF variant holds seven texture references; a scene has few materials and `bsdf_at`
+// The glTF variant holds eleven texture references; a scene has few materials and `bsdf_at`
 // reads them by reference, so boxing it would only add an indirection per hit.
 #[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug, PartialEq)]
@@ -101,6 +107,25 @@ pub struct GltfPbrParams {
     pub specular_color_texture: Option<TextureRef>,
     /// KHR_materials_ior ior (1.5 without the extension; 0 or at least 1).
     pub ior: f32,
+    /// KHR_materials_sheen sheenColorFactor, linear RGB in [0, 1] (black: no sheen).
+    pub sheen_color: Vec3,
+    /// KHR_materials_sheen sheenColorTexture (RGB, sRGB-encoded).
+    pub sheen_color_texture: Option<TextureRef>,
+    /// KHR_materials_sheen sheenRoughnessFactor in [0, 1].
+    pub sheen_roughness: f32,
+    /// KHR_materials_sheen sheenRoughnessTexture (A = sheen roughness).
+    pub sheen_roughness_texture: Option<TextureRef>,
+    /// KHR_materials_iridescence iridescenceFactor in [0, 1] (0: no thin film).
+    pub iridescence: f32,
+    /// KHR_materials_iridescence iridescenceTexture (R = iridescence).
+    pub iridescence_texture: Option<TextureRef>,
+    /// KHR_materials_iridescence iridescenceIor (1.3 by default).
+    pub iridescence_ior: f32,
+    /// KHR_materials_iridescence iridescenceThicknessMinimum and Maximum, in nanometres.
+    pub iridescence_thickness: [f32; 2],
+    /// KHR_materials_iridescence iridescenceThicknessTexture (G blends from the minimum to
+    /// the maximum thickness; without it the thickness is the maximum).
+    pub iridescence_thickness_texture: Option<TextureRef>,
     /// KHR_materials_clearcoat clearcoatFactor (0: no coat).
     pub clearcoat: f32,
     /// KHR_materials_clearcoat clearcoatTexture (R = clearcoat).
@@ -109,6 +134,10 @@ pub struct GltfPbrParams {
     pub clearcoat_roughness: f32,
     /// KHR_materials_clearcoat clearcoatRoughnessTexture (G = clearcoat roughness).
     pub clearcoat_roughness_texture: Option<TextureRef>,
+    /// KHR_materials_clearcoat clearcoatNormalTexture: the coat's own tangent-space normal
+    /// map (in the base's tangent frame). Without it the coat is shaded with the interpolated
+    /// normal, not the base's mapped one, as the extension says.
+    pub clearcoat_normal_map: Option<NormalMap>,
     /// KHR_materials_transmission transmissionFactor in [0, 1] (0: opaque).
     pub transmission: f32,
     /// KHR_materials_transmission transmissionTexture (R = transmission).
@@ -132,10 +161,20 @@ impl Default for GltfPbrParams {
             specular_color: Vec3::ONE,
             specular_color_texture: None,
             ior: 1.5,
+            sheen_color: Vec3::ZERO,
+            sheen_color_texture: None,
+            sheen_roughness: 0.0,
+            sheen_roughness_texture: None,
+            iridescence: 0.0,
+            iridescence_texture: None,
+            iridescence_ior: 1.3,
+            iridescence_thickness: [100.0, 400.0],
+            iridescence_thickness_texture: None,
             clearcoat: 0.0,
             clearcoat_texture: None,
             clearcoat_roughness: 0.0,
             clearcoat_roughness_texture: None,
+            clearcoat_normal_map: None,
             transmission: 0.0,
             transmission_texture: None,
             volume: None,
@@ -150,8 +189,8 @@ impl Default for GltfPbrParams {
 /// definition).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Volume {
-    /// thicknessFactor (> 0; the thickness texture is not used: the path tracer measures the
-    /// distance travelled inside instead).
+    /// thicknessFactor (> 0; the thickness texture is not used: the extension says ray tracers
+    /// should use the distance travelled inside, which the path tracer measures).
     pub thickness: f32,
     /// The absorption coefficient `sigma_a` per channel, 1/m (0: clear).
     pub sigma_a: Vec3,
@@ -328,9 +367,19 @@ impl Material {
     /// Every texture reference the material holds.
     pub fn texture_refs(&self) -> impl Iterator<Item = TextureRef> + '_ {
         let r = match &self.reflectance {
-            Reflectance::Diffuse { kd_texture, .. } => {
-                [*kd_texture, None, None, None, None, None, None]
-            }
+            Reflectance::Diffuse { kd_texture, .. } => [
+                *kd_texture,
+                None,
+                None,
+                None,
+                None,
+                None,
+                None,
+                None,
+                None,
+                None,
+                None,
+            ],
             Reflectance::Paper {
                 kd_texture,
                 wetness,
@@ -343,13 +392,21 @@ impl Material {
                 None,
                 None,
                 None,
+                None,
+                None,
+                None,
+                None,
             ],
-            Reflectance::Unlit => [None; 7],
+            Reflectance::Unlit => [None; 11],
             Reflectance::GltfPbr(g) => [
                 g.base_color_texture,
                 g.metallic_roughness_texture,
                 g.specular_texture,
                 g.specular_color_texture,
+                g.sheen_color_texture,
+                g.sheen_roughness_texture,
+                g.iridescence_texture,
+                g.iridescence_thickness_texture,
                 g.clearcoat_texture,
                 g.clearcoat_roughness_texture,
                 g.transmission_texture,
@@ -360,6 +417,7 @@ impl Material {
                 self.emission_texture,
                 self.alpha.texture,
                 self.normal_map.map(|n| n.texture),
+                self.coat_normal_map().map(|n| n.texture),
             ])
             .flatten()
     }
@@ -414,10 +472,32 @@ impl Material {
                         * sample(g.specular_color_texture).truncate())
                     .max(Vec3::ZERO),
                     ior: g.ior,
+                    sheen_color: if g.sheen_color.max_element() > 0.0 {
+                        (g.sheen_color * sample(g.sheen_color_texture).truncate())
+                            .clamp(Vec3::ZERO, Vec3::ONE)
+                    } else {
+                        Vec3::ZERO
+                    },
+                    sheen_roughness: (g.sheen_roughness * sample(g.sheen_roughness_texture).w)
+                        .clamp(0.0, 1.0),
+                    iridescence: if g.iridescence > 0.0 {
+                        (g.iridescence * sample(g.iridescence_texture).x).clamp(0.0, 1.0)
+                    } else {
+                        0.0
+                    },
+                    iridescence_ior: g.iridescence_ior,
+                    iridescence_thickness: {
+                        let [min, max] = g.iridescence_thickness;
+                        match g.iridescence_thickness_texture {
+                            Some(t) => min + (max - min) * sample(Some(t)).y,
+                            None => max,
+                        }
+                    },
                     clearcoat: (g.clearcoat * sample(g.clearcoat_texture).x).clamp(0.0, 1.0),
                     clearcoat_roughness: (g.clearcoat_roughness
                         * sample(g.clearcoat_roughness_texture).y)
                         .clamp(0.0, 1.0),
+                    coat_normal: Vec3::Z,
                     transmission: if g.transmission > 0.0 {
                         (g.transmission * sample(g.transmission_texture).x).clamp(0.0, 1.0)
                     } else {
@@ -444,6 +524,29 @@ impl Material {
             Reflectance::Unlit => emission * at.color.truncate(),
             _ => emission,
         }
+    }
+
+    /// Whether the material has a clear coat (KHR_materials_clearcoat with a factor above 0),
+    /// whose normal may differ from the shading normal.
+    #[inline]
+    pub fn has_coat(&self) -> bool {
+        matches!(&self.reflectance, Reflectance::GltfPbr(g) if g.clearcoat > 0.0)
+    }
+
+    /// The clear coat's normal map (clearcoatNormalTexture), where the material has a coat.
+    #[inline]
+    pub fn coat_normal_map(&self) -> Option<NormalMap> {
+        match &self.reflectance {
+            Reflectance::GltfPbr(g) if g.clearcoat > 0.0 => g.clearcoat_normal_map,
+            _ => None,
+        }
+    }
+
+    /// The normal map that tangents are generated for (MikkTSpace in its texture space): the
+    /// base's, else the coat's; `None` when the material needs no tangents.
+    #[inline]
+    pub fn tangent_space_map(&self) -> Option<NormalMap> {
+        self.normal_map.or(self.coat_normal_map())
     }
 
     /// The medium inside the material's surface (KHR_materials_volume), if it bounds one.

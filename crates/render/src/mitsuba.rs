@@ -21,12 +21,14 @@
 //! | KHR_materials_transmission 1, metallic 0, with KHR_materials_volume | `dielectric` (roughness 0) or `roughdielectric` (ggx, alpha = roughness^2), `int_ior` = ior, `specular_transmittance` = base colour | no: exact Fresnel instead of Schlick's (warning); the volume's attenuation needs an interior medium, not exported (warning) |
 //! | the same, thin-walled and smooth | `thindielectric` | no: a slab with two interfaces and its inter-reflections, ours one interface (warning) |
 //! | other transmissive materials | `principled` (a volume) or `principledthin` (thin-walled) with `spec_trans` = transmission | no (warning) |
+//! | KHR_materials_iridescence | not exported | no (warning) |
+//! | KHR_materials_sheen (opaque glTF) | principled `sheen` = max3(sheenColor), `sheen_tint` 0 | no: Disney's white, Schlick-weighted sheen, not the Charlie lobe; sheenColor's hue, sheenRoughness and the textures are lost (warning); not exported on transmissive materials (warning) |
 //! | diffuse | `diffuse` | yes |
 //! | KHR_materials_unlit ([`Reflectance::Unlit`]) | `diffuse` of reflectance 0 and an `area` emitter of the base colour | yes (vertex colours are not exported, as for every material) |
 //! | kd / base colour / emission texture | `bitmap` (an EXR of texture x factor, so the factor is baked in) | yes (bilinear, repeat) |
 //! | wet/dry map ([`Wetness`](crate::material::Wetness)) | `alpha` and `specular_reflectance` as `bitmap`s baked per texel of the dryness map (`mix(wet, dry, w)`) | yes for `ggx` and `ward`'s alpha (linear in `w`, so bilinear filtering commutes); blinn_phong's alpha is not linear in the shininess (approximation already) |
 //! | double-sided material | BSDF wrapped in `twosided` | yes |
-//! | normal map ([`NormalMap`](crate::normal_map::NormalMap)) | not exported | no (warning) |
+//! | normal map ([`NormalMap`](crate::normal_map::NormalMap)), clearcoatNormalTexture | not exported | no (warning) |
 //! | instanced mesh ([`Instances`]) | a `shapegroup` of its object-space meshes (one PLY per material) and an `instance` with its `to_world` matrix per placement | yes |
 //! | perspective camera | `perspective`, `fov_axis` y, `fov` in degrees, `to_world` as a `lookat` | yes |
 //! | orthographic camera | `orthographic`, `to_world` a `scale` by the half-width then a `lookat` moved back by `near_clip` (see [`sensor_xml`]) | yes |
@@ -389,7 +391,16 @@ impl<'a> MaterialWriter<'a> {
             ("specularColorTexture", g.specular_color_texture),
             ("clearcoatTexture", g.clearcoat_texture),
             ("clearcoatRoughnessTexture", g.clearcoat_roughness_texture),
+            ("sheenColorTexture", g.sheen_color_texture),
+            ("sheenRoughnessTexture", g.sheen_roughness_texture),
         ];
+        if g.clearcoat > 0.0 && g.clearcoat_normal_map.is_some() {
+            self.warnings.push(format!(
+                "material {:?}: clearcoatNormalTexture is not exported; the coat is shaded \
+                 with the interpolated normal",
+                m.name
+            ));
+        }
         for (name, texture) in unexported {
             if texture.is_some() {
                 self.warnings.push(format!(
@@ -428,10 +439,27 @@ impl<'a> MaterialWriter<'a> {
         } else {
             String::new()
         };
+        if g.iridescence > 0.0 {
+            self.warnings.push(format!(
+                "material {:?}: KHR_materials_iridescence is not exported (Mitsuba's principled \
+                 BSDF has no thin film); rendered without iridescence",
+                m.name
+            ));
+        }
+        let sheen = g.sheen_color.max_element();
+        let sheen = if sheen > 0.0 {
+            self.warnings.push(format!(
+                "material {:?}: KHR_materials_sheen (colour {}, roughness {}) exported as                  principled sheen {sheen:?} (Disney's white sheen, Schlick-weighted, not the                  Charlie lobe; the colour's hue and the roughness are lost): approximation",
+                m.name, g.sheen_color, g.sheen_roughness
+            ));
+            format!("<float name=\"sheen\" value=\"{sheen:?}\"/>")
+        } else {
+            String::new()
+        };
         Ok(format!(
             "<bsdf type=\"principled\">{base}\
              <float name=\"metallic\" value=\"{:?}\"/>\
-             <float name=\"roughness\" value=\"{:?}\"/>{}{coat}</bsdf>",
+             <float name=\"roughness\" value=\"{:?}\"/>{}{sheen}{coat}</bsdf>",
             g.metallic, g.roughness, dielectric.xml
         ))
     }
@@ -460,6 +488,18 @@ impl<'a> MaterialWriter<'a> {
             self.warnings.push(format!(
                 "material {name:?}: transmissionTexture is not exported; its factor is used \
                  everywhere"
+            ));
+        }
+        if g.sheen_color.max_element() > 0.0 {
+            self.warnings.push(format!(
+                "material {name:?}: KHR_materials_sheen is not exported on a transmissive \
+                 material; rendered without sheen"
+            ));
+        }
+        if g.iridescence > 0.0 {
+            self.warnings.push(format!(
+                "material {name:?}: KHR_materials_iridescence is not exported; rendered \
+                 without iridescence"
             ));
         }
         if let Some(v) = g.volume {
@@ -1592,5 +1632,62 @@ mod tests {
         assert_eq!(baked.unwrap().image, image);
         // The XML parses.
         roxmltree::Document::parse(&e.xml).unwrap();
+    }
+
+    /// KHR_materials_sheen becomes principled `sheen` (its colour's largest channel) with a
+    /// warning on an opaque material, and is dropped with a warning on a transmissive one;
+    /// a clear coat's normal map is named as not exported.
+    #[test]
+    fn sheen_and_coat_normal_are_approximated_with_warnings() {
+        use crate::material::GltfPbrParams;
+        use crate::normal_map::NormalMap;
+        let velvet = |transmission: f32| {
+            Reflectance::GltfPbr(GltfPbrParams {
+                base_color: Vec3::splat(0.05),
+                metallic: 0.0,
+                roughness: 0.7,
+                sheen_color: Vec3::new(0.2, 0.6, 0.4),
+                sheen_roughness: 0.5,
+                clearcoat: 0.5,
+                clearcoat_normal_map: Some(NormalMap {
+                    texture: TextureRef::new(0),
+                    scale: 1.0,
+                }),
+                transmission,
+                ..GltfPbrParams::default()
+            })
+        };
+        let mut fx = Fixture::new();
+        fx.materials[2].reflectance = velvet(0.0);
+        let ex = export_parts(&fx.parts(), &fx.cameras[0], &opts()).unwrap();
+        let doc = roxmltree::Document::parse(&ex.xml).unwrap();
+        let sheen = doc
+            .descendants()
+            .find(|n| n.attribute("name") == Some("sheen"))
+            .and_then(|n| n.attribute("value"))
+            .unwrap_or_else(|| panic!("no sheen in {}", ex.xml));
+        assert_eq!(sheen, "0.6");
+        for needle in [
+            "KHR_materials_sheen",
+            "clearcoatNormalTexture is not exported",
+        ] {
+            assert!(
+                ex.warnings
+                    .iter()
+                    .any(|w| w.contains("\"wall\"") && w.contains(needle)),
+                "no warning about {needle}: {:?}",
+                ex.warnings
+            );
+        }
+        fx.materials[2].reflectance = velvet(0.5);
+        let ex = export_parts(&fx.parts(), &fx.cameras[0], &opts()).unwrap();
+        assert!(!ex.xml.contains("name=\"sheen\""), "{}", ex.xml);
+        assert!(
+            ex.warnings
+                .iter()
+                .any(|w| w.contains("KHR_materials_sheen is not exported")),
+            "{:?}",
+            ex.warnings
+        );
     }
 }

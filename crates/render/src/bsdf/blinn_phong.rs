@@ -62,6 +62,7 @@ impl Model for BlinnPhong {
         Reflectances {
             diffuse: self.kd,
             glossy: self.ks,
+            sheen: Vec3::ZERO,
         }
     }
 

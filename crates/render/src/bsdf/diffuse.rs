@@ -36,6 +36,7 @@ impl Model for Diffuse {
         Reflectances {
             diffuse: self.kd,
             glossy: Vec3::ZERO,
+            sheen: Vec3::ZERO,
         }
     }
 

@@ -44,6 +44,7 @@ impl Model for Ggx {
         Reflectances {
             diffuse: self.kd,
             glossy: self.ks,
+            sheen: Vec3::ZERO,
         }
     }
 

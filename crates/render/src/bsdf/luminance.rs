@@ -26,7 +26,10 @@ pub struct LuminanceEval {
     at: AtWo,
 }
 
-/// A [`Bsdf`]'s [`Model::AtWo`], for the model its variant names.
+/// A [`Bsdf`]'s [`Model::AtWo`], for the model its variant names. The glTF variant is the
+/// largest (its sheen, coat frame and thin film); it is made once per `wo` on the hot path,
+/// where boxing it would allocate.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug)]
 enum AtWo {
     Diffuse(<Diffuse as Model>::AtWo),

@@ -1,13 +1,15 @@
 //! The glTF 2.0 metallic-roughness BRDF [`GltfPbr`] (specification appendix B) with the
-//! parameters of KHR_materials_specular, KHR_materials_ior and KHR_materials_clearcoat: a
-//! Lambertian lobe and a GGX lobe coupled by Schlick's Fresnel, under an optional smooth GGX
-//! coat, with the specular transmission of KHR_materials_transmission (thin-walled, or
+//! parameters of KHR_materials_specular, KHR_materials_ior, KHR_materials_sheen and
+//! KHR_materials_clearcoat: a Lambertian lobe and a GGX lobe coupled by Schlick's Fresnel,
+//! under an optional sheen and an optional smooth GGX coat, with the specular transmission of KHR_materials_transmission (thin-walled, or
 //! refracting into a KHR_materials_volume).
 
 use super::dielectric::{microfacet_transmission, outside_cos, refract};
 use super::diffuse::lambert;
 use super::ggx;
+use super::iridescence;
 use super::numbers::{Lanes, Spectrum};
+use super::sheen::SheenAtWo;
 use super::{
     glossy_probability, half_vector, reflect, rgb_lobes, BsdfSample, Lobe, LobeValues, Lobes,
     Model, Reflectances, MIN_ALPHA, MIN_LOBE_PROBABILITY,
@@ -28,12 +30,28 @@ use streaks_image::luminance;
 ///   `f0 = specular_color`, clamped) and `fr = f0 + (1 - f0) s`,
 ///   `dielectric_brdf = (1 - specular max_value(fr)) base / pi + specular fr specular_brdf`;
 /// - `material = mix(dielectric_brdf, metal_brdf, metallic)`;
-/// - clearcoat (KHR_materials_clearcoat's `fresnel_coat`): `f = mix(material, coat_brdf,
+/// - iridescence (KHR_materials_iridescence): both Fresnel terms, the dielectric's `fr` and
+///   the metal's `base + (1 - base) s`, become `mix(F, F_film(wo.h, F0), iridescence)` with
+///   `F_film` the thin film's reflectance over a base of that F0 (see `iridescence.rs`), in
+///   the specular lobe and in the dielectric's diffuse weight `1 - specular max_value(fr)`;
+///   not from inside a volume, and the transmission keeps Schlick's weight;
+/// - sheen (KHR_materials_sheen's albedo scaling, see `sheen.rs`): `sheen_material =
+///   sheen_color f_sheen + material (1 - max3(sheen_color) max(E(n.wo), E(n.wi)))`, with
+///   `f_sheen` the Charlie lobe of `alpha = sheen_roughness^2` and `E` its directional
+///   albedo; the sheen is part of the diffuse lobe, sampled cosine-weighted;
+/// - clearcoat (KHR_materials_clearcoat's `fresnel_coat`): `f = mix(sheen_material, coat_brdf,
 ///   clearcoat Fc)` with `coat_brdf` the same `D V` at `alpha = clearcoat_roughness^2` and
 ///   `Fc = 0.04 + 0.96 (1 - |n.wo|)^5`.
 ///
 /// As the extension says, the coat's Fresnel is taken at the normal, not the half vector, so
-/// a coated material is not reciprocal (its coat weight depends on `wo` alone). Without the
+/// a coated material is not reciprocal (its coat weight depends on `wo` alone).
+///
+/// The coat has its own normal `nc` ([`GltfPbr::coat_normal`], KHR_materials_clearcoat's
+/// clearcoatNormalTexture; without one the interpolated normal, not the base's mapped one):
+/// `Fc` takes `nc.wo`, and the coat's lobe is the GGX lobe in the frame of `nc`, as a BRDF
+/// about `nc`: its contribution toward `wi` is `coat_brdf(wo, wi) (nc.wi)`, so its value in
+/// this frame (whose cosine is `n.wi`) is `coat_brdf (nc.wi) / (n.wi)`, zero where `wi` is
+/// below `nc`'s hemisphere; no coat where `wo` is. Its visible normals are sampled about `nc`. Without the
 /// extensions (specular 1, specular colour 1, ior 1.5, clearcoat 0) this is the core model,
 /// whose diffuse weight is `(1 - metallic) (1 - F_dielectric)`.
 ///
@@ -85,10 +103,24 @@ pub struct GltfPbr {
     pub specular_color: Vec3,
     /// KHR_materials_ior `ior`: 1.5 without the extension, 0 or at least 1.
     pub ior: f32,
+    /// KHR_materials_sheen `sheenColor`, linear RGB in [0, 1] (black: no sheen).
+    pub sheen_color: Vec3,
+    /// KHR_materials_sheen `sheenRoughness` in [0, 1].
+    pub sheen_roughness: f32,
+    /// KHR_materials_iridescence `iridescence` in [0, 1] (0: no thin film).
+    pub iridescence: f32,
+    /// KHR_materials_iridescence `iridescenceIor`, the film's index (1.3 by default).
+    pub iridescence_ior: f32,
+    /// The film's thickness in nanometres (KHR_materials_iridescence; 0: no film).
+    pub iridescence_thickness: f32,
     /// KHR_materials_clearcoat `clearcoat` in [0, 1] (0: no coat).
     pub clearcoat: f32,
     /// KHR_materials_clearcoat `clearcoatRoughness` in [0, 1].
     pub clearcoat_roughness: f32,
+    /// The coat's unit normal in the local shading frame: `Vec3::Z` (the shading normal)
+    /// unless a clearcoatNormalTexture tilts it, or the base's normal map tilts the shading
+    /// normal and the coat keeps the interpolated one (see [`GltfPbr`]).
+    pub coat_normal: Vec3,
     /// KHR_materials_transmission `transmission` in [0, 1] (0: opaque).
     pub transmission: f32,
     /// Thin-walled (no KHR_materials_volume): transmitted light goes straight through; false:
@@ -100,7 +132,7 @@ pub struct GltfPbr {
 }
 
 /// The glTF defaults: white, metallic 1, roughness 1, and the extensions' defaults (specular 1,
-/// specular colour 1, ior 1.5, no clear coat, no transmission).
+/// specular colour 1, ior 1.5, no sheen, no clear coat, no transmission).
 impl Default for GltfPbr {
     fn default() -> Self {
         GltfPbr {
@@ -110,8 +142,14 @@ impl Default for GltfPbr {
             specular: 1.0,
             specular_color: Vec3::ONE,
             ior: 1.5,
+            sheen_color: Vec3::ZERO,
+            sheen_roughness: 0.0,
+            iridescence: 0.0,
+            iridescence_ior: 1.3,
+            iridescence_thickness: 400.0,
             clearcoat: 0.0,
             clearcoat_roughness: 0.0,
+            coat_normal: Vec3::Z,
             transmission: 0.0,
             thin_walled: true,
             inside: false,
@@ -215,10 +253,52 @@ impl GltfPbr {
         (1.0 - self.specular * m, self.specular * (1.0 - m))
     }
 
-    /// The coat's weight for `wo`, `clearcoat Fc(n.wo)`.
+    /// The sheen's terms for `wo` of cosine `cos_o`; `None` without a sheen.
     #[inline]
-    fn coat_weight(&self, cos_o: f32) -> f32 {
-        self.clearcoat * (COAT_F0 + (1.0 - COAT_F0) * schlick_weight(cos_o))
+    fn sheen_at(&self, cos_o: f32) -> Option<SheenAtWo> {
+        (self.sheen_color.max_element() > 0.0).then(|| SheenAtWo::new(self.sheen_roughness, cos_o))
+    }
+
+    /// The base's weight under the sheen for `wo` alone, `1 - max3(sheen_color) E(cos_o)`
+    /// (1 without a sheen): what the sheen leaves of the light arriving along `wo`.
+    #[inline]
+    fn sheen_base_weight(&self, sheen: &Option<SheenAtWo>) -> f32 {
+        sheen.map_or(1.0, |s| 1.0 - self.sheen_color.max_element() * s.e_o)
+    }
+
+    /// The coat's weight for `wo` of cosine `cos_c` with the coat's normal, `clearcoat
+    /// Fc(nc.wo)`; 0 where `wo` is below the coat.
+    #[inline]
+    fn coat_weight(&self, cos_c: f32) -> f32 {
+        if cos_c <= 0.0 {
+            return 0.0;
+        }
+        self.clearcoat * (COAT_F0 + (1.0 - COAT_F0) * schlick_weight(cos_c))
+    }
+
+    /// `nc.wo`, the cosine of `wo` with the coat's normal.
+    #[inline]
+    fn coat_cos(&self, wo: Vec3) -> f32 {
+        if self.coat_normal == Vec3::Z {
+            wo.z
+        } else {
+            wo.dot(self.coat_normal)
+        }
+    }
+
+    /// The coat's frame for `wo` where its normal is not the shading normal.
+    #[inline]
+    fn coat_frame(&self, wo: Vec3) -> Option<CoatFrame> {
+        (self.clearcoat > 0.0 && self.coat_normal != Vec3::Z).then(|| {
+            let (s, t) = self.coat_normal.any_orthonormal_pair();
+            let n = self.coat_normal;
+            CoatFrame {
+                s,
+                t,
+                n,
+                wo: Vec3::new(wo.dot(s), wo.dot(t), wo.dot(n)),
+            }
+        })
     }
 
     /// The albedo estimates of the diffuse part, the base's microfacet part, the coat and the
@@ -227,15 +307,22 @@ impl GltfPbr {
     /// at or above a tenth of its value at normal incidence, as rough microfacets transmit
     /// where the macroscopic direction would be totally reflected.
     #[inline]
-    fn lobe_estimates(&self, cos_o: f32) -> [f32; 4] {
+    fn lobe_estimates(&self, wo: Vec3) -> [f32; 4] {
+        let (cos_o, cos_c) = (wo.z, self.coat_cos(wo));
         let s = self.schlick_at(cos_o);
-        let coat_weight = self.coat_weight(cos_o);
-        let base_weight = 1.0 - coat_weight;
+        let coat_weight = self.coat_weight(cos_c);
+        let mut base_weight = 1.0 - coat_weight;
+        let sheen = self.sheen_at(cos_o);
+        let mut sheen_estimate = 0.0;
+        if let Some(sh) = sheen {
+            sheen_estimate = base_weight * luminance(self.sheen_color) * sh.e_o;
+            base_weight *= self.sheen_base_weight(&sheen);
+        }
         let glossy_colour = self.glossy_f0() * (1.0 - s) + Vec3::splat(self.glossy_f90() * s);
         let base = base_weight * luminance(glossy_colour) * ggx::albedo_factor(cos_o, self.alpha());
-        let coat = coat_weight * ggx::albedo_factor(cos_o, self.coat_alpha());
+        let coat = coat_weight * ggx::albedo_factor(cos_c, self.coat_alpha());
         let (a, b) = self.diffuse_weight_terms();
-        let diffuse = base_weight * luminance(self.diffuse_color()) * (a - b * s);
+        let diffuse = base_weight * luminance(self.diffuse_color()) * (a - b * s) + sheen_estimate;
         let transmission =
             base_weight * luminance(self.transmission_color()) * (a - b * s).max(0.1 * a);
         [diffuse, base, coat, transmission]
@@ -245,8 +332,8 @@ impl GltfPbr {
     /// `cos_o`, from [`GltfPbr::lobe_estimates`]. The coat's share is 0 without a coat, 1 when
     /// the base has no microfacet part, else clamped to `[0.05, 0.95]` as the lobe choice is.
     #[inline]
-    fn lobe_probabilities(&self, cos_o: f32) -> (f32, f32) {
-        let [diffuse, base, coat, _] = self.lobe_estimates(cos_o);
+    fn lobe_probabilities(&self, wo: Vec3) -> (f32, f32) {
+        let [diffuse, base, coat, _] = self.lobe_estimates(wo);
         let coat_share = if coat <= 0.0 {
             0.0
         } else if base <= 0.0 {
@@ -261,11 +348,11 @@ impl GltfPbr {
     /// glossy, transmission, proportional to [`GltfPbr::lobe_estimates`], and every lobe whose
     /// colour is not black kept at [`MIN_LOBE_PROBABILITY`] or more.
     #[inline]
-    fn transmissive_probabilities(&self, cos_o: f32) -> [f32; 3] {
-        let [diffuse, base, coat, transmission] = self.lobe_estimates(cos_o);
+    fn transmissive_probabilities(&self, wo: Vec3) -> [f32; 3] {
+        let [diffuse, base, coat, transmission] = self.lobe_estimates(wo);
         let w = [diffuse, base + coat, transmission];
         let possible = [
-            luminance(self.diffuse_color()) > 0.0,
+            luminance(self.diffuse_color()) > 0.0 || luminance(self.sheen_color) > 0.0,
             luminance(self.glossy_f0()) > 0.0 || self.glossy_f90() > 0.0 || self.clearcoat > 0.0,
             luminance(self.transmission_color()) > 0.0,
         ];
@@ -294,7 +381,7 @@ impl GltfPbr {
         if wo.z <= 0.0 || wi.z == 0.0 {
             return (LobeValues::default(), 0.0);
         }
-        let [p_diffuse, p_glossy, p_transmission] = self.transmissive_probabilities(wo.z);
+        let [p_diffuse, p_glossy, p_transmission] = self.transmissive_probabilities(wo);
         if wi.z > 0.0 {
             let (f, glossy_pdf) = rgb_lobes(self, wo, wi);
             let mut pdf = 0.0;
@@ -321,7 +408,7 @@ impl GltfPbr {
     /// (see the type's documentation).
     #[inline]
     fn transmission_lobe(&self, at: &GltfAtWo, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
-        let colour = self.transmission_color() * at.base_weight;
+        let colour = self.transmission_color() * (at.base_weight * at.sheen_transmission);
         let weight = |s: f32| at.diffuse_a - at.diffuse_b * s;
         if self.thin_walled {
             let mirrored = Vec3::new(wi.x, wi.y, -wi.z);
@@ -342,7 +429,7 @@ impl GltfPbr {
     /// `wo`, mirrored (thin-walled) or refracted (a volume) through the sampled normal, or its
     /// delta direction for a smooth surface.
     pub(super) fn sample_transmissive(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
-        let [p_diffuse, p_glossy, p_transmission] = self.transmissive_probabilities(wo.z);
+        let [p_diffuse, p_glossy, p_transmission] = self.transmissive_probabilities(wo);
         let (wi, lobe) = if u_lobe < p_glossy {
             (self.sample_glossy(wo, u)?, Lobe::Glossy)
         } else if u_lobe < p_glossy + p_transmission || p_diffuse <= 0.0 {
@@ -387,7 +474,8 @@ impl GltfPbr {
             return None;
         }
         let (a, b) = self.diffuse_weight_terms();
-        let base_weight = 1.0 - self.coat_weight(wo.z);
+        let base_weight = (1.0 - self.coat_weight(self.coat_cos(wo)))
+            * self.sheen_base_weight(&self.sheen_at(wo.z));
         let weight = (a - b * schlick_weight(cos_outside)) * base_weight * scale;
         let f = self.transmission_color() * (weight / -wi.z);
         Some(BsdfSample {
@@ -401,12 +489,35 @@ impl GltfPbr {
 
     /// The coat's share of the glossy lobe's samples for `wo` (0 without a coat).
     #[inline]
-    fn coat_share(&self, cos_o: f32) -> f32 {
+    fn coat_share(&self, wo: Vec3) -> f32 {
         if self.clearcoat > 0.0 {
-            self.lobe_probabilities(cos_o).1
+            self.lobe_probabilities(wo).1
         } else {
             0.0
         }
+    }
+}
+
+/// The coat's orthonormal frame (`n` its normal) in the shading frame, and `wo` in it.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct CoatFrame {
+    s: Vec3,
+    t: Vec3,
+    n: Vec3,
+    wo: Vec3,
+}
+
+impl CoatFrame {
+    /// Directions in lanes from the shading frame to the coat's.
+    #[inline(always)]
+    fn coat_from_shading<L: Lanes>(&self, w: [L; 3]) -> [L; 3] {
+        [self.s, self.t, self.n].map(|a| w[0] * a.x + w[1] * a.y + w[2] * a.z)
+    }
+
+    /// A direction from the coat's frame to the shading frame.
+    #[inline]
+    fn shading_from_coat(&self, w: Vec3) -> Vec3 {
+        self.s * w.x + self.t * w.y + self.n * w.z
     }
 }
 
@@ -421,8 +532,10 @@ fn schlick_weight<L: Lanes>(cos: L) -> L {
 pub(super) struct GltfAtWo {
     /// The base's GGX lobe.
     base: ggx::GgxAtWo,
-    /// The coat's GGX lobe.
+    /// The coat's GGX lobe (for `wo` in the coat's frame).
     coat: ggx::GgxAtWo,
+    /// The coat's frame where its normal is not the shading normal.
+    coat_frame: Option<CoatFrame>,
     /// [`GltfPbr::glossy_f90`].
     f90: f32,
     /// [`GltfPbr::diffuse_weight_terms`].
@@ -437,6 +550,59 @@ pub(super) struct GltfAtWo {
     /// `ior` when `wo` is inside a volume (Schlick's weight then takes the outside cosine),
     /// else 0.
     inside_ior: f32,
+    /// The sheen's terms (`None` without a sheen).
+    sheen: Option<SheenAtWo>,
+    /// `max3(sheen_color)`.
+    sheen_max: f32,
+    /// The transmission's weight under the sheen, `1 - max3(sheen_color) E(cos_o)`.
+    sheen_transmission: f32,
+    /// The thin film (`None` without one).
+    film: Option<Film>,
+}
+
+/// A [`GltfPbr`]'s thin film (KHR_materials_iridescence) and the Fresnel terms it changes.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Film {
+    iridescence: f32,
+    ior: f32,
+    thickness: f32,
+    /// The dielectric's F0 ([`GltfPbr::dielectric_f0`]) and the metal's (the base colour).
+    dielectric_f0: Vec3,
+    metal_f0: Vec3,
+    specular: f32,
+    metallic: f32,
+}
+
+impl Film {
+    /// The dielectric's Fresnel term `mix(f0 + (1 - f0) s, F_film, iridescence)` at the
+    /// cosine `cos` of `wo` with the microfacet normal.
+    #[inline]
+    fn dielectric(&self, cos: f32) -> Vec3 {
+        self.mixed(cos, self.dielectric_f0)
+    }
+
+    /// `mix(f0 + (1 - f0) s, F_film(f0), iridescence)`.
+    #[inline]
+    fn mixed(&self, cos: f32, f0: Vec3) -> Vec3 {
+        let cos = cos.abs();
+        let s = schlick_weight(cos);
+        let schlick = f0 + (Vec3::ONE - f0) * s;
+        let film = iridescence::fresnel(cos, self.ior, self.thickness, f0);
+        schlick + (film - schlick) * self.iridescence
+    }
+
+    /// The glossy colour `(1 - metallic) specular F_dielectric + metallic F_metal`.
+    #[inline]
+    fn glossy_colour(&self, cos: f32) -> Vec3 {
+        (1.0 - self.metallic) * self.specular * self.dielectric(cos)
+            + self.metallic * self.mixed(cos, self.metal_f0)
+    }
+
+    /// The dielectric's diffuse weight `1 - specular max_value(F_dielectric)`.
+    #[inline]
+    fn diffuse_weight(&self, cos: f32) -> f32 {
+        1.0 - self.specular * self.dielectric(cos).max_element()
+    }
 }
 
 impl Model for GltfPbr {
@@ -445,29 +611,48 @@ impl Model for GltfPbr {
     #[inline]
     fn at_wo(&self, wo: Vec3) -> GltfAtWo {
         let (diffuse_a, diffuse_b) = self.diffuse_weight_terms();
-        let coat_weight = self.coat_weight(wo.z);
+        let coat_frame = self.coat_frame(wo);
+        let coat_wo = coat_frame.map_or(wo, |c| c.wo);
+        let coat_weight = self.coat_weight(coat_wo.z);
+        let sheen = self.sheen_at(wo.z);
         GltfAtWo {
             base: ggx::GgxAtWo::new(self.alpha(), wo),
-            coat: ggx::GgxAtWo::new(self.coat_alpha(), wo),
+            coat: ggx::GgxAtWo::new(self.coat_alpha(), coat_wo),
+            coat_frame,
             f90: self.glossy_f90(),
             diffuse_a,
             diffuse_b,
             base_weight: 1.0 - coat_weight,
             coat_weight,
-            coat_share: self.coat_share(wo.z),
+            coat_share: self.coat_share(wo),
             inside_ior: if self.inside { 1.0 / self.etap() } else { 0.0 },
+            sheen,
+            sheen_max: self.sheen_color.max_element(),
+            sheen_transmission: self.sheen_base_weight(&sheen),
+            film: (self.iridescence > 0.0 && self.iridescence_thickness > 0.0 && !self.inside)
+                .then(|| Film {
+                    iridescence: self.iridescence,
+                    ior: self.iridescence_ior,
+                    thickness: self.iridescence_thickness,
+                    dielectric_f0: self.dielectric_f0(),
+                    metal_f0: self.base_color,
+                    specular: self.specular,
+                    metallic: self.metallic,
+                }),
         }
     }
 
-    /// `c_diff` and [`GltfPbr::glossy_f0`]: the diffuse lobe is the Lambertian lobe of `c_diff`
-    /// times the lane term `1 - specular max_value(fr)`, the glossy lobe
-    /// `glossy_f0 (1 - s) + glossy_f90 s` times the microfacet lobe; both under the coat's
-    /// `1 - clearcoat Fc`.
+    /// `c_diff`, [`GltfPbr::glossy_f0`] and the sheen colour: the diffuse lobe is the
+    /// Lambertian lobe of `c_diff` times the lane term `1 - specular max_value(fr)`, the glossy
+    /// lobe `glossy_f0 (1 - s) + glossy_f90 s` times the microfacet lobe, both under the
+    /// sheen's albedo scaling, plus the sheen colour times the sheen lobe (in the diffuse
+    /// lobe); all under the coat's `1 - clearcoat Fc`.
     #[inline]
     fn reflectances(&self) -> Reflectances<Vec3> {
         Reflectances {
             diffuse: self.diffuse_color(),
             glossy: self.glossy_f0(),
+            sheen: self.sheen_color,
         }
     }
 
@@ -492,17 +677,48 @@ impl Model for GltfPbr {
         } else {
             schlick_weight(cos)
         };
-        let diffuse_weight = (L::splat(at.diffuse_a) - s * at.diffuse_b) * at.base_weight;
-        let colour = r.glossy * s.one_minus() + S::grey(s * at.f90);
+        let (mut diffuse_weight, colour) = match &at.film {
+            None => (
+                (L::splat(at.diffuse_a) - s * at.diffuse_b) * at.base_weight,
+                r.glossy * s.one_minus() + S::grey(s * at.f90),
+            ),
+            Some(film) => (
+                cos.lanewise(|c| film.diffuse_weight(c)) * at.base_weight,
+                S::from_rgb(cos, |c| film.glossy_colour(c)),
+            ),
+        };
         let mut glossy = colour * (spec * at.base_weight);
+        let mut sheen = None;
+        if let Some(sh) = &at.sheen {
+            let scale = sh.base_weight(at.sheen_max, wi[2]);
+            diffuse_weight = diffuse_weight * scale;
+            glossy = glossy * scale;
+            sheen = Some(r.sheen * (sh.lobe(h[2], wi[2]) * at.base_weight));
+        }
         let mut glossy_pdf = pdf;
         if at.coat_weight > 0.0 {
-            let (coat, coat_pdf) = ggx::microfacet_correlated(&at.coat, wo, wi);
+            let (coat, coat_pdf) = match &at.coat_frame {
+                None => ggx::microfacet_correlated(&at.coat, wo, wi),
+                Some(c) => {
+                    let wi_c = c.coat_from_shading(wi);
+                    let (coat, pdf) = ggx::microfacet_correlated(&at.coat, c.wo, wi_c);
+                    // A BRDF about the coat's normal (see the type's documentation); the
+                    // visible normals' density is zero where the half vector is below it.
+                    (
+                        (coat * wi_c[2] / wi[2]).where_positive(wi_c[2]),
+                        pdf.where_positive(wi_c[2] + c.wo.z),
+                    )
+                }
+            };
             glossy = glossy + S::grey(coat * at.coat_weight);
             glossy_pdf = pdf * (1.0 - at.coat_share) + coat_pdf * at.coat_share;
         }
+        let mut diffuse = lambert(r.diffuse) * diffuse_weight;
+        if let Some(sheen) = sheen {
+            diffuse = diffuse + sheen;
+        }
         Lobes {
-            diffuse: lambert(r.diffuse) * diffuse_weight,
+            diffuse,
             glossy,
             glossy_pdf,
         }
@@ -510,16 +726,21 @@ impl Model for GltfPbr {
 
     #[inline]
     fn glossy_probability(&self, wo: Vec3) -> f32 {
-        self.lobe_probabilities(wo.z).0
+        self.lobe_probabilities(wo).0
     }
 
     /// The coat with probability [`GltfPbr::coat_share`] (`u.x` rescaled to choose), else the
-    /// base's lobe; each by its visible normals.
+    /// base's lobe; each by its visible normals (the coat's about its own normal).
     #[inline]
     fn sample_glossy(&self, wo: Vec3, u: Vec2) -> Option<Vec3> {
-        let q = self.coat_share(wo.z);
+        let q = self.coat_share(wo);
         let (alpha, u) = if u.x < q {
-            (self.coat_alpha(), Vec2::new(u.x / q, u.y))
+            let u = Vec2::new(u.x / q, u.y);
+            if let Some(c) = self.coat_frame(wo) {
+                let h = ggx::sample_visible_normal(c.wo, self.coat_alpha(), u)?;
+                return Some(c.shading_from_coat(reflect(c.wo, h)));
+            }
+            (self.coat_alpha(), u)
         } else {
             (self.alpha(), Vec2::new((u.x - q) / (1.0 - q), u.y))
         };
@@ -540,8 +761,8 @@ mod tests {
     //! f64 from appendix B and the extensions' pseudocode, white furnaces and analytic cases.
     use super::*;
     use crate::bsdf::tests::{
-        d3, gltf_variants, mc_albedo, random_dir, run, GLTF_ANGLES, GLTF_ROUGHNESS,
-        GLTF_VARIANT_ANGLES,
+        d3, gltf_variants, mc_albedo, random_dir, run, COAT_NORMALS, COAT_NORMAL_ANGLES,
+        GLTF_ANGLES, GLTF_ROUGHNESS, GLTF_VARIANT_ANGLES,
     };
     use crate::bsdf::{Bsdf, Diffuse, Ggx};
     use crate::sampling::Pcg32;
@@ -588,6 +809,94 @@ mod tests {
         }
     }
 
+    /// A coat whose normal is tilted by `tilt` radians toward +X of the shading frame.
+    fn tilted_coat(base: GltfPbr, tilt: f32) -> GltfPbr {
+        GltfPbr {
+            coat_normal: Vec3::new(tilt.sin(), 0.0, tilt.cos()),
+            ..base
+        }
+    }
+
+    /// A tilted coat (clearcoatNormalTexture) samples what it evaluates: over a dark rough
+    /// dielectric and over a metal, the tilt toward and away from `wo`'s azimuth.
+    #[test]
+    fn chi_square_tilted_coat() {
+        let materials: [GltfPbr; COAT_NORMALS] = [
+            tilted_coat(gltf_variants()[2], 0.3),
+            tilted_coat(gltf_variants()[3], -0.5),
+        ];
+        for (k, g) in materials.into_iter().enumerate() {
+            for theta in COAT_NORMAL_ANGLES {
+                let name = format!("tilted coat {k} {g:?} theta_o {theta}");
+                run(name, Bsdf::GltfPbr(g), theta, 8 + k as u64);
+            }
+        }
+    }
+
+    /// A coat normal map tilts the coat's highlight and not the base's: with the coat's
+    /// normal tilted by 10 degrees, the coat's peak moves to the mirror direction about the
+    /// tilted normal, and the base's value at its own mirror direction is unchanged but for
+    /// the coat's Fresnel weight, now taken at the tilted normal.
+    #[test]
+    fn coat_normal_tilts_the_coat_highlight_only() {
+        let flat = GltfPbr {
+            base_color: Vec3::splat(0.5),
+            metallic: 1.0,
+            roughness: 0.4,
+            clearcoat: 1.0,
+            clearcoat_roughness: 0.05,
+            ..GltfPbr::default()
+        };
+        let tilt = 10f32.to_radians();
+        let tilted = tilted_coat(flat, tilt);
+        let wo = Vec3::new(30f32.to_radians().sin(), 0.0, 30f32.to_radians().cos());
+        let mirror = |n: Vec3| 2.0 * wo.dot(n) * n - wo;
+        let (r_base, r_coat) = (mirror(Vec3::Z), mirror(tilted.coat_normal));
+        let glossy = |g: GltfPbr, wi: Vec3| Bsdf::GltfPbr(g).eval_lobes(wo, wi).glossy.x;
+        let base_only = |g: GltfPbr, wi: Vec3| {
+            Bsdf::GltfPbr(GltfPbr {
+                clearcoat: 0.0,
+                ..g
+            })
+            .eval_lobes(wo, wi)
+            .glossy
+            .x
+        };
+        // The coat's narrow peak: at r_coat when tilted, at r_base when flat.
+        assert!(glossy(tilted, r_coat) > 20.0 * glossy(flat, r_coat));
+        assert!(
+            glossy(flat, r_base) > 20.0 * glossy(tilted, r_base) - 20.0 * base_only(flat, r_base)
+        );
+        // At r_base the tilted material is the base alone, weighed by 1 - Fc(nc.wo).
+        let fc = |cos: f32| 0.04 + 0.96 * (1.0 - cos).powi(5);
+        let want = base_only(flat, r_base) * (1.0 - fc(wo.dot(tilted.coat_normal)));
+        let got = glossy(tilted, r_base);
+        assert!((got - want).abs() < 1e-3 * want, "{got} vs {want}");
+        // The coat's value at its peak is the flat coat's for the same directions in the
+        // coat's frame (20 degrees), times nc.wi / n.wi.
+        let coat = |g: GltfPbr, wo: Vec3, wi: Vec3| {
+            let all = Bsdf::GltfPbr(g).eval_lobes(wo, wi).glossy.x;
+            let base = Bsdf::GltfPbr(GltfPbr {
+                clearcoat: 0.0,
+                ..g
+            })
+            .eval_lobes(wo, wi)
+            .glossy
+            .x;
+            all - base * (1.0 - fc(wo.dot(g.coat_normal)))
+        };
+        let wo_c = Vec3::new(20f32.to_radians().sin(), 0.0, 20f32.to_radians().cos());
+        let ratio = r_coat.dot(tilted.coat_normal) / r_coat.z;
+        let c_tilted = coat(tilted, wo, r_coat);
+        let c_flat = coat(flat, wo_c, Vec3::new(-wo_c.x, 0.0, wo_c.z)) * ratio;
+        assert!(
+            (c_tilted - c_flat).abs() < 2e-3 * c_flat,
+            "{c_tilted} vs {c_flat}"
+        );
+        // Flat: exactly the untilted material.
+        assert_eq!(tilted_coat(flat, 0.0), flat);
+    }
+
     /// GGX's `D` and the height-correlated `V` as appendix B writes them.
     fn spec_d_v(alpha: f64, n_h: f64, n_l: f64, n_v: f64) -> f64 {
         let a2 = alpha * alpha;
@@ -614,18 +923,43 @@ mod tests {
         let w = (1.0 - v_h).powi(5);
         let ior = g.ior as f64;
         let ior_f0 = ((1.0 - ior) / (1.0 + ior)).powi(2);
+        // KHR_materials_iridescence: each Fresnel term mixed with the thin film's.
+        let k = if g.iridescence_thickness > 0.0 {
+            g.iridescence as f64
+        } else {
+            0.0
+        };
+        let film = |f0: [f64; 3]| {
+            let (ior, d) = (g.iridescence_ior as f64, g.iridescence_thickness as f64);
+            super::super::iridescence::tests::reference(v_h, ior, d, f0)
+        };
+        let f0_d: [f64; 3] =
+            std::array::from_fn(|c| (ior_f0 * g.specular_color[c] as f64).min(1.0));
+        let film_d = film(f0_d);
+        let film_m = film(g.base_color.to_array().map(f64::from));
         let fr: [f64; 3] = std::array::from_fn(|c| {
-            let f0 = (ior_f0 * g.specular_color[c] as f64).min(1.0);
-            f0 + (1.0 - f0) * w
+            let f0 = f0_d[c];
+            let schlick = f0 + (1.0 - f0) * w;
+            schlick + (film_d[c] - schlick) * k
         });
         let fr_max = fr[0].max(fr[1]).max(fr[2]);
         let (weight, metallic) = (g.specular as f64, g.metallic as f64);
         let coat = g.clearcoat as f64 * (0.04 + 0.96 * (1.0 - v[2].abs()).powi(5));
+        // KHR_materials_sheen's albedo scaling (E from the table; the variants' roughnesses
+        // are where E <= 1, so the lobe is not renormalised).
+        let sheen_max = g.sheen_color.max_element() as f64;
+        let e = |cos: f64| super::super::sheen::albedo(cos as f32, g.sheen_roughness) as f64;
+        let scaling = 1.0 - sheen_max * e(v[2]).max(e(l[2]));
+        let sheen_brdf = super::super::sheen::integration::lobe(g.sheen_roughness as f64, v, l);
         std::array::from_fn(|c| {
             let base = g.base_color[c] as f64;
             let dielectric = (1.0 - weight * fr_max) * base / PI64 + weight * fr[c] * specular_brdf;
-            let metal = (base + (1.0 - base) * w) * specular_brdf;
-            let material = (1.0 - metallic) * dielectric + metallic * metal;
+            let metal_f = base + (1.0 - base) * w;
+            let metal = (metal_f + (film_m[c] - metal_f) * k) * specular_brdf;
+            let mut material = (1.0 - metallic) * dielectric + metallic * metal;
+            if sheen_max > 0.0 {
+                material = g.sheen_color[c] as f64 * sheen_brdf + material * scaling;
+            }
             (1.0 - coat) * material + coat * coat_brdf
         })
     }
@@ -717,6 +1051,49 @@ mod tests {
             let (u, u2) = (rng.next_f32(), rng.next_2d());
             assert_eq!(road.sample(wo, u, u2), lambert.sample(wo, u, u2));
         }
+    }
+
+    /// A white sheen over a white Lambertian base (specular 0) or a white metal reflects at
+    /// most what it receives, at low roughness (where the extension's lobe alone gains
+    /// energy at grazing angles and is renormalised) as at high; and a sheen over black
+    /// reflects about `sheen_color E` (the table) at normal incidence.
+    #[test]
+    fn white_furnace_sheen() {
+        for sheen_roughness in [0.05f32, 0.15, 0.3, 0.6, 1.0] {
+            for theta in [0.0f32, 60.0, 80.0, 88.0] {
+                let wo = Vec3::new(theta.to_radians().sin(), 0.0, theta.to_radians().cos());
+                for base in [
+                    GltfPbr {
+                        specular: 0.0,
+                        ..pbr(Vec3::ONE, 0.0, 0.5)
+                    },
+                    pbr(Vec3::ONE, 1.0, 0.3),
+                ] {
+                    let g = GltfPbr {
+                        sheen_color: Vec3::ONE,
+                        sheen_roughness,
+                        ..base
+                    };
+                    let (a, err) = mc_albedo(&Bsdf::GltfPbr(g), wo, 100_000, 26);
+                    assert!(
+                        a <= 1.0 + 3.0 * err + 2e-3,
+                        "{g:?} theta {theta}: albedo {a} +- {err}"
+                    );
+                }
+            }
+        }
+        let black = GltfPbr {
+            specular: 0.0,
+            sheen_color: Vec3::splat(0.8),
+            sheen_roughness: 0.7,
+            ..pbr(Vec3::ZERO, 0.0, 0.5)
+        };
+        let (a, err) = mc_albedo(&Bsdf::GltfPbr(black), Vec3::Z, 200_000, 27);
+        let want = 0.8 * super::super::sheen::albedo(1.0, 0.7) as f64;
+        assert!(
+            (a - want).abs() < 4.0 * err + 2e-3,
+            "{a} +- {err} vs {want}"
+        );
     }
 
     #[test]

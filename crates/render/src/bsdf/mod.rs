@@ -18,7 +18,9 @@
 //! KHR_materials_clearcoat coat, which counts as glossy (in [`LobeValues::glossy`] and
 //! [`Lobe::Glossy`]): its glossy lobe is the base's microfacet lobe and the coat's, sampled as
 //! a mixture (see [`GltfPbr`]). A coated [`GltfPbr`] is not reciprocal: the extension takes
-//! the coat's Fresnel at `n.wo`.
+//! the coat's Fresnel at `n.wo`. Its KHR_materials_sheen layer counts as diffuse (in
+//! [`LobeValues::diffuse`] and [`Lobe::Diffuse`]): a broad lobe, sampled cosine-weighted
+//! with the Lambertian one (see `sheen.rs`).
 //!
 //! Sampling: every model with both lobes picks the glossy lobe with a probability that depends
 //! only on `wo`: proportional to an estimate of the two lobes' directional albedos for this `wo`
@@ -49,7 +51,10 @@
 //!   the paper's [`Ggx`];
 //! - `ward.rs`: [`Ward`]; `blinn_phong.rs`: [`BlinnPhong`]; `metallic_roughness.rs`: glTF's
 //!   metallic-roughness model [`GltfPbr`], with its extensions and its transmission; `dielectric.rs`: refraction and the GGX microfacet transmission (Walter
-//!   et al. 2007) it uses for a volume's boundary;
+//!   et al. 2007) it uses for a volume's boundary; `sheen.rs`: KHR_materials_sheen's lobe
+//!   (Charlie distribution, fitted visibility, directional albedo) that [`GltfPbr`] layers
+//!   over its base, with its albedo table in `sheen_table.rs`; `iridescence.rs`:
+//!   KHR_materials_iridescence's thin-film Fresnel term;
 //! - `luminance.rs`: [`LuminanceEval`], the light choice's `luminance(f(wo, wi))`: the
 //!   luminances of a model's reflectances and its `Model::AtWo`, taken once per `wo`, and
 //!   its lobes.
@@ -67,9 +72,12 @@ mod blinn_phong;
 mod dielectric;
 mod diffuse;
 mod ggx;
+mod iridescence;
 mod luminance;
 mod metallic_roughness;
 pub(crate) mod numbers;
+mod sheen;
+mod sheen_table;
 mod ward;
 
 pub use blinn_phong::BlinnPhong;
@@ -88,7 +96,7 @@ use std::f32::consts::TAU;
 /// Which part of a model produced a sampled or evaluated contribution.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Lobe {
-    /// The Lambertian part (`kd / pi`).
+    /// The Lambertian part (`kd / pi`), with a glTF material's sheen (sampled with it).
     Diffuse,
     /// The glossy (microfacet or Phong-like) part; streaks come from it.
     Glossy,
@@ -99,7 +107,7 @@ pub enum Lobe {
 /// BRDF values split by lobe, so the integrator can attribute glossy light to the specular layer.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct LobeValues {
-    /// Diffuse part of `f(wo, wi)`.
+    /// Diffuse part of `f(wo, wi)` (a glTF material's sheen included).
     pub diffuse: Vec3,
     /// Glossy part of `f(wo, wi)`.
     pub glossy: Vec3,
@@ -170,23 +178,26 @@ pub const MIN_ALPHA: f32 = 1e-4;
 // ---------------------------------------------------------------------------------------------
 // What a model provides
 
-/// A model's two reflectances, the colours its lobes scale: the diffuse lobe's and the glossy
+/// A model's reflectances, the colours its lobes scale: the diffuse lobe's and the glossy
 /// lobe's (`kd` and `ks` for the paper models; `c_diff` and the glossy colour at normal
-/// incidence for glTF), as RGB
-/// or as luminances. [`LuminanceEval`] takes their luminances once per `wo`.
+/// incidence for glTF), and a glTF material's sheen colour (KHR_materials_sheen; black for
+/// every other model), as RGB or as luminances. [`LuminanceEval`] takes their luminances once
+/// per `wo`.
 #[derive(Clone, Copy, Debug)]
 struct Reflectances<S> {
     diffuse: S,
     glossy: S,
+    sheen: S,
 }
 
 impl<S> Reflectances<S> {
-    /// Both reflectances through `f`.
+    /// Every reflectance through `f`.
     #[inline(always)]
     fn map<T>(self, f: impl Fn(S) -> T) -> Reflectances<T> {
         Reflectances {
             diffuse: f(self.diffuse),
             glossy: f(self.glossy),
+            sheen: f(self.sheen),
         }
     }
 }
@@ -518,6 +529,20 @@ impl Bsdf {
         }
     }
 
+    /// The BSDF with a [`GltfPbr`]'s clear coat shaded about `n` (unit, in the local shading
+    /// frame; see [`GltfPbr::coat_normal`]); every other BSDF, and one without a coat, is
+    /// unchanged.
+    #[inline]
+    pub fn with_coat_normal(self, n: Vec3) -> Self {
+        match self {
+            Bsdf::GltfPbr(m) if m.clearcoat > 0.0 => Bsdf::GltfPbr(GltfPbr {
+                coat_normal: n.normalize_or(Vec3::Z),
+                ..m
+            }),
+            b => b,
+        }
+    }
+
     /// The BSDF seen from the back face of its surface (`wo` on the side opposite the
     /// geometric normal of the triangle's winding): a [`GltfPbr`] bounding a volume
     /// (KHR_materials_volume) then refracts from inside (relative index `1 / ior`); every
@@ -550,21 +575,27 @@ mod tests {
     pub(super) const GLTF_ROUGHNESS: [f32; 3] = [0.15, 0.5, 1.0];
     pub(super) const GLTF_ANGLES: [f32; 4] = [0.0, 45.0, 85.0, 88.0];
     pub(super) const GLTF_VARIANT_ANGLES: [f32; 4] = [0.0, 60.0, 85.0, 88.0];
-    const GLTF_VARIANTS: usize = 5;
+    const GLTF_VARIANTS: usize = 8;
     /// Every chi-square test in the module, for the Sidak correction.
     const NUM_TESTS: usize = 2 * ALPHAS.len() * (ANGLES.len() + MIXED_ANGLES.len())
         + SHININESS.len() * (ANGLES.len() + MIXED_ANGLES.len())
         + 2 * GLTF_ROUGHNESS.len() * GLTF_ANGLES.len()
         + GLTF_VARIANTS * GLTF_VARIANT_ANGLES.len()
         + 2
-        + ROUGHENED_MODELS * ROUGHENED_ANGLES.len();
+        + ROUGHENED_MODELS * ROUGHENED_ANGLES.len()
+        + COAT_NORMALS * COAT_NORMAL_ANGLES.len();
+    /// The tilted coat normals' chi-square tests: materials and angles.
+    pub(super) const COAT_NORMALS: usize = 2;
+    pub(super) const COAT_NORMAL_ANGLES: [f32; 3] = [0.0, 50.0, 80.0];
     /// The roughened lobes' chi-square tests: models and angles.
     const ROUGHENED_MODELS: usize = 5;
     const ROUGHENED_ANGLES: [f32; 2] = [30.0, 80.0];
 
     /// glTF materials with the extensions' parameters: KHR_materials_specular with a coloured
-    /// F0 and KHR_materials_ior (1.33, and 0 as the specular-glossiness conversion uses), and
-    /// KHR_materials_clearcoat over a dark dielectric, a metal and a pure diffuse base.
+    /// F0 and KHR_materials_ior (1.33, and 0 as the specular-glossiness conversion uses),
+    /// KHR_materials_clearcoat over a dark dielectric, a metal and a pure diffuse base, and
+    /// KHR_materials_sheen over a dark dielectric (velvet), KHR_materials_iridescence over a
+    /// dielectric, and both under a coat over a metal.
     pub(super) fn gltf_variants() -> [GltfPbr; GLTF_VARIANTS] {
         let base = GltfPbr {
             base_color: Vec3::new(0.8, 0.5, 0.2),
@@ -604,6 +635,32 @@ mod tests {
                 specular: 0.0,
                 clearcoat: 1.0,
                 clearcoat_roughness: 0.05,
+                ..base
+            },
+            GltfPbr {
+                base_color: Vec3::new(0.075, 0.06, 0.04),
+                roughness: 0.7,
+                sheen_color: Vec3::new(0.9, 0.7, 0.6),
+                sheen_roughness: 0.6,
+                ..base
+            },
+            GltfPbr {
+                roughness: 0.25,
+                iridescence: 0.8,
+                iridescence_ior: 1.3,
+                iridescence_thickness: 350.0,
+                ..base
+            },
+            GltfPbr {
+                metallic: 1.0,
+                roughness: 0.3,
+                iridescence: 1.0,
+                iridescence_ior: 1.8,
+                iridescence_thickness: 250.0,
+                sheen_color: Vec3::new(0.2, 0.4, 1.0),
+                sheen_roughness: 0.35,
+                clearcoat: 0.5,
+                clearcoat_roughness: 0.2,
                 ..base
             },
         ]

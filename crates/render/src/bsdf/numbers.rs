@@ -47,6 +47,8 @@ pub(crate) trait Lanes:
     fn saturate(self) -> Self;
     /// `self` where `z > 0`, else 0.
     fn where_positive(self, z: Self) -> Self;
+    /// `f` of each lane (a table lookup, say), one lane at a time.
+    fn lanewise(self, f: impl Fn(f32) -> f32) -> Self;
 }
 
 impl Lanes for f32 {
@@ -86,6 +88,10 @@ impl Lanes for f32 {
             0.0
         }
     }
+    #[inline(always)]
+    fn lanewise(self, f: impl Fn(f32) -> f32) -> Self {
+        f(self)
+    }
 }
 
 impl Lanes for Vec4 {
@@ -120,6 +126,10 @@ impl Lanes for Vec4 {
     #[inline(always)]
     fn where_positive(self, z: Self) -> Self {
         Vec4::select(z.cmpgt(Vec4::ZERO), self, Vec4::ZERO)
+    }
+    #[inline(always)]
+    fn lanewise(self, f: impl Fn(f32) -> f32) -> Self {
+        Vec4::from_array(self.to_array().map(f))
     }
 }
 
@@ -224,6 +234,10 @@ impl<const N: usize> Lanes for Wide<N> {
     #[inline(always)]
     fn where_positive(self, z: Self) -> Self {
         self.zip(z, |x, z| if z > 0.0 { x } else { 0.0 })
+    }
+    #[inline(always)]
+    fn lanewise(self, f: impl Fn(f32) -> f32) -> Self {
+        self.map(f)
     }
 }
 
@@ -404,6 +418,9 @@ pub(crate) trait Spectrum<L: Lanes>:
     fn one_minus(self) -> Self;
     /// The grey reflectance `x` in every channel (whose luminance is `x`).
     fn grey(x: L) -> Self;
+    /// The reflectance `f(x)` of each lane's `x`, `f` giving linear RGB (its luminance for
+    /// luminance lanes), one lane at a time.
+    fn from_rgb(x: L, f: impl Fn(f32) -> Vec3) -> Self;
 }
 
 impl Spectrum<f32> for Vec3 {
@@ -415,6 +432,10 @@ impl Spectrum<f32> for Vec3 {
     fn grey(x: f32) -> Self {
         Vec3::splat(x)
     }
+    #[inline(always)]
+    fn from_rgb(x: f32, f: impl Fn(f32) -> Vec3) -> Self {
+        f(x)
+    }
 }
 
 impl<L: Lanes> Spectrum<L> for L {
@@ -425,5 +446,9 @@ impl<L: Lanes> Spectrum<L> for L {
     #[inline(always)]
     fn grey(x: L) -> Self {
         x
+    }
+    #[inline(always)]
+    fn from_rgb(x: L, f: impl Fn(f32) -> Vec3) -> Self {
+        x.lanewise(|c| streaks_image::luminance(f(c)))
     }
 }

@@ -59,6 +59,7 @@ impl Model for Ward {
         Reflectances {
             diffuse: self.kd,
             glossy: self.ks,
+            sheen: Vec3::ZERO,
         }
     }
 

@@ -660,6 +660,7 @@ mod tests {
                     ng: -Vec3::Z,
                     ns: -Vec3::Z,
                     mapped: None,
+                    coat_normal: None,
                     attributes: VertexAttributes::from_uv(Vec2::ZERO),
                     triangle: 0,
                     material: 0,

@@ -47,10 +47,18 @@
 //! - Materials: glTF metallic-roughness ([`crate::bsdf::GltfPbr`]: the specification's
 //!   appendix B with the height-correlated Smith visibility), with KHR_materials_specular
 //!   (specularFactor and specularTexture's alpha, specularColorFactor and the sRGB
-//!   specularColorTexture), KHR_materials_ior (ior, 1.5 by default, 0 or at least 1) and
+//!   specularColorTexture), KHR_materials_ior (ior, 1.5 by default, 0 or at least 1),
+//!   KHR_materials_sheen (sheenColorFactor and the sRGB sheenColorTexture's RGB,
+//!   sheenRoughnessFactor and sheenRoughnessTexture's alpha: the Charlie sheen lobe over the
+//!   base by the extension's albedo scaling, see `bsdf/sheen.rs`), KHR_materials_iridescence
+//!   (iridescenceFactor and iridescenceTexture's red channel, iridescenceIor, the thickness
+//!   range blended by iridescenceThicknessTexture's green channel: the thin-film Fresnel of
+//!   `bsdf/iridescence.rs`) and
 //!   KHR_materials_clearcoat (clearcoatFactor and clearcoatTexture's red channel,
-//!   clearcoatRoughnessFactor and clearcoatRoughnessTexture's green channel; a
-//!   clearcoatNormalTexture is a warning, the coat uses the base's normal), with those
+//!   clearcoatRoughnessFactor and clearcoatRoughnessTexture's green channel, and
+//!   clearcoatNormalTexture, the coat's own normal map in the base's tangent space; without
+//!   it the coat is shaded with the interpolated normal, not the base's mapped one, as the
+//!   extension says: [`crate::geometry::SurfaceHit::coat_normal`]), with those
 //!   extensions' formulas; values outside the schemas' ranges are errors naming the material.
 //!   KHR_materials_transmission (transmissionFactor and transmissionTexture's red channel)
 //!   makes that share of the dielectric's diffuse part a specular transmission tinted by the
@@ -61,8 +69,9 @@
 //!   thicknessFactor above 0 the mesh bounds a volume: it refracts by its ior entering
 //!   through the front faces and leaving through the back faces, and absorbs inside by
 //!   Beer-Lambert's law from attenuationColor and attenuationDistance over the distance the
-//!   path travels inside ([`crate::material::Volume`]); a thicknessTexture is a warning (the
-//!   travelled distance replaces it).
+//!   path travels inside ([`crate::material::Volume`]). A thicknessTexture is validated
+//!   and not used: the extension says ray tracers should ignore it and use the traced
+//!   distance, as the path tracer does.
 //!   A specularFactor of 0 (Blender's Specular IOR Level 0) is exactly Lambertian. Unless
 //!   `extras.streaks` chooses one of the paper's models: `{"bsdf": "ggx" | "ward" | "blinn_phong", "kd": [r,g,b], "ks": [r,g,b],
 //!   "alpha": a, "shininess": s}` (`alpha` for ggx and ward, `shininess` for blinn_phong;
@@ -182,7 +191,7 @@ use crate::camera::Camera;
 use crate::geometry::{Ray, SurfaceHit};
 use crate::light::{Environment, Light, LightSampler, SurfaceMesh};
 use crate::material::Material;
-use crate::normal_map::{self, MappedNormal};
+use crate::normal_map::{self, MappedNormal, NormalMap};
 use crate::sampling::{pcg_hash, u32_to_unit_f32};
 use crate::texture::Texture;
 use glam::{Vec2, Vec3, Vec4};
@@ -581,31 +590,42 @@ impl Scene {
         tangent: impl FnOnce() -> Vec4,
     ) -> SurfaceHit {
         let ng = s.ng;
-        let (ns, mapped) = match self.materials[s.material as usize].normal_map {
-            Some(map) => {
-                let tangent = tangent();
-                if tangent.truncate() == Vec3::ZERO {
-                    (s.ns, None)
-                } else {
-                    let n = map.perturb(s.ns, tangent, s.attributes.uv, &self.textures);
-                    // On the viewer's side of the surface, as the integrator shades it.
-                    let wo = -ray.direction;
-                    let side = if ng.dot(wo) < 0.0 { -1.0 } else { 1.0 };
-                    let valid = normal_map::valid_reflection_normal(ng * side, wo, n * side) * side;
-                    let mapped = MappedNormal {
-                        smooth: s.ns,
-                        mapped: n,
-                    };
-                    (valid, Some(mapped))
-                }
+        let material = &self.materials[s.material as usize];
+        let tangent = material.tangent_space_map().map(|_| tangent());
+        let tangent = tangent.filter(|t| t.truncate() != Vec3::ZERO);
+        // A mapped normal made valid on the viewer's side of the surface, as the integrator
+        // shades it.
+        let wo = -ray.direction;
+        let side = if ng.dot(wo) < 0.0 { -1.0 } else { 1.0 };
+        let mapped_normal = |map: NormalMap, tangent: Vec4| {
+            let n = map.perturb(s.ns, tangent, s.attributes.uv, &self.textures);
+            let valid = normal_map::valid_reflection_normal(ng * side, wo, n * side) * side;
+            (n, valid)
+        };
+        let (ns, mapped) = match (material.normal_map, tangent) {
+            (Some(map), Some(tangent)) => {
+                let (n, valid) = mapped_normal(map, tangent);
+                let mapped = MappedNormal {
+                    smooth: s.ns,
+                    mapped: n,
+                };
+                (valid, Some(mapped))
             }
             _ => (s.ns, None),
+        };
+        // The coat's own normal (KHR_materials_clearcoat): its map's, else the interpolated
+        // normal where the base's map changed the shading normal.
+        let coat_normal = match (material.coat_normal_map(), tangent) {
+            (Some(map), Some(tangent)) => Some(mapped_normal(map, tangent).1),
+            _ if mapped.is_some() && material.has_coat() => Some(s.ns),
+            _ => None,
         };
         SurfaceHit {
             t,
             p: s.p,
             ng,
             ns: if ns.dot(ng) < 0.0 { -ns } else { ns },
+            coat_normal: coat_normal.map(|n| if n.dot(ng) < 0.0 { -n } else { n }),
             // Both turned by the smooth normal's side (the mapped one may point below).
             mapped: mapped.map(|m| {
                 let side = if m.smooth.dot(ng) < 0.0 { -1.0 } else { 1.0 };

@@ -366,14 +366,14 @@ mod tests {
         assert!(err.to_string().contains("KHR_texture_basisu"), "{err}");
         // Used but not required: a warning naming the material, and the scene loads.
         let (mut doc, bin) = test_doc();
-        doc["extensionsUsed"] = json!(["KHR_lights_punctual", "KHR_materials_sheen"]);
+        doc["extensionsUsed"] = json!(["KHR_lights_punctual", "KHR_materials_anisotropy"]);
         doc["materials"][0]["extensions"] =
-            json!({"KHR_materials_sheen": {"sheenColorFactor": [1, 1, 1]}});
+            json!({"KHR_materials_anisotropy": {"anisotropyStrength": 1}});
         let scene = Scene::load(&write_embedded(dir.path(), doc, &bin)).unwrap();
         assert!(
             scene.warnings.iter().any(|w| w.contains(
-                "KHR_materials_sheen on 1 material: rendered without sheen \
-                                     (material \"asphalt\" (0))"
+                "KHR_materials_anisotropy on 1 material: rendered as an isotropic surface \
+                 (material \"asphalt\" (0))"
             )),
             "{:?}",
             scene.warnings

@@ -30,6 +30,8 @@ pub const HONOURED: &[&str] = &[
     "KHR_draco_mesh_compression",
     "KHR_materials_specular",
     "KHR_materials_ior",
+    "KHR_materials_sheen",
+    "KHR_materials_iridescence",
     "KHR_materials_clearcoat",
     "KHR_texture_transform",
     "KHR_materials_transmission",
@@ -41,8 +43,6 @@ pub const HONOURED: &[&str] = &[
 /// How an element that uses `extension` is rendered when the extension is not honoured.
 fn without(extension: &str) -> &'static str {
     match extension {
-        "KHR_materials_sheen" => "rendered without sheen",
-        "KHR_materials_iridescence" => "rendered without iridescence",
         "KHR_materials_anisotropy" => "rendered as an isotropic surface",
         "KHR_materials_dispersion" => "rendered without dispersion",
         "KHR_materials_pbrSpecularGlossiness" => {
@@ -154,8 +154,6 @@ fn names<'a>(json: &'a Value, key: &str) -> impl Iterator<Item = &'a str> {
 /// to see the model (docs/decisions/0025 has the reasons). Extensions that geometry or images
 /// need are not here: without them there is nothing right to show.
 pub const RENDERED_WITHOUT: &[&str] = &[
-    "KHR_materials_sheen",
-    "KHR_materials_iridescence",
     "KHR_materials_anisotropy",
     "KHR_materials_dispersion",
     "KHR_materials_diffuse_transmission",
@@ -394,15 +392,15 @@ mod tests {
     #[test]
     fn used_and_unsupported_warns_once_counting_the_users() {
         let doc = json!({
-            "extensionsUsed": ["KHR_materials_iridescence", "KHR_materials_sheen",
+            "extensionsUsed": ["KHR_materials_dispersion", "KHR_materials_anisotropy",
                                "KHR_materials_emissive_strength", "EXT_unknown"],
             "materials": [
-                {"name": "glass", "extensions": {"KHR_materials_iridescence": {"iridescenceFactor": 1}}},
-                {"name": "road", "extensions": {"KHR_materials_sheen": {"sheenColorFactor": [1, 1, 1]}}},
+                {"name": "glass", "extensions": {"KHR_materials_dispersion": {"dispersion": 1}}},
+                {"name": "road", "extensions": {"KHR_materials_anisotropy": {"anisotropyStrength": 1}}},
                 {"extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 5}}},
-                {"extensions": {"KHR_materials_iridescence": {}}},
-                {"extensions": {"KHR_materials_iridescence": {}}},
-                {"extensions": {"KHR_materials_iridescence": {}}}
+                {"extensions": {"KHR_materials_dispersion": {}}},
+                {"extensions": {"KHR_materials_dispersion": {}}},
+                {"extensions": {"KHR_materials_dispersion": {}}}
             ]
         });
         let w = lines("street.gltf", &doc).unwrap();
@@ -410,10 +408,10 @@ mod tests {
             w,
             [
                 "street.gltf: EXT_unknown is listed in extensionsUsed but nothing uses it",
-                "street.gltf: KHR_materials_iridescence on 4 materials: rendered without \
-                 iridescence (material \"glass\" (0); material 3; material 4 and 1 more)",
-                "street.gltf: KHR_materials_sheen on 1 material: rendered without sheen \
-                 (material \"road\" (1))",
+                "street.gltf: KHR_materials_dispersion on 4 materials: rendered without \
+                 dispersion (material \"glass\" (0); material 3; material 4 and 1 more)",
+                "street.gltf: KHR_materials_anisotropy on 1 material: rendered as an \
+                 isotropic surface (material \"road\" (1))",
             ]
         );
     }
@@ -424,10 +422,10 @@ mod tests {
     fn required_shading_extensions_are_warnings() {
         let doc = json!({
             "extensionsUsed": ["KHR_materials_dispersion"],
-            "extensionsRequired": ["KHR_materials_iridescence"],
+            "extensionsRequired": ["KHR_materials_anisotropy"],
             "materials": [
-                {"extensions": {"KHR_materials_iridescence": {}}},
-                {"extensions": {"KHR_materials_iridescence": {}}}
+                {"extensions": {"KHR_materials_anisotropy": {}}},
+                {"extensions": {"KHR_materials_anisotropy": {}}}
             ]
         });
         let w = lines("s.gltf", &doc).unwrap();
@@ -435,8 +433,8 @@ mod tests {
         assert!(w[0].contains("KHR_materials_dispersion is listed"), "{w:?}");
         assert!(
             w[1].starts_with(
-                "s.gltf: KHR_materials_iridescence (required by the file, which is loaded \
-                 without it) on 2 materials: rendered without iridescence"
+                "s.gltf: KHR_materials_anisotropy (required by the file, which is loaded \
+                 without it) on 2 materials: rendered as an isotropic surface"
             ),
             "{w:?}"
         );

@@ -1,5 +1,5 @@
-//! Materials: glTF metallic-roughness with KHR_materials_specular, _ior, _clearcoat,
-//! _transmission and _volume, the paper's models and the road flag from `extras.streaks`, and
+//! Materials: glTF metallic-roughness with KHR_materials_specular, _ior, _sheen,
+//! _iridescence, _clearcoat, _transmission and _volume, the paper's models and the road flag from `extras.streaks`, and
 //! the glTF default material.
 
 use super::textures::{JsonTextureInfo, UvTransform};
@@ -67,11 +67,91 @@ pub(super) struct Clearcoat {
     #[serde(default)]
     clearcoat_roughness_factor: f32,
     clearcoat_roughness_texture: Option<JsonTextureInfo>,
-    clearcoat_normal_texture: Option<serde_json::Value>,
+    clearcoat_normal_texture: Option<JsonNormalTextureInfo>,
     #[serde(skip)]
     texture: Option<TextureRef>,
     #[serde(skip)]
     roughness_texture: Option<TextureRef>,
+    #[serde(skip)]
+    normal_map: Option<NormalMap>,
+}
+
+/// A normalTextureInfo read from the JSON (KHR_materials_clearcoat's clearcoatNormalTexture):
+/// a textureInfo with a `scale`.
+#[derive(Clone, Copy, Debug, Deserialize)]
+pub(super) struct JsonNormalTextureInfo {
+    #[serde(flatten)]
+    info: JsonTextureInfo,
+    #[serde(default = "one")]
+    scale: f32,
+}
+
+/// normalTextureInfo's default scale.
+fn one() -> f32 {
+    1.0
+}
+
+/// A material's KHR_materials_sheen object, as the JSON has it, and its decoded textures.
+#[derive(Debug, Default, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub(super) struct Sheen {
+    #[serde(default)]
+    sheen_color_factor: [f32; 3],
+    sheen_color_texture: Option<JsonTextureInfo>,
+    #[serde(default)]
+    sheen_roughness_factor: f32,
+    sheen_roughness_texture: Option<JsonTextureInfo>,
+    #[serde(skip)]
+    color_texture: Option<TextureRef>,
+    #[serde(skip)]
+    roughness_texture: Option<TextureRef>,
+}
+
+/// A material's KHR_materials_iridescence object, as the JSON has it, and its decoded
+/// textures.
+#[derive(Debug, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub(super) struct Iridescence {
+    #[serde(default)]
+    iridescence_factor: f32,
+    iridescence_texture: Option<JsonTextureInfo>,
+    #[serde(default = "film_ior")]
+    iridescence_ior: f32,
+    #[serde(default = "film_min")]
+    iridescence_thickness_minimum: f32,
+    #[serde(default = "film_max")]
+    iridescence_thickness_maximum: f32,
+    iridescence_thickness_texture: Option<JsonTextureInfo>,
+    #[serde(skip)]
+    texture: Option<TextureRef>,
+    #[serde(skip)]
+    thickness_texture: Option<TextureRef>,
+}
+
+/// KHR_materials_iridescence's defaults: the film's index, its thickness range in nm.
+fn film_ior() -> f32 {
+    1.3
+}
+fn film_min() -> f32 {
+    100.0
+}
+fn film_max() -> f32 {
+    400.0
+}
+
+impl Default for Iridescence {
+    fn default() -> Self {
+        Iridescence {
+            iridescence_factor: 0.0,
+            iridescence_texture: None,
+            iridescence_ior: film_ior(),
+            iridescence_thickness_minimum: film_min(),
+            iridescence_thickness_maximum: film_max(),
+            iridescence_thickness_texture: None,
+            texture: None,
+            thickness_texture: None,
+        }
+    }
 }
 
 /// A material's KHR_materials_transmission object, as the JSON has it, and its decoded texture.
@@ -91,7 +171,7 @@ pub(super) struct Transmission {
 pub(super) struct JsonVolume {
     #[serde(default)]
     thickness_factor: f32,
-    thickness_texture: Option<serde_json::Value>,
+    thickness_texture: Option<JsonTextureInfo>,
     #[serde(default = "infinite")]
     attenuation_distance: f32,
     #[serde(default = "white")]
@@ -221,9 +301,11 @@ impl Loader<'_> {
             Some(x) => self.paper(x, base_color_texture, mr_texture, &element)?,
             None => {
                 let specular = self.specular(m, &element)?;
+                let sheen = self.sheen(m, document, &element)?;
+                let film = self.iridescence(m, document, &element)?;
                 let clearcoat = self.clearcoat(m, document, &element)?;
                 let transmission = self.transmission(m, document, &element)?;
-                let volume = self.volume(m, &element)?;
+                let volume = self.volume(m, document, &element)?;
                 Reflectance::GltfPbr(GltfPbrParams {
                     base_color: base.truncate(),
                     base_color_texture,
@@ -235,10 +317,23 @@ impl Loader<'_> {
                     specular_color: specular.color,
                     specular_color_texture: specular.color_texture,
                     ior: specular.ior,
+                    sheen_color: Vec3::from(sheen.sheen_color_factor),
+                    sheen_color_texture: sheen.color_texture,
+                    sheen_roughness: sheen.sheen_roughness_factor,
+                    sheen_roughness_texture: sheen.roughness_texture,
+                    iridescence: film.iridescence_factor,
+                    iridescence_texture: film.texture,
+                    iridescence_ior: film.iridescence_ior,
+                    iridescence_thickness: [
+                        film.iridescence_thickness_minimum,
+                        film.iridescence_thickness_maximum,
+                    ],
+                    iridescence_thickness_texture: film.thickness_texture,
                     clearcoat: clearcoat.clearcoat_factor,
                     clearcoat_texture: clearcoat.texture,
                     clearcoat_roughness: clearcoat.clearcoat_roughness_factor,
                     clearcoat_roughness_texture: clearcoat.roughness_texture,
+                    clearcoat_normal_map: clearcoat.normal_map,
                     transmission: transmission.transmission_factor,
                     transmission_texture: transmission.texture,
                     volume,
@@ -310,8 +405,8 @@ impl Loader<'_> {
     }
 
     /// KHR_materials_clearcoat of a glTF material (no coat where absent), read from the JSON
-    /// (the gltf crate does not know the extension); its textures are decoded, and a
-    /// clearcoatNormalTexture is a warning, as the coat is shaded with the base's normal.
+    /// (the gltf crate does not know the extension); its textures are decoded, the
+    /// clearcoatNormalTexture as the coat's own normal map.
     pub(super) fn clearcoat(
         &mut self,
         m: &gltf::Material,
@@ -325,14 +420,21 @@ impl Loader<'_> {
         self.unit_factor((NAME, "clearcoatFactor"), c.clearcoat_factor, element)?;
         let roughness = c.clearcoat_roughness_factor;
         self.unit_factor((NAME, "clearcoatRoughnessFactor"), roughness, element)?;
-        if c.clearcoat_normal_texture.is_some() {
-            let without = "the clear coat is shaded with the base's normal";
-            self.warn(
-                "KHR_materials_clearcoat clearcoatNormalTexture",
-                "material",
-                element,
-                without,
-            );
+        if let Some(n) = c.clearcoat_normal_texture {
+            if !n.scale.is_finite() {
+                let why = format!(
+                    "{NAME}: clearcoatNormalTexture.scale {} is invalid",
+                    n.scale
+                );
+                return Err(self.bad(element, why));
+            }
+            let key = (NAME, "clearcoatNormalTexture");
+            c.normal_map = self
+                .extension_texture(document, key, Some(n.info), element)?
+                .map(|texture| NormalMap {
+                    texture,
+                    scale: n.scale,
+                });
         }
         let (info, key) = (c.clearcoat_texture, (NAME, "clearcoatTexture"));
         c.texture = self.extension_texture(document, key, info, element)?;
@@ -342,6 +444,78 @@ impl Loader<'_> {
         );
         c.roughness_texture = self.extension_texture(document, key, info, element)?;
         Ok(c)
+    }
+
+    /// KHR_materials_sheen of a glTF material (none: black sheen, no layer), with its
+    /// textures (the colour sRGB, the roughness linear); a colour channel or the roughness
+    /// outside [0, 1] is an error.
+    pub(super) fn sheen(
+        &mut self,
+        m: &gltf::Material,
+        document: &gltf::Document,
+        element: &str,
+    ) -> Result<Sheen, SceneError> {
+        const NAME: &str = "KHR_materials_sheen";
+        let Some(mut sh) = self.material_extension::<Sheen>(m, NAME, element)? else {
+            return Ok(Sheen::default());
+        };
+        for c in sh.sheen_color_factor {
+            self.unit_factor((NAME, "sheenColorFactor"), c, element)?;
+        }
+        let roughness = sh.sheen_roughness_factor;
+        self.unit_factor((NAME, "sheenRoughnessFactor"), roughness, element)?;
+        let (info, key) = (sh.sheen_color_texture, (NAME, "sheenColorTexture"));
+        sh.color_texture =
+            self.extension_texture_in(document, key, info, ColorSpace::Srgb, element)?;
+        let (info, key) = (sh.sheen_roughness_texture, (NAME, "sheenRoughnessTexture"));
+        sh.roughness_texture = self.extension_texture(document, key, info, element)?;
+        Ok(sh)
+    }
+
+    /// KHR_materials_iridescence of a glTF material (none: iridescence 0), with its textures;
+    /// a factor outside [0, 1], an index below 1 or a negative or non-finite thickness is an
+    /// error.
+    pub(super) fn iridescence(
+        &mut self,
+        m: &gltf::Material,
+        document: &gltf::Document,
+        element: &str,
+    ) -> Result<Iridescence, SceneError> {
+        const NAME: &str = "KHR_materials_iridescence";
+        let Some(mut f) = self.material_extension::<Iridescence>(m, NAME, element)? else {
+            return Ok(Iridescence::default());
+        };
+        self.unit_factor((NAME, "iridescenceFactor"), f.iridescence_factor, element)?;
+        if !(f.iridescence_ior.is_finite() && f.iridescence_ior >= 1.0) {
+            let why = format!(
+                "{NAME}: iridescenceIor {} must be at least 1",
+                f.iridescence_ior
+            );
+            return Err(self.bad(element, why));
+        }
+        for (key, d) in [
+            (
+                "iridescenceThicknessMinimum",
+                f.iridescence_thickness_minimum,
+            ),
+            (
+                "iridescenceThicknessMaximum",
+                f.iridescence_thickness_maximum,
+            ),
+        ] {
+            if !(d.is_finite() && d >= 0.0) {
+                let why = format!("{NAME}: {key} {d} must be finite and not negative");
+                return Err(self.bad(element, why));
+            }
+        }
+        let (info, key) = (f.iridescence_texture, (NAME, "iridescenceTexture"));
+        f.texture = self.extension_texture(document, key, info, element)?;
+        let (info, key) = (
+            f.iridescence_thickness_texture,
+            (NAME, "iridescenceThicknessTexture"),
+        );
+        f.thickness_texture = self.extension_texture(document, key, info, element)?;
+        Ok(f)
     }
 
     /// KHR_materials_transmission of a glTF material (none: transmission 0), with its texture;
@@ -363,12 +537,15 @@ impl Loader<'_> {
     }
 
     /// KHR_materials_volume of a glTF material: `None` (thin-walled, as the extension says)
-    /// without it or with thicknessFactor 0; out-of-range values are errors, and a
-    /// thicknessTexture is a warning (the path tracer measures the distance travelled inside
-    /// instead of reading it).
+    /// without it or with thicknessFactor 0; out-of-range values are errors. A
+    /// thicknessTexture is validated (its index names a texture; the texture info and its
+    /// KHR_texture_transform are well formed and finite) and not used: the extension says
+    /// that ray tracers should ignore it and use the distance the ray travels inside, which
+    /// the path tracer measures.
     pub(super) fn volume(
         &mut self,
         m: &gltf::Material,
+        document: &gltf::Document,
         element: &str,
     ) -> Result<Option<Volume>, SceneError> {
         let Some(v) = self.material_extension::<JsonVolume>(m, "KHR_materials_volume", element)?
@@ -392,18 +569,19 @@ impl Loader<'_> {
             let why = format!("attenuationColor {colour} is not in [0, 1]");
             return Err(self.bad(element, reason(why)));
         }
+        if let Some(t) = v.thickness_texture {
+            if document.textures().nth(t.index).is_none() {
+                let why = format!("thicknessTexture: texture {} does not exist", t.index);
+                return Err(self.bad(element, reason(why)));
+            }
+            if t.transform.is_some_and(|t| !t.is_finite()) {
+                let why = "thicknessTexture: KHR_texture_transform has a non-finite offset, \
+                           rotation or scale";
+                return Err(self.bad(element, reason(why.into())));
+            }
+        }
         if v.thickness_factor == 0.0 {
             return Ok(None);
-        }
-        if v.thickness_texture.is_some() {
-            let without =
-                "the volume's thickness is the distance the path travels inside the closed mesh";
-            self.warn(
-                "KHR_materials_volume thicknessTexture",
-                "material",
-                element,
-                without,
-            );
         }
         Ok(Some(Volume::new(
             v.thickness_factor,
@@ -445,14 +623,26 @@ impl Loader<'_> {
     }
 
     /// The texture `info` names, the textureInfo `key` of material extension `extension`
-    /// (`None` without one), decoded as linear data, which every texture these extensions
-    /// name is; an index past the file's textures is an error naming the material, the
+    /// (`None` without one), decoded as linear data, which most textures these extensions
+    /// name are; an index past the file's textures is an error naming the material, the
     /// extension and the key.
     fn extension_texture(
         &mut self,
         document: &gltf::Document,
+        key: (&str, &str),
+        info: Option<JsonTextureInfo>,
+        element: &str,
+    ) -> Result<Option<TextureRef>, SceneError> {
+        self.extension_texture_in(document, key, info, ColorSpace::Linear, element)
+    }
+
+    /// [`Loader::extension_texture`] decoded in colour space `space` (sRGB for a colour).
+    fn extension_texture_in(
+        &mut self,
+        document: &gltf::Document,
         (extension, key): (&str, &str),
         info: Option<JsonTextureInfo>,
+        space: ColorSpace,
         element: &str,
     ) -> Result<Option<TextureRef>, SceneError> {
         let Some(info) = info else {
@@ -462,7 +652,6 @@ impl Loader<'_> {
             let why = format!("{extension}: {key}: texture {} does not exist", info.index);
             return Err(self.bad(element, why));
         };
-        let space = ColorSpace::Linear;
         self.texture_of(&texture, info.tex_coord, info.transform, space, element)
     }
 
@@ -754,6 +943,108 @@ mod tests {
     }
 
     #[test]
+    fn iridescence_is_read_with_its_textures() {
+        // One texel: R 255, G 128, B 0, A 64.
+        let dir = png_file("t.png", 1, 1, vec![255, 128, 0, 64]);
+        let (mut doc, bin) = test_doc();
+        doc["extensionsRequired"] = json!(["KHR_materials_iridescence"]);
+        doc["extensionsUsed"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!("KHR_materials_iridescence"));
+        doc["images"] = json!([{"uri": "t.png"}]);
+        doc["textures"] = json!([{"source": 0}]);
+        doc["materials"][1]["extensions"]["KHR_materials_iridescence"] = json!({
+            "iridescenceFactor": 0.5, "iridescenceTexture": {"index": 0},
+            "iridescenceIor": 1.8, "iridescenceThicknessMinimum": 200,
+            "iridescenceThicknessMaximum": 600, "iridescenceThicknessTexture": {"index": 0}});
+        let scene = Scene::load(&write_embedded(dir.path(), doc.clone(), &bin)).unwrap();
+        assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+        let Bsdf::GltfPbr(g) = scene.materials[1].bsdf_at(
+            &crate::geometry::VertexAttributes::from_uv(Vec2::ZERO),
+            &scene.textures,
+        ) else {
+            panic!("not a glTF material")
+        };
+        assert_eq!((g.iridescence, g.iridescence_ior), (0.5, 1.8));
+        let want = 200.0 + 400.0 * 128.0 / 255.0;
+        assert!((g.iridescence_thickness - want).abs() < 1e-3, "{g:?}");
+        for (value, what) in [
+            (json!({"iridescenceIor": 0.5}), "iridescenceIor 0.5"),
+            (
+                json!({"iridescenceThicknessMaximum": -1}),
+                "iridescenceThicknessMaximum -1",
+            ),
+            (json!({"iridescenceFactor": 2}), "iridescenceFactor 2"),
+        ] {
+            let mut d = doc.clone();
+            d["materials"][1]["extensions"] = json!({ "KHR_materials_iridescence": value });
+            let err = Scene::load(&write_embedded(dir.path(), d, &bin))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                err.contains("material \"glow\" (1)") && err.contains(what),
+                "{err}"
+            );
+        }
+    }
+
+    #[test]
+    fn sheen_is_read_with_its_textures() {
+        // One texel: R 255, G 128, B 0, A 64.
+        let dir = png_file("t.png", 1, 1, vec![255, 128, 0, 64]);
+        let (mut doc, bin) = test_doc();
+        doc["extensionsUsed"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!("KHR_materials_sheen"));
+        doc["images"] = json!([{"uri": "t.png"}]);
+        doc["textures"] = json!([{"source": 0}]);
+        doc["materials"][1]["extensions"]["KHR_materials_sheen"] = json!({
+            "sheenColorFactor": [0.9, 0.5, 1.0], "sheenColorTexture": {"index": 0},
+            "sheenRoughnessFactor": 0.8, "sheenRoughnessTexture": {"index": 0}});
+        let scene = Scene::load(&write_embedded(dir.path(), doc.clone(), &bin)).unwrap();
+        assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+        // Decoded twice: sRGB (colour) and linear (roughness).
+        assert_eq!(scene.textures.len(), 2);
+        let Bsdf::GltfPbr(g) = scene.materials[1].bsdf_at(
+            &crate::geometry::VertexAttributes::from_uv(Vec2::ZERO),
+            &scene.textures,
+        ) else {
+            panic!("not a glTF material")
+        };
+        // sRGB 128/255 is linear 0.2158; the roughness is the texel's alpha.
+        let want = Vec3::new(0.9, 0.5 * 0.2158, 0.0);
+        assert!((g.sheen_color - want).abs().max_element() < 1e-3, "{g:?}");
+        assert!(
+            (g.sheen_roughness - 0.8 * 64.0 / 255.0).abs() < 1e-4,
+            "{g:?}"
+        );
+        // Out of range: errors naming the material and the factor.
+        for (value, what) in [
+            (
+                json!({"sheenColorFactor": [1.5, 0, 0]}),
+                "sheenColorFactor 1.5",
+            ),
+            (
+                json!({"sheenRoughnessFactor": -0.1}),
+                "sheenRoughnessFactor -0.1",
+            ),
+            (json!({"sheenColorTexture": {"index": 3}}), "texture 3"),
+        ] {
+            let mut d = doc.clone();
+            d["materials"][1]["extensions"] = json!({ "KHR_materials_sheen": value });
+            let err = Scene::load(&write_embedded(dir.path(), d, &bin))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                err.contains("material \"glow\" (1)") && err.contains(what),
+                "{err}"
+            );
+        }
+    }
+
+    #[test]
     fn specular_ior_and_clearcoat_are_read_with_their_textures() {
         // One texel: R 255, G 128, B 0, A 64.
         let dir = png_file("t.png", 1, 1, vec![255, 128, 0, 64]);
@@ -776,14 +1067,19 @@ mod tests {
             "clearcoatRoughnessFactor": 0.2, "clearcoatRoughnessTexture": {"index": 0},
             "clearcoatNormalTexture": {"index": 0}});
         let scene = Scene::load(&write_embedded(dir.path(), doc.clone(), &bin)).unwrap();
-        // Honoured: no "uses KHR_materials_..." warning; the coat's normal map is named.
+        // Honoured: no "uses KHR_materials_..." warning; the coat's normal map is read (the
+        // uv-less triangle renders without it, as with a base normal map).
         assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
         assert!(
-            scene.warnings[0].contains("material \"glow\" (1)")
-                && scene.warnings[0].contains("clearcoatNormalTexture on 1 material"),
+            scene.warnings[0].contains("mesh \"tri\" (1)")
+                && scene.warnings[0].contains("rendered without the normal map"),
             "{:?}",
             scene.warnings
         );
+        let coat_map = scene.materials[1]
+            .coat_normal_map()
+            .expect("a coat normal map");
+        assert_eq!(coat_map.scale, 1.0);
         // The image decoded twice: linear (specular, clearcoat) and sRGB (specular colour).
         assert_eq!(scene.textures.len(), 2);
         let Bsdf::GltfPbr(g) = scene.materials[1].bsdf_at(
@@ -876,19 +1172,16 @@ mod tests {
         };
         assert!((g.transmission - 0.8 * 128.0 / 255.0).abs() < 1e-4, "{g:?}");
         assert!(g.thin_walled && scene.materials[1].volume().is_none());
-        // A volume: attenuation colour and distance give sigma_a; thicknessTexture warns.
+        // A volume: attenuation colour and distance give sigma_a; a thicknessTexture is
+        // validated and not used (no warning, no texture decoded for it).
         let mut d = doc.clone();
         d["materials"][1]["extensions"]["KHR_materials_volume"] = json!({
-            "thicknessFactor": 0.02, "thicknessTexture": {"index": 0},
+            "thicknessFactor": 0.02, "thicknessTexture": {"index": 0, "texCoord": 1},
             "attenuationDistance": 0.5, "attenuationColor": [0.5, 1.0, 0.25]});
+        let textures = scene.textures.len();
         let scene = Scene::load(&write_embedded(dir.path(), d, &bin)).unwrap();
-        assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
-        assert!(
-            scene.warnings[0].contains("material \"glow\" (1)")
-                && scene.warnings[0].contains("thicknessTexture on 1 material"),
-            "{:?}",
-            scene.warnings
-        );
+        assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+        assert_eq!(scene.textures.len(), textures);
         let v = scene.materials[1].volume().expect("a volume");
         let want = Vec3::new(0.5f32.ln(), 0.0, 0.25f32.ln()) / -0.5;
         assert!((v.sigma_a - want).abs().max_element() < 1e-5, "{v:?}");
@@ -927,6 +1220,22 @@ mod tests {
                 "KHR_materials_volume",
                 json!({"thicknessFactor": -1}),
                 "thicknessFactor -1",
+            ),
+            (
+                "KHR_materials_volume",
+                json!({"thicknessFactor": 1, "thicknessTexture": {"index": 7}}),
+                "thicknessTexture: texture 7 does not exist",
+            ),
+            (
+                "KHR_materials_volume",
+                json!({"thicknessTexture": {"index": 0, "extensions":
+                    {"KHR_texture_transform": {"scale": [1e39, 1]}}}}),
+                "thicknessTexture",
+            ),
+            (
+                "KHR_materials_volume",
+                json!({"thicknessTexture": {"texCoord": 0}}),
+                "index",
             ),
             (
                 "KHR_materials_volume",

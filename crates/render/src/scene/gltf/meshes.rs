@@ -112,7 +112,7 @@ impl Loader<'_> {
             let normal_mapped = prim
                 .material()
                 .index()
-                .is_some_and(|i| self.parts.materials[i].normal_map.is_some());
+                .is_some_and(|i| self.parts.materials[i].tangent_space_map().is_some());
             let has_normals = prim.get(&gltf::Semantic::Normals).is_some();
             let tangent_acc = prim
                 .get(&gltf::Semantic::Tangents)
@@ -212,7 +212,7 @@ impl Loader<'_> {
                         // MikkTSpace works in the normal map's own texture space: its uv set
                         // through its KHR_texture_transform (a rotation turns the frame).
                         let map_uvs: Vec<Vec2> =
-                            match self.parts.materials[material as usize].normal_map {
+                            match self.parts.materials[material as usize].tangent_space_map() {
                                 Some(map) => (0..uvs.len())
                                     .map(|i| {
                                         let uv1 = uvs1.as_ref().map_or(uvs[i], |u| u[i]);
@@ -644,6 +644,65 @@ mod tests {
         // scale 0 flattens the map: (2c - 1) * (0, 0, 1).
         let (doc, bin) = normal_mapped_doc(theta, 0.0);
         assert!((quad_normal(&load_doc(doc, &bin)) - Vec3::Y).length() < 1e-6);
+    }
+
+    /// KHR_materials_clearcoat's clearcoatNormalTexture tilts the coat's normal and not the
+    /// shading normal (and gets tangents generated); a base normal map without a coat map
+    /// leaves the coat on the interpolated normal.
+    #[test]
+    fn clearcoat_normal_texture_tilts_the_coat_only() {
+        let theta = 0.4f32;
+        let coat_doc = |theta: f32, base_too: bool| {
+            let (mut doc, bin) = normal_mapped_doc(theta, 1.0);
+            let map = doc["materials"][0]["normalTexture"].clone();
+            if !base_too {
+                doc["materials"][0]
+                    .as_object_mut()
+                    .unwrap()
+                    .remove("normalTexture");
+            }
+            let mut coat = json!({"clearcoatFactor": 1.0, "clearcoatRoughnessFactor": 0.1});
+            if !base_too {
+                coat["clearcoatNormalTexture"] = map;
+            }
+            // A metallic-roughness material (not the paper model of `extras`).
+            doc["materials"][0]
+                .as_object_mut()
+                .unwrap()
+                .remove("extras");
+            doc["materials"][0]["extensions"] = json!({ "KHR_materials_clearcoat": coat });
+            doc["extensionsUsed"]
+                .as_array_mut()
+                .unwrap()
+                .push(json!("KHR_materials_clearcoat"));
+            (doc, bin)
+        };
+        let (doc, bin) = coat_doc(theta, false);
+        let scene = load_doc(doc, &bin);
+        assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+        assert_eq!(scene.mesh.tangents.len(), scene.mesh.positions.len());
+        let ray = crate::geometry::Ray::new(Vec3::new(21.0, 5.0, 0.5), -Vec3::Y);
+        let hit = scene.intersect(&ray).unwrap();
+        assert!((hit.ns - Vec3::Y).length() < 1e-6, "{}", hit.ns);
+        let coat = hit.coat_normal.expect("a coat normal");
+        assert!((coat.dot(Vec3::Y).acos() - theta).abs() < 0.01, "{coat}");
+        assert!(coat.x > 0.0 && coat.z.abs() < 0.01, "{coat}");
+        // The base's map alone: the coat keeps the interpolated normal.
+        let (doc, bin) = coat_doc(theta, true);
+        let hit = load_doc(doc, &bin).intersect(&ray).unwrap();
+        assert!((hit.ns.dot(Vec3::Y).acos() - theta).abs() < 0.01);
+        assert_eq!(hit.coat_normal, Some(Vec3::Y));
+        // Neither map: no coat normal.
+        let (doc, bin) = coat_doc(0.0, true);
+        let mut doc = doc;
+        doc["materials"][0]
+            .as_object_mut()
+            .unwrap()
+            .remove("normalTexture");
+        assert_eq!(
+            load_doc(doc, &bin).intersect(&ray).unwrap().coat_normal,
+            None
+        );
     }
 
     #[test]

@@ -571,15 +571,14 @@ mod tests {
         }
     }
 
-    /// The default camera's bounds unite one cube per primitive placement, whether the mesh
+    /// The default camera's bounds unite one box per primitive placement, whether the mesh
     /// is flattened (placed once per mesh copy) or instanced (one mesh placed twice).
     #[test]
-    fn framing_bounds_unite_the_cubes_of_the_placed_primitives() {
+    fn framing_bounds_unite_the_boxes_of_the_placed_primitives() {
         let bin: Vec<u8> = [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]
             .iter()
             .flat_map(|v| v.to_le_bytes())
             .collect();
-        let r = std::f32::consts::FRAC_1_SQRT_2;
         for share in [true, false] {
             let mesh = |m: usize| if share { 0 } else { m };
             let doc = json!({
@@ -596,8 +595,8 @@ mod tests {
             let scene = load_doc(doc, &bin);
             assert_eq!(scene.instances.is_empty(), !share);
             let [lo, hi] = scene.framing_bounds.unwrap();
-            let want_lo = Vec3::new(0.5 - r, 0.5 - r, -r);
-            let want_hi = Vec3::new(10.5 + r, 0.5 + r, r);
+            let want_lo = Vec3::ZERO;
+            let want_hi = Vec3::new(11.0, 1.0, 0.0);
             assert!(
                 (lo - want_lo).length() < 1e-5 && (hi - want_hi).length() < 1e-5,
                 "share {share}: {lo} {hi}"

@@ -72,6 +72,14 @@ impl UvTransform {
             tex_coord: t.tex_coord,
         })
     }
+
+    /// Whether its offset, rotation and scale are finite (a texture that is read checks this
+    /// when it is decoded).
+    pub(super) fn is_finite(&self) -> bool {
+        Vec2::from(self.offset).is_finite()
+            && self.rotation.is_finite()
+            && Vec2::from(self.scale).is_finite()
+    }
 }
 
 /// The first 12 bytes of every KTX2 file: `«KTX 20»\r\n\x1A\n`.
@@ -224,7 +232,7 @@ impl Loader<'_> {
             Some(t) => {
                 let (offset, rotation, scale) =
                     (Vec2::from(t.offset), t.rotation, Vec2::from(t.scale));
-                if !(offset.is_finite() && rotation.is_finite() && scale.is_finite()) {
+                if !t.is_finite() {
                     return Err(self.bad(
                         element,
                         "KHR_texture_transform has a non-finite offset, rotation or scale",
