@@ -79,13 +79,16 @@ fn render(dir: &TestDir, name: &str, file: &Path) -> Rendered {
     let (w, h, channels) = read_exr_channels(&out, &["R", "G", "B", "depth.Z"])
         .unwrap_or_else(|e| panic!("{name}: cannot read its render: {e}"));
     let (mut covered, mut sum) = (0usize, 0.0f64);
-    for i in 0..(w * h) as usize {
-        let rgb = [channels[0][i], channels[1][i], channels[2][i]];
+    let [r, g, b, depth] = &channels[..] else {
+        panic!("{name}: four channels expected");
+    };
+    for (i, &z) in depth.iter().enumerate() {
+        let rgb = [r[i], g[i], b[i]];
         assert!(
             rgb.iter().all(|v| v.is_finite() && *v >= 0.0),
             "{name}: pixel {i} is {rgb:?}"
         );
-        if channels[3][i].is_finite() {
+        if z.is_finite() {
             covered += 1;
             sum += (0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]) as f64;
         }
