@@ -2,8 +2,10 @@
 
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
+use streaks_image::color::luminance;
 use streaks_image::png::write_png;
-use streaks_image::GrayImage;
+use streaks_image::stats::quantile_below;
+use streaks_image::{GrayImage, RgbImage};
 use streaks_render::integrator::{self, Layers, RenderJob, RenderOutput};
 use streaks_render::output;
 
@@ -156,6 +158,9 @@ pub fn run(args: Args) -> Result<()> {
             .save_png(path)
             .with_context(|| format!("cannot write the road mask {}", path.display()))?;
     }
+    if let Some(warning) = black_image_warning(&out.image, opts.exposure) {
+        eprintln!("warning: {}: {warning}", args.output.display());
+    }
     let s = &out.stats;
     let secs = s.seconds.max(1e-9);
     let pixels = (width as u64 * height as u64).max(1);
@@ -178,9 +183,52 @@ pub fn run(args: Args) -> Result<()> {
     Ok(())
 }
 
+/// Below this linear luminance a pixel develops to at most 8 of 255 in sRGB: black to the eye.
+const BLACK: f32 = 0.0024;
+
+/// A render whose 99th-percentile luminance, at `exposure` stops, develops to black ([`BLACK`])
+/// though light reached the film gets a warning with the exposure that would show it: the one
+/// that takes the 99th-percentile luminance (the brightest pixel's, when fewer than 1 % of
+/// the pixels got light) to 18 % grey. Files with weak photometric lights do this (a 3 lux
+/// directional light is 3/683 W/m^2), as do models whose only light is hidden from the camera,
+/// and a black image without a word looks like a failure.
+fn black_image_warning(image: &RgbImage, exposure: f32) -> Option<String> {
+    let lum: Vec<f32> = image.pixels.iter().map(|&p| luminance(p)).collect();
+    let p99 = quantile_below(lum.iter().copied(), 0.99)?;
+    if p99 * exposure.exp2() >= BLACK {
+        return None;
+    }
+    let brightest = lum
+        .iter()
+        .copied()
+        .filter(|v| v.is_finite())
+        .fold(0.0, f32::max);
+    let bright = if p99 > 0.0 { p99 } else { brightest };
+    if bright <= 0.0 {
+        return None;
+    }
+    let ev = (0.18 / bright).log2().round();
+    Some(format!(
+        "the image is black at --exposure {exposure} (99th-percentile luminance {p99:.2e}, \
+         brightest {brightest:.2e}); --exposure {ev} shows it, or light the scene with --env or \
+         --env-color"
+    ))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_dim_render_is_named_with_the_exposure_that_shows_it() {
+        let dim = RgbImage::from_fn(10, 10, |x, _| glam::Vec3::splat(1e-5 * x as f32));
+        let w = black_image_warning(&dim, 0.0).expect("a warning");
+        assert!(w.contains("--exposure 11 shows it"), "{w}");
+        assert!(black_image_warning(&dim, 11.0).is_none());
+        assert!(black_image_warning(&RgbImage::new(4, 4), 0.0).is_none());
+        let lit = RgbImage::from_fn(4, 4, |_, _| glam::Vec3::splat(0.5));
+        assert!(black_image_warning(&lit, 0.0).is_none());
+    }
 
     #[test]
     fn formats_from_extensions() {
