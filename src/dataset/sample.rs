@@ -9,11 +9,10 @@ use streaks_dataset::kitti::write_kitti;
 use streaks_dataset::layout::{sample_id, Layout};
 use streaks_dataset::meta::{render_seed, RenderMeta, RigMeta, SampleMeta, SampleStats};
 use streaks_dataset::settings::Settings;
-use streaks_dataset::write::{write_views, GroundTruth};
+use streaks_dataset::write::{disparity_range, write_calib, write_views, GroundTruth};
 use streaks_image::write_bytes_atomically;
 use streaks_render::scene::Scene;
 use streaks_scenes::procedural::{sample, GeneratorConfig, GENERATOR_VERSION};
-use streaks_stereo::calib::MiddleburyCalib;
 use streaks_stereo::render::{
     light_records, render_pair, rig_from_camera, scene_has_road, PairSettings,
 };
@@ -124,20 +123,8 @@ fn write_sample(
     let has_road = scene_has_road(&scene);
 
     let pixels = left.disparity.data.len().max(1) as f64;
-    let finite: Vec<f32> = left
-        .disparity
-        .data
-        .iter()
-        .copied()
-        .filter(|d| d.is_finite())
-        .collect();
-    let range = finite
-        .iter()
-        .copied()
-        .fold(None, |r: Option<(f32, f32)>, d| {
-            Some(r.map_or((d, d), |(a, b)| (a.min(d), b.max(d))))
-        });
-    MiddleburyCalib::of_rig(&rig, range).save(&files.calib())?;
+    let range = disparity_range(left);
+    write_calib(&files, &rig, left)?;
 
     let count = |flags: &mut dyn Iterator<Item = bool>| flags.filter(|&b| b).count() as f64;
     let stats = SampleStats {
@@ -146,7 +133,7 @@ fn write_sample(
         road_share: has_road.then(|| count(&mut left.road_surface.iter().copied()) / pixels),
         disparity_min: range.map(|r| r.0),
         disparity_max: range.map(|r| r.1),
-        valid_share: finite.len() as f64 / pixels,
+        valid_share: left.disparity.data.iter().filter(|d| d.is_finite()).count() as f64 / pixels,
         nonfinite_dropped: left.output.stats.nonfinite_dropped
             + right.output.stats.nonfinite_dropped,
     };

@@ -24,6 +24,7 @@ fn stereo_writes_the_pair_ground_truth_and_rig_then_maps_and_prepares_it() {
         t.files_in("out"),
         [
             "anaglyph.png",
+            "calib.txt",
             "depth0.pfm",
             "depth1.pfm",
             "disp0.pfm",
@@ -45,6 +46,14 @@ fn stereo_writes_the_pair_ground_truth_and_rig_then_maps_and_prepares_it() {
         (30, 20)
     );
     assert_eq!(rig.baseline(), 0.1);
+    // calib.txt agrees with rig.json (Middlebury's baseline in mm, width, height).
+    let calib = streaks_stereo::calib::MiddleburyCalib::load(&t.join("out/calib.txt")).unwrap();
+    assert_eq!((calib.width, calib.height), (30, 20));
+    assert!(
+        (calib.baseline_mm - 100.0).abs() < 1e-3,
+        "{}",
+        calib.baseline_mm
+    );
     // The point lamp 2 m above the road and the emissive sign (one lamp of two triangles,
     // centred at (0, 1.75, -3) in the world).
     assert!(file

@@ -10,6 +10,7 @@ use streaks_image::pfm::write_pfm;
 use streaks_image::png::write_png_buffer;
 use streaks_render::output::write_exr;
 use streaks_render::scene::Scene;
+use streaks_stereo::calib::MiddleburyCalib;
 use streaks_stereo::pair::write_pair_views;
 use streaks_stereo::render::{light_records, scene_has_road, EyeView};
 use streaks_stereo::rig::{Eye, Rig};
@@ -58,7 +59,7 @@ pub fn write_views(
 
 /// Writes a rendered pair as `streaks stereo -o DIR` does into `dir` (which must exist): both
 /// views with their ground truth ([`write_views`], [`GroundTruth::Both`]), `side_by_side.png`,
-/// `anaglyph.png` and `rig.json`.
+/// `anaglyph.png`, `rig.json` and `calib.txt` ([`write_calib`]).
 pub fn write_pair(
     dir: &std::path::Path,
     scene: &Scene,
@@ -71,5 +72,25 @@ pub fn write_pair(
     write_pair_views(&files.side_by_side(), &files.anaglyph(), &left, &right)?;
     let road = rig.road_frame().ok();
     RigFile::new(rig, light_records(scene, road.as_ref())).save(&files.rig_json())?;
+    write_calib(&files, rig, &views[0])
+}
+
+/// The range `(min, max)` of a view's finite ground-truth disparities; `None` when there is
+/// none.
+pub fn disparity_range(view: &EyeView) -> Option<(f32, f32)> {
+    view.disparity
+        .data
+        .iter()
+        .copied()
+        .filter(|d| d.is_finite())
+        .fold(None, |r: Option<(f32, f32)>, d| {
+            Some(r.map_or((d, d), |(a, b)| (a.min(d), b.max(d))))
+        })
+}
+
+/// Writes `calib.txt`, the Middlebury 2014 calibration of `rig`, with the left view's
+/// [`disparity_range`] as `vmin` and `vmax` (0 and 0 when it has none).
+pub fn write_calib(files: &SampleDir, rig: &Rig, left: &EyeView) -> Result<(), DatasetError> {
+    MiddleburyCalib::of_rig(rig, disparity_range(left)).save(&files.calib())?;
     Ok(())
 }
