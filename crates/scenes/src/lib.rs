@@ -20,10 +20,12 @@ pub mod albedo;
 pub mod crosscheck;
 pub mod estimate;
 pub mod gltf_writer;
+pub mod light_sources;
 pub mod mesh;
 pub mod paper;
 pub mod procedural;
 pub mod street;
+pub mod weather;
 pub mod wetness;
 
 use std::path::{Path, PathBuf};
