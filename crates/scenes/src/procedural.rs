@@ -289,7 +289,7 @@ pub struct ExposureConfig {
 
 impl Default for ExposureConfig {
     fn default() -> Self {
-        Self { ev: [5.0, 7.0] }
+        Self { ev: [4.5, 6.5] }
     }
 }
 
