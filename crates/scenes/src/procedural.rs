@@ -11,7 +11,7 @@
 //! and the weather ([`crate::weather`]: rain, fog, sensor preset, exposure time, rig speed).
 //!
 //! Light levels are physical (see `docs/decisions/0030-physical-light-levels-in-the-generator.md`):
-//! street luminaires of 5-20 klm, headlights of 7-27 kcd, lit windows and shop windows at the
+//! street luminaires of 8-26 klm, headlights of 7-27 kcd, lit windows and shop windows at the
 //! luminances of real ones, an urban sky glow of 15-17 mag/arcsec^2; colours come from the
 //! lamps' spectra ([`crate::light_sources`]) at a given luminance.
 //!
@@ -141,7 +141,7 @@ impl Default for LampConfig {
                 (LightSource::Led3000K, 0.25),
                 (LightSource::Led4000K, 0.2),
             ]),
-            intensity: [1.0, 4.0],
+            intensity: [1.5, 5.0],
             both_sides: 0.6,
         }
     }
@@ -643,20 +643,11 @@ const LAMP_CONE_DEG: (f64, f64) = (60.0, 85.0);
 
 /// Draws one key of `weights` (non-negative, positive sum) with one uniform number.
 fn weighted<K: Copy>(rng: &mut ChaCha8Rng, weights: &BTreeMap<K, f64>) -> K {
-    let total: f64 = weights.values().sum();
-    let u = rng.random::<f64>() * total;
-    let mut acc = 0.0;
-    let mut chosen = None;
-    for (k, w) in weights {
-        if *w > 0.0 {
-            chosen = Some(*k);
-            acc += w;
-            if u < acc {
-                break;
-            }
-        }
-    }
-    chosen.expect("validated: a positive weight")
+    let i = crate::weather::pick(weights.values().copied(), rng.random::<f64>());
+    *weights
+        .keys()
+        .nth(i)
+        .expect("pick returns an index of the weights")
 }
 
 /// A number drawn uniformly in `r` (`r[0]`, without a draw, when the range is one value).
@@ -1393,7 +1384,7 @@ mod tests {
             let p = &s.params["lamps"];
             let kind: LightSource = serde_json::from_value(p["type"].clone()).unwrap();
             let i_y = p["intensity_w_sr"].as_f64().unwrap();
-            assert!((1.0..=4.0).contains(&i_y));
+            assert!((1.5..=5.0).contains(&i_y));
             let color: [f64; 3] = serde_json::from_value(p["color"].clone()).unwrap();
             for c in 0..3 {
                 assert!((color[c] - kind.rgb()[c]).abs() < 1e-6, "{kind}: {color:?}");

@@ -196,8 +196,10 @@ impl Weather {
     }
 }
 
-/// Index drawn from `weights` (non-negative, positive sum) with `u` uniform in [0, 1).
-fn pick(weights: impl Iterator<Item = f64> + Clone, u: f64) -> usize {
+/// Index drawn from `weights` (non-negative, positive sum) with `u` uniform in [0, 1): the
+/// first whose cumulative weight exceeds `u` times the total (the last positive one if
+/// rounding leaves none).
+pub(crate) fn pick(weights: impl Iterator<Item = f64> + Clone, u: f64) -> usize {
     let total: f64 = weights.clone().sum();
     let mut acc = 0.0;
     let mut last = 0;
