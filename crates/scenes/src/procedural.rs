@@ -1397,5 +1397,25 @@ mod tests {
                 "{lens_intensity} vs {i_y}"
             );
         }
+        // In the file: every street lamp a downward spot whose candela times its colour's
+        // luminance is the drawn intensity x 683.
+        let (gltf, s) = read(&config);
+        let i_cd = s.params["lamps"]["intensity_cd"].as_f64().unwrap();
+        let lights = gltf["extensions"]["KHR_lights_punctual"]["lights"]
+            .as_array()
+            .unwrap();
+        let lamps: Vec<_> = lights
+            .iter()
+            .filter(|l| l["name"].as_str().unwrap().starts_with("street_lamp_"))
+            .collect();
+        assert!(!lamps.is_empty());
+        for l in lamps {
+            assert_eq!(l["type"], "spot");
+            let outer = l["spot"]["outerConeAngle"].as_f64().unwrap();
+            assert!((outer.to_degrees() - 85.0).abs() < 1e-4, "{outer}");
+            let color: [f64; 3] = serde_json::from_value(l["color"].clone()).unwrap();
+            let cd = l["intensity"].as_f64().unwrap() * luminance(color);
+            assert!((cd / i_cd - 1.0).abs() < 1e-5, "{cd} cd vs {i_cd}");
+        }
     }
 }
