@@ -7,7 +7,9 @@ use std::time::Instant;
 use streaks_dataset::files::{SampleDir, SCENE_GLTF};
 use streaks_dataset::kitti::write_kitti;
 use streaks_dataset::layout::{sample_id, Layout};
-use streaks_dataset::meta::{render_seed, RenderMeta, RigMeta, SampleMeta, SampleStats};
+use streaks_dataset::meta::{
+    render_seed, FogMeta, RenderMeta, RigMeta, SampleMeta, SampleStats, WeatherMeta,
+};
 use streaks_dataset::settings::Settings;
 use streaks_dataset::write::{disparity_range, write_calib, write_views, GroundTruth};
 use streaks_image::write_bytes_atomically;
@@ -169,6 +171,20 @@ fn write_sample(
             seed_right: seed.wrapping_add(1),
             mean_spp: Some([left, right].map(|v| v.output.stats.samples as f64 / pixels)),
         },
+        weather: s.weather.as_ref().map(|w| WeatherMeta {
+            rain_class: w.rain_class.clone(),
+            rain_mm_h: w.rain_mm_h,
+            rain_seed: w.rain_seed,
+            fog: w.fog.map(|f| FogMeta {
+                sigma_t: f.sigma_t,
+                albedo: f.albedo,
+                g: f.g,
+                height_falloff: f.height_falloff,
+            }),
+            sensor: w.sensor.clone(),
+            exposure_s: w.exposure_s,
+            rig_velocity: w.rig_velocity,
+        }),
     };
     write_bytes_atomically(&files.meta(), &meta.to_bytes())?;
     write_kitti(layout, index, &files, &left.disparity)?;

@@ -244,6 +244,12 @@ fn ground_truth_reads_back_as_stereo_loaders_read_it() {
     assert!(meta["rig"]["baseline_m"].as_f64().unwrap() > 0.0);
     assert!(meta["stats"]["disparity_max"].as_f64().unwrap() > 0.0);
     assert!(meta.get("seconds").is_none());
+    // The generator's weather: rain, fog (or null), sensor, exposure time and rig velocity.
+    let weather = &meta["weather"];
+    assert!(weather["rain_mm_h"].as_f64().unwrap() >= 0.0, "{weather}");
+    assert!(weather["fog"].is_null() || weather["fog"]["sigma_t"].as_f64().unwrap() > 0.0);
+    assert!(weather["sensor"].is_string() && weather["exposure_s"].as_f64().unwrap() > 0.0);
+    assert_eq!(weather["rig_velocity"].as_array().unwrap().len(), 3);
 }
 
 #[test]
@@ -759,6 +765,8 @@ fn bad_dataset_arguments_are_refused() {
     generate(&t, "x", &["--config", "unknown.toml"]).assert_failure_mentioning("lanez");
     std::fs::write(t.join("range.toml"), "[rig]\nbaseline = [0.4, 0.1]\n").unwrap();
     generate(&t, "x", &["--config", "range.toml"]).assert_failure_mentioning("rig.baseline");
+    std::fs::write(t.join("fog.toml"), "[weather.fog]\ng = [0.5, 1.5]\n").unwrap();
+    generate(&t, "x", &["--config", "fog.toml"]).assert_failure_mentioning("weather.fog.g");
     generate_n(&t, "x", "0", &[]).assert_failure_mentioning("--count");
     // Nothing was written by the refused runs.
     assert!(!t.join("x").exists());

@@ -60,6 +60,39 @@ pub struct SampleStats {
     pub nonfinite_dropped: u64,
 }
 
+/// A sample's fog as `meta.json` records it (the scene's `extras.streaks.fog`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FogMeta {
+    /// Extinction coefficient at road level, 1/m.
+    pub sigma_t: f64,
+    /// Single-scattering albedo.
+    pub albedo: f64,
+    /// Henyey-Greenstein asymmetry.
+    pub g: f64,
+    /// Density falloff with height, 1/m (0: homogeneous).
+    pub height_falloff: f64,
+}
+
+/// A sample's weather and camera as the generator drew them: rain, fog, the sensor preset,
+/// the exposure time and the rig's velocity.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct WeatherMeta {
+    /// The rain class drawn (`dry`, `drizzle`, `moderate`, `heavy`, or a config's own).
+    pub rain_class: String,
+    /// Rain rate, mm/h (0: no rain falls).
+    pub rain_mm_h: f64,
+    /// Seed of the rain drops (the scene's `extras.streaks.rain.seed`).
+    pub rain_seed: u32,
+    /// The fog, or `null`.
+    pub fog: Option<FogMeta>,
+    /// The sensor preset's name.
+    pub sensor: String,
+    /// Exposure (shutter) time, seconds.
+    pub exposure_s: f64,
+    /// The rig's velocity in world space, m/s.
+    pub rig_velocity: [f64; 3],
+}
+
 /// How a sample was rendered: the dataset's render settings, the eyes' seeds and the samples
 /// they took.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -172,6 +205,10 @@ pub struct SampleMeta {
     pub stats: SampleStats,
     /// Render settings.
     pub render: RenderMeta,
+    /// The weather the generator drew (`None`: the config had none, or the sample was written
+    /// before the field existed; the file then has no `weather` key).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub weather: Option<WeatherMeta>,
 }
 
 impl SampleMeta {
@@ -197,6 +234,63 @@ impl SampleMeta {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A sample's meta.json with a weather record reads back equal; one without the key (an
+    /// old file, or a config without weather) reads as `None` and is written without it.
+    #[test]
+    fn weather_round_trips_and_old_files_read() {
+        let weather = WeatherMeta {
+            rain_class: "heavy".into(),
+            rain_mm_h: 22.5,
+            rain_seed: 99,
+            fog: Some(FogMeta {
+                sigma_t: 0.02,
+                albedo: 0.95,
+                g: 0.8,
+                height_falloff: 0.1,
+            }),
+            sensor: "automotive_hdr".into(),
+            exposure_s: 0.02,
+            rig_velocity: [0.0, 0.0, -8.0],
+        };
+        let text = serde_json::to_string(&weather).unwrap();
+        assert_eq!(
+            text,
+            r#"{"rain_class":"heavy","rain_mm_h":22.5,"rain_seed":99,"fog":{"sigma_t":0.02,"albedo":0.95,"g":0.8,"height_falloff":0.1},"sensor":"automotive_hdr","exposure_s":0.02,"rig_velocity":[0.0,0.0,-8.0]}"#
+        );
+        assert_eq!(serde_json::from_str::<WeatherMeta>(&text).unwrap(), weather);
+        let clear: WeatherMeta = serde_json::from_str(
+            r#"{"rain_class":"dry","rain_mm_h":0.0,"rain_seed":1,"fog":null,"sensor":"automotive_linear","exposure_s":0.01,"rig_velocity":[0,0,0]}"#,
+        )
+        .unwrap();
+        assert_eq!(clear.fog, None);
+
+        let mut meta: serde_json::Value = serde_json::json!({
+            "id": "000000", "index": 0, "seed": 1, "render_seed": 2, "street": 0,
+            "split": "train", "config_hash": "x", "generator_version": "g", "camera": "driver",
+            "exposure_ev": 6.0, "road_mask": true, "params": {},
+            "rig": {"baseline_m": 0.2, "focal_px": 100.0, "width": 8, "height": 8,
+                    "principal_point": [4.0, 4.0],
+                    "world_from_rig": {"position": [0.0, 1.0, 0.0], "x_axis": [1.0, 0.0, 0.0],
+                                       "y_axis": [0.0, 1.0, 0.0], "z_axis": [0.0, 0.0, 1.0]},
+                    "rig_height_m": 1.0},
+            "lights": [],
+            "stats": {"streak_share": 0.0, "streak_threshold": 1.0, "road_share": null,
+                      "disparity_min": null, "disparity_max": null, "valid_share": 1.0,
+                      "nonfinite_dropped": 0},
+            "render": {"spp": 4, "max_depth": 8, "seed_left": 2, "seed_right": 3},
+        });
+        let old: SampleMeta = serde_json::from_value(meta.clone()).unwrap();
+        assert_eq!(old.weather, None);
+        assert!(!String::from_utf8(old.to_bytes())
+            .unwrap()
+            .contains("weather"));
+        meta["weather"] = serde_json::to_value(&weather).unwrap();
+        let new: SampleMeta = serde_json::from_value(meta).unwrap();
+        assert_eq!(new.weather.as_ref(), Some(&weather));
+        let again: SampleMeta = serde_json::from_slice(&new.to_bytes()).unwrap();
+        assert_eq!(again, new);
+    }
 
     #[test]
     fn render_seeds_differ_by_index_and_seed() {

@@ -242,8 +242,8 @@ pub struct Doc {
     textures_used: Vec<usize>,
     triangles: usize,
     description: String,
-    /// `scenes[0].extras.streaks.environment`, if any.
-    environment: Option<serde_json::Value>,
+    /// `scenes[0].extras.streaks`: the environment, fog and rain, if any.
+    scene_extras: serde_json::Map<String, Value>,
 }
 
 impl std::fmt::Debug for Doc {
@@ -275,14 +275,20 @@ impl Doc {
             textures_used: Vec::new(),
             triangles: 0,
             description: description.to_owned(),
-            environment: None,
+            scene_extras: serde_json::Map::new(),
         }
     }
 
     /// Sets the scene's environment light, `scenes[0].extras.streaks.environment` (for
     /// example `{"color": [r, g, b]}`).
     pub fn set_environment(&mut self, environment: serde_json::Value) {
-        self.environment = Some(environment);
+        self.set_scene_extra("environment", environment);
+    }
+
+    /// Sets `scenes[0].extras.streaks.KEY` (`environment`, `fog`, `rain`: the scene-level
+    /// extras the renderer reads).
+    pub fn set_scene_extra(&mut self, key: &str, value: serde_json::Value) {
+        self.scene_extras.insert(key.to_owned(), value);
     }
 
     /// Number of triangles added so far.
@@ -603,8 +609,8 @@ impl Doc {
         if !self.cameras.is_empty() {
             root["cameras"] = json!(self.cameras);
         }
-        if let Some(env) = &self.environment {
-            root["scenes"][0]["extras"]["streaks"] = json!({ "environment": env });
+        if !self.scene_extras.is_empty() {
+            root["scenes"][0]["extras"]["streaks"] = Value::Object(self.scene_extras.clone());
         }
         let mut used = Vec::new();
         if !self.lights.is_empty() {

@@ -7,6 +7,8 @@
 //! meshes, [`gltf_writer::Material`]s, [`gltf_writer::Light`]s and cameras into a glTF document,
 //! [`estimate`] chooses light intensities from the streak's peak radiance, [`wetness`] makes
 //! the road's dryness map, and [`paper`], [`street`] and [`crosscheck`] lay out the scenes.
+//! [`procedural`] draws streets for datasets, with lamp colours from spectra
+//! ([`light_sources`]) and the weather ([`weather`]: rain, fog, sensor, exposure, motion).
 //!
 //! ```
 //! let dir = tempfile::tempdir()?;
@@ -20,10 +22,12 @@ pub mod albedo;
 pub mod crosscheck;
 pub mod estimate;
 pub mod gltf_writer;
+pub mod light_sources;
 pub mod mesh;
 pub mod paper;
 pub mod procedural;
 pub mod street;
+pub mod weather;
 pub mod wetness;
 
 use std::path::{Path, PathBuf};

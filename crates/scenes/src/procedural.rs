@@ -4,10 +4,16 @@
 //! A [`GeneratorConfig`] (TOML; [`GeneratorConfig::default`] is the documented default, and
 //! `config/default.toml` beside this crate is the same file with comments) gives a range for
 //! every parameter of a [`Street`]: the road's lanes and widths, kerbs and pavements, facades
-//! and their lit windows, street lamps (spacing, height, lens size, colour temperature,
-//! intensity), parked, leading and oncoming cars, traffic lights and signs, wetness (global
-//! level, the puddle map's wet and dry specular, ripples as a normal map), the stereo rig
-//! (height, lateral position, pitch, baseline, focal length) and the PNG exposure.
+//! and their lit windows, street lamps (spacing, height, lens size, lamp type, intensity),
+//! parked, leading and oncoming cars, traffic lights and signs, wetness (global level, the
+//! puddle map's wet and dry specular, ripples as a normal map), the stereo rig (height,
+//! lateral position, pitch, baseline, focal length), the PNG exposure, the night sky's glow
+//! and the weather ([`crate::weather`]: rain, fog, sensor preset, exposure time, rig speed).
+//!
+//! Light levels are physical (see `docs/decisions/0030-physical-light-levels-in-the-generator.md`):
+//! street luminaires of 8-26 klm, headlights of 7-27 kcd, lit windows and shop windows at the
+//! luminances of real ones, an urban sky glow of 15-17 mag/arcsec^2; colours come from the
+//! lamps' spectra ([`crate::light_sources`]) at a given luminance.
 //!
 //! [`sample`] turns `(config, seed, index)` into a [`SampleScene`]: a glTF document named
 //! `scene`, the camera to render, the baseline and exposure, the street it belongs to and its
@@ -16,13 +22,16 @@
 //! come from ChaCha8 streams seeded by a hash of `(seed, street)` for the street and of
 //! `(seed, index)` for the rig, so changing one sample never moves another.
 
+use crate::light_sources::{luminance, LightSource};
 use crate::street::{Car, Ripples, Sign, Signal, Street, StreetStyle, TrafficLight};
+use crate::weather::{Weather, WeatherConfig};
 use crate::Error;
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
+use std::collections::BTreeMap;
 use std::path::Path;
 
 /// The generator's version, written into datasets: it changes whenever the same
@@ -30,7 +39,7 @@ use std::path::Path;
 pub const GENERATOR_VERSION: &str = concat!(
     "streaks-scenes ",
     env!("CARGO_PKG_VERSION"),
-    " procedural/1"
+    " procedural/2"
 );
 
 /// A closed range `[min, max]` of a real parameter, written `[min, max]` in TOML.
@@ -66,6 +75,11 @@ pub struct StreetConfig {
     pub cool_windows: Range,
     /// Share of the ground-floor shop windows that are lit.
     pub lit_shops: Range,
+    /// Luminance of a lit upper window, cd/m^2 (a curtained room or an office seen from the
+    /// street).
+    pub window_luminance: Range,
+    /// Luminance of a lit shop window, cd/m^2.
+    pub shop_luminance: Range,
     /// Probability that the street has telephone poles.
     pub poles: f64,
 }
@@ -84,6 +98,8 @@ impl Default for StreetConfig {
             lit_windows: [0.05, 0.45],
             cool_windows: [0.0, 0.4],
             lit_shops: [0.1, 0.8],
+            window_luminance: [5.0, 40.0],
+            shop_luminance: [50.0, 300.0],
             poles: 0.5,
         }
     }
@@ -99,10 +115,13 @@ pub struct LampConfig {
     pub height: Range,
     /// Half size of the lens across the road, metres (along the road it is half of that).
     pub lens: Range,
-    /// Correlated colour temperature, kelvin (about 2000 for high-pressure sodium, 3000 to
-    /// 5000 for LED lamps).
-    pub temperature: Range,
-    /// Radiant intensity, W/sr (written to the glTF in candela).
+    /// Lamp types and their weights (one type per street): `low_pressure_sodium`,
+    /// `high_pressure_sodium`, `led_2200k`, `led_2700k`, `led_3000k`, `led_4000k`
+    /// ([`LightSource`]).
+    pub types: BTreeMap<LightSource, f64>,
+    /// Luminous intensity of a luminaire in its beam, in W/sr of luminance (candela / 683):
+    /// a spot light straight down, uniform to 60 degrees from the nadir and fading out at
+    /// 85, plus its lens (a downward Lambertian emitter of the same intensity at the nadir).
     pub intensity: Range,
     /// Probability of lamps on both sides (staggered) rather than on the right only.
     pub both_sides: f64,
@@ -114,8 +133,15 @@ impl Default for LampConfig {
             spacing: [20.0, 40.0],
             height: [5.0, 9.0],
             lens: [0.12, 0.35],
-            temperature: [1900.0, 5000.0],
-            intensity: [120.0, 600.0],
+            types: BTreeMap::from([
+                (LightSource::LowPressureSodium, 0.05),
+                (LightSource::HighPressureSodium, 0.35),
+                (LightSource::Led2200K, 0.05),
+                (LightSource::Led2700K, 0.1),
+                (LightSource::Led3000K, 0.25),
+                (LightSource::Led4000K, 0.2),
+            ]),
+            intensity: [1.5, 5.0],
             both_sides: 0.6,
         }
     }
@@ -131,8 +157,11 @@ pub struct CarConfig {
     pub ahead: CountRange,
     /// Oncoming cars: headlights (spot lights) on.
     pub oncoming: CountRange,
-    /// Headlight radiant intensity on axis, W/sr.
+    /// Headlight luminous intensity on axis, in W/sr of luminance (candela / 683).
     pub headlight_intensity: Range,
+    /// Headlight types and their weights (one type per street): `halogen`, `xenon`,
+    /// `led_headlight` ([`LightSource`]).
+    pub headlight_types: BTreeMap<LightSource, f64>,
 }
 
 impl Default for CarConfig {
@@ -142,6 +171,11 @@ impl Default for CarConfig {
             ahead: [0, 2],
             oncoming: [0, 2],
             headlight_intensity: [10.0, 40.0],
+            headlight_types: BTreeMap::from([
+                (LightSource::Halogen, 0.5),
+                (LightSource::Xenon, 0.15),
+                (LightSource::LedHeadlight, 0.35),
+            ]),
         }
     }
 }
@@ -152,7 +186,8 @@ impl Default for CarConfig {
 pub struct TrafficConfig {
     /// Traffic lights (red, amber or green at random).
     pub traffic_lights: CountRange,
-    /// Signal radiant intensity on axis, W/sr.
+    /// Signal radiant intensity on axis, W/sr (the spot light the lit signal casts; its lens
+    /// is as bright as a 200 mm signal's, about 270 cd).
     pub signal_intensity: Range,
     /// Road signs on posts.
     pub signs: CountRange,
@@ -162,7 +197,7 @@ impl Default for TrafficConfig {
     fn default() -> Self {
         Self {
             traffic_lights: [0, 2],
-            signal_intensity: [30.0, 90.0],
+            signal_intensity: [0.3, 1.2],
             signs: [0, 4],
         }
     }
@@ -173,7 +208,8 @@ impl Default for TrafficConfig {
 #[serde(default, deny_unknown_fields)]
 pub struct WetnessConfig {
     /// Global wetness in [0, 1]: 0.5 is the shipped streets' balance of puddles, wet
-    /// asphalt and drier patches; 1 floods the road.
+    /// asphalt and drier patches; 1 floods the road. With weather, the rain rate sets it
+    /// within this range (the low end when dry, see [`Weather::wetness_level`]).
     pub level: Range,
     /// Asphalt diffuse reflectance.
     pub asphalt_kd: Range,
@@ -185,9 +221,11 @@ pub struct WetnessConfig {
     pub ks_dry: Range,
     /// GGX alpha of dry asphalt.
     pub alpha_dry: Range,
-    /// Probability that rain ripples the road (a normal map).
+    /// Probability that rain ripples the road (a normal map); with weather, it ripples
+    /// whenever rain falls.
     pub ripples: f64,
-    /// Ripple strength (`normalTexture.scale`: the steepest slope).
+    /// Ripple strength (`normalTexture.scale`: the steepest slope); with weather, the rain
+    /// rate sets it within this range ([`Weather::ripple_strength`]).
     pub ripple_strength: Range,
     /// Metres covered by one tile of the ripple map.
     pub ripple_tile: Range,
@@ -251,7 +289,7 @@ pub struct ExposureConfig {
 
 impl Default for ExposureConfig {
     fn default() -> Self {
-        Self { ev: [-0.5, 1.5] }
+        Self { ev: [4.5, 6.5] }
     }
 }
 
@@ -317,18 +355,23 @@ pub struct GeneratorConfig {
     pub exposure: ExposureConfig,
     /// Streets and splits.
     pub dataset: DatasetConfig,
-    /// The night sky's glow, an environment light; none by default (the sky is black).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub sky: Option<SkyConfig>,
+    /// The night sky's glow, an environment light.
+    pub sky: SkyConfig,
+    /// Rain, fog, sensor, exposure time and motion.
+    pub weather: WeatherConfig,
 }
 
 /// The night sky's glow: a constant environment light of radiance `color * glow` (W/(m^2 sr)),
 /// written in each sample's `scene.gltf` as `scenes[0].extras.streaks.environment`, so that
-/// the sample is rendered with it and the file says so.
+/// the sample is rendered with it and the file says so. The default is an overcast city sky
+/// lit from below by its streets: 0.016-0.11 cd/m^2 (17 to 15 mag/arcsec^2, the range Puschnig
+/// et al. 2014 measured over Vienna; clouds brighten a city's sky), orange-pink.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SkyConfig {
-    /// The glow's radiance, drawn per street.
+    /// `false`: no environment is written (the sky is black).
+    pub enabled: bool,
+    /// The glow's radiance, drawn per street (times the colour, whose luminance is 0.79).
     pub glow: Range,
     /// Its linear RGB colour (a city's sodium-orange or a moonlit blue).
     pub color: [f64; 3],
@@ -337,7 +380,8 @@ pub struct SkyConfig {
 impl Default for SkyConfig {
     fn default() -> Self {
         Self {
-            glow: [0.002, 0.02],
+            enabled: true,
+            glow: [3e-5, 2e-4],
             color: [1.0, 0.75, 0.55],
         }
     }
@@ -409,6 +453,17 @@ impl GeneratorConfig {
                 Err(format!("{name} = {p} must be a probability in [0, 1]"))
             }
         };
+        let weights = |name: &str, w: &BTreeMap<LightSource, f64>| -> Result<(), String> {
+            if w.is_empty() || w.values().any(|v| !(v.is_finite() && *v >= 0.0)) {
+                return Err(format!(
+                    "{name} must give at least one type, each with a weight >= 0"
+                ));
+            }
+            if w.values().sum::<f64>() <= 0.0 {
+                return Err(format!("{name}: the weights add up to 0"));
+            }
+            Ok(())
+        };
         let s = &self.street;
         count("street.lanes", s.lanes, 8)?;
         if s.lanes[0] == 0 {
@@ -424,12 +479,14 @@ impl GeneratorConfig {
         real("street.lit_windows", s.lit_windows, 0.0, 1.0)?;
         real("street.cool_windows", s.cool_windows, 0.0, 1.0)?;
         real("street.lit_shops", s.lit_shops, 0.0, 1.0)?;
+        real("street.window_luminance", s.window_luminance, 0.0, 1e5)?;
+        real("street.shop_luminance", s.shop_luminance, 0.0, 1e5)?;
         prob("street.poles", s.poles)?;
         let l = &self.lamps;
         real("lamps.spacing", l.spacing, 5.0, 500.0)?;
         real("lamps.height", l.height, 3.0, 20.0)?;
         real("lamps.lens", l.lens, 0.02, 1.0)?;
-        real("lamps.temperature", l.temperature, 1000.0, 15000.0)?;
+        weights("lamps.types", &l.types)?;
         real("lamps.intensity", l.intensity, 0.0, 1e6)?;
         prob("lamps.both_sides", l.both_sides)?;
         let c = &self.cars;
@@ -437,6 +494,7 @@ impl GeneratorConfig {
         count("cars.ahead", c.ahead, 8)?;
         count("cars.oncoming", c.oncoming, 8)?;
         real("cars.headlight_intensity", c.headlight_intensity, 0.0, 1e5)?;
+        weights("cars.headlight_types", &c.headlight_types)?;
         let t = &self.traffic;
         count("traffic.traffic_lights", t.traffic_lights, 8)?;
         real("traffic.signal_intensity", t.signal_intensity, 0.0, 1e5)?;
@@ -484,7 +542,9 @@ impl GeneratorConfig {
                 sp.train, sp.val, sp.test
             ));
         }
-        if let Some(sky) = &self.sky {
+        self.weather.validate()?;
+        {
+            let sky = &self.sky;
             real("sky.glow", sky.glow, 0.0, 100.0)?;
             if !sky
                 .color
@@ -551,6 +611,10 @@ pub struct SampleScene {
     pub split: Split,
     /// Every drawn parameter, for `meta.json`.
     pub params: serde_json::Value,
+    /// The drawn weather (`None` when the config's weather is disabled): its fog and rain are
+    /// in the scene's extras; the sensor preset, exposure time and rig velocity are for the
+    /// render and `meta.json`.
+    pub weather: Option<Weather>,
 }
 
 /// Camera node name of generated streets.
@@ -570,8 +634,24 @@ const STREET_STREAM: u64 = 1;
 const RIG_STREAM: u64 = 2;
 const SPLIT_STREAM: u64 = 3;
 const SKY_STREAM: u64 = 4;
+const WEATHER_STREAM: u64 = 5;
+const CAMERA_STREAM: u64 = 6;
 
-fn uniform(rng: &mut ChaCha8Rng, r: Range) -> f64 {
+/// The lamps' beam: a spot light straight down, full intensity to 60 degrees from the nadir,
+/// none beyond 85 (a road luminaire's wide, cut-off distribution).
+const LAMP_CONE_DEG: (f64, f64) = (60.0, 85.0);
+
+/// Draws one key of `weights` (non-negative, positive sum) with one uniform number.
+fn weighted<K: Copy>(rng: &mut ChaCha8Rng, weights: &BTreeMap<K, f64>) -> K {
+    let i = crate::weather::pick(weights.values().copied(), rng.random::<f64>());
+    *weights
+        .keys()
+        .nth(i)
+        .expect("pick returns an index of the weights")
+}
+
+/// A number drawn uniformly in `r` (`r[0]`, without a draw, when the range is one value).
+pub(crate) fn uniform(rng: &mut ChaCha8Rng, r: Range) -> f64 {
     if r[1] > r[0] {
         rng.random_range(r[0]..=r[1])
     } else {
@@ -581,35 +661,6 @@ fn uniform(rng: &mut ChaCha8Rng, r: Range) -> f64 {
 
 fn count(rng: &mut ChaCha8Rng, r: CountRange) -> u32 {
     rng.random_range(r[0]..=r[1])
-}
-
-/// Linear sRGB colour (max component 1) of a blackbody at `kelvin`: Kim et al.'s cubic
-/// spline for the Planckian locus in CIE 1931 xy (valid 1667 K to 25000 K), then XYZ to
-/// linear sRGB.
-pub fn blackbody_rgb(kelvin: f64) -> [f64; 3] {
-    let t = kelvin.clamp(1667.0, 25000.0);
-    let (t1, t2, t3) = (1e3 / t, 1e6 / (t * t), 1e9 / (t * t * t));
-    let x = if t <= 4000.0 {
-        -0.2661239 * t3 - 0.2343589 * t2 + 0.8776956 * t1 + 0.179910
-    } else {
-        -3.0258469 * t3 + 2.1070379 * t2 + 0.2226347 * t1 + 0.240390
-    };
-    let y = if t <= 2222.0 {
-        -1.1063814 * x.powi(3) - 1.34811020 * x * x + 2.18555832 * x - 0.20219683
-    } else if t <= 4000.0 {
-        -0.9549476 * x.powi(3) - 1.37418593 * x * x + 2.09137015 * x - 0.16748867
-    } else {
-        3.0817580 * x.powi(3) - 5.87338670 * x * x + 3.75112997 * x - 0.37001483
-    };
-    let (cx, cy, cz) = (x / y, 1.0, (1.0 - x - y) / y);
-    let rgb = [
-        3.2404542 * cx - 1.5371385 * cy - 0.4985314 * cz,
-        -0.969_266 * cx + 1.8760108 * cy + 0.0415560 * cz,
-        0.0556434 * cx - 0.2040259 * cy + 1.0572252 * cz,
-    ]
-    .map(|c: f64| c.max(0.0));
-    let peak = rgb[0].max(rgb[1]).max(rgb[2]);
-    rgb.map(|c| crate::gltf_writer::round7(c / peak))
 }
 
 /// Positions along the road from `start` towards `far` every `spacing` metres (at least
@@ -671,14 +722,50 @@ pub fn sample(config: &GeneratorConfig, seed: u64, index: u64) -> Result<SampleS
     street.style.eye = eye;
     street.style.pitch_tan = pitch_deg.to_radians().tan() as f32;
     street.style.yfov_deg = yfov_deg;
+    // The weather in its own streams: a config with weather draws every other parameter as
+    // one without; the rain then sets the road's wetness and ripples.
+    let weather = config.weather.enabled.then(|| {
+        let mut street_rng = ChaCha8Rng::seed_from_u64(mix(seed, WEATHER_STREAM, street_id));
+        let mut sample_rng = ChaCha8Rng::seed_from_u64(mix(seed, CAMERA_STREAM, index));
+        let w = crate::weather::draw(&config.weather, &mut street_rng, &mut sample_rng);
+        let wc = &config.wetness;
+        street.style.wetness = w.wetness_level(wc.level) as f32;
+        street.style.ripples = w
+            .ripple_strength(wc.ripple_strength)
+            .map(|strength| Ripples {
+                strength: crate::gltf_writer::round7(strength),
+                tile_m: uniform(&mut street_rng, wc.ripple_tile) as f32,
+                seed: street_rng.random(),
+            });
+        params["wetness"]["level"] = json!(street.style.wetness);
+        params["wetness"]["ripples"] = json!(street
+            .style
+            .ripples
+            .map(|r| json!({"strength": r.strength, "tile_m": r.tile_m})));
+        w
+    });
     let mut doc = street.build()?;
-    if let Some(sky) = &config.sky {
+    let sky = &config.sky;
+    if sky.enabled && sky.glow[1] > 0.0 {
         // Its own stream: a config with a sky draws every other parameter as one without.
         let mut sky_rng = ChaCha8Rng::seed_from_u64(mix(seed, SKY_STREAM, street_id));
         let glow = uniform(&mut sky_rng, sky.glow);
         let color = sky.color.map(|c| crate::gltf_writer::round7(c * glow));
         doc.set_environment(json!({ "color": color }));
-        params["sky"] = json!({ "glow": glow, "color": color });
+        params["sky"] = json!({
+            "glow": glow,
+            "color": color,
+            "luminance_cd_m2": luminance(color) * crate::gltf_writer::LUMENS_PER_WATT,
+        });
+    }
+    if let Some(w) = &weather {
+        if let Some(fog) = w.fog_extras() {
+            doc.set_scene_extra("fog", fog);
+        }
+        if let Some(rain) = w.rain_extras() {
+            doc.set_scene_extra("rain", rain);
+        }
+        params["weather"] = json!(w);
     }
     let split = split_of(config, seed, street_id);
     params["rig"] = json!({
@@ -700,6 +787,7 @@ pub fn sample(config: &GeneratorConfig, seed: u64, index: u64) -> Result<SampleS
         street: street_id,
         split,
         params,
+        weather,
     })
 }
 
@@ -741,7 +829,7 @@ fn random_street(
     let spacing = uniform(rng, lc.spacing) as f32;
     let lamp_height = uniform(rng, lc.height) as f32;
     let lens = uniform(rng, lc.lens) as f32;
-    let temperature = uniform(rng, lc.temperature);
+    let lamp_type = weighted(rng, &lc.types);
     let lamp_intensity = uniform(rng, lc.intensity);
     let both_sides = rng.random_bool(lc.both_sides);
     // The first lamp lies within one spacing ahead, and always on the modelled street.
@@ -752,14 +840,26 @@ fn random_street(
     } else {
         Vec::new()
     };
-    let lamp_color = blackbody_rgb(temperature);
-    let marker = 40.0 * lamp_intensity / 250.0;
-    let lens_radiance = lamp_color.map(|c| crate::gltf_writer::round7(c * marker));
+    // The light's colour at peak 1 and the intensity that gives it the drawn luminance; the
+    // lens (2 lens x lens, facing down) at luminance I / area: as bright as the luminaire.
+    let round7 = crate::gltf_writer::round7;
+    let lamp_color = lamp_type.rgb().map(round7);
+    let lamp_power = round7(lamp_intensity / luminance(lamp_color));
+    let lens_area = 2.0 * f64::from(lens) * f64::from(lens);
+    let lens_radiance = lamp_type
+        .rgb_with_luminance(lamp_intensity / lens_area)
+        .map(round7);
 
     // Cars: parked ones in the outer lanes by the kerbs, leading ones in the driver's lane,
     // oncoming ones in the lanes left of the centre.
     let cc = &config.cars;
     let headlight_intensity = uniform(rng, cc.headlight_intensity);
+    let headlight_type = weighted(rng, &cc.headlight_types);
+    let headlight_color = headlight_type.rgb().map(round7);
+    let headlight_power = round7(headlight_intensity / luminance(headlight_color));
+    let headlamp_radiance = headlight_type
+        .rgb_with_luminance(luminance(StreetStyle::SHIPPED.headlamp_radiance))
+        .map(round7);
     let paint = |rng: &mut ChaCha8Rng| -> [f64; 3] {
         const PAINTS: [[f64; 3]; 8] = [
             [0.2, 0.02, 0.02],
@@ -873,6 +973,13 @@ fn random_street(
     let lit = uniform(rng, sc.lit_windows) as f32;
     let cool = uniform(rng, sc.cool_windows) as f32;
     let lit_shops = uniform(rng, sc.lit_shops) as f32;
+    let lm = crate::gltf_writer::LUMENS_PER_WATT;
+    let window_luminance = uniform(rng, sc.window_luminance);
+    let shop_luminance = uniform(rng, sc.shop_luminance);
+    let window_scale = round7(window_luminance / lm / luminance(crate::street::WINDOW_WARM));
+    let shop_radiance = LightSource::Led3000K
+        .rgb_with_luminance(shop_luminance / lm)
+        .map(round7);
 
     // Wetness.
     let wc = &config.wetness;
@@ -894,11 +1001,14 @@ fn random_street(
         kerb,
         facade_x,
         lamp_height,
-        lamp_intensity,
+        lamp_intensity: lamp_power,
         lamp_color,
         lens_half: (0.5 * lens, lens),
         lens_radiance,
-        headlight_intensity,
+        lamp_cone: Some((LAMP_CONE_DEG.0.to_radians(), LAMP_CONE_DEG.1.to_radians())),
+        headlight_intensity: headlight_power,
+        headlight_color,
+        headlamp_radiance,
         signal_intensity,
         wetness,
         asphalt_kd,
@@ -907,6 +1017,8 @@ fn random_street(
         ripples,
         lit_windows: (lit * (1.0 - cool), lit),
         lit_shops,
+        window_scale,
+        shop_radiance: Some(shop_radiance),
         facade_kd,
         ..StreetStyle::SHIPPED
     };
@@ -945,15 +1057,20 @@ fn random_street(
             "lit_windows": lit,
             "cool_windows": cool,
             "lit_shops": lit_shops,
+            "window_luminance_cd_m2": window_luminance,
+            "shop_luminance_cd_m2": shop_luminance,
             "poles": poles,
         },
         "lamps": {
             "spacing": spacing,
             "height": lamp_height,
             "lens_half_size": lens,
-            "temperature_k": temperature,
+            "type": lamp_type,
+            "cct_k": lamp_type.cct(),
             "color": lamp_color,
             "intensity_w_sr": lamp_intensity,
+            "intensity_cd": lamp_intensity * lm,
+            "lens_radiance": lens_radiance,
             "right": lamps_right,
             "left": lamps_left,
         },
@@ -964,6 +1081,7 @@ fn random_street(
             "color": c.color,
         })).collect::<Vec<_>>(),
         "headlight_intensity_w_sr": headlight_intensity,
+        "headlight_type": headlight_type,
         "traffic_lights": traffic_lights.iter().map(|t| json!({
             "z": t.z, "side": t.side, "signal": t.signal,
         })).collect::<Vec<_>>(),
@@ -1066,8 +1184,8 @@ mod tests {
             }
             baselines.push(baseline);
             assert!((0.1..=0.4).contains(&baseline));
-            let t = p["lamps"]["temperature_k"].as_f64().unwrap();
-            assert!((1900.0..=5000.0).contains(&t));
+            let kind: LightSource = serde_json::from_value(p["lamps"]["type"].clone()).unwrap();
+            assert!(config.lamps.types.contains_key(&kind), "{kind}");
             assert!(lights >= 2, "street {i}: {lights} lights");
         }
         assert_eq!(lanes.len(), 3, "{lanes:?}");
@@ -1109,55 +1227,61 @@ mod tests {
         assert!(n[1] > 12 && n[2] > 12, "{n:?}");
     }
 
-    #[test]
-    fn blackbody_colours_run_from_orange_to_white() {
-        let sodium = blackbody_rgb(2000.0);
-        let led = blackbody_rgb(4000.0);
-        let d65 = blackbody_rgb(6500.0);
-        assert_eq!(sodium[0], 1.0);
-        assert!(sodium[2] < 0.15 && sodium[1] < 0.6, "{sodium:?}");
-        assert!(led[2] > sodium[2] && led[1] > sodium[1], "{led:?}");
-        assert!(d65.iter().all(|&c| c > 0.85), "{d65:?}");
+    /// The scene's glTF as JSON and the sample's parameters and weather.
+    fn read(config: &GeneratorConfig) -> (serde_json::Value, SampleScene) {
+        let s = sample(config, 7, 3).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let files = s.doc.write(dir.path()).unwrap();
+        let gltf = files
+            .iter()
+            .find(|f| f.extension().is_some_and(|e| e == "gltf"));
+        let json: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(gltf.unwrap()).unwrap()).unwrap();
+        (json, s)
     }
 
-    /// A config with a `[sky]` writes the glow in the scene's extras and draws everything
-    /// else as the config without it; the default writes no environment; bad skies say why.
+    /// Removes `scenes[0].extras.streaks.KEY`.
+    fn without(mut gltf: serde_json::Value, key: &str) -> serde_json::Value {
+        if let Some(streaks) = gltf["scenes"][0]["extras"]["streaks"].as_object_mut() {
+            streaks.remove(key);
+            if streaks.is_empty() {
+                gltf["scenes"][0]["extras"]
+                    .as_object_mut()
+                    .unwrap()
+                    .remove("streaks");
+            }
+        }
+        gltf
+    }
+
+    /// The sky glow is on by default and written in the scene's extras; it draws everything
+    /// else as a config without it; bad skies say why.
     #[test]
     fn a_sky_glow_is_written_in_the_scene_and_changes_nothing_else() {
-        let read = |config: &GeneratorConfig| {
-            let s = sample(config, 7, 3).unwrap();
-            let dir = tempfile::tempdir().unwrap();
-            let files = s.doc.write(dir.path()).unwrap();
-            let gltf = files
-                .iter()
-                .find(|f| f.extension().is_some_and(|e| e == "gltf"));
-            let json: serde_json::Value =
-                serde_json::from_slice(&std::fs::read(gltf.unwrap()).unwrap()).unwrap();
-            (json, s.params)
-        };
-        let (plain, plain_params) = read(&GeneratorConfig::default());
-        assert!(plain["scenes"][0]["extras"].get("streaks").is_none());
-        assert!(plain_params.get("sky").is_none());
-        let sky = GeneratorConfig::from_toml_str(
-            "[sky]\nglow = [0.01, 0.01]\ncolor = [1.0, 0.5, 0.25]\n",
+        let mut config = GeneratorConfig::default();
+        config.weather.enabled = false;
+        let (glowing, s) = read(&config);
+        let env = &glowing["scenes"][0]["extras"]["streaks"]["environment"]["color"];
+        let rgb: [f64; 3] = serde_json::from_value(env.clone()).unwrap();
+        let cd_m2 = luminance(rgb) * 683.0;
+        assert!((0.015..=0.12).contains(&cd_m2), "{rgb:?}: {cd_m2} cd/m^2");
+        assert!(rgb[0] > rgb[1] && rgb[1] > rgb[2], "orange-pink: {rgb:?}");
+        assert_eq!(s.params["sky"]["color"], json!(rgb));
+        config.sky.enabled = false;
+        let (dark, dark_s) = read(&config);
+        assert!(dark["scenes"][0]["extras"].get("streaks").is_none());
+        assert!(dark_s.params.get("sky").is_none());
+        assert_eq!(without(glowing, "environment"), dark);
+        let fixed = GeneratorConfig::from_toml_str(
+            "[sky]\nglow = [0.01, 0.01]\ncolor = [1.0, 0.5, 0.25]\n[weather]\nenabled = false\n",
             "sky.toml",
         )
         .unwrap();
-        let (glowing, params) = read(&sky);
+        let (gltf, _) = read(&fixed);
         assert_eq!(
-            glowing["scenes"][0]["extras"]["streaks"]["environment"],
+            gltf["scenes"][0]["extras"]["streaks"]["environment"],
             json!({"color": [0.01, 0.005, 0.0025]})
         );
-        assert_eq!(params["sky"]["glow"], json!(0.01));
-        let mut without = glowing.clone();
-        without["scenes"][0]["extras"]
-            .as_object_mut()
-            .unwrap()
-            .remove("streaks");
-        assert_eq!(without, plain);
-        // The default config's serialised forms name no sky (dataset.json keeps its bytes).
-        assert!(!GeneratorConfig::default().to_toml().contains("sky"));
-        assert!(GeneratorConfig::default().to_json().get("sky").is_none());
         for (text, needle) in [
             ("[sky]\nglow = [-1, 0.1]\n", "sky.glow"),
             ("[sky]\ncolor = [2, 0, 0]\n", "sky.color"),
@@ -1166,6 +1290,132 @@ mod tests {
                 .unwrap_err()
                 .to_string();
             assert!(e.contains(needle), "{text:?}: {e}");
+        }
+    }
+
+    /// Weather draws in its own streams: with it, every parameter but the road's wetness and
+    /// ripples is the one drawn without it; its fog and rain are in the scene's extras as the
+    /// scene contract has them, and the road's wetness follows the rain rate.
+    #[test]
+    fn weather_changes_only_the_wetness_and_writes_fog_and_rain() {
+        let mut config = GeneratorConfig::default();
+        // Rain and fog always, so the extras are there to check.
+        config.weather.rain = vec![crate::weather::RainClass {
+            name: "heavy".into(),
+            probability: 1.0,
+            mm_h: [20.0, 20.0],
+        }];
+        config.weather.fog.probability = 1.0;
+        let (wet_gltf, wet) = read(&config);
+        let mut plain_config = config.clone();
+        plain_config.weather.enabled = false;
+        let (dry_gltf, dry) = read(&plain_config);
+        assert!(dry.weather.is_none() && dry.params.get("weather").is_none());
+        let w = wet.weather.clone().unwrap();
+        assert_eq!(w.rain_mm_h, 20.0);
+        let streaks = &wet_gltf["scenes"][0]["extras"]["streaks"];
+        assert_eq!(
+            streaks["rain"],
+            json!({"rate_mm_h": 20.0, "seed": w.rain_seed, "radius": 20.0})
+        );
+        let fog = w.fog.unwrap();
+        assert_eq!(
+            streaks["fog"],
+            json!({"sigma_t": fog.sigma_t, "albedo": fog.albedo, "g": fog.g,
+                   "height_falloff": fog.height_falloff})
+        );
+        // Every parameter but the wetness is the same.
+        let strip = |p: &serde_json::Value| {
+            let mut p = p.clone();
+            let o = p.as_object_mut().unwrap();
+            o.remove("weather");
+            o.remove("wetness");
+            p
+        };
+        assert_eq!(strip(&wet.params), strip(&dry.params));
+        for key in ["asphalt_kd", "ks_wet", "alpha_wet", "ks_dry", "alpha_dry"] {
+            assert_eq!(
+                wet.params["wetness"][key], dry.params["wetness"][key],
+                "{key}"
+            );
+        }
+        let level = wet.params["wetness"]["level"].as_f64().unwrap();
+        let expected = 0.3 + 0.6 * 20.0 / 23.0;
+        assert!((level - expected).abs() < 1e-6, "{level} vs {expected}");
+        assert!(!wet.params["wetness"]["ripples"].is_null());
+        assert_eq!(
+            (wet.baseline, wet.exposure_ev),
+            (dry.baseline, dry.exposure_ev)
+        );
+        // The glTF differs from the dry one by the extras and the road (material, textures).
+        let a = without(without(wet_gltf, "fog"), "rain");
+        assert_eq!(a["scenes"][0]["extras"], dry_gltf["scenes"][0]["extras"]);
+        assert_eq!(a["nodes"], dry_gltf["nodes"]);
+        assert_eq!(a["extensions"], dry_gltf["extensions"]);
+        // Pairs of a street share rain and fog; exposure and speed are per sample.
+        config.dataset.pairs_per_street = 2;
+        config.weather.rain = WeatherConfig::default().rain;
+        let a = sample(&config, 3, 4).unwrap().weather.unwrap();
+        let b = sample(&config, 3, 5).unwrap().weather.unwrap();
+        assert_eq!(
+            (a.rain_mm_h, a.fog, &a.sensor),
+            (b.rain_mm_h, b.fog, &b.sensor)
+        );
+        assert_ne!(a.exposure_s, b.exposure_s);
+        assert_ne!(a.rain_seed, b.rain_seed);
+        let e = GeneratorConfig::from_toml_str("[weather.fog]\ng = [0.5, 1.5]\n", "x.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("weather.fog.g") && e.contains("x.toml"), "{e}");
+        let e = GeneratorConfig::from_toml_str("[lamps.types]\nmercury = 1.0\n", "x.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("mercury"), "{e}");
+    }
+
+    /// Lights at physical levels: a lamp's luminance (Y of colour x intensity) is the drawn
+    /// intensity, its lens is as bright as the luminaire over its area, and the lamp type's
+    /// colour is the light's.
+    #[test]
+    fn lamps_carry_their_photometric_intensity() {
+        let config = GeneratorConfig::default();
+        for i in 0..20 {
+            let s = sample(&config, 11, i).unwrap();
+            let p = &s.params["lamps"];
+            let kind: LightSource = serde_json::from_value(p["type"].clone()).unwrap();
+            let i_y = p["intensity_w_sr"].as_f64().unwrap();
+            assert!((1.5..=5.0).contains(&i_y));
+            let color: [f64; 3] = serde_json::from_value(p["color"].clone()).unwrap();
+            for c in 0..3 {
+                assert!((color[c] - kind.rgb()[c]).abs() < 1e-6, "{kind}: {color:?}");
+            }
+            let lens: [f64; 3] = serde_json::from_value(p["lens_radiance"].clone()).unwrap();
+            let half = p["lens_half_size"].as_f64().unwrap();
+            let lens_intensity = luminance(lens) * 2.0 * half * half;
+            assert!(
+                (lens_intensity / i_y - 1.0).abs() < 1e-3,
+                "{lens_intensity} vs {i_y}"
+            );
+        }
+        // In the file: every street lamp a downward spot whose candela times its colour's
+        // luminance is the drawn intensity x 683.
+        let (gltf, s) = read(&config);
+        let i_cd = s.params["lamps"]["intensity_cd"].as_f64().unwrap();
+        let lights = gltf["extensions"]["KHR_lights_punctual"]["lights"]
+            .as_array()
+            .unwrap();
+        let lamps: Vec<_> = lights
+            .iter()
+            .filter(|l| l["name"].as_str().unwrap().starts_with("street_lamp_"))
+            .collect();
+        assert!(!lamps.is_empty());
+        for l in lamps {
+            assert_eq!(l["type"], "spot");
+            let outer = l["spot"]["outerConeAngle"].as_f64().unwrap();
+            assert!((outer.to_degrees() - 85.0).abs() < 1e-4, "{outer}");
+            let color: [f64; 3] = serde_json::from_value(l["color"].clone()).unwrap();
+            let cd = l["intensity"].as_f64().unwrap() * luminance(color);
+            assert!((cd / i_cd - 1.0).abs() < 1e-5, "{cd} cd vs {i_cd}");
         }
     }
 }

@@ -29,6 +29,10 @@ pub const LAMP_INTENSITY: f64 = 250.0;
 pub const HEADLIGHT_INTENSITY: f64 = 20.0;
 /// Red signal light radiant intensity on axis (W/sr).
 pub const SIGNAL_INTENSITY: f64 = 60.0;
+/// Radiance of a lit warm window (before [`StreetStyle::window_scale`]), W/(m^2 sr).
+pub const WINDOW_WARM: [f64; 3] = [1.6, 1.2, 0.7];
+/// Radiance of a lit cool window (before [`StreetStyle::window_scale`]), W/(m^2 sr).
+pub const WINDOW_COOL: [f64; 3] = [0.8, 0.95, 1.2];
 /// Size in texels of the tiling albedo textures (stone, brick, wood).
 pub const TILE_TEXELS: u32 = 256;
 /// Metres covered by one tile on small objects (poles, kerbs): 1 cm per texel.
@@ -147,8 +151,15 @@ pub struct StreetStyle {
     pub lens_half: (f32, f32),
     /// Radiance of the lamp lens.
     pub lens_radiance: [f64; 3],
-    /// Headlight radiant intensity on axis (W/sr).
+    /// The lamps' beam: `None`, a point light (the shipped streets); `Some((inner, outer))`,
+    /// a spot light pointing straight down with these glTF cone angles (radians).
+    pub lamp_cone: Option<(f64, f64)>,
+    /// Headlight radiant intensity on axis (W/sr) times [`StreetStyle::headlight_color`].
     pub headlight_intensity: f64,
+    /// Headlight colour (max component 1).
+    pub headlight_color: [f64; 3],
+    /// Radiance of a lit headlamp lens.
+    pub headlamp_radiance: [f64; 3],
     /// Traffic signal radiant intensity on axis (W/sr).
     pub signal_intensity: f64,
     /// Global wetness in [0, 1]: 0.5 is the shipped streets' balance of puddles, wet asphalt
@@ -167,6 +178,11 @@ pub struct StreetStyle {
     pub lit_windows: (f32, f32),
     /// Share of the shop windows that are lit.
     pub lit_shops: f32,
+    /// Factor on the radiance of the lit upper windows (warm and cool).
+    pub window_scale: f64,
+    /// Radiance of the lit shop windows: `None`, they are lit warm windows (the shipped
+    /// streets); `Some`, their own emitter `shop_window` of this radiance.
+    pub shop_radiance: Option<[f64; 3]>,
     /// Mean diffuse colour of the three facade materials (brick, render, concrete).
     pub facade_kd: [[f64; 3]; 3],
     /// The driver's camera (the stereo rig's centre): eye position.
@@ -189,7 +205,10 @@ impl StreetStyle {
         lamp_color: [1.0, 0.78, 0.5],
         lens_half: (0.12, 0.25),
         lens_radiance: [40.0, 30.0, 18.0],
+        lamp_cone: None,
         headlight_intensity: HEADLIGHT_INTENSITY,
+        headlight_color: [1.0, 0.95, 0.85],
+        headlamp_radiance: [30.0, 28.5, 25.5],
         signal_intensity: SIGNAL_INTENSITY,
         wetness: 0.5,
         asphalt_kd: ASPHALT_KD,
@@ -198,6 +217,8 @@ impl StreetStyle {
         ripples: None,
         lit_windows: (0.22, 0.3),
         lit_shops: 0.5,
+        window_scale: 1.0,
+        shop_radiance: None,
         facade_kd: [[0.16, 0.09, 0.07], [0.3, 0.28, 0.24], [0.18, 0.18, 0.19]],
         eye: EYE,
         pitch_tan: 0.035,
@@ -570,7 +591,10 @@ impl Street {
             );
             doc.add_light(&Light {
                 name: format!("street_lamp_{k}"),
-                kind: LightKind::Point,
+                kind: match st.lamp_cone {
+                    None => LightKind::Point,
+                    Some((inner, outer)) => LightKind::Spot { inner, outer },
+                },
                 color: st.lamp_color,
                 intensity: st.lamp_intensity,
                 position: Vec3::new(head_x, st.lamp_height, z),
@@ -642,10 +666,13 @@ impl Street {
             [0.01; 3],
             [0.3; 3],
         );
-        let warm = Material::emitter("window_warm", [1.6, 1.2, 0.7]);
-        let cool = Material::emitter("window_cool", [0.8, 0.95, 1.2]);
+        let lit = |c: [f64; 3]| c.map(|c| round7(c * st.window_scale));
+        let warm = Material::emitter("window_warm", lit(WINDOW_WARM));
+        let cool = Material::emitter("window_cool", lit(WINDOW_COOL));
+        let shop = Material::emitter("shop_window", st.shop_radiance.unwrap_or_default());
         let mut by_material: Vec<Mesh> = vec![Mesh::new(); 3];
         let (mut dark, mut lit_warm, mut lit_cool) = (Mesh::new(), Mesh::new(), Mesh::new());
+        let mut lit_shop = Mesh::new();
         let mut counter = 0u32;
         for side in [1.0f32, -1.0] {
             let mut z0 = self.near;
@@ -688,10 +715,12 @@ impl Street {
                     let mut zc = z0 - 3.5;
                     while zc > z1 + 3.0 {
                         counter += 1;
-                        let target = if hash01(counter, self.seed) < st.lit_shops {
-                            &mut lit_warm
-                        } else {
+                        let target = if hash01(counter, self.seed) >= st.lit_shops {
                             &mut dark
+                        } else if st.shop_radiance.is_some() {
+                            &mut lit_shop
+                        } else {
+                            &mut lit_warm
                         };
                         target.rect(Vec3::new(x, 1.5, zc), normal_u * 1.3, Vec3::Y * 0.9);
                         zc -= 5.0;
@@ -736,6 +765,7 @@ impl Street {
             ("windows_dark", &dark, &glass),
             ("windows_lit_warm", &lit_warm, &warm),
             ("windows_lit_cool", &lit_cool, &cool),
+            ("shop_windows_lit", &lit_shop, &shop),
         ] {
             if !m.indices.is_empty() {
                 doc.add_mesh(name, m, mat)?;
@@ -831,7 +861,7 @@ fn add_car(doc: &mut Doc, k: usize, car: &Car, st: &StreetStyle) -> Result<(), E
                 inner: 0.15,
                 outer: 0.4,
             },
-            color: [1.0, 0.95, 0.85],
+            color: st.headlight_color,
             intensity: st.headlight_intensity,
             position: Vec3::new(hx, 0.72, front + dir * 0.05),
             direction: Vec3::new(0.0, -0.03, dir),
@@ -854,7 +884,7 @@ fn add_car(doc: &mut Doc, k: usize, car: &Car, st: &StreetStyle) -> Result<(), E
         )
     } else {
         (
-            Material::emitter("headlamp_lens", [30.0, 28.5, 25.5]),
+            Material::emitter("headlamp_lens", st.headlamp_radiance),
             Material::emitter("tail_light", [6.0, 0.3, 0.15]),
         )
     };
