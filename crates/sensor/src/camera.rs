@@ -31,7 +31,7 @@ impl Capture {
 /// Exposes `radiance` (linear RGB, W/(m^2 sr)) with `profile`: the radiance is scaled by
 /// `2^scene_ev` (a correction for scenes whose lights are not at physical scale; 0 for
 /// physical scenes), spread by the lens's PSF, vignetted for a focal length of `focal_px`
-/// pixels, turned into electrons with noise drawn from `seed` (deterministic for a seed on any
+/// pixels (infinite for an orthographic camera: no vignetting), turned into electrons with noise drawn from `seed` (deterministic for a seed on any
 /// number of threads; give each eye of a pair its own) and read out to DN.
 pub fn capture(
     profile: &SensorProfile,
@@ -49,9 +49,9 @@ pub fn capture(
             h
         )));
     }
-    if !(focal_px.is_finite() && focal_px > 0.0) {
+    if !(focal_px > 0.0) {
         return Err(SensorError::Image(format!(
-            "the focal length must be a positive number of pixels, got {focal_px}"
+            "the focal length must be a positive number of pixels (or infinite), got {focal_px}"
         )));
     }
     if !scene_ev.is_finite() {
@@ -243,6 +243,9 @@ mod tests {
             "{corner} / {centre} vs {v}"
         );
         assert!(v < 0.5);
+        // An orthographic camera has no field angle.
+        let raw = capture(&p, &flat(1000.0, 64), f64::INFINITY, 0.0, 0).unwrap();
+        assert_eq!(raw.dn.get(0, 0), raw.dn.get(31, 31));
     }
 
     #[test]

@@ -273,10 +273,11 @@ pub fn convolve(plane: &mut [f32], width: usize, height: usize, kernel: &[f64], 
 }
 
 /// The vignetting factor `1 - s (1 - cos^4 theta)` of the pixel `(x, y)` of a `width x height`
-/// image with focal length `focal_px` pixels (see the module documentation).
+/// image with focal length `focal_px` pixels (see the module documentation); 1 for an
+/// infinite focal length (an orthographic camera).
 #[inline]
 pub fn vignetting(x: u32, y: u32, width: u32, height: u32, focal_px: f64, strength: f64) -> f64 {
-    if strength == 0.0 {
+    if strength == 0.0 || focal_px.is_infinite() {
         return 1.0;
     }
     let dx = f64::from(x) + 0.5 - 0.5 * f64::from(width);
