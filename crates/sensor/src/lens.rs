@@ -59,14 +59,14 @@ pub fn bessel_j1(x: f64) -> f64 {
     } else {
         let z = 8.0 / ax;
         let y = z * z;
-        let xx = ax - 2.356_194_491;
+        let xx = ax - 3.0 * std::f64::consts::FRAC_PI_4;
         let a = 1.0
             + y * (0.183_105e-2
                 + y * (-0.351_639_649_6e-4 + y * (0.245_752_017_4e-5 + y * (-0.240_337_019e-6))));
         let b = 0.046_874_999_95
             + y * (-0.200_269_087_3e-3
                 + y * (0.844_919_909_6e-5 + y * (-0.882_289_87e-6 + y * 0.105_787_412e-6)));
-        let ans = (0.636_619_772 / ax).sqrt() * (xx.cos() * a - z * xx.sin() * b);
+        let ans = (std::f64::consts::FRAC_2_PI / ax).sqrt() * (xx.cos() * a - z * xx.sin() * b);
         if x < 0.0 {
             -ans
         } else {
