@@ -1,7 +1,7 @@
 //! [`capture`]: a linear radiance image through the lens ([`crate::lens`]) and the sensor
 //! ([`crate::sensor`]) to raw DN ([`Capture`]).
 
-use crate::lens::{convolve, psf, psf_is_identity, vignetting};
+use crate::lens::{convolve, psf_is_identity, psfs, vignetting};
 use crate::sensor::Sensor;
 use crate::{SensorError, SensorProfile};
 use glam::Vec3;
@@ -64,13 +64,14 @@ pub fn capture(
         std::array::from_fn(|c| radiance.pixels.iter().map(|p| p[c] * scale).collect());
     if !psf_is_identity(profile) {
         let radius = profile.psf_radius_px as usize;
-        for (c, plane) in planes.iter_mut().enumerate() {
+        let kernels = psfs(profile);
+        for (plane, kernel) in planes.iter_mut().zip(&kernels) {
             // NaN and infinity would spread over the whole frame: no light.
             plane
                 .iter_mut()
                 .filter(|v| !v.is_finite())
                 .for_each(|v| *v = 0.0);
-            convolve(plane, w, h, &psf(profile, c), radius);
+            convolve(plane, w, h, kernel, radius);
         }
     }
     let sensor = Sensor::new(profile);

@@ -154,6 +154,26 @@ fn kernel(radius: u32, f: impl Fn(f64, f64) -> f64 + Sync) -> Vec<f64> {
 /// (the Airy part a delta without [`SensorProfile::diffraction`]), normalised to sum 1;
 /// `(2 R + 1)^2` values, row-major, centre at `(R, R)`.
 pub fn psf(profile: &SensorProfile, c: usize) -> Vec<f64> {
+    mix(profile, c, veil(profile).as_deref())
+}
+
+/// The PSFs of the three channels ([`psf`]), the veil computed once.
+pub fn psfs(profile: &SensorProfile) -> [Vec<f64>; 3] {
+    let veil = veil(profile);
+    std::array::from_fn(|c| mix(profile, c, veil.as_deref()))
+}
+
+/// The profile's normalised veil kernel, if it has a veil.
+fn veil(profile: &SensorProfile) -> Option<Vec<f64>> {
+    (profile.veil > 0.0).then(|| {
+        let mut v = veil_kernel(profile.psf_radius_px, profile.veil_core_px);
+        normalise(&mut v);
+        v
+    })
+}
+
+/// Channel `c`'s PSF from its Airy part and the normalised `veil` kernel.
+fn mix(profile: &SensorProfile, c: usize, veil: Option<&[f64]>) -> Vec<f64> {
     let radius = profile.psf_radius_px;
     let side = 2 * radius as usize + 1;
     let centre = radius as usize * side + radius as usize;
@@ -171,10 +191,8 @@ pub fn psf(profile: &SensorProfile, c: usize) -> Vec<f64> {
         d[centre] = 1.0;
         d
     };
-    if profile.veil > 0.0 {
-        let mut v = veil_kernel(radius, profile.veil_core_px);
-        normalise(&mut v);
-        for (k, v) in k.iter_mut().zip(&v) {
+    if let Some(v) = veil {
+        for (k, v) in k.iter_mut().zip(v) {
             *k = (1.0 - profile.veil) * *k + profile.veil * v;
         }
     }
