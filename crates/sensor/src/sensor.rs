@@ -151,6 +151,65 @@ mod tests {
         assert!((e / (0.6 * photons) - 1.0).abs() < 1e-12);
     }
 
+    /// Chi-square of the read-out electrons (gain 1, no read noise, no black level) against
+    /// the Poisson pmf, cells with fewer than 5 expected merged, at the 0.001 level.
+    #[test]
+    fn shot_noise_is_poisson() {
+        let p = SensorProfile {
+            read_noise_e: 0.0,
+            gain_e_per_dn: 1.0,
+            black_level_dn: 0.0,
+            bit_depth: 24,
+            full_well_e: 1e6,
+            ..SensorProfile::default()
+        };
+        let s = Sensor::new(&p);
+        // Chi-square 0.999 quantiles for 1..=40 degrees of freedom would need a table; the
+        // Wilson-Hilferty approximation is within 1 % of them here.
+        let critical = |dof: f64| {
+            let z = 3.090_2; // the normal's 0.999 quantile
+            dof * (1.0 - 2.0 / (9.0 * dof) + z * (2.0 / (9.0 * dof)).sqrt()).powi(3)
+        };
+        for (mean, seed) in [(0.7, 1), (3.7, 2), (11.5, 3), (57.0, 4), (400.0, 5)] {
+            let n = 200_000;
+            let max = (mean + 12.0 * f64::sqrt(mean) + 20.0) as usize;
+            let mut counts = vec![0u32; max + 1];
+            let mut rng = Sensor::row_rng(seed, 0);
+            for _ in 0..n {
+                let k = s.read_out(mean, &mut rng) as usize;
+                counts[k.min(max)] += 1;
+            }
+            // Poisson pmf by the recurrence p(k) = p(k-1) mean / k, in logs for large means.
+            let pmf = |k: usize| -> f64 {
+                let mut log = -mean;
+                for i in 1..=k {
+                    log += (mean / i as f64).ln();
+                }
+                log.exp()
+            };
+            let (mut chi2, mut dof) = (0.0, 0.0);
+            let (mut exp_acc, mut obs_acc) = (0.0, 0.0);
+            let mut tail = 1.0;
+            for (k, &c) in counts.iter().enumerate() {
+                let e = if k == max { tail } else { pmf(k) };
+                tail -= e;
+                exp_acc += e * f64::from(n);
+                obs_acc += f64::from(c);
+                if exp_acc >= 5.0 || k == max {
+                    chi2 += (obs_acc - exp_acc).powi(2) / exp_acc.max(1e-9);
+                    dof += 1.0;
+                    exp_acc = 0.0;
+                    obs_acc = 0.0;
+                }
+            }
+            let dof = dof - 1.0;
+            assert!(
+                chi2 < critical(dof),
+                "mean {mean}: chi2 {chi2} with {dof} dof"
+            );
+        }
+    }
+
     #[test]
     fn read_out_clips_to_the_full_well_and_the_adc() {
         let p = SensorProfile::default();
