@@ -40,6 +40,8 @@ pub fn capture(
     scene_ev: f64,
     seed: u64,
 ) -> Result<Capture, SensorError> {
+    // A profile built in code has not been through the TOML reader's checks.
+    profile.check("given to capture")?;
     let (w, h) = (radiance.width as usize, radiance.height as usize);
     if w == 0 || h == 0 || radiance.pixels.len() != w * h {
         return Err(SensorError::Image(format!(
@@ -307,6 +309,12 @@ mod tests {
         assert!(capture(&p, &bad, 100.0, 0.0, 0).is_err());
         assert!(capture(&p, &flat(0.1, 4), 0.0, 0.0, 0).is_err());
         assert!(capture(&p, &flat(0.1, 4), 10.0, f64::NAN, 0).is_err());
+        let bad_profile = SensorProfile {
+            veil_core_px: 0.0,
+            ..p.clone()
+        };
+        let e = capture(&bad_profile, &flat(0.1, 4), 10.0, 0.0, 0).unwrap_err();
+        assert!(e.to_string().contains("veil_core_px"), "{e}");
         // NaN and infinite radiance are no light, not a frame full of NaN.
         let mut img = flat(0.0, 16);
         img.pixels[5] = Vec3::new(f32::NAN, f32::INFINITY, -1.0);

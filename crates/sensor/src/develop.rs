@@ -18,17 +18,19 @@ pub fn tone(x: f64) -> u8 {
     (srgb_oetf(y as f32) * 255.0 + 0.5) as u8
 }
 
-/// The capture developed through the tone curve (see the module documentation).
+/// The capture developed through the tone curve (see the module documentation). A capture
+/// with fewer pixels than its size (only a hand-made one) develops its missing pixels black.
 pub fn develop(capture: &Capture) -> image::RgbImage {
     let dn = &capture.dn;
     let scale = capture.develop_ev.exp2() / (capture.white_dn - capture.black_dn);
-    let bytes = dn
-        .pixels
-        .iter()
-        .flat_map(|p| p.to_array())
-        .map(|v| tone((f64::from(v) - capture.black_dn) * scale))
-        .collect();
-    image::RgbImage::from_raw(dn.width, dn.height, bytes).expect("three bytes per pixel")
+    image::RgbImage::from_fn(dn.width, dn.height, |x, y| {
+        let i = y as usize * dn.width as usize + x as usize;
+        let p = dn.pixels.get(i).copied().unwrap_or(glam::Vec3::ZERO);
+        image::Rgb(
+            p.to_array()
+                .map(|v| tone((f64::from(v) - capture.black_dn) * scale)),
+        )
+    })
 }
 
 #[cfg(test)]
@@ -74,5 +76,9 @@ mod tests {
             ..capture
         };
         assert_eq!(develop(&bright).as_raw()[6..], [255, 255, 255]);
+        // A hand-made capture short of pixels does not panic.
+        let mut short = bright.clone();
+        short.dn.pixels.pop();
+        assert_eq!(develop(&short).as_raw()[6..], [0, 0, 0]);
     }
 }
