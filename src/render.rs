@@ -3,11 +3,13 @@
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
 use streaks_image::color::luminance;
-use streaks_image::png::write_png;
+use streaks_image::png::{write_png, write_png_buffer};
 use streaks_image::stats::quantile_below;
 use streaks_image::{GrayImage, RgbImage};
+use streaks_render::camera::Camera;
 use streaks_render::integrator::{self, Layers, RenderJob, RenderOutput};
 use streaks_render::output;
+use streaks_sensor::{capture, Capture, SensorProfile};
 
 use crate::render_opts::{Loaded, RenderOpts};
 use streaks_stereo::render::{road_surface, scene_has_road};
@@ -90,6 +92,7 @@ pub fn run(args: Args) -> Result<()> {
     }
     let opts = &args.render;
     opts.check()?;
+    let sensor = opts.sensor_profile()?;
     let layers = Layers {
         depth: args.layers.contains(&Layer::Depth),
         normal: args.layers.contains(&Layer::Normal),
@@ -142,12 +145,25 @@ pub fn run(args: Args) -> Result<()> {
         pool.install(|| integrator::render(&scene, &camera, &job, &|n| bar.inc(n)));
     bar.finish_and_clear();
 
+    let raw = match &sensor {
+        Some(profile) => Some(expose(profile, &out.image, &camera, opts)?),
+        None => None,
+    };
+    let png_of = |path: &Path| -> Result<()> {
+        match &raw {
+            Some(raw) => write_png_buffer(path, &raw.develop())?,
+            None => write_png(path, &out.image, opts.exposure)?,
+        }
+        Ok(())
+    };
     match format {
-        Format::Exr => output::write_exr(&args.output, &out)?,
-        Format::Png => write_png(&args.output, &out.image, opts.exposure)?,
+        Format::Exr => {
+            output::write_exr_with_sensor(&args.output, &out, raw.as_ref().map(|r| &r.dn))?
+        }
+        Format::Png => png_of(&args.output)?,
     }
     if let Some(png) = &args.png {
-        write_png(png, &out.image, opts.exposure)?;
+        png_of(png)?;
     }
     if let (Some(path), Some(material)) = (&args.road_mask, &out.material) {
         let road = road_surface(&scene, material)
@@ -158,7 +174,9 @@ pub fn run(args: Args) -> Result<()> {
             .save_png(path)
             .with_context(|| format!("cannot write the road mask {}", path.display()))?;
     }
-    if let Some(warning) = black_image_warning(&out.image, opts.exposure) {
+    // A camera's image is as its profile develops it.
+    if let Some(warning) = black_image_warning(&out.image, opts.exposure).filter(|_| raw.is_none())
+    {
         eprintln!("warning: {}: {warning}", args.output.display());
     }
     let s = &out.stats;
@@ -181,6 +199,27 @@ pub fn run(args: Args) -> Result<()> {
         s.nonfinite_dropped
     );
     Ok(())
+}
+
+/// The render through the camera `profile`: `--exposure` scales the radiance, the focal
+/// length in pixels gives the vignetting (none for an orthographic camera), the noise is drawn
+/// from `--seed`.
+fn expose(
+    profile: &SensorProfile,
+    image: &RgbImage,
+    camera: &Camera,
+    opts: &RenderOpts,
+) -> Result<Capture> {
+    let focal = camera
+        .focal_px(image.height)
+        .map_or(f64::INFINITY, f64::from);
+    Ok(capture(
+        profile,
+        image,
+        focal,
+        f64::from(opts.exposure),
+        u64::from(opts.seed),
+    )?)
 }
 
 /// Below this linear luminance a pixel develops to at most 8 of 255 in sRGB: black to the eye.

@@ -8,6 +8,7 @@ use std::path::Path;
 use streaks_render::camera::{Camera, FRAMING_WARNING};
 use streaks_render::light::Environment;
 use streaks_render::scene::Scene;
+use streaks_sensor::SensorProfile;
 use streaks_settings::{RenderSettings, SettingsError};
 
 use crate::cli::{image_size, load_scene, progress_bar};
@@ -46,9 +47,17 @@ pub struct RenderOpts {
     /// Worker threads [default: all cores].
     #[arg(long)]
     pub threads: Option<usize>,
-    /// Exposure of the PNGs in stops (linear * 2^EV before the sRGB curve).
+    /// Exposure of the PNGs in stops (linear * 2^EV before the sRGB curve); with --sensor,
+    /// a factor 2^EV on the scene's radiance before the lens (for scenes whose lights are not
+    /// at physical scale).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
+    /// See the render through a camera: a preset (automotive_hdr, automotive_linear, ideal) or
+    /// a profile file (a path with a / or ending in .toml; see docs/sensor.md). The EXR gets
+    /// the raw DN as a `sensor` layer and the PNGs are developed from them; the render and
+    /// the ground truth stay as they are.
+    #[arg(long, value_name = "PRESET|FILE.toml")]
+    pub sensor: Option<String>,
     /// Path regularisation (biased): roughen glossy lobes after a diffuse or rough bounce, as
     /// Cycles' "Filter Glossy" does; far fewer fireflies, the first bounce (streaks) unchanged.
     #[arg(long)]
@@ -153,7 +162,16 @@ impl RenderOpts {
         if !self.exposure.is_finite() {
             bail!("--exposure must be a finite number of stops");
         }
+        self.sensor_profile()?;
         self.env.check()
+    }
+
+    /// The camera profile of `--sensor`, if given.
+    pub fn sensor_profile(&self) -> Result<Option<SensorProfile>> {
+        self.sensor
+            .as_deref()
+            .map(|arg| SensorProfile::resolve(arg).context("--sensor"))
+            .transpose()
     }
 
     /// The render settings of the flags (`--spp`, `--max-depth`, `--regularize`,

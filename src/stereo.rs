@@ -6,7 +6,7 @@ use anyhow::{bail, Context, Result};
 use std::path::PathBuf;
 use streaks_analysis::report::AnalyzeParams;
 use streaks_dataset::write::write_pair;
-use streaks_stereo::render::{render_pair, rig_from_camera, PairSettings};
+use streaks_stereo::render::{expose_pair, render_pair, rig_from_camera, PairSettings};
 use streaks_stereo::rig::Rig;
 use streaks_stereo::streak_mask::StreakMaskParams;
 
@@ -34,6 +34,7 @@ pub fn run(args: Args) -> Result<()> {
     // Phase 1: everything that needs no scene.
     let opts = &args.render;
     opts.check()?;
+    let sensor = opts.sensor_profile()?;
     if !(args.baseline.is_finite() && args.baseline > 0.0) {
         bail!(
             "--baseline must be a positive number of metres, got {}",
@@ -60,8 +61,11 @@ pub fn run(args: Args) -> Result<()> {
     // Phase 3: render both eyes under one progress bar and write everything.
     let pool = opts.thread_pool()?;
     let bar = opts.progress(2, width, height)?;
-    let views = pool.install(|| render_pair(&scene, &rig, &settings, &|n| bar.inc(n)))?;
+    let mut views = pool.install(|| render_pair(&scene, &rig, &settings, &|n| bar.inc(n)))?;
     bar.finish_and_clear();
+    if let Some(profile) = &sensor {
+        pool.install(|| expose_pair(&mut views, &rig, profile, opts.seed, opts.exposure))?;
+    }
     write_pair(&args.output, &scene, &rig, &views, opts.exposure)
         .with_context(|| format!("writing the pair into {}", args.output.display()))?;
     let seconds: f64 = views.iter().map(|v| v.output.stats.seconds).sum();

@@ -11,5 +11,6 @@ mod detect;
 mod khronos;
 mod measure;
 mod render;
+mod sensor;
 mod special_files;
 mod stereo;

@@ -8,7 +8,7 @@ use image::RgbImage;
 use streaks_image::develop;
 use streaks_image::pfm::write_pfm;
 use streaks_image::png::write_png_buffer;
-use streaks_render::output::write_exr;
+use streaks_render::output::write_exr_with_sensor;
 use streaks_render::scene::Scene;
 use streaks_stereo::calib::MiddleburyCalib;
 use streaks_stereo::pair::write_pair_views;
@@ -27,7 +27,8 @@ pub enum GroundTruth {
 }
 
 /// Writes both views of a rendered pair into `files` (whose folder must exist): per eye the
-/// EXR with its layers, the 8-bit sRGB PNG at `exposure_ev` stops and the ground-truth
+/// EXR with its layers (and the `sensor` layer of a view exposed through a camera model), the
+/// 8-bit sRGB PNG (at `exposure_ev` stops, or developed from the camera's DN) and the ground-truth
 /// disparity; the depth, streak mask and (when the scene flags a road material) road-surface
 /// mask of the views `truth` says. Returns the two sRGB images.
 pub fn write_views(
@@ -40,8 +41,12 @@ pub fn write_views(
     let has_road = scene_has_road(scene);
     let mut srgb = Vec::with_capacity(2);
     for (eye, view) in Eye::BOTH.into_iter().zip(views) {
-        write_exr(&files.exr(eye), &view.output)?;
-        let img = develop(&view.output.image, exposure_ev)?;
+        let raw = view.sensor.as_ref();
+        write_exr_with_sensor(&files.exr(eye), &view.output, raw.map(|c| &c.dn))?;
+        let img = match raw {
+            Some(capture) => capture.develop(),
+            None => develop(&view.output.image, exposure_ev)?,
+        };
         write_png_buffer(&files.png(eye), &img)?;
         srgb.push(img);
         write_pfm(&files.disparity(eye), &view.disparity)?;

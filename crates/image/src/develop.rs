@@ -2,8 +2,8 @@
 //! sRGB that every PNG of a render holds (`streaks render`, the pairs of `streaks stereo` and
 //! the dataset's `im0.png`/`im1.png`).
 //!
-//! The camera model is deliberately simple (docs/design.md: no sensor noise, glare or
-//! vignetting): the exposure scales the radiance by `2^exposure_ev`, the sensor clips at 1
+//! The camera model is deliberately simple (no sensor noise, glare or vignetting; the
+//! `streaks-sensor` crate adds those with `--sensor`, developing its raw DN by its own curve): the exposure scales the radiance by `2^exposure_ev`, the sensor clips at 1
 //! (negative values and NaN to 0), and the tone curve is the sRGB transfer function, rounded to
 //! 8 bits.
 

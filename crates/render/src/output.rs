@@ -3,6 +3,8 @@
 //! Channels: `R`, `G`, `B` (the beauty image, linear) plus, when present, `depth.Z`,
 //! `normal.X`/`normal.Y`/`normal.Z`, `albedo.R`/`.G`/`.B`, `specular.R`/`.G`/`.B` and
 //! `spp.Y` (samples taken per pixel, as float32: exact up to 2^24) (OpenEXR's `layer.channel` naming, which Blender, Nuke and `exrheader` show as layers).
+//! A render through a camera model (`--sensor`) also has `sensor.R`/`.G`/`.B`, the camera's
+//! raw values in DN as float32 ([`write_exr_with_sensor`]); `R`, `G`, `B` stay the render.
 //! [`write_exr`] writes them and [`read_exr_layer`] reads them back, from the names here; the
 //! file itself is written by [`streaks_image::exr`] (atomically).
 
@@ -23,10 +25,22 @@ pub const NORMAL: [&str; 3] = ["normal.X", "normal.Y", "normal.Z"];
 pub const DEPTH: &str = "depth.Z";
 /// The samples-per-pixel layer's channel.
 pub const SPP: &str = "spp.Y";
+/// The sensor layer's channels (raw DN of a camera model).
+pub const SENSOR: [&str; 3] = ["sensor.R", "sensor.G", "sensor.B"];
 
 /// Writes the render as a float32 EXR: the beauty image and the layers present in `output`
 /// (see the module documentation), atomically.
 pub fn write_exr(path: &Path, output: &RenderOutput) -> Result<(), ImageError> {
+    write_exr_with_sensor(path, output, None)
+}
+
+/// [`write_exr`] with the `sensor` layer (raw DN of a camera model, the size of the render)
+/// when `sensor` is given.
+pub fn write_exr_with_sensor(
+    path: &Path,
+    output: &RenderOutput,
+    sensor: Option<&RgbImage>,
+) -> Result<(), ImageError> {
     let img = &output.image;
     let mut channels: Vec<ExrChannel> = Vec::new();
     let mut push_rgb = |names: [&'static str; 3], image: &RgbImage| {
@@ -43,6 +57,9 @@ pub fn write_exr(path: &Path, output: &RenderOutput) -> Result<(), ImageError> {
     if let Some(normal) = &output.normal {
         push_rgb(NORMAL, normal);
     }
+    if let Some(sensor) = sensor {
+        push_rgb(SENSOR, sensor);
+    }
     if let Some(depth) = &output.depth {
         channels.push((DEPTH, depth.clone()));
     }
@@ -52,13 +69,14 @@ pub fn write_exr(path: &Path, output: &RenderOutput) -> Result<(), ImageError> {
     streaks_image::exr::write_exr(path, img.width, img.height, channels)
 }
 
-/// Reads a layer written by [`write_exr`]: `"albedo"`, `"specular"` (RGB), `"normal"` (XYZ
+/// Reads a layer written by [`write_exr`]: `"albedo"`, `"specular"`, `"sensor"` (RGB), `"normal"` (XYZ
 /// into the RGB slots), `"depth"` (Z) or `"spp"` (samples per pixel; one channel, repeated
 /// into all three slots).
 pub fn read_exr_layer(path: &Path, name: &str) -> Result<RgbImage, ImageError> {
     match name {
         "albedo" => read_exr_rgb_channels(path, ALBEDO),
         "specular" => read_exr_rgb_channels(path, SPECULAR),
+        "sensor" => read_exr_rgb_channels(path, SENSOR),
         "normal" => read_exr_rgb_channels(path, NORMAL),
         "depth" | "spp" => {
             let channel = if name == "depth" { DEPTH } else { SPP };
@@ -68,7 +86,9 @@ pub fn read_exr_layer(path: &Path, name: &str) -> Result<RgbImage, ImageError> {
         }
         other => Err(ImageError::MissingChannels {
             path: path.to_path_buf(),
-            what: format!("layer {other:?} (the layers are albedo, specular, normal, depth, spp)"),
+            what: format!(
+                "layer {other:?} (the layers are albedo, specular, normal, depth, spp, sensor)"
+            ),
         }),
     }
 }
@@ -127,6 +147,11 @@ mod tests {
         assert!(err.to_string().contains("\"beauty\""), "{err}");
         // Only the image is left in the folder (no temporary files).
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+        assert!(read_exr_layer(&path, "sensor").is_err());
+        let raw = gradient(5, 3);
+        write_exr_with_sensor(&path, &out, Some(&raw)).unwrap();
+        assert_eq!(read_exr_layer(&path, "sensor").unwrap(), raw);
+        assert_eq!(read_exr_rgb(&path).unwrap(), out.image);
     }
 
     #[test]

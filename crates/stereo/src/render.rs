@@ -12,6 +12,10 @@
 //! The left eye is rendered with the given seed and the right eye with `seed + 1`, so that
 //! the two views' sampling noise is independent and cannot pull a matcher toward zero disparity.
 //!
+//! Through a camera model ([`expose_pair`], `--sensor`), each eye gets its raw capture
+//! ([`EyeView::sensor`]) with its own noise seed (the eye's render seed); the ground truth and
+//! the streak masks stay those of the render.
+//!
 //! The views are written into a sample folder by the `streaks-dataset` crate (its `write`
 //! module), which names every file.
 //!
@@ -28,6 +32,7 @@ use streaks_render::camera::Camera;
 use streaks_render::integrator::{render, Layers, RenderJob, RenderOutput};
 use streaks_render::light::{Emitter, Light};
 use streaks_render::scene::Scene;
+use streaks_sensor::{capture, Capture, SensorProfile};
 use streaks_settings::RenderSettings;
 
 /// A road pixel's first-hit normal is within this angle's cosine of +Y (10 degrees).
@@ -100,6 +105,9 @@ pub struct EyeView {
     pub streak_mask: GrayImage,
     /// The specular-luminance threshold the mask used.
     pub streak_threshold: f32,
+    /// The eye's raw capture through a camera model ([`expose_pair`]); `None` for the render
+    /// alone.
+    pub sensor: Option<Capture>,
 }
 
 impl EyeView {
@@ -139,10 +147,7 @@ pub fn render_eye(
     let job = RenderJob {
         width: w,
         height: h,
-        seed: match eye {
-            Eye::Left => settings.seed,
-            Eye::Right => settings.seed.wrapping_add(1),
-        },
+        seed: eye_seed(settings.seed, eye),
         layers: Layers {
             depth: true,
             normal: true,
@@ -198,6 +203,7 @@ pub fn render_eye(
         streak_mask,
         streak_threshold,
         output,
+        sensor: None,
     })
 }
 
@@ -214,6 +220,38 @@ pub fn road_surface(scene: &Scene, materials: &[u32]) -> Vec<bool> {
 /// (`extras.streaks.road: true`); without one, [`EyeView::road_surface`] is empty of road.
 pub fn scene_has_road(scene: &Scene) -> bool {
     scene.materials.iter().any(|m| m.road)
+}
+
+/// The render seed of `eye` for a pair of seed `seed`: `seed` left, `seed + 1` right.
+pub fn eye_seed(seed: u32, eye: Eye) -> u32 {
+    match eye {
+        Eye::Left => seed,
+        Eye::Right => seed.wrapping_add(1),
+    }
+}
+
+/// Exposes both rendered eyes of `rig` through the camera `profile` ([`EyeView::sensor`]):
+/// the radiance times `2^scene_ev`, each eye's noise drawn from its render seed
+/// ([`eye_seed`] of `seed`), so the two eyes' noise is independent.
+pub fn expose_pair(
+    views: &mut [EyeView; 2],
+    rig: &Rig,
+    profile: &SensorProfile,
+    seed: u32,
+    scene_ev: f32,
+) -> Result<(), StereoError> {
+    for (eye, view) in Eye::BOTH.into_iter().zip(views.iter_mut()) {
+        let raw = capture(
+            profile,
+            &view.output.image,
+            f64::from(rig.focal_px()),
+            f64::from(scene_ev),
+            u64::from(eye_seed(seed, eye)),
+        )
+        .map_err(|e| StereoError::Render(format!("the {eye} eye's sensor: {e}")))?;
+        view.sensor = Some(raw);
+    }
+    Ok(())
 }
 
 /// Renders both eyes (left first) with one `progress` over both: it receives increments of
