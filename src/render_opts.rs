@@ -7,6 +7,7 @@ use indicatif::ProgressBar;
 use std::path::Path;
 use streaks_render::camera::{Camera, FRAMING_WARNING};
 use streaks_render::light::Environment;
+use streaks_render::motion::Motion;
 use streaks_render::scene::Scene;
 use streaks_settings::{RenderSettings, SettingsError};
 
@@ -61,6 +62,18 @@ pub struct RenderOpts {
     /// The environment light flags.
     #[command(flatten)]
     pub env: EnvOpts,
+    /// Shutter time in seconds, centred on the scene's moment (open at -S/2, close at +S/2):
+    /// rain drops and a moving rig (--rig-velocity) blur over it [default: 0, no blur].
+    #[arg(long, value_name = "S", default_value_t = 0.0)]
+    pub shutter: f32,
+    /// The rig's velocity in m/s, world space, during the shutter (both eyes move together).
+    #[arg(
+        long,
+        value_name = "X,Y,Z",
+        value_delimiter = ',',
+        allow_negative_numbers = true
+    )]
+    pub rig_velocity: Option<Vec<f32>>,
 }
 
 /// The environment light flags of `streaks render`, `streaks stereo` and `streaks
@@ -153,6 +166,7 @@ impl RenderOpts {
         if !self.exposure.is_finite() {
             bail!("--exposure must be a finite number of stops");
         }
+        self.motion()?;
         self.env.check()
     }
 
@@ -167,10 +181,34 @@ impl RenderOpts {
         }
     }
 
+    /// The shutter and rig motion of `--shutter` and `--rig-velocity`.
+    pub fn motion(&self) -> Result<Motion> {
+        if !(self.shutter.is_finite() && self.shutter >= 0.0) {
+            bail!(
+                "--shutter must be a time of 0 s or more (got {})",
+                self.shutter
+            );
+        }
+        let rig_velocity = match self.rig_velocity.as_deref() {
+            Some(&[x, y, z]) => Vec3::new(x, y, z),
+            Some(other) => bail!(
+                "--rig-velocity takes three numbers, X,Y,Z in m/s (got {})",
+                other.len()
+            ),
+            None => Vec3::ZERO,
+        };
+        let motion = Motion::centred(self.shutter, rig_velocity);
+        motion
+            .check()
+            .map_err(|e| anyhow::anyhow!("--shutter/--rig-velocity: {e}"))?;
+        Ok(motion)
+    }
+
     /// Phase 2: loads the scene (with the environment of `--env` or `--env-color`, if given;
-    /// printing its warnings), picks the camera and sizes the image.
+    /// printing its warnings), picks the camera, sizes the image, and places the scene's
+    /// rain drops (if it has rain) around that camera for the shutter of the flags.
     pub fn load(&self, path: &Path) -> Result<Loaded> {
-        let scene = self.env.load_scene(path, self.allow_outside_scene)?;
+        let mut scene = self.env.load_scene(path, self.allow_outside_scene)?;
         for warning in &scene.warnings {
             eprintln!("warning: {warning}");
         }
@@ -189,6 +227,9 @@ impl RenderOpts {
                 scene.default_camera(width as f32 / height as f32)
             }
         };
+        scene
+            .place_rain(&camera, width, height, self.motion()?)
+            .with_context(|| format!("the rain of the scene {}", path.display()))?;
         Ok(Loaded {
             scene,
             camera,

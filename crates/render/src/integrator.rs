@@ -141,6 +141,18 @@
 //!   threshold on it.
 //! - `spp`: the number of samples the pixel took (kept and dropped), `spp` everywhere unless
 //!   adaptive sampling stopped its tile earlier.
+//! - `rain`: the share of the pixel's camera samples (kept and dropped) whose first hit was a
+//!   rain drop ([`crate::rain`]).
+//!
+//! The first-hit layers (depth, normal, albedo, material) are taken at the reference time 0
+//! from the camera where the scene puts it, and ignore rain drops
+//! ([`Scene::intersect_surfaces`]): they are the ground truth of the scene behind the rain.
+//!
+//! Time ([`crate::motion`]): with the shutter open for a nonzero interval
+//! ([`RenderJob::motion`]), each camera sample draws one more number after its film position,
+//! its time `t` uniform over the shutter, and its ray starts at the camera moved by the rig's
+//! velocity times `t`; every ray of the path carries `t`. With a closed shutter nothing is
+//! drawn and the image is the one a renderer without time makes.
 
 use crate::bsdf::Bsdf;
 use crate::camera::Camera;
@@ -148,6 +160,7 @@ use crate::film::{Film, Pixel};
 use crate::geometry::{offset_ray_origin, Frame, Ray};
 use crate::light::{LightSampler, Receiver, Visibility};
 use crate::material::Volume;
+use crate::motion::Motion;
 use crate::sampling::{power_heuristic, Sampler};
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
@@ -180,6 +193,8 @@ pub struct Layers {
     pub material: bool,
     /// Samples taken per pixel (see adaptive sampling in the module documentation).
     pub spp: bool,
+    /// Share of the camera samples whose first hit was a rain drop.
+    pub rain: bool,
 }
 
 /// One image to render: its size, seed and layers, and how to sample it.
@@ -195,6 +210,8 @@ pub struct RenderJob {
     pub layers: Layers,
     /// Samples, adaptive sampling, path length and regularisation.
     pub settings: RenderSettings,
+    /// The shutter interval and the rig's velocity ([`Motion::default`]: no motion blur).
+    pub motion: Motion,
 }
 
 /// Adaptive sampling: the side of the square tiles of pixels that stop together (see the
@@ -260,6 +277,9 @@ pub struct RenderOutput {
     pub material: Option<Vec<u32>>,
     /// Samples taken per pixel, row-major (if requested).
     pub spp: Option<Vec<u32>>,
+    /// Share of each pixel's camera samples whose first hit was a rain drop, row-major (if
+    /// requested).
+    pub rain: Option<Vec<f32>>,
     /// Counters.
     pub stats: RenderStats,
 }
@@ -270,6 +290,8 @@ struct PathResult {
     radiance: Vec3,
     specular: Vec3,
     rays: u64,
+    /// Whether the camera ray's first hit was a rain drop.
+    rain: bool,
 }
 
 /// Renders `camera`'s view of `scene` on the current rayon thread pool.
@@ -359,6 +381,7 @@ pub fn render(
         specular: layers.specular.then(|| film.specular()),
         material: layers.material.then(|| film.material()),
         spp: layers.spp.then(|| film.spp()),
+        rain: layers.rain.then(|| film.rain()),
         stats: RenderStats {
             seconds: start.elapsed().as_secs_f64(),
             samples: film.samples(),
@@ -475,15 +498,20 @@ fn take_sample(
 ) -> u64 {
     sampler.start_pixel_sample((x, y), s);
     let film_pos = Vec2::new(x as f32, y as f32) + sampler.next_2d();
-    let ray = camera.generate_ray(film_pos, job.width, job.height);
+    let mut ray = camera.generate_ray(film_pos, job.width, job.height);
+    if job.motion.is_blurred() {
+        ray.time = job.motion.time(sampler.next_1d());
+        ray.origin += job.motion.rig_velocity * ray.time;
+    }
     let path = trace_path(scene, ray, sampler, job);
     pixel.add_sample(path.radiance, path.specular);
+    pixel.rain += u32::from(path.rain);
     path.rays
 }
 
 /// Fills the depth, normal, albedo and material of `pixel` from the pixel-centre ray.
 fn first_hit_layers(scene: &Scene, ray: &Ray, origin: Vec3, forward: Vec3, pixel: &mut Pixel) {
-    if let Some(hit) = scene.intersect(ray) {
+    if let Some(hit) = scene.intersect_surfaces(ray) {
         pixel.depth = (hit.p - origin).dot(forward);
         pixel.material = hit.material;
         pixel.normal = if hit.ns.dot(ray.direction) > 0.0 {
@@ -581,6 +609,7 @@ fn trace_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, job: &RenderJo
             break;
         };
         let wo = -ray.direction;
+        out.rain |= depth == 0 && hit.triangle == crate::rain::RAIN_TRIANGLE;
         if let Some(v) = medium {
             throughput *= v.transmittance(hit.t);
         }
@@ -674,6 +703,7 @@ fn trace_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, job: &RenderJo
                                 origin,
                                 direction: ls.wi,
                                 t_max,
+                                time: ray.time,
                             };
                             if scene.occluded(&shadow) {
                                 Vec3::ZERO
@@ -686,6 +716,7 @@ fn trace_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, job: &RenderJo
                                 origin,
                                 direction: ls.wi,
                                 t_max: ls.dist * (1.0 + 1e-4),
+                                time: ray.time,
                             };
                             match scene.intersect(&ray) {
                                 Some(h)
@@ -745,7 +776,7 @@ fn trace_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, job: &RenderJo
             min_ray_pdf = min_ray_pdf.min(bs.pdf);
         }
         medium = medium_along(bs.wi.z);
-        ray = Ray::new(offset_ray_origin(hit.p, ng, wi), wi);
+        ray = Ray::new(scene.spawn_origin(&hit, ng, wi), wi).at_time(ray.time);
         depth += 1;
 
         // Russian roulette (Mitsuba's rule).
@@ -813,6 +844,7 @@ pub(crate) mod tests {
             seed: 1,
             layers: Layers::default(),
             settings: RenderSettings::new(spp, max_depth),
+            motion: Default::default(),
         }
     }
 
@@ -1121,6 +1153,7 @@ pub(crate) mod tests {
             specular: true,
             material: true,
             spp: true,
+            rain: true,
         };
         let run = |threads| {
             rayon::ThreadPoolBuilder::new()

@@ -188,10 +188,12 @@ pub use validate::MAX_COORDINATE;
 
 use crate::accel::Accel;
 use crate::camera::Camera;
-use crate::geometry::{Ray, SurfaceHit};
+use crate::geometry::{offset_ray_origin, Ray, SurfaceHit, VertexAttributes};
 use crate::light::{Environment, Light, LightSampler, SurfaceMesh};
 use crate::material::Material;
+use crate::motion::Motion;
 use crate::normal_map::{self, MappedNormal, NormalMap};
+use crate::rain::{offset_from_drop, DropField, Rain, RainError, RainParams, RainView};
 use crate::sampling::{pcg_hash, u32_to_unit_f32};
 use crate::texture::Texture;
 use glam::{Vec2, Vec3, Vec4};
@@ -247,6 +249,9 @@ pub struct Scene {
     pub light_sampler: LightSampler,
     /// Things in the file that were skipped or defaulted, for the command to print.
     pub warnings: Vec<String>,
+    /// Rain in the air (`scenes[i].extras.streaks.rain`, [`crate::rain`]): its drops are
+    /// placed for a view by [`Scene::place_rain`]; `None` for a dry scene.
+    pub rain: Option<Rain>,
 }
 
 /// The in-memory ingredients of a [`Scene`], for [`Scene::from_parts`].
@@ -400,6 +405,7 @@ impl Scene {
             instances,
             light_sampler,
             warnings,
+            rain: None,
         })
     }
 
@@ -527,7 +533,83 @@ impl Scene {
         self.stops(geometry, ray, triangle, id, b)
     }
 
-    /// Closest hit along `ray` within `(t_min, ray.t_max)` (see [`Accel::t_min`]) where the
+    /// Closest hit along `ray` (at its time) on the scene's surfaces or a rain drop: what
+    /// [`Scene::intersect_surfaces`] finds, unless a drop of the placed rain
+    /// ([`Scene::place_rain`]) is nearer. A drop's hit has [`crate::rain::RAIN_TRIANGLE`] as
+    /// its triangle and the water material ([`crate::rain::water_material`]).
+    #[inline]
+    pub fn intersect(&self, ray: &Ray) -> Option<SurfaceHit> {
+        let surface = self.intersect_surfaces(ray);
+        let Some(rain) = self.rain.as_ref().filter(|r| !r.field.is_empty()) else {
+            return surface;
+        };
+        let mut nearer = *ray;
+        if let Some(h) = &surface {
+            nearer.t_max = h.t;
+        }
+        match rain.field.intersect(&nearer) {
+            Some((t, _, n)) => Some(SurfaceHit {
+                t,
+                p: ray.at(t),
+                ng: n,
+                ns: n,
+                mapped: None,
+                coat_normal: None,
+                attributes: VertexAttributes::from_uv(Vec2::ZERO),
+                triangle: crate::rain::RAIN_TRIANGLE,
+                material: rain.material,
+            }),
+            None => surface,
+        }
+    }
+
+    /// The origin of a ray that leaves `hit` (with geometric normal `ng`) toward `w`: offset
+    /// off the surface by [`offset_ray_origin`], or for a rain drop by
+    /// [`crate::rain::offset_from_drop`] (a drop can be smaller than the triangles' offset).
+    #[inline]
+    pub fn spawn_origin(&self, hit: &SurfaceHit, ng: Vec3, w: Vec3) -> Vec3 {
+        if hit.triangle == crate::rain::RAIN_TRIANGLE {
+            offset_from_drop(hit.p, ng, w)
+        } else {
+            offset_ray_origin(hit.p, ng, w)
+        }
+    }
+
+    /// Gives the scene rain (what `extras.streaks.rain` asks for): adds the water material
+    /// to [`Scene::materials`]; no drops until [`Scene::place_rain`].
+    pub fn set_rain(&mut self, params: RainParams) {
+        let material = self.materials.len() as u32;
+        self.materials.push(crate::rain::water_material());
+        self.rain = Some(Rain {
+            params,
+            material,
+            field: DropField::default(),
+        });
+    }
+
+    /// Places the scene's rain drops (if it has rain) for a `width` x `height` view of
+    /// `camera` with the shutter and rig motion of `motion`: in the camera's view frustum
+    /// widened by [`crate::rain::RIG_MARGIN`], so that both eyes of a stereo rig centred on
+    /// `camera` see the same drops. Returns the number of drops. Renders of other views see
+    /// these drops too (all of them where they are seen from this camera's region).
+    pub fn place_rain(
+        &mut self,
+        camera: &Camera,
+        width: u32,
+        height: u32,
+        motion: Motion,
+    ) -> Result<usize, RainError> {
+        let Some(rain) = &mut self.rain else {
+            return Ok(0);
+        };
+        let view = RainView::of_camera(camera, width, height, motion, crate::rain::RIG_MARGIN)
+            .ok_or(RainError::Orthographic)?;
+        rain.field = DropField::place(&rain.params, &view)?;
+        Ok(rain.field.len())
+    }
+
+    /// Closest hit along `ray` within `(t_min, ray.t_max)` (see [`Accel::t_min`]) on the
+    /// scene's surfaces, ignoring rain drops (the ground-truth layers use it), where the
     /// ray stops, on the flat triangles or an instance: hits on alpha-masked-out points are
     /// skipped, and `BLEND` surfaces stop the ray with probability alpha (stochastic
     /// transparency, decided by a hash of the ray and the triangle). The shading normal is the
@@ -537,7 +619,7 @@ impl Scene {
     /// the side of the geometric normal. A hit on an instance has
     /// [`INSTANCED_TRIANGLE`] as its triangle.
     #[inline]
-    pub fn intersect(&self, ray: &Ray) -> Option<SurfaceHit> {
+    pub fn intersect_surfaces(&self, ray: &Ray) -> Option<SurfaceHit> {
         let flat = self
             .accel
             .intersect_filtered(ray, |t, b| self.stops(self.geometry(), ray, t, t, b));
@@ -641,7 +723,7 @@ impl Scene {
     }
 
     /// Whether anything blocks `ray` within `(t_min, ray.t_max)` (shadow query), with the
-    /// same alpha test as [`Scene::intersect`].
+    /// same alpha test as [`Scene::intersect`]; a rain drop blocks it like any glass.
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
         self.accel
@@ -650,6 +732,7 @@ impl Scene {
                 && self.instances.occluded(ray, self.accel.t_min(), |i, t, b| {
                     self.instance_stops(ray, i, t, b)
                 }))
+            || self.rain.as_ref().is_some_and(|r| r.field.occluded(ray))
     }
 }
 
