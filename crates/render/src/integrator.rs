@@ -161,6 +161,7 @@ use crate::geometry::{offset_ray_origin, Frame, Ray};
 use crate::light::{LightSampler, Receiver, Visibility};
 use crate::material::Volume;
 use crate::motion::Motion;
+use crate::rain::{CameraRain, RainPath};
 use crate::sampling::{power_heuristic, Sampler};
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
@@ -315,6 +316,12 @@ pub fn render(
         .normalize();
     let l = job.layers;
     let need_centre = l.depth || l.normal || l.albedo || l.material;
+    // The drops this camera sees, binned by pixel (none without rain).
+    let rain = scene
+        .rain
+        .as_ref()
+        .and_then(|r| CameraRain::build(&r.field, camera, width, height, &job.motion));
+    let rain = rain.as_ref();
 
     match job.settings.noise_target {
         None => film.par_rows_mut().enumerate().for_each(|(y, row)| {
@@ -327,7 +334,8 @@ pub fn render(
                     row_rays += centre_ray(scene, camera, job, forward, (x, y), pixel);
                 }
                 for s in 0..job.settings.spp {
-                    row_rays += take_sample(scene, camera, job, &mut sampler, (x, y), s, pixel);
+                    row_rays +=
+                        take_sample(scene, camera, job, rain, &mut sampler, (x, y), s, pixel);
                 }
             }
             rays.fetch_add(row_rays, Ordering::Relaxed);
@@ -359,6 +367,7 @@ pub fn render(
                             scene,
                             camera,
                             job,
+                            rain,
                             target,
                             &mut sampler,
                             tile,
@@ -438,6 +447,7 @@ fn render_tile_adaptive(
     scene: &Scene,
     camera: &Camera,
     job: &RenderJob,
+    rain: Option<&CameraRain>,
     target: f32,
     sampler: &mut Sampler,
     tile: Tile,
@@ -456,7 +466,7 @@ fn render_tile_adaptive(
         for xy in tile.pixels() {
             let pixel = &mut band[index(xy)];
             for s in taken..next {
-                rays += take_sample(scene, camera, job, sampler, xy, s, pixel);
+                rays += take_sample(scene, camera, job, rain, sampler, xy, s, pixel);
             }
         }
         taken = next;
@@ -487,10 +497,12 @@ fn centre_ray(
 
 /// Takes sample `s` of pixel `(x, y)` into `pixel`; returns the rays traced.
 #[inline]
+#[allow(clippy::too_many_arguments)]
 fn take_sample(
     scene: &Scene,
     camera: &Camera,
     job: &RenderJob,
+    rain: Option<&CameraRain>,
     sampler: &mut Sampler,
     (x, y): (u32, u32),
     s: u32,
@@ -503,7 +515,7 @@ fn take_sample(
         ray.time = job.motion.time(sampler.next_1d());
         ray.origin += job.motion.rig_velocity * ray.time;
     }
-    let path = trace_path(scene, ray, sampler, job);
+    let path = trace_path(scene, ray, sampler, job, rain);
     pixel.add_sample(path.radiance, path.specular);
     pixel.rain += u32::from(path.rain);
     path.rays
@@ -511,7 +523,7 @@ fn take_sample(
 
 /// Fills the depth, normal, albedo and material of `pixel` from the pixel-centre ray.
 fn first_hit_layers(scene: &Scene, ray: &Ray, origin: Vec3, forward: Vec3, pixel: &mut Pixel) {
-    if let Some(hit) = scene.intersect_surfaces(ray) {
+    if let Some(hit) = scene.intersect(ray) {
         pixel.depth = (hit.p - origin).dot(forward);
         pixel.material = hit.material;
         pixel.normal = if hit.ns.dot(ray.direction) > 0.0 {
@@ -566,7 +578,13 @@ impl Arrival {
 }
 
 /// Traces one camera path (see the module documentation).
-fn trace_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, job: &RenderJob) -> PathResult {
+fn trace_path(
+    scene: &Scene,
+    mut ray: Ray,
+    sampler: &mut Sampler,
+    job: &RenderJob,
+    rain: Option<&CameraRain>,
+) -> PathResult {
     let (max_depth, want_specular) = (job.settings.max_depth, job.layers.specular);
     let lights: &LightSampler = &scene.light_sampler;
     let mut out = PathResult::default();
@@ -585,6 +603,8 @@ fn trace_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, job: &RenderJo
     let mut first_bsdf: Option<(Bsdf, Frame, Vec3)> = None;
     // The smallest density of the directions chosen so far (path regularisation).
     let mut min_ray_pdf = f32::INFINITY;
+    // Which rain drops the next ray can meet.
+    let mut rain_path = RainPath::camera(rain);
 
     while depth < max_depth {
         out.rays += 1;
@@ -595,7 +615,7 @@ fn trace_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, job: &RenderJo
             prev_bsdf_pdf,
             first_bsdf,
         };
-        let Some(hit) = scene.intersect(&ray) else {
+        let Some(hit) = scene.intersect_path(&ray, &mut rain_path) else {
             // 1'. The environment, for a ray that escapes (not from inside a volume, whose
             // closed surface a ray cannot leave unseen).
             if let (Some(env), None) = (lights.environment(), medium) {

@@ -34,13 +34,13 @@
 //!   CWBVH the instances' top level uses, [`crate::accel::Tlas`]), and a leaf is an exact
 //!   ray-sphere test at the ray's time. No triangles are made.
 
-use crate::accel::Tlas;
 use crate::camera::{Camera, Projection};
 use crate::geometry::Ray;
 use crate::material::{GltfPbrParams, Material, Reflectance, Volume};
 use crate::motion::Motion;
 use crate::sampling::Pcg32;
 use glam::{Affine3A, Vec2, Vec3};
+use rayon::prelude::*;
 
 /// Marshall-Palmer's intercept `N0`, drops per m^3 per mm of diameter.
 pub const MP_N0: f64 = 8000.0;
@@ -258,13 +258,11 @@ impl RainView {
     }
 }
 
-/// A scene's drops for one view, and their BVH.
+/// A scene's drops, placed for one view (sorted along a Morton curve of their centres).
 #[derive(Debug, Default)]
 pub struct DropField {
     /// The drops.
     pub drops: Vec<Drop>,
-    /// The BVH over their swept boxes (`None` without drops).
-    bvh: Option<Tlas>,
 }
 
 /// Why drops could not be placed.
@@ -357,14 +355,8 @@ impl DropField {
                 count: drops.len() as u64,
             });
         }
-        Ok(DropField::new(drops, motion.open, motion.close))
-    }
-
-    /// A field of the given drops with their BVH over the shutter `[open, close]`.
-    pub fn new(drops: Vec<Drop>, open: f32, close: f32) -> DropField {
-        let boxes: Vec<[Vec3; 2]> = drops.iter().map(|d| d.swept_box(open, close)).collect();
-        let bvh = Tlas::build(&boxes);
-        DropField { drops, bvh }
+        sort_spatially(&mut drops);
+        Ok(DropField { drops })
     }
 
     /// The number of drops.
@@ -376,40 +368,233 @@ impl DropField {
     pub fn is_empty(&self) -> bool {
         self.drops.is_empty()
     }
+}
 
-    /// Approximate heap memory of the drops and their BVH, in bytes.
-    pub fn memory_bytes(&self) -> usize {
-        std::mem::size_of_val(self.drops.as_slice())
-            + self.bvh.as_ref().map_or(0, Tlas::memory_bytes)
+/// Sorts `drops` along a Morton (Z-order) curve of their centres, so that drops near each
+/// other in space are near each other in memory: the BVH's leaves then read neighbouring
+/// drops, which matters with millions of them.
+fn sort_spatially(drops: &mut [Drop]) {
+    let Some([lo, hi]) = drops
+        .iter()
+        .map(|d| [d.centre, d.centre])
+        .reduce(|[a, b], [c, d]| [a.min(c), b.max(d)])
+    else {
+        return;
+    };
+    let scale = 1023.0 / (hi - lo).max_element().max(1e-6);
+    let key = |d: &Drop| {
+        let q = ((d.centre - lo) * scale)
+            .as_uvec3()
+            .min(glam::UVec3::splat(1023));
+        spread(q.x) | (spread(q.y) << 1) | (spread(q.z) << 2)
+    };
+    drops.sort_by_cached_key(key);
+}
+
+/// The bits of a 10-bit `v` spread to every third bit.
+fn spread(v: u32) -> u32 {
+    let mut x = v & 0x3ff;
+    x = (x | (x << 16)) & 0x0300_00ff;
+    x = (x | (x << 8)) & 0x0300_f00f;
+    x = (x | (x << 4)) & 0x030c_30c3;
+    (x | (x << 2)) & 0x0924_9249
+}
+
+/// A camera's view of the drops: for each bin of [`BIN`] x [`BIN`] pixels, a copy of every
+/// drop whose sphere, moving over the shutter relative to the moving camera, projects into
+/// it. A camera ray reads the drops of its own bin only (tens, not millions), in memory order.
+/// Built by [`crate::integrator::render`] for the camera it renders.
+#[derive(Debug)]
+pub struct CameraRain {
+    /// World to camera rotation.
+    camera_from_world: glam::Mat3,
+    /// Focal length in pixels.
+    focal: f32,
+    /// Image size in pixels.
+    size: Vec2,
+    /// Bins across and down.
+    bins: (u32, u32),
+    /// Where each bin's drops start in `drops` (one more entry than bins).
+    starts: Vec<u32>,
+    /// The bins' drops, bin after bin.
+    drops: Vec<Drop>,
+}
+
+/// The side of a [`CameraRain`] bin, pixels.
+pub const BIN: u32 = 1;
+
+impl CameraRain {
+    /// The index of `field` as the perspective `camera` sees it in a `width` x `height` image
+    /// over the shutter of `motion` (the camera moving at the rig's velocity); `None` for an
+    /// orthographic camera or without drops.
+    pub fn build(
+        field: &DropField,
+        camera: &Camera,
+        width: u32,
+        height: u32,
+        motion: &Motion,
+    ) -> Option<CameraRain> {
+        let Projection::Perspective { yfov, .. } = camera.projection else {
+            return None;
+        };
+        if field.is_empty() || width == 0 || height == 0 {
+            return None;
+        }
+        let focal = 0.5 * height as f32 / (0.5 * yfov).tan();
+        let camera_from_world = glam::Mat3::from(camera.world_from_camera.matrix3).transpose();
+        let eye = camera.position();
+        let size = Vec2::new(width as f32, height as f32);
+        let bins = (width.div_ceil(BIN), height.div_ceil(BIN));
+        // The bins a drop covers: the box of its sphere's projections at the shutter's two
+        // ends, each seen from where the camera is then.
+        let cover = |d: &Drop| -> [u32; 4] {
+            const NONE: [u32; 4] = [u32::MAX; 4];
+            let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
+            for t in [motion.open, motion.close] {
+                let c = camera_from_world * (d.centre_at(t) - eye - motion.rig_velocity * t);
+                let (z, r) = (-c.z, d.radius);
+                if z - r <= 1e-4 {
+                    return NONE;
+                }
+                // The sphere lies in the box c +- r; over that box x / z is largest at the
+                // near face when x + r > 0 and at the far face otherwise (likewise the least).
+                let extreme = |v: f32, near_if_positive: bool| {
+                    v / if (v > 0.0) == near_if_positive {
+                        z - r
+                    } else {
+                        z + r
+                    }
+                };
+                let (x0, x1) = (extreme(c.x - r, false), extreme(c.x + r, true));
+                let (y0, y1) = (extreme(c.y - r, false), extreme(c.y + r, true));
+                lo = lo.min(Vec2::new(
+                    0.5 * size.x + focal * x0,
+                    0.5 * size.y - focal * y1,
+                ));
+                hi = hi.max(Vec2::new(
+                    0.5 * size.x + focal * x1,
+                    0.5 * size.y - focal * y0,
+                ));
+            }
+            if hi.x < 0.0 || hi.y < 0.0 || lo.x >= size.x || lo.y >= size.y {
+                return NONE;
+            }
+            let b = BIN as f32;
+            let (x0, y0) = ((lo.x / b).max(0.0) as u32, (lo.y / b).max(0.0) as u32);
+            let x1 = ((hi.x / b) as u32).min(bins.0 - 1);
+            let y1 = ((hi.y / b) as u32).min(bins.1 - 1);
+            [x0, y0, x1, y1]
+        };
+        let covers: Vec<[u32; 4]> = field.drops.par_iter().map(cover).collect();
+        let bin_count = (bins.0 * bins.1) as usize;
+        let mut starts = vec![0u32; bin_count + 1];
+        for &[x0, y0, x1, y1] in covers.iter().filter(|c| c[0] != u32::MAX) {
+            for y in y0..=y1 {
+                for x in x0..=x1 {
+                    starts[(y * bins.0 + x) as usize + 1] += 1;
+                }
+            }
+        }
+        for i in 0..bin_count {
+            starts[i + 1] += starts[i];
+        }
+        let mut fill = starts.clone();
+        let placeholder = Drop {
+            centre: Vec3::ZERO,
+            radius: 0.0,
+            speed: 0.0,
+        };
+        let mut drops = vec![placeholder; starts[bin_count] as usize];
+        for (d, &[x0, y0, x1, y1]) in field.drops.iter().zip(&covers) {
+            if x0 == u32::MAX {
+                continue;
+            }
+            for y in y0..=y1 {
+                for x in x0..=x1 {
+                    let slot = &mut fill[(y * bins.0 + x) as usize];
+                    drops[*slot as usize] = *d;
+                    *slot += 1;
+                }
+            }
+        }
+        Some(CameraRain {
+            camera_from_world,
+            focal,
+            size,
+            bins,
+            starts,
+            drops,
+        })
     }
 
-    /// The nearest drop `ray` meets before `ray.t_max` at its time: the parameter, the drop's
-    /// index and the outward normal.
+    /// How many drop copies the bins hold.
+    pub fn entries(&self) -> usize {
+        self.drops.len()
+    }
+
+    /// The nearest drop the camera ray `ray` (from the camera, at its time) meets before
+    /// `t_max`: the parameter, the drop and its outward normal there.
     #[inline]
-    pub fn intersect(&self, ray: &Ray) -> Option<(f32, u32, Vec3)> {
-        let bvh = self.bvh.as_ref()?;
-        let mut best: Option<(f32, u32, Vec3)> = None;
-        bvh.closest(ray, 0.0, |i, t_max| {
-            match self.drops[i as usize].intersect(ray, t_max) {
-                Some((t, n)) => {
-                    best = Some((t, i, n));
-                    t
-                }
-                None => f32::INFINITY,
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<(f32, Drop, Vec3)> {
+        let d = self.camera_from_world * ray.direction;
+        if d.z >= 0.0 {
+            return None;
+        }
+        let film = Vec2::new(
+            0.5 * self.size.x + self.focal * d.x / -d.z,
+            0.5 * self.size.y - self.focal * d.y / -d.z,
+        );
+        if !(film.x >= 0.0 && film.y >= 0.0 && film.x < self.size.x && film.y < self.size.y) {
+            return None;
+        }
+        let (x, y) = (
+            (film.x as u32 / BIN).min(self.bins.0 - 1),
+            (film.y as u32 / BIN).min(self.bins.1 - 1),
+        );
+        let bin = (y * self.bins.0 + x) as usize;
+        let (a, b) = (self.starts[bin] as usize, self.starts[bin + 1] as usize);
+        let mut best: Option<(f32, Drop, Vec3)> = None;
+        let mut end = t_max;
+        for drop in &self.drops[a..b] {
+            if let Some((t, n)) = drop.intersect(ray, end) {
+                end = t;
+                best = Some((t, *drop, n));
             }
-        });
+        }
         best
     }
+}
 
-    /// Whether a drop blocks `ray` before `ray.t_max` at its time.
+/// Which drops the next ray of a path can meet: a camera ray those of its camera's
+/// [`CameraRain`], a ray leaving a drop hit that drop (its way out, or nothing for a ray
+/// leaving its outside), any other ray none (see the module documentation).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RainPath<'a> {
+    /// The camera's index, for the camera ray (taken by the first query).
+    pub camera: Option<&'a CameraRain>,
+    /// The drop the previous ray hit.
+    pub drop: Option<Drop>,
+}
+
+impl<'a> RainPath<'a> {
+    /// The state of a camera path of a camera whose drops are `camera` (`None`: no rain).
+    pub fn camera(camera: Option<&'a CameraRain>) -> Self {
+        RainPath { camera, drop: None }
+    }
+
+    /// The nearest drop the path's next ray meets before `t_max`, and the state for the ray
+    /// after it.
     #[inline]
-    pub fn occluded(&self, ray: &Ray) -> bool {
-        let Some(bvh) = &self.bvh else {
-            return false;
+    pub fn intersect(&mut self, ray: &Ray, t_max: f32) -> Option<(f32, Drop, Vec3)> {
+        let found = if let Some(camera) = self.camera.take() {
+            camera.intersect(ray, t_max)
+        } else if let Some(drop) = self.drop {
+            drop.intersect(ray, t_max).map(|(t, n)| (t, drop, n))
+        } else {
+            None
         };
-        bvh.any(ray, 0.0, |i| {
-            self.drops[i as usize].intersect(ray, ray.t_max).is_some()
-        })
+        self.drop = found.map(|f| f.1);
+        found
     }
 }
 
@@ -613,31 +798,307 @@ mod tests {
         }
     }
 
+    /// The nearest drop along `ray` by testing every drop of the field.
+    fn every_drop(field: &DropField, ray: &Ray, t_max: f32) -> Option<(f32, Drop)> {
+        let mut best: Option<(f32, Drop)> = None;
+        for d in &field.drops {
+            if let Some((t, _)) = d.intersect(ray, best.map_or(t_max, |b| b.0)) {
+                best = Some((t, *d));
+            }
+        }
+        best
+    }
+
     #[test]
-    fn the_field_finds_the_drop_a_ray_is_aimed_at_at_its_time() {
+    fn the_camera_index_finds_what_testing_every_drop_finds() {
         let params = RainParams {
             rate_mm_h: 25.0,
             seed: 1,
             radius: 4.0,
         };
-        let field = DropField::place(&params, &view()).unwrap();
-        assert!(field.len() > 1000);
-        let origin = Vec3::new(0.0, 1.4, 0.0);
-        for (k, d) in field.drops.iter().enumerate().step_by(97) {
-            let time = 1.0 / 200.0;
-            let mut ray = Ray::new(origin, (d.centre_at(time) - origin).normalize());
+        let camera = Camera::perspective(
+            "c",
+            Affine3A::from_rotation_translation(
+                glam::Quat::from_rotation_y(0.4),
+                Vec3::new(1.0, 1.4, -2.0),
+            ),
+            0.8,
+            None,
+        );
+        let (w, h) = (120, 80);
+        // A shutter with the rig driving sideways and forward.
+        let motion = Motion::centred(1.0 / 30.0, Vec3::new(3.0, 0.0, -8.0));
+        let view = RainView::of_camera(&camera, w, h, motion, RIG_MARGIN).unwrap();
+        let field = DropField::place(&params, &view).unwrap();
+        assert!(field.len() > 1000, "{}", field.len());
+        let index = CameraRain::build(&field, &camera, w, h, &motion).unwrap();
+        let mut rng = Pcg32::new(5, 5);
+        let (mut hits, mut aimed_hits) = (0, 0);
+        for k in 0..40_000 {
+            let time = motion.time(rng.next_f32());
+            // Random rays, and rays aimed at a drop's centre at the ray's time.
+            let film = if k % 2 == 0 {
+                Vec2::new(w as f32 * rng.next_f32(), h as f32 * rng.next_f32())
+            } else {
+                let d = field.drops[(rng.next_u32() as usize) % field.len()];
+                let eye = camera.position() + motion.rig_velocity * time;
+                match camera.project(d.centre_at(time) - motion.rig_velocity * time, w, h) {
+                    Some(p) if p.x >= 0.0 && p.y >= 0.0 && p.x < w as f32 && p.y < h as f32 => {
+                        let _ = eye;
+                        p
+                    }
+                    _ => continue,
+                }
+            };
+            let mut ray = camera.generate_ray(film, w, h);
+            ray.origin += motion.rig_velocity * time;
             ray.time = time;
-            let (t, _, _) = field.intersect(&ray).expect("aimed at a drop");
-            let aimed = (d.centre_at(time) - origin).length() - d.radius;
-            // The drop aimed at, or one in front of it.
-            assert!(t <= aimed + 1e-4, "drop {k}: {t} vs {aimed}");
-            assert!(field.occluded(&ray));
-            // The drop falls out of the ray's way when the ray is at another time.
-            let mut later = ray;
-            later.time = -1.0 / 200.0;
-            if d.speed * 0.01 > 2.5 * d.radius {
-                assert!(d.intersect(&later, f32::INFINITY).is_none(), "drop {k}");
+            let want = every_drop(&field, &ray, 50.0);
+            let got = index.intersect(&ray, 50.0);
+            assert_eq!(want.map(|w| w.1), got.map(|g| g.1), "ray {k}");
+            if let (Some(a), Some(b)) = (want, got) {
+                assert_eq!(a.0, b.0);
+                hits += 1;
+                aimed_hits += k % 2;
             }
         }
+        assert!(
+            hits > 500 && aimed_hits > 300,
+            "{hits} hits, {aimed_hits} aimed"
+        );
+    }
+
+    #[test]
+    fn a_path_meets_the_drop_it_entered_on_its_way_out() {
+        let drop = Drop {
+            centre: Vec3::new(0.0, 0.0, -2.0),
+            radius: 1e-3,
+            speed: 4.0,
+        };
+        let field = DropField { drops: vec![drop] };
+        let camera = Camera::perspective("c", Affine3A::IDENTITY, 0.5, None);
+        let index = CameraRain::build(&field, &camera, 64, 64, &Motion::default()).unwrap();
+        let mut path = RainPath::camera(Some(&index));
+        let ray = Ray::new(Vec3::ZERO, -Vec3::Z);
+        let (t, d, n) = path.intersect(&ray, f32::INFINITY).unwrap();
+        assert!((t - (2.0 - 1e-3)).abs() < 1e-5 && d == drop && n.z > 0.99);
+        // Refracted in: the next ray starts just inside and leaves through the far side.
+        let p = ray.at(t);
+        let inside = Ray::new(offset_from_drop(p, n, -Vec3::Z), -Vec3::Z);
+        let (t2, _, n2) = path.intersect(&inside, f32::INFINITY).unwrap();
+        assert!((t2 - 2e-3).abs() < 1e-4 && n2.z < -0.99, "{t2} {n2}");
+        // Leaving outward: nothing more to meet, and after a miss no drop at all.
+        let out = Ray::new(offset_from_drop(inside.at(t2), n2, -Vec3::Z), -Vec3::Z);
+        assert!(path.intersect(&out, f32::INFINITY).is_none());
+        assert!(path.intersect(&ray, f32::INFINITY).is_none());
+    }
+}
+
+#[cfg(test)]
+mod render_tests {
+    use super::*;
+    use crate::integrator::tests::quad;
+    use crate::integrator::{render, Layers, RenderJob};
+    use crate::scene::{Scene, SceneParts};
+    use streaks_settings::RenderSettings;
+
+    /// The share of a pixel `[i, i+1)` lit by a half-plane whose edge sits at film position
+    /// `s`, averaged over `s` uniform in `[s0, s1]` (the analytic motion blur of an edge).
+    fn swept_share(i: f32, s0: f32, s1: f32) -> f32 {
+        let steps = 10_000;
+        (0..steps)
+            .map(|k| {
+                let s = s0 + (s1 - s0) * (k as f32 + 0.5) / steps as f32;
+                (s - i).clamp(0.0, 1.0)
+            })
+            .sum::<f32>()
+            / steps as f32
+    }
+
+    #[test]
+    fn a_moving_rig_blurs_an_edge_by_the_analytic_swept_fraction() {
+        // An emitter of radiance 1 on x < 0 at z = -2, seen by a camera moving along +X.
+        let mut wall = Material::diffuse("wall", Vec3::ZERO);
+        wall.emission = Vec3::ONE;
+        let mut parts = SceneParts {
+            materials: vec![wall],
+            ..Default::default()
+        };
+        let z = -2.0;
+        quad(
+            &mut parts,
+            [
+                Vec3::new(-50.0, -50.0, z),
+                Vec3::new(0.0, -50.0, z),
+                Vec3::new(0.0, 50.0, z),
+                Vec3::new(-50.0, 50.0, z),
+            ],
+            0,
+        );
+        let scene = Scene::from_parts(parts).unwrap();
+        let (w, h, yfov) = (64u32, 16u32, 0.3f32);
+        let camera = Camera::perspective("c", Affine3A::IDENTITY, yfov, None);
+        let focal = 0.5 * h as f32 / (0.5 * yfov).tan();
+        let (speed, shutter) = (10.0f32, 0.05f32);
+        let job = |motion| RenderJob {
+            width: w,
+            height: h,
+            seed: 2,
+            layers: Layers::default(),
+            settings: RenderSettings::new(512, 1),
+            motion,
+        };
+        let blurred = render(
+            &scene,
+            &camera,
+            &job(Motion::centred(shutter, Vec3::new(speed, 0.0, 0.0))),
+            &|_| {},
+        );
+        let sharp = render(&scene, &camera, &job(Motion::default()), &|_| {});
+        // The edge's film position moves from W/2 + a to W/2 - a.
+        let a = focal * speed * 0.5 * shutter / -z;
+        assert!(a > 4.0, "blur of {a} px");
+        let mut worst = 0.0f32;
+        for i in 0..w {
+            let want = swept_share(i as f32, 0.5 * w as f32 - a, 0.5 * w as f32 + a);
+            let got = blurred.image.get(i, 8).x;
+            worst = worst.max((got - want).abs());
+            let edge = if i < w / 2 { 1.0 } else { 0.0 };
+            assert_eq!(sharp.image.get(i, 8).x, edge, "pixel {i} without blur");
+        }
+        assert!(worst < 0.01, "largest error {worst}");
+    }
+
+    /// A grey wall at depth `depth` in front of a camera at the origin, lit by an emissive
+    /// ceiling 20 m up, with rain of `rate` mm/h within 4 m.
+    fn wall_scene(depth: f32, rate: f32) -> Scene {
+        let mut lamp = Material::diffuse("lamp", Vec3::ZERO);
+        lamp.emission = Vec3::ONE;
+        lamp.double_sided = true;
+        let mut parts = SceneParts {
+            materials: vec![Material::diffuse("wall", Vec3::splat(0.5)), lamp],
+            ..Default::default()
+        };
+        let s = 30.0;
+        quad(
+            &mut parts,
+            [
+                Vec3::new(-s, -s, -depth),
+                Vec3::new(s, -s, -depth),
+                Vec3::new(s, s, -depth),
+                Vec3::new(-s, s, -depth),
+            ],
+            0,
+        );
+        quad(
+            &mut parts,
+            [
+                Vec3::new(-s, 20.0, s),
+                Vec3::new(-s, 20.0, -s),
+                Vec3::new(s, 20.0, -s),
+                Vec3::new(s, 20.0, s),
+            ],
+            1,
+        );
+        let mut scene = Scene::from_parts(parts).unwrap();
+        scene.set_rain(RainParams {
+            rate_mm_h: rate,
+            seed: 9,
+            radius: 4.0,
+        });
+        scene
+    }
+
+    #[test]
+    fn the_rain_layer_is_the_drops_cross_section_and_ground_truth_ignores_them() {
+        let depth = 3.5;
+        let mut scene = wall_scene(depth, 100.0);
+        let camera = Camera::perspective("c", Affine3A::IDENTITY, 0.3, None);
+        let (w, h) = (32, 24);
+        let motion = Motion::centred(1.0 / 60.0, Vec3::ZERO);
+        let drops = scene.place_rain(&camera, w, h, motion).unwrap();
+        assert!(drops > 10_000, "{drops} drops");
+        let job = RenderJob {
+            width: w,
+            height: h,
+            seed: 1,
+            layers: Layers {
+                depth: true,
+                rain: true,
+                ..Layers::default()
+            },
+            settings: RenderSettings::new(64, 4),
+            motion,
+        };
+        let out = render(&scene, &camera, &job, &|_| {});
+        // Depth is the wall's everywhere: the drops are not in the ground truth.
+        let forward_depth = out.depth.as_ref().unwrap();
+        assert!(forward_depth.iter().all(|&d| (d - depth).abs() < 1e-4));
+        // The share of camera rays that meet a drop first: 1 - exp(-sigma L), sigma the
+        // drops' cross-section per volume, L the path through the rain (from 0.5 m to the
+        // wall; the field of view is narrow, so L is nearly the same for every pixel).
+        let lambda = mp_lambda(100.0);
+        let steps = 10_000;
+        let dd = (D_MAX_MM - D_MIN_MM) / steps as f64;
+        let sigma: f64 = (0..steps)
+            .map(|k| {
+                let d = D_MIN_MM + (k as f64 + 0.5) * dd;
+                MP_N0 * (-lambda * d).exp() * std::f64::consts::PI * (0.5e-3 * d).powi(2) * dd
+            })
+            .sum();
+        let want = 1.0 - (-sigma * (depth - RAIN_NEAR) as f64).exp();
+        let rain = out.rain.as_ref().unwrap();
+        let got = rain.iter().map(|&r| r as f64).sum::<f64>() / rain.len() as f64;
+        assert!(
+            (got - want).abs() < 0.15 * want,
+            "rain share {got}, cross-section predicts {want}"
+        );
+        // A dry render of the same scene: no drop, a zero layer.
+        let mut dry = wall_scene(depth, 100.0);
+        dry.rain = None;
+        let out = render(&dry, &camera, &job, &|_| {});
+        assert!(out.rain.unwrap().iter().all(|&r| r == 0.0));
+    }
+
+    #[test]
+    fn both_eyes_of_a_rig_see_the_same_drops() {
+        let mut scene = wall_scene(6.0, 25.0);
+        let centre = Camera::perspective("c", Affine3A::IDENTITY, 0.6, None);
+        let (w, h) = (96, 64);
+        let motion = Motion::default();
+        scene.place_rain(&centre, w, h, motion).unwrap();
+        let field = &scene.rain.as_ref().unwrap().field;
+        let eye = |x: f32| {
+            Camera::perspective(
+                "eye",
+                Affine3A::from_translation(Vec3::new(x, 0.0, 0.0)),
+                0.6,
+                None,
+            )
+        };
+        let (left, right) = (eye(-0.0325), eye(0.0325));
+        let li = CameraRain::build(field, &left, w, h, &motion).unwrap();
+        let ri = CameraRain::build(field, &right, w, h, &motion).unwrap();
+        let mut seen = 0;
+        for d in field.drops.iter().step_by(7) {
+            let (Some(pl), Some(pr)) =
+                (left.project(d.centre, w, h), right.project(d.centre, w, h))
+            else {
+                continue;
+            };
+            let inside = |p: Vec2| p.x >= 0.0 && p.y >= 0.0 && p.x < w as f32 && p.y < h as f32;
+            if !(inside(pl) && inside(pr)) {
+                continue;
+            }
+            let (lray, rray) = (left.generate_ray(pl, w, h), right.generate_ray(pr, w, h));
+            let l = li.intersect(&lray, 100.0).unwrap();
+            let r = ri.intersect(&rray, 100.0).unwrap();
+            // Each eye meets the drop where it is, or a drop in front of it.
+            let tl = d.intersect(&lray, 100.0).unwrap().0;
+            let tr = d.intersect(&rray, 100.0).unwrap().0;
+            assert!(l.0 <= tl && r.0 <= tr, "an eye misses a drop in view");
+            seen += usize::from(l.1 == *d && r.1 == *d);
+        }
+        assert!(seen > 200, "{seen} drops checked");
     }
 }

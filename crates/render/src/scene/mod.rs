@@ -193,7 +193,7 @@ use crate::light::{Environment, Light, LightSampler, SurfaceMesh};
 use crate::material::Material;
 use crate::motion::Motion;
 use crate::normal_map::{self, MappedNormal, NormalMap};
-use crate::rain::{offset_from_drop, DropField, Rain, RainError, RainParams, RainView};
+use crate::rain::{offset_from_drop, DropField, Rain, RainError, RainParams, RainPath, RainView};
 use crate::sampling::{pcg_hash, u32_to_unit_f32};
 use crate::texture::Texture;
 use glam::{Vec2, Vec3, Vec4};
@@ -533,21 +533,19 @@ impl Scene {
         self.stops(geometry, ray, triangle, id, b)
     }
 
-    /// Closest hit along `ray` (at its time) on the scene's surfaces or a rain drop: what
-    /// [`Scene::intersect_surfaces`] finds, unless a drop of the placed rain
-    /// ([`Scene::place_rain`]) is nearer. A drop's hit has [`crate::rain::RAIN_TRIANGLE`] as
-    /// its triangle and the water material ([`crate::rain::water_material`]).
+    /// Closest hit along `ray` (at its time), the ray of a camera path in state `path`, on
+    /// the scene's surfaces or a rain drop: what [`Scene::intersect`] finds, unless a drop the
+    /// path can meet ([`RainPath`]: the camera ray the drops its camera sees, a ray leaving a
+    /// drop that drop) is nearer. A drop's hit has [`crate::rain::RAIN_TRIANGLE`] as its
+    /// triangle and the water material ([`crate::rain::water_material`]).
     #[inline]
-    pub fn intersect(&self, ray: &Ray) -> Option<SurfaceHit> {
-        let surface = self.intersect_surfaces(ray);
-        let Some(rain) = self.rain.as_ref().filter(|r| !r.field.is_empty()) else {
+    pub fn intersect_path(&self, ray: &Ray, path: &mut RainPath) -> Option<SurfaceHit> {
+        let surface = self.intersect(ray);
+        let (Some(rain), true) = (&self.rain, path.camera.is_some() || path.drop.is_some()) else {
             return surface;
         };
-        let mut nearer = *ray;
-        if let Some(h) = &surface {
-            nearer.t_max = h.t;
-        }
-        match rain.field.intersect(&nearer) {
+        let t_max = surface.as_ref().map_or(ray.t_max, |h| h.t);
+        match path.intersect(ray, t_max) {
             Some((t, _, n)) => Some(SurfaceHit {
                 t,
                 p: ray.at(t),
@@ -609,7 +607,7 @@ impl Scene {
     }
 
     /// Closest hit along `ray` within `(t_min, ray.t_max)` (see [`Accel::t_min`]) on the
-    /// scene's surfaces, ignoring rain drops (the ground-truth layers use it), where the
+    /// scene's surfaces (never a rain drop: [`Scene::intersect_path`]), where the
     /// ray stops, on the flat triangles or an instance: hits on alpha-masked-out points are
     /// skipped, and `BLEND` surfaces stop the ray with probability alpha (stochastic
     /// transparency, decided by a hash of the ray and the triangle). The shading normal is the
@@ -619,7 +617,7 @@ impl Scene {
     /// the side of the geometric normal. A hit on an instance has
     /// [`INSTANCED_TRIANGLE`] as its triangle.
     #[inline]
-    pub fn intersect_surfaces(&self, ray: &Ray) -> Option<SurfaceHit> {
+    pub fn intersect(&self, ray: &Ray) -> Option<SurfaceHit> {
         let flat = self
             .accel
             .intersect_filtered(ray, |t, b| self.stops(self.geometry(), ray, t, t, b));
@@ -723,7 +721,7 @@ impl Scene {
     }
 
     /// Whether anything blocks `ray` within `(t_min, ray.t_max)` (shadow query), with the
-    /// same alpha test as [`Scene::intersect`]; a rain drop blocks it like any glass.
+    /// same alpha test as [`Scene::intersect`]; rain drops cast no shadow ([`crate::rain`]).
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
         self.accel
@@ -732,7 +730,6 @@ impl Scene {
                 && self.instances.occluded(ray, self.accel.t_min(), |i, t, b| {
                     self.instance_stops(ray, i, t, b)
                 }))
-            || self.rain.as_ref().is_some_and(|r| r.field.occluded(ray))
     }
 }
 
