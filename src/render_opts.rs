@@ -64,7 +64,12 @@ pub struct RenderOpts {
     pub env: EnvOpts,
     /// Shutter time in seconds, centred on the scene's moment (open at -S/2, close at +S/2):
     /// rain drops and a moving rig (--rig-velocity) blur over it [default: 0, no blur].
-    #[arg(long, value_name = "S", default_value_t = 0.0)]
+    #[arg(
+        long,
+        value_name = "S",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
     pub shutter: f32,
     /// The rig's velocity in m/s, world space, during the shutter (both eyes move together).
     #[arg(

@@ -153,6 +153,11 @@
 //! its time `t` uniform over the shutter, and its ray starts at the camera moved by the rig's
 //! velocity times `t`; every ray of the path carries `t`. With a closed shutter nothing is
 //! drawn and the image is the one a renderer without time makes.
+//!
+//! Rain ([`crate::rain`]): the camera ray meets the drops of its camera's index
+//! ([`crate::rain::CameraRain`], built at the start of the render), and a path that hit a drop
+//! its way out of it ([`Scene::intersect_path`]); a drop hit is shaded as any smooth
+//! dielectric surface. Other rays, shadow rays included, do not meet drops.
 
 use crate::bsdf::Bsdf;
 use crate::camera::Camera;
