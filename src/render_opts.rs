@@ -109,14 +109,8 @@ impl EnvOpts {
         if self.env_strength.is_some() && self.env.is_none() && self.env_color.is_none() {
             bail!("--env-strength needs --env or --env-color");
         }
-        let colour = match self.env_color.as_deref() {
-            Some(&[r, g, b]) => Vec3::new(r, g, b),
-            Some(other) => bail!(
-                "--env-color takes three numbers, R,G,B (got {})",
-                other.len()
-            ),
-            None => Vec3::ONE,
-        };
+        let colour =
+            three_numbers("--env-color", "R,G,B", self.env_color.as_deref())?.unwrap_or(Vec3::ONE);
         Environment::constant(colour, self.strength())
             .map_err(|e| anyhow::anyhow!("--env-color/--env-strength: {e}"))?;
         Ok(())
@@ -194,14 +188,12 @@ impl RenderOpts {
                 self.shutter
             );
         }
-        let rig_velocity = match self.rig_velocity.as_deref() {
-            Some(&[x, y, z]) => Vec3::new(x, y, z),
-            Some(other) => bail!(
-                "--rig-velocity takes three numbers, X,Y,Z in m/s (got {})",
-                other.len()
-            ),
-            None => Vec3::ZERO,
-        };
+        let rig_velocity = three_numbers(
+            "--rig-velocity",
+            "X,Y,Z in m/s",
+            self.rig_velocity.as_deref(),
+        )?
+        .unwrap_or(Vec3::ZERO);
         let motion = Motion::centred(self.shutter, rig_velocity);
         motion
             .check()
@@ -257,6 +249,16 @@ impl RenderOpts {
             .checked_mul(self.spp as u64)
             .context("the number of samples (views x width x height x spp) overflows")?;
         Ok(progress_bar(total))
+    }
+}
+
+/// The vector of a flag that takes three comma-separated numbers (`what` names them), if
+/// given; an error naming the flag for any other count.
+fn three_numbers(flag: &str, what: &str, values: Option<&[f32]>) -> Result<Option<Vec3>> {
+    match values {
+        Some(&[x, y, z]) => Ok(Some(Vec3::new(x, y, z))),
+        Some(other) => bail!("{flag} takes three numbers, {what} (got {})", other.len()),
+        None => Ok(None),
     }
 }
 
