@@ -146,7 +146,7 @@
 //!
 //! The first-hit layers (depth, normal, albedo, material) are taken at the reference time 0
 //! from the camera where the scene puts it, and ignore rain drops
-//! ([`Scene::intersect_surfaces`]): they are the ground truth of the scene behind the rain.
+//! ([`Scene::intersect`] meets no drop): they are the ground truth of the scene behind the rain.
 //!
 //! Time ([`crate::motion`]): with the shutter open for a nonzero interval
 //! ([`RenderJob::motion`]), each camera sample draws one more number after its film position,

@@ -126,6 +126,10 @@
 //!   nothing and emits its base colour (factor, texture, times COLOR_0) as radiance, so the
 //!   camera sees exactly the base colour; like any emitter it lights the rest of the scene
 //!   (docs/decisions/0027).
+//! - Rain (`scenes[i].extras.streaks.rain = {"rate_mm_h": R, "seed": n, "radius": m}`, seed
+//!   and radius optional, 0 and 20 m): [`Scene::rain`] holds it and a water material; its
+//!   drops are placed for a view by [`Scene::place_rain`] and met by camera rays through
+//!   [`Scene::intersect_path`] ([`crate::rain`] has the physics and the limits).
 //!
 //! ## Wet and dry patches (an extension of the contract)
 //!
