@@ -125,6 +125,7 @@ fn bench(c: &mut Criterion) {
         seed: 0,
         layers: Layers::default(),
         settings: RenderSettings::new(1, 4),
+        motion: Default::default(),
     };
     let mut group = c.benchmark_group("render");
     group.sample_size(10);

@@ -75,6 +75,7 @@ fn job(spp: u32) -> RenderJob {
         seed: 1,
         layers: Layers::default(),
         settings: RenderSettings::new(spp, 4),
+        motion: Default::default(),
     }
 }
 

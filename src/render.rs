@@ -100,6 +100,7 @@ pub fn run(args: Args) -> Result<()> {
         specular: args.layers.contains(&Layer::Specular),
         material: args.road_mask.is_some(),
         spp: args.layers.contains(&Layer::Spp),
+        rain: false,
     };
     if let Some(mask) = &args.road_mask {
         if format_of(mask)? != Format::Png {
@@ -130,8 +131,13 @@ pub fn run(args: Args) -> Result<()> {
         width,
         height,
         seed: opts.seed,
-        layers,
+        // The rain layer comes with every render of a rainy scene.
+        layers: Layers {
+            rain: scene.rain.is_some(),
+            ..layers
+        },
         settings: opts.settings(),
+        motion: opts.motion()?,
     };
     create_parent(&args.output)?;
     for path in args.png.iter().chain(&args.road_mask) {

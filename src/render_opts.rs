@@ -7,6 +7,7 @@ use indicatif::ProgressBar;
 use std::path::Path;
 use streaks_render::camera::{Camera, FRAMING_WARNING};
 use streaks_render::light::Environment;
+use streaks_render::motion::Motion;
 use streaks_render::scene::Scene;
 use streaks_sensor::SensorProfile;
 use streaks_settings::{RenderSettings, SettingsError};
@@ -70,6 +71,19 @@ pub struct RenderOpts {
     /// The environment light flags.
     #[command(flatten)]
     pub env: EnvOpts,
+    /// Shutter time in seconds, centred on the scene's moment (open at -S/2, close at +S/2):
+    /// rain drops and a moving rig (--rig-velocity) blur over it [default: the --sensor
+    /// profile's exposure_s, else 0, no blur].
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    pub shutter: Option<f32>,
+    /// The rig's velocity in m/s, world space, during the shutter (both eyes move together).
+    #[arg(
+        long,
+        value_name = "X,Y,Z",
+        value_delimiter = ',',
+        allow_negative_numbers = true
+    )]
+    pub rig_velocity: Option<Vec<f32>>,
 }
 
 /// The environment light flags of `streaks render`, `streaks stereo` and `streaks
@@ -100,14 +114,8 @@ impl EnvOpts {
         if self.env_strength.is_some() && self.env.is_none() && self.env_color.is_none() {
             bail!("--env-strength needs --env or --env-color");
         }
-        let colour = match self.env_color.as_deref() {
-            Some(&[r, g, b]) => Vec3::new(r, g, b),
-            Some(other) => bail!(
-                "--env-color takes three numbers, R,G,B (got {})",
-                other.len()
-            ),
-            None => Vec3::ONE,
-        };
+        let colour =
+            three_numbers("--env-color", "R,G,B", self.env_color.as_deref())?.unwrap_or(Vec3::ONE);
         Environment::constant(colour, self.strength())
             .map_err(|e| anyhow::anyhow!("--env-color/--env-strength: {e}"))?;
         Ok(())
@@ -163,6 +171,7 @@ impl RenderOpts {
             bail!("--exposure must be a finite number of stops");
         }
         self.sensor_profile()?;
+        self.motion()?;
         self.env.check()
     }
 
@@ -185,10 +194,37 @@ impl RenderOpts {
         }
     }
 
+    /// The shutter and rig motion of `--shutter` and `--rig-velocity`: without `--shutter`,
+    /// the shutter is the `--sensor` profile's exposure time (a camera's exposure is its
+    /// shutter), or closed without a sensor.
+    pub fn motion(&self) -> Result<Motion> {
+        let shutter = match self.shutter {
+            Some(s) => s,
+            None => self
+                .sensor_profile()?
+                .map_or(0.0, |profile| profile.exposure_s as f32),
+        };
+        if !(shutter.is_finite() && shutter >= 0.0) {
+            bail!("--shutter must be a time of 0 s or more (got {shutter})");
+        }
+        let rig_velocity = three_numbers(
+            "--rig-velocity",
+            "X,Y,Z in m/s",
+            self.rig_velocity.as_deref(),
+        )?
+        .unwrap_or(Vec3::ZERO);
+        let motion = Motion::centred(shutter, rig_velocity);
+        motion
+            .check()
+            .map_err(|e| anyhow::anyhow!("--shutter/--rig-velocity: {e}"))?;
+        Ok(motion)
+    }
+
     /// Phase 2: loads the scene (with the environment of `--env` or `--env-color`, if given;
-    /// printing its warnings), picks the camera and sizes the image.
+    /// printing its warnings), picks the camera, sizes the image, and places the scene's
+    /// rain drops (if it has rain) around that camera for the shutter of the flags.
     pub fn load(&self, path: &Path) -> Result<Loaded> {
-        let scene = self.env.load_scene(path, self.allow_outside_scene)?;
+        let mut scene = self.env.load_scene(path, self.allow_outside_scene)?;
         for warning in &scene.warnings {
             eprintln!("warning: {warning}");
         }
@@ -207,6 +243,9 @@ impl RenderOpts {
                 scene.default_camera(width as f32 / height as f32)
             }
         };
+        scene
+            .place_rain(&camera, width, height, self.motion()?)
+            .with_context(|| format!("the rain of the scene {}", path.display()))?;
         Ok(Loaded {
             scene,
             camera,
@@ -229,6 +268,16 @@ impl RenderOpts {
             .checked_mul(self.spp as u64)
             .context("the number of samples (views x width x height x spp) overflows")?;
         Ok(progress_bar(total))
+    }
+}
+
+/// The vector of a flag that takes three comma-separated numbers (`what` names them), if
+/// given; an error naming the flag for any other count.
+fn three_numbers(flag: &str, what: &str, values: Option<&[f32]>) -> Result<Option<Vec3>> {
+    match values {
+        Some(&[x, y, z]) => Ok(Some(Vec3::new(x, y, z))),
+        Some(other) => bail!("{flag} takes three numbers, {what} (got {})", other.len()),
+        None => Ok(None),
     }
 }
 

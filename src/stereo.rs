@@ -57,6 +57,7 @@ pub fn run(args: Args) -> Result<()> {
         seed: opts.seed,
         exposure_ev: opts.exposure,
         mask: StreakMaskParams::default(),
+        motion: opts.motion()?,
     };
     // Phase 3: render both eyes under one progress bar and write everything.
     let pool = opts.thread_pool()?;

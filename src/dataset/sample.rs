@@ -99,16 +99,20 @@ fn write_sample(
         .write(dir)
         .with_context(|| format!("cannot write the scene into {}", dir.display()))?;
     let gltf = dir.join(SCENE_GLTF);
-    let scene =
+    let mut scene =
         Scene::load(&gltf).with_context(|| format!("cannot load the scene {}", gltf.display()))?;
     for w in &scene.warnings {
         warn(format!("sample {}: {w}", sample_id(index)));
     }
     let camera = scene
         .camera(Some(&s.camera))
-        .with_context(|| format!("in the scene {}", gltf.display()))?;
+        .with_context(|| format!("in the scene {}", gltf.display()))?
+        .clone();
     let render = &settings.settings;
-    let rig = rig_from_camera(camera, render.width, render.height, s.baseline)
+    scene
+        .place_rain(&camera, render.width, render.height, Default::default())
+        .with_context(|| format!("the rain of the scene {}", gltf.display()))?;
+    let rig = rig_from_camera(&camera, render.width, render.height, s.baseline)
         .with_context(|| format!("the stereo rig of {}", gltf.display()))?;
     let seed = render_seed(settings.seed, index);
     let pair = PairSettings {
@@ -116,6 +120,7 @@ fn write_sample(
         seed,
         exposure_ev: s.exposure_ev,
         mask: StreakMaskParams::default(),
+        motion: Default::default(),
     };
     let views = render_pair(&scene, &rig, &pair, &|_| {})?;
     let [left, right] = &views;

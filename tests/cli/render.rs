@@ -595,3 +595,65 @@ fn environment_flags_light_the_sky() {
         "{text}"
     );
 }
+
+#[test]
+fn rain_writes_its_layer_and_motion_flags_are_checked() {
+    let t = TestDir::new();
+    t.write_tiny_gltf();
+    let gltf = std::fs::read_to_string(t.join("scene.gltf")).unwrap();
+    let with_rain = |rain: &str| {
+        gltf.replace(
+            r#""scenes": [{"nodes": [0, 1, 2, 3]}]"#,
+            &format!(
+                r#""scenes": [{{"nodes": [0, 1, 2, 3], "extras": {{"streaks": {{"rain": {rain}}}}}}}]"#
+            ),
+        )
+    };
+    std::fs::write(
+        t.join("rain.gltf"),
+        with_rain(r#"{"rate_mm_h": 100, "radius": 3}"#),
+    )
+    .unwrap();
+    let args = |scene: &'static str, out: &'static str| {
+        vec![
+            "render",
+            scene,
+            "-o",
+            out,
+            "--spp",
+            "16",
+            "--height",
+            "40",
+            "--max-depth",
+            "4",
+            "--layers",
+            "depth",
+        ]
+    };
+    let mut rainy = args("rain.gltf", "rain.exr");
+    rainy.extend(["--shutter", "0.02", "--rig-velocity", "1,0,-2"]);
+    t.streaks(&rainy).assert_success();
+    let rain = read_exr_layer(&t.join("rain.exr"), "rain").unwrap();
+    let share: f32 = rain.pixels.iter().map(|p| p.x).sum::<f32>() / rain.pixels.len() as f32;
+    assert!(share > 0.0 && share < 0.2, "rain share {share}");
+    // Depth is that of the dry scene: the drops are not in the ground truth.
+    t.streaks(&args("scene.gltf", "dry.exr")).assert_success();
+    let depth = |f: &str| read_exr_layer(&t.join(f), "depth").unwrap();
+    assert_eq!(depth("rain.exr"), depth("dry.exr"));
+    // A dry scene has no rain layer.
+    assert!(read_exr_layer(&t.join("dry.exr"), "rain").is_err());
+
+    let mut bad = args("rain.gltf", "x.exr");
+    bad.extend(["--shutter", "-1"]);
+    t.streaks(&bad).assert_failure_mentioning("--shutter");
+    let mut bad = args("rain.gltf", "x.exr");
+    bad.extend(["--rig-velocity", "1,2"]);
+    t.streaks(&bad).assert_failure_mentioning("--rig-velocity");
+    std::fs::write(t.join("bad.gltf"), with_rain(r#"{"rate_mm_h": -1}"#)).unwrap();
+    t.streaks(&args("bad.gltf", "x.exr"))
+        .assert_failure_mentioning("extras.streaks.rain.rate_mm_h");
+    std::fs::write(t.join("bad.gltf"), with_rain(r#"{"rate": 5}"#)).unwrap();
+    t.streaks(&args("bad.gltf", "x.exr"))
+        .assert_failure_mentioning("rate");
+    assert!(!t.join("x.exr").exists());
+}

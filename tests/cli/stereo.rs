@@ -273,6 +273,7 @@ fn settings(spp: u32) -> PairSettings {
         seed: 7,
         exposure_ev: 0.0,
         mask: StreakMaskParams::default(),
+        motion: Default::default(),
     }
 }
 

@@ -140,6 +140,7 @@ fn main() {
         seed: 1,
         layers: Default::default(),
         settings: RenderSettings::new(4, 3),
+        motion: Default::default(),
     };
     let mut images = Vec::new();
     for shared in [true, false] {

@@ -1155,6 +1155,7 @@ mod tests {
                 origin,
                 direction,
                 t_max,
+                time: 0.0,
             };
             let (bvh, r) = accel.bvh_ray(&ray, accel.t_min).unwrap();
             let tris = &accel.tris;

@@ -460,6 +460,7 @@ mod tests {
                 ..Layers::default()
             },
             settings: streaks_settings::RenderSettings::new(16, 1),
+            motion: Default::default(),
         };
         let out = render(&scene, &cam, &job, &|_| {});
         let depth = out.depth.as_ref().unwrap();

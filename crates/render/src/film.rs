@@ -45,6 +45,8 @@ pub struct Pixel {
     /// Index into the scene's materials of the pixel-centre ray's first hit ([`NO_MATERIAL`]
     /// on a miss).
     pub material: u32,
+    /// Number of camera samples (kept or dropped) whose first hit was a rain drop.
+    pub rain: u32,
 }
 
 /// [`Pixel::material`] of a pixel whose centre ray hits nothing.
@@ -63,6 +65,7 @@ impl Default for Pixel {
             normal: Vec3::ZERO,
             albedo: Vec3::ZERO,
             material: NO_MATERIAL,
+            rain: 0,
         }
     }
 }
@@ -200,6 +203,15 @@ impl Film {
     /// The samples-per-pixel layer: samples taken per pixel (kept and dropped), row-major.
     pub fn spp(&self) -> Vec<u32> {
         self.pixels.iter().map(Pixel::taken).collect()
+    }
+
+    /// The rain layer: the share of each pixel's samples (kept and dropped) whose first hit
+    /// was a rain drop, row-major (0 for a pixel without samples).
+    pub fn rain(&self) -> Vec<f32> {
+        self.pixels
+            .iter()
+            .map(|p| p.rain as f32 / p.taken().max(1) as f32)
+            .collect()
     }
 
     /// Total number of samples taken (kept and dropped).

@@ -12,6 +12,9 @@ pub struct Ray {
     pub direction: Vec3,
     /// Largest parameter of interest (`f32::INFINITY` for an unbounded ray).
     pub t_max: f32,
+    /// The instant the ray samples, seconds from the reference time 0 ([`crate::motion`]);
+    /// rays a path spawns inherit it.
+    pub time: f32,
 }
 
 impl Ray {
@@ -22,7 +25,14 @@ impl Ray {
             origin,
             direction,
             t_max: f32::INFINITY,
+            time: 0.0,
         }
+    }
+
+    /// The same ray at time `time`.
+    #[inline]
+    pub fn at_time(self, time: f32) -> Self {
+        Self { time, ..self }
     }
 
     /// The point at parameter `t`.

@@ -141,6 +141,23 @@
 //!   threshold on it.
 //! - `spp`: the number of samples the pixel took (kept and dropped), `spp` everywhere unless
 //!   adaptive sampling stopped its tile earlier.
+//! - `rain`: the share of the pixel's camera samples (kept and dropped) whose first hit was a
+//!   rain drop ([`crate::rain`]).
+//!
+//! The first-hit layers (depth, normal, albedo, material) are taken at the reference time 0
+//! from the camera where the scene puts it, and ignore rain drops
+//! ([`Scene::intersect`] meets no drop): they are the ground truth of the scene behind the rain.
+//!
+//! Time ([`crate::motion`]): with the shutter open for a nonzero interval
+//! ([`RenderJob::motion`]), each camera sample draws one more number after its film position,
+//! its time `t` uniform over the shutter, and its ray starts at the camera moved by the rig's
+//! velocity times `t`; every ray of the path carries `t`. With a closed shutter nothing is
+//! drawn and the image is the one a renderer without time makes.
+//!
+//! Rain ([`crate::rain`]): the camera ray meets the drops of its camera's index
+//! ([`crate::rain::CameraRain`], built at the start of the render), and a path that hit a drop
+//! its way out of it ([`Scene::intersect_path`]); a drop hit is shaded as any smooth
+//! dielectric surface. Other rays, shadow rays included, do not meet drops.
 
 use crate::bsdf::Bsdf;
 use crate::camera::Camera;
@@ -148,6 +165,8 @@ use crate::film::{Film, Pixel};
 use crate::geometry::{offset_ray_origin, Frame, Ray};
 use crate::light::{LightSampler, Receiver, Visibility};
 use crate::material::Volume;
+use crate::motion::Motion;
+use crate::rain::{CameraRain, RainPath};
 use crate::sampling::{power_heuristic, Sampler};
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
@@ -180,6 +199,8 @@ pub struct Layers {
     pub material: bool,
     /// Samples taken per pixel (see adaptive sampling in the module documentation).
     pub spp: bool,
+    /// Share of the camera samples whose first hit was a rain drop.
+    pub rain: bool,
 }
 
 /// One image to render: its size, seed and layers, and how to sample it.
@@ -195,6 +216,8 @@ pub struct RenderJob {
     pub layers: Layers,
     /// Samples, adaptive sampling, path length and regularisation.
     pub settings: RenderSettings,
+    /// The shutter interval and the rig's velocity ([`Motion::default`]: no motion blur).
+    pub motion: Motion,
 }
 
 /// Adaptive sampling: the side of the square tiles of pixels that stop together (see the
@@ -260,6 +283,9 @@ pub struct RenderOutput {
     pub material: Option<Vec<u32>>,
     /// Samples taken per pixel, row-major (if requested).
     pub spp: Option<Vec<u32>>,
+    /// Share of each pixel's camera samples whose first hit was a rain drop, row-major (if
+    /// requested).
+    pub rain: Option<Vec<f32>>,
     /// Counters.
     pub stats: RenderStats,
 }
@@ -270,6 +296,8 @@ struct PathResult {
     radiance: Vec3,
     specular: Vec3,
     rays: u64,
+    /// Whether the camera ray's first hit was a rain drop.
+    rain: bool,
 }
 
 /// Renders `camera`'s view of `scene` on the current rayon thread pool.
@@ -293,6 +321,12 @@ pub fn render(
         .normalize();
     let l = job.layers;
     let need_centre = l.depth || l.normal || l.albedo || l.material;
+    // The drops this camera sees, binned by pixel (none without rain).
+    let rain = scene
+        .rain
+        .as_ref()
+        .and_then(|r| CameraRain::build(&r.field, camera, width, height, &job.motion));
+    let rain = rain.as_ref();
 
     match job.settings.noise_target {
         None => film.par_rows_mut().enumerate().for_each(|(y, row)| {
@@ -305,7 +339,8 @@ pub fn render(
                     row_rays += centre_ray(scene, camera, job, forward, (x, y), pixel);
                 }
                 for s in 0..job.settings.spp {
-                    row_rays += take_sample(scene, camera, job, &mut sampler, (x, y), s, pixel);
+                    row_rays +=
+                        take_sample(scene, camera, job, rain, &mut sampler, (x, y), s, pixel);
                 }
             }
             rays.fetch_add(row_rays, Ordering::Relaxed);
@@ -337,6 +372,7 @@ pub fn render(
                             scene,
                             camera,
                             job,
+                            rain,
                             target,
                             &mut sampler,
                             tile,
@@ -359,6 +395,7 @@ pub fn render(
         specular: layers.specular.then(|| film.specular()),
         material: layers.material.then(|| film.material()),
         spp: layers.spp.then(|| film.spp()),
+        rain: layers.rain.then(|| film.rain()),
         stats: RenderStats {
             seconds: start.elapsed().as_secs_f64(),
             samples: film.samples(),
@@ -415,6 +452,7 @@ fn render_tile_adaptive(
     scene: &Scene,
     camera: &Camera,
     job: &RenderJob,
+    rain: Option<&CameraRain>,
     target: f32,
     sampler: &mut Sampler,
     tile: Tile,
@@ -433,7 +471,7 @@ fn render_tile_adaptive(
         for xy in tile.pixels() {
             let pixel = &mut band[index(xy)];
             for s in taken..next {
-                rays += take_sample(scene, camera, job, sampler, xy, s, pixel);
+                rays += take_sample(scene, camera, job, rain, sampler, xy, s, pixel);
             }
         }
         taken = next;
@@ -464,10 +502,12 @@ fn centre_ray(
 
 /// Takes sample `s` of pixel `(x, y)` into `pixel`; returns the rays traced.
 #[inline]
+#[allow(clippy::too_many_arguments)]
 fn take_sample(
     scene: &Scene,
     camera: &Camera,
     job: &RenderJob,
+    rain: Option<&CameraRain>,
     sampler: &mut Sampler,
     (x, y): (u32, u32),
     s: u32,
@@ -475,9 +515,14 @@ fn take_sample(
 ) -> u64 {
     sampler.start_pixel_sample((x, y), s);
     let film_pos = Vec2::new(x as f32, y as f32) + sampler.next_2d();
-    let ray = camera.generate_ray(film_pos, job.width, job.height);
-    let path = trace_path(scene, ray, sampler, job);
+    let mut ray = camera.generate_ray(film_pos, job.width, job.height);
+    if job.motion.is_blurred() {
+        ray.time = job.motion.time(sampler.next_1d());
+        ray.origin += job.motion.rig_velocity * ray.time;
+    }
+    let path = trace_path(scene, ray, sampler, job, rain);
     pixel.add_sample(path.radiance, path.specular);
+    pixel.rain += u32::from(path.rain);
     path.rays
 }
 
@@ -538,7 +583,13 @@ impl Arrival {
 }
 
 /// Traces one camera path (see the module documentation).
-fn trace_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, job: &RenderJob) -> PathResult {
+fn trace_path(
+    scene: &Scene,
+    mut ray: Ray,
+    sampler: &mut Sampler,
+    job: &RenderJob,
+    rain: Option<&CameraRain>,
+) -> PathResult {
     let (max_depth, want_specular) = (job.settings.max_depth, job.layers.specular);
     let lights: &LightSampler = &scene.light_sampler;
     let mut out = PathResult::default();
@@ -557,6 +608,8 @@ fn trace_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, job: &RenderJo
     let mut first_bsdf: Option<(Bsdf, Frame, Vec3)> = None;
     // The smallest density of the directions chosen so far (path regularisation).
     let mut min_ray_pdf = f32::INFINITY;
+    // Which rain drops the next ray can meet.
+    let mut rain_path = RainPath::camera(rain);
 
     while depth < max_depth {
         out.rays += 1;
@@ -567,7 +620,7 @@ fn trace_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, job: &RenderJo
             prev_bsdf_pdf,
             first_bsdf,
         };
-        let Some(hit) = scene.intersect(&ray) else {
+        let Some(hit) = scene.intersect_path(&ray, &mut rain_path) else {
             // 1'. The environment, for a ray that escapes (not from inside a volume, whose
             // closed surface a ray cannot leave unseen).
             if let (Some(env), None) = (lights.environment(), medium) {
@@ -581,6 +634,7 @@ fn trace_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, job: &RenderJo
             break;
         };
         let wo = -ray.direction;
+        out.rain |= depth == 0 && hit.triangle == crate::rain::RAIN_TRIANGLE;
         if let Some(v) = medium {
             throughput *= v.transmittance(hit.t);
         }
@@ -674,6 +728,7 @@ fn trace_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, job: &RenderJo
                                 origin,
                                 direction: ls.wi,
                                 t_max,
+                                time: ray.time,
                             };
                             if scene.occluded(&shadow) {
                                 Vec3::ZERO
@@ -686,6 +741,7 @@ fn trace_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, job: &RenderJo
                                 origin,
                                 direction: ls.wi,
                                 t_max: ls.dist * (1.0 + 1e-4),
+                                time: ray.time,
                             };
                             match scene.intersect(&ray) {
                                 Some(h)
@@ -745,7 +801,7 @@ fn trace_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, job: &RenderJo
             min_ray_pdf = min_ray_pdf.min(bs.pdf);
         }
         medium = medium_along(bs.wi.z);
-        ray = Ray::new(offset_ray_origin(hit.p, ng, wi), wi);
+        ray = Ray::new(scene.spawn_origin(&hit, ng, wi), wi).at_time(ray.time);
         depth += 1;
 
         // Russian roulette (Mitsuba's rule).
@@ -813,6 +869,7 @@ pub(crate) mod tests {
             seed: 1,
             layers: Layers::default(),
             settings: RenderSettings::new(spp, max_depth),
+            motion: Default::default(),
         }
     }
 
@@ -1121,6 +1178,7 @@ pub(crate) mod tests {
             specular: true,
             material: true,
             spp: true,
+            rain: true,
         };
         let run = |threads| {
             rayon::ThreadPoolBuilder::new()

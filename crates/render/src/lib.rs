@@ -66,6 +66,7 @@
 //!     seed: 0,
 //!     layers: Layers::default(),
 //!     settings: RenderSettings::new(4, 1),
+//!     motion: Default::default(),
 //! };
 //! let out = render(&scene, &camera, &job, &|_| {});
 //! assert!(out.image.pixels.iter().all(|p| (*p - Vec3::splat(2.0)).abs().max_element() < 1e-6));
@@ -82,8 +83,10 @@ pub mod integrator;
 pub mod light;
 pub mod material;
 pub mod mitsuba;
+pub mod motion;
 pub mod normal_map;
 pub mod output;
+pub mod rain;
 pub mod regression;
 pub mod sampling;
 pub mod scene;

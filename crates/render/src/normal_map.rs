@@ -404,6 +404,7 @@ mod tests {
                 seed: 3,
                 layers: Layers::default(),
                 settings: RenderSettings::new(spp, max_depth),
+                motion: Default::default(),
             }
         }
 

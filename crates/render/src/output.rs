@@ -2,7 +2,9 @@
 //!
 //! Channels: `R`, `G`, `B` (the beauty image, linear) plus, when present, `depth.Z`,
 //! `normal.X`/`normal.Y`/`normal.Z`, `albedo.R`/`.G`/`.B`, `specular.R`/`.G`/`.B` and
-//! `spp.Y` (samples taken per pixel, as float32: exact up to 2^24) (OpenEXR's `layer.channel` naming, which Blender, Nuke and `exrheader` show as layers).
+//! `spp.Y` (samples taken per pixel, as float32: exact up to 2^24), `rain.Y` (the share of
+//! the pixel's camera samples whose first hit was a rain drop) (OpenEXR's `layer.channel`
+//! naming, which Blender, Nuke and `exrheader` show as layers).
 //! A render through a camera model (`--sensor`) also has `sensor.R`/`.G`/`.B`, the camera's
 //! raw values in DN as float32 ([`write_exr_with_sensor`]); `R`, `G`, `B` stay the render.
 //! [`write_exr`] writes them and [`read_exr_layer`] reads them back, from the names here; the
@@ -27,6 +29,9 @@ pub const DEPTH: &str = "depth.Z";
 pub const SPP: &str = "spp.Y";
 /// The sensor layer's channels (raw DN of a camera model).
 pub const SENSOR: [&str; 3] = ["sensor.R", "sensor.G", "sensor.B"];
+/// The rain layer's channel: the share of the pixel's camera samples whose first hit was a
+/// rain drop.
+pub const RAIN: &str = "rain.Y";
 
 /// Writes the render as a float32 EXR: the beauty image and the layers present in `output`
 /// (see the module documentation), atomically.
@@ -66,20 +71,27 @@ pub fn write_exr_with_sensor(
     if let Some(spp) = &output.spp {
         channels.push((SPP, spp.iter().map(|&n| n as f32).collect()));
     }
+    if let Some(rain) = &output.rain {
+        channels.push((RAIN, rain.clone()));
+    }
     streaks_image::exr::write_exr(path, img.width, img.height, channels)
 }
 
-/// Reads a layer written by [`write_exr`]: `"albedo"`, `"specular"`, `"sensor"` (RGB), `"normal"` (XYZ
-/// into the RGB slots), `"depth"` (Z) or `"spp"` (samples per pixel; one channel, repeated
-/// into all three slots).
+/// Reads a layer written by [`write_exr`]: `"albedo"`, `"specular"`, `"sensor"` (RGB),
+/// `"normal"` (XYZ into the RGB slots), `"depth"` (Z), `"spp"` (samples per pixel) or `"rain"`
+/// (one channel, repeated into all three slots).
 pub fn read_exr_layer(path: &Path, name: &str) -> Result<RgbImage, ImageError> {
     match name {
         "albedo" => read_exr_rgb_channels(path, ALBEDO),
         "specular" => read_exr_rgb_channels(path, SPECULAR),
         "sensor" => read_exr_rgb_channels(path, SENSOR),
         "normal" => read_exr_rgb_channels(path, NORMAL),
-        "depth" | "spp" => {
-            let channel = if name == "depth" { DEPTH } else { SPP };
+        "depth" | "spp" | "rain" => {
+            let channel = match name {
+                "depth" => DEPTH,
+                "spp" => SPP,
+                _ => RAIN,
+            };
             let (w, h, planes) = read_exr_channels(path, &[channel])?;
             let z = &planes[0];
             Ok(RgbImage::from_planes(w, h, [z, z, z]))
@@ -87,7 +99,7 @@ pub fn read_exr_layer(path: &Path, name: &str) -> Result<RgbImage, ImageError> {
         other => Err(ImageError::MissingChannels {
             path: path.to_path_buf(),
             what: format!(
-                "layer {other:?} (the layers are albedo, specular, normal, depth, spp, sensor)"
+                "layer {other:?} (the layers are albedo, specular, normal, depth, spp, rain, sensor)"
             ),
         }),
     }
@@ -119,6 +131,7 @@ mod tests {
             specular: Some(gradient(w, h)),
             material: None,
             spp: Some((0..w * h).map(|i| 16 + 8 * i).collect()),
+            rain: Some((0..w * h).map(|i| i as f32 / 16.0).collect()),
             stats: RenderStats::default(),
         }
     }
@@ -141,6 +154,8 @@ mod tests {
         assert_eq!(depth.get(4, 0).z, f32::INFINITY);
         let spp = read_exr_layer(&path, "spp").unwrap();
         assert_eq!(spp.get(2, 1).x, (16 + 8 * 7) as f32);
+        let rain = read_exr_layer(&path, "rain").unwrap();
+        assert_eq!(rain.get(2, 1).y, 7.0 / 16.0);
         let err = read_exr_layer(&path, "albedo").unwrap_err();
         assert!(err.to_string().contains("albedo.R"), "{err}");
         let err = read_exr_layer(&path, "beauty").unwrap_err();

@@ -123,6 +123,7 @@ impl RegressionCase {
             seed,
             layers: Layers::default(),
             settings: RenderSettings::new(spp, self.max_depth),
+            motion: Default::default(),
         }
     }
 

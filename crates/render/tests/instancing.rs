@@ -49,6 +49,7 @@ fn image(scene: &Scene) -> Vec<Vec3> {
         seed: 3,
         layers: Default::default(),
         settings: RenderSettings::new(16, 4),
+        motion: Default::default(),
     };
     render(scene, scene.camera(None).unwrap(), &job, &|_| {})
         .image

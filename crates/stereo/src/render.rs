@@ -31,6 +31,7 @@ use streaks_image::GrayImage;
 use streaks_render::camera::Camera;
 use streaks_render::integrator::{render, Layers, RenderJob, RenderOutput};
 use streaks_render::light::{Emitter, Light};
+use streaks_render::motion::Motion;
 use streaks_render::scene::Scene;
 use streaks_sensor::{capture, Capture, SensorProfile};
 use streaks_settings::RenderSettings;
@@ -84,6 +85,8 @@ pub struct PairSettings {
     pub exposure_ev: f32,
     /// The streak-mask definition.
     pub mask: StreakMaskParams,
+    /// The shutter and the rig's motion (the same for both eyes).
+    pub motion: Motion,
 }
 
 /// One rendered eye with its ground truth.
@@ -155,8 +158,10 @@ pub fn render_eye(
             specular: true,
             material: true,
             spp: false,
+            rain: scene.rain.is_some(),
         },
         settings: settings.render,
+        motion: settings.motion,
     };
     let output = render(scene, &eye_camera(rig, eye), &job, progress);
     let missing =

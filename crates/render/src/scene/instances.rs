@@ -62,6 +62,7 @@ impl Instance {
             origin: self.object_from_world.transform_point3(ray.origin),
             direction: self.object_from_world.transform_vector3(ray.direction),
             t_max: ray.t_max,
+            time: ray.time,
         }
     }
 

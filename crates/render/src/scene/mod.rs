@@ -126,6 +126,10 @@
 //!   nothing and emits its base colour (factor, texture, times COLOR_0) as radiance, so the
 //!   camera sees exactly the base colour; like any emitter it lights the rest of the scene
 //!   (docs/decisions/0027).
+//! - Rain (`scenes[i].extras.streaks.rain = {"rate_mm_h": R, "seed": n, "radius": m}`, seed
+//!   and radius optional, 0 and 20 m): [`Scene::rain`] holds it and a water material; its
+//!   drops are placed for a view by [`Scene::place_rain`] and met by camera rays through
+//!   [`Scene::intersect_path`] ([`crate::rain`] has the physics and the limits).
 //!
 //! ## Wet and dry patches (an extension of the contract)
 //!
@@ -188,10 +192,12 @@ pub use validate::MAX_COORDINATE;
 
 use crate::accel::Accel;
 use crate::camera::Camera;
-use crate::geometry::{Ray, SurfaceHit};
+use crate::geometry::{offset_ray_origin, Ray, SurfaceHit, VertexAttributes};
 use crate::light::{Environment, Light, LightSampler, SurfaceMesh};
 use crate::material::Material;
+use crate::motion::Motion;
 use crate::normal_map::{self, MappedNormal, NormalMap};
+use crate::rain::{offset_from_drop, DropField, Rain, RainError, RainParams, RainPath, RainView};
 use crate::sampling::{pcg_hash, u32_to_unit_f32};
 use crate::texture::Texture;
 use glam::{Vec2, Vec3, Vec4};
@@ -247,6 +253,9 @@ pub struct Scene {
     pub light_sampler: LightSampler,
     /// Things in the file that were skipped or defaulted, for the command to print.
     pub warnings: Vec<String>,
+    /// Rain in the air (`scenes[i].extras.streaks.rain`, [`crate::rain`]): its drops are
+    /// placed for a view by [`Scene::place_rain`]; `None` for a dry scene.
+    pub rain: Option<Rain>,
 }
 
 /// The in-memory ingredients of a [`Scene`], for [`Scene::from_parts`].
@@ -400,6 +409,7 @@ impl Scene {
             instances,
             light_sampler,
             warnings,
+            rain: None,
         })
     }
 
@@ -527,7 +537,81 @@ impl Scene {
         self.stops(geometry, ray, triangle, id, b)
     }
 
-    /// Closest hit along `ray` within `(t_min, ray.t_max)` (see [`Accel::t_min`]) where the
+    /// Closest hit along `ray` (at its time), the ray of a camera path in state `path`, on
+    /// the scene's surfaces or a rain drop: what [`Scene::intersect`] finds, unless a drop the
+    /// path can meet ([`RainPath`]: the camera ray the drops its camera sees, a ray leaving a
+    /// drop that drop) is nearer. A drop's hit has [`crate::rain::RAIN_TRIANGLE`] as its
+    /// triangle and the water material ([`crate::rain::water_material`]).
+    #[inline]
+    pub fn intersect_path(&self, ray: &Ray, path: &mut RainPath) -> Option<SurfaceHit> {
+        let surface = self.intersect(ray);
+        let (Some(rain), true) = (&self.rain, path.camera.is_some() || path.drop.is_some()) else {
+            return surface;
+        };
+        let t_max = surface.as_ref().map_or(ray.t_max, |h| h.t);
+        match path.intersect(ray, t_max) {
+            Some((t, _, n)) => Some(SurfaceHit {
+                t,
+                p: ray.at(t),
+                ng: n,
+                ns: n,
+                mapped: None,
+                coat_normal: None,
+                attributes: VertexAttributes::from_uv(Vec2::ZERO),
+                triangle: crate::rain::RAIN_TRIANGLE,
+                material: rain.material,
+            }),
+            None => surface,
+        }
+    }
+
+    /// The origin of a ray that leaves `hit` (with geometric normal `ng`) toward `w`: offset
+    /// off the surface by [`offset_ray_origin`], or for a rain drop by
+    /// [`crate::rain::offset_from_drop`] (a drop can be smaller than the triangles' offset).
+    #[inline]
+    pub fn spawn_origin(&self, hit: &SurfaceHit, ng: Vec3, w: Vec3) -> Vec3 {
+        if hit.triangle == crate::rain::RAIN_TRIANGLE {
+            offset_from_drop(hit.p, ng, w)
+        } else {
+            offset_ray_origin(hit.p, ng, w)
+        }
+    }
+
+    /// Gives the scene rain (what `extras.streaks.rain` asks for): adds the water material
+    /// to [`Scene::materials`]; no drops until [`Scene::place_rain`].
+    pub fn set_rain(&mut self, params: RainParams) {
+        let material = self.materials.len() as u32;
+        self.materials.push(crate::rain::water_material());
+        self.rain = Some(Rain {
+            params,
+            material,
+            field: DropField::default(),
+        });
+    }
+
+    /// Places the scene's rain drops (if it has rain) for a `width` x `height` view of
+    /// `camera` with the shutter and rig motion of `motion`: in the camera's view frustum
+    /// widened by [`crate::rain::RIG_MARGIN`], so that both eyes of a stereo rig centred on
+    /// `camera` see the same drops. Returns the number of drops. Renders of other views see
+    /// these drops too (all of them where they are seen from this camera's region).
+    pub fn place_rain(
+        &mut self,
+        camera: &Camera,
+        width: u32,
+        height: u32,
+        motion: Motion,
+    ) -> Result<usize, RainError> {
+        let Some(rain) = &mut self.rain else {
+            return Ok(0);
+        };
+        let view = RainView::of_camera(camera, width, height, motion, crate::rain::RIG_MARGIN)
+            .ok_or(RainError::Orthographic)?;
+        rain.field = DropField::place(&rain.params, &view)?;
+        Ok(rain.field.len())
+    }
+
+    /// Closest hit along `ray` within `(t_min, ray.t_max)` (see [`Accel::t_min`]) on the
+    /// scene's surfaces (never a rain drop: [`Scene::intersect_path`]), where the
     /// ray stops, on the flat triangles or an instance: hits on alpha-masked-out points are
     /// skipped, and `BLEND` surfaces stop the ray with probability alpha (stochastic
     /// transparency, decided by a hash of the ray and the triangle). The shading normal is the
@@ -641,7 +725,7 @@ impl Scene {
     }
 
     /// Whether anything blocks `ray` within `(t_min, ray.t_max)` (shadow query), with the
-    /// same alpha test as [`Scene::intersect`].
+    /// same alpha test as [`Scene::intersect`]; rain drops cast no shadow ([`crate::rain`]).
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
         self.accel

@@ -213,9 +213,11 @@ pub(in crate::scene) fn load(path: &Path, files: &Files) -> Result<Scene, SceneE
     let scene = document
         .default_scene()
         .or_else(|| document.scenes().next());
+    let mut rain = None;
     match scene {
         Some(scene) => {
             loader.parts.environment = loader.environment(&scene)?;
+            rain = loader.rain(&scene)?;
             // Nodes reached by several paths (a DAG) are visited once per path, which may be
             // exponentially many: they are counted first.
             count_visits(path, &document, &scene)?;
@@ -251,6 +253,9 @@ pub(in crate::scene) fn load(path: &Path, files: &Files) -> Result<Scene, SceneE
     let boxes = std::mem::take(&mut loader.primitive_boxes);
     let mut scene = Scene::from_parts(loader.parts)?;
     scene.framing_bounds = crate::camera::union_bounds(boxes);
+    if let Some(rain) = rain {
+        scene.set_rain(rain);
+    }
     Ok(scene)
 }
 

@@ -822,6 +822,7 @@ mod tests {
                 seed: 1,
                 layers: Layers::default(),
                 settings: RenderSettings::new(4, max_depth),
+                motion: Default::default(),
             };
             let out = render(&scene, scene.camera(None).unwrap(), &job, &|_| {});
             for p in &out.image.pixels {

@@ -32,6 +32,7 @@
 //! - `meshes`: primitives, their attributes in world space, triangulation, tangents;
 //! - `materials`: materials and their KHR_materials_* extensions, `extras.streaks`;
 //! - `environment`: the scene's environment light, `scenes[i].extras.streaks.environment`;
+//! - `rain`: the scene's rain, `scenes[i].extras.streaks.rain` ([`crate::rain`]);
 //! - `textures`: texture infos, KHR_texture_transform, samplers, images;
 //! - [`extensions`]: which extensions are honoured, and the ones that are not a material's
 //!   field: KHR_lights_punctual (and the file's light units), EXT_mesh_gpu_instancing;
@@ -48,6 +49,7 @@ pub mod extensions;
 mod materials;
 mod meshes;
 mod nodes;
+mod rain;
 #[cfg(test)]
 mod test_docs;
 mod textures;
