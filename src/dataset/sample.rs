@@ -13,10 +13,13 @@ use streaks_dataset::meta::{
 use streaks_dataset::settings::Settings;
 use streaks_dataset::write::{disparity_range, write_calib, write_views, GroundTruth};
 use streaks_image::write_bytes_atomically;
+use glam::Vec3;
+use streaks_render::motion::Motion;
 use streaks_render::scene::Scene;
 use streaks_scenes::procedural::{sample, GeneratorConfig, GENERATOR_VERSION};
+use streaks_sensor::SensorProfile;
 use streaks_stereo::render::{
-    light_records, render_pair, rig_from_camera, scene_has_road, PairSettings,
+    expose_pair, light_records, render_pair, rig_from_camera, scene_has_road, PairSettings,
 };
 use streaks_stereo::rigfile::PoseRecord;
 use streaks_stereo::streak_mask::StreakMaskParams;
@@ -85,6 +88,19 @@ pub fn render_sample(
     })
 }
 
+/// The camera of a sample with weather: the sensor preset `name` with the drawn shutter time
+/// `exposure_s`, developed as the preset develops its own shutter time (its `develop_ev` raised
+/// by `log2(preset exposure / exposure_s)`: the camera's auto exposure keeps the image's
+/// brightness by gain, so a shorter shutter shows as more noise and less motion blur, not as a
+/// darker image).
+fn sample_sensor(name: &str, exposure_s: f64) -> Result<SensorProfile> {
+    let mut profile = SensorProfile::preset(name)
+        .with_context(|| format!("the sample's sensor preset {name:?}"))?;
+    profile.develop_ev += (profile.exposure_s / exposure_s).log2();
+    profile.exposure_s = exposure_s;
+    Ok(profile)
+}
+
 /// Builds, renders and writes sample `index` into `dir`, and writes its KITTI files.
 fn write_sample(
     layout: &Layout,
@@ -109,8 +125,12 @@ fn write_sample(
         .with_context(|| format!("in the scene {}", gltf.display()))?
         .clone();
     let render = &settings.settings;
+    // The camera's shutter (the drawn exposure time) and the rig's motion over it.
+    let motion = s.weather.as_ref().map_or(Motion::default(), |w| {
+        Motion::centred(w.exposure_s as f32, Vec3::from(w.rig_velocity.map(|v| v as f32)))
+    });
     scene
-        .place_rain(&camera, render.width, render.height, Default::default())
+        .place_rain(&camera, render.width, render.height, motion)
         .with_context(|| format!("the rain of the scene {}", gltf.display()))?;
     let rig = rig_from_camera(&camera, render.width, render.height, s.baseline)
         .with_context(|| format!("the stereo rig of {}", gltf.display()))?;
@@ -120,9 +140,14 @@ fn write_sample(
         seed,
         exposure_ev: s.exposure_ev,
         mask: StreakMaskParams::default(),
-        motion: Default::default(),
+        motion,
     };
-    let views = render_pair(&scene, &rig, &pair, &|_| {})?;
+    let mut views = render_pair(&scene, &rig, &pair, &|_| {})?;
+    if let Some(weather) = &s.weather {
+        let profile = sample_sensor(&weather.sensor, weather.exposure_s)?;
+        // The generator's lights are physical: the radiance goes to the sensor unscaled.
+        expose_pair(&mut views, &rig, &profile, seed, 0.0)?;
+    }
     let [left, right] = &views;
 
     let files = SampleDir::new(dir);
