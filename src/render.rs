@@ -97,6 +97,7 @@ pub fn run(args: Args) -> Result<()> {
         specular: args.layers.contains(&Layer::Specular),
         material: args.road_mask.is_some(),
         spp: args.layers.contains(&Layer::Spp),
+        fog: false,
     };
     if let Some(mask) = &args.road_mask {
         if format_of(mask)? != Format::Png {
@@ -127,7 +128,11 @@ pub fn run(args: Args) -> Result<()> {
         width,
         height,
         seed: opts.seed,
-        layers,
+        // A foggy scene's EXR gets the fog's transmittance (`fog.Y`) too.
+        layers: Layers {
+            fog: scene.fog.is_some() && format == Format::Exr,
+            ..layers
+        },
         settings: opts.settings(),
     };
     create_parent(&args.output)?;

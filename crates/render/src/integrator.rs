@@ -146,15 +146,16 @@ use crate::bsdf::Bsdf;
 use crate::camera::Camera;
 use crate::film::{Film, Pixel};
 use crate::geometry::{offset_ray_origin, Frame, Ray};
-use crate::light::{LightSampler, Receiver, Visibility};
+use crate::light::{LightSample, LightSampler, Receiver, Visibility};
 use crate::material::Volume;
+use crate::medium::{Flight, Fog};
 use crate::sampling::{power_heuristic, Sampler};
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
-use streaks_image::RgbImage;
+use streaks_image::{luminance, RgbImage};
 use streaks_settings::RenderSettings;
 
 /// Depth from which Russian roulette may end a path (Mitsuba 3's `rr_depth`, whose default is
@@ -180,6 +181,8 @@ pub struct Layers {
     pub material: bool,
     /// Samples taken per pixel (see adaptive sampling in the module documentation).
     pub spp: bool,
+    /// The fog's transmittance to the pixel-centre ray's first hit.
+    pub fog: bool,
 }
 
 /// One image to render: its size, seed and layers, and how to sample it.
@@ -260,6 +263,9 @@ pub struct RenderOutput {
     pub material: Option<Vec<u32>>,
     /// Samples taken per pixel, row-major (if requested).
     pub spp: Option<Vec<u32>>,
+    /// The fog's transmittance (luminance) from the camera to the pixel-centre ray's first
+    /// hit, row-major (if requested; 1 without fog).
+    pub fog: Option<Vec<f32>>,
     /// Counters.
     pub stats: RenderStats,
 }
@@ -292,7 +298,7 @@ pub fn render(
         .transform_vector3(-Vec3::Z)
         .normalize();
     let l = job.layers;
-    let need_centre = l.depth || l.normal || l.albedo || l.material;
+    let need_centre = l.depth || l.normal || l.albedo || l.material || l.fog;
 
     match job.settings.noise_target {
         None => film.par_rows_mut().enumerate().for_each(|(y, row)| {
@@ -359,6 +365,7 @@ pub fn render(
         specular: layers.specular.then(|| film.specular()),
         material: layers.material.then(|| film.material()),
         spp: layers.spp.then(|| film.spp()),
+        fog: layers.fog.then(|| film.fog()),
         stats: RenderStats {
             seconds: start.elapsed().as_secs_f64(),
             samples: film.samples(),
@@ -481,9 +488,15 @@ fn take_sample(
     path.rays
 }
 
-/// Fills the depth, normal, albedo and material of `pixel` from the pixel-centre ray.
+/// Fills the depth, normal, albedo, material and fog transmittance of `pixel` from the
+/// pixel-centre ray.
 fn first_hit_layers(scene: &Scene, ray: &Ray, origin: Vec3, forward: Vec3, pixel: &mut Pixel) {
-    if let Some(hit) = scene.intersect(ray) {
+    let found = scene.intersect(ray);
+    if let Some(fog) = &scene.fog {
+        let t = found.as_ref().map_or(f32::INFINITY, |h| h.t);
+        pixel.fog = luminance(fog.transmittance(ray.origin, ray.direction, t));
+    }
+    if let Some(hit) = found {
         pixel.depth = (hit.p - origin).dot(forward);
         pixel.material = hit.material;
         pixel.normal = if hit.ns.dot(ray.direction) > 0.0 {
@@ -507,6 +520,9 @@ struct Arrival {
     prev_bsdf_pdf: f32,
     /// The first hit's BSDF, frame and `wo`, for the specular layer.
     first_bsdf: Option<(Bsdf, Frame, Vec3)>,
+    /// The product of the fog's pass weights of the path's segments (1 without fog), for the
+    /// specular layer.
+    fog_pass: Vec3,
 }
 
 impl Arrival {
@@ -531,7 +547,8 @@ impl Arrival {
             if let (1, Some((bsdf, frame, wo_local))) = (self.depth, self.first_bsdf) {
                 let wi_local = frame.to_local(dir);
                 let glossy = bsdf.eval_lobes(wo_local, wi_local).glossy;
-                out.specular += le * glossy * (wi_local.z * weight / self.prev_bsdf_pdf);
+                out.specular +=
+                    self.fog_pass * (le * glossy * (wi_local.z * weight / self.prev_bsdf_pdf));
             }
         }
     }
@@ -557,19 +574,71 @@ fn trace_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, job: &RenderJo
     let mut first_bsdf: Option<(Bsdf, Frame, Vec3)> = None;
     // The smallest density of the directions chosen so far (path regularisation).
     let mut min_ray_pdf = f32::INFINITY;
+    // The fog, the colour channel its free flights are sampled in (one per path, as in
+    // Mitsuba's volpath; drawn only when there is fog) and the product of its pass weights.
+    let fog = scene.fog.as_ref();
+    let channel = match fog {
+        Some(_) => ((sampler.next_1d() * 3.0) as usize).min(2),
+        None => 0,
+    };
+    let mut fog_pass = Vec3::ONE;
 
     while depth < max_depth {
         out.rays += 1;
+        let found = scene.intersect(&ray);
+        // A free flight through the fog, when the path is in it (outside every volume).
+        if let (Some(fog), None) = (fog, medium) {
+            let t_max = found.as_ref().map_or(f32::INFINITY, |h| h.t);
+            let u = sampler.next_1d();
+            match fog.sample_flight(ray.origin, ray.direction, t_max, channel, u) {
+                Flight::Pass { weight } => {
+                    throughput *= weight;
+                    fog_pass *= weight;
+                }
+                Flight::Collision { t, weight } => {
+                    throughput *= weight;
+                    // 1-3 at a point of the fog: a vertex and a bounce like a surface's.
+                    if depth + 1 >= max_depth {
+                        break;
+                    }
+                    let p = ray.origin + ray.direction * t;
+                    let rx = Receiver::in_medium(p);
+                    out.rays += scatter_in_fog(
+                        scene,
+                        fog,
+                        &rx,
+                        -ray.direction,
+                        throughput,
+                        sampler,
+                        &mut out.radiance,
+                    );
+                    let [dx, dy, _, u_rr] = sampler.next_4d();
+                    let ps = fog.phase().sample(-ray.direction, Vec2::new(dx, dy));
+                    prev = Some(rx);
+                    prev_bsdf_pdf = ps.pdf;
+                    prev_delta = false;
+                    min_ray_pdf = min_ray_pdf.min(ps.pdf);
+                    ray = Ray::new(p, ps.wi);
+                    depth += 1;
+                    if !survives_roulette(depth, &mut throughput, u_rr) {
+                        break;
+                    }
+                    continue;
+                }
+            }
+        }
         // Where the path stands, for light arriving along this ray.
         let arrival = Arrival {
             depth,
             prev_delta,
             prev_bsdf_pdf,
             first_bsdf,
+            fog_pass,
         };
-        let Some(hit) = scene.intersect(&ray) else {
+        let Some(hit) = found else {
             // 1'. The environment, for a ray that escapes (not from inside a volume, whose
-            // closed surface a ray cannot leave unseen).
+            // closed surface a ray cannot leave unseen; through the fog, its pass weight is
+            // in the throughput).
             if let (Some(env), None) = (lights.environment(), medium) {
                 let le = env.le(ray.direction);
                 if le.max_element() > 0.0 {
@@ -663,45 +732,10 @@ fn trace_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, job: &RenderJo
                 if total.max_element() > 0.0 {
                     let origin = offset_ray_origin(hit.p, ng, ls.wi);
                     out.rays += 1;
-                    let li = match ls.visibility {
-                        Visibility::ShadowRay => {
-                            let t_max = if ls.dist.is_finite() {
-                                (ls.dist - (origin - hit.p).length()) * (1.0 - SHADOW_EPSILON)
-                            } else {
-                                f32::INFINITY
-                            };
-                            let shadow = Ray {
-                                origin,
-                                direction: ls.wi,
-                                t_max,
-                            };
-                            if scene.occluded(&shadow) {
-                                Vec3::ZERO
-                            } else {
-                                ls.li
-                            }
-                        }
-                        Visibility::FirstHit { emitter } => {
-                            let ray = Ray {
-                                origin,
-                                direction: ls.wi,
-                                t_max: ls.dist * (1.0 + 1e-4),
-                            };
-                            match scene.intersect(&ray) {
-                                Some(h)
-                                    if lights
-                                        .emitters()
-                                        .emitter_of(h.triangle)
-                                        .is_some_and(|(e, _)| e == emitter as usize) =>
-                                {
-                                    scene.emitted_radiance(&h, -ls.wi)
-                                }
-                                _ => Vec3::ZERO,
-                            }
-                        }
-                    };
-                    let li = match medium_along(wi_local.z) {
-                        Some(v) if ls.dist.is_finite() => li * v.transmittance(ls.dist),
+                    let li = visible_li(scene, lights, origin, hit.p, &ls);
+                    let li = match (medium_along(wi_local.z), fog) {
+                        (Some(v), _) if ls.dist.is_finite() => li * v.transmittance(ls.dist),
+                        (None, Some(fog)) => li * fog.transmittance(hit.p, ls.wi, ls.dist),
                         _ => li,
                     };
                     if li.max_element() > 0.0 {
@@ -713,7 +747,7 @@ fn trace_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, job: &RenderJo
                         let scale = li * (wi_local.z.abs() * weight / ls.pdf);
                         out.radiance += throughput * total * scale;
                         if depth == 0 && want_specular {
-                            out.specular += f.glossy * scale;
+                            out.specular += throughput * f.glossy * scale;
                         }
                     }
                 }
@@ -748,19 +782,123 @@ fn trace_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, job: &RenderJo
         ray = Ray::new(offset_ray_origin(hit.p, ng, wi), wi);
         depth += 1;
 
-        // Russian roulette (Mitsuba's rule).
-        if depth >= RR_DEPTH {
-            let q = throughput.max_element().min(0.95);
-            if u_rr >= q {
-                break;
-            }
-            throughput /= q;
-        }
-        if throughput.max_element() <= 0.0 {
+        if !survives_roulette(depth, &mut throughput, u_rr) {
             break;
         }
     }
     out
+}
+
+/// Russian roulette (Mitsuba's rule) after the path's `depth`-th bounce with `u_rr`: whether
+/// the path goes on (its throughput divided by the survival probability); also `false` once
+/// the throughput is zero.
+#[inline]
+fn survives_roulette(depth: u32, throughput: &mut Vec3, u_rr: f32) -> bool {
+    if depth >= RR_DEPTH {
+        let q = throughput.max_element().min(0.95);
+        if u_rr >= q {
+            return false;
+        }
+        *throughput /= q;
+    }
+    throughput.max_element() > 0.0
+}
+
+/// The light of sample `ls` that reaches `origin` (offset from the shading point `from`),
+/// before any medium: `ls.li` if a shadow ray finds the way free (or, for a compact emitter,
+/// the emission of the emitter a closest-hit ray lands on, if it is that one), else zero.
+#[inline]
+fn visible_li(
+    scene: &Scene,
+    lights: &LightSampler,
+    origin: Vec3,
+    from: Vec3,
+    ls: &LightSample,
+) -> Vec3 {
+    match ls.visibility {
+        Visibility::ShadowRay => {
+            let t_max = if ls.dist.is_finite() {
+                (ls.dist - (origin - from).length()) * (1.0 - SHADOW_EPSILON)
+            } else {
+                f32::INFINITY
+            };
+            let shadow = Ray {
+                origin,
+                direction: ls.wi,
+                t_max,
+            };
+            if scene.occluded(&shadow) {
+                Vec3::ZERO
+            } else {
+                ls.li
+            }
+        }
+        Visibility::FirstHit { emitter } => {
+            let ray = Ray {
+                origin,
+                direction: ls.wi,
+                t_max: ls.dist * (1.0 + 1e-4),
+            };
+            match scene.intersect(&ray) {
+                Some(h)
+                    if lights
+                        .emitters()
+                        .emitter_of(h.triangle)
+                        .is_some_and(|(e, _)| e == emitter as usize) =>
+                {
+                    scene.emitted_radiance(&h, -ls.wi)
+                }
+                _ => Vec3::ZERO,
+            }
+        }
+    }
+}
+
+/// Next-event estimation at a collision with the fog at `rx.p` (a medium receiver): one light
+/// sample, weighted by the phase function toward it and, unless it is a delta light, by the
+/// power heuristic against phase sampling; the fog's transmittance on the shadow ray (to
+/// infinity for the environment). Draws one 4D sample (light point and choice), as a surface
+/// vertex does; adds `throughput`-weighted light to `radiance` and returns the rays traced.
+#[inline]
+fn scatter_in_fog(
+    scene: &Scene,
+    fog: &Fog,
+    rx: &Receiver,
+    wo: Vec3,
+    throughput: Vec3,
+    sampler: &mut Sampler,
+    radiance: &mut Vec3,
+) -> u64 {
+    let lights = &scene.light_sampler;
+    let [px, py, u_light, _] = sampler.next_4d();
+    let Some(ls) = lights.sample_li(
+        &scene.materials,
+        &scene.textures,
+        rx,
+        u_light,
+        Vec2::new(px, py),
+    ) else {
+        return 0;
+    };
+    let phase = fog.phase().eval(wo, ls.wi);
+    if !(phase > 0.0) {
+        return 0;
+    }
+    let li = visible_li(scene, lights, rx.p, rx.p, &ls);
+    let li = if li.max_element() > 0.0 {
+        li * fog.transmittance(rx.p, ls.wi, ls.dist)
+    } else {
+        li
+    };
+    if li.max_element() > 0.0 {
+        let weight = if ls.delta {
+            1.0
+        } else {
+            power_heuristic(1.0, ls.pdf, 1.0, phase)
+        };
+        *radiance += throughput * li * (phase * weight / ls.pdf);
+    }
+    1
 }
 
 #[cfg(test)]

@@ -312,7 +312,10 @@ mod tests {
         let (o, up) = (Vec3::new(0.0, 2.0, 0.0), Vec3::new(0.0, 0.6, 0.8));
         let inf = fog.optical_depth(o, up, f32::INFINITY);
         let far = quadrature(&fog, o, up, 200.0, 200_000);
-        assert!((inf - far).abs().max_element() < 1e-4 * far.max_element(), "{inf} {far}");
+        assert!(
+            (inf - far).abs().max_element() < 1e-4 * far.max_element(),
+            "{inf} {far}"
+        );
         assert_eq!(fog.transmittance(o, Vec3::X, f32::INFINITY), Vec3::ZERO);
         assert_eq!(
             fog.transmittance(o, -up, f32::INFINITY),
@@ -338,10 +341,12 @@ mod tests {
                     let t_max = 25.0;
                     let mut rng = Pcg32::new(7, channel as u64);
                     let mut ts: Vec<f32> = (0..n)
-                        .map(|_| match fog.sample_flight(o, d, t_max, channel, rng.next_f32()) {
-                            Flight::Collision { t, .. } => t,
-                            Flight::Pass { .. } => t_max,
-                        })
+                        .map(
+                            |_| match fog.sample_flight(o, d, t_max, channel, rng.next_f32()) {
+                                Flight::Collision { t, .. } => t,
+                                Flight::Pass { .. } => t_max,
+                            },
+                        )
                         .collect();
                     ts.sort_by(f32::total_cmp);
                     let cdf = |t: f32| {
@@ -393,8 +398,7 @@ mod tests {
         for i in 0..steps {
             let t = (i as f32 + 0.5) * h;
             let p = o + d * t;
-            expected +=
-                fog.sigma_t_at(p) * fog.albedo() * fog.transmittance(o, d, t) * (f(t) * h);
+            expected += fog.sigma_t_at(p) * fog.albedo() * fog.transmittance(o, d, t) * (f(t) * h);
         }
         for channel in 0..3 {
             let mut rng = Pcg32::new(3, 11 + channel as u64);
@@ -416,12 +420,24 @@ mod tests {
         let (s, a) = (Vec3::splat(0.1), Vec3::splat(0.9));
         assert!(Fog::new(s, a, 0.5, 0.0, 0.0).is_ok());
         let neg = Vec3::new(-0.1, 0.1, 0.1);
-        assert!(matches!(Fog::new(neg, a, 0.5, 0.0, 0.0), Err(FogError::SigmaT(_))));
+        assert!(matches!(
+            Fog::new(neg, a, 0.5, 0.0, 0.0),
+            Err(FogError::SigmaT(_))
+        ));
         let high = Vec3::splat(1.1);
-        assert!(matches!(Fog::new(s, high, 0.5, 0.0, 0.0), Err(FogError::Albedo(_))));
+        assert!(matches!(
+            Fog::new(s, high, 0.5, 0.0, 0.0),
+            Err(FogError::Albedo(_))
+        ));
         assert!(matches!(Fog::new(s, a, 1.0, 0.0, 0.0), Err(FogError::G(_))));
-        assert!(matches!(Fog::new(s, a, f32::NAN, 0.0, 0.0), Err(FogError::G(_))));
-        assert!(matches!(Fog::new(s, a, 0.5, -1.0, 0.0), Err(FogError::HeightFalloff(_))));
+        assert!(matches!(
+            Fog::new(s, a, f32::NAN, 0.0, 0.0),
+            Err(FogError::G(_))
+        ));
+        assert!(matches!(
+            Fog::new(s, a, 0.5, -1.0, 0.0),
+            Err(FogError::HeightFalloff(_))
+        ));
         assert!(matches!(
             Fog::new(s, a, 0.5, 0.0, f32::INFINITY),
             Err(FogError::ReferenceHeight(_))

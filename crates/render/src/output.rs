@@ -2,7 +2,8 @@
 //!
 //! Channels: `R`, `G`, `B` (the beauty image, linear) plus, when present, `depth.Z`,
 //! `normal.X`/`normal.Y`/`normal.Z`, `albedo.R`/`.G`/`.B`, `specular.R`/`.G`/`.B` and
-//! `spp.Y` (samples taken per pixel, as float32: exact up to 2^24) (OpenEXR's `layer.channel` naming, which Blender, Nuke and `exrheader` show as layers).
+//! `spp.Y` (samples taken per pixel, as float32: exact up to 2^24) and `fog.Y` (the fog's
+//! transmittance to the pixel-centre ray's first hit, 1 without fog) (OpenEXR's `layer.channel` naming, which Blender, Nuke and `exrheader` show as layers).
 //! [`write_exr`] writes them and [`read_exr_layer`] reads them back, from the names here; the
 //! file itself is written by [`streaks_image::exr`] (atomically).
 
@@ -23,6 +24,8 @@ pub const NORMAL: [&str; 3] = ["normal.X", "normal.Y", "normal.Z"];
 pub const DEPTH: &str = "depth.Z";
 /// The samples-per-pixel layer's channel.
 pub const SPP: &str = "spp.Y";
+/// The fog transmittance layer's channel.
+pub const FOG: &str = "fog.Y";
 
 /// Writes the render as a float32 EXR: the beauty image and the layers present in `output`
 /// (see the module documentation), atomically.
@@ -49,26 +52,35 @@ pub fn write_exr(path: &Path, output: &RenderOutput) -> Result<(), ImageError> {
     if let Some(spp) = &output.spp {
         channels.push((SPP, spp.iter().map(|&n| n as f32).collect()));
     }
+    if let Some(fog) = &output.fog {
+        channels.push((FOG, fog.clone()));
+    }
     streaks_image::exr::write_exr(path, img.width, img.height, channels)
 }
 
 /// Reads a layer written by [`write_exr`]: `"albedo"`, `"specular"` (RGB), `"normal"` (XYZ
-/// into the RGB slots), `"depth"` (Z) or `"spp"` (samples per pixel; one channel, repeated
-/// into all three slots).
+/// into the RGB slots), `"depth"` (Z), `"spp"` (samples per pixel) or `"fog"` (fog
+/// transmittance; these three one channel, repeated into all three slots).
 pub fn read_exr_layer(path: &Path, name: &str) -> Result<RgbImage, ImageError> {
     match name {
         "albedo" => read_exr_rgb_channels(path, ALBEDO),
         "specular" => read_exr_rgb_channels(path, SPECULAR),
         "normal" => read_exr_rgb_channels(path, NORMAL),
-        "depth" | "spp" => {
-            let channel = if name == "depth" { DEPTH } else { SPP };
+        "depth" | "spp" | "fog" => {
+            let channel = match name {
+                "depth" => DEPTH,
+                "spp" => SPP,
+                _ => FOG,
+            };
             let (w, h, planes) = read_exr_channels(path, &[channel])?;
             let z = &planes[0];
             Ok(RgbImage::from_planes(w, h, [z, z, z]))
         }
         other => Err(ImageError::MissingChannels {
             path: path.to_path_buf(),
-            what: format!("layer {other:?} (the layers are albedo, specular, normal, depth, spp)"),
+            what: format!(
+                "layer {other:?} (the layers are albedo, specular, normal, depth, spp, fog)"
+            ),
         }),
     }
 }
@@ -99,6 +111,7 @@ mod tests {
             specular: Some(gradient(w, h)),
             material: None,
             spp: Some((0..w * h).map(|i| 16 + 8 * i).collect()),
+            fog: Some((0..w * h).map(|i| 1.0 / (1 + i) as f32).collect()),
             stats: RenderStats::default(),
         }
     }
@@ -121,6 +134,8 @@ mod tests {
         assert_eq!(depth.get(4, 0).z, f32::INFINITY);
         let spp = read_exr_layer(&path, "spp").unwrap();
         assert_eq!(spp.get(2, 1).x, (16 + 8 * 7) as f32);
+        let fog = read_exr_layer(&path, "fog").unwrap();
+        assert_eq!(fog.get(2, 1).y, 1.0 / 8.0);
         let err = read_exr_layer(&path, "albedo").unwrap_err();
         assert!(err.to_string().contains("albedo.R"), "{err}");
         let err = read_exr_layer(&path, "beauty").unwrap_err();

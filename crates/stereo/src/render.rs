@@ -150,6 +150,7 @@ pub fn render_eye(
             specular: true,
             material: true,
             spp: false,
+            fog: false,
         },
         settings: settings.render,
     };

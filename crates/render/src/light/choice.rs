@@ -7,7 +7,8 @@
 //! cosine toward it (zero below the shading or the geometric surface). The 1% share by `E`
 //! alone is defensive sampling: every emitter that can light the point keeps a positive
 //! probability even where the BSDF toward its centre is zero. On a glossy wet road the
-//! mixture sends a streak's shadow rays to the lamp that makes the streak.
+//! mixture sends a streak's shadow rays to the lamp that makes the streak. A point in the fog
+//! ([`Receiver::in_medium`]) has no BSDF to weigh by: its choice goes by `E` alone.
 //!
 //! The share is small because every shadow ray it sends elsewhere is wasted in a streak pixel,
 //! and what it guards against is mostly covered otherwise: a punctual light's `F` is exact,
