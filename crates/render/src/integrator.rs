@@ -906,6 +906,7 @@ pub(crate) mod tests {
     use super::*;
     use crate::light::Light;
     use crate::material::Material;
+    use crate::medium::Fog;
     use crate::scene::SceneParts;
     use glam::{Affine3A, Quat};
     use std::f32::consts::PI;
@@ -1259,6 +1260,7 @@ pub(crate) mod tests {
             specular: true,
             material: true,
             spp: true,
+            fog: true,
         };
         let run = |threads| {
             rayon::ThreadPoolBuilder::new()
@@ -1916,5 +1918,200 @@ pub(crate) mod tests {
         });
         let lit = Scene::from_parts(parts).unwrap();
         assert!(lit.warnings.is_empty() && lit.environment().is_none());
+    }
+
+    /// A camera at the origin looking down -Z with a field of view so narrow that its one
+    /// pixel is a single ray.
+    fn pencil() -> Camera {
+        camera(Vec3::ZERO, 0.0, 1e-4)
+    }
+
+    /// Single scattering toward the pencil camera, by the midpoint rule along its ray out to
+    /// `t_end`: `int sigma_s(t) T(t) [int over the light of p(wo, wi) T(r) dE(r)] dt`, with
+    /// `light(p)` giving the light's `(wi, r, irradiance)` pieces at `p`.
+    fn single_scattering(
+        fog: &Fog,
+        t_end: f32,
+        light: impl Fn(Vec3) -> Vec<(Vec3, f32, Vec3)>,
+    ) -> Vec3 {
+        let (o, d) = (Vec3::ZERO, -Vec3::Z);
+        let steps = 4000;
+        let h = t_end / steps as f32;
+        let mut sum = Vec3::ZERO;
+        for i in 0..steps {
+            let t = (i as f32 + 0.5) * h;
+            let p = o + d * t;
+            let mut inscatter = Vec3::ZERO;
+            for (wi, r, e) in light(p) {
+                let phase = fog.phase().eval(-d, wi);
+                inscatter += e * phase * fog.transmittance(p, wi, r);
+            }
+            sum += fog.sigma_t_at(p) * fog.albedo() * fog.transmittance(o, d, t) * inscatter * h;
+        }
+        sum
+    }
+
+    fn foggy_scene(parts: SceneParts, fog: Fog) -> Scene {
+        Scene::from_parts(SceneParts {
+            fog: Some(fog),
+            ..parts
+        })
+        .unwrap()
+    }
+
+    #[test]
+    fn fog_scatters_a_point_light_into_a_ray_as_the_in_scattering_integral() {
+        let light_pos = Vec3::new(0.0, 1.0, -3.0);
+        let intensity = Vec3::new(10.0, 8.0, 6.0);
+        for (fog, spp) in [
+            (
+                Fog::homogeneous(Vec3::splat(0.1), Vec3::splat(0.8), 0.6).unwrap(),
+                60_000,
+            ),
+            (
+                Fog::new(
+                    Vec3::new(0.05, 0.1, 0.2),
+                    Vec3::new(0.9, 0.7, 0.5),
+                    -0.3,
+                    0.4,
+                    0.5,
+                )
+                .unwrap(),
+                150_000,
+            ),
+        ] {
+            let parts = SceneParts {
+                lights: vec![Light::Point {
+                    position: light_pos,
+                    intensity,
+                    range: None,
+                }],
+                ..Default::default()
+            };
+            let scene = foggy_scene(parts, fog);
+            let out = render(&scene, &pencil(), &settings(1, 1, spp, 2), &|_| {});
+            let got = out.image.get(0, 0);
+            let expected = single_scattering(&fog, 200.0, |p| {
+                let to = light_pos - p;
+                let r = to.length();
+                vec![(to / r, r, intensity / (r * r))]
+            });
+            let err = ((got - expected) / expected).abs().max_element();
+            assert!(err < 0.015, "{fog:?}: {got} vs {expected}");
+        }
+    }
+
+    #[test]
+    fn fog_scatters_an_area_light_into_a_ray_with_mis() {
+        // A 0.5 m square lamp at y = 1 facing down, above the ray; the phase function's
+        // samples that hit it are weighed against light sampling.
+        let le = Vec3::new(4.0, 3.0, 2.0);
+        let mut glow = Material::diffuse("glow", Vec3::ZERO);
+        glow.emission = le;
+        let (c, s) = (Vec3::new(0.2, 1.0, -2.5), 0.25);
+        let mut parts = SceneParts {
+            materials: vec![glow],
+            ..Default::default()
+        };
+        quad(
+            &mut parts,
+            [
+                c + Vec3::new(-s, 0.0, -s),
+                c + Vec3::new(s, 0.0, -s),
+                c + Vec3::new(s, 0.0, s),
+                c + Vec3::new(-s, 0.0, s),
+            ],
+            0,
+        );
+        let fog = Fog::homogeneous(Vec3::new(0.2, 0.3, 0.4), Vec3::splat(0.9), 0.5).unwrap();
+        let scene = foggy_scene(parts, fog);
+        let out = render(&scene, &pencil(), &settings(1, 1, 100_000, 2), &|_| {});
+        let got = out.image.get(0, 0);
+        let n = 24;
+        let expected = single_scattering(&fog, 60.0, |p| {
+            let mut pieces = Vec::with_capacity(n * n);
+            let da = (2.0 * s / n as f32).powi(2);
+            for i in 0..n {
+                for j in 0..n {
+                    let u = -s + (i as f32 + 0.5) * 2.0 * s / n as f32;
+                    let v = -s + (j as f32 + 0.5) * 2.0 * s / n as f32;
+                    let to = c + Vec3::new(u, 0.0, v) - p;
+                    let r = to.length();
+                    // The lamp faces down: its cosine toward p is (to.y / r).
+                    let cos = (to.y / r).max(0.0);
+                    pieces.push((to / r, r, le * (cos * da / (r * r))));
+                }
+            }
+            pieces
+        });
+        let err = ((got - expected) / expected).abs().max_element();
+        assert!(err < 0.015, "{got} vs {expected}");
+    }
+
+    #[test]
+    fn absorbing_fog_dims_a_lit_floor_by_beer_lambert_both_ways() {
+        let kd = Vec3::new(0.5, 0.4, 0.3);
+        let light_pos = Vec3::new(0.3, 2.0, -1.0);
+        let intensity = Vec3::splat(10.0);
+        let mut parts = SceneParts {
+            materials: vec![Material::diffuse("floor", kd)],
+            lights: vec![Light::Point {
+                position: light_pos,
+                intensity,
+                range: None,
+            }],
+            ..Default::default()
+        };
+        floor(&mut parts);
+        let sigma = Vec3::new(0.05, 0.1, 0.2);
+        let fog = Fog::homogeneous(sigma, Vec3::ZERO, 0.0).unwrap();
+        let scene = foggy_scene(parts, fog);
+        let cam = camera(Vec3::new(0.0, 1.5, 2.0), -0.6, 0.6);
+        let (w, h) = (12, 8);
+        let mut set = settings(w, h, 2000, 2);
+        set.layers.fog = true;
+        let out = render(&scene, &cam, &set, &|_| {});
+        let k = 4;
+        let (mut got, mut expected) = (Vec3::ZERO, Vec3::ZERO);
+        for y in 0..h {
+            for x in 0..w {
+                got += out.image.get(x, y);
+                for i in 0..k {
+                    for j in 0..k {
+                        let o = Vec2::new((i as f32 + 0.5) / k as f32, (j as f32 + 0.5) / k as f32);
+                        let ray = cam.generate_ray(Vec2::new(x as f32, y as f32) + o, w, h);
+                        let t = -ray.origin.y / ray.direction.y;
+                        let p = ray.at(t);
+                        let d = light_pos - p;
+                        let tr = (-sigma * (t + d.length())).exp();
+                        expected +=
+                            intensity * kd * tr * (d.y / d.length() / d.length_squared() / PI)
+                                / (k * k) as f32;
+                    }
+                }
+            }
+        }
+        let err = ((got - expected) / expected).abs().max_element();
+        assert!(err < 0.01, "{got} vs {expected}");
+        // The fog layer: the transmittance's luminance to the centre ray's hit.
+        let ray = cam.generate_ray(Vec2::new(5.5, 6.5), w, h);
+        let t = -ray.origin.y / ray.direction.y;
+        let layer = out.fog.unwrap()[(6 * w + 5) as usize];
+        assert!(
+            (layer - luminance((-sigma * t).exp())).abs() < 1e-5,
+            "{layer}"
+        );
+    }
+
+    #[test]
+    fn a_scene_without_fog_has_a_fog_layer_of_one_and_draws_no_fog_numbers() {
+        let scene = street(Vec3::splat(0.3), Vec3::splat(0.2));
+        let cam = camera(Vec3::new(0.0, 1.5, 2.0), -0.3, 0.8);
+        let mut set = settings(8, 6, 4, 4);
+        let plain = render(&scene, &cam, &set, &|_| {});
+        set.layers.fog = true;
+        let with_layer = render(&scene, &cam, &set, &|_| {});
+        assert!(with_layer.fog.unwrap().iter().all(|&f| f == 1.0));
+        assert_eq!(plain.image, with_layer.image);
     }
 }

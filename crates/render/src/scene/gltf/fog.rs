@@ -12,22 +12,18 @@ use crate::scene::SceneError;
 use glam::Vec3;
 use serde::Deserialize;
 
-/// A scalar or an RGB triple.
-#[derive(Deserialize)]
-#[serde(untagged)]
-enum Colour {
-    /// The same value in every channel.
-    Grey(f32),
-    /// Linear RGB.
-    Rgb([f32; 3]),
-}
-
-impl Colour {
-    fn rgb(self) -> Vec3 {
-        match self {
-            Colour::Grey(v) => Vec3::splat(v),
-            Colour::Rgb(c) => Vec3::from_array(c),
-        }
+/// A scalar or an RGB triple named `key`, as linear RGB.
+fn colour(key: &str, value: &serde_json::Value) -> Result<Vec3, String> {
+    let number = |v: &serde_json::Value| v.as_f64().map(|x| x as f32);
+    if let Some(x) = number(value) {
+        return Ok(Vec3::splat(x));
+    }
+    match value
+        .as_array()
+        .map(|a| a.iter().map(number).collect::<Option<Vec<f32>>>())
+    {
+        Some(Some(c)) if c.len() == 3 => Ok(Vec3::new(c[0], c[1], c[2])),
+        _ => Err(format!("{key} must be a number or [r, g, b], got {value}")),
     }
 }
 
@@ -35,8 +31,8 @@ impl Colour {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct FogExtras {
-    sigma_t: Colour,
-    albedo: Colour,
+    sigma_t: serde_json::Value,
+    albedo: serde_json::Value,
     g: f32,
     height_falloff: Option<f32>,
     reference_height: Option<f32>,
@@ -58,8 +54,8 @@ impl Loader<'_> {
         let fog: FogExtras =
             serde_json::from_value(value.clone()).map_err(|e| bad(e.to_string()))?;
         Fog::new(
-            fog.sigma_t.rgb(),
-            fog.albedo.rgb(),
+            colour("sigma_t", &fog.sigma_t).map_err(bad)?,
+            colour("albedo", &fog.albedo).map_err(bad)?,
             fog.g,
             fog.height_falloff.unwrap_or(0.0),
             fog.reference_height.unwrap_or(0.0),
