@@ -54,8 +54,25 @@
 //! boundary from its back face leaves it; along every segment inside, the throughput (and a
 //! shadow ray's light) is multiplied by the Beer-Lambert transmittance of the segment's length.
 //! Limits: one medium at a time (nested or overlapping volumes are not tracked: leaving an
-//! inner volume puts the path in air), a camera inside a volume starts in air, and the
-//! boundary must be closed and consistently wound.
+//! inner volume puts the path in air, or in the fog), a camera inside a volume starts in air
+//! (or fog), and the boundary must be closed and consistently wound.
+//!
+//! Fog ([`Scene::fog`], [`crate::medium::Fog`]; decisions/0030): it fills the space outside
+//! the volumes, the camera and the lights included, and follows Mitsuba 3's `volpath`
+//! (`volpath.cpp`). A path chooses one colour channel at its start (one random number, drawn
+//! only when the scene has fog: fog-free renders are unchanged); every segment outside a volume
+//! draws one more for an exact free flight in that channel
+//! ([`crate::medium::Fog::sample_flight`]). A flight that passes the segment multiplies the
+//! throughput by `T / T_c` (the environment, for an escaping ray, is then seen times its
+//! transmittance to infinity: nothing through homogeneous fog); one that ends in the fog
+//! multiplies it by `T sigma_s / (T_c sigma_t,c)` and makes a vertex there, which counts as a
+//! bounce (`max_depth`) exactly as a surface vertex: next-event estimation with a light chosen
+//! by irradiance alone ([`Receiver::in_medium`]), weighed by the Henyey-Greenstein phase
+//! function and, for area lights and the environment, by the power heuristic against phase
+//! sampling; then a phase-function sample for the next direction (its density is the MIS
+//! density of an emitter the path hits next), and Russian roulette. It draws the same two 4D
+//! samples a surface vertex draws. Shadow rays from surfaces and from the fog multiply by the
+//! fog's analytic transmittance (to infinity for the environment).
 //!
 //! Path regularisation ([`RenderSettings::regularize`], off by default; biased): a glossy
 //! lobe seen after a diffuse or rough bounce is roughened, so that the light a small lamp
@@ -141,6 +158,10 @@
 //!   threshold on it.
 //! - `spp`: the number of samples the pixel took (kept and dropped), `spp` everywhere unless
 //!   adaptive sampling stopped its tile earlier.
+//! - `fog`: the luminance of the fog's transmittance from the camera to the pixel-centre ray's
+//!   first hit (to infinity on a miss; 1 without fog). With fog, the `specular` layer's light
+//!   carries the fog's pass weights of its two segments, and light scattered by the fog is not
+//!   in it.
 
 use crate::bsdf::Bsdf;
 use crate::camera::Camera;
@@ -881,7 +902,7 @@ fn scatter_in_fog(
         return 0;
     };
     let phase = fog.phase().eval(wo, ls.wi);
-    if !(phase > 0.0) {
+    if phase <= 0.0 || phase.is_nan() {
         return 0;
     }
     let li = visible_li(scene, lights, rx.p, rx.p, &ls);

@@ -96,7 +96,7 @@ impl Fog {
         if !(albedo.is_finite() && albedo.min_element() >= 0.0 && albedo.max_element() <= 1.0) {
             return Err(FogError::Albedo(albedo));
         }
-        if !(g.abs() < 1.0) {
+        if g.is_nan() || g.abs() >= 1.0 {
             return Err(FogError::G(g));
         }
         if !(height_falloff.is_finite() && height_falloff >= 0.0) {
