@@ -2024,49 +2024,52 @@ pub(crate) mod tests {
 
     #[test]
     fn fog_scatters_an_area_light_into_a_ray_with_mis() {
-        // A 0.5 m square lamp at y = 1 facing down, above the ray; the phase function's
-        // samples that hit it are weighed against light sampling.
+        // A square lamp facing down above the ray: small (light sampling wins the MIS) and
+        // large and near (the phase function's samples that hit it carry much of the light).
         let le = Vec3::new(4.0, 3.0, 2.0);
-        let mut glow = Material::diffuse("glow", Vec3::ZERO);
-        glow.emission = le;
-        let (c, s) = (Vec3::new(0.2, 1.0, -2.5), 0.25);
-        let mut parts = SceneParts {
-            materials: vec![glow],
-            ..Default::default()
-        };
-        quad(
-            &mut parts,
-            [
-                c + Vec3::new(-s, 0.0, -s),
-                c + Vec3::new(s, 0.0, -s),
-                c + Vec3::new(s, 0.0, s),
-                c + Vec3::new(-s, 0.0, s),
-            ],
-            0,
-        );
-        let fog = Fog::homogeneous(Vec3::new(0.2, 0.3, 0.4), Vec3::splat(0.9), 0.5).unwrap();
-        let scene = foggy_scene(parts, fog);
-        let out = render(&scene, &pencil(), &settings(1, 1, 100_000, 2), &|_| {});
-        let got = out.image.get(0, 0);
-        let n = 24;
-        let expected = single_scattering(&fog, 60.0, |p| {
-            let mut pieces = Vec::with_capacity(n * n);
-            let da = (2.0 * s / n as f32).powi(2);
-            for i in 0..n {
-                for j in 0..n {
-                    let u = -s + (i as f32 + 0.5) * 2.0 * s / n as f32;
-                    let v = -s + (j as f32 + 0.5) * 2.0 * s / n as f32;
-                    let to = c + Vec3::new(u, 0.0, v) - p;
-                    let r = to.length();
-                    // The lamp faces down: its cosine toward p is (to.y / r).
-                    let cos = (to.y / r).max(0.0);
-                    pieces.push((to / r, r, le * (cos * da / (r * r))));
+        for (c, s, n) in [
+            (Vec3::new(0.2, 1.0, -2.5), 0.25, 24),
+            (Vec3::new(0.0, 0.6, -3.0), 3.0, 96),
+        ] {
+            let mut glow = Material::diffuse("glow", Vec3::ZERO);
+            glow.emission = le;
+            let mut parts = SceneParts {
+                materials: vec![glow],
+                ..Default::default()
+            };
+            quad(
+                &mut parts,
+                [
+                    c + Vec3::new(-s, 0.0, -s),
+                    c + Vec3::new(s, 0.0, -s),
+                    c + Vec3::new(s, 0.0, s),
+                    c + Vec3::new(-s, 0.0, s),
+                ],
+                0,
+            );
+            let fog = Fog::homogeneous(Vec3::new(0.2, 0.3, 0.4), Vec3::splat(0.9), 0.5).unwrap();
+            let scene = foggy_scene(parts, fog);
+            let out = render(&scene, &pencil(), &settings(1, 1, 100_000, 2), &|_| {});
+            let got = out.image.get(0, 0);
+            let expected = single_scattering(&fog, 60.0, |p| {
+                let mut pieces = Vec::with_capacity(n * n);
+                let da = (2.0 * s / n as f32).powi(2);
+                for i in 0..n {
+                    for j in 0..n {
+                        let u = -s + (i as f32 + 0.5) * 2.0 * s / n as f32;
+                        let v = -s + (j as f32 + 0.5) * 2.0 * s / n as f32;
+                        let to = c + Vec3::new(u, 0.0, v) - p;
+                        let r = to.length();
+                        // The lamp faces down: its cosine toward p is (to.y / r).
+                        let cos = (to.y / r).max(0.0);
+                        pieces.push((to / r, r, le * (cos * da / (r * r))));
+                    }
                 }
-            }
-            pieces
-        });
-        let err = ((got - expected) / expected).abs().max_element();
-        assert!(err < 0.015, "{got} vs {expected}");
+                pieces
+            });
+            let err = ((got - expected) / expected).abs().max_element();
+            assert!(err < 0.015, "lamp of side {}: {got} vs {expected}", 2.0 * s);
+        }
     }
 
     #[test]

@@ -638,6 +638,9 @@ mod tests {
         let p = Vec3::new(0.5, 0.0, -4.0);
         let rx = receiver(p, glossy, Vec3::new(0.0, 1.5, 0.0) - p);
         check_choice(ls, &rx);
+        // A point in the fog sees every light, below it too, and chooses by irradiance alone.
+        check_choice(ls, &Receiver::in_medium(p));
+        check_choice(ls, &Receiver::in_medium(Vec3::new(0.5, 6.0, -4.0)));
 
         // Unbiased: f * L * cos / pdf over many choices against the exact sum over the lights.
         let diffuse = Bsdf::Diffuse(Diffuse { kd: Vec3::ONE });
