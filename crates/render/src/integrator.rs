@@ -976,8 +976,9 @@ pub(crate) mod tests {
         }
     }
 
-    #[test]
-    fn diffuse_plane_under_point_light_matches_the_analytic_value() {
+    /// The floor of diffuse reflectance `kd` under a point light of intensity `intensity` at
+    /// `light_pos`: `(kd, light_pos, intensity, parts)`.
+    fn lit_floor() -> (Vec3, Vec3, Vec3, SceneParts) {
         let kd = Vec3::new(0.5, 0.4, 0.3);
         let light_pos = Vec3::new(0.3, 2.0, -1.0);
         let intensity = Vec3::splat(10.0);
@@ -991,6 +992,12 @@ pub(crate) mod tests {
             ..Default::default()
         };
         floor(&mut parts);
+        (kd, light_pos, intensity, parts)
+    }
+
+    #[test]
+    fn diffuse_plane_under_point_light_matches_the_analytic_value() {
+        let (kd, light_pos, intensity, parts) = lit_floor();
         let scene = Scene::from_parts(parts).unwrap();
         let cam = camera(Vec3::new(0.0, 1.5, 2.0), -0.6, 0.6);
         let (w, h) = (24, 16);
@@ -2074,19 +2081,7 @@ pub(crate) mod tests {
 
     #[test]
     fn absorbing_fog_dims_a_lit_floor_by_beer_lambert_both_ways() {
-        let kd = Vec3::new(0.5, 0.4, 0.3);
-        let light_pos = Vec3::new(0.3, 2.0, -1.0);
-        let intensity = Vec3::splat(10.0);
-        let mut parts = SceneParts {
-            materials: vec![Material::diffuse("floor", kd)],
-            lights: vec![Light::Point {
-                position: light_pos,
-                intensity,
-                range: None,
-            }],
-            ..Default::default()
-        };
-        floor(&mut parts);
+        let (kd, light_pos, intensity, parts) = lit_floor();
         let sigma = Vec3::new(0.05, 0.1, 0.2);
         let fog = Fog::homogeneous(sigma, Vec3::ZERO, 0.0).unwrap();
         let scene = foggy_scene(parts, fog);
