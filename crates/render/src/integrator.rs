@@ -169,7 +169,7 @@ use crate::film::{Film, Pixel};
 use crate::geometry::{offset_ray_origin, Frame, Ray};
 use crate::light::{LightSample, LightSampler, Receiver, Visibility};
 use crate::material::Volume;
-use crate::medium::{Flight, Fog};
+use crate::medium::Fog;
 use crate::sampling::{power_heuristic, Sampler};
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
@@ -606,47 +606,59 @@ fn trace_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, job: &RenderJo
 
     while depth < max_depth {
         out.rays += 1;
-        let found = scene.intersect(&ray);
-        // A free flight through the fog, when the path is in it (outside every volume).
-        if let (Some(fog), None) = (fog, medium) {
-            let t_max = found.as_ref().map_or(f32::INFINITY, |h| h.t);
-            let u = sampler.next_1d();
-            match fog.sample_flight(ray.origin, ray.direction, t_max, channel, u) {
-                Flight::Pass { weight } => {
-                    throughput *= weight;
-                    fog_pass *= weight;
-                }
-                Flight::Collision { t, weight } => {
-                    throughput *= weight;
-                    // 1-3 at a point of the fog: a vertex and a bounce like a surface's.
-                    if depth + 1 >= max_depth {
-                        break;
+        // A free flight through the fog, when the path is in it (outside every volume): its
+        // distance is drawn first and the surfaces are searched only up to it (Mitsuba's
+        // order; the search stops earlier when the fog stops the path).
+        let (found, collision) = match (fog, medium) {
+            (Some(fog), None) => {
+                let u = sampler.next_1d();
+                let t = fog.sample_distance(ray.origin, ray.direction, channel, u);
+                let found = scene.intersect(&Ray {
+                    t_max: ray.t_max.min(t),
+                    ..ray
+                });
+                match found {
+                    None if t < ray.t_max => (None, Some((fog, t))),
+                    _ => {
+                        let t_pass = found.as_ref().map_or(ray.t_max, |h| h.t);
+                        let weight = fog.pass_weight(ray.origin, ray.direction, t_pass, channel);
+                        throughput *= weight;
+                        fog_pass *= weight;
+                        (found, None)
                     }
-                    let p = ray.origin + ray.direction * t;
-                    let rx = Receiver::in_medium(p);
-                    out.rays += scatter_in_fog(
-                        scene,
-                        fog,
-                        &rx,
-                        -ray.direction,
-                        throughput,
-                        sampler,
-                        &mut out.radiance,
-                    );
-                    let [dx, dy, _, u_rr] = sampler.next_4d();
-                    let ps = fog.phase().sample(-ray.direction, Vec2::new(dx, dy));
-                    prev = Some(rx);
-                    prev_bsdf_pdf = ps.pdf;
-                    prev_delta = false;
-                    min_ray_pdf = min_ray_pdf.min(ps.pdf);
-                    ray = Ray::new(p, ps.wi);
-                    depth += 1;
-                    if !survives_roulette(depth, &mut throughput, u_rr) {
-                        break;
-                    }
-                    continue;
                 }
             }
+            _ => (scene.intersect(&ray), None),
+        };
+        if let Some((fog, t)) = collision {
+            throughput *= fog.collision_weight(ray.origin, ray.direction, t, channel);
+            // 1-3 at a point of the fog: a vertex and a bounce like a surface's.
+            if depth + 1 >= max_depth {
+                break;
+            }
+            let p = ray.origin + ray.direction * t;
+            let rx = Receiver::in_medium(p);
+            out.rays += scatter_in_fog(
+                scene,
+                fog,
+                &rx,
+                -ray.direction,
+                throughput,
+                sampler,
+                &mut out.radiance,
+            );
+            let [dx, dy, _, u_rr] = sampler.next_4d();
+            let ps = fog.phase().sample(-ray.direction, Vec2::new(dx, dy));
+            prev = Some(rx);
+            prev_bsdf_pdf = ps.pdf;
+            prev_delta = false;
+            min_ray_pdf = min_ray_pdf.min(ps.pdf);
+            ray = Ray::new(p, ps.wi);
+            depth += 1;
+            if !survives_roulette(depth, &mut throughput, u_rr) {
+                break;
+            }
+            continue;
         }
         // Where the path stands, for light arriving along this ray.
         let arrival = Arrival {

@@ -209,38 +209,62 @@ impl Fog {
         Vec3::new(r(self.sigma_t.x), r(self.sigma_t.y), r(self.sigma_t.z))
     }
 
-    /// Samples a free flight along the segment `o + s d`, `s` in `[0, t_max]` (`t_max` may be
-    /// infinite), in colour channel `channel` (0..3) with `u` in [0, 1) (see the module
-    /// documentation).
+    /// Samples the distance of a free flight along the ray `o + s d` in colour channel
+    /// `channel` (0..3) with `u` in [0, 1): exact for that channel's extinction (see the
+    /// module documentation); infinite when the flight never ends (a clear channel, or looking
+    /// up through fog that thins with height past its total optical depth).
     #[inline]
-    pub fn sample_flight(&self, o: Vec3, d: Vec3, t_max: f32, channel: usize, u: f32) -> Flight {
+    pub fn sample_distance(&self, o: Vec3, d: Vec3, channel: usize, u: f32) -> f32 {
         let sc = self.sigma_t[channel];
         let a = self.density(o.y);
         let b = self.height_falloff * d.y;
-        let t = if sc > 0.0 && a > 0.0 {
-            // The density-weighted length at which the flight ends.
-            let s = -(-u).ln_1p() / (sc * a);
-            if b == 0.0 {
-                s
+        if !(sc > 0.0 && a > 0.0) {
+            return f32::INFINITY;
+        }
+        // The density-weighted length at which the flight ends.
+        let s = -(-u).ln_1p() / (sc * a);
+        if b == 0.0 {
+            s
+        } else {
+            let x = s * b;
+            if x >= 1.0 {
+                f32::INFINITY
             } else {
-                let x = s * b;
-                if x >= 1.0 {
-                    f32::INFINITY
-                } else {
-                    -(-x).ln_1p() / b
-                }
+                -(-x).ln_1p() / b
+            }
+        }
+    }
+
+    /// The weight `T / T_c` of a flight in channel `channel` that passes the segment `o + s d`,
+    /// `s` in `[0, t]` (`t` may be infinite).
+    #[inline]
+    pub fn pass_weight(&self, o: Vec3, d: Vec3, t: f32, channel: usize) -> Vec3 {
+        self.ratio_to_channel(self.density_length(o, d, t), channel)
+    }
+
+    /// The weight `T sigma_s / (T_c sigma_t,c)` of a flight in channel `channel` (whose
+    /// extinction must be positive) that ends at distance `t` along `o + s d`.
+    #[inline]
+    pub fn collision_weight(&self, o: Vec3, d: Vec3, t: f32, channel: usize) -> Vec3 {
+        let l = self.density_length(o, d, t);
+        self.ratio_to_channel(l, channel) * self.albedo * (self.sigma_t / self.sigma_t[channel])
+    }
+
+    /// Samples a free flight along the segment `o + s d`, `s` in `[0, t_max]` (`t_max` may be
+    /// infinite), in colour channel `channel` (0..3) with `u` in [0, 1) (see the module
+    /// documentation): [`Fog::sample_distance`] with [`Fog::collision_weight`] or
+    /// [`Fog::pass_weight`].
+    #[inline]
+    pub fn sample_flight(&self, o: Vec3, d: Vec3, t_max: f32, channel: usize, u: f32) -> Flight {
+        let t = self.sample_distance(o, d, channel, u);
+        if t < t_max {
+            Flight::Collision {
+                t,
+                weight: self.collision_weight(o, d, t, channel),
             }
         } else {
-            f32::INFINITY
-        };
-        if t < t_max {
-            let l = self.density_length(o, d, t);
-            let weight = self.ratio_to_channel(l, channel) * self.albedo * (self.sigma_t / sc);
-            Flight::Collision { t, weight }
-        } else {
-            let l = self.density_length(o, d, t_max);
             Flight::Pass {
-                weight: self.ratio_to_channel(l, channel),
+                weight: self.pass_weight(o, d, t_max, channel),
             }
         }
     }
