@@ -167,7 +167,7 @@ use crate::bsdf::Bsdf;
 use crate::camera::Camera;
 use crate::film::{Film, Pixel};
 use crate::geometry::{offset_ray_origin, Frame, Ray};
-use crate::light::{LightSample, LightSampler, Receiver, Visibility};
+use crate::light::{Light, LightSample, LightSampler, Receiver, Visibility};
 use crate::material::Volume;
 use crate::medium::Fog;
 use crate::sampling::{power_heuristic, Sampler};
@@ -603,6 +603,13 @@ fn trace_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, job: &RenderJo
         None => 0,
     };
     let mut fog_pass = Vec3::ONE;
+    // Whether the fog's single scattering of point and spot lights along the camera segment
+    // is estimated by equiangular sampling (see `equiangular_direct`) instead of at
+    // collisions (later segments keep the collisions' estimate: a halo seen directly is what
+    // needs it, and every equiangular segment costs a full surface search and a shadow ray).
+    let equiangular = fog.is_some() && scene.lights.iter().any(|l| light_position(l).is_some());
+    // Whether the current segment's point and spot lights were estimated that way.
+    let mut along = false;
 
     while depth < max_depth {
         out.rays += 1;
@@ -613,19 +620,32 @@ fn trace_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, job: &RenderJo
             (Some(fog), None) => {
                 let u = sampler.next_1d();
                 let t = fog.sample_distance(ray.origin, ray.direction, channel, u);
+                // Equiangular sampling needs the whole segment; else the search may stop at t.
+                along = equiangular && depth == 0 && depth + 1 < max_depth;
                 let found = scene.intersect(&Ray {
-                    t_max: ray.t_max.min(t),
+                    t_max: if along { ray.t_max } else { ray.t_max.min(t) },
                     ..ray
                 });
-                match found {
-                    None if t < ray.t_max => (None, Some((fog, t))),
-                    _ => {
-                        let t_pass = found.as_ref().map_or(ray.t_max, |h| h.t);
-                        let weight = fog.pass_weight(ray.origin, ray.direction, t_pass, channel);
-                        throughput *= weight;
-                        fog_pass *= weight;
-                        (found, None)
-                    }
+                let t_seg = found.as_ref().map_or(ray.t_max, |h| h.t);
+                if along {
+                    let u = sampler.next_2d();
+                    out.rays += equiangular_direct(
+                        scene,
+                        fog,
+                        &ray,
+                        t_seg,
+                        throughput,
+                        u,
+                        &mut out.radiance,
+                    );
+                }
+                if t < t_seg {
+                    (None, Some((fog, t)))
+                } else {
+                    let weight = fog.pass_weight(ray.origin, ray.direction, t_seg, channel);
+                    throughput *= weight;
+                    fog_pass *= weight;
+                    (found, None)
                 }
             }
             _ => (scene.intersect(&ray), None),
@@ -644,6 +664,7 @@ fn trace_path(scene: &Scene, mut ray: Ray, sampler: &mut Sampler, job: &RenderJo
                 &rx,
                 -ray.direction,
                 throughput,
+                along,
                 sampler,
                 &mut out.radiance,
             );
@@ -887,11 +908,126 @@ fn visible_li(
     }
 }
 
+/// The position of a point or spot light and the luminance of its intensity; `None` for a
+/// directional light.
+#[inline]
+fn light_position(light: &Light) -> Option<(Vec3, f32)> {
+    match *light {
+        Light::Point {
+            position,
+            intensity,
+            ..
+        }
+        | Light::Spot {
+            position,
+            intensity,
+            ..
+        } => Some((position, luminance(intensity))),
+        Light::Directional { .. } => None,
+    }
+}
+
+/// The equiangular parameters of a light at `position` seen along the ray `o + t d`, `t` in
+/// `[0, t_seg]`: the distance `h` of the ray's closest approach (at least 1e-4), its parameter
+/// `delta`, and the angles `(theta_a, theta_b)` under which the segment's ends are seen.
+#[inline]
+fn equiangular_frame(o: Vec3, d: Vec3, t_seg: f32, position: Vec3) -> (f32, f32, f32, f32) {
+    let delta = (position - o).dot(d);
+    let h = (position - (o + d * delta)).length().max(1e-4);
+    let theta_a = (-delta).atan2(h);
+    let theta_b = if t_seg.is_finite() {
+        (t_seg - delta).atan2(h)
+    } else {
+        std::f32::consts::FRAC_PI_2
+    };
+    (h, delta, theta_a, theta_b)
+}
+
+/// The fog's single scattering of the point and spot lights along one whole segment
+/// (`ray` up to `t_seg`, in the fog), estimated by equiangular sampling (Kulla and Fajardo
+/// 2012): a light is chosen in proportion to `I (theta_b - theta_a) / h`, the integral of its
+/// `I / r^2` over the segment, and a distance with density proportional to `1 / r^2` toward it;
+/// the estimate is `T(t) sigma_s(t) p(wo, wi) L_i T_light / (pmf pdf(t))`, bounded however
+/// close the ray passes the light (a collision near a lamp would carry `1 / r^2`). It replaces
+/// next-event estimation toward these lights at collisions ([`scatter_in_fog`]); directional
+/// lights, emitter meshes and the environment stay there. `throughput` is the path's at the
+/// segment's start; draws nothing (`u` is given); returns the rays traced. Walks the lights
+/// twice: no allocation.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn equiangular_direct(
+    scene: &Scene,
+    fog: &Fog,
+    ray: &Ray,
+    t_seg: f32,
+    throughput: Vec3,
+    u: Vec2,
+    radiance: &mut Vec3,
+) -> u64 {
+    let (o, d) = (ray.origin, ray.direction);
+    let weight = |light: &Light| {
+        light_position(light).map_or(0.0, |(position, lum)| {
+            let (h, _, a, b) = equiangular_frame(o, d, t_seg, position);
+            let w = lum * (b - a) / h;
+            if w.is_finite() && w > 0.0 {
+                w
+            } else {
+                0.0
+            }
+        })
+    };
+    let total: f32 = scene.lights.iter().map(weight).sum();
+    if !(total > 0.0 && total.is_finite()) {
+        return 0;
+    }
+    let target = u.x * total;
+    let (mut acc, mut chosen) = (0.0f32, None);
+    for light in &scene.lights {
+        let w = weight(light);
+        if w > 0.0 {
+            chosen = Some((light, w));
+            acc += w;
+            if target < acc {
+                break;
+            }
+        }
+    }
+    let Some((light, w)) = chosen else {
+        return 0;
+    };
+    let Some((position, _)) = light_position(light) else {
+        return 0;
+    };
+    let (h, delta, a, b) = equiangular_frame(o, d, t_seg, position);
+    let t = (delta + h * (a + u.y * (b - a)).tan()).clamp(0.0, t_seg);
+    let off = t - delta;
+    let pdf_t = h / ((b - a) * (h * h + off * off));
+    let p = o + d * t;
+    let Some(ls) = light.sample_li(p) else {
+        return 0;
+    };
+    let phase = fog.phase().eval(-d, ls.wi);
+    let li = visible_li(scene, &scene.light_sampler, p, p, &ls);
+    if li.max_element() <= 0.0 {
+        return 1;
+    }
+    let sigma_s = fog.sigma_t_at(p) * fog.albedo();
+    let tr = fog.transmittance(o, d, t) * fog.transmittance(p, ls.wi, ls.dist);
+    let estimate = throughput * tr * sigma_s * li * (phase * total / (w * pdf_t));
+    if estimate.is_finite() {
+        *radiance += estimate;
+    }
+    1
+}
+
 /// Next-event estimation at a collision with the fog at `rx.p` (a medium receiver): one light
 /// sample, weighted by the phase function toward it and, unless it is a delta light, by the
 /// power heuristic against phase sampling; the fog's transmittance on the shadow ray (to
-/// infinity for the environment). Draws one 4D sample (light point and choice), as a surface
-/// vertex does; adds `throughput`-weighted light to `radiance` and returns the rays traced.
+/// infinity for the environment). With `positional_elsewhere`, a point or spot light chosen
+/// adds nothing: [`equiangular_direct`] estimates their light along the whole segment. Draws
+/// one 4D sample (light point and choice), as a surface vertex does; adds
+/// `throughput`-weighted light to `radiance` and returns the rays traced.
+#[allow(clippy::too_many_arguments)]
 #[inline]
 fn scatter_in_fog(
     scene: &Scene,
@@ -899,6 +1035,7 @@ fn scatter_in_fog(
     rx: &Receiver,
     wo: Vec3,
     throughput: Vec3,
+    positional_elsewhere: bool,
     sampler: &mut Sampler,
     radiance: &mut Vec3,
 ) -> u64 {
@@ -913,6 +1050,9 @@ fn scatter_in_fog(
     ) else {
         return 0;
     };
+    if positional_elsewhere && ls.delta && ls.dist.is_finite() {
+        return 0;
+    }
     let phase = fog.phase().eval(wo, ls.wi);
     if phase <= 0.0 || phase.is_nan() {
         return 0;
@@ -2000,9 +2140,34 @@ pub(crate) mod tests {
     }
 
     #[test]
-    fn fog_scatters_a_point_light_into_a_ray_as_the_in_scattering_integral() {
-        let light_pos = Vec3::new(0.0, 1.0, -3.0);
-        let intensity = Vec3::new(10.0, 8.0, 6.0);
+    fn fog_scatters_point_and_spot_lights_into_a_ray_as_the_in_scattering_integral() {
+        // A lamp above the ray, a weaker one beside it further on, a spot light whose beam
+        // crosses the ray (a headlight's visible beam), and a directional light (which the
+        // collisions' next-event estimation handles, not the equiangular one).
+        let lights = vec![
+            Light::Point {
+                position: Vec3::new(0.0, 1.0, -3.0),
+                intensity: Vec3::new(10.0, 8.0, 6.0),
+                range: None,
+            },
+            Light::Point {
+                position: Vec3::new(-1.0, 0.3, -8.0),
+                intensity: Vec3::splat(2.0),
+                range: None,
+            },
+            Light::Spot {
+                position: Vec3::new(2.0, 0.5, -5.0),
+                direction: Vec3::new(-1.0, -0.1, 0.2).normalize(),
+                intensity: Vec3::new(30.0, 30.0, 20.0),
+                cos_inner: 0.35f32.cos(),
+                cos_outer: 0.5f32.cos(),
+                range: None,
+            },
+            Light::Directional {
+                direction: Vec3::new(0.3, -1.0, -0.2).normalize(),
+                irradiance: Vec3::splat(0.5),
+            },
+        ];
         for (fog, spp) in [
             (
                 Fog::homogeneous(Vec3::splat(0.1), Vec3::splat(0.8), 0.6).unwrap(),
@@ -2020,24 +2185,24 @@ pub(crate) mod tests {
                 150_000,
             ),
         ] {
-            let parts = SceneParts {
-                lights: vec![Light::Point {
-                    position: light_pos,
-                    intensity,
-                    range: None,
-                }],
-                ..Default::default()
-            };
-            let scene = foggy_scene(parts, fog);
-            let out = render(&scene, &pencil(), &settings(1, 1, spp, 2), &|_| {});
-            let got = out.image.get(0, 0);
-            let expected = single_scattering(&fog, 200.0, |p| {
-                let to = light_pos - p;
-                let r = to.length();
-                vec![(to / r, r, intensity / (r * r))]
-            });
-            let err = ((got - expected) / expected).abs().max_element();
-            assert!(err < 0.015, "{fog:?}: {got} vs {expected}");
+            for n in [1, 4] {
+                let parts = SceneParts {
+                    lights: lights[..n].to_vec(),
+                    ..Default::default()
+                };
+                let scene = foggy_scene(parts, fog);
+                let out = render(&scene, &pencil(), &settings(1, 1, spp, 2), &|_| {});
+                let got = out.image.get(0, 0);
+                let expected = single_scattering(&fog, 200.0, |p| {
+                    lights[..n]
+                        .iter()
+                        .filter_map(|l| l.sample_li(p))
+                        .map(|ls| (ls.wi, ls.dist, ls.li))
+                        .collect()
+                });
+                let err = ((got - expected) / expected).abs().max_element();
+                assert!(err < 0.015, "{n} lights, {fog:?}: {got} vs {expected}");
+            }
         }
     }
 
