@@ -2144,7 +2144,7 @@ pub(crate) mod tests {
         // A lamp above the ray, a weaker one beside it further on, a spot light whose beam
         // crosses the ray (a headlight's visible beam), and a directional light (which the
         // collisions' next-event estimation handles, not the equiangular one).
-        let lights = vec![
+        let lights = [
             Light::Point {
                 position: Vec3::new(0.0, 1.0, -3.0),
                 intensity: Vec3::new(10.0, 8.0, 6.0),
