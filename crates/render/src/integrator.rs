@@ -72,7 +72,12 @@
 //! sampling; then a phase-function sample for the next direction (its density is the MIS
 //! density of an emitter the path hits next), and Russian roulette. It draws the same two 4D
 //! samples a surface vertex draws. Shadow rays from surfaces and from the fog multiply by the
-//! fog's analytic transmittance (to infinity for the environment).
+//! fog's analytic transmittance (to infinity for the environment). On the camera segment the
+//! light of point and spot lights scattered once by the fog is estimated instead by
+//! equiangular sampling (Kulla and Fajardo 2012, `equiangular_direct`: two more random numbers,
+//! a full surface search and one shadow ray), which stays bounded where the ray passes close
+//! to a lamp; collisions on that segment then leave these lights out of their next-event
+//! estimate.
 //!
 //! Path regularisation ([`RenderSettings::regularize`], off by default; biased): a glossy
 //! lobe seen after a diffuse or rough bounce is roughened, so that the light a small lamp
