@@ -101,6 +101,7 @@ pub fn run(args: Args) -> Result<()> {
         material: args.road_mask.is_some(),
         spp: args.layers.contains(&Layer::Spp),
         rain: false,
+        fog: false,
     };
     if let Some(mask) = &args.road_mask {
         if format_of(mask)? != Format::Png {
@@ -131,9 +132,11 @@ pub fn run(args: Args) -> Result<()> {
         width,
         height,
         seed: opts.seed,
-        // The rain layer comes with every render of a rainy scene.
+        // The rain layer comes with every render of a rainy scene, and a foggy scene's EXR
+        // gets the fog's transmittance (`fog.Y`).
         layers: Layers {
             rain: scene.rain.is_some(),
+            fog: scene.fog.is_some() && format == Format::Exr,
             ..layers
         },
         settings: opts.settings(),

@@ -656,4 +656,54 @@ fn rain_writes_its_layer_and_motion_flags_are_checked() {
     t.streaks(&args("bad.gltf", "x.exr"))
         .assert_failure_mentioning("rate");
     assert!(!t.join("x.exr").exists());
+/// The tiny scene with `fog` in its scene's extras.
+fn write_foggy_gltf(t: &TestDir, fog: &str) {
+    let path = t.write_tiny_gltf();
+    let text = std::fs::read_to_string(&path).unwrap().replace(
+        r#""scenes": [{"nodes": [0, 1, 2, 3]}]"#,
+        &format!(
+            r#""scenes": [{{"nodes": [0, 1, 2, 3], "extras": {{"streaks": {{"fog": {fog}}}}}}}]"#
+        ),
+    );
+    assert!(text.contains("\"fog\""));
+    std::fs::write(&path, text).unwrap();
+}
+
+#[test]
+fn a_foggy_scene_renders_with_its_fog_layer() {
+    let t = TestDir::new();
+    write_foggy_gltf(
+        &t,
+        r#"{"sigma_t": [0.1, 0.15, 0.2], "albedo": 0.9, "g": 0.7}"#,
+    );
+    let args = [
+        "render",
+        "scene.gltf",
+        "-o",
+        "out/img.exr",
+        "--spp",
+        "4",
+        "--height",
+        "20",
+    ];
+    t.streaks(&args).assert_success();
+    let path = t.join("out/img.exr");
+    let fog = read_exr_layer(&path, "fog").unwrap();
+    let partly = |x: f32| x > 0.0 && x < 1.0;
+    // The floor seen through a few metres of fog; nothing of the black sky comes through.
+    assert!(partly(fog.get(15, 19).x), "{}", fog.get(15, 19));
+    assert_eq!(fog.get(0, 0).x, 0.0);
+    // Without fog there is no fog layer.
+    let clear = TestDir::new();
+    clear.write_tiny_gltf();
+    clear.streaks(&args).assert_success();
+    assert!(read_exr_layer(&clear.join("out/img.exr"), "fog").is_err());
+}
+
+#[test]
+fn bad_fog_fails_naming_the_key() {
+    let t = TestDir::new();
+    write_foggy_gltf(&t, r#"{"sigma_t": 0.1, "albedo": 0.9, "g": 1.5}"#);
+    t.streaks(&["render", "scene.gltf", "-o", "img.exr", "--spp", "1"])
+        .assert_failure_mentioning("extras.streaks.fog");
 }

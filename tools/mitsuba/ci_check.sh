@@ -2,7 +2,8 @@
 # CI check: streaks render against Mitsuba 3 on scenes/crosscheck.gltf, with the noise test of
 # tools/mitsuba/README.md, then on the same scene with the glass pane of glass_pane.py
 # (KHR_materials_transmission with a volume: Mitsuba's dielectric) at max depth 8, then on its
-# road and wall lit by the environment map of env_scene.py only (Mitsuba's envmap; about 5 s).
+# road and wall lit by the environment map of env_scene.py only (Mitsuba's envmap; about 5 s),
+# then on the whole scene in the homogeneous fog of fog_scene.py (Mitsuba's volpath; about 15 s).
 # Exits 0 on agreement, 1 on disagreement, 2 when it cannot run.
 # Environment: STREAKS (the binary; default target/debug/streaks, built with cargo build),
 # CROSSCHECK_SPP (default 64), CROSSCHECK_WIDTH/HEIGHT (default 160x120), CROSSCHECK_K (4).
@@ -40,4 +41,8 @@ python3 "$here/env_scene.py" "$repo/target/crosscheck/env" >&2
 check_scene "$repo/target/crosscheck/env/env_crosscheck.gltf" 4 ci_env \
     --region top=0,0,1,0.06 --region wall=0.1,0.1,0.9,0.45 --region road=0,0.62,1,1 \
     --region streak=0.35,0.7,0.65,1
+python3 "$here/fog_scene.py" "$repo/target/crosscheck/fog" >&2
+check_scene "$repo/target/crosscheck/fog/fog_crosscheck.gltf" 4 ci_fog \
+    --region sky=0,0,1,0.3 --region wall=0.45,0.05,1,0.5 --region road=0,0.6,1,1 \
+    --region halo=0.55,0.05,0.8,0.3 --region lamp_halo=0.25,0.2,0.45,0.45
 exit "$status"

@@ -47,6 +47,9 @@ pub struct Pixel {
     pub material: u32,
     /// Number of camera samples (kept or dropped) whose first hit was a rain drop.
     pub rain: u32,
+    /// Luminance of the fog's transmittance from the camera to the pixel-centre ray's first
+    /// hit (to the sky on a miss; 1 without fog).
+    pub fog: f32,
 }
 
 /// [`Pixel::material`] of a pixel whose centre ray hits nothing.
@@ -66,6 +69,7 @@ impl Default for Pixel {
             albedo: Vec3::ZERO,
             material: NO_MATERIAL,
             rain: 0,
+            fog: 1.0,
         }
     }
 }
@@ -198,6 +202,11 @@ impl Film {
     /// The first-hit material layer ([`NO_MATERIAL`] on a miss).
     pub fn material(&self) -> Vec<u32> {
         self.pixels.iter().map(|p| p.material).collect()
+    }
+
+    /// The fog layer: the fog's transmittance to the pixel-centre ray's first hit, row-major.
+    pub fn fog(&self) -> Vec<f32> {
+        self.pixels.iter().map(|p| p.fog).collect()
     }
 
     /// The samples-per-pixel layer: samples taken per pixel (kept and dropped), row-major.

@@ -54,8 +54,30 @@
 //! boundary from its back face leaves it; along every segment inside, the throughput (and a
 //! shadow ray's light) is multiplied by the Beer-Lambert transmittance of the segment's length.
 //! Limits: one medium at a time (nested or overlapping volumes are not tracked: leaving an
-//! inner volume puts the path in air), a camera inside a volume starts in air, and the
-//! boundary must be closed and consistently wound.
+//! inner volume puts the path in air, or in the fog), a camera inside a volume starts in air
+//! (or fog), and the boundary must be closed and consistently wound.
+//!
+//! Fog ([`Scene::fog`], [`crate::medium::Fog`]; decisions/0030): it fills the space outside
+//! the volumes, the camera and the lights included, and follows Mitsuba 3's `volpath`
+//! (`volpath.cpp`). A path chooses one colour channel at its start (one random number, drawn
+//! only when the scene has fog: fog-free renders are unchanged); every segment outside a volume
+//! draws one more for an exact free flight in that channel
+//! ([`crate::medium::Fog::sample_flight`]). A flight that passes the segment multiplies the
+//! throughput by `T / T_c` (the environment, for an escaping ray, is then seen times its
+//! transmittance to infinity: nothing through homogeneous fog); one that ends in the fog
+//! multiplies it by `T sigma_s / (T_c sigma_t,c)` and makes a vertex there, which counts as a
+//! bounce (`max_depth`) exactly as a surface vertex: next-event estimation with a light chosen
+//! by irradiance alone ([`Receiver::in_medium`]), weighed by the Henyey-Greenstein phase
+//! function and, for area lights and the environment, by the power heuristic against phase
+//! sampling; then a phase-function sample for the next direction (its density is the MIS
+//! density of an emitter the path hits next), and Russian roulette. It draws the same two 4D
+//! samples a surface vertex draws. Shadow rays from surfaces and from the fog multiply by the
+//! fog's analytic transmittance (to infinity for the environment). On the camera segment the
+//! light of point and spot lights scattered once by the fog is estimated instead by
+//! equiangular sampling (Kulla and Fajardo 2012, `equiangular_direct`: two more random numbers,
+//! a full surface search and one shadow ray), which stays bounded where the ray passes close
+//! to a lamp; collisions on that segment then leave these lights out of their next-event
+//! estimate.
 //!
 //! Path regularisation ([`RenderSettings::regularize`], off by default; biased): a glossy
 //! lobe seen after a diffuse or rough bounce is roughened, so that the light a small lamp
@@ -143,6 +165,10 @@
 //!   adaptive sampling stopped its tile earlier.
 //! - `rain`: the share of the pixel's camera samples (kept and dropped) whose first hit was a
 //!   rain drop ([`crate::rain`]).
+//! - `fog`: the luminance of the fog's transmittance from the camera to the pixel-centre ray's
+//!   first hit (to infinity on a miss; 1 without fog). With fog, the `specular` layer's light
+//!   carries the fog's pass weights of its two segments, and light scattered by the fog is not
+//!   in it.
 //!
 //! The first-hit layers (depth, normal, albedo, material) are taken at the reference time 0
 //! from the camera where the scene puts it, and ignore rain drops
@@ -163,17 +189,18 @@ use crate::bsdf::Bsdf;
 use crate::camera::Camera;
 use crate::film::{Film, Pixel};
 use crate::geometry::{offset_ray_origin, Frame, Ray};
-use crate::light::{LightSampler, Receiver, Visibility};
+use crate::light::{Light, LightSample, LightSampler, Receiver, Visibility};
 use crate::material::Volume;
 use crate::motion::Motion;
 use crate::rain::{CameraRain, RainPath};
+use crate::medium::Fog;
 use crate::sampling::{power_heuristic, Sampler};
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
-use streaks_image::RgbImage;
+use streaks_image::{luminance, RgbImage};
 use streaks_settings::RenderSettings;
 
 /// Depth from which Russian roulette may end a path (Mitsuba 3's `rr_depth`, whose default is
@@ -201,6 +228,8 @@ pub struct Layers {
     pub spp: bool,
     /// Share of the camera samples whose first hit was a rain drop.
     pub rain: bool,
+    /// The fog's transmittance to the pixel-centre ray's first hit.
+    pub fog: bool,
 }
 
 /// One image to render: its size, seed and layers, and how to sample it.
@@ -286,6 +315,9 @@ pub struct RenderOutput {
     /// Share of each pixel's camera samples whose first hit was a rain drop, row-major (if
     /// requested).
     pub rain: Option<Vec<f32>>,
+    /// The fog's transmittance (luminance) from the camera to the pixel-centre ray's first
+    /// hit, row-major (if requested; 1 without fog).
+    pub fog: Option<Vec<f32>>,
     /// Counters.
     pub stats: RenderStats,
 }
@@ -320,7 +352,7 @@ pub fn render(
         .transform_vector3(-Vec3::Z)
         .normalize();
     let l = job.layers;
-    let need_centre = l.depth || l.normal || l.albedo || l.material;
+    let need_centre = l.depth || l.normal || l.albedo || l.material || l.fog;
     // The drops this camera sees, binned by pixel (none without rain).
     let rain = scene
         .rain
@@ -396,6 +428,7 @@ pub fn render(
         material: layers.material.then(|| film.material()),
         spp: layers.spp.then(|| film.spp()),
         rain: layers.rain.then(|| film.rain()),
+        fog: layers.fog.then(|| film.fog()),
         stats: RenderStats {
             seconds: start.elapsed().as_secs_f64(),
             samples: film.samples(),
@@ -526,9 +559,15 @@ fn take_sample(
     path.rays
 }
 
-/// Fills the depth, normal, albedo and material of `pixel` from the pixel-centre ray.
+/// Fills the depth, normal, albedo, material and fog transmittance of `pixel` from the
+/// pixel-centre ray.
 fn first_hit_layers(scene: &Scene, ray: &Ray, origin: Vec3, forward: Vec3, pixel: &mut Pixel) {
-    if let Some(hit) = scene.intersect(ray) {
+    let found = scene.intersect(ray);
+    if let Some(fog) = &scene.fog {
+        let t = found.as_ref().map_or(f32::INFINITY, |h| h.t);
+        pixel.fog = luminance(fog.transmittance(ray.origin, ray.direction, t));
+    }
+    if let Some(hit) = found {
         pixel.depth = (hit.p - origin).dot(forward);
         pixel.material = hit.material;
         pixel.normal = if hit.ns.dot(ray.direction) > 0.0 {
@@ -552,6 +591,9 @@ struct Arrival {
     prev_bsdf_pdf: f32,
     /// The first hit's BSDF, frame and `wo`, for the specular layer.
     first_bsdf: Option<(Bsdf, Frame, Vec3)>,
+    /// The product of the fog's pass weights of the path's segments (1 without fog), for the
+    /// specular layer.
+    fog_pass: Vec3,
 }
 
 impl Arrival {
@@ -576,7 +618,8 @@ impl Arrival {
             if let (1, Some((bsdf, frame, wo_local))) = (self.depth, self.first_bsdf) {
                 let wi_local = frame.to_local(dir);
                 let glossy = bsdf.eval_lobes(wo_local, wi_local).glossy;
-                out.specular += le * glossy * (wi_local.z * weight / self.prev_bsdf_pdf);
+                out.specular +=
+                    self.fog_pass * (le * glossy * (wi_local.z * weight / self.prev_bsdf_pdf));
             }
         }
     }
@@ -610,19 +653,107 @@ fn trace_path(
     let mut min_ray_pdf = f32::INFINITY;
     // Which rain drops the next ray can meet.
     let mut rain_path = RainPath::camera(rain);
+    // The fog, the colour channel its free flights are sampled in (one per path, as in
+    // Mitsuba's volpath; drawn only when there is fog) and the product of its pass weights.
+    let fog = scene.fog.as_ref();
+    let channel = match fog {
+        Some(_) => ((sampler.next_1d() * 3.0) as usize).min(2),
+        None => 0,
+    };
+    let mut fog_pass = Vec3::ONE;
+    // Whether the fog's single scattering of point and spot lights along the camera segment
+    // is estimated by equiangular sampling (see `equiangular_direct`) instead of at
+    // collisions (later segments keep the collisions' estimate: a halo seen directly is what
+    // needs it, and every equiangular segment costs a full surface search and a shadow ray).
+    let equiangular = fog.is_some() && scene.lights.iter().any(|l| light_position(l).is_some());
+    // Whether the current segment's point and spot lights were estimated that way.
+    let mut along = false;
 
     while depth < max_depth {
         out.rays += 1;
+        // A free flight through the fog, when the path is in it (outside every volume): its
+        // distance is drawn first and the surfaces are searched only up to it (Mitsuba's
+        // order; the search stops earlier when the fog stops the path).
+        let (found, collision) = match (fog, medium) {
+            (Some(fog), None) => {
+                let u = sampler.next_1d();
+                let t = fog.sample_distance(ray.origin, ray.direction, channel, u);
+                // Equiangular sampling needs the whole segment; else the search may stop at t.
+                along = equiangular && depth == 0 && depth + 1 < max_depth;
+                let found = scene.intersect_path(
+                    &Ray {
+                        t_max: if along { ray.t_max } else { ray.t_max.min(t) },
+                        ..ray
+                    },
+                    &mut rain_path,
+                );
+                let t_seg = found.as_ref().map_or(ray.t_max, |h| h.t);
+                if along {
+                    let u = sampler.next_2d();
+                    out.rays += equiangular_direct(
+                        scene,
+                        fog,
+                        &ray,
+                        t_seg,
+                        throughput,
+                        u,
+                        &mut out.radiance,
+                    );
+                }
+                if t < t_seg {
+                    (None, Some((fog, t)))
+                } else {
+                    let weight = fog.pass_weight(ray.origin, ray.direction, t_seg, channel);
+                    throughput *= weight;
+                    fog_pass *= weight;
+                    (found, None)
+                }
+            }
+            _ => (scene.intersect_path(&ray, &mut rain_path), None),
+        };
+        if let Some((fog, t)) = collision {
+            throughput *= fog.collision_weight(ray.origin, ray.direction, t, channel);
+            // 1-3 at a point of the fog: a vertex and a bounce like a surface's.
+            if depth + 1 >= max_depth {
+                break;
+            }
+            let p = ray.origin + ray.direction * t;
+            let rx = Receiver::in_medium(p);
+            out.rays += scatter_in_fog(
+                scene,
+                fog,
+                &rx,
+                -ray.direction,
+                throughput,
+                along,
+                sampler,
+                &mut out.radiance,
+            );
+            let [dx, dy, _, u_rr] = sampler.next_4d();
+            let ps = fog.phase().sample(-ray.direction, Vec2::new(dx, dy));
+            prev = Some(rx);
+            prev_bsdf_pdf = ps.pdf;
+            prev_delta = false;
+            min_ray_pdf = min_ray_pdf.min(ps.pdf);
+            ray = Ray::new(p, ps.wi).at_time(ray.time);
+            depth += 1;
+            if !survives_roulette(depth, &mut throughput, u_rr) {
+                break;
+            }
+            continue;
+        }
         // Where the path stands, for light arriving along this ray.
         let arrival = Arrival {
             depth,
             prev_delta,
             prev_bsdf_pdf,
             first_bsdf,
+            fog_pass,
         };
-        let Some(hit) = scene.intersect_path(&ray, &mut rain_path) else {
+        let Some(hit) = found else {
             // 1'. The environment, for a ray that escapes (not from inside a volume, whose
-            // closed surface a ray cannot leave unseen).
+            // closed surface a ray cannot leave unseen; through the fog, its pass weight is
+            // in the throughput).
             if let (Some(env), None) = (lights.environment(), medium) {
                 let le = env.le(ray.direction);
                 if le.max_element() > 0.0 {
@@ -717,47 +848,10 @@ fn trace_path(
                 if total.max_element() > 0.0 {
                     let origin = offset_ray_origin(hit.p, ng, ls.wi);
                     out.rays += 1;
-                    let li = match ls.visibility {
-                        Visibility::ShadowRay => {
-                            let t_max = if ls.dist.is_finite() {
-                                (ls.dist - (origin - hit.p).length()) * (1.0 - SHADOW_EPSILON)
-                            } else {
-                                f32::INFINITY
-                            };
-                            let shadow = Ray {
-                                origin,
-                                direction: ls.wi,
-                                t_max,
-                                time: ray.time,
-                            };
-                            if scene.occluded(&shadow) {
-                                Vec3::ZERO
-                            } else {
-                                ls.li
-                            }
-                        }
-                        Visibility::FirstHit { emitter } => {
-                            let ray = Ray {
-                                origin,
-                                direction: ls.wi,
-                                t_max: ls.dist * (1.0 + 1e-4),
-                                time: ray.time,
-                            };
-                            match scene.intersect(&ray) {
-                                Some(h)
-                                    if lights
-                                        .emitters()
-                                        .emitter_of(h.triangle)
-                                        .is_some_and(|(e, _)| e == emitter as usize) =>
-                                {
-                                    scene.emitted_radiance(&h, -ls.wi)
-                                }
-                                _ => Vec3::ZERO,
-                            }
-                        }
-                    };
-                    let li = match medium_along(wi_local.z) {
-                        Some(v) if ls.dist.is_finite() => li * v.transmittance(ls.dist),
+                    let li = visible_li(scene, lights, origin, hit.p, &ls);
+                    let li = match (medium_along(wi_local.z), fog) {
+                        (Some(v), _) if ls.dist.is_finite() => li * v.transmittance(ls.dist),
+                        (None, Some(fog)) => li * fog.transmittance(hit.p, ls.wi, ls.dist),
                         _ => li,
                     };
                     if li.max_element() > 0.0 {
@@ -769,7 +863,7 @@ fn trace_path(
                         let scale = li * (wi_local.z.abs() * weight / ls.pdf);
                         out.radiance += throughput * total * scale;
                         if depth == 0 && want_specular {
-                            out.specular += f.glossy * scale;
+                            out.specular += throughput * f.glossy * scale;
                         }
                     }
                 }
@@ -804,19 +898,241 @@ fn trace_path(
         ray = Ray::new(scene.spawn_origin(&hit, ng, wi), wi).at_time(ray.time);
         depth += 1;
 
-        // Russian roulette (Mitsuba's rule).
-        if depth >= RR_DEPTH {
-            let q = throughput.max_element().min(0.95);
-            if u_rr >= q {
-                break;
-            }
-            throughput /= q;
-        }
-        if throughput.max_element() <= 0.0 {
+        if !survives_roulette(depth, &mut throughput, u_rr) {
             break;
         }
     }
     out
+}
+
+/// Russian roulette (Mitsuba's rule) after the path's `depth`-th bounce with `u_rr`: whether
+/// the path goes on (its throughput divided by the survival probability); also `false` once
+/// the throughput is zero.
+#[inline]
+fn survives_roulette(depth: u32, throughput: &mut Vec3, u_rr: f32) -> bool {
+    if depth >= RR_DEPTH {
+        let q = throughput.max_element().min(0.95);
+        if u_rr >= q {
+            return false;
+        }
+        *throughput /= q;
+    }
+    throughput.max_element() > 0.0
+}
+
+/// The light of sample `ls` that reaches `origin` (offset from the shading point `from`),
+/// before any medium: `ls.li` if a shadow ray finds the way free (or, for a compact emitter,
+/// the emission of the emitter a closest-hit ray lands on, if it is that one), else zero.
+/// These rays meet only the scene's surfaces, which do not move, so they carry no time.
+#[inline]
+fn visible_li(
+    scene: &Scene,
+    lights: &LightSampler,
+    origin: Vec3,
+    from: Vec3,
+    ls: &LightSample,
+) -> Vec3 {
+    match ls.visibility {
+        Visibility::ShadowRay => {
+            let t_max = if ls.dist.is_finite() {
+                (ls.dist - (origin - from).length()) * (1.0 - SHADOW_EPSILON)
+            } else {
+                f32::INFINITY
+            };
+            let shadow = Ray {
+                t_max,
+                ..Ray::new(origin, ls.wi)
+            };
+            if scene.occluded(&shadow) {
+                Vec3::ZERO
+            } else {
+                ls.li
+            }
+        }
+        Visibility::FirstHit { emitter } => {
+            let ray = Ray {
+                t_max: ls.dist * (1.0 + 1e-4),
+                ..Ray::new(origin, ls.wi)
+            };
+            match scene.intersect(&ray) {
+                Some(h)
+                    if lights
+                        .emitters()
+                        .emitter_of(h.triangle)
+                        .is_some_and(|(e, _)| e == emitter as usize) =>
+                {
+                    scene.emitted_radiance(&h, -ls.wi)
+                }
+                _ => Vec3::ZERO,
+            }
+        }
+    }
+}
+
+/// The position of a point or spot light and the luminance of its intensity; `None` for a
+/// directional light.
+#[inline]
+fn light_position(light: &Light) -> Option<(Vec3, f32)> {
+    match *light {
+        Light::Point {
+            position,
+            intensity,
+            ..
+        }
+        | Light::Spot {
+            position,
+            intensity,
+            ..
+        } => Some((position, luminance(intensity))),
+        Light::Directional { .. } => None,
+    }
+}
+
+/// The equiangular parameters of a light at `position` seen along the ray `o + t d`, `t` in
+/// `[0, t_seg]`: the distance `h` of the ray's closest approach (at least 1e-4), its parameter
+/// `delta`, and the angles `(theta_a, theta_b)` under which the segment's ends are seen.
+#[inline]
+fn equiangular_frame(o: Vec3, d: Vec3, t_seg: f32, position: Vec3) -> (f32, f32, f32, f32) {
+    let delta = (position - o).dot(d);
+    let h = (position - (o + d * delta)).length().max(1e-4);
+    let theta_a = (-delta).atan2(h);
+    let theta_b = if t_seg.is_finite() {
+        (t_seg - delta).atan2(h)
+    } else {
+        std::f32::consts::FRAC_PI_2
+    };
+    (h, delta, theta_a, theta_b)
+}
+
+/// The fog's single scattering of the point and spot lights along one whole segment
+/// (`ray` up to `t_seg`, in the fog), estimated by equiangular sampling (Kulla and Fajardo
+/// 2012): a light is chosen in proportion to `I (theta_b - theta_a) / h`, the integral of its
+/// `I / r^2` over the segment, and a distance with density proportional to `1 / r^2` toward it;
+/// the estimate is `T(t) sigma_s(t) p(wo, wi) L_i T_light / (pmf pdf(t))`, bounded however
+/// close the ray passes the light (a collision near a lamp would carry `1 / r^2`). It replaces
+/// next-event estimation toward these lights at collisions ([`scatter_in_fog`]); directional
+/// lights, emitter meshes and the environment stay there. `throughput` is the path's at the
+/// segment's start; draws nothing (`u` is given); returns the rays traced. Walks the lights
+/// twice: no allocation.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn equiangular_direct(
+    scene: &Scene,
+    fog: &Fog,
+    ray: &Ray,
+    t_seg: f32,
+    throughput: Vec3,
+    u: Vec2,
+    radiance: &mut Vec3,
+) -> u64 {
+    let (o, d) = (ray.origin, ray.direction);
+    let weight = |light: &Light| {
+        light_position(light).map_or(0.0, |(position, lum)| {
+            let (h, _, a, b) = equiangular_frame(o, d, t_seg, position);
+            let w = lum * (b - a) / h;
+            if w.is_finite() && w > 0.0 {
+                w
+            } else {
+                0.0
+            }
+        })
+    };
+    let total: f32 = scene.lights.iter().map(weight).sum();
+    if !(total > 0.0 && total.is_finite()) {
+        return 0;
+    }
+    let target = u.x * total;
+    let (mut acc, mut chosen) = (0.0f32, None);
+    for light in &scene.lights {
+        let w = weight(light);
+        if w > 0.0 {
+            chosen = Some((light, w));
+            acc += w;
+            if target < acc {
+                break;
+            }
+        }
+    }
+    let Some((light, w)) = chosen else {
+        return 0;
+    };
+    let Some((position, _)) = light_position(light) else {
+        return 0;
+    };
+    let (h, delta, a, b) = equiangular_frame(o, d, t_seg, position);
+    let t = (delta + h * (a + u.y * (b - a)).tan()).clamp(0.0, t_seg);
+    let off = t - delta;
+    let pdf_t = h / ((b - a) * (h * h + off * off));
+    let p = o + d * t;
+    let Some(ls) = light.sample_li(p) else {
+        return 0;
+    };
+    let phase = fog.phase().eval(-d, ls.wi);
+    let li = visible_li(scene, &scene.light_sampler, p, p, &ls);
+    if li.max_element() <= 0.0 {
+        return 1;
+    }
+    let sigma_s = fog.sigma_t_at(p) * fog.albedo();
+    let tr = fog.transmittance(o, d, t) * fog.transmittance(p, ls.wi, ls.dist);
+    let estimate = throughput * tr * sigma_s * li * (phase * total / (w * pdf_t));
+    if estimate.is_finite() {
+        *radiance += estimate;
+    }
+    1
+}
+
+/// Next-event estimation at a collision with the fog at `rx.p` (a medium receiver): one light
+/// sample, weighted by the phase function toward it and, unless it is a delta light, by the
+/// power heuristic against phase sampling; the fog's transmittance on the shadow ray (to
+/// infinity for the environment). With `positional_elsewhere`, a point or spot light chosen
+/// adds nothing: [`equiangular_direct`] estimates their light along the whole segment. Draws
+/// one 4D sample (light point and choice), as a surface vertex does; adds
+/// `throughput`-weighted light to `radiance` and returns the rays traced.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn scatter_in_fog(
+    scene: &Scene,
+    fog: &Fog,
+    rx: &Receiver,
+    wo: Vec3,
+    throughput: Vec3,
+    positional_elsewhere: bool,
+    sampler: &mut Sampler,
+    radiance: &mut Vec3,
+) -> u64 {
+    let lights = &scene.light_sampler;
+    let [px, py, u_light, _] = sampler.next_4d();
+    let Some(ls) = lights.sample_li(
+        &scene.materials,
+        &scene.textures,
+        rx,
+        u_light,
+        Vec2::new(px, py),
+    ) else {
+        return 0;
+    };
+    if positional_elsewhere && ls.delta && ls.dist.is_finite() {
+        return 0;
+    }
+    let phase = fog.phase().eval(wo, ls.wi);
+    if phase <= 0.0 || phase.is_nan() {
+        return 0;
+    }
+    let li = visible_li(scene, lights, rx.p, rx.p, &ls);
+    let li = if li.max_element() > 0.0 {
+        li * fog.transmittance(rx.p, ls.wi, ls.dist)
+    } else {
+        li
+    };
+    if li.max_element() > 0.0 {
+        let weight = if ls.delta {
+            1.0
+        } else {
+            power_heuristic(1.0, ls.pdf, 1.0, phase)
+        };
+        *radiance += throughput * li * (phase * weight / ls.pdf);
+    }
+    1
 }
 
 #[cfg(test)]
@@ -824,6 +1140,7 @@ pub(crate) mod tests {
     use super::*;
     use crate::light::Light;
     use crate::material::Material;
+    use crate::medium::Fog;
     use crate::scene::SceneParts;
     use glam::{Affine3A, Quat};
     use std::f32::consts::PI;
@@ -873,8 +1190,9 @@ pub(crate) mod tests {
         }
     }
 
-    #[test]
-    fn diffuse_plane_under_point_light_matches_the_analytic_value() {
+    /// The floor of diffuse reflectance `kd` under a point light of intensity `intensity` at
+    /// `light_pos`: `(kd, light_pos, intensity, parts)`.
+    fn lit_floor() -> (Vec3, Vec3, Vec3, SceneParts) {
         let kd = Vec3::new(0.5, 0.4, 0.3);
         let light_pos = Vec3::new(0.3, 2.0, -1.0);
         let intensity = Vec3::splat(10.0);
@@ -888,6 +1206,12 @@ pub(crate) mod tests {
             ..Default::default()
         };
         floor(&mut parts);
+        (kd, light_pos, intensity, parts)
+    }
+
+    #[test]
+    fn diffuse_plane_under_point_light_matches_the_analytic_value() {
+        let (kd, light_pos, intensity, parts) = lit_floor();
         let scene = Scene::from_parts(parts).unwrap();
         let cam = camera(Vec3::new(0.0, 1.5, 2.0), -0.6, 0.6);
         let (w, h) = (24, 16);
@@ -1179,6 +1503,7 @@ pub(crate) mod tests {
             material: true,
             spp: true,
             rain: true,
+            fog: true,
         };
         let run = |threads| {
             rayon::ThreadPoolBuilder::new()
@@ -1836,5 +2161,216 @@ pub(crate) mod tests {
         });
         let lit = Scene::from_parts(parts).unwrap();
         assert!(lit.warnings.is_empty() && lit.environment().is_none());
+    }
+
+    /// A camera at the origin looking down -Z with a field of view so narrow that its one
+    /// pixel is a single ray.
+    fn pencil() -> Camera {
+        camera(Vec3::ZERO, 0.0, 1e-4)
+    }
+
+    /// Single scattering toward the pencil camera, by the midpoint rule along its ray out to
+    /// `t_end`: `int sigma_s(t) T(t) [int over the light of p(wo, wi) T(r) dE(r)] dt`, with
+    /// `light(p)` giving the light's `(wi, r, irradiance)` pieces at `p`.
+    fn single_scattering(
+        fog: &Fog,
+        t_end: f32,
+        light: impl Fn(Vec3) -> Vec<(Vec3, f32, Vec3)>,
+    ) -> Vec3 {
+        let (o, d) = (Vec3::ZERO, -Vec3::Z);
+        let steps = 4000;
+        let h = t_end / steps as f32;
+        let mut sum = Vec3::ZERO;
+        for i in 0..steps {
+            let t = (i as f32 + 0.5) * h;
+            let p = o + d * t;
+            let mut inscatter = Vec3::ZERO;
+            for (wi, r, e) in light(p) {
+                let phase = fog.phase().eval(-d, wi);
+                inscatter += e * phase * fog.transmittance(p, wi, r);
+            }
+            sum += fog.sigma_t_at(p) * fog.albedo() * fog.transmittance(o, d, t) * inscatter * h;
+        }
+        sum
+    }
+
+    fn foggy_scene(parts: SceneParts, fog: Fog) -> Scene {
+        Scene::from_parts(SceneParts {
+            fog: Some(fog),
+            ..parts
+        })
+        .unwrap()
+    }
+
+    #[test]
+    fn fog_scatters_point_and_spot_lights_into_a_ray_as_the_in_scattering_integral() {
+        // A lamp above the ray, a weaker one beside it further on, a spot light whose beam
+        // crosses the ray (a headlight's visible beam), and a directional light (which the
+        // collisions' next-event estimation handles, not the equiangular one).
+        let lights = [
+            Light::Point {
+                position: Vec3::new(0.0, 1.0, -3.0),
+                intensity: Vec3::new(10.0, 8.0, 6.0),
+                range: None,
+            },
+            Light::Point {
+                position: Vec3::new(-1.0, 0.3, -8.0),
+                intensity: Vec3::splat(2.0),
+                range: None,
+            },
+            Light::Spot {
+                position: Vec3::new(2.0, 0.5, -5.0),
+                direction: Vec3::new(-1.0, -0.1, 0.2).normalize(),
+                intensity: Vec3::new(30.0, 30.0, 20.0),
+                cos_inner: 0.35f32.cos(),
+                cos_outer: 0.5f32.cos(),
+                range: None,
+            },
+            Light::Directional {
+                direction: Vec3::new(0.3, -1.0, -0.2).normalize(),
+                irradiance: Vec3::splat(0.5),
+            },
+        ];
+        for (fog, spp) in [
+            (
+                Fog::homogeneous(Vec3::splat(0.1), Vec3::splat(0.8), 0.6).unwrap(),
+                60_000,
+            ),
+            (
+                Fog::new(
+                    Vec3::new(0.05, 0.1, 0.2),
+                    Vec3::new(0.9, 0.7, 0.5),
+                    -0.3,
+                    0.4,
+                    0.5,
+                )
+                .unwrap(),
+                150_000,
+            ),
+        ] {
+            for n in [1, 4] {
+                let parts = SceneParts {
+                    lights: lights[..n].to_vec(),
+                    ..Default::default()
+                };
+                let scene = foggy_scene(parts, fog);
+                let out = render(&scene, &pencil(), &settings(1, 1, spp, 2), &|_| {});
+                let got = out.image.get(0, 0);
+                let expected = single_scattering(&fog, 200.0, |p| {
+                    lights[..n]
+                        .iter()
+                        .filter_map(|l| l.sample_li(p))
+                        .map(|ls| (ls.wi, ls.dist, ls.li))
+                        .collect()
+                });
+                let err = ((got - expected) / expected).abs().max_element();
+                assert!(err < 0.015, "{n} lights, {fog:?}: {got} vs {expected}");
+            }
+        }
+    }
+
+    #[test]
+    fn fog_scatters_an_area_light_into_a_ray_with_mis() {
+        // A square lamp facing down above the ray: small (light sampling wins the MIS) and
+        // large and near (the phase function's samples that hit it carry much of the light).
+        let le = Vec3::new(4.0, 3.0, 2.0);
+        for (c, s, n) in [
+            (Vec3::new(0.2, 1.0, -2.5), 0.25, 24),
+            (Vec3::new(0.0, 0.6, -3.0), 3.0, 96),
+        ] {
+            let mut glow = Material::diffuse("glow", Vec3::ZERO);
+            glow.emission = le;
+            let mut parts = SceneParts {
+                materials: vec![glow],
+                ..Default::default()
+            };
+            quad(
+                &mut parts,
+                [
+                    c + Vec3::new(-s, 0.0, -s),
+                    c + Vec3::new(s, 0.0, -s),
+                    c + Vec3::new(s, 0.0, s),
+                    c + Vec3::new(-s, 0.0, s),
+                ],
+                0,
+            );
+            let fog = Fog::homogeneous(Vec3::new(0.2, 0.3, 0.4), Vec3::splat(0.9), 0.5).unwrap();
+            let scene = foggy_scene(parts, fog);
+            let out = render(&scene, &pencil(), &settings(1, 1, 100_000, 2), &|_| {});
+            let got = out.image.get(0, 0);
+            let expected = single_scattering(&fog, 60.0, |p| {
+                let mut pieces = Vec::with_capacity(n * n);
+                let da = (2.0 * s / n as f32).powi(2);
+                for i in 0..n {
+                    for j in 0..n {
+                        let u = -s + (i as f32 + 0.5) * 2.0 * s / n as f32;
+                        let v = -s + (j as f32 + 0.5) * 2.0 * s / n as f32;
+                        let to = c + Vec3::new(u, 0.0, v) - p;
+                        let r = to.length();
+                        // The lamp faces down: its cosine toward p is (to.y / r).
+                        let cos = (to.y / r).max(0.0);
+                        pieces.push((to / r, r, le * (cos * da / (r * r))));
+                    }
+                }
+                pieces
+            });
+            let err = ((got - expected) / expected).abs().max_element();
+            assert!(err < 0.015, "lamp of side {}: {got} vs {expected}", 2.0 * s);
+        }
+    }
+
+    #[test]
+    fn absorbing_fog_dims_a_lit_floor_by_beer_lambert_both_ways() {
+        let (kd, light_pos, intensity, parts) = lit_floor();
+        let sigma = Vec3::new(0.05, 0.1, 0.2);
+        let fog = Fog::homogeneous(sigma, Vec3::ZERO, 0.0).unwrap();
+        let scene = foggy_scene(parts, fog);
+        let cam = camera(Vec3::new(0.0, 1.5, 2.0), -0.6, 0.6);
+        let (w, h) = (12, 8);
+        let mut set = settings(w, h, 2000, 2);
+        set.layers.fog = true;
+        let out = render(&scene, &cam, &set, &|_| {});
+        let k = 4;
+        let (mut got, mut expected) = (Vec3::ZERO, Vec3::ZERO);
+        for y in 0..h {
+            for x in 0..w {
+                got += out.image.get(x, y);
+                for i in 0..k {
+                    for j in 0..k {
+                        let o = Vec2::new((i as f32 + 0.5) / k as f32, (j as f32 + 0.5) / k as f32);
+                        let ray = cam.generate_ray(Vec2::new(x as f32, y as f32) + o, w, h);
+                        let t = -ray.origin.y / ray.direction.y;
+                        let p = ray.at(t);
+                        let d = light_pos - p;
+                        let tr = (-sigma * (t + d.length())).exp();
+                        expected +=
+                            intensity * kd * tr * (d.y / d.length() / d.length_squared() / PI)
+                                / (k * k) as f32;
+                    }
+                }
+            }
+        }
+        let err = ((got - expected) / expected).abs().max_element();
+        assert!(err < 0.01, "{got} vs {expected}");
+        // The fog layer: the transmittance's luminance to the centre ray's hit.
+        let ray = cam.generate_ray(Vec2::new(5.5, 6.5), w, h);
+        let t = -ray.origin.y / ray.direction.y;
+        let layer = out.fog.unwrap()[(6 * w + 5) as usize];
+        assert!(
+            (layer - luminance((-sigma * t).exp())).abs() < 1e-5,
+            "{layer}"
+        );
+    }
+
+    #[test]
+    fn a_scene_without_fog_has_a_fog_layer_of_one_and_draws_no_fog_numbers() {
+        let scene = street(Vec3::splat(0.3), Vec3::splat(0.2));
+        let cam = camera(Vec3::new(0.0, 1.5, 2.0), -0.3, 0.8);
+        let mut set = settings(8, 6, 4, 4);
+        let plain = render(&scene, &cam, &set, &|_| {});
+        set.layers.fog = true;
+        let with_layer = render(&scene, &cam, &set, &|_| {});
+        assert!(with_layer.fog.unwrap().iter().all(|&f| f == 1.0));
+        assert_eq!(plain.image, with_layer.image);
     }
 }

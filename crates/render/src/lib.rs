@@ -13,6 +13,8 @@
 //! - [`material`] and [`texture`]: what a scene stores; a material turns into a [`bsdf::Bsdf`]
 //!   at a surface point. [`normal_map`]: tangent-space normal maps and the rule that keeps a
 //!   perturbed shading normal valid.
+//! - [`medium`]: the scene's fog ([`medium::Fog`]: extinction, albedo, height falloff, exact
+//!   transmittance and free-flight sampling) and [`phase`]: its Henyey-Greenstein phase function.
 //! - [`light`]: one file per concept: the punctual lights ([`light::Light`]), the emitters
 //!   ([`light::Emitters`]: punctual lights and meshes of emissive triangles, built once with the
 //!   scene), the light tree ([`light::LightTree`]) and the light choice ([`light::LightSampler`]).
@@ -82,11 +84,13 @@ pub mod geometry;
 pub mod integrator;
 pub mod light;
 pub mod material;
+pub mod medium;
 pub mod mitsuba;
 pub mod motion;
 pub mod normal_map;
 pub mod output;
 pub mod rain;
+pub mod phase;
 pub mod regression;
 pub mod sampling;
 pub mod scene;

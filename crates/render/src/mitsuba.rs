@@ -36,7 +36,9 @@
 //! | constant environment ([`Environment::Constant`], also the default of a scene without lights) | `constant` with the same `radiance` | yes |
 //! | environment map ([`Environment::Map`]) | `envmap` of the map's texels (written to `textures/environment.exr`), `scale` = strength, no `to_world` | yes: the same direction mapping, texel centres and bilinear lookup (a map of one row or column is written with it repeated) |
 //! | film, filter | `hdrfilm` (rgb, float32) with a `box` filter | yes |
-//! | integrator | `path` with the same `max_depth` | yes (Russian roulette differs: unbiased either way) |
+//! | integrator | `path` with the same `max_depth` (`volpath` with fog) | yes (Russian roulette differs: unbiased either way) |
+//! | fog ([`Fog`]), homogeneous | `homogeneous` medium `fog` (`sigma_t` as RGB / its largest channel, times `scale`; `albedo`; `hg` phase with the same `g`), referenced by the sensor and as the `exterior` of shapes whose material has a volume | yes (Mitsuba's shadow rays estimate the transmittance by tracking, ours evaluate it: the same expectation) |
+//! | fog with `height_falloff` | refused ([`MitsubaError::FogFalloff`]) | falloff is tested against quadrature in our own tests |
 //! | sampler | `independent` with `sample_count` and `seed` | noise differs, expectation the same |
 //!
 //! Mitsuba's camera looks along +Z in its local frame with +X to the *left*; `lookat` with our
@@ -47,6 +49,7 @@ use crate::bsdf;
 use crate::camera::{Camera, Projection};
 use crate::light::{Environment, Light};
 use crate::material::{GltfPbrParams, Material, PaperModel, Reflectance};
+use crate::medium::Fog;
 use crate::scene::{Instances, Scene, SceneError, TriangleMesh};
 use crate::texture::{Sampler, Texture, TextureId, TextureRef};
 use glam::{Vec2, Vec3};
@@ -86,6 +89,18 @@ pub enum MitsubaError {
     /// Writing a file failed.
     #[error(transparent)]
     Output(#[from] ImageError),
+    /// The scene's fog falls off with height, which Mitsuba's `homogeneous` medium cannot
+    /// express.
+    #[error(
+        "{file}: extras.streaks.fog: height_falloff {falloff} cannot be exported (Mitsuba's \
+         homogeneous medium has none); export the scene with a homogeneous fog"
+    )]
+    FogFalloff {
+        /// The scene file.
+        file: PathBuf,
+        /// The fog's height falloff, per metre.
+        falloff: f32,
+    },
 }
 
 /// Render settings written into the Mitsuba scene (the same as `streaks render`'s).
@@ -205,6 +220,7 @@ pub(crate) struct ExportedScene<'a> {
     pub(crate) lights: &'a [Light],
     pub(crate) instances: &'a Instances,
     pub(crate) environment: Option<&'a Environment>,
+    pub(crate) fog: Option<&'a Fog>,
 }
 
 /// Converts `scene` to Mitsuba 3 with the render settings `opts`. A scene without a camera
@@ -219,6 +235,7 @@ pub fn export(scene: &Scene, opts: &ExportOptions) -> Result<MitsubaExport, Mits
         lights: &scene.lights,
         instances: &scene.instances,
         environment: scene.environment(),
+        fog: scene.fog.as_ref(),
     };
     match scene.find_camera(opts.camera.as_deref())? {
         Some(camera) => export_parts(&parts, camera, opts),
@@ -815,7 +832,7 @@ const ORTHO_NEAR_CLIP: f32 = 0.01;
 /// half-width `s W / 2` gives our rectangle (`s` the pixel size,
 /// [`Camera::pixel_metres`]), and the lookat origin is moved back by `near_clip` so that
 /// the rays start on our camera plane.
-fn sensor_xml(cam: &Camera, opts: &ExportOptions) -> String {
+fn sensor_xml(cam: &Camera, opts: &ExportOptions, medium: Option<&str>) -> String {
     let origin = cam.position();
     let forward = cam
         .world_from_camera
@@ -845,8 +862,9 @@ fn sensor_xml(cam: &Camera, opts: &ExportOptions) -> String {
             )
         }
     };
+    let medium = medium.map_or(String::new(), |id| format!("<ref id=\"{id}\"/>"));
     format!(
-        "<sensor type=\"{kind}\">{projection}\
+        "<sensor type=\"{kind}\">{medium}{projection}\
          <transform name=\"to_world\">{scale}<lookat origin=\"{}\" target=\"{}\" up=\"{}\"/></transform>\
          <sampler type=\"independent\"><integer name=\"sample_count\" value=\"{}\"/>\
          <integer name=\"seed\" value=\"{}\"/></sampler>\
@@ -910,6 +928,47 @@ fn meshes_by_material(parts: &ExportedScene<'_>) -> Vec<(usize, PlyMesh)> {
         .collect()
 }
 
+/// The `id` of the exported fog's `<medium>`.
+const FOG_ID: &str = "fog";
+
+/// The fog as a Mitsuba `homogeneous` medium with an `hg` phase function: `sigma_t` as an RGB
+/// in [0, 1] (its largest channel 1) times `scale` (the plugin asks for RGB extinction in
+/// [0, 1]), `albedo`, `g`. A fog that falls off with height is refused
+/// ([`MitsubaError::FogFalloff`]).
+fn fog_xml(source: &Path, fog: &Fog) -> Result<String, MitsubaError> {
+    if fog.height_falloff() != 0.0 {
+        return Err(MitsubaError::FogFalloff {
+            file: source.to_path_buf(),
+            falloff: fog.height_falloff(),
+        });
+    }
+    let sigma = fog.sigma_t();
+    let scale = sigma.max_element();
+    let unit = if scale > 0.0 {
+        sigma / scale
+    } else {
+        Vec3::ZERO
+    };
+    Ok(format!(
+        "<medium type=\"homogeneous\" id=\"{FOG_ID}\">{}<float name=\"scale\" value=\"{scale:?}\"/>\
+         {}<phase type=\"hg\"><float name=\"g\" value=\"{:?}\"/></phase></medium>",
+        rgb("sigma_t", unit),
+        rgb("albedo", fog.albedo()),
+        fog.phase().g
+    ))
+}
+
+/// `<ref name="exterior" id="fog"/>` for a shape whose material has a volume (which the path
+/// tracer enters through its front face and leaves into the fog), when the scene has fog;
+/// else nothing. Thin-walled and opaque shapes keep the path's medium, as ours do.
+fn exterior_xml(parts: &ExportedScene<'_>, m: &Material) -> String {
+    if parts.fog.is_some() && m.volume().is_some() {
+        format!("<ref name=\"exterior\" id=\"{FOG_ID}\"/>")
+    } else {
+        String::new()
+    }
+}
+
 /// [`export`] on the parts of a scene, with the camera already chosen.
 pub(crate) fn export_parts(
     parts: &ExportedScene<'_>,
@@ -931,12 +990,21 @@ pub(crate) fn export_parts(
          <!-- Exported by streaks export-mitsuba from {} -->\n<scene version=\"3.0.0\">",
         esc(&parts.source.display().to_string()).replace("--", "- -")
     );
+    let integrator = if parts.fog.is_some() {
+        "volpath"
+    } else {
+        "path"
+    };
     let _ = writeln!(
         xml,
-        "<integrator type=\"path\"><integer name=\"max_depth\" value=\"{}\"/></integrator>",
+        "<integrator type=\"{integrator}\"><integer name=\"max_depth\" value=\"{}\"/></integrator>",
         opts.max_depth
     );
-    let _ = writeln!(xml, "{}", sensor_xml(camera, opts));
+    if let Some(fog) = parts.fog {
+        let _ = writeln!(xml, "{}", fog_xml(parts.source, fog)?);
+    }
+    let fog_ref = parts.fog.map(|_| FOG_ID);
+    let _ = writeln!(xml, "{}", sensor_xml(camera, opts, fog_ref));
     for light in parts.lights {
         let _ = writeln!(xml, "{}", light_xml(light, &mut warnings));
     }
@@ -1000,10 +1068,11 @@ pub(crate) fn export_parts(
         // emitter tests the shading normal, which on a smooth lamp mesh darkens the rim (0.2% of
         // a sphere lamp's streak on scenes/crosscheck.gltf). Face normals make the two agree.
         let face_normals = m.is_emissive();
+        let exterior = exterior_xml(parts, m);
         let _ = writeln!(
             xml,
             "<shape type=\"ply\"><string name=\"filename\" value=\"{}\"/>\
-             <boolean name=\"face_normals\" value=\"{face_normals}\"/>{bsdf}{emitter}</shape>",
+             <boolean name=\"face_normals\" value=\"{face_normals}\"/>{bsdf}{emitter}{exterior}</shape>",
             esc(&mesh.file_name)
         );
     }
@@ -1018,9 +1087,10 @@ pub(crate) fn export_parts(
                 .file_name
                 .replacen("meshes/", &format!("meshes/i{k}_"), 1);
             let bsdf = bsdf_of(&mut mw, index)?;
+            let exterior = exterior_xml(parts, &parts.materials[index]);
             let _ = write!(
                 xml,
-                "<shape type=\"ply\"><string name=\"filename\" value=\"{}\"/>{bsdf}</shape>",
+                "<shape type=\"ply\"><string name=\"filename\" value=\"{}\"/>{bsdf}{exterior}</shape>",
                 esc(&mesh.file_name)
             );
             meshes.push((index, mesh));
@@ -1176,6 +1246,7 @@ mod tests {
                 lights: &self.lights,
                 instances: &self.instances,
                 environment: None,
+                fog: None,
             }
         }
     }
@@ -1278,6 +1349,57 @@ mod tests {
         let ex = export_parts(&unlit.parts(), &unlit.cameras[0], &opts()).unwrap();
         assert_eq!(ex.xml, lamp.xml);
         assert!(ex.xml.contains("<emitter type=\"area\">"), "{}", ex.xml);
+    }
+
+    #[test]
+    fn fog_exports_as_a_homogeneous_medium_the_sensor_refers_to() {
+        let fx = Fixture::new();
+        let fog = Fog::homogeneous(Vec3::new(0.02, 0.04, 0.05), Vec3::splat(0.9), 0.7).unwrap();
+        let parts = ExportedScene {
+            fog: Some(&fog),
+            ..fx.parts()
+        };
+        let ex = export_parts(&parts, &fx.cameras[0], &opts()).unwrap();
+        let doc = roxmltree::Document::parse(&ex.xml).unwrap();
+        let medium = doc
+            .descendants()
+            .find(|n| n.has_tag_name("medium"))
+            .unwrap();
+        assert_eq!(medium.attribute("type"), Some("homogeneous"));
+        assert_eq!(medium.attribute("id"), Some("fog"));
+        let value = |name: &str| {
+            medium
+                .descendants()
+                .find(|c| c.attribute("name") == Some(name))
+                .and_then(|c| c.attribute("value"))
+                .unwrap()
+                .to_owned()
+        };
+        let unit = floats(&value("sigma_t"));
+        let scale: f32 = value("scale").parse().unwrap();
+        for (c, want) in [0.02f32, 0.04, 0.05].into_iter().enumerate() {
+            assert!((unit[c] * scale - want).abs() < 1e-7, "{unit:?} x {scale}");
+        }
+        assert_eq!(floats(&value("albedo")), [0.9, 0.9, 0.9]);
+        assert_eq!(value("g"), "0.7");
+        let sensor = doc
+            .descendants()
+            .find(|n| n.has_tag_name("sensor"))
+            .unwrap();
+        assert!(sensor
+            .children()
+            .any(|c| c.has_tag_name("ref") && c.attribute("id") == Some("fog")));
+        let integrator = doc.descendants().find(|n| n.has_tag_name("integrator"));
+        assert_eq!(integrator.unwrap().attribute("type"), Some("volpath"));
+        // A fog that thins with height is refused, naming the file.
+        let falling = Fog::new(Vec3::splat(0.1), Vec3::ONE, 0.0, 0.2, 0.0).unwrap();
+        let parts = ExportedScene {
+            fog: Some(&falling),
+            ..fx.parts()
+        };
+        let err = export_parts(&parts, &fx.cameras[0], &opts()).unwrap_err();
+        assert!(matches!(err, MitsubaError::FogFalloff { .. }), "{err}");
+        assert!(err.to_string().contains("test.gltf"), "{err}");
     }
 
     #[test]

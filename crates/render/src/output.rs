@@ -3,8 +3,9 @@
 //! Channels: `R`, `G`, `B` (the beauty image, linear) plus, when present, `depth.Z`,
 //! `normal.X`/`normal.Y`/`normal.Z`, `albedo.R`/`.G`/`.B`, `specular.R`/`.G`/`.B` and
 //! `spp.Y` (samples taken per pixel, as float32: exact up to 2^24), `rain.Y` (the share of
-//! the pixel's camera samples whose first hit was a rain drop) (OpenEXR's `layer.channel`
-//! naming, which Blender, Nuke and `exrheader` show as layers).
+//! the pixel's camera samples whose first hit was a rain drop) and `fog.Y` (the fog's
+//! transmittance to the pixel-centre ray's first hit, 1 without fog) (OpenEXR's
+//! `layer.channel` naming, which Blender, Nuke and `exrheader` show as layers).
 //! A render through a camera model (`--sensor`) also has `sensor.R`/`.G`/`.B`, the camera's
 //! raw values in DN as float32 ([`write_exr_with_sensor`]); `R`, `G`, `B` stay the render.
 //! [`write_exr`] writes them and [`read_exr_layer`] reads them back, from the names here; the
@@ -32,6 +33,8 @@ pub const SENSOR: [&str; 3] = ["sensor.R", "sensor.G", "sensor.B"];
 /// The rain layer's channel: the share of the pixel's camera samples whose first hit was a
 /// rain drop.
 pub const RAIN: &str = "rain.Y";
+/// The fog transmittance layer's channel.
+pub const FOG: &str = "fog.Y";
 
 /// Writes the render as a float32 EXR: the beauty image and the layers present in `output`
 /// (see the module documentation), atomically.
@@ -74,23 +77,28 @@ pub fn write_exr_with_sensor(
     if let Some(rain) = &output.rain {
         channels.push((RAIN, rain.clone()));
     }
+    if let Some(fog) = &output.fog {
+        channels.push((FOG, fog.clone()));
+    }
     streaks_image::exr::write_exr(path, img.width, img.height, channels)
 }
 
 /// Reads a layer written by [`write_exr`]: `"albedo"`, `"specular"`, `"sensor"` (RGB),
-/// `"normal"` (XYZ into the RGB slots), `"depth"` (Z), `"spp"` (samples per pixel) or `"rain"`
-/// (one channel, repeated into all three slots).
+/// `"normal"` (XYZ into the RGB slots), `"depth"` (Z), `"spp"` (samples per pixel), `"rain"`
+/// (rain share) or `"fog"` (fog transmittance; the last four one channel, repeated into all
+/// three slots).
 pub fn read_exr_layer(path: &Path, name: &str) -> Result<RgbImage, ImageError> {
     match name {
         "albedo" => read_exr_rgb_channels(path, ALBEDO),
         "specular" => read_exr_rgb_channels(path, SPECULAR),
         "sensor" => read_exr_rgb_channels(path, SENSOR),
         "normal" => read_exr_rgb_channels(path, NORMAL),
-        "depth" | "spp" | "rain" => {
+        "depth" | "spp" | "rain" | "fog" => {
             let channel = match name {
                 "depth" => DEPTH,
                 "spp" => SPP,
-                _ => RAIN,
+                "rain" => RAIN,
+                _ => FOG,
             };
             let (w, h, planes) = read_exr_channels(path, &[channel])?;
             let z = &planes[0];
@@ -99,7 +107,7 @@ pub fn read_exr_layer(path: &Path, name: &str) -> Result<RgbImage, ImageError> {
         other => Err(ImageError::MissingChannels {
             path: path.to_path_buf(),
             what: format!(
-                "layer {other:?} (the layers are albedo, specular, normal, depth, spp, rain, sensor)"
+                "layer {other:?} (the layers are albedo, specular, normal, depth, spp, rain, fog, sensor)"
             ),
         }),
     }
@@ -132,6 +140,7 @@ mod tests {
             material: None,
             spp: Some((0..w * h).map(|i| 16 + 8 * i).collect()),
             rain: Some((0..w * h).map(|i| i as f32 / 16.0).collect()),
+            fog: Some((0..w * h).map(|i| 1.0 / (1 + i) as f32).collect()),
             stats: RenderStats::default(),
         }
     }
@@ -156,6 +165,8 @@ mod tests {
         assert_eq!(spp.get(2, 1).x, (16 + 8 * 7) as f32);
         let rain = read_exr_layer(&path, "rain").unwrap();
         assert_eq!(rain.get(2, 1).y, 7.0 / 16.0);
+        let fog = read_exr_layer(&path, "fog").unwrap();
+        assert_eq!(fog.get(2, 1).y, 1.0 / 8.0);
         let err = read_exr_layer(&path, "albedo").unwrap_err();
         assert!(err.to_string().contains("albedo.R"), "{err}");
         let err = read_exr_layer(&path, "beauty").unwrap_err();

@@ -159,6 +159,7 @@ pub fn render_eye(
             material: true,
             spp: false,
             rain: scene.rain.is_some(),
+            fog: scene.fog.is_some(),
         },
         settings: settings.render,
         motion: settings.motion,

@@ -7,7 +7,8 @@
 //! cosine toward it (zero below the shading or the geometric surface). The 1% share by `E`
 //! alone is defensive sampling: every emitter that can light the point keeps a positive
 //! probability even where the BSDF toward its centre is zero. On a glossy wet road the
-//! mixture sends a streak's shadow rays to the lamp that makes the streak.
+//! mixture sends a streak's shadow rays to the lamp that makes the streak. A point in the fog
+//! ([`Receiver::in_medium`]) has no BSDF to weigh by: its choice goes by `E` alone.
 //!
 //! The share is small because every shadow ray it sends elsewhere is wasted in a streak pixel,
 //! and what it guards against is mostly covered otherwise: a punctual light's `F` is exact,
@@ -637,6 +638,9 @@ mod tests {
         let p = Vec3::new(0.5, 0.0, -4.0);
         let rx = receiver(p, glossy, Vec3::new(0.0, 1.5, 0.0) - p);
         check_choice(ls, &rx);
+        // A point in the fog sees every light, below it too, and chooses by irradiance alone.
+        check_choice(ls, &Receiver::in_medium(p));
+        check_choice(ls, &Receiver::in_medium(Vec3::new(0.5, 6.0, -4.0)));
 
         // Unbiased: f * L * cos / pdf over many choices against the exact sum over the lights.
         let diffuse = Bsdf::Diffuse(Diffuse { kd: Vec3::ONE });

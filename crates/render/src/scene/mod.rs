@@ -196,6 +196,7 @@ use crate::geometry::{offset_ray_origin, Ray, SurfaceHit, VertexAttributes};
 use crate::light::{Environment, Light, LightSampler, SurfaceMesh};
 use crate::material::Material;
 use crate::motion::Motion;
+use crate::medium::Fog;
 use crate::normal_map::{self, MappedNormal, NormalMap};
 use crate::rain::{offset_from_drop, DropField, Rain, RainError, RainParams, RainPath, RainView};
 use crate::sampling::{pcg_hash, u32_to_unit_f32};
@@ -251,6 +252,9 @@ pub struct Scene {
     /// with the scene from its triangles, materials and lights, and the environment light
     /// ([`Scene::environment`]).
     pub light_sampler: LightSampler,
+    /// The fog that fills the space outside the objects (`scenes[i].extras.streaks.fog` in
+    /// glTF), if any; see [`crate::medium`].
+    pub fog: Option<Fog>,
     /// Things in the file that were skipped or defaulted, for the command to print.
     pub warnings: Vec<String>,
     /// Rain in the air (`scenes[i].extras.streaks.rain`, [`crate::rain`]): its drops are
@@ -282,6 +286,8 @@ pub struct SceneParts {
     /// and no punctual light or emissive triangle either, the scene gets a uniform white
     /// environment ([`DEFAULT_ENVIRONMENT_RADIANCE`]) and a warning ([`NO_LIGHT_WARNING`]).
     pub environment: Option<Environment>,
+    /// The fog (`scenes[i].extras.streaks.fog` in glTF), if any.
+    pub fog: Option<Fog>,
     /// Warnings to pass on.
     pub warnings: Vec<String>,
 }
@@ -326,6 +332,7 @@ impl Scene {
             instanced_meshes,
             instances,
             environment,
+            fog,
             mut warnings,
         } = parts;
         let bad = |element: String, reason: String| SceneError::invalid(&source, element, reason);
@@ -408,6 +415,7 @@ impl Scene {
             accel,
             instances,
             light_sampler,
+            fog,
             warnings,
             rain: None,
         })

@@ -218,6 +218,7 @@ pub(in crate::scene) fn load(path: &Path, files: &Files) -> Result<Scene, SceneE
         Some(scene) => {
             loader.parts.environment = loader.environment(&scene)?;
             rain = loader.rain(&scene)?;
+            loader.parts.fog = loader.fog(&scene)?;
             // Nodes reached by several paths (a DAG) are visited once per path, which may be
             // exponentially many: they are counted first.
             count_visits(path, &document, &scene)?;

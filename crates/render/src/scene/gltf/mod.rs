@@ -33,6 +33,7 @@
 //! - `materials`: materials and their KHR_materials_* extensions, `extras.streaks`;
 //! - `environment`: the scene's environment light, `scenes[i].extras.streaks.environment`;
 //! - `rain`: the scene's rain, `scenes[i].extras.streaks.rain` ([`crate::rain`]);
+//! - `fog`: the scene's fog, `scenes[i].extras.streaks.fog` ([`crate::medium::Fog`]);
 //! - `textures`: texture infos, KHR_texture_transform, samplers, images;
 //! - [`extensions`]: which extensions are honoured, and the ones that are not a material's
 //!   field: KHR_lights_punctual (and the file's light units), EXT_mesh_gpu_instancing;
@@ -46,6 +47,7 @@ mod compression;
 mod document;
 mod environment;
 pub mod extensions;
+mod fog;
 mod materials;
 mod meshes;
 mod nodes;
