@@ -656,6 +656,8 @@ fn rain_writes_its_layer_and_motion_flags_are_checked() {
     t.streaks(&args("bad.gltf", "x.exr"))
         .assert_failure_mentioning("rate");
     assert!(!t.join("x.exr").exists());
+}
+
 /// The tiny scene with `fog` in its scene's extras.
 fn write_foggy_gltf(t: &TestDir, fog: &str) {
     let path = t.write_tiny_gltf();
