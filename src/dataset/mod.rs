@@ -5,6 +5,8 @@
 //! - [`index`]: `streaks dataset index DIR` verifies the files against `manifest.jsonl`, or
 //!   (the first time, or with `--rebuild`) checks what is on disk and writes `manifest.jsonl`
 //!   and `splits/`;
+//! - [`preview`]: `streaks dataset preview SAMPLE -o PNG` writes a sample's left image beside
+//!   its ground-truth disparity (and rain mask) for a person to look at;
 //! - [`sample`]: rendering and writing one sample.
 //!
 //! The folder layout, `dataset.json`, `meta.json`, the manifest, the locks, the shards and the
@@ -14,6 +16,7 @@
 
 pub mod generate;
 pub mod index;
+pub mod preview;
 pub mod sample;
 
 use anyhow::Result;
@@ -33,6 +36,9 @@ enum Command {
     /// Verify a dataset folder against its manifest.jsonl (or, the first time or with
     /// --rebuild, write manifest.jsonl and splits/ from what is on disk).
     Index(index::Args),
+    /// Write a sample's left image beside its ground-truth disparity (and rain mask) as one
+    /// PNG.
+    Preview(preview::Args),
 }
 
 /// Runs the subcommand.
@@ -40,5 +46,6 @@ pub fn run(args: Args) -> Result<()> {
     match args.command {
         Command::Generate(a) => generate::run(a),
         Command::Index(a) => index::run(a),
+        Command::Preview(a) => preview::run(a),
     }
 }

@@ -105,6 +105,10 @@ pub struct Names {
     pub streak_mask: [&'static str; 2],
     /// The road-surface mask.
     pub road_mask: [&'static str; 2],
+    /// The rain mask: the share of the pixel's camera samples that met a rain drop.
+    pub rain_mask: [&'static str; 2],
+    /// The fog's transmittance from the camera to the pixel's first hit.
+    pub fog: [&'static str; 2],
 }
 
 /// The sample layout (Middlebury style): `im0.png`, `disp0.pfm`, ...
@@ -115,6 +119,8 @@ pub const SAMPLE_NAMES: Names = Names {
     depth: ["depth0.pfm", "depth1.pfm"],
     streak_mask: ["streaks0.png", "streaks1.png"],
     road_mask: [ROAD_MASK, "road1.png"],
+    rain_mask: ["rain0.png", "rain1.png"],
+    fog: ["fog0.pfm", "fog1.pfm"],
 };
 
 /// The older pair layout of `streaks stereo`: `left.png`, `disparity_left.pfm`, ... (read,
@@ -126,6 +132,8 @@ pub const PAIR_NAMES: Names = Names {
     depth: ["depth_left.pfm", "depth_right.pfm"],
     streak_mask: ["streak_mask_left.png", "streak_mask_right.png"],
     road_mask: ["road_mask_left.png", "road_mask_right.png"],
+    rain_mask: ["rain_mask_left.png", "rain_mask_right.png"],
+    fog: ["fog_left.pfm", "fog_right.pfm"],
 };
 
 fn eye_index(eye: Eye) -> usize {
@@ -238,6 +246,18 @@ impl SampleDir {
     /// the scene flags a road material).
     pub fn road_mask(&self, eye: Eye) -> PathBuf {
         self.eye_file(self.names.road_mask, eye)
+    }
+
+    /// The rain mask (`rain0.png`: 0 where no camera sample met a drop, 255 where all did;
+    /// written only when the scene has rain).
+    pub fn rain_mask(&self, eye: Eye) -> PathBuf {
+        self.eye_file(self.names.rain_mask, eye)
+    }
+
+    /// The fog's transmittance from the camera to each pixel's first hit (`fog0.pfm`, 1 = no
+    /// fog, 0 on the sky through a homogeneous fog; written only when the scene has fog).
+    pub fn fog(&self, eye: Eye) -> PathBuf {
+        self.eye_file(self.names.fog, eye)
     }
 
     /// `calib.txt`.

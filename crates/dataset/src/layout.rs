@@ -297,10 +297,14 @@ impl Conventions {
                  disp1 the right view's (its match in the left view is at x + d); inf = no value (the pixel-centre ray hits nothing)"),
             depth: s("depth0.pfm: view-space depth Z in metres of the left view's pixel-centre first hit (along the camera's -Z), inf = none"),
             pfm: s("Middlebury/SceneFlow: greyscale 'Pf', scale -1 (little-endian), rows stored bottom to top, inf = no value"),
-            images: s("im0/im1.png: 8-bit sRGB of the linear render times 2^exposure_ev (meta.json), clipped; \
-                 im0/im1.exr: linear float32 RGB with the layers depth.Z, normal.X/Y/Z and specular.R/G/B"),
+            images: s("im0/im1.png: 8-bit sRGB developed from the camera's raw values (the sensor layer) through the sensor's \
+                 tone curve (docs/sensor.md) when meta.json has weather, else the linear render times 2^exposure_ev (meta.json), clipped; \
+                 im0/im1.exr: linear float32 RGB (the exact render, no noise or glare) with the layers depth.Z, normal.X/Y/Z and \
+                 specular.R/G/B, and sensor.R/G/B (raw DN), rain.Y and fog.Y when present"),
             masks: s("8-bit greyscale PNG, 0 or 255: streaks0.png the left view's streak pixels (specular layer threshold), \
-                 road0.png the left pixels whose first hit is a road material (extras.streaks.road), absent when the scene flags none"),
+                 road0.png the left pixels whose first hit is a road material (extras.streaks.road), absent when the scene flags none; \
+                 rain0/rain1.png 0-255: the share of each pixel's camera samples that met a rain drop (present when it rains); \
+                 fog0/fog1.pfm: the fog's transmittance from the camera to the pixel-centre ray's first hit (present with fog)"),
             calib: s("Middlebury 2014 calib.txt: cam0/cam1 = [f 0 cx; 0 f cy; 0 0 1] with the top-left pixel centre at (0, 0), \
                  doffs = 0, baseline in mm, ndisp a multiple of 16 above the largest disparity, vmin/vmax the finite disparity range"),
             kitti: s("KITTI 2015: image_2 = im0.png, image_3 = im1.png, disp_occ_0 = disp0 as uint16 PNG of round(256 d), 0 = no value \
@@ -330,10 +334,20 @@ impl FileList {
     pub fn current() -> Self {
         Self {
             sample: SAMPLE_FILES.map(String::from).to_vec(),
-            optional: BTreeMap::from([(
-                ROAD_MASK.to_owned(),
-                "the scene flags a road material (meta.json road_mask)".to_owned(),
-            )]),
+            optional: BTreeMap::from([
+                (
+                    ROAD_MASK.to_owned(),
+                    "the scene flags a road material (meta.json road_mask)".to_owned(),
+                ),
+                (
+                    "rain0.png, rain1.png".to_owned(),
+                    "it rains (meta.json weather.rain_mm_h > 0)".to_owned(),
+                ),
+                (
+                    "fog0.pfm, fog1.pfm".to_owned(),
+                    "the scene has fog (meta.json weather.fog)".to_owned(),
+                ),
+            ]),
             scene: vec![
                 SCENE_GLTF.to_owned(),
                 SCENE_BIN.to_owned(),

@@ -420,6 +420,17 @@ pub fn check_sample(
     if meta.road_mask {
         expected.push(file_name(&road_mask));
     }
+    let weather = meta.weather.as_ref();
+    let rain_masks = Eye::BOTH.map(|eye| sample.rain_mask(eye));
+    let fog_maps = Eye::BOTH.map(|eye| sample.fog(eye));
+    let has_rain = weather.is_some_and(|w| w.rain_mm_h > 0.0);
+    let has_fog = weather.is_some_and(|w| w.fog.is_some());
+    if has_rain {
+        expected.extend(rain_masks.iter().map(|p| file_name(p)));
+    }
+    if has_fog {
+        expected.extend(fog_maps.iter().map(|p| file_name(p)));
+    }
     expected.push(SCENE_GLTF.to_owned());
     if sample.scene().is_file() {
         expected.extend(scene_files(&sample.scene())?);
@@ -444,6 +455,9 @@ pub fn check_sample(
     if meta.road_mask {
         pngs.push(road_mask);
     }
+    if has_rain {
+        pngs.extend(rain_masks);
+    }
     for p in pngs {
         check_size(&p, size, GrayImage::load(&p))?;
     }
@@ -451,7 +465,10 @@ pub fn check_sample(
         sample.disparity(Eye::Left),
         sample.disparity(Eye::Right),
         sample.depth(Eye::Left),
-    ] {
+    ]
+    .into_iter()
+    .chain(has_fog.then_some(fog_maps).into_iter().flatten())
+    {
         check_size(&p, size, read_pfm(&p))?;
     }
     for p in Eye::BOTH.map(|eye| sample.exr(eye)) {

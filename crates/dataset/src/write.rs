@@ -6,6 +6,7 @@ use crate::error::DatasetError;
 use crate::files::SampleDir;
 use image::RgbImage;
 use streaks_image::develop;
+use streaks_image::GrayImage;
 use streaks_image::pfm::write_pfm;
 use streaks_image::png::write_png_buffer;
 use streaks_render::output::write_exr_with_sensor;
@@ -29,7 +30,8 @@ pub enum GroundTruth {
 /// Writes both views of a rendered pair into `files` (whose folder must exist): per eye the
 /// EXR with its layers (and the `sensor` layer of a view exposed through a camera model), the
 /// 8-bit sRGB PNG (at `exposure_ev` stops, or developed from the camera's DN) and the ground-truth
-/// disparity; the depth, streak mask and (when the scene flags a road material) road-surface
+/// disparity, the rain mask (when the scene has rain) and the fog's transmittance (when it
+/// has fog); the depth, streak mask and (when the scene flags a road material) road-surface
 /// mask of the views `truth` says. Returns the two sRGB images.
 pub fn write_views(
     files: &SampleDir,
@@ -50,6 +52,13 @@ pub fn write_views(
         write_png_buffer(&files.png(eye), &img)?;
         srgb.push(img);
         write_pfm(&files.disparity(eye), &view.disparity)?;
+        let (w, h) = (view.disparity.width, view.disparity.height);
+        if let Some(rain) = &view.output.rain {
+            GrayImage::from_vec(w, h, rain.clone())?.save_png(&files.rain_mask(eye))?;
+        }
+        if let Some(fog) = &view.output.fog {
+            write_pfm(&files.fog(eye), &GrayImage::from_vec(w, h, fog.clone())?)?;
+        }
         if eye == Eye::Left || truth == GroundTruth::Both {
             write_pfm(&files.depth(eye), &view.depth)?;
             view.streak_mask.save_png(&files.streak_mask(eye))?;

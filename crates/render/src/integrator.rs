@@ -175,10 +175,11 @@
 //! ([`Scene::intersect`] meets no drop): they are the ground truth of the scene behind the rain.
 //!
 //! Time ([`crate::motion`]): with the shutter open for a nonzero interval
-//! ([`RenderJob::motion`]), each camera sample draws one more number after its film position,
+//! ([`RenderJob::motion`]) and something moving (the rig, or rain drops in the camera's
+//! view), each camera sample draws one more number after its film position,
 //! its time `t` uniform over the shutter, and its ray starts at the camera moved by the rig's
-//! velocity times `t`; every ray of the path carries `t`. With a closed shutter nothing is
-//! drawn and the image is the one a renderer without time makes.
+//! velocity times `t`; every ray of the path carries `t`. With a closed shutter, or nothing
+//! moving, nothing is drawn and the image is the one a renderer without time makes.
 //!
 //! Rain ([`crate::rain`]): the camera ray meets the drops of its camera's index
 //! ([`crate::rain::CameraRain`], built at the start of the render), and a path that hit a drop
@@ -549,7 +550,8 @@ fn take_sample(
     sampler.start_pixel_sample((x, y), s);
     let film_pos = Vec2::new(x as f32, y as f32) + sampler.next_2d();
     let mut ray = camera.generate_ray(film_pos, job.width, job.height);
-    if job.motion.is_blurred() {
+    // Only moving things need a time: the rig, or rain drops in view.
+    if job.motion.is_blurred() && (job.motion.rig_velocity != Vec3::ZERO || rain.is_some()) {
         ray.time = job.motion.time(sampler.next_1d());
         ray.origin += job.motion.rig_velocity * ray.time;
     }
