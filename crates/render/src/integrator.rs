@@ -520,10 +520,74 @@ fn take_sample(
         ray.time = job.motion.time(sampler.next_1d());
         ray.origin += job.motion.rig_velocity * ray.time;
     }
-    let path = trace_path(scene, ray, sampler, job, rain);
-    pixel.add_sample(path.radiance, path.specular);
-    pixel.rain += u32::from(path.rain);
-    path.rays
+    let swept_estimator = scene
+        .rain
+        .as_ref()
+        .is_some_and(|r| r.estimator == crate::rain::RainEstimator::Swept);
+    let swept = match rain {
+        Some(rain) if swept_estimator && job.motion.is_blurred() => {
+            Some(swept_drops(scene, rain, &ray, job))
+        }
+        _ => None,
+    };
+    let Some(swept) = swept else {
+        let path = trace_path(scene, ray, sampler, job, RainPath::camera(rain));
+        pixel.add_sample(path.radiance, path.specular);
+        pixel.rain += f32::from(u8::from(path.rain));
+        return path.rays;
+    };
+    if swept.is_empty() {
+        let path = trace_path(scene, ray, sampler, job, RainPath::camera(None));
+        pixel.add_sample(path.radiance, path.specular);
+        return path.rays;
+    }
+    // The time integral split on whether a drop covers the ray: the background (no drop) at
+    // a time outside every drop's interval, weighted by that share of the shutter, and the
+    // drops at a time drawn over their intervals (counted with overlaps, so weighted by
+    // their summed length over the number of intervals holding the time), traced with
+    // every drop at that time (its first hit is the nearest drop there).
+    let motion = &job.motion;
+    let shutter = motion.close - motion.open;
+    let u = (ray.time - motion.open) / shutter;
+    let covered = swept.coverage(motion);
+    let origin = ray.origin - motion.rig_velocity * ray.time;
+    let mut background_ray = ray;
+    background_ray.time = swept.time_outside(u, motion);
+    background_ray.origin = origin + motion.rig_velocity * background_ray.time;
+    let background = trace_path(scene, background_ray, sampler, job, RainPath::camera(None));
+    let mut drop_ray = ray;
+    drop_ray.time = swept.sample_time(sampler.next_1d()).unwrap_or(ray.time);
+    drop_ray.origin = origin + motion.rig_velocity * drop_ray.time;
+    let drop = trace_path(scene, drop_ray, sampler, job, RainPath::camera(rain));
+    let w = swept.total() / shutter / swept.covering(drop_ray.time).max(1) as f32;
+    pixel.add_sample(
+        background.radiance * (1.0 - covered) + drop.radiance * w,
+        background.specular * (1.0 - covered) + drop.specular * w,
+    );
+    pixel.rain += covered;
+    background.rays + drop.rays
+}
+
+/// The drops that cover the camera ray `ray` (at its sample's time) during the shutter in
+/// front of the scene ([`CameraRain::swept`]; the scene's surface found where the camera
+/// stands in the middle of the shutter).
+#[inline]
+fn swept_drops(
+    scene: &Scene,
+    rain: &CameraRain,
+    ray: &Ray,
+    job: &RenderJob,
+) -> crate::rain::SweptSet {
+    let origin = ray.origin - job.motion.rig_velocity * ray.time;
+    let mut set = rain.swept(origin, ray.direction);
+    if !set.is_empty() {
+        let mid = 0.5 * (job.motion.open + job.motion.close);
+        let probe = Ray::new(origin + job.motion.rig_velocity * mid, ray.direction);
+        if let Some(surface) = scene.intersect(&probe) {
+            set.retain_nearer(surface.t);
+        }
+    }
+    set
 }
 
 /// Fills the depth, normal, albedo and material of `pixel` from the pixel-centre ray.
@@ -588,7 +652,7 @@ fn trace_path(
     mut ray: Ray,
     sampler: &mut Sampler,
     job: &RenderJob,
-    rain: Option<&CameraRain>,
+    mut rain_path: RainPath,
 ) -> PathResult {
     let (max_depth, want_specular) = (job.settings.max_depth, job.layers.specular);
     let lights: &LightSampler = &scene.light_sampler;
@@ -608,8 +672,6 @@ fn trace_path(
     let mut first_bsdf: Option<(Bsdf, Frame, Vec3)> = None;
     // The smallest density of the directions chosen so far (path regularisation).
     let mut min_ray_pdf = f32::INFINITY;
-    // Which rain drops the next ray can meet.
-    let mut rain_path = RainPath::camera(rain);
 
     while depth < max_depth {
         out.rays += 1;

@@ -586,6 +586,7 @@ impl Scene {
             params,
             material,
             field: DropField::default(),
+            estimator: crate::rain::RainEstimator::default(),
         });
     }
 
