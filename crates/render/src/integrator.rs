@@ -141,8 +141,9 @@
 //!   threshold on it.
 //! - `spp`: the number of samples the pixel took (kept and dropped), `spp` everywhere unless
 //!   adaptive sampling stopped its tile earlier.
-//! - `rain`: the share of the pixel's camera samples (kept and dropped) whose first hit was a
-//!   rain drop ([`crate::rain`]).
+//! - `rain`: the mean over the pixel's camera samples (kept and dropped) of the share of the
+//!   shutter during which a rain drop was the ray's first hit (with a closed shutter, the
+//!   share of samples whose first hit was a drop) ([`crate::rain`]).
 //!
 //! The first-hit layers (depth, normal, albedo, material) are taken at the reference time 0
 //! from the camera where the scene puts it, and ignore rain drops
@@ -157,7 +158,16 @@
 //! Rain ([`crate::rain`]): the camera ray meets the drops of its camera's index
 //! ([`crate::rain::CameraRain`], built at the start of the render), and a path that hit a drop
 //! its way out of it ([`Scene::intersect_path`]); a drop hit is shaded as any smooth
-//! dielectric surface. Other rays, shadow rays included, do not meet drops.
+//! dielectric surface. Other rays, shadow rays included, do not meet drops. Under an open
+//! shutter (and [`crate::rain::RainEstimator::Swept`], the default) a camera sample first
+//! finds the drops that cover its ray at some time of the shutter in front of the scene
+//! ([`crate::rain::CameraRain::swept`]); with none it traces as a dry render does, drawing
+//! nothing more. Otherwise it traces two paths from its one time variate `u`: the background
+//! (no drop) at the `u`-quantile of the times no drop covers the ray, weighted by their share
+//! `1 - c` of the shutter, and the drops at the `u`-quantile of their intervals laid end to
+//! end, traced with every drop at that time (the nearest covering one is the first hit) and
+//! weighted by the intervals' summed length over the shutter divided by how many intervals
+//! hold that time. Both are unbiased parts of the time integral; the rain layer gets `c`.
 
 use crate::bsdf::Bsdf;
 use crate::camera::Camera;
@@ -543,12 +553,12 @@ fn take_sample(
     }
     // The time integral split on whether a drop covers the ray: the background (no drop) at
     // a time outside every drop's interval, weighted by that share of the shutter, and the
-    // drops at a time drawn over their intervals (counted with overlaps, so weighted by
+    // drops at a time over their intervals (counted with overlaps, so weighted by
     // their summed length over the number of intervals holding the time), traced with
     // every drop at that time (its first hit is the nearest drop there).
     let motion = &job.motion;
     let shutter = motion.close - motion.open;
-    let u = (ray.time - motion.open) / shutter;
+    let u = ((ray.time - motion.open) / shutter).clamp(0.0, 1.0 - f32::EPSILON);
     let covered = swept.coverage(motion);
     let origin = ray.origin - motion.rig_velocity * ray.time;
     let mut background_ray = ray;
@@ -556,7 +566,9 @@ fn take_sample(
     background_ray.origin = origin + motion.rig_velocity * background_ray.time;
     let background = trace_path(scene, background_ray, sampler, job, RainPath::camera(None));
     let mut drop_ray = ray;
-    drop_ray.time = swept.sample_time(sampler.next_1d()).unwrap_or(ray.time);
+    // The same variate as the background's time: stratified over the pixel's samples (the
+    // two paths' expectations add up, so their correlation biases nothing).
+    drop_ray.time = swept.sample_time(u).unwrap_or(ray.time);
     drop_ray.origin = origin + motion.rig_velocity * drop_ray.time;
     let drop = trace_path(scene, drop_ray, sampler, job, RainPath::camera(rain));
     let w = swept.total() / shutter / swept.covering(drop_ray.time).max(1) as f32;

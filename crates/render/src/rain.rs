@@ -33,7 +33,15 @@
 //!   at the ray's time. Camera rays meet drops through a per-camera index ([`CameraRain`],
 //!   built at the start of each render): for every pixel, a copy of each drop whose sphere,
 //!   moving over the shutter relative to the moving camera, projects into it, so a camera ray
-//!   tests the few drops of its own pixel; no triangles are made. A path that hit a drop tests
+//!   tests the few drops of its own pixel; no triangles are made. Under an open shutter a
+//!   camera ray does not meet the drops at one time: the drops that cover it at some time of
+//!   the shutter ([`CameraRain::swept`], [`Drop::swept_interval`]: in the camera's frame the
+//!   ray stands still and a drop's centre moves at its velocity less the rig's, so its
+//!   distance from the ray is below the radius on one interval, a quadratic's roots) give the
+//!   share of the shutter the ray sees rain, and the integrator traces the background outside
+//!   those times and the drops inside them, each weighted by its share (Garg and Nayar 2007:
+//!   a streak is `tau/T` of the drop's radiance plus `1 - tau/T` of the background's), so a
+//!   drop is a continuous streak at any sample count ([`RainEstimator`]). A path that hit a drop tests
 //!   that drop again to find its way out ([`RainPath`]); no other ray meets drops: they cast
 //!   no shadow and are not seen in reflections (their extinction, 1e-3 to 3e-3 per metre, is
 //!   the fog's domain). A BVH over the drops' swept boxes, tested by every ray, was 5-7 times
@@ -312,7 +320,7 @@ impl Drop {
 }
 
 /// The most drops [`CameraRain::swept`] keeps for one camera ray (the nearest).
-pub const MAX_SWEPT: usize = 8;
+pub const MAX_SWEPT: usize = 16;
 
 /// The drops that cover one camera ray during the shutter, each with its interval
 /// ([`SweptHit`]): the [`MAX_SWEPT`] nearest, in no order. At a time in one or more
@@ -1054,6 +1062,121 @@ mod tests {
             }
         }
         assert!(partial > 100, "only {partial} partly covered cases");
+    }
+
+    #[test]
+    fn swept_set_times_follow_their_densities_chi_square() {
+        let motion = Motion::centred(0.02, Vec3::ZERO);
+        let mut set = SweptSet::default();
+        // Overlapping, nested and separate intervals, pushed out of order.
+        for (t0, t1, depth) in [
+            (0.002, 0.006, 3.0),
+            (-0.008, -0.004, 1.0),
+            (-0.005, 0.001, 2.0),
+            (-0.003, -0.002, 5.0),
+            (0.0085, 0.01, 4.0),
+        ] {
+            set.push(SweptHit {
+                drop: SweptSet::default().hits[0].drop,
+                t0,
+                t1,
+                depth,
+            });
+        }
+        let covered = 0.009 + 0.004 + 0.0015;
+        assert!((set.coverage(&motion) - covered / 0.02).abs() < 1e-5);
+        assert_eq!(set.covering(-0.0045), 2);
+        assert_eq!(set.covering(-0.0025), 2);
+        assert_eq!(set.covering(0.007), 0);
+        let total = set.total();
+        let free = 0.02 - covered;
+        let config = ChiSquareConfig {
+            cells: (80, 1),
+            num_tests: 2,
+            ..ChiSquareConfig::default()
+        };
+        let range = (motion.open as f64, motion.close as f64);
+        let inside = chi_square_2d(
+            "times over the drops' intervals",
+            &config,
+            range,
+            (0.0, 1.0),
+            |rng| {
+                Some((
+                    set.sample_time(rng.next_f32())? as f64,
+                    rng.next_f32() as f64,
+                ))
+            },
+            |t, _| set.covering(t as f32) as f64 / total as f64,
+        );
+        assert!(inside.passed, "{inside}");
+        assert!((inside.pdf_integral - 1.0).abs() < 2e-2, "{inside}");
+        let outside = chi_square_2d(
+            "times outside the drops' intervals",
+            &config,
+            range,
+            (0.0, 1.0),
+            |rng| {
+                let t = set.time_outside(rng.next_f32(), &motion);
+                assert_eq!(set.covering(t), 0, "time {t} is covered");
+                Some((t as f64, rng.next_f32() as f64))
+            },
+            |t, _| f64::from(u8::from(set.covering(t as f32) == 0)) / free as f64,
+        );
+        assert!(outside.passed, "{outside}");
+        assert!((outside.pdf_integral - 1.0).abs() < 2e-2, "{outside}");
+        // Keeping the nearest: a full set drops its farthest for a nearer drop.
+        let mut full = SweptSet::default();
+        for k in 0..MAX_SWEPT + 3 {
+            let mut h = set.hits()[0];
+            h.depth = (MAX_SWEPT + 3 - k) as f32;
+            full.push(h);
+        }
+        assert_eq!(full.left_out, 3);
+        assert!(full.hits().iter().all(|h| h.depth <= MAX_SWEPT as f32));
+    }
+
+    #[test]
+    fn swept_sets_of_a_street_view_rarely_fill_up() {
+        // The shipped street's camera (45 degree yfov, 16:9) at 320x180, rain to 20 m.
+        let camera = Camera::perspective("c", Affine3A::IDENTITY, 45f32.to_radians(), None);
+        let (w, h) = (320u32, 180u32);
+        for (rate, shutter) in [(1.0, 1.0 / 60.0), (25.0, 1.0 / 60.0), (25.0, 1.0 / 30.0)] {
+            let motion = Motion::centred(shutter, Vec3::ZERO);
+            let params = RainParams {
+                rate_mm_h: rate,
+                seed: 1,
+                radius: DEFAULT_RADIUS,
+            };
+            let view = RainView::of_camera(&camera, w, h, motion, RIG_MARGIN).unwrap();
+            let field = DropField::place(&params, &view).unwrap();
+            let index = CameraRain::build(&field, &camera, w, h, &motion).unwrap();
+            let (mut met, mut overlapped, mut full, mut covered) = (0, 0, 0, 0.0f64);
+            let rays = w * h;
+            for y in 0..h {
+                for x in 0..w {
+                    let film = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+                    let ray = camera.generate_ray(film, w, h);
+                    let set = index.swept(ray.origin, ray.direction);
+                    met += u32::from(!set.is_empty());
+                    let f = set.coverage(&motion);
+                    covered += f as f64;
+                    overlapped += u32::from(set.total() / shutter > f + 1e-6);
+                    full += u32::from(set.left_out > 0);
+                }
+            }
+            let share = |n: u32| n as f64 / rays as f64;
+            eprintln!(
+                "{rate} mm/h, 1/{:.0} s: {:.1} % of camera rays meet a swept drop, {:.2} % two \
+                 at once, {:.4} % more than {MAX_SWEPT}; mean coverage {:.4}",
+                1.0 / shutter,
+                100.0 * share(met),
+                100.0 * share(overlapped),
+                100.0 * share(full),
+                covered / rays as f64
+            );
+            assert!(share(full) < 1e-3, "{rate} mm/h: {full} rays fill the set");
+        }
     }
 
     #[test]
