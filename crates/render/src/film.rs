@@ -45,8 +45,9 @@ pub struct Pixel {
     /// Index into the scene's materials of the pixel-centre ray's first hit ([`NO_MATERIAL`]
     /// on a miss).
     pub material: u32,
-    /// Number of camera samples (kept or dropped) whose first hit was a rain drop.
-    pub rain: u32,
+    /// Sum over the camera samples (kept or dropped) of the share of the shutter during which
+    /// the sample's ray met a rain drop first (1 or 0 for a sample taken at one time).
+    pub rain: f32,
     /// Luminance of the fog's transmittance from the camera to the pixel-centre ray's first
     /// hit (to the sky on a miss; 1 without fog).
     pub fog: f32,
@@ -68,7 +69,7 @@ impl Default for Pixel {
             normal: Vec3::ZERO,
             albedo: Vec3::ZERO,
             material: NO_MATERIAL,
-            rain: 0,
+            rain: 0.0,
             fog: 1.0,
         }
     }
@@ -214,12 +215,13 @@ impl Film {
         self.pixels.iter().map(Pixel::taken).collect()
     }
 
-    /// The rain layer: the share of each pixel's samples (kept and dropped) whose first hit
-    /// was a rain drop, row-major (0 for a pixel without samples).
+    /// The rain layer: the mean over each pixel's samples (kept and dropped) of the share of
+    /// the shutter during which the first hit was a rain drop, row-major (0 for a pixel
+    /// without samples).
     pub fn rain(&self) -> Vec<f32> {
         self.pixels
             .iter()
-            .map(|p| p.rain as f32 / p.taken().max(1) as f32)
+            .map(|p| p.rain / p.taken().max(1) as f32)
             .collect()
     }
 

@@ -163,8 +163,9 @@
 //!   threshold on it.
 //! - `spp`: the number of samples the pixel took (kept and dropped), `spp` everywhere unless
 //!   adaptive sampling stopped its tile earlier.
-//! - `rain`: the share of the pixel's camera samples (kept and dropped) whose first hit was a
-//!   rain drop ([`crate::rain`]).
+//! - `rain`: the mean over the pixel's camera samples (kept and dropped) of the share of the
+//!   shutter during which a rain drop was the ray's first hit (with a closed shutter, the
+//!   share of samples whose first hit was a drop) ([`crate::rain`]).
 //! - `fog`: the luminance of the fog's transmittance from the camera to the pixel-centre ray's
 //!   first hit (to infinity on a miss; 1 without fog). With fog, the `specular` layer's light
 //!   carries the fog's pass weights of its two segments, and light scattered by the fog is not
@@ -184,7 +185,16 @@
 //! Rain ([`crate::rain`]): the camera ray meets the drops of its camera's index
 //! ([`crate::rain::CameraRain`], built at the start of the render), and a path that hit a drop
 //! its way out of it ([`Scene::intersect_path`]); a drop hit is shaded as any smooth
-//! dielectric surface. Other rays, shadow rays included, do not meet drops.
+//! dielectric surface. Other rays, shadow rays included, do not meet drops. Under an open
+//! shutter (and [`crate::rain::RainEstimator::Swept`], the default) a camera sample first
+//! finds the drops that cover its ray at some time of the shutter in front of the scene
+//! ([`crate::rain::CameraRain::swept`]); with none it traces as a dry render does, drawing
+//! nothing more. Otherwise it traces two paths from its one time variate `u`: the background
+//! (no drop) at the `u`-quantile of the times no drop covers the ray, weighted by their share
+//! `1 - c` of the shutter, and the drops at the `u`-quantile of their intervals laid end to
+//! end, traced with every drop at that time (the nearest covering one is the first hit) and
+//! weighted by the intervals' summed length over the shutter divided by how many intervals
+//! hold that time. Both are unbiased parts of the time integral; the rain layer gets `c`.
 
 use crate::bsdf::Bsdf;
 use crate::camera::Camera;
@@ -555,10 +565,76 @@ fn take_sample(
         ray.time = job.motion.time(sampler.next_1d());
         ray.origin += job.motion.rig_velocity * ray.time;
     }
-    let path = trace_path(scene, ray, sampler, job, rain);
-    pixel.add_sample(path.radiance, path.specular);
-    pixel.rain += u32::from(path.rain);
-    path.rays
+    let swept_estimator = scene
+        .rain
+        .as_ref()
+        .is_some_and(|r| r.estimator == crate::rain::RainEstimator::Swept);
+    let swept = match rain {
+        Some(rain) if swept_estimator && job.motion.is_blurred() => {
+            Some(swept_drops(scene, rain, &ray, job))
+        }
+        _ => None,
+    };
+    let Some(swept) = swept else {
+        let path = trace_path(scene, ray, sampler, job, RainPath::camera(rain));
+        pixel.add_sample(path.radiance, path.specular);
+        pixel.rain += f32::from(u8::from(path.rain));
+        return path.rays;
+    };
+    if swept.is_empty() {
+        let path = trace_path(scene, ray, sampler, job, RainPath::camera(None));
+        pixel.add_sample(path.radiance, path.specular);
+        return path.rays;
+    }
+    // The time integral split on whether a drop covers the ray: the background (no drop) at
+    // a time outside every drop's interval, weighted by that share of the shutter, and the
+    // drops at a time over their intervals (counted with overlaps, so weighted by
+    // their summed length over the number of intervals holding the time), traced with
+    // every drop at that time (its first hit is the nearest drop there).
+    let motion = &job.motion;
+    let shutter = motion.close - motion.open;
+    let u = ((ray.time - motion.open) / shutter).clamp(0.0, 1.0 - f32::EPSILON);
+    let covered = swept.coverage(motion);
+    let origin = ray.origin - motion.rig_velocity * ray.time;
+    let mut background_ray = ray;
+    background_ray.time = swept.time_outside(u, motion);
+    background_ray.origin = origin + motion.rig_velocity * background_ray.time;
+    let background = trace_path(scene, background_ray, sampler, job, RainPath::camera(None));
+    let mut drop_ray = ray;
+    // The same variate as the background's time: stratified over the pixel's samples (the
+    // two paths' expectations add up, so their correlation biases nothing).
+    drop_ray.time = swept.sample_time(u).unwrap_or(ray.time);
+    drop_ray.origin = origin + motion.rig_velocity * drop_ray.time;
+    let drop = trace_path(scene, drop_ray, sampler, job, RainPath::camera(rain));
+    let w = swept.total() / shutter / swept.covering(drop_ray.time).max(1) as f32;
+    pixel.add_sample(
+        background.radiance * (1.0 - covered) + drop.radiance * w,
+        background.specular * (1.0 - covered) + drop.specular * w,
+    );
+    pixel.rain += covered;
+    background.rays + drop.rays
+}
+
+/// The drops that cover the camera ray `ray` (at its sample's time) during the shutter in
+/// front of the scene ([`CameraRain::swept`]; the scene's surface found where the camera
+/// stands in the middle of the shutter).
+#[inline]
+fn swept_drops(
+    scene: &Scene,
+    rain: &CameraRain,
+    ray: &Ray,
+    job: &RenderJob,
+) -> crate::rain::SweptSet {
+    let origin = ray.origin - job.motion.rig_velocity * ray.time;
+    let mut set = rain.swept(origin, ray.direction);
+    if !set.is_empty() {
+        let mid = 0.5 * (job.motion.open + job.motion.close);
+        let probe = Ray::new(origin + job.motion.rig_velocity * mid, ray.direction);
+        if let Some(surface) = scene.intersect(&probe) {
+            set.retain_nearer(surface.t);
+        }
+    }
+    set
 }
 
 /// Fills the depth, normal, albedo, material and fog transmittance of `pixel` from the
@@ -633,7 +709,7 @@ fn trace_path(
     mut ray: Ray,
     sampler: &mut Sampler,
     job: &RenderJob,
-    rain: Option<&CameraRain>,
+    mut rain_path: RainPath,
 ) -> PathResult {
     let (max_depth, want_specular) = (job.settings.max_depth, job.layers.specular);
     let lights: &LightSampler = &scene.light_sampler;
@@ -653,8 +729,6 @@ fn trace_path(
     let mut first_bsdf: Option<(Bsdf, Frame, Vec3)> = None;
     // The smallest density of the directions chosen so far (path regularisation).
     let mut min_ray_pdf = f32::INFINITY;
-    // Which rain drops the next ray can meet.
-    let mut rain_path = RainPath::camera(rain);
     // The fog, the colour channel its free flights are sampled in (one per path, as in
     // Mitsuba's volpath; drawn only when there is fog) and the product of its pass weights.
     let fog = scene.fog.as_ref();

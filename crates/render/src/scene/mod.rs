@@ -594,6 +594,7 @@ impl Scene {
             params,
             material,
             field: DropField::default(),
+            estimator: crate::rain::RainEstimator::default(),
         });
     }
 
