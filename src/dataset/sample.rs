@@ -2,6 +2,7 @@
 //! publish it with one rename.
 
 use anyhow::{Context, Result};
+use glam::Vec3;
 use std::path::Path;
 use std::time::Instant;
 use streaks_dataset::files::{SampleDir, SCENE_GLTF};
@@ -13,7 +14,6 @@ use streaks_dataset::meta::{
 use streaks_dataset::settings::Settings;
 use streaks_dataset::write::{disparity_range, write_calib, write_views, GroundTruth};
 use streaks_image::write_bytes_atomically;
-use glam::Vec3;
 use streaks_render::motion::Motion;
 use streaks_render::scene::Scene;
 use streaks_scenes::procedural::{sample, GeneratorConfig, GENERATOR_VERSION};
@@ -127,7 +127,10 @@ fn write_sample(
     let render = &settings.settings;
     // The camera's shutter (the drawn exposure time) and the rig's motion over it.
     let motion = s.weather.as_ref().map_or(Motion::default(), |w| {
-        Motion::centred(w.exposure_s as f32, Vec3::from(w.rig_velocity.map(|v| v as f32)))
+        Motion::centred(
+            w.exposure_s as f32,
+            Vec3::from(w.rig_velocity.map(|v| v as f32)),
+        )
     });
     scene
         .place_rain(&camera, render.width, render.height, motion)
