@@ -36,7 +36,7 @@ enum Command {
     /// Verify a dataset folder against its manifest.jsonl (or, the first time or with
     /// --rebuild, write manifest.jsonl and splits/ from what is on disk).
     Index(index::Args),
-    /// Write a sample's left image beside its ground-truth disparity (and rain mask) as one
+    /// Write a sample's left image beside its ground-truth disparity (and rain or fog mask) as one
     /// PNG.
     Preview(preview::Args),
 }

@@ -1,7 +1,9 @@
 //! `streaks dataset preview SAMPLE -o PNG`: one picture of a sample for a person to look at:
 //! the left image as the sample's camera saw it (`im0.png`) beside its ground-truth disparity
 //! (`disp0.pfm`, turbo colours from 0 px to the sample's largest disparity, no value black)
-//! and, when it rains, the rain mask (`rain0.png`) under them.
+//! and, when the sample has them, its rain mask (`rain0.png`, stretched so that its brightest
+//! pixel is white: most drops cover a pixel for a small share of the shutter) or else its fog
+//! transmittance (`fog0.pfm`, white = clear, black = hidden) as a third panel.
 
 use anyhow::{bail, Context, Result};
 use image::{imageops, Rgb, RgbImage};
@@ -13,7 +15,8 @@ use streaks_image::pfm::read_pfm;
 use streaks_image::png::write_png_buffer;
 use streaks_stereo::rig::Eye;
 
-/// Write a sample's left image beside its ground-truth disparity (and rain mask) as one PNG.
+/// Write a sample's left image beside its ground-truth disparity (and its rain mask or fog
+/// transmittance) as one PNG.
 #[derive(clap::Args, Debug)]
 pub struct Args {
     /// The sample folder (`DIR/samples/NNNNNN`).
@@ -52,21 +55,46 @@ pub fn run(args: Args) -> Result<()> {
         .fold(0.0f32, f32::max);
     let colours = disparity_preview(&disp, Some((0.0, largest.max(1.0))));
     let rain_path = files.rain_mask(Eye::Left);
-    let rain = if rain_path.is_file() {
+    let fog_path = files.fog(Eye::Left);
+    let third = if rain_path.is_file() {
         let mask = load_image(&rain_path)
             .with_context(|| format!("cannot read the rain mask {}", rain_path.display()))?
-            .to_rgb8();
-        Some(mask)
+            .to_luma8();
+        let top = mask.pixels().map(|p| p.0[0]).max().unwrap_or(0).max(1);
+        Some(RgbImage::from_fn(mask.width(), mask.height(), |x, y| {
+            let v = (u32::from(mask.get_pixel(x, y).0[0]) * 255 / u32::from(top)) as u8;
+            Rgb([v, v, v])
+        }))
+    } else if fog_path.is_file() {
+        let fog = read_pfm(&fog_path)
+            .with_context(|| format!("cannot read the fog {}", fog_path.display()))?;
+        Some(RgbImage::from_fn(
+            fog.width as u32,
+            fog.height as u32,
+            |x, y| {
+                let t = fog.data[y as usize * fog.width + x as usize];
+                let v = (t.clamp(0.0, 1.0) * 255.0).round() as u8;
+                Rgb([v, v, v])
+            },
+        ))
     } else {
         None
     };
     let (w, h) = left.dimensions();
-    let rows = if rain.is_some() { 2 } else { 1 };
-    let mut out = RgbImage::from_pixel(2 * w, rows * h, Rgb([0, 0, 0]));
+    if let Some(panel) = &third {
+        if panel.dimensions() != (w, h) {
+            bail!(
+                "the rain or fog mask of {} is not {w}x{h}",
+                args.sample.display()
+            );
+        }
+    }
+    let panels = if third.is_some() { 3 } else { 2 };
+    let mut out = RgbImage::from_pixel(panels * w, h, Rgb([0, 0, 0]));
     imageops::replace(&mut out, &left, 0, 0);
     imageops::replace(&mut out, &colours, i64::from(w), 0);
-    if let Some(mask) = &rain {
-        imageops::replace(&mut out, mask, 0, i64::from(h));
+    if let Some(panel) = &third {
+        imageops::replace(&mut out, panel, 2 * i64::from(w), 0);
     }
     if let Some(parent) = args.output.parent().filter(|p| !p.as_os_str().is_empty()) {
         std::fs::create_dir_all(parent)

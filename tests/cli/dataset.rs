@@ -863,3 +863,50 @@ fn adaptive_datasets_record_their_target_and_are_deterministic() {
     generate_n(&t, "x", "1", &["--noise-target", "low"]).assert_failure_mentioning("off");
     assert!(!t.join("x").exists());
 }
+
+/// A sample in heavy rain and fog has its per-eye rain masks and fog transmittance, the
+/// sensor's raw layer, a weather record, and passes `index`; `dataset preview` draws it as
+/// three panels (image, disparity, rain mask), a missing sample is an error naming the file.
+#[test]
+fn weather_samples_have_rain_and_fog_masks_and_a_preview() {
+    let t = TestDir::new();
+    std::fs::write(
+        t.join("wet.toml"),
+        "[weather]\nrain = [{ name = \"heavy\", probability = 1.0, mm_h = [40.0, 40.0] }]\n\
+         sensor = { automotive_linear = 1.0 }\n\
+         [weather.fog]\nprobability = 1.0\nsigma_t = [0.02, 0.02]\n",
+    )
+    .unwrap();
+    generate_n(&t, "ds", "1", &["--config", "wet.toml"]).assert_success();
+    let sample = t.join("ds/samples/000000");
+    for f in ["rain0.png", "rain1.png", "fog0.pfm", "fog1.pfm"] {
+        assert!(sample.join(f).is_file(), "{f}");
+    }
+    let fog = read_pfm(&sample.join("fog0.pfm")).unwrap();
+    assert!(fog.data.iter().all(|&v| (0.0..=1.0).contains(&v)));
+    assert!(fog.data.iter().any(|&v| v < 1.0));
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(sample.join("meta.json")).unwrap()).unwrap();
+    assert_eq!(meta["weather"]["rain_mm_h"], 40.0);
+    assert_eq!(meta["weather"]["sensor"], "automotive_linear");
+    assert!(streaks_render::output::read_exr_layer(&sample.join("im0.exr"), "sensor").is_ok());
+    t.streaks(&["dataset", "index", "ds"]).assert_success();
+    // A missing rain mask is found.
+    std::fs::remove_file(sample.join("rain1.png")).unwrap();
+    t.streaks(&["dataset", "index", "ds", "--rebuild"])
+        .assert_failure_mentioning("rain1.png");
+
+    t.streaks(&[
+        "dataset",
+        "preview",
+        "ds/samples/000000",
+        "-o",
+        "p/preview.png",
+    ])
+    .assert_success();
+    let preview = image::open(t.join("p/preview.png")).unwrap();
+    assert_eq!((preview.width(), preview.height()), (3 * 64, 40));
+    t.streaks(&["dataset", "preview", "ds/samples/000009", "-o", "q.png"])
+        .assert_failure_mentioning("im0.png");
+    assert!(!t.join("q.png").exists());
+}

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The README's weather gallery: one generated street (dataset seed $SEED, sample 0) dry, in
 # drizzle, in heavy rain and in fog, each as its camera (the automotive_hdr sensor, 1/50 s, the
-# rig at 29 km/h) sees it, beside its ground-truth disparity; the rainy ones with their rain
-# mask under them. The weather is drawn in its own random streams, so the four configs give the
+# rig at 29 km/h) sees it, beside its ground-truth disparity and (rain) its rain mask or (fog)
+# its transmittance. The weather is drawn in its own random streams, so the four configs give the
 # same street. Writes docs/images/weather_{dry,drizzle,heavy,fog}.png.
 #
 #   bash tools/gallery/weather.sh            # uses `streaks` from PATH, or STREAKS=path

@@ -605,8 +605,16 @@ fn take_sample(
     // two paths' expectations add up, so their correlation biases nothing).
     drop_ray.time = swept.sample_time(u).unwrap_or(ray.time);
     drop_ray.origin = origin + motion.rig_velocity * drop_ray.time;
-    let drop = trace_path(scene, drop_ray, sampler, job, RainPath::camera(rain));
-    let w = swept.total() / shutter / swept.covering(drop_ray.time).max(1) as f32;
+    // Russian roulette on the drops' path: traced with probability
+    // `q = min(1, RAIN_ROULETTE * covered)` and divided by it (unbiased), so that the many rays
+    // a far, thin drop grazes for a sliver of the shutter do not each pay a second path.
+    let q = (RAIN_ROULETTE * covered).min(1.0);
+    let drop = if sampler.next_1d() < q {
+        trace_path(scene, drop_ray, sampler, job, RainPath::camera(rain))
+    } else {
+        PathResult::default()
+    };
+    let w = swept.total() / shutter / swept.covering(drop_ray.time).max(1) as f32 / q.max(1e-30);
     pixel.add_sample(
         background.radiance * (1.0 - covered) + drop.radiance * w,
         background.specular * (1.0 - covered) + drop.specular * w,
@@ -614,6 +622,13 @@ fn take_sample(
     pixel.rain += covered;
     background.rays + drop.rays
 }
+
+/// Rain: the factor on a camera ray's covered share of the shutter that gives the probability
+/// of tracing its drops' path (Russian roulette; see `take_sample`). 4 traces every ray a drop
+/// covers for a quarter of the shutter or more (a near drop) and one in four of those covered
+/// for 1/16 (a far, thin drop); the cost it saves is measured in docs/benchmarks.md
+/// ("Weather").
+const RAIN_ROULETTE: f32 = 4.0;
 
 /// The drops that cover the camera ray `ray` (at its sample's time) during the shutter in
 /// front of the scene ([`CameraRain::swept`]; the scene's surface found where the camera
