@@ -909,6 +909,19 @@ fn trace_path(
         };
         if let Some(ls) = lights.sample_li(&scene.materials, &scene.textures, &rx, u_light, u_point)
         {
+            if ls.delta && hit.triangle == crate::rain::RAIN_TRIANGLE {
+                // A drop glints in a delta light, which its smooth surface cannot show.
+                out.rays += 1;
+                let origin = crate::rain::offset_from_drop(hit.p, ng, ls.wi);
+                let li = visible_li(scene, lights, origin, hit.p, &ls);
+                let li = match (medium, fog) {
+                    (Some(v), _) if ls.dist.is_finite() => li * v.transmittance(ls.dist),
+                    (None, Some(fog)) => li * fog.transmittance(hit.p, ls.wi, ls.dist),
+                    _ => li,
+                };
+                let phase = crate::rain::glint_phase(-ls.wi.dot(wo));
+                out.radiance += throughput * li * (phase / ls.pdf);
+            }
             let wi_local = frame.to_local(ls.wi);
             if wi_local.z * ng.dot(ls.wi) > 0.0 {
                 // The BSDF's density of wi matters only for MIS against an area light.

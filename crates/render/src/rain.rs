@@ -930,6 +930,75 @@ pub fn offset_from_drop(p: Vec3, n: Vec3, w: Vec3) -> Vec3 {
     p + eps * side
 }
 
+/// The unpolarised Fresnel reflectance of water seen from air (index [`WATER_IOR`]) at an
+/// angle of incidence of cosine `cos_i`: the exact mean of the s and p reflectances, 1 at
+/// grazing. (The drops' BSDF uses Schlick's approximation; the glint's phase function below
+/// takes the exact value, which its energy tests check against.)
+#[inline]
+fn water_fresnel(cos_i: f64) -> f64 {
+    let n = f64::from(WATER_IOR);
+    let cos_i = cos_i.clamp(0.0, 1.0);
+    let sin_t = (1.0 - cos_i * cos_i).max(0.0).sqrt() / n;
+    let cos_t = (1.0 - sin_t * sin_t).max(0.0).sqrt();
+    let rs = (cos_i - n * cos_t) / (cos_i + n * cos_t);
+    let rp = (n * cos_i - cos_t) / (n * cos_i + cos_t);
+    0.5 * (rs * rs + rp * rp)
+}
+
+/// The deflection `2 (i - r)` of a ray entering a water sphere at incidence angle `i` and
+/// leaving it after one refraction in and one out (`sin i = n sin r`), with its derivative in `i`.
+#[inline]
+fn refraction_deflection(i: f64) -> (f64, f64) {
+    let n = f64::from(WATER_IOR);
+    let r = (i.sin() / n).asin();
+    (2.0 * (i - r), 2.0 - 2.0 * i.cos() / (n * r.cos()))
+}
+
+/// A sub-pixel water drop's *pixel-averaged* scattering of a collimated beam, per steradian:
+/// lit with irradiance `E` at normal incidence, the drop's radiance averaged over its
+/// projected disc toward a viewer at scattering angle `theta` (`cos_theta` = the light's
+/// propagation direction dotted with the direction to the viewer) is `E * glint_phase(cos_theta)`.
+///
+/// Geometric optics of a sphere (van de Hulst, "Light scattering by small particles", 1957,
+/// ch. 12): the intensity of the ray class `p` is `E a^2 |sin i cos i / (sin theta dtheta/di)|`
+/// times its Fresnel factor, and dividing by the disc area `pi a^2` gives the average radiance.
+/// Two classes: `p = 0`, external reflection (`i = (pi - theta) / 2`, `F(i) / (4 pi)`), and
+/// `p = 1`, refraction in and out (`theta = 2 (i - r)`, factor `(1 - F(i))^2`, zero beyond
+/// the grazing deflection of about 82.5 degrees). Unpolarised, no absorption, no higher
+/// classes (`p = 2` makes the rainbow) and no diffraction. Integrated over the sphere it gives
+/// the disc averages of `F` and `(1 - F)^2` (tested). A path that hits a drop adds this for
+/// delta lights, which its refracted continuation cannot reach: as the hit point is uniform
+/// over the drop's disc in the pixel, its expectation is the pixel average.
+pub fn glint_phase(cos_theta: f32) -> f32 {
+    use std::f64::consts::{FRAC_PI_2, PI};
+    let c = f64::from(cos_theta).clamp(-1.0, 1.0);
+    // p = 0: cos i = cos((pi - theta) / 2) = sin(theta / 2).
+    let p0 = water_fresnel(((1.0 - c) * 0.5).sqrt()) / (4.0 * PI);
+    let theta = c.acos();
+    let (theta_max, _) = refraction_deflection(FRAC_PI_2);
+    let p1 = if theta >= theta_max {
+        0.0
+    } else if theta < 1e-6 {
+        // The limit sin i / sin theta -> 1 / (dtheta/di at 0) = 1 / (2 (1 - 1/n)).
+        let t = 1.0 - water_fresnel(1.0);
+        let k = 1.0 - 1.0 / f64::from(WATER_IOR);
+        t * t / (4.0 * PI * k * k)
+    } else {
+        // theta(i) is increasing and convex with slope 2 (1 - 1/n) at 0, so the chord start
+        // lies right of the root and Newton's steps fall monotonically onto it.
+        let k = 1.0 - 1.0 / f64::from(WATER_IOR);
+        let mut i = (theta / (2.0 * k)).min(FRAC_PI_2);
+        for _ in 0..8 {
+            let (t, dt) = refraction_deflection(i);
+            i = (i - (t - theta) / dt).clamp(0.0, FRAC_PI_2);
+        }
+        let (_, dt) = refraction_deflection(i);
+        let t = 1.0 - water_fresnel(i.cos());
+        t * t * i.sin() * i.cos() / (PI * theta.sin() * dt.abs())
+    };
+    (p0 + p1) as f32
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
