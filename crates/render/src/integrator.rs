@@ -909,8 +909,9 @@ fn trace_path(
         };
         if let Some(ls) = lights.sample_li(&scene.materials, &scene.textures, &rx, u_light, u_point)
         {
-            if ls.delta && hit.triangle == crate::rain::RAIN_TRIANGLE {
-                // A drop glints in a delta light, which its smooth surface cannot show.
+            if ls.delta && front && hit.triangle == crate::rain::RAIN_TRIANGLE {
+                // A drop glints in a delta light, which its smooth surface cannot show (once,
+                // where a path meets it from outside: the phase holds the light through it).
                 out.rays += 1;
                 let origin = crate::rain::offset_from_drop(hit.p, ng, ls.wi);
                 let li = visible_li(scene, lights, origin, hit.p, &ls);

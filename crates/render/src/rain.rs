@@ -1003,6 +1003,7 @@ pub fn glint_phase(cos_theta: f32) -> f32 {
 mod tests {
     use super::*;
     use crate::testing::{chi_square_2d, ChiSquareConfig};
+    use std::f64::consts::PI as PI64;
 
     #[test]
     fn marshall_palmer_number_density_matches_the_closed_form_and_the_survey_figures() {
@@ -1442,6 +1443,69 @@ mod tests {
         assert!(path.intersect(&out, f32::INFINITY).is_none());
         assert!(path.intersect(&ray, f32::INFINITY).is_none());
     }
+
+    /// The disc average `int_0^{pi/2} g(i) 2 sin i cos i di` of `g` of the incidence angle.
+    fn disc_average(g: impl Fn(f64) -> f64) -> f64 {
+        let steps = 200_000;
+        let di = std::f64::consts::FRAC_PI_2 / steps as f64;
+        (0..steps)
+            .map(|k| {
+                let i = (k as f64 + 0.5) * di;
+                g(i) * 2.0 * i.sin() * i.cos() * di
+            })
+            .sum()
+    }
+
+    /// `int f(cos theta) d omega` over the sphere of directions (midpoint rule in theta).
+    fn sphere_integral(f: impl Fn(f32) -> f64) -> f64 {
+        let steps = 400_000;
+        let dt = std::f64::consts::PI / steps as f64;
+        (0..steps)
+            .map(|k| {
+                let t = (k as f64 + 0.5) * dt;
+                f(t.cos() as f32) * 2.0 * std::f64::consts::PI * t.sin() * dt
+            })
+            .sum()
+    }
+
+    #[test]
+    fn the_glints_phase_scatters_the_fresnel_shares_of_the_disc() {
+        // p = 0 alone (i = (pi - theta) / 2) and the rest, p = 1.
+        let p0 = |c: f32| water_fresnel(((1.0 - f64::from(c)) * 0.5).sqrt()) / (4.0 * PI64);
+        let got0 = sphere_integral(p0);
+        let got1 = sphere_integral(|c| f64::from(glint_phase(c)) - p0(c));
+        let want0 = disc_average(|i| water_fresnel(i.cos()));
+        let want1 = disc_average(|i| (1.0 - water_fresnel(i.cos())).powi(2));
+        assert!((got0 - want0).abs() < 1e-4 * want0, "p = 0: {got0} vs {want0}");
+        assert!((got1 - want1).abs() < 1e-3 * want1, "p = 1: {got1} vs {want1}");
+        // Nearly all the light: what is left is the internal reflections (p >= 2).
+        assert!(got0 + got1 > 0.9 && got0 + got1 < 1.0, "{}", got0 + got1);
+    }
+
+    #[test]
+    fn the_glints_phase_has_its_analytic_limits() {
+        let n = f64::from(WATER_IOR);
+        let f0 = ((n - 1.0) / (n + 1.0)).powi(2);
+        assert!((water_fresnel(1.0) - f0).abs() < 1e-12);
+        assert!((water_fresnel(0.0) - 1.0).abs() < 1e-12);
+        // Backscatter: only the external reflection at normal incidence.
+        let back = f64::from(glint_phase(-1.0));
+        assert!((back - f0 / (4.0 * PI64)).abs() < 1e-6 * back, "{back}");
+        // Forward: the refracted limit, continuous with the angles next to it.
+        let k = 1.0 - 1.0 / n;
+        let fwd = (1.0 - f0).powi(2) / (4.0 * PI64 * k * k) + 1.0 / (4.0 * PI64);
+        let got = f64::from(glint_phase(1.0));
+        assert!((got - fwd).abs() < 1e-5 * fwd, "{got} vs {fwd}");
+        let near = f64::from(glint_phase(1e-3f32.cos()));
+        assert!((near - got).abs() < 1e-2 * got, "{near} vs {got}");
+        // Beyond the grazing deflection only p = 0 is left; just before it p = 1 is not.
+        let (theta_max, _) = refraction_deflection(std::f64::consts::FRAC_PI_2);
+        assert!((theta_max.to_degrees() - 82.46).abs() < 0.05, "{theta_max}");
+        let past = (theta_max + 1e-3).cos() as f32;
+        let c = ((1.0 - f64::from(past)) * 0.5).sqrt();
+        assert!((f64::from(glint_phase(past)) - water_fresnel(c) / (4.0 * PI64)).abs() < 1e-7);
+        assert!(glint_phase((theta_max - 1e-2).cos() as f32) > glint_phase(past));
+    }
 }
 
 #[cfg(test)]
@@ -1746,5 +1810,59 @@ mod render_tests {
             seen += usize::from(l.1 == *d && r.1 == *d);
         }
         assert!(seen > 200, "{seen} drops checked");
+    }
+
+    #[test]
+    fn a_drop_in_one_pixel_glints_with_its_analytic_average_radiance() {
+        // One drop of radius 1 cm 2 m in front of the camera, alone in a 1 x 1 image, lit by
+        // a point light behind it (scattering angle about 18 degrees: p = 0 and p = 1).
+        let (a, d) = (0.01f32, 2.0f32);
+        let light = Vec3::new(0.0, 1.0, -5.0);
+        let intensity = 100.0f32;
+        let mut scene = Scene::from_parts(SceneParts {
+            lights: vec![crate::light::Light::Point {
+                position: light,
+                intensity: Vec3::splat(intensity),
+                range: None,
+            }],
+            ..Default::default()
+        })
+        .unwrap();
+        scene.set_rain(RainParams {
+            rate_mm_h: 1.0,
+            seed: 0,
+            radius: 4.0,
+        });
+        let centre = Vec3::new(0.0, 0.0, -d);
+        scene.rain.as_mut().unwrap().field.drops = vec![Drop {
+            centre,
+            radius: a,
+            speed: 0.0,
+        }];
+        let yfov = 0.05f32;
+        let camera = Camera::perspective("c", Affine3A::IDENTITY, yfov, None);
+        let job = RenderJob {
+            width: 1,
+            height: 1,
+            seed: 3,
+            layers: Layers::default(),
+            settings: RenderSettings::new(1 << 18, 4),
+            motion: Motion::default(),
+        };
+        let out = render(&scene, &camera, &job, &|_| {});
+        let got = f64::from(out.image.get(0, 0).x);
+        // The drop's share of the pixel (on the film plane) times E P(theta).
+        let tan_alpha = (a / d).asin().tan() as f64;
+        let half = (0.5 * yfov).tan() as f64;
+        let share = std::f64::consts::PI * tan_alpha * tan_alpha / (4.0 * half * half);
+        let to_light = light - centre;
+        let e = f64::from(intensity / to_light.length_squared());
+        let cos_theta = -to_light.normalize().dot(Vec3::Z);
+        let want = share * e * f64::from(glint_phase(cos_theta));
+        assert!(want > 0.0 && (got - want).abs() < 0.03 * want, "{got} vs {want}");
+        // Without the drop: black.
+        scene.rain.as_mut().unwrap().field.drops.clear();
+        let out = render(&scene, &camera, &job, &|_| {});
+        assert_eq!(out.image.get(0, 0), Vec3::ZERO);
     }
 }
