@@ -185,7 +185,9 @@
 //! Rain ([`crate::rain`]): the camera ray meets the drops of its camera's index
 //! ([`crate::rain::CameraRain`], built at the start of the render), and a path that hit a drop
 //! its way out of it ([`Scene::intersect_path`]); a drop hit is shaded as any smooth
-//! dielectric surface. Other rays, shadow rays included, do not meet drops. Under an open
+//! dielectric surface, and where a path meets a drop from outside its next-event estimation
+//! of a delta light (a shadow ray, the fog's transmittance) goes through the drop's
+//! pixel-averaged scattering ([`crate::rain::glint_phase`]) instead. Other rays, shadow rays included, do not meet drops. Under an open
 //! shutter (and [`crate::rain::RainEstimator::Swept`], the default) a camera sample first
 //! finds the drops that cover its ray at some time of the shutter in front of the scene
 //! ([`crate::rain::CameraRain::swept`]); with none it traces as a dry render does, drawing
@@ -202,9 +204,9 @@ use crate::film::{Film, Pixel};
 use crate::geometry::{offset_ray_origin, Frame, Ray};
 use crate::light::{Light, LightSample, LightSampler, Receiver, Visibility};
 use crate::material::Volume;
+use crate::medium::Fog;
 use crate::motion::Motion;
 use crate::rain::{CameraRain, RainPath};
-use crate::medium::Fog;
 use crate::sampling::{power_heuristic, Sampler};
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};

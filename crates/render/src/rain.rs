@@ -46,6 +46,12 @@
 //!   no shadow and are not seen in reflections (their extinction, 1e-3 to 3e-3 per metre, is
 //!   the fog's domain). A BVH over the drops' swept boxes, tested by every ray, was 5-7 times
 //!   slower than a dry render (docs/decisions/0034-rain-drops-seen-by-camera-rays.md).
+//! - Glints: a smooth drop cannot show a point, spot or directional light by its reflection or
+//!   refraction (a delta path never reaches a delta light), so where a path meets a drop from
+//!   outside, the integrator adds next-event estimation of delta lights through the drop's
+//!   pixel-averaged scattering, [`glint_phase`]: the geometric-optics intensity of a water
+//!   sphere (external reflection and one refraction through it, van de Hulst 1957, ch. 12)
+//!   over its disc (docs/decisions/0037-rain-drops-glint-in-delta-lights.md).
 
 use crate::camera::{Camera, Projection};
 use crate::geometry::Ray;
@@ -1476,8 +1482,14 @@ mod tests {
         let got1 = sphere_integral(|c| f64::from(glint_phase(c)) - p0(c));
         let want0 = disc_average(|i| water_fresnel(i.cos()));
         let want1 = disc_average(|i| (1.0 - water_fresnel(i.cos())).powi(2));
-        assert!((got0 - want0).abs() < 1e-4 * want0, "p = 0: {got0} vs {want0}");
-        assert!((got1 - want1).abs() < 1e-3 * want1, "p = 1: {got1} vs {want1}");
+        assert!(
+            (got0 - want0).abs() < 1e-4 * want0,
+            "p = 0: {got0} vs {want0}"
+        );
+        assert!(
+            (got1 - want1).abs() < 1e-3 * want1,
+            "p = 1: {got1} vs {want1}"
+        );
         // Nearly all the light: what is left is the internal reflections (p >= 2).
         assert!(got0 + got1 > 0.9 && got0 + got1 < 1.0, "{}", got0 + got1);
     }
@@ -1859,7 +1871,10 @@ mod render_tests {
         let e = f64::from(intensity / to_light.length_squared());
         let cos_theta = -to_light.normalize().dot(Vec3::Z);
         let want = share * e * f64::from(glint_phase(cos_theta));
-        assert!(want > 0.0 && (got - want).abs() < 0.03 * want, "{got} vs {want}");
+        assert!(
+            want > 0.0 && (got - want).abs() < 0.03 * want,
+            "{got} vs {want}"
+        );
         // Without the drop: black.
         scene.rain.as_mut().unwrap().field.drops.clear();
         let out = render(&scene, &camera, &job, &|_| {});
