@@ -1450,28 +1450,22 @@ mod tests {
         assert!(path.intersect(&ray, f32::INFINITY).is_none());
     }
 
-    /// The disc average `int_0^{pi/2} g(i) 2 sin i cos i di` of `g` of the incidence angle.
-    fn disc_average(g: impl Fn(f64) -> f64) -> f64 {
-        let steps = 200_000;
-        let di = std::f64::consts::FRAC_PI_2 / steps as f64;
-        (0..steps)
-            .map(|k| {
-                let i = (k as f64 + 0.5) * di;
-                g(i) * 2.0 * i.sin() * i.cos() * di
-            })
-            .sum()
+    /// `int_0^hi f(x) dx` by the midpoint rule on `steps` intervals.
+    fn midpoint(hi: f64, steps: u32, f: impl Fn(f64) -> f64) -> f64 {
+        let dx = hi / f64::from(steps);
+        (0..steps).map(|k| f((f64::from(k) + 0.5) * dx) * dx).sum()
     }
 
-    /// `int f(cos theta) d omega` over the sphere of directions (midpoint rule in theta).
+    /// The disc average `int_0^{pi/2} g(i) 2 sin i cos i di` of `g` of the incidence angle.
+    fn disc_average(g: impl Fn(f64) -> f64) -> f64 {
+        midpoint(std::f64::consts::FRAC_PI_2, 200_000, |i| {
+            g(i) * 2.0 * i.sin() * i.cos()
+        })
+    }
+
+    /// `int f(cos theta) d omega` over the sphere of directions.
     fn sphere_integral(f: impl Fn(f32) -> f64) -> f64 {
-        let steps = 400_000;
-        let dt = std::f64::consts::PI / steps as f64;
-        (0..steps)
-            .map(|k| {
-                let t = (k as f64 + 0.5) * dt;
-                f(t.cos() as f32) * 2.0 * std::f64::consts::PI * t.sin() * dt
-            })
-            .sum()
+        midpoint(PI64, 400_000, |t| f(t.cos() as f32) * 2.0 * PI64 * t.sin())
     }
 
     #[test]
