@@ -185,7 +185,9 @@
 //! Rain ([`crate::rain`]): the camera ray meets the drops of its camera's index
 //! ([`crate::rain::CameraRain`], built at the start of the render), and a path that hit a drop
 //! its way out of it ([`Scene::intersect_path`]); a drop hit is shaded as any smooth
-//! dielectric surface. Other rays, shadow rays included, do not meet drops. Under an open
+//! dielectric surface, and where a path meets a drop from outside its next-event estimation
+//! of a delta light (a shadow ray, the fog's transmittance) goes through the drop's
+//! pixel-averaged scattering ([`crate::rain::glint_phase`]) instead. Other rays, shadow rays included, do not meet drops. Under an open
 //! shutter (and [`crate::rain::RainEstimator::Swept`], the default) a camera sample first
 //! finds the drops that cover its ray at some time of the shutter in front of the scene
 //! ([`crate::rain::CameraRain::swept`]); with none it traces as a dry render does, drawing
@@ -924,6 +926,20 @@ fn trace_path(
         };
         if let Some(ls) = lights.sample_li(&scene.materials, &scene.textures, &rx, u_light, u_point)
         {
+            if ls.delta && front && hit.triangle == crate::rain::RAIN_TRIANGLE {
+                // A drop glints in a delta light, which its smooth surface cannot show (once,
+                // where a path meets it from outside: the phase holds the light through it).
+                out.rays += 1;
+                let origin = crate::rain::offset_from_drop(hit.p, ng, ls.wi);
+                let li = visible_li(scene, lights, origin, hit.p, &ls);
+                let li = match (medium, fog) {
+                    (Some(v), _) if ls.dist.is_finite() => li * v.transmittance(ls.dist),
+                    (None, Some(fog)) => li * fog.transmittance(hit.p, ls.wi, ls.dist),
+                    _ => li,
+                };
+                let phase = crate::rain::glint_phase(-ls.wi.dot(wo));
+                out.radiance += throughput * li * (phase / ls.pdf);
+            }
             let wi_local = frame.to_local(ls.wi);
             if wi_local.z * ng.dot(ls.wi) > 0.0 {
                 // The BSDF's density of wi matters only for MIS against an area light.

@@ -46,6 +46,12 @@
 //!   no shadow and are not seen in reflections (their extinction, 1e-3 to 3e-3 per metre, is
 //!   the fog's domain). A BVH over the drops' swept boxes, tested by every ray, was 5-7 times
 //!   slower than a dry render (docs/decisions/0034-rain-drops-seen-by-camera-rays.md).
+//! - Glints: a smooth drop cannot show a point, spot or directional light by its reflection or
+//!   refraction (a delta path never reaches a delta light), so where a path meets a drop from
+//!   outside, the integrator adds next-event estimation of delta lights through the drop's
+//!   pixel-averaged scattering, [`glint_phase`]: the geometric-optics intensity of a water
+//!   sphere (external reflection and one refraction through it, van de Hulst 1957, ch. 12)
+//!   over its disc (docs/decisions/0037-rain-drops-glint-in-delta-lights.md).
 
 use crate::camera::{Camera, Projection};
 use crate::geometry::Ray;
@@ -930,10 +936,80 @@ pub fn offset_from_drop(p: Vec3, n: Vec3, w: Vec3) -> Vec3 {
     p + eps * side
 }
 
+/// The unpolarised Fresnel reflectance of water seen from air (index [`WATER_IOR`]) at an
+/// angle of incidence of cosine `cos_i`: the exact mean of the s and p reflectances, 1 at
+/// grazing. (The drops' BSDF uses Schlick's approximation; the glint's phase function below
+/// takes the exact value, which its energy tests check against.)
+#[inline]
+fn water_fresnel(cos_i: f64) -> f64 {
+    let n = f64::from(WATER_IOR);
+    let cos_i = cos_i.clamp(0.0, 1.0);
+    let sin_t = (1.0 - cos_i * cos_i).max(0.0).sqrt() / n;
+    let cos_t = (1.0 - sin_t * sin_t).max(0.0).sqrt();
+    let rs = (cos_i - n * cos_t) / (cos_i + n * cos_t);
+    let rp = (n * cos_i - cos_t) / (n * cos_i + cos_t);
+    0.5 * (rs * rs + rp * rp)
+}
+
+/// The deflection `2 (i - r)` of a ray entering a water sphere at incidence angle `i` and
+/// leaving it after one refraction in and one out (`sin i = n sin r`), with its derivative in `i`.
+#[inline]
+fn refraction_deflection(i: f64) -> (f64, f64) {
+    let n = f64::from(WATER_IOR);
+    let r = (i.sin() / n).asin();
+    (2.0 * (i - r), 2.0 - 2.0 * i.cos() / (n * r.cos()))
+}
+
+/// A sub-pixel water drop's *pixel-averaged* scattering of a collimated beam, per steradian:
+/// lit with irradiance `E` at normal incidence, the drop's radiance averaged over its
+/// projected disc toward a viewer at scattering angle `theta` (`cos_theta` = the light's
+/// propagation direction dotted with the direction to the viewer) is `E * glint_phase(cos_theta)`.
+///
+/// Geometric optics of a sphere (van de Hulst, "Light scattering by small particles", 1957,
+/// ch. 12): the intensity of the ray class `p` is `E a^2 |sin i cos i / (sin theta dtheta/di)|`
+/// times its Fresnel factor, and dividing by the disc area `pi a^2` gives the average radiance.
+/// Two classes: `p = 0`, external reflection (`i = (pi - theta) / 2`, `F(i) / (4 pi)`), and
+/// `p = 1`, refraction in and out (`theta = 2 (i - r)`, factor `(1 - F(i))^2`, zero beyond
+/// the grazing deflection of about 82.5 degrees). Unpolarised, no absorption, no higher
+/// classes (`p = 2` makes the rainbow) and no diffraction. Integrated over the sphere it gives
+/// the disc averages of `F` and `(1 - F)^2` (tested). A path that hits a drop adds this for
+/// delta lights, which its refracted continuation cannot reach: as the hit point is uniform
+/// over the drop's disc in the pixel, its expectation is the pixel average.
+pub fn glint_phase(cos_theta: f32) -> f32 {
+    use std::f64::consts::{FRAC_PI_2, PI};
+    let c = f64::from(cos_theta).clamp(-1.0, 1.0);
+    // p = 0: cos i = cos((pi - theta) / 2) = sin(theta / 2).
+    let p0 = water_fresnel(((1.0 - c) * 0.5).sqrt()) / (4.0 * PI);
+    let theta = c.acos();
+    let (theta_max, _) = refraction_deflection(FRAC_PI_2);
+    let p1 = if theta >= theta_max {
+        0.0
+    } else if theta < 1e-6 {
+        // The limit sin i / sin theta -> 1 / (dtheta/di at 0) = 1 / (2 (1 - 1/n)).
+        let t = 1.0 - water_fresnel(1.0);
+        let k = 1.0 - 1.0 / f64::from(WATER_IOR);
+        t * t / (4.0 * PI * k * k)
+    } else {
+        // theta(i) is increasing and convex with slope 2 (1 - 1/n) at 0, so the chord start
+        // lies right of the root and Newton's steps fall monotonically onto it.
+        let k = 1.0 - 1.0 / f64::from(WATER_IOR);
+        let mut i = (theta / (2.0 * k)).min(FRAC_PI_2);
+        for _ in 0..8 {
+            let (t, dt) = refraction_deflection(i);
+            i = (i - (t - theta) / dt).clamp(0.0, FRAC_PI_2);
+        }
+        let (_, dt) = refraction_deflection(i);
+        let t = 1.0 - water_fresnel(i.cos());
+        t * t * i.sin() * i.cos() / (PI * theta.sin() * dt.abs())
+    };
+    (p0 + p1) as f32
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::testing::{chi_square_2d, ChiSquareConfig};
+    use std::f64::consts::PI as PI64;
 
     #[test]
     fn marshall_palmer_number_density_matches_the_closed_form_and_the_survey_figures() {
@@ -1373,6 +1449,69 @@ mod tests {
         assert!(path.intersect(&out, f32::INFINITY).is_none());
         assert!(path.intersect(&ray, f32::INFINITY).is_none());
     }
+
+    /// `int_0^hi f(x) dx` by the midpoint rule on `steps` intervals.
+    fn midpoint(hi: f64, steps: u32, f: impl Fn(f64) -> f64) -> f64 {
+        let dx = hi / f64::from(steps);
+        (0..steps).map(|k| f((f64::from(k) + 0.5) * dx) * dx).sum()
+    }
+
+    /// The disc average `int_0^{pi/2} g(i) 2 sin i cos i di` of `g` of the incidence angle.
+    fn disc_average(g: impl Fn(f64) -> f64) -> f64 {
+        midpoint(std::f64::consts::FRAC_PI_2, 200_000, |i| {
+            g(i) * 2.0 * i.sin() * i.cos()
+        })
+    }
+
+    /// `int f(cos theta) d omega` over the sphere of directions.
+    fn sphere_integral(f: impl Fn(f32) -> f64) -> f64 {
+        midpoint(PI64, 400_000, |t| f(t.cos() as f32) * 2.0 * PI64 * t.sin())
+    }
+
+    #[test]
+    fn the_glints_phase_scatters_the_fresnel_shares_of_the_disc() {
+        // p = 0 alone (i = (pi - theta) / 2) and the rest, p = 1.
+        let p0 = |c: f32| water_fresnel(((1.0 - f64::from(c)) * 0.5).sqrt()) / (4.0 * PI64);
+        let got0 = sphere_integral(p0);
+        let got1 = sphere_integral(|c| f64::from(glint_phase(c)) - p0(c));
+        let want0 = disc_average(|i| water_fresnel(i.cos()));
+        let want1 = disc_average(|i| (1.0 - water_fresnel(i.cos())).powi(2));
+        assert!(
+            (got0 - want0).abs() < 1e-4 * want0,
+            "p = 0: {got0} vs {want0}"
+        );
+        assert!(
+            (got1 - want1).abs() < 1e-3 * want1,
+            "p = 1: {got1} vs {want1}"
+        );
+        // Nearly all the light: what is left is the internal reflections (p >= 2).
+        assert!(got0 + got1 > 0.9 && got0 + got1 < 1.0, "{}", got0 + got1);
+    }
+
+    #[test]
+    fn the_glints_phase_has_its_analytic_limits() {
+        let n = f64::from(WATER_IOR);
+        let f0 = ((n - 1.0) / (n + 1.0)).powi(2);
+        assert!((water_fresnel(1.0) - f0).abs() < 1e-12);
+        assert!((water_fresnel(0.0) - 1.0).abs() < 1e-12);
+        // Backscatter: only the external reflection at normal incidence.
+        let back = f64::from(glint_phase(-1.0));
+        assert!((back - f0 / (4.0 * PI64)).abs() < 1e-6 * back, "{back}");
+        // Forward: the refracted limit, continuous with the angles next to it.
+        let k = 1.0 - 1.0 / n;
+        let fwd = (1.0 - f0).powi(2) / (4.0 * PI64 * k * k) + 1.0 / (4.0 * PI64);
+        let got = f64::from(glint_phase(1.0));
+        assert!((got - fwd).abs() < 1e-5 * fwd, "{got} vs {fwd}");
+        let near = f64::from(glint_phase(1e-3f32.cos()));
+        assert!((near - got).abs() < 1e-2 * got, "{near} vs {got}");
+        // Beyond the grazing deflection only p = 0 is left; just before it p = 1 is not.
+        let (theta_max, _) = refraction_deflection(std::f64::consts::FRAC_PI_2);
+        assert!((theta_max.to_degrees() - 82.46).abs() < 0.05, "{theta_max}");
+        let past = (theta_max + 1e-3).cos() as f32;
+        let c = ((1.0 - f64::from(past)) * 0.5).sqrt();
+        assert!((f64::from(glint_phase(past)) - water_fresnel(c) / (4.0 * PI64)).abs() < 1e-7);
+        assert!(glint_phase((theta_max - 1e-2).cos() as f32) > glint_phase(past));
+    }
 }
 
 #[cfg(test)]
@@ -1677,5 +1816,62 @@ mod render_tests {
             seen += usize::from(l.1 == *d && r.1 == *d);
         }
         assert!(seen > 200, "{seen} drops checked");
+    }
+
+    #[test]
+    fn a_drop_in_one_pixel_glints_with_its_analytic_average_radiance() {
+        // One drop of radius 1 cm 2 m in front of the camera, alone in a 1 x 1 image, lit by
+        // a point light behind it (scattering angle about 18 degrees: p = 0 and p = 1).
+        let (a, d) = (0.01f32, 2.0f32);
+        let light = Vec3::new(0.0, 1.0, -5.0);
+        let intensity = 100.0f32;
+        let mut scene = Scene::from_parts(SceneParts {
+            lights: vec![crate::light::Light::Point {
+                position: light,
+                intensity: Vec3::splat(intensity),
+                range: None,
+            }],
+            ..Default::default()
+        })
+        .unwrap();
+        scene.set_rain(RainParams {
+            rate_mm_h: 1.0,
+            seed: 0,
+            radius: 4.0,
+        });
+        let centre = Vec3::new(0.0, 0.0, -d);
+        scene.rain.as_mut().unwrap().field.drops = vec![Drop {
+            centre,
+            radius: a,
+            speed: 0.0,
+        }];
+        let yfov = 0.05f32;
+        let camera = Camera::perspective("c", Affine3A::IDENTITY, yfov, None);
+        let job = RenderJob {
+            width: 1,
+            height: 1,
+            seed: 3,
+            layers: Layers::default(),
+            settings: RenderSettings::new(1 << 18, 4),
+            motion: Motion::default(),
+        };
+        let out = render(&scene, &camera, &job, &|_| {});
+        let got = f64::from(out.image.get(0, 0).x);
+        // The drop's share of the pixel (on the film plane) times E P(theta).
+        let tan_alpha = (a / d).asin().tan() as f64;
+        let half = (0.5 * yfov).tan() as f64;
+        let share = std::f64::consts::PI * tan_alpha * tan_alpha / (4.0 * half * half);
+        let to_light = light - centre;
+        let e = f64::from(intensity / to_light.length_squared());
+        let cos_theta = -to_light.normalize().dot(Vec3::Z);
+        let want = share * e * f64::from(glint_phase(cos_theta));
+        assert!(
+            want > 0.0 && (got - want).abs() < 0.03 * want,
+            "{got} vs {want}"
+        );
+        // Without the drop: black.
+        scene.rain.as_mut().unwrap().field.drops.clear();
+        let out = render(&scene, &camera, &job, &|_| {});
+        assert_eq!(out.image.get(0, 0), Vec3::ZERO);
     }
 }
