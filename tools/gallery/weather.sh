@@ -5,7 +5,7 @@
 # its transmittance. The weather is drawn in its own random streams, so the four configs give the
 # same street. Writes docs/images/weather_{dry,drizzle,heavy,fog}.png.
 #
-#   bash tools/gallery/weather.sh            # uses `streaks` from PATH, or STREAKS=path
+#   bash tools/gallery/weather.sh   # `streaks` from PATH (or STREAKS=path); WEATHERS="heavy fog" for some
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 streaks="${STREAKS:-streaks}"
@@ -13,7 +13,7 @@ seed="${SEED:-3}"
 spp="${SPP:-64}"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
-for weather in dry drizzle heavy fog; do
+for weather in ${WEATHERS:-dry drizzle heavy fog}; do
     start=$(date +%s)
     "$streaks" dataset generate -o "$work/$weather" --config "tools/gallery/$weather.toml" \
         --count 1 --seed "$seed" --width 640 --height 384 --spp "$spp"

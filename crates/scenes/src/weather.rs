@@ -98,7 +98,7 @@ impl Default for WeatherConfig {
                 RainClass::new("moderate", 0.25, [2.0, 10.0]),
                 RainClass::new("heavy", 0.15, [10.0, 50.0]),
             ],
-            rain_radius: 20.0,
+            rain_radius: 12.0,
             fog: FogConfig::default(),
             sensor: BTreeMap::from([
                 ("automotive_hdr".to_owned(), 0.7),
