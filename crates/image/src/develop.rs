@@ -1,11 +1,12 @@
-//! Developing a render: linear radiance through the project's one camera model to the 8-bit
-//! sRGB that every PNG of a render holds (`streaks render`, the pairs of `streaks stereo` and
-//! the dataset's `im0.png`/`im1.png`).
+//! Developing a render without a camera model: linear radiance to the 8-bit sRGB that the PNGs
+//! of `streaks render` and `streaks stereo` hold without `--sensor` (and a dataset's
+//! `im0.png`/`im1.png` when its config has no `[weather]`). With a camera model the
+//! `streaks-sensor` crate develops its raw DN by its own curve (noise, glare and vignetting
+//! included).
 //!
-//! The camera model is deliberately simple (no sensor noise, glare or vignetting; the
-//! `streaks-sensor` crate adds those with `--sensor`, developing its raw DN by its own curve): the exposure scales the radiance by `2^exposure_ev`, the sensor clips at 1
-//! (negative values and NaN to 0), and the tone curve is the sRGB transfer function, rounded to
-//! 8 bits.
+//! This curve has no noise, glare or vignetting: the exposure scales the radiance by
+//! `2^exposure_ev`, values clip at 1 (negative values and NaN to 0), and the tone curve is the
+//! sRGB transfer function, rounded to 8 bits.
 
 use crate::color::srgb_oetf;
 use crate::{ImageError, RgbImage};
