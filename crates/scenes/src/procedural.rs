@@ -1316,7 +1316,7 @@ mod tests {
         let streaks = &wet_gltf["scenes"][0]["extras"]["streaks"];
         assert_eq!(
             streaks["rain"],
-            json!({"rate_mm_h": 20.0, "seed": w.rain_seed, "radius": 20.0})
+            json!({"rate_mm_h": 20.0, "seed": w.rain_seed, "radius": config.weather.rain_radius})
         );
         let fog = w.fog.unwrap();
         assert_eq!(
