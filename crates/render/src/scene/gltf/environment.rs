@@ -79,16 +79,14 @@ fn error_chain(e: &dyn std::error::Error) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::super::test_docs::{load_doc, load_err, test_doc};
+    use super::super::test_docs::{load_doc, load_err, test_doc_with_streaks_extra};
     use crate::light::Environment;
     use glam::Vec3;
     use serde_json::json;
 
     /// The test document with `environment` in its scene's extras, and its buffer.
     fn doc(environment: serde_json::Value) -> (serde_json::Value, Vec<u8>) {
-        let (mut doc, bin) = test_doc();
-        doc["scenes"][0]["extras"] = json!({"streaks": {"environment": environment}});
-        (doc, bin)
+        test_doc_with_streaks_extra("environment", environment)
     }
 
     #[test]

@@ -67,16 +67,14 @@ impl Loader<'_> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::test_docs::{load_doc, load_err, test_doc};
+    use super::super::test_docs::{load_doc, load_err, test_doc, test_doc_with_streaks_extra};
     use crate::medium::Fog;
     use glam::Vec3;
     use serde_json::json;
 
     /// The test document with `fog` in its scene's extras, and its buffer.
     fn doc(fog: serde_json::Value) -> (serde_json::Value, Vec<u8>) {
-        let (mut doc, bin) = test_doc();
-        doc["scenes"][0]["extras"] = json!({"streaks": {"fog": fog}});
-        (doc, bin)
+        test_doc_with_streaks_extra("fog", fog)
     }
 
     #[test]

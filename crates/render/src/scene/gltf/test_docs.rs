@@ -55,6 +55,14 @@ impl Doc {
     }
 }
 
+/// The test document ([`test_doc`]) with `value` as `scenes[0].extras.streaks.<key>`, and its
+/// buffer: how the scene-level extras (environment, fog, rain) are tested.
+pub(super) fn test_doc_with_streaks_extra(key: &str, value: Value) -> (Value, Vec<u8>) {
+    let (mut doc, bin) = test_doc();
+    doc["scenes"][0]["extras"] = serde_json::json!({ "streaks": { key: value } });
+    (doc, bin)
+}
+
 /// The test scene: a quad (indexed, normals, uvs) under a TRS parent and a matrix child, a
 /// non-indexed emissive triangle without normals, a camera, and three punctual lights.
 pub(super) fn test_doc() -> (Value, Vec<u8>) {
