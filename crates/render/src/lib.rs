@@ -79,6 +79,7 @@
 pub mod accel;
 pub mod bsdf;
 pub mod camera;
+pub mod class;
 pub mod film;
 pub mod geometry;
 pub mod integrator;

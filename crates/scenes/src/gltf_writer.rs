@@ -12,6 +12,7 @@ use crate::Error;
 use glam::{Quat, Vec3};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
+pub use streaks_render::class::Class;
 
 /// glTF `ARRAY_BUFFER` target.
 const ARRAY_BUFFER: u32 = 34962;
@@ -227,6 +228,35 @@ pub struct Light {
     pub direction: Vec3,
 }
 
+/// What a node is: its semantic class and the object it is part of, written as the node's
+/// `extras.streaks` (`class`, `instance`; see [`streaks_render::class`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Tag {
+    /// The semantic class.
+    pub class: Class,
+    /// The object this node is part of (all the nodes of one car share it); `None` for stuff
+    /// (road, sidewalk, buildings) that has no instances.
+    pub instance: Option<u32>,
+}
+
+impl Tag {
+    /// A node of class `class` that is part of no countable object.
+    pub fn stuff(class: Class) -> Self {
+        Self {
+            class,
+            instance: None,
+        }
+    }
+
+    /// A node of class `class` that is part of object `instance`.
+    pub fn object(class: Class, instance: u32) -> Self {
+        Self {
+            class,
+            instance: Some(instance),
+        }
+    }
+}
+
 /// A glTF document under construction.
 pub struct Doc {
     name: String,
@@ -351,8 +381,31 @@ impl Doc {
         self.accessors.len() - 1
     }
 
-    /// Adds `mesh` (world coordinates) as a node named `name` with material `material`.
+    /// Adds `mesh` (world coordinates) as a node named `name` with material `material` and no
+    /// semantic tag.
     pub fn add_mesh(&mut self, name: &str, mesh: &Mesh, material: &Material) -> Result<(), Error> {
+        self.add_node(name, mesh, material, None)
+    }
+
+    /// Adds `mesh` (world coordinates) as a node named `name` with material `material`, tagged
+    /// with its class and instance (`extras.streaks`).
+    pub fn add_tagged_mesh(
+        &mut self,
+        name: &str,
+        mesh: &Mesh,
+        material: &Material,
+        tag: Tag,
+    ) -> Result<(), Error> {
+        self.add_node(name, mesh, material, Some(tag))
+    }
+
+    fn add_node(
+        &mut self,
+        name: &str,
+        mesh: &Mesh,
+        material: &Material,
+        tag: Option<Tag>,
+    ) -> Result<(), Error> {
         if mesh.indices.is_empty() {
             return Err(Error::Scene {
                 scene: self.name.clone(),
@@ -419,8 +472,15 @@ impl Doc {
             "name": name,
             "primitives": [{ "attributes": attributes, "indices": indices, "material": mat }],
         }));
-        self.nodes
-            .push(json!({ "name": name, "mesh": self.meshes.len() - 1 }));
+        let mut node = json!({ "name": name, "mesh": self.meshes.len() - 1 });
+        if let Some(tag) = tag {
+            let mut streaks = json!({ "class": tag.class.name() });
+            if let Some(instance) = tag.instance {
+                streaks["instance"] = json!(instance);
+            }
+            node["extras"] = json!({ "streaks": streaks });
+        }
+        self.nodes.push(node);
         self.triangles += mesh.indices.len() / 3;
         Ok(())
     }
