@@ -24,6 +24,7 @@ pub mod estimate;
 pub mod gltf_writer;
 pub mod light_sources;
 pub mod mesh;
+pub mod model;
 pub mod paper;
 pub mod procedural;
 pub mod street;
