@@ -74,7 +74,7 @@ pub fn transformed(mesh: &Mesh, pose: Affine3A) -> Mesh {
         normals: mesh
             .normals
             .iter()
-            .map(|&n| Vec3::from(normal * n).normalize_or_zero())
+            .map(|&n| (normal * n).normalize_or_zero())
             .collect(),
         uvs: mesh.uvs.clone(),
         indices: mesh.indices.clone(),
