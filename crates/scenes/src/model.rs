@@ -8,7 +8,7 @@
 use crate::gltf_writer::{Class, Doc, Light, Material, Tag};
 use crate::mesh::Mesh;
 use crate::Error;
-use glam::{Affine3A, Vec3};
+use glam::Affine3A;
 
 /// One part of a model: a mesh in the model's frame with one material and one class.
 #[derive(Clone, Debug)]
@@ -125,7 +125,7 @@ impl Doc {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::Quat;
+    use glam::{Quat, Vec3};
 
     #[test]
     fn a_placed_box_keeps_its_faces_outward_and_its_size() {
