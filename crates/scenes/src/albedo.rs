@@ -23,6 +23,27 @@ pub enum Pattern {
     Brick,
     /// Wood grain: streaks along v (the pole's height), fine across u.
     Wood,
+    /// Asphalt grain (as [`Pattern::Asphalt`]) with the wear of an old road: darker, finer
+    /// repair patches on a 64-texel grid and meandering black tar seams (sealed cracks).
+    PatchedAsphalt,
+    /// Stone setts (cobbles) 16 x 16 texels in rows offset by half a sett, domed (darker at
+    /// their edges), each its own tone, in dark 2-texel joints.
+    Setts,
+    /// Paving slabs 64 x 64 texels with 1-texel joints, each slab its own tone and speckle,
+    /// some stained.
+    Slabs,
+    /// English bond brick: courses of stretchers (16 x 4 texels) alternating with courses
+    /// of headers (8 x 4), 1-texel mortar joints.
+    EnglishBrick,
+    /// Flemish bond brick: stretchers (16 texels) and headers (8) alternating in every course,
+    /// each course shifted by 12 texels; the texture's width must be a multiple of 24.
+    FlemishBrick,
+    /// Plaster or render, weathered: smooth low-contrast trowel texture, vertical dirt
+    /// runs and blotchy stains.
+    Plaster,
+    /// Cast concrete: fine pores and speckle on formwork panels of 128 x 64 texels, with
+    /// darker panel joints and tie holes.
+    Concrete,
 }
 
 /// White noise in [0, 1) at texel (i, j).
@@ -75,6 +96,112 @@ fn value(pattern: Pattern, i: u32, j: u32, (w, h): (u32, u32), seed: u32) -> f32
             let streak = tiling_noise(x / 4.0, y / 64.0, (px, py), seed.wrapping_add(1));
             let fine = white(i, j / 8, seed);
             0.3 + 0.7 * (0.6 * streak + 0.25 * fine + 0.15 * noise(16, 2))
+        }
+        Pattern::PatchedAsphalt => {
+            let grain = value(Pattern::Asphalt, i, j, (w, h), seed);
+            // A repair patch in one 64-texel cell of seven: fresh, finer and darker binder.
+            let (ci, cj) = (i / 64, j / 64);
+            let cell = hash(seed ^ hash(ci ^ hash(cj.wrapping_add(0x5bd1))));
+            let (pi, pj) = (i % 64, j % 64);
+            let (x0, y0) = (4 + cell % 12, 4 + (cell >> 4) % 12);
+            let (x1, y1) = (40 + (cell >> 8) % 20, 40 + (cell >> 12) % 20);
+            let patched = cell % 7 == 0 && (x0..x1).contains(&pi) && (y0..y1).contains(&pj);
+            // Tar seams: where smooth noise crosses one level, a line about 2 texels wide.
+            let seam = (tiling_noise(
+                x / 48.0,
+                y / 48.0,
+                ((w / 48).max(1) as i32, (h / 48).max(1) as i32),
+                seed.wrapping_add(9),
+            ) - 0.5)
+                .abs()
+                < 0.012;
+            if seam {
+                0.03 + 0.02 * white(i, j, seed.wrapping_add(3))
+            } else if patched {
+                0.6 * grain + 0.04
+            } else {
+                grain
+            }
+        }
+        Pattern::Setts => {
+            let row = j / 16;
+            let shifted = i + if row % 2 == 1 { 8 } else { 0 };
+            let (col, pi, pj) = (shifted / 16 % (w / 16).max(1), shifted % 16, j % 16);
+            if pi < 2 || pj < 2 {
+                // Joints: dark sand and grit.
+                0.12 + 0.08 * white(i, j, seed)
+            } else {
+                let (dx, dy) = ((pi as f32 - 8.5) / 7.0, (pj as f32 - 8.5) / 7.0);
+                let dome = 1.0 - 0.35 * (dx * dx + dy * dy).min(1.0);
+                let tone = white(col, row, seed.wrapping_add(7));
+                dome * (0.45 + 0.3 * tone + 0.15 * white(i, j, seed) + 0.1 * noise(4, 4))
+            }
+        }
+        Pattern::Slabs => {
+            let (col, row) = (i / 64, j / 64);
+            if i % 64 == 63 || j % 64 == 63 {
+                0.25 + 0.1 * white(i, j, seed)
+            } else {
+                let tone = white(col, row, seed.wrapping_add(7));
+                let stain = if hash(seed ^ hash(col ^ hash(row.wrapping_add(77)))) % 5 == 0 {
+                    0.75 + 0.25 * noise(16, 6)
+                } else {
+                    1.0
+                };
+                stain * (0.5 + 0.2 * tone + 0.15 * noise(8, 2) + 0.15 * white(i, j, seed))
+            }
+        }
+        Pattern::EnglishBrick | Pattern::FlemishBrick => {
+            let row = j / 4;
+            // (brick index, position in the brick, brick length) along the course.
+            let (brick, at, len) = if pattern == Pattern::EnglishBrick {
+                if row % 2 == 0 {
+                    (i / 16, i % 16, 16)
+                } else {
+                    let s = i + 4;
+                    (s / 8, s % 8, 8)
+                }
+            } else {
+                let s = (i + if row % 2 == 1 { 12 } else { 0 }) % w.max(1);
+                let (unit, k) = (s / 24, s % 24);
+                if k < 16 {
+                    (2 * unit, k, 16)
+                } else {
+                    (2 * unit + 1, k - 16, 8)
+                }
+            };
+            if j % 4 == 3 || at == len - 1 {
+                0.9 + 0.1 * white(i, j, seed)
+            } else {
+                let b = white(brick % (w / 4).max(1), row, seed.wrapping_add(7));
+                // Headers (burnt ends) are darker.
+                let burnt = if len == 8 { 0.8 } else { 1.0 };
+                burnt * (0.35 + 0.3 * b + 0.25 * white(i, j, seed) + 0.1 * noise(8, 3))
+            }
+        }
+        Pattern::Plaster => {
+            let trowel = 0.5 * noise(32, 1) + 0.3 * noise(8, 2) + 0.2 * white(i, j, seed);
+            // Dirt runs: noise stretched 16x along v, kept only where it is high.
+            let (px, py) = ((w / 4).max(1) as i32, (h / 64).max(1) as i32);
+            let run = tiling_noise(x / 4.0, y / 64.0, (px, py), seed.wrapping_add(11));
+            let runs = ((run - 0.6) / 0.4).max(0.0);
+            let stain = ((noise(64, 12) - 0.55) / 0.45).max(0.0);
+            (0.8 + 0.2 * trowel) * (1.0 - 0.35 * runs) * (1.0 - 0.3 * stain)
+        }
+        Pattern::Concrete => {
+            let (pi, pj) = (i % 128, j % 64);
+            let joint = pi == 0 || pj == 0;
+            let tie = [32u32, 96].iter().any(|&c| pi.abs_diff(c) <= 1)
+                && [16u32, 48].iter().any(|&c| pj.abs_diff(c) <= 1);
+            let pore = white(i, j, seed.wrapping_add(13)) > 0.985;
+            let base = 0.6 + 0.15 * noise(32, 1) + 0.1 * noise(4, 2) + 0.15 * white(i, j, seed);
+            if tie || pore {
+                0.3 * base
+            } else if joint {
+                0.75 * base
+            } else {
+                base
+            }
         }
     }
 }

@@ -19,6 +19,7 @@
 #![deny(missing_docs)]
 
 pub mod albedo;
+pub mod buildings;
 pub mod crosscheck;
 pub mod estimate;
 pub mod gltf_writer;
@@ -28,6 +29,7 @@ pub mod model;
 pub mod paper;
 pub mod procedural;
 pub mod street;
+pub mod surfaces;
 pub mod weather;
 pub mod wetness;
 
