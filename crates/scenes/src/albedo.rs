@@ -41,7 +41,7 @@ pub enum Pattern {
     /// Plaster or render, weathered: smooth low-contrast trowel texture, vertical dirt
     /// runs and blotchy stains.
     Plaster,
-    /// Cast concrete: fine pores and speckle on formwork panels of 128 x 64 texels, with
+    /// Cast concrete: fine pores and speckle on formwork panels of 64 x 64 texels, with
     /// darker panel joints and tie holes.
     Concrete,
 }
@@ -189,9 +189,9 @@ fn value(pattern: Pattern, i: u32, j: u32, (w, h): (u32, u32), seed: u32) -> f32
             (0.8 + 0.2 * trowel) * (1.0 - 0.35 * runs) * (1.0 - 0.3 * stain)
         }
         Pattern::Concrete => {
-            let (pi, pj) = (i % 128, j % 64);
+            let (pi, pj) = (i % 64, j % 64);
             let joint = pi == 0 || pj == 0;
-            let tie = [32u32, 96].iter().any(|&c| pi.abs_diff(c) <= 1)
+            let tie = [16u32, 48].iter().any(|&c| pi.abs_diff(c) <= 1)
                 && [16u32, 48].iter().any(|&c| pj.abs_diff(c) <= 1);
             let pore = white(i, j, seed.wrapping_add(13)) > 0.985;
             let base = 0.6 + 0.15 * noise(32, 1) + 0.1 * noise(4, 2) + 0.15 * white(i, j, seed);

@@ -1239,4 +1239,102 @@ mod tests {
             assert!((p.x - side * 6.0).abs() < 1e-5 && (p.z + 20.0).abs() < 1e-5);
         }
     }
+
+    /// The correlation of the wall's albedo with itself `tiles` texture tiles further along
+    /// the street, on the facade plane rasterised every 2 cm along z and 10 cm up: with the
+    /// wall's own texture coordinates (`scattered`) or with coordinates continuous over the
+    /// wall, the position divided by the tile (the box facades' tiling).
+    fn tile_correlation(surface: Surface, scattered: bool, tiles: f32) -> f64 {
+        let mut s = specs(1, 20.0).remove(0);
+        s.surface = surface;
+        s.recess = 0.0;
+        s.upper_setback = None;
+        let mut doc = Doc::new("t", "t");
+        let pal = palette(&mut doc, std::slice::from_ref(&s), 0.0);
+        let model = facade(&s, &pal).unwrap();
+        let wall = model.parts.iter().find(|p| p.name == "wall").unwrap();
+        let (w, h) = surface.texels();
+        let (png, _) = crate::albedo::albedo_png(surface.pattern(), (w, h), 5).unwrap();
+        let img = image::load_from_memory(&png).unwrap().to_luma8();
+        let tile = surface.tile_m();
+        let m = &wall.mesh;
+        // The wall's triangles in the plane x = 0, facing the street.
+        let tris: Vec<[usize; 3]> = m
+            .indices
+            .chunks(3)
+            .map(|t| [t[0] as usize, t[1] as usize, t[2] as usize])
+            .filter(|t| t.iter().all(|&k| m.positions[k].x.abs() < 1e-4 && m.normals[k].x < -0.99))
+            .collect();
+        let (nz, ny) = ((s.frontage / 0.02) as usize, (s.wall_height() / 0.1) as usize);
+        let mut grid = vec![None; nz * ny];
+        for t in &tris {
+            let p = t.map(|k| glam::Vec2::new(m.positions[k].z, m.positions[k].y));
+            let (lo, hi) = (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
+            let d = (p[1] - p[0]).perp_dot(p[2] - p[0]);
+            for j in 0..ny {
+                let y = (j as f32 + 0.5) * 0.1;
+                if y < lo.y || y > hi.y {
+                    continue;
+                }
+                for i in 0..nz {
+                    let z = -0.5 * s.frontage + (i as f32 + 0.5) * 0.02;
+                    if z < lo.x || z > hi.x {
+                        continue;
+                    }
+                    let q = glam::Vec2::new(z, y);
+                    let b1 = (q - p[0]).perp_dot(p[2] - p[0]) / d;
+                    let b2 = (p[1] - p[0]).perp_dot(q - p[0]) / d;
+                    if b1 < 0.0 || b2 < 0.0 || b1 + b2 > 1.0 {
+                        continue;
+                    }
+                    let uv = if scattered {
+                        m.uvs[t[0]] * (1.0 - b1 - b2) + m.uvs[t[1]] * b1 + m.uvs[t[2]] * b2
+                    } else {
+                        glam::Vec2::new(z / tile.x, -y / tile.y)
+                    };
+                    let ti = ((uv.x.rem_euclid(1.0) * w as f32) as u32).min(w - 1);
+                    let tj = ((uv.y.rem_euclid(1.0) * h as f32) as u32).min(h - 1);
+                    grid[j * nz + i] = Some(f64::from(img.get_pixel(ti, tj).0[0]));
+                }
+            }
+        }
+        let lag = (tiles * tile.x / 0.02).round() as usize;
+        let pairs: Vec<(f64, f64)> = (0..ny)
+            .flat_map(|j| (0..nz - lag).map(move |i| (j, i)))
+            .filter_map(|(j, i)| Some((grid[j * nz + i]?, grid[j * nz + i + lag]?)))
+            .collect();
+        assert!(pairs.len() > 10_000, "{}", pairs.len());
+        let n = pairs.len() as f64;
+        let (ma, mb) = (
+            pairs.iter().map(|p| p.0).sum::<f64>() / n,
+            pairs.iter().map(|p| p.1).sum::<f64>() / n,
+        );
+        let cov = pairs.iter().map(|p| (p.0 - ma) * (p.1 - mb)).sum::<f64>();
+        let va = pairs.iter().map(|p| (p.0 - ma).powi(2)).sum::<f64>();
+        let vb = pairs.iter().map(|p| (p.1 - mb).powi(2)).sum::<f64>();
+        cov / (va * vb).sqrt()
+    }
+
+    /// The repetition of a wall's texture: its correlation at one tile along the street in
+    /// excess of that at half a tile (a whole number of bricks, slabs or formwork panels, so
+    /// the joints align at both lags and only the repetition of the texels themselves counts).
+    fn repetition(surface: Surface, scattered: bool) -> f64 {
+        tile_correlation(surface, scattered, 1.0) - tile_correlation(surface, scattered, 0.5)
+    }
+
+    #[test]
+    fn the_wall_texture_does_not_repeat_at_its_tile() {
+        for surface in Surface::WALLS {
+            let (new, old) = (repetition(surface, true), repetition(surface, false));
+            println!(
+                "{}: repetition {new:.3} (continuous tiling {old:.3}); correlation at one tile \
+                 {:.3} ({:.3})",
+                surface.name(),
+                tile_correlation(surface, true, 1.0),
+                tile_correlation(surface, false, 1.0)
+            );
+            assert!(old > 0.15, "{surface:?}: the continuous tiling repeats: {old}");
+            assert!(new.abs() < 0.1, "{surface:?}: {new}");
+        }
+    }
 }

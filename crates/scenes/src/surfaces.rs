@@ -186,8 +186,7 @@ impl Surface {
             Surface::Brick(Bond::Flemish) => (24, 8),
             Surface::Brick(_) => (16, 8),
             Surface::Setts => (16, 32),
-            Surface::Slabs => (64, 64),
-            Surface::Concrete => (128, 64),
+            Surface::Slabs | Surface::Concrete => (64, 64),
             _ => (1, 1),
         }
     }
