@@ -1263,9 +1263,15 @@ mod tests {
             .indices
             .chunks(3)
             .map(|t| [t[0] as usize, t[1] as usize, t[2] as usize])
-            .filter(|t| t.iter().all(|&k| m.positions[k].x.abs() < 1e-4 && m.normals[k].x < -0.99))
+            .filter(|t| {
+                t.iter()
+                    .all(|&k| m.positions[k].x.abs() < 1e-4 && m.normals[k].x < -0.99)
+            })
             .collect();
-        let (nz, ny) = ((s.frontage / 0.02) as usize, (s.wall_height() / 0.1) as usize);
+        let (nz, ny) = (
+            (s.frontage / 0.02) as usize,
+            (s.wall_height() / 0.1) as usize,
+        );
         let mut grid = vec![None; nz * ny];
         for t in &tris {
             let p = t.map(|k| glam::Vec2::new(m.positions[k].z, m.positions[k].y));
@@ -1333,7 +1339,10 @@ mod tests {
                 tile_correlation(surface, true, 1.0),
                 tile_correlation(surface, false, 1.0)
             );
-            assert!(old > 0.15, "{surface:?}: the continuous tiling repeats: {old}");
+            assert!(
+                old > 0.15,
+                "{surface:?}: the continuous tiling repeats: {old}"
+            );
             assert!(new.abs() < 0.1, "{surface:?}: {new}");
         }
     }
