@@ -1036,17 +1036,33 @@ mod tests {
     #[test]
     fn the_default_config_validates_and_bad_values_are_named() {
         BuildingsConfig::default().validate().unwrap();
-        let mut c = BuildingsConfig::default();
-        c.balconies = 1.5;
+        let c = BuildingsConfig {
+            balconies: 1.5,
+            ..Default::default()
+        };
         assert!(c.validate().unwrap_err().contains("buildings.balconies"));
-        let mut c = BuildingsConfig::default();
-        c.storeys = [5, 2];
+        let c = BuildingsConfig {
+            storeys: [5, 2],
+            ..Default::default()
+        };
         assert!(c.validate().unwrap_err().contains("buildings.storeys"));
         let mut c = BuildingsConfig::default();
         c.materials.clear();
         assert!(c.validate().unwrap_err().contains("buildings.materials"));
         let e = toml::from_str::<BuildingsConfig>("balcony = 0.5").unwrap_err();
         assert!(e.to_string().contains("balcony"), "{e}");
+    }
+
+    #[test]
+    fn the_documented_snippet_is_the_default() {
+        #[derive(Deserialize)]
+        #[serde(deny_unknown_fields)]
+        struct Snippet {
+            buildings: BuildingsConfig,
+        }
+        let text = include_str!("../config/buildings.toml.snippet");
+        let s: Snippet = toml::from_str(text).unwrap();
+        assert_eq!(s.buildings, BuildingsConfig::default());
     }
 
     #[test]
