@@ -1,9 +1,10 @@
 //! Albedo textures for the street's surfaces, so that stereo matching finds texture on the
 //! road, poles, kerbs, sidewalks and facades: deterministic grey patterns (fine asphalt
-//! grain, stone/plaster speckle, brick courses, vertical wood grain) from value noise and a
+//! grain, patched asphalt with tar seams, stone speckle, setts, paving slabs, brick in three
+//! bonds, weathered plaster, formwork concrete, vertical wood grain) from value noise and a
 //! per-texel hash, written as 8-bit grey sRGB PNGs (the glTF baseColorTexture, whose linear
 //! value multiplies the material's `kd`). Every pattern but asphalt tiles with repeat
-//! wrapping. [`albedo_png`] also returns the texture's mean linear value, by which the caller
+//! wrapping. [`crate::surfaces`] gives them measured albedos and non-repeating tiling. [`albedo_png`] also returns the texture's mean linear value, by which the caller
 //! divides `kd` to keep the surface's mean colour.
 
 use crate::wetness::{hash, tiling_noise};
@@ -107,14 +108,7 @@ fn value(pattern: Pattern, i: u32, j: u32, (w, h): (u32, u32), seed: u32) -> f32
             let (x1, y1) = (40 + (cell >> 8) % 20, 40 + (cell >> 12) % 20);
             let patched = cell % 7 == 0 && (x0..x1).contains(&pi) && (y0..y1).contains(&pj);
             // Tar seams: where smooth noise crosses one level, a line about 2 texels wide.
-            let seam = (tiling_noise(
-                x / 48.0,
-                y / 48.0,
-                ((w / 48).max(1) as i32, (h / 48).max(1) as i32),
-                seed.wrapping_add(9),
-            ) - 0.5)
-                .abs()
-                < 0.012;
+            let seam = (noise(32, 9) - 0.5).abs() < 0.012;
             if seam {
                 0.03 + 0.02 * white(i, j, seed.wrapping_add(3))
             } else if patched {
@@ -158,8 +152,9 @@ fn value(pattern: Pattern, i: u32, j: u32, (w, h): (u32, u32), seed: u32) -> f32
                 if row % 2 == 0 {
                     (i / 16, i % 16, 16)
                 } else {
+                    // Headers, shifted by a quarter stretcher (the queen closer), wrapping.
                     let s = i + 4;
-                    (s / 8, s % 8, 8)
+                    ((s / 8) % (w / 8).max(1), s % 8, 8)
                 }
             } else {
                 let s = (i + if row % 2 == 1 { 12 } else { 0 }) % w.max(1);
@@ -173,7 +168,7 @@ fn value(pattern: Pattern, i: u32, j: u32, (w, h): (u32, u32), seed: u32) -> f32
             if j % 4 == 3 || at == len - 1 {
                 0.9 + 0.1 * white(i, j, seed)
             } else {
-                let b = white(brick % (w / 4).max(1), row, seed.wrapping_add(7));
+                let b = white(brick, row, seed.wrapping_add(7));
                 // Headers (burnt ends) are darker.
                 let burnt = if len == 8 { 0.8 } else { 1.0 };
                 burnt * (0.35 + 0.3 * b + 0.25 * white(i, j, seed) + 0.1 * noise(8, 3))
@@ -274,9 +269,18 @@ mod tests {
 
     #[test]
     fn tiling_patterns_wrap_without_a_seam() {
-        // The step across the wrap (last column to first) is like an ordinary step.
-        for pattern in [Pattern::Stone, Pattern::Wood] {
-            let (w, h) = (64, 128);
+        // The step across the wrap (last column to first) is like the step across the middle
+        // (also a joint of setts, slabs and formwork panels, whose cells divide half the width).
+        for pattern in [
+            Pattern::Stone,
+            Pattern::Wood,
+            Pattern::Plaster,
+            Pattern::Concrete,
+            Pattern::Setts,
+            Pattern::Slabs,
+            Pattern::PatchedAsphalt,
+        ] {
+            let (w, h) = (128, 128);
             let v = |i, j| value(pattern, i, j, (w, h), 5);
             let wrap: f32 = (0..h).map(|j| (v(w - 1, j) - v(0, j)).abs()).sum();
             let inner: f32 = (0..h).map(|j| (v(w / 2 - 1, j) - v(w / 2, j)).abs()).sum();
