@@ -32,7 +32,7 @@ pub fn showroom(night: bool) -> Result<Doc, Error> {
         "Every vehicle body type and furniture piece in a line-up",
     );
     let mut ground = Mesh::new();
-    ground.rect(Vec3::new(10.0, 0.0, 0.0), Vec3::Z * 40.0, Vec3::X * 40.0);
+    ground.rect(Vec3::new(-5.0, 0.0, 0.0), Vec3::Z * 50.0, Vec3::X * 50.0);
     doc.add_tagged_mesh(
         "ground",
         &ground,
@@ -175,7 +175,7 @@ pub fn showroom(night: bool) -> Result<Doc, Error> {
     for _ in 0..3 {
         pieces.push(("bollard", BollardSpec::draw(&mut rng).build()));
     }
-    let mut x = -1.0f32;
+    let mut x = -44.0f32;
     for (name, m) in &pieces {
         let step = if *name == "bus_stop" {
             3.0
@@ -189,13 +189,13 @@ pub fn showroom(night: bool) -> Result<Doc, Error> {
             &mut doc,
             name,
             m,
-            Affine3A::from_translation(Vec3::new(x, 0.0, 6.0)),
+            Affine3A::from_translation(Vec3::new(x, 0.0, 4.0)),
         )?;
         x += step;
     }
     // A wall with a lit shop sign at the back.
     let mut wall = Mesh::new();
-    wall.cuboid(Vec3::new(-6.0, 0.0, 12.0), Vec3::new(30.0, 6.0, 13.0));
+    wall.cuboid(Vec3::new(-48.0, 0.0, 12.0), Vec3::new(34.0, 6.0, 13.0));
     doc.add_tagged_mesh(
         "wall",
         &wall,
@@ -213,19 +213,26 @@ pub fn showroom(night: bool) -> Result<Doc, Error> {
         &mut doc,
         "shop_sign",
         &sign.build(),
-        Affine3A::from_translation(Vec3::new(8.0, 0.0, 12.0)),
+        Affine3A::from_translation(Vec3::new(-6.0, 0.0, 12.0)),
     )?;
     if !night {
         doc.set_environment(serde_json::json!({ "color": [0.25, 0.25, 0.27] }));
     }
-    let target = Vec3::new(12.0, 1.2, 2.0);
+    let target = Vec3::new(-6.0, 1.5, 4.0);
     doc.add_camera(
         "showroom",
-        Vec3::new(2.0, 6.0, -19.0),
+        Vec3::new(-6.0, 9.0, -34.0),
         target,
-        40.0,
+        55.0,
         16.0 / 9.0,
     );
+    // Close-ups: the cars from the front right, the furniture row, the braking car's back.
+    let cars = Vec3::new(9.0, 0.8, -1.0);
+    doc.add_camera("cars", Vec3::new(16.0, 2.2, -9.0), cars, 40.0, 16.0 / 9.0);
+    let row = Vec3::new(-22.0, 2.8, 4.0);
+    doc.add_camera("furniture", Vec3::new(-24.0, 2.0, -7.0), row, 60.0, 16.0 / 9.0);
+    let back = Vec3::new(-2.5, 0.8, -4.0);
+    doc.add_camera("braking", Vec3::new(-4.5, 1.6, -11.0), back, 35.0, 16.0 / 9.0);
     Ok(doc)
 }
 
