@@ -321,8 +321,10 @@ mod tests {
 
     #[test]
     fn bad_values_are_named() {
-        let mut c = ObjectsConfig::default();
-        c.brake_lights = 1.5;
+        let c = ObjectsConfig {
+            brake_lights: 1.5,
+            ..Default::default()
+        };
         let e = c.validate().unwrap_err();
         assert!(e.contains("objects.brake_lights"), "{e}");
         let mut c = ObjectsConfig::default();

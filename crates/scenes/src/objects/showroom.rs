@@ -230,9 +230,21 @@ pub fn showroom(night: bool) -> Result<Doc, Error> {
     let cars = Vec3::new(9.0, 0.8, -1.0);
     doc.add_camera("cars", Vec3::new(16.0, 2.2, -9.0), cars, 40.0, 16.0 / 9.0);
     let row = Vec3::new(-22.0, 2.8, 4.0);
-    doc.add_camera("furniture", Vec3::new(-24.0, 2.0, -7.0), row, 60.0, 16.0 / 9.0);
+    doc.add_camera(
+        "furniture",
+        Vec3::new(-24.0, 2.0, -7.0),
+        row,
+        60.0,
+        16.0 / 9.0,
+    );
     let back = Vec3::new(-2.5, 0.8, -4.0);
-    doc.add_camera("braking", Vec3::new(-4.5, 1.6, -11.0), back, 35.0, 16.0 / 9.0);
+    doc.add_camera(
+        "braking",
+        Vec3::new(-4.5, 1.6, -11.0),
+        back,
+        35.0,
+        16.0 / 9.0,
+    );
     Ok(doc)
 }
 
