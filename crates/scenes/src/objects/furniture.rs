@@ -54,6 +54,19 @@ pub struct LampLight {
     pub lens_radiance: [f64; 3],
 }
 
+impl From<&crate::street::StreetStyle> for LampLight {
+    /// The light of a street's lamps as the street draws it (`lamp_color`,
+    /// `lamp_intensity`, `lamp_cone`, `lens_radiance`).
+    fn from(st: &crate::street::StreetStyle) -> Self {
+        Self {
+            color: st.lamp_color,
+            intensity: st.lamp_intensity,
+            cone: st.lamp_cone,
+            lens_radiance: st.lens_radiance,
+        }
+    }
+}
+
 /// A street lamp.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StreetLampSpec {
