@@ -12,6 +12,7 @@ use crate::Error;
 use glam::{Quat, Vec3};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 pub use streaks_render::class::Class;
 
 /// glTF `ARRAY_BUFFER` target.
@@ -105,6 +106,86 @@ pub enum Reflect {
     /// A black, non-reflecting surface (glTF metallic-roughness with base colour 0): used
     /// for emitters, whose look is their emission.
     Black,
+    /// glTF metallic-roughness, with an optional clear coat and transmission: car paint,
+    /// glass, rubber, metal, and the materials of the user's assets.
+    Pbr(Pbr),
+}
+
+/// glTF metallic-roughness parameters (`pbrMetallicRoughness`), with
+/// `KHR_materials_clearcoat`, `KHR_materials_transmission`, `KHR_materials_ior` and
+/// `KHR_materials_volume` when set.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Pbr {
+    /// baseColorFactor (linear RGB; alpha is written as 1).
+    pub base_color: [f64; 3],
+    /// metallicFactor in [0, 1].
+    pub metallic: f64,
+    /// roughnessFactor in [0, 1] (perceptual: GGX alpha is its square).
+    pub roughness: f64,
+    /// baseColorTexture: an sRGB PNG multiplying `base_color`, read with the mesh's texture
+    /// coordinates.
+    pub base_color_texture: Option<Png>,
+    /// A clear coat over the base (car paint).
+    pub clearcoat: Option<Clearcoat>,
+    /// Specular transmission (glass).
+    pub transmission: Option<Transmission>,
+}
+
+impl Pbr {
+    /// An opaque dielectric or metal without texture, coat or transmission.
+    pub fn new(base_color: [f64; 3], metallic: f64, roughness: f64) -> Self {
+        Self {
+            base_color,
+            metallic,
+            roughness,
+            base_color_texture: None,
+            clearcoat: None,
+            transmission: None,
+        }
+    }
+}
+
+/// `KHR_materials_clearcoat`: a smooth dielectric layer (index 1.5) over the base.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Clearcoat {
+    /// clearcoatFactor in [0, 1].
+    pub factor: f64,
+    /// clearcoatRoughnessFactor in [0, 1].
+    pub roughness: f64,
+}
+
+/// `KHR_materials_transmission` with its index of refraction (`KHR_materials_ior`).
+/// Without a volume the surface is thin-walled: light goes through without bending, tinted
+/// by the base colour (a window pane modelled as one sheet).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Transmission {
+    /// transmissionFactor in [0, 1].
+    pub factor: f64,
+    /// Index of refraction (1.5 for soda-lime glass).
+    pub ior: f64,
+    /// `KHR_materials_volume`, for a closed mesh of thick glass.
+    pub volume: Option<Volume>,
+}
+
+/// `KHR_materials_volume`: the medium inside a closed transmissive mesh.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Volume {
+    /// thicknessFactor, metres (> 0).
+    pub thickness: f64,
+    /// attenuationColor: the colour white light has after `attenuation_distance`.
+    pub attenuation_color: [f64; 3],
+    /// attenuationDistance, metres (> 0).
+    pub attenuation_distance: f64,
+}
+
+/// A PNG image carried by a material before it is in a [`Doc`]: written once per document
+/// as `DOC_NAME.png`, shared by every material that carries the same name and bytes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Png {
+    /// The file-name suffix (`DOC_NAME.png`).
+    pub name: String,
+    /// The encoded PNG.
+    pub bytes: Arc<Vec<u8>>,
 }
 
 /// A material: reflectance plus optional emission.
@@ -177,6 +258,17 @@ impl Material {
     /// A Mitsuba-style diffuse material: `ggx` with ks = 0.
     pub fn diffuse(name: &str, kd: [f64; 3]) -> Self {
         Self::paper(name, PaperBsdf::Ggx { alpha: 0.5 }, kd, [0.0; 3])
+    }
+
+    /// A glTF metallic-roughness material without emission.
+    pub fn pbr(name: &str, pbr: Pbr) -> Self {
+        Self {
+            name: name.to_owned(),
+            reflect: Reflect::Pbr(pbr),
+            emission: None,
+            double_sided: false,
+            road: false,
+        }
     }
 
     /// A black, one-sided emitter of radiance `radiance`.
@@ -426,11 +518,27 @@ impl Doc {
         let pos = self.push_vec_accessor(&positions, true);
         let nor = self.push_vec_accessor(&normals, false);
         let mut attributes = json!({ "POSITION": pos, "NORMAL": nor });
-        let textured = matches!(
-            &material.reflect,
-            Reflect::Paper { dryness, albedo, normal, .. }
-                if dryness.is_some() || albedo.is_some() || normal.is_some()
-        );
+        let textured = match &material.reflect {
+            Reflect::Paper {
+                dryness,
+                albedo,
+                normal,
+                ..
+            } => dryness.is_some() || albedo.is_some() || normal.is_some(),
+            Reflect::Pbr(p) => p.base_color_texture.is_some(),
+            Reflect::Black => false,
+        };
+        if textured && mesh.uvs.len() != mesh.positions.len() {
+            return Err(Error::Scene {
+                scene: self.name.clone(),
+                element: name.to_owned(),
+                reason: format!(
+                    "a textured material needs one texture coordinate per vertex ({} for {})",
+                    mesh.uvs.len(),
+                    mesh.positions.len()
+                ),
+            });
+        }
         if textured {
             let bytes: Vec<u8> = mesh
                 .uvs
@@ -496,9 +604,68 @@ impl Doc {
         }
     }
 
+    /// The image index of `png`, adding it on first use (same name and bytes); another
+    /// image of the same name gets a numbered name.
+    fn png_index(&mut self, png: &Png) -> usize {
+        let mut suffix = png.name.clone();
+        for n in 1.. {
+            let file = format!("{}_{}.png", self.name, suffix);
+            match self.images.iter().position(|(f, _)| *f == file) {
+                Some(i) if self.images[i].1[..] == png.bytes[..] => return i,
+                Some(_) => suffix = format!("{}_{n}", png.name),
+                None => break,
+            }
+        }
+        self.add_png(&suffix, png.bytes.to_vec())
+    }
+
     fn material_index(&mut self, m: &Material) -> usize {
         let mut v = json!({ "name": m.name });
         match &m.reflect {
+            Reflect::Pbr(p) => {
+                let b = p.base_color.map(round7);
+                let mut pbr = json!({
+                    "baseColorFactor": [b[0], b[1], b[2], 1.0],
+                    "metallicFactor": round7(p.metallic),
+                    "roughnessFactor": round7(p.roughness),
+                });
+                if let Some(png) = &p.base_color_texture {
+                    let image = self.png_index(png);
+                    let tex = self.texture_index(image);
+                    pbr["baseColorTexture"] = json!({ "index": tex });
+                }
+                v["pbrMetallicRoughness"] = pbr;
+                let mut ext = serde_json::Map::new();
+                if let Some(c) = p.clearcoat {
+                    ext.insert(
+                        "KHR_materials_clearcoat".into(),
+                        json!({
+                            "clearcoatFactor": round7(c.factor),
+                            "clearcoatRoughnessFactor": round7(c.roughness),
+                        }),
+                    );
+                }
+                if let Some(t) = p.transmission {
+                    ext.insert(
+                        "KHR_materials_transmission".into(),
+                        json!({ "transmissionFactor": round7(t.factor) }),
+                    );
+                    ext.insert("KHR_materials_ior".into(), json!({ "ior": round7(t.ior) }));
+                    if let Some(vol) = t.volume {
+                        ext.insert(
+                            "KHR_materials_volume".into(),
+                            json!({
+                                "thicknessFactor": round7(vol.thickness),
+                                "attenuationColor": vol.attenuation_color.map(round7),
+                                "attenuationDistance": round7(vol.attenuation_distance),
+                            }),
+                        );
+                    }
+                }
+                if !ext.is_empty() {
+                    v["extensions"] = Value::Object(ext);
+                }
+            }
             Reflect::Black => {
                 v["pbrMetallicRoughness"] = json!({
                     "baseColorFactor": [0.0, 0.0, 0.0, 1.0],
@@ -575,9 +742,8 @@ impl Doc {
                     round7(e[2] / peak)
                 ]);
                 if peak != 1.0 {
-                    v["extensions"] = json!({
-                        "KHR_materials_emissive_strength": { "emissiveStrength": peak }
-                    });
+                    v["extensions"]["KHR_materials_emissive_strength"] =
+                        json!({ "emissiveStrength": peak });
                 }
             }
         }
@@ -677,11 +843,20 @@ impl Doc {
             used.push("KHR_lights_punctual");
             root["extensions"] = json!({ "KHR_lights_punctual": { "lights": self.lights } });
         }
-        if self.materials.iter().any(|m| {
-            m.pointer("/extensions/KHR_materials_emissive_strength")
-                .is_some()
-        }) {
-            used.push("KHR_materials_emissive_strength");
+        for ext in [
+            "KHR_materials_emissive_strength",
+            "KHR_materials_clearcoat",
+            "KHR_materials_transmission",
+            "KHR_materials_ior",
+            "KHR_materials_volume",
+        ] {
+            if self
+                .materials
+                .iter()
+                .any(|m| m.pointer(&format!("/extensions/{ext}")).is_some())
+            {
+                used.push(ext);
+            }
         }
         if self.materials.iter().any(|m| {
             m.pointer("/normalTexture/extensions/KHR_texture_transform")
@@ -795,6 +970,84 @@ mod tests {
             d.materials[1]["emissiveFactor"][2].as_f64(),
             Some(round7(1.0 / 3.0))
         );
+    }
+
+    /// Paint with a clear coat, thin glass and thick glass written by the writer load in the
+    /// renderer as glTF PBR with the factors written, and without warnings.
+    #[test]
+    fn pbr_materials_load_in_the_renderer() {
+        use streaks_render::material::Reflectance;
+        let mut d = Doc::new("pbr", "");
+        let paint = Pbr {
+            clearcoat: Some(Clearcoat {
+                factor: 1.0,
+                roughness: 0.03,
+            }),
+            ..Pbr::new([0.5, 0.02, 0.01], 0.4, 0.35)
+        };
+        let thin = Pbr {
+            transmission: Some(Transmission {
+                factor: 0.9,
+                ior: 1.52,
+                volume: None,
+            }),
+            ..Pbr::new([0.8, 0.85, 0.82], 0.0, 0.0)
+        };
+        let thick = Pbr {
+            transmission: Some(Transmission {
+                factor: 1.0,
+                ior: 1.5,
+                volume: Some(Volume {
+                    thickness: 0.01,
+                    attenuation_color: [0.5, 0.8, 0.7],
+                    attenuation_distance: 0.2,
+                }),
+            }),
+            ..Pbr::new([1.0; 3], 0.0, 0.05)
+        };
+        let mut lit = Material::pbr("lit", Pbr::new([0.1; 3], 0.0, 0.5));
+        lit.emission = Some([4.0, 2.0, 1.0]);
+        let mut m = Mesh::new();
+        m.cuboid(Vec3::ZERO, Vec3::ONE);
+        for (k, mat) in [
+            Material::pbr("paint", paint),
+            Material::pbr("thin_glass", thin),
+            Material::pbr("thick_glass", thick),
+            lit,
+        ]
+        .iter()
+        .enumerate()
+        {
+            d.add_tagged_mesh(&format!("m{k}"), &m, mat, Tag::object(Class::Car, 1))
+                .unwrap();
+        }
+        let dir = tempfile::tempdir().unwrap();
+        d.write(dir.path()).unwrap();
+        let scene = streaks_render::scene::Scene::load(&dir.path().join("pbr.gltf")).unwrap();
+        assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+        let get = |name: &str| {
+            let m = scene.materials.iter().find(|m| m.name == name).unwrap();
+            let Reflectance::GltfPbr(p) = &m.reflectance else {
+                panic!("{name} is not glTF PBR: {:?}", m.reflectance);
+            };
+            (p.clone(), m.emission)
+        };
+        let (p, _) = get("paint");
+        assert_eq!(p.base_color, glam::Vec3::new(0.5, 0.02, 0.01));
+        assert_eq!((p.metallic, p.roughness), (0.4, 0.35));
+        assert_eq!((p.clearcoat, p.clearcoat_roughness), (1.0, 0.03));
+        assert_eq!(p.transmission, 0.0);
+        let (p, _) = get("thin_glass");
+        assert_eq!((p.transmission, p.ior, p.clearcoat), (0.9, 1.52, 0.0));
+        assert!(p.volume.is_none());
+        let (p, _) = get("thick_glass");
+        let v = p.volume.expect("a volume");
+        assert_eq!(v.thickness, 0.01);
+        // attenuationColor c after distance d: sigma_a = -ln(c) / d.
+        let want = -(0.8f32.ln()) / 0.2;
+        assert!((v.sigma_a.y - want).abs() < 1e-4, "{} {want}", v.sigma_a.y);
+        let (_, e) = get("lit");
+        assert_eq!(e, glam::Vec3::new(4.0, 2.0, 1.0));
     }
 
     #[test]

@@ -26,6 +26,7 @@ pub mod gltf_writer;
 pub mod light_sources;
 pub mod mesh;
 pub mod model;
+pub mod objects;
 pub mod paper;
 pub mod procedural;
 pub mod street;
@@ -68,6 +69,14 @@ pub enum Error {
         /// The cause.
         #[source]
         source: std::io::Error,
+    },
+    /// A glTF asset of the user's pool cannot be used.
+    #[error("asset {}: {reason}", path.display())]
+    Asset {
+        /// The asset's file.
+        path: PathBuf,
+        /// What is wrong.
+        reason: String,
     },
     /// A generator config does not parse or has a bad value.
     #[error("generator config {origin}: {reason}")]

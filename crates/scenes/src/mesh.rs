@@ -155,6 +155,135 @@ impl Mesh {
     }
 }
 
+/// Solids for modelled objects (cars, street furniture): flat-shaded facets, prisms from a
+/// side profile, cylinders along any axis, ellipsoids and flat polygons.
+impl Mesh {
+    /// One flat triangle with its geometric normal, wound to face `outward`; texture
+    /// coordinates are the corners' positions projected on the triangle's plane (metres).
+    pub fn facet(&mut self, p: [Vec3; 3], outward: Vec3) {
+        let g = (p[1] - p[0]).cross(p[2] - p[0]);
+        if g.length_squared() < 1e-16 {
+            return;
+        }
+        let n = if g.dot(outward) >= 0.0 {
+            g.normalize()
+        } else {
+            -g.normalize()
+        };
+        let u = (p[1] - p[0]).normalize();
+        let v = n.cross(u);
+        let i: Vec<u32> = p
+            .iter()
+            .map(|&q| self.vertex(q, n, Vec2::new((q - p[0]).dot(u), (q - p[0]).dot(v))))
+            .collect();
+        self.triangle(i[0], i[1], i[2], n);
+    }
+
+    /// A flat convex polygon (corners in order around it), one-sided, facing `normal`.
+    pub fn polygon(&mut self, p: &[Vec3], normal: Vec3) {
+        for k in 1..p.len().saturating_sub(1) {
+            self.facet([p[0], p[k], p[k + 1]], normal);
+        }
+    }
+
+    /// A closed prism: the convex polygon `profile` in the (z, y) plane (corners in order
+    /// around it, any orientation) extruded across X from `-half_width(y)` to
+    /// `+half_width(y)`. A half width that falls linearly with height gives a body's
+    /// tumblehome; the sides stay planar. Facets face away from the solid's centroid.
+    pub fn prism(&mut self, profile: &[Vec2], half_width: impl Fn(f32) -> f32) {
+        let n = profile.len();
+        if n < 3 {
+            return;
+        }
+        let at = |k: usize, side: f32| {
+            let q = profile[k % n];
+            Vec3::new(side * half_width(q.y), q.y, q.x)
+        };
+        let centre = profile
+            .iter()
+            .fold(Vec3::ZERO, |c, q| c + Vec3::new(0.0, q.y, q.x))
+            / n as f32;
+        let face = |m: &mut Mesh, t: [Vec3; 3]| {
+            let c = (t[0] + t[1] + t[2]) / 3.0;
+            m.facet(t, c - centre);
+        };
+        for side in [-1.0f32, 1.0] {
+            for k in 1..n - 1 {
+                face(self, [at(0, side), at(k, side), at(k + 1, side)]);
+            }
+        }
+        for k in 0..n {
+            let (a, b) = (at(k, -1.0), at(k + 1, -1.0));
+            let (c, d) = (at(k + 1, 1.0), at(k, 1.0));
+            face(self, [a, b, c]);
+            face(self, [a, c, d]);
+        }
+    }
+
+    /// A closed cylinder from `a` to `b` (smooth sides, flat caps at both ends), outward.
+    pub fn cylinder_between(&mut self, a: Vec3, b: Vec3, radius: f32, segments: u32) {
+        let axis = (b - a).normalize();
+        let (e1, e2) = axis.any_orthonormal_pair();
+        let dir = |k: u32| {
+            let t = std::f32::consts::TAU * (k % segments) as f32 / segments as f32;
+            e1 * t.cos() + e2 * t.sin()
+        };
+        let height = (b - a).length();
+        for k in 0..segments {
+            let (d0, d1) = (dir(k), dir(k + 1));
+            let arc = std::f32::consts::TAU * radius / segments as f32;
+            let (u0, u1) = (k as f32 * arc, (k + 1) as f32 * arc);
+            let i0 = self.vertex(a + d0 * radius, d0, Vec2::new(u0, height));
+            let i1 = self.vertex(a + d1 * radius, d1, Vec2::new(u1, height));
+            let j1 = self.vertex(b + d1 * radius, d1, Vec2::new(u1, 0.0));
+            let j0 = self.vertex(b + d0 * radius, d0, Vec2::new(u0, 0.0));
+            let out = (d0 + d1).normalize();
+            self.triangle(i0, i1, j1, out);
+            self.triangle(i0, j1, j0, out);
+        }
+        for (c, n) in [(a, -axis), (b, axis)] {
+            let ci = self.vertex(c, n, Vec2::ZERO);
+            for k in 0..segments {
+                let (d0, d1) = (dir(k), dir(k + 1));
+                let p = self.vertex(c + d0 * radius, n, (d0 * radius).truncate());
+                let q = self.vertex(c + d1 * radius, n, (d1 * radius).truncate());
+                self.triangle(ci, p, q, n);
+            }
+        }
+    }
+
+    /// A closed ellipsoid with semi-axes `radii` along X, Y and Z (a [`Mesh::sphere`]
+    /// stretched, normals transformed with it).
+    pub fn ellipsoid(&mut self, centre: Vec3, radii: Vec3, rings: u32, segments: u32) {
+        let first = self.positions.len();
+        self.sphere(Vec3::ZERO, 1.0, rings, segments);
+        for k in first..self.positions.len() {
+            self.positions[k] = centre + self.positions[k] * radii;
+            self.normals[k] = (self.normals[k] / radii).normalize();
+        }
+    }
+
+    /// A flat one-sided disc of `segments` sides facing `normal`.
+    pub fn disc(&mut self, centre: Vec3, normal: Vec3, radius: f32, segments: u32) {
+        let (e1, e2) = normal.normalize().any_orthonormal_pair();
+        let ring: Vec<Vec3> = (0..segments)
+            .map(|k| {
+                let t = std::f32::consts::TAU * k as f32 / segments as f32;
+                centre + (e1 * t.cos() + e2 * t.sin()) * radius
+            })
+            .collect();
+        self.polygon(&ring, normal);
+    }
+
+    /// Smallest and largest corner of the axis-aligned box around the vertices.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.positions.iter().fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), &p| (lo.min(p), hi.max(p)),
+        )
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
