@@ -413,8 +413,15 @@ pub fn page(report: &Report, thumbs: &[SampleThumbs]) -> String {
     for s in &report.samples {
         for (j, r) in s.results.iter().enumerate() {
             let first = if j == 0 {
+                let plane = match &s.road_plane {
+                    Some(c) if c.violated => format!(
+                        "<br><span class=\"fail\" title=\"{}\">not on the road plane</span>",
+                        esc(&c.message())
+                    ),
+                    _ => String::new(),
+                };
                 format!(
-                    "<td rowspan=\"{}\">{}<br><span class=\"note\">{}x{}</span></td>",
+                    "<td rowspan=\"{}\">{}<br><span class=\"note\">{}x{}</span>{plane}</td>",
                     s.results.len(),
                     esc(&s.id),
                     s.width,

@@ -475,10 +475,13 @@ pub fn run(args: Args) -> Result<()> {
         .output
         .clone()
         .unwrap_or_else(|| root.join("stats.html"));
-    let page_dir = page_path
+    let page_parent = page_path
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."))
+        .unwrap_or(Path::new("."));
+    std::fs::create_dir_all(page_parent)
+        .with_context(|| format!("cannot create the folder {}", page_parent.display()))?;
+    let page_dir = page_parent
         .canonicalize()
         .with_context(|| format!("cannot open the folder of {}", page_path.display()))?;
 
