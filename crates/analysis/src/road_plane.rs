@@ -87,7 +87,7 @@ impl RoadPlaneCheck {
         let cxy = sxy / nf - mx * my;
         let czy = szy / nf - mz * my;
         let det = cxx * czz - cxz * cxz;
-        if !(det > 1e-12 * (cxx * czz).max(1e-300)) {
+        if det.is_nan() || det <= 1e-12 * (cxx * czz).max(1e-300) {
             return None;
         }
         let a = (cxy * czz - czy * cxz) / det;

@@ -120,13 +120,12 @@ fn lk_err(what: impl Into<String>) -> impl FnOnce(LkError) -> ReportError {
 fn analyze_streak(
     index: usize,
     streak: &Streak,
-    input: &StereoInput,
-    prepared: (&GrayImage, &GrayImage),
-    view: &RigView,
+    on: &RegionInput,
     params: &AnalyzeParams,
     lk: &LkParams,
     predict: bool,
 ) -> Result<StreakReport, ReportError> {
+    let (input, view) = (on.input, on.view);
     let (w, h) = (input.left.width as f32, input.left.height);
     let centres: Vec<(usize, f32)> = streak
         .centres
@@ -134,7 +133,7 @@ fn analyze_streak(
         .copied()
         .filter(|&(y, x)| y < h && (0.0..=w).contains(&x))
         .collect();
-    let measured = lk_rows(prepared.0, prepared.1, &centres, lk)
+    let measured = lk_rows(on.left, on.right, &centres, lk)
         .map_err(lk_err(format!("LK along streak {index}")))?;
     let mut light = match_light(streak, &input.lights, view, params.match_tolerance_px);
     let mut predicted = std::collections::HashMap::new();
@@ -213,7 +212,7 @@ fn analyze_streak(
     })
 }
 
-/// What [`measure_region`] needs besides the region.
+/// What [`measure_region`] and [`analyze_streak`] need besides the region or streak.
 struct RegionInput<'a> {
     input: &'a StereoInput,
     view: &'a RigView,
@@ -312,12 +311,6 @@ pub fn analyze(input: &StereoInput, params: &AnalyzeParams) -> Result<Analysis, 
     let found = detect_streaks(&input.left, &detect)?;
     // Every LK measurement is made on the prepared pair.
     let (left, right) = prepare_pair(&input.left, &input.right);
-    let streaks = found
-        .streaks
-        .iter()
-        .enumerate()
-        .map(|(i, s)| analyze_streak(i, s, input, (&left, &right), &view, params, &lk, predict))
-        .collect::<Result<Vec<_>, _>>()?;
     let ri = RegionInput {
         input,
         view: &view,
@@ -325,6 +318,12 @@ pub fn analyze(input: &StereoInput, params: &AnalyzeParams) -> Result<Analysis, 
         right: &right,
         min_ncc: params.min_ncc,
     };
+    let streaks = found
+        .streaks
+        .iter()
+        .enumerate()
+        .map(|(i, s)| analyze_streak(i, s, &ri, params, &lk, predict))
+        .collect::<Result<Vec<_>, _>>()?;
     let mut regions = Vec::new();
     for r in &params.regions {
         let g = r.region;
