@@ -12,6 +12,7 @@ mod detect;
 mod disparity;
 mod export_mitsuba;
 mod figure;
+mod html;
 mod lk;
 mod locus;
 mod paper;

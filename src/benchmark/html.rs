@@ -2,6 +2,7 @@
 //! bar charts, thumbnails as base64 PNG data URIs), readable offline.
 
 use super::report::{FailureKind, MethodScore, Report, REGIONS};
+use crate::html::{bar_chart, esc, Bar, CSS};
 use anyhow::Result;
 use std::fmt::Write;
 use streaks_analysis::benchmark::{
@@ -57,14 +58,6 @@ impl SampleThumbs {
     }
 }
 
-/// `s` escaped for HTML text and attributes.
-fn esc(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
-}
-
 fn pct(v: f64) -> String {
     format!("{:.1} %", 100.0 * v)
 }
@@ -93,48 +86,6 @@ fn esc_code(s: &str) -> String {
         .collect()
 }
 
-const CSS: &str = r#"
-:root { --ink: #1f2430; --muted: #5b6475; --line: #e3e6ec; --bg: #f6f7f9; --card: #fff; }
-* { box-sizing: border-box; }
-body { margin: 0; font: 15px/1.5 system-ui, -apple-system, "Segoe UI", Roboto, sans-serif;
-       color: var(--ink); background: var(--bg); }
-header { background: #1f2a44; color: #fff; padding: 28px 40px 22px; }
-header h1 { margin: 0 0 6px; font-size: 26px; font-weight: 650; letter-spacing: .2px; }
-header p { margin: 2px 0; color: #c9d1e4; }
-main { padding: 10px 40px 40px; max-width: 1400px; }
-section { background: var(--card); border: 1px solid var(--line); border-radius: 10px;
-          padding: 18px 22px; margin: 22px 0; box-shadow: 0 1px 2px rgba(0,0,0,.04); }
-h2 { margin: 0 0 12px; font-size: 19px; }
-h3 { margin: 18px 0 8px; font-size: 15px; color: var(--muted); font-weight: 600; }
-table { border-collapse: collapse; margin: 4px 0 10px; font-variant-numeric: tabular-nums; }
-th, td { padding: 5px 12px; text-align: right; border-bottom: 1px solid var(--line); }
-th { font-weight: 600; color: var(--muted); font-size: 13px; background: #fafbfc; }
-td:first-child, th:first-child, td.l, th.l { text-align: left; }
-td:first-child { white-space: nowrap; }
-tr:last-child td { border-bottom: none; }
-.swatch { display: inline-block; width: 11px; height: 11px; border-radius: 2px;
-          margin-right: 7px; vertical-align: -1px; }
-.grid { display: flex; flex-wrap: wrap; gap: 18px 26px; }
-.grid > div { flex: 0 1 auto; }
-.note { color: var(--muted); font-size: 13.5px; max-width: 1000px; }
-.methods td, .methods th { text-align: left; }
-td.none { color: #9aa1ad; }
-.sample { margin: 14px 0 22px; }
-.sample h3 { margin: 0 0 6px; color: var(--ink); }
-.thumbs { display: grid; grid-template-columns: repeat(auto-fill, minmax(220px, 1fr));
-          gap: 10px; max-width: 1300px; }
-figure { margin: 0; }
-figure img { display: block; width: 100%; height: auto; border-radius: 4px;
-             border: 1px solid var(--line); }
-figcaption { font-size: 12.5px; color: var(--muted); margin-top: 3px; }
-code { background: #eef1f5; padding: 1px 5px; border-radius: 4px; font-size: 13px; }
-.fail { color: #b3261e; font-weight: 600; }
-p.fail { background: #fdecea; border: 1px solid #f3b8b3; border-radius: 6px; padding: 8px 12px; }
-pre { background: #f3f4f7; padding: 6px 8px; border-radius: 4px; font-size: 12px;
-      max-height: 260px; overflow: auto; white-space: pre-wrap; text-align: left; }
-td.reason { text-align: left; max-width: 700px; }
-"#;
-
 /// The failed-samples cell of a summary row: `–` when none.
 fn failed_cell(m: &MethodScore) -> String {
     match m.failed {
@@ -160,41 +111,6 @@ fn region_row(out: &mut String, method: &str, colour: &str, e: &DisparityErrors)
         pct(e.below_1px),
         e.truth_pixels
     );
-}
-
-/// A horizontal bar chart (inline SVG) of `(label, colour, value)` bars, values formatted by
-/// `fmt`.
-fn bar_chart(title: &str, bars: &[Bar], fmt: &dyn Fn(f64) -> String) -> String {
-    let (label_w, bar_w, row_h) = (140.0, 300.0, 24.0);
-    let max = bars.iter().map(|b| b.2).fold(0.0f64, f64::max);
-    let scale = if max > 0.0 { bar_w / max } else { 0.0 };
-    let h = 30.0 + row_h * bars.len() as f64;
-    let mut s = format!(
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" \
-         role=\"img\" aria-label=\"{t}\"><text x=\"0\" y=\"16\" font-size=\"13.5\" \
-         font-weight=\"600\" fill=\"#1f2430\">{t}</text>",
-        w = label_w + bar_w + 80.0,
-        t = esc(title)
-    );
-    for (i, (label, colour, v)) in bars.iter().enumerate() {
-        let y = 28.0 + row_h * i as f64;
-        let len = (v * scale).max(if *v > 0.0 { 1.0 } else { 0.0 });
-        let _ = write!(
-            s,
-            "<text x=\"{lx}\" y=\"{ty}\" font-size=\"12.5\" text-anchor=\"end\" \
-             fill=\"#5b6475\">{l}</text><rect x=\"{label_w}\" y=\"{y}\" width=\"{len:.1}\" \
-             height=\"{bh}\" rx=\"3\" fill=\"{colour}\"/><text x=\"{vx:.1}\" y=\"{ty}\" \
-             font-size=\"12\" fill=\"#1f2430\">{v}</text>",
-            lx = label_w - 8.0,
-            ty = y + 13.0,
-            l = esc(label),
-            bh = row_h - 7.0,
-            vx = label_w + len + 6.0,
-            v = esc(&fmt(*v)),
-        );
-    }
-    s.push_str("</svg>");
-    s
 }
 
 /// The legend of the error maps (inline SVG).
@@ -318,9 +234,6 @@ fn failures(o: &mut String, report: &Report) {
     }
     o.push_str("</section>\n");
 }
-
-/// A bar of a chart: label, colour, value.
-type Bar = (String, String, f64);
 
 /// The page.
 pub fn page(report: &Report, thumbs: &[SampleThumbs]) -> String {
@@ -500,8 +413,15 @@ pub fn page(report: &Report, thumbs: &[SampleThumbs]) -> String {
     for s in &report.samples {
         for (j, r) in s.results.iter().enumerate() {
             let first = if j == 0 {
+                let plane = match &s.road_plane {
+                    Some(c) if c.violated => format!(
+                        "<br><span class=\"fail\" title=\"{}\">not on the road plane</span>",
+                        esc(&c.message())
+                    ),
+                    _ => String::new(),
+                };
                 format!(
-                    "<td rowspan=\"{}\">{}<br><span class=\"note\">{}x{}</span></td>",
+                    "<td rowspan=\"{}\">{}<br><span class=\"note\">{}x{}</span>{plane}</td>",
                     s.results.len(),
                     esc(&s.id),
                     s.width,

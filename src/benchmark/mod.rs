@@ -31,9 +31,11 @@ use report::{Input, MethodInfo, MethodScore, Report, SampleReport};
 use std::path::PathBuf;
 use std::time::Duration;
 use streaks_analysis::benchmark::{error_map, score_regions, BAD_THRESHOLD_PX};
-use streaks_dataset::files::load_mask;
+use streaks_analysis::road_plane::RoadPlaneCheck;
+use streaks_dataset::files::{load_mask, SampleDir};
 use streaks_image::pfm::read_pfm;
 use streaks_image::{write_bytes_atomically, GrayImage};
+use streaks_stereo::rig::Eye;
 
 /// Score stereo methods against a dataset's or pair folders' ground truth.
 #[derive(clap::Args, Debug)]
@@ -121,6 +123,19 @@ fn methods(args: &Args) -> Result<Vec<Method>> {
     Ok(out)
 }
 
+/// The road-plane check of `sample` with its `road` mask ([`RoadPlaneCheck::from_depth`]),
+/// when it has a ground-truth depth (`None` without one).
+fn road_plane(sample: &input::Sample, road: &GrayImage) -> Result<Option<RoadPlaneCheck>> {
+    let files = SampleDir::open(&sample.dir)?;
+    let path = files.depth(Eye::Left);
+    if !path.is_file() {
+        return Ok(None);
+    }
+    let depth = read_pfm(&path).with_context(|| format!("reading the depth {}", path.display()))?;
+    let (rig, _) = files.rig()?;
+    Ok(RoadPlaneCheck::from_depth(&depth, road, &rig))
+}
+
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<()> {
     let methods = methods(&args)?;
@@ -181,12 +196,20 @@ pub fn run(args: Args) -> Result<()> {
                 .to_rgb8();
             thumbs.push(html::SampleThumbs::new(&sample.id, &left, &maps)?);
         }
+        let road_plane = match &road {
+            Some(road) => road_plane(sample, road)?,
+            None => None,
+        };
+        if let Some(c) = road_plane.filter(|c| c.violated) {
+            bar.suspend(|| eprintln!("warning: sample {}: {}", sample.id, c.message()));
+        }
         sample_reports.push(SampleReport {
             id: sample.id.clone(),
             dir: sample.dir.display().to_string(),
             width: size.0,
             height: size.1,
             road_mask: road.is_some(),
+            road_plane,
             results,
         });
     }

@@ -7,6 +7,8 @@
 //!   and `splits/`;
 //! - [`preview`]: `streaks dataset preview SAMPLE -o PNG` writes a sample's left image beside
 //!   its ground-truth disparity (and rain mask) for a person to look at;
+//! - [`stats`]: `streaks dataset stats DIR` writes an HTML page of histograms of the drawn
+//!   parameters, with thumbnails, and a contact sheet;
 //! - [`sample`]: rendering and writing one sample.
 //!
 //! The folder layout, `dataset.json`, `meta.json`, the manifest, the locks, the shards and the
@@ -18,6 +20,7 @@ pub mod generate;
 pub mod index;
 pub mod preview;
 pub mod sample;
+pub mod stats;
 
 use anyhow::Result;
 
@@ -39,6 +42,9 @@ enum Command {
     /// Write a sample's left image beside its ground-truth disparity (and rain or fog mask) as one
     /// PNG.
     Preview(preview::Args),
+    /// Write an HTML page of histograms of the drawn parameters, with thumbnails, and a contact
+    /// sheet of twelve samples.
+    Stats(stats::Args),
 }
 
 /// Runs the subcommand.
@@ -47,5 +53,6 @@ pub fn run(args: Args) -> Result<()> {
         Command::Generate(a) => generate::run(a),
         Command::Index(a) => index::run(a),
         Command::Preview(a) => preview::run(a),
+        Command::Stats(a) => stats::run(a),
     }
 }

@@ -190,3 +190,55 @@ fn analyze_reads_a_dataset_sample() {
         (baseline(&r["rig"]["baseline_m"]) - baseline(&meta["rig"]["baseline_m"])).abs() < 1e-6
     );
 }
+
+/// `streaks analyze` checks the road plane of a dataset sample from its depth and road mask;
+/// with the road pixels' depths stretched by 30 % (points below the plane, farther down the
+/// farther they are), it warns, records the violation in report.json, and predicts no streak.
+#[test]
+fn analyze_says_when_the_road_is_not_a_plane() {
+    let t = TestDir::new();
+    t.streaks(&[
+        "dataset", "generate", "-o", "ds", "--count", "1", "--width", "96", "--height", "64",
+        "--spp", "2",
+    ])
+    .assert_success();
+    let sample = t.join("ds/samples/000000");
+    let run = t.streaks(&["analyze", "ds/samples/000000"]);
+    run.assert_success();
+    let report = || -> serde_json::Value {
+        serde_json::from_slice(&std::fs::read(sample.join("analysis/report.json")).unwrap())
+            .unwrap()
+    };
+    let plane = &report()["road_plane"];
+    assert!(plane["points"].as_u64().unwrap() >= 20, "{plane}");
+    assert!(run.stderr().contains("road plane") || run.stderr().contains("road-plane"));
+
+    let depth_path = sample.join("depth0.pfm");
+    let mut depth = streaks_image::pfm::read_pfm(&depth_path).unwrap();
+    let road = streaks_image::GrayImage::load(&sample.join("road0.png")).unwrap();
+    for (z, m) in depth.data.iter_mut().zip(&road.data) {
+        if *m > 0.5 {
+            *z *= 1.3;
+        }
+    }
+    streaks_image::pfm::write_pfm(&depth_path, &depth).unwrap();
+    let run = t.streaks(&["analyze", "ds/samples/000000"]);
+    run.assert_success();
+    assert!(
+        run.stderr()
+            .contains("warning: road-plane assumption violated"),
+        "{}",
+        run.stderr()
+    );
+    let r = report();
+    let plane = &r["road_plane"];
+    assert_eq!(plane["violated"], true, "{plane}");
+    // The rig is about 1.2 m high: at 30 % more depth a road point is 0.3 x 1.2 m below.
+    assert!(plane["max_m"].as_f64().unwrap() < -0.2, "{plane}");
+    for s in r["streaks"].as_array().unwrap() {
+        assert!(s["comparison"].is_null() && s["centre_comparison"].is_null());
+        for row in s["rows"].as_array().unwrap() {
+            assert!(row["predicted_px"].is_null(), "{row}");
+        }
+    }
+}

@@ -1,4 +1,5 @@
-//! End-to-end tests of `streaks dataset generate` and `streaks dataset index`: determinism
+//! End-to-end tests of `streaks dataset generate`, `streaks dataset index` and `streaks dataset
+//! stats`: determinism
 //! (repeated, other thread counts, sharded), resuming and repair, the ground truth's formats,
 //! and bad input. Tiny images (64 x 40 at 2 spp) keep them fast in debug builds.
 
@@ -909,4 +910,62 @@ fn weather_samples_have_rain_and_fog_masks_and_a_preview() {
     t.streaks(&["dataset", "preview", "ds/samples/000009", "-o", "q.png"])
         .assert_failure_mentioning("im0.png");
     assert!(!t.join("q.png").exists());
+}
+
+/// `dataset stats` writes its page, thumbnails and contact sheet; the page shows the drawn
+/// parameters with their config ranges; hostile strings in a `meta.json` reach the page
+/// escaped; a broken sample and a missing one are named, skipped and listed.
+#[test]
+fn stats_page_shows_the_parameters_and_escapes_what_it_reads() {
+    let t = TestDir::new();
+    generate(&t, "ds", &[]).assert_success();
+    t.streaks(&["dataset", "stats", "ds"]).assert_success();
+    let page = std::fs::read_to_string(t.join("ds/stats.html")).unwrap();
+    let config: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(t.join("ds/dataset.json")).unwrap()).unwrap();
+    let height = config["config"]["lamps"]["height"].to_string();
+    assert!(page.contains("[lamps]") && page.contains(">lamps.height</text>"));
+    assert!(
+        page.contains(&format!("config: <code>{height}</code>")),
+        "{height}"
+    );
+    assert_eq!(
+        t.files_in("ds/stats/thumbs"),
+        ["000000.png", "000001.png", "000002.png"]
+    );
+    for id in ["000000", "000001", "000002"] {
+        assert!(page.contains(&format!("href=\"samples/{id}/\"")), "{id}");
+    }
+    // Three tiles of 480 x 300 (64 x 40 enlarged), captions of 26 px, gaps of 4 px.
+    let sheet = image::open(t.join("ds/stats/contact_sheet.png")).unwrap();
+    assert_eq!(
+        (sheet.width(), sheet.height()),
+        (3 * 480 + 4 * 4, 300 + 26 + 2 * 4)
+    );
+
+    // Hostile strings, a broken sample and a missing one.
+    let meta_path = t.join("ds/samples/000001/meta.json");
+    let mut meta: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&meta_path).unwrap()).unwrap();
+    meta["params"]["lamps"]["type"] = "<script>alert(1)</script>".into();
+    meta["split"] = "\"><img src=x onerror=alert(2)>".into();
+    std::fs::write(&meta_path, serde_json::to_vec(&meta).unwrap()).unwrap();
+    std::fs::write(t.join("ds/samples/000002/meta.json"), "{broken").unwrap();
+    std::fs::remove_dir_all(t.join("ds/samples/000000")).unwrap();
+    let run = t.streaks(&["dataset", "stats", "ds", "-o", "out/page.html"]);
+    run.assert_success();
+    assert!(
+        run.stderr().contains("sample 000002 skipped"),
+        "{}",
+        run.stderr()
+    );
+    let page = std::fs::read_to_string(t.join("out/page.html")).unwrap();
+    assert!(!page.contains("<script>") && !page.contains("<img src=x"));
+    assert!(page.contains("&lt;script&gt;alert(1)&lt;/script&gt;"));
+    assert!(page.contains("&quot;&gt;&lt;img src=x onerror=alert(2)&gt;"));
+    assert!(page.contains("Missing or skipped (2)"));
+    assert!(page.contains("<td>000000</td><td class=\"reason\">missing: no sample folder</td>"));
+    assert!(page.contains("<td>000002</td><td class=\"reason\">"));
+    // The page is outside the dataset: its links are file URLs.
+    assert!(page.contains("href=\"file:///"));
 }

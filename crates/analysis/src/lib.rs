@@ -29,6 +29,8 @@
 //! - [`repair`]: streak-robust stereo: the road plane from the pair's own v-disparity, and
 //!   the masking or repair of the pixels streaks and reflections put beneath the road;
 //!   [`repair::estimate`], the dense estimate with or without it.
+//! - [`road_plane`]: whether the road is the plane `Y = 0` the analysis assumes, measured on
+//!   a sample's ground-truth depth and road mask.
 //! - [`sgm`]: dense semi-global matching, and its errors against a ground truth (bad-2.0).
 //! - [`report`]: the per-streak analysis of a rendered or photographed pair (Fig. 6, Fig. 8):
 //!   measured against predicted disparity per row, poles and road against their ground truth,
@@ -70,6 +72,7 @@ pub mod model;
 pub mod plot;
 pub mod repair;
 pub mod report;
+pub mod road_plane;
 pub mod sgm;
 pub mod streak_classifier;
 pub mod synth;

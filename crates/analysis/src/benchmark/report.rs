@@ -224,6 +224,9 @@ pub struct SampleReport {
     pub height: usize,
     /// Whether it has a road mask (else the road regions are `null`).
     pub road_mask: bool,
+    /// How far its road departs from the plane `Y = 0` the analysis assumes, when it has a
+    /// road mask and a ground-truth depth ([`crate::road_plane`]).
+    pub road_plane: Option<crate::road_plane::RoadPlaneCheck>,
     /// Per method.
     pub results: Vec<MethodScore>,
 }

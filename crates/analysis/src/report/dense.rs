@@ -178,6 +178,7 @@ mod tests {
             truth_disparity: Some(truth),
             truth_depth: None,
             truth_streak_mask: Some(mask),
+            truth_road_mask: None,
         };
         let a = analyze(&input, &AnalyzeParams::default()).unwrap();
         let acc = a.report.dense.accuracy.expect("scored against the truth");

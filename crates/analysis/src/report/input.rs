@@ -26,13 +26,16 @@ pub struct StereoInput {
     pub truth_depth: Option<GrayImage>,
     /// The renderer's streak mask of the left image, if present.
     pub truth_streak_mask: Option<GrayImage>,
+    /// The left view's road-surface mask (`road0.png`), if present.
+    pub truth_road_mask: Option<GrayImage>,
 }
 
 impl StereoInput {
     /// Loads the sample folder `dir` ([`SampleDir`]: a `streaks stereo` folder in either
     /// layout, or a dataset sample): both images (the EXR, or the PNG when there is no EXR),
     /// the rig and lights (`rig.json`, or a dataset sample's `meta.json`), and the left view's
-    /// ground-truth disparity and depth and the renderer's streak mask if present.
+    /// ground-truth disparity and depth, the renderer's streak mask and the road-surface mask if
+    /// present.
     pub fn load(dir: &Path) -> Result<Self, ReportError> {
         let dataset = |e: streaks_dataset::DatasetError| ReportError::Input {
             path: dir.to_path_buf(),
@@ -53,6 +56,7 @@ impl StereoInput {
             truth_disparity: optional(files.disparity(Eye::Left), read_pfm)?,
             truth_depth: optional(files.depth(Eye::Left), read_pfm)?,
             truth_streak_mask: optional(files.streak_mask(Eye::Left), GrayImage::load)?,
+            truth_road_mask: optional(files.road_mask(Eye::Left), GrayImage::load)?,
         };
         let i = input.rig.intrinsics();
         let size = (i.width() as usize, i.height() as usize);
@@ -73,6 +77,10 @@ impl StereoInput {
             (
                 name(files.streak_mask(Eye::Left)),
                 input.truth_streak_mask.as_ref(),
+            ),
+            (
+                name(files.road_mask(Eye::Left)),
+                input.truth_road_mask.as_ref(),
             ),
         ];
         for (what, img) in named {

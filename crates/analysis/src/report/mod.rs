@@ -62,6 +62,7 @@ use crate::detect::{DetectError, MaskScore};
 use crate::lk::LkError;
 use crate::model::ModelError;
 use crate::plot::PlotError;
+use crate::road_plane::RoadPlaneCheck;
 use crate::sgm::SgmError;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -274,6 +275,10 @@ pub struct Report {
     /// for; this recall is the honest measure of the detector (its precision counts
     /// detections outside those components as false).
     pub detection_vertical: Option<MaskScore>,
+    /// How far the road departs from the plane `Y = 0` that Eq. 4 and the streak-centre model
+    /// assume, from the ground-truth depth and road mask when the input has both. When it is
+    /// violated, no streak gets a prediction (docs/decisions/0048).
+    pub road_plane: Option<RoadPlaneCheck>,
 }
 
 /// The report and the images it was made from.

@@ -281,5 +281,9 @@ pub fn summary_table(report: &Report) -> String {
             d.precision, d.recall, d.truth
         ));
     }
+    if let Some(c) = &report.road_plane {
+        let warn = if c.violated { "warning: " } else { "" };
+        s.push_str(&format!("{warn}{}\n", c.message()));
+    }
     s
 }

@@ -13,6 +13,7 @@ use crate::centre::CentreModel;
 use crate::detect::{detect_streaks, score_mask, vertical_truth, DetectParams, Streak};
 use crate::lk::{lk_rows, prepare_pair, LkError, LkParams, RowDisparity};
 use crate::model::streak_rows;
+use crate::road_plane::RoadPlaneCheck;
 use crate::sgm::{sgm, SgmParams};
 use glam::{DVec3, Vec3};
 use std::path::{Path, PathBuf};
@@ -112,18 +113,19 @@ fn lk_err(what: impl Into<String>) -> impl FnOnce(LkError) -> ReportError {
     move |source| ReportError::Lk { what, source }
 }
 
-/// Measures one streak along its centres and predicts it from the light it is matched to; the
+/// Measures one streak along its centres and predicts it from the light it is matched to
+/// (unless `predict` is false: the road is not the plane Eq. 4 assumes, [`RoadPlaneCheck`]); the
 /// match is dropped when the streak's disparity is the road's
 /// ([`AnalyzeParams::road_reject_px`]: a glow or road texture, not a reflection).
 fn analyze_streak(
     index: usize,
     streak: &Streak,
-    input: &StereoInput,
-    prepared: (&GrayImage, &GrayImage),
-    view: &RigView,
+    on: &RegionInput,
     params: &AnalyzeParams,
     lk: &LkParams,
+    predict: bool,
 ) -> Result<StreakReport, ReportError> {
+    let (input, view) = (on.input, on.view);
     let (w, h) = (input.left.width as f32, input.left.height);
     let centres: Vec<(usize, f32)> = streak
         .centres
@@ -131,11 +133,11 @@ fn analyze_streak(
         .copied()
         .filter(|&(y, x)| y < h && (0.0..=w).contains(&x))
         .collect();
-    let measured = lk_rows(prepared.0, prepared.1, &centres, lk)
+    let measured = lk_rows(on.left, on.right, &centres, lk)
         .map_err(lk_err(format!("LK along streak {index}")))?;
     let mut light = match_light(streak, &input.lights, view, params.match_tolerance_px);
     let mut predicted = std::collections::HashMap::new();
-    if let Some(l) = &light {
+    if let Some(l) = light.as_ref().filter(|_| predict) {
         let rows = streak.first_row as u32..streak.last_row as u32 + 1;
         let mirror = DVec3::new(l.road[0], -l.road[1], l.road[2]);
         let model_x = l.mirror_px[0] - 0.5 * view.camera.disparity_px(mirror);
@@ -210,7 +212,7 @@ fn analyze_streak(
     })
 }
 
-/// What [`measure_region`] needs besides the region.
+/// What [`measure_region`] and [`analyze_streak`] need besides the region or streak.
 struct RegionInput<'a> {
     input: &'a StereoInput,
     view: &'a RigView,
@@ -286,6 +288,11 @@ pub fn analyze(input: &StereoInput, params: &AnalyzeParams) -> Result<Analysis, 
         });
     }
     let view = RigView::new(&input.rig)?;
+    let road_plane = match (&input.truth_depth, &input.truth_road_mask) {
+        (Some(depth), Some(road)) => RoadPlaneCheck::from_depth(depth, road, &input.rig),
+        _ => None,
+    };
+    let predict = road_plane.is_none_or(|c| !c.violated);
     let range = disparity_range(input, &view);
     // The search range of the scene: a wider one lets windows near the left edge run out of
     // the right image and the integer search pick a flat window.
@@ -304,12 +311,6 @@ pub fn analyze(input: &StereoInput, params: &AnalyzeParams) -> Result<Analysis, 
     let found = detect_streaks(&input.left, &detect)?;
     // Every LK measurement is made on the prepared pair.
     let (left, right) = prepare_pair(&input.left, &input.right);
-    let streaks = found
-        .streaks
-        .iter()
-        .enumerate()
-        .map(|(i, s)| analyze_streak(i, s, input, (&left, &right), &view, params, &lk))
-        .collect::<Result<Vec<_>, _>>()?;
     let ri = RegionInput {
         input,
         view: &view,
@@ -317,6 +318,12 @@ pub fn analyze(input: &StereoInput, params: &AnalyzeParams) -> Result<Analysis, 
         right: &right,
         min_ncc: params.min_ncc,
     };
+    let streaks = found
+        .streaks
+        .iter()
+        .enumerate()
+        .map(|(i, s)| analyze_streak(i, s, &ri, params, &lk, predict))
+        .collect::<Result<Vec<_>, _>>()?;
     let mut regions = Vec::new();
     for r in &params.regions {
         let g = r.region;
@@ -408,6 +415,7 @@ pub fn analyze(input: &StereoInput, params: &AnalyzeParams) -> Result<Analysis, 
         dense: dense_summary,
         detection,
         detection_vertical,
+        road_plane,
     };
     Ok(Analysis {
         report,
@@ -460,6 +468,7 @@ mod tests {
             truth_disparity: Some(truth),
             truth_depth: Some(depth),
             truth_streak_mask: None,
+            truth_road_mask: None,
         };
         let a = analyze(&input, &AnalyzeParams::default()).unwrap();
         let road = a.report.regions.iter().find(|r| r.kind == "road");
@@ -532,6 +541,7 @@ mod tests {
             truth_disparity: None,
             truth_depth: None,
             truth_streak_mask: None,
+            truth_road_mask: None,
         };
         let params = AnalyzeParams {
             lk: LkParams {
@@ -586,6 +596,7 @@ mod tests {
             truth_disparity: Some(pair.disparity),
             truth_depth: None,
             truth_streak_mask: None,
+            truth_road_mask: None,
         };
         let view = RigView::new(&input.rig).unwrap();
         let region = Region {
