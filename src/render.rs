@@ -27,6 +27,10 @@ pub enum Layer {
     Specular,
     /// Samples taken per pixel (channel `spp.Y`; all `--spp` unless `--noise-target`).
     Spp,
+    /// The first hit's object slot (channel `object.Y`; 0 is the sky, 1 unlabelled, then
+    /// one slot per distinct `extras.streaks` class and instance of the scene's nodes, in
+    /// the order the node walk meets them).
+    Object,
 }
 
 /// Path-trace a scene's camera to a linear EXR (and optionally an sRGB PNG).
@@ -99,6 +103,7 @@ pub fn run(args: Args) -> Result<()> {
         albedo: args.layers.contains(&Layer::Albedo),
         specular: args.layers.contains(&Layer::Specular),
         material: args.road_mask.is_some(),
+        object: args.layers.contains(&Layer::Object),
         spp: args.layers.contains(&Layer::Spp),
         rain: false,
         fog: false,

@@ -161,6 +161,7 @@ pub fn run(args: Args) -> Result<()> {
         },
         files: FileList::current(),
         conventions: Conventions::current(),
+        classes: streaks_dataset::segmentation::class_table(),
     };
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads.unwrap_or(0))

@@ -12,7 +12,9 @@ use streaks_dataset::meta::{
     render_seed, FogMeta, RenderMeta, RigMeta, SampleMeta, SampleStats, WeatherMeta,
 };
 use streaks_dataset::settings::Settings;
-use streaks_dataset::write::{disparity_range, write_calib, write_views, GroundTruth};
+use streaks_dataset::write::{
+    disparity_range, instance_numbering, write_calib, write_views, GroundTruth,
+};
 use streaks_image::write_bytes_atomically;
 use streaks_render::motion::Motion;
 use streaks_render::scene::Scene;
@@ -155,6 +157,7 @@ fn write_sample(
 
     let files = SampleDir::new(dir);
     write_views(&files, &scene, &views, s.exposure_ev, GroundTruth::Left)?;
+    let instances = instance_numbering(&files, &scene)?.records().to_vec();
     let has_road = scene_has_road(&scene);
 
     let pixels = left.disparity.data.len().max(1) as f64;
@@ -218,6 +221,7 @@ fn write_sample(
             exposure_s: w.exposure_s,
             rig_velocity: w.rig_velocity,
         }),
+        instances: Some(instances),
     };
     write_bytes_atomically(&files.meta(), &meta.to_bytes())?;
     write_kitti(layout, index, &files, &left.disparity)?;

@@ -12,6 +12,8 @@
 //! streaks0.png            streak mask of the left view (streaks1.png: the right view's)
 //! road0.png               road-surface mask of the left view, when the scene flags a road
 //!                         (road1.png: the right view's)
+//! semantic0.png, semantic1.png   8-bit label ids (Cityscapes labelIds; see segmentation)
+//! instance0.png, instance1.png   16-bit instance ids (Cityscapes instanceIds)
 //! calib.txt               Middlebury 2014 calibration
 //! meta.json               a dataset sample's metadata (rig, lights, seeds, statistics)
 //! rig.json                a pair's rig and lights (`streaks stereo`)
@@ -109,6 +111,10 @@ pub struct Names {
     pub rain_mask: [&'static str; 2],
     /// The fog's transmittance from the camera to the pixel's first hit.
     pub fog: [&'static str; 2],
+    /// The semantic map (label ids).
+    pub semantic: [&'static str; 2],
+    /// The instance map (Cityscapes instance ids).
+    pub instance: [&'static str; 2],
 }
 
 /// The sample layout (Middlebury style): `im0.png`, `disp0.pfm`, ...
@@ -121,6 +127,8 @@ pub const SAMPLE_NAMES: Names = Names {
     road_mask: [ROAD_MASK, "road1.png"],
     rain_mask: ["rain0.png", "rain1.png"],
     fog: ["fog0.pfm", "fog1.pfm"],
+    semantic: ["semantic0.png", "semantic1.png"],
+    instance: ["instance0.png", "instance1.png"],
 };
 
 /// The older pair layout of `streaks stereo`: `left.png`, `disparity_left.pfm`, ... (read,
@@ -134,6 +142,8 @@ pub const PAIR_NAMES: Names = Names {
     road_mask: ["road_mask_left.png", "road_mask_right.png"],
     rain_mask: ["rain_mask_left.png", "rain_mask_right.png"],
     fog: ["fog_left.pfm", "fog_right.pfm"],
+    semantic: ["semantic_left.png", "semantic_right.png"],
+    instance: ["instance_left.png", "instance_right.png"],
 };
 
 fn eye_index(eye: Eye) -> usize {
@@ -258,6 +268,17 @@ impl SampleDir {
     /// fog, 0 on the sky through a homogeneous fog; written only when the scene has fog).
     pub fn fog(&self, eye: Eye) -> PathBuf {
         self.eye_file(self.names.fog, eye)
+    }
+
+    /// The semantic map (`semantic0.png`, 8-bit label ids; see [`crate::segmentation`]).
+    pub fn semantic(&self, eye: Eye) -> PathBuf {
+        self.eye_file(self.names.semantic, eye)
+    }
+
+    /// The instance map (`instance0.png`, 16-bit Cityscapes instance ids; see
+    /// [`crate::segmentation`]).
+    pub fn instance(&self, eye: Eye) -> PathBuf {
+        self.eye_file(self.names.instance, eye)
     }
 
     /// `calib.txt`.

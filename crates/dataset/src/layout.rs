@@ -20,6 +20,7 @@ use crate::files::{
     MANIFEST, ROAD_MASK, SAMPLES_DIR, SAMPLE_FILES, SAMPLE_LOCK_PREFIX, SCENE_BIN, SCENE_GLTF,
     SPLITS_DIR, SPLIT_EXTENSION, TMP_PREFIX,
 };
+use crate::segmentation::ClassRecord;
 use crate::settings::Settings;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
@@ -283,6 +284,9 @@ pub struct Conventions {
     pub splits: String,
     /// Seeds.
     pub seeds: String,
+    /// The segmentation maps (empty in datasets written before them).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub segmentation: String,
 }
 
 impl Conventions {
@@ -312,6 +316,12 @@ impl Conventions {
             splits: s("by street: every sample of one street is in the same split (splits/{train,val,test}.txt, sample ids)"),
             seeds: s("each sample is reproducible from (config, seed, index); its render seed is derived from (seed, index), \
                  the right eye uses render seed + 1"),
+            segmentation: s("Cityscapes label convention, per eye: semantic0/semantic1.png 8-bit label ids (dataset.json classes) of the \
+                 pixel-centre ray's first hit, sky on a miss, rain where drops cover at least half of the pixel's samples; \
+                 instance0/instance1.png 16-bit: labelId for stuff and things without an instance, labelId * 1000 + k for an \
+                 object's pixels (k: its index among the sample's objects of its class, ordered by instance id; meta.json \
+                 instances maps (class, k) to the scene's extras.streaks.instance); under rain the instance map keeps the \
+                 surface behind the drops. KITTI view: kitti/training/semantic = semantic0, kitti/training/instance = labelId * 256 + k"),
         }
     }
 }
@@ -346,6 +356,10 @@ impl FileList {
                 (
                     "fog0.pfm, fog1.pfm".to_owned(),
                     "the scene has fog (meta.json weather.fog)".to_owned(),
+                ),
+                (
+                    "semantic0.png, semantic1.png, instance0.png, instance1.png".to_owned(),
+                    "the sample has segmentation maps (meta.json instances)".to_owned(),
                 ),
             ]),
             scene: vec![
@@ -383,6 +397,10 @@ pub struct DatasetInfo {
     pub files: FileList,
     /// The conventions.
     pub conventions: Conventions,
+    /// The semantic classes of the segmentation maps (empty in datasets written before
+    /// them).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub classes: Vec<ClassRecord>,
 }
 
 impl DatasetInfo {
@@ -562,6 +580,7 @@ mod tests {
             },
             files: FileList::current(),
             conventions: Conventions::current(),
+            classes: Vec::new(),
         }
     }
 

@@ -11,6 +11,8 @@
 //! - [`layout`]: the dataset folder, `dataset.json` and the conventions it states, and its
 //!   Middlebury-style sample folders;
 //! - [`kitti`]: the KITTI 2015 view of a sample;
+//! - [`segmentation`]: the semantic and instance maps, the class table and the instance
+//!   numbering (Cityscapes' label convention);
 //! - [`manifest`]: reading `manifest.jsonl` back and checking files against it;
 //! - [`lock`]: the advisory locks that make runs on one folder safe or refused;
 //! - [`shard`]: `--shard K/N`;
@@ -28,6 +30,7 @@ pub mod layout;
 pub mod lock;
 pub mod manifest;
 pub mod meta;
+pub mod segmentation;
 pub mod settings;
 pub mod shard;
 pub mod verify;

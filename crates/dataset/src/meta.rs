@@ -2,6 +2,7 @@
 //! statistics; and the render seed of a sample.
 
 use crate::error::DatasetError;
+use crate::segmentation::InstanceRecord;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::path::Path;
@@ -209,6 +210,11 @@ pub struct SampleMeta {
     /// before the field existed; the file then has no `weather` key).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub weather: Option<WeatherMeta>,
+    /// The objects of the instance maps: each `(class, k)` of `instanceN.png`'s
+    /// `labelId * 1000 + k` with the scene's instance id ([`crate::segmentation`]). `None`
+    /// (no key) in samples written before the segmentation maps, which have none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub instances: Option<Vec<InstanceRecord>>,
 }
 
 impl SampleMeta {

@@ -2,8 +2,9 @@
 //! ([`check_sample`], [`index_dir`]), or every file against `manifest.jsonl` ([`verify`]).
 //!
 //! A sample is good when its folder has every file ([`SAMPLE_FILES`], the road mask when its
-//! meta says so, and the files its `scene.gltf` refers to), only regular files, its images,
-//! EXRs and PFMs decode at the dataset's size, its `calib.txt` parses with that size, and its
+//! meta says so, the segmentation maps when its meta has `instances`, and the files its
+//! `scene.gltf` refers to), only regular files, its images, EXRs and PFMs decode at the
+//! dataset's size, its segmentation maps hold only ids of `dataset.json`'s class table, its `calib.txt` parses with that size, and its
 //! `meta.json` parses and names its index, the dataset's seed and configuration. Missing
 //! KITTI files of a good sample are written again from it when the caller allows.
 //!
@@ -29,6 +30,7 @@ use crate::kitti::write_kitti;
 use crate::layout::{sample_id, DatasetInfo, Layout, SPLITS};
 use crate::manifest::{sha256_hex, verify_batch, Difference, Entry, Lines};
 use crate::meta::SampleStats;
+use crate::segmentation::{check_instance, check_semantic};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -431,6 +433,12 @@ pub fn check_sample(
     if has_fog {
         expected.extend(fog_maps.iter().map(|p| file_name(p)));
     }
+    let has_segmentation = meta.instances.is_some();
+    let semantic = Eye::BOTH.map(|eye| sample.semantic(eye));
+    let instance = Eye::BOTH.map(|eye| sample.instance(eye));
+    if has_segmentation {
+        expected.extend(semantic.iter().chain(&instance).map(|p| file_name(p)));
+    }
     expected.push(SCENE_GLTF.to_owned());
     if sample.scene().is_file() {
         expected.extend(scene_files(&sample.scene())?);
@@ -460,6 +468,20 @@ pub fn check_sample(
     }
     for p in pngs {
         check_size(&p, size, GrayImage::load(&p))?;
+    }
+    if has_segmentation {
+        if info.classes.is_empty() {
+            return Err(DatasetError::Invalid {
+                path: sample.meta(),
+                reason: "the sample has segmentation maps but dataset.json has no classes".into(),
+            });
+        }
+        for p in &semantic {
+            check_semantic(p, size, &info.classes)?;
+        }
+        for p in &instance {
+            check_instance(p, size, &info.classes)?;
+        }
     }
     for p in [
         sample.disparity(Eye::Left),

@@ -4,6 +4,7 @@
 
 use crate::error::DatasetError;
 use crate::files::SampleDir;
+use crate::segmentation::{InstanceNumbering, MAX_INSTANCES_PER_CLASS};
 use image::RgbImage;
 use streaks_image::develop;
 use streaks_image::pfm::write_pfm;
@@ -31,8 +32,9 @@ pub enum GroundTruth {
 /// EXR with its layers (and the `sensor` layer of a view exposed through a camera model), the
 /// 8-bit sRGB PNG (at `exposure_ev` stops, or developed from the camera's DN) and the ground-truth
 /// disparity, the rain mask (when the scene has rain) and the fog's transmittance (when it
-/// has fog); the depth, streak mask and (when the scene flags a road material) road-surface
-/// mask of the views `truth` says. Returns the two sRGB images.
+/// has fog), the segmentation maps ([`write_segmentation`]); the depth, streak mask and
+/// (when the scene flags a road material) road-surface mask of the views `truth` says.
+/// Returns the two sRGB images.
 pub fn write_views(
     files: &SampleDir,
     scene: &Scene,
@@ -67,8 +69,53 @@ pub fn write_views(
             }
         }
     }
+    write_segmentation(files, scene, views)?;
     let [left, right]: [RgbImage; 2] = srgb.try_into().expect("two views");
     Ok([left, right])
+}
+
+/// The numbering of `scene`'s objects in its instance maps
+/// ([`crate::segmentation::InstanceNumbering`]); too many objects of one class is an error
+/// naming the sample folder `files`.
+pub fn instance_numbering(
+    files: &SampleDir,
+    scene: &Scene,
+) -> Result<InstanceNumbering, DatasetError> {
+    InstanceNumbering::new(&scene.objects).map_err(|reason| DatasetError::Invalid {
+        path: files.path().to_path_buf(),
+        reason,
+    })
+}
+
+/// Writes each view's semantic map (`semantic0.png`, [`EyeView::semantic`], 8-bit) and
+/// instance map (`instance0.png`, 16-bit Cityscapes instance ids from the view's `object`
+/// layer and [`instance_numbering`]); see [`crate::segmentation`].
+pub fn write_segmentation(
+    files: &SampleDir,
+    scene: &Scene,
+    views: &[EyeView; 2],
+) -> Result<(), DatasetError> {
+    let numbering = instance_numbering(files, scene)?;
+    for (eye, view) in Eye::BOTH.into_iter().zip(views) {
+        let (w, h) = (view.disparity.width as u32, view.disparity.height as u32);
+        let missing = |what: &str| DatasetError::Invalid {
+            path: files.semantic(eye),
+            reason: format!("the {eye} view has no {what}"),
+        };
+        let semantic = image::GrayImage::from_raw(w, h, view.semantic.clone())
+            .ok_or_else(|| missing("semantic map of its size"))?;
+        write_png_buffer(&files.semantic(eye), &semantic)?;
+        let slots = view
+            .output
+            .object
+            .as_ref()
+            .ok_or_else(|| missing("object layer"))?;
+        let ids = numbering.map(&scene.objects, slots, MAX_INSTANCES_PER_CLASS);
+        let instance = image::ImageBuffer::<image::Luma<u16>, _>::from_raw(w, h, ids)
+            .ok_or_else(|| missing("object layer of its size"))?;
+        write_png_buffer(&files.instance(eye), &instance)?;
+    }
+    Ok(())
 }
 
 /// Writes a rendered pair as `streaks stereo -o DIR` does into `dir` (which must exist): both

@@ -45,6 +45,9 @@ pub struct Pixel {
     /// Index into the scene's materials of the pixel-centre ray's first hit ([`NO_MATERIAL`]
     /// on a miss).
     pub material: u32,
+    /// The slot in the scene's objects ([`crate::scene::Scene::objects`]) of the pixel-centre
+    /// ray's first hit ([`crate::scene::SKY_OBJECT`] on a miss).
+    pub object: u32,
     /// Sum over the camera samples (kept or dropped) of the share of the shutter during which
     /// the sample's ray met a rain drop first (1 or 0 for a sample taken at one time).
     pub rain: f32,
@@ -69,6 +72,7 @@ impl Default for Pixel {
             normal: Vec3::ZERO,
             albedo: Vec3::ZERO,
             material: NO_MATERIAL,
+            object: crate::scene::SKY_OBJECT,
             rain: 0.0,
             fog: 1.0,
         }
@@ -205,6 +209,11 @@ impl Film {
         self.pixels.iter().map(|p| p.material).collect()
     }
 
+    /// The first-hit object layer ([`crate::scene::SKY_OBJECT`] on a miss).
+    pub fn object(&self) -> Vec<u32> {
+        self.pixels.iter().map(|p| p.object).collect()
+    }
+
     /// The fog layer: the fog's transmittance to the pixel-centre ray's first hit, row-major.
     pub fn fog(&self) -> Vec<f32> {
         self.pixels.iter().map(|p| p.fog).collect()
@@ -266,6 +275,7 @@ mod tests {
         assert!(img.pixels.iter().all(|p| p.is_finite()));
         assert_eq!(film.depth()[0], f32::INFINITY);
         assert_eq!(film.material(), vec![NO_MATERIAL; 6]);
+        assert_eq!(film.object(), vec![crate::scene::SKY_OBJECT; 6]);
         assert_eq!(film.spp(), vec![0, 4, 0, 0, 0, 1]);
         assert_eq!(film.samples(), 5);
     }

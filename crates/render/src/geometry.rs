@@ -91,6 +91,9 @@ pub struct SurfaceHit {
     pub triangle: u32,
     /// Material index.
     pub material: u32,
+    /// The slot in [`crate::scene::Scene::objects`] of what the hit is part of (the
+    /// unlabelled object for a rain drop).
+    pub object: u32,
 }
 
 /// An orthonormal frame; `n` is the local +Z axis (the shading normal).

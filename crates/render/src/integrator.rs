@@ -151,6 +151,10 @@
 //! - `material`: the index into [`Scene::materials`] of the pixel-centre ray's first hit
 //!   ([`crate::film::NO_MATERIAL`] on a miss); with [`crate::material::Material::road`] it tells
 //!   which pixels see the road surface first.
+//! - `object`: the slot in [`Scene::objects`] of the pixel-centre ray's first hit (the same
+//!   ray and rule as `material`; [`crate::scene::SKY_OBJECT`] on a miss): what the pixel sees,
+//!   as a semantic class and an instance, for segmentation maps. A rain drop in front is not
+//!   a hit here (see below): the `rain` layer says where drops cover the pixel.
 //! - `specular`: the part of the pixel's radiance that reached the camera by exactly one
 //!   reflection of an emitter off the glossy lobe at the first surface hit (the environment
 //!   counts as an emitter: a glossy road's reflection of the sky is a streak too): the glossy part
@@ -171,7 +175,7 @@
 //!   carries the fog's pass weights of its two segments, and light scattered by the fog is not
 //!   in it.
 //!
-//! The first-hit layers (depth, normal, albedo, material) are taken at the reference time 0
+//! The first-hit layers (depth, normal, albedo, material, object) are taken at the reference time 0
 //! from the camera where the scene puts it, and ignore rain drops
 //! ([`Scene::intersect`] meets no drop): they are the ground truth of the scene behind the rain.
 //!
@@ -237,6 +241,8 @@ pub struct Layers {
     pub specular: bool,
     /// First-hit material index of the pixel-centre ray.
     pub material: bool,
+    /// First-hit object slot ([`Scene::objects`]) of the pixel-centre ray.
+    pub object: bool,
     /// Samples taken per pixel (see adaptive sampling in the module documentation).
     pub spp: bool,
     /// Share of the camera samples whose first hit was a rain drop.
@@ -323,6 +329,9 @@ pub struct RenderOutput {
     /// First-hit material index per pixel, row-major (if requested; see the module
     /// documentation).
     pub material: Option<Vec<u32>>,
+    /// First-hit object slot ([`Scene::objects`]) per pixel, row-major (if requested; see
+    /// the module documentation).
+    pub object: Option<Vec<u32>>,
     /// Samples taken per pixel, row-major (if requested).
     pub spp: Option<Vec<u32>>,
     /// Share of each pixel's camera samples whose first hit was a rain drop, row-major (if
@@ -365,7 +374,7 @@ pub fn render(
         .transform_vector3(-Vec3::Z)
         .normalize();
     let l = job.layers;
-    let need_centre = l.depth || l.normal || l.albedo || l.material || l.fog;
+    let need_centre = l.depth || l.normal || l.albedo || l.material || l.object || l.fog;
     // The drops this camera sees, binned by pixel (none without rain).
     let rain = scene
         .rain
@@ -439,6 +448,7 @@ pub fn render(
         albedo: layers.albedo.then(|| film.albedo()),
         specular: layers.specular.then(|| film.specular()),
         material: layers.material.then(|| film.material()),
+        object: layers.object.then(|| film.object()),
         spp: layers.spp.then(|| film.spp()),
         rain: layers.rain.then(|| film.rain()),
         fog: layers.fog.then(|| film.fog()),
@@ -654,8 +664,8 @@ fn swept_drops(
     set
 }
 
-/// Fills the depth, normal, albedo, material and fog transmittance of `pixel` from the
-/// pixel-centre ray.
+/// Fills the depth, normal, albedo, material, object and fog transmittance of `pixel` from
+/// the pixel-centre ray.
 fn first_hit_layers(scene: &Scene, ray: &Ray, origin: Vec3, forward: Vec3, pixel: &mut Pixel) {
     let found = scene.intersect(ray);
     if let Some(fog) = &scene.fog {
@@ -665,6 +675,7 @@ fn first_hit_layers(scene: &Scene, ray: &Ray, origin: Vec3, forward: Vec3, pixel
     if let Some(hit) = found {
         pixel.depth = (hit.p - origin).dot(forward);
         pixel.material = hit.material;
+        pixel.object = hit.object;
         pixel.normal = if hit.ns.dot(ray.direction) > 0.0 {
             -hit.ns
         } else {
@@ -1558,8 +1569,9 @@ pub(crate) mod tests {
         assert!(out.image.pixels.iter().all(|p| *p == Vec3::ZERO));
     }
 
-    /// A glossy floor, an emissive sign (above the view of the test camera, seen only in
-    /// reflection) and two punctual lights, for the determinism and specular-layer tests.
+    /// A glossy floor (tagged as the road), an emissive sign (above the view of the test
+    /// camera, seen only in reflection; unlabelled) and two punctual lights, for the
+    /// determinism and specular-layer tests.
     fn street(kd: Vec3, ks: Vec3) -> Scene {
         let mut sign = Material::diffuse("sign", Vec3::ZERO);
         sign.emission = Vec3::new(4.0, 2.0, 1.0);
@@ -1594,6 +1606,12 @@ pub(crate) mod tests {
             ],
             1,
         );
+        parts.objects = crate::scene::base_table();
+        parts.objects.push(crate::scene::SceneObject {
+            class: Some(crate::class::Class::Road),
+            instance: 0,
+        });
+        parts.mesh.triangle_objects = vec![2, 2, 1, 1];
         Scene::from_parts(parts).unwrap()
     }
 
@@ -1608,6 +1626,7 @@ pub(crate) mod tests {
             albedo: true,
             specular: true,
             material: true,
+            object: true,
             spp: true,
             rain: true,
             fog: true,
@@ -1635,6 +1654,20 @@ pub(crate) mod tests {
         assert!(material.contains(&0));
         assert!(material.contains(&crate::film::NO_MATERIAL));
         assert!(scene.materials[0].road && !scene.materials[1].road);
+        // The object layer, by the same ray: the floor's slot (the road) where the depth is
+        // finite, the sky's on a miss.
+        assert_eq!(one.object, two.object);
+        let object = one.object.as_ref().unwrap();
+        for (o, z) in object.iter().zip(depth) {
+            let want = if z.is_finite() {
+                2
+            } else {
+                crate::scene::SKY_OBJECT
+            };
+            assert_eq!(*o, want, "{z}");
+        }
+        assert!(object.contains(&2) && object.contains(&crate::scene::SKY_OBJECT));
+        assert_eq!(scene.objects[2].class, Some(crate::class::Class::Road));
         // Asking for the layers does not change the image.
         set.layers = Layers::default();
         let plain = rayon::ThreadPoolBuilder::new()
@@ -1643,7 +1676,7 @@ pub(crate) mod tests {
             .unwrap()
             .install(|| render(&scene, &cam, &set, &|_| {}));
         assert_eq!(plain.image, one.image);
-        assert!(plain.material.is_none());
+        assert!(plain.material.is_none() && plain.object.is_none());
         // Another seed gives another image.
         set.seed = 2;
         let other = rayon::ThreadPoolBuilder::new()

@@ -4,7 +4,9 @@
 //! `normal.X`/`normal.Y`/`normal.Z`, `albedo.R`/`.G`/`.B`, `specular.R`/`.G`/`.B` and
 //! `spp.Y` (samples taken per pixel, as float32: exact up to 2^24), `rain.Y` (the share of
 //! the pixel's camera samples whose first hit was a rain drop) and `fog.Y` (the fog's
-//! transmittance to the pixel-centre ray's first hit, 1 without fog) (OpenEXR's
+//! transmittance to the pixel-centre ray's first hit, 1 without fog) and `object.Y` (the
+//! slot in the scene's objects of the pixel-centre ray's first hit, as float32: exact up to
+//! 2^24; 0 is the sky, see [`crate::scene::SceneObject`]) (OpenEXR's
 //! `layer.channel` naming, which Blender, Nuke and `exrheader` show as layers).
 //! A render through a camera model (`--sensor`) also has `sensor.R`/`.G`/`.B`, the camera's
 //! raw values in DN as float32 ([`write_exr_with_sensor`]); `R`, `G`, `B` stay the render.
@@ -35,6 +37,9 @@ pub const SENSOR: [&str; 3] = ["sensor.R", "sensor.G", "sensor.B"];
 pub const RAIN: &str = "rain.Y";
 /// The fog transmittance layer's channel.
 pub const FOG: &str = "fog.Y";
+/// The object layer's channel: the slot in the scene's objects of the pixel-centre ray's
+/// first hit.
+pub const OBJECT: &str = "object.Y";
 
 /// Writes the render as a float32 EXR: the beauty image and the layers present in `output`
 /// (see the module documentation), atomically.
@@ -80,24 +85,28 @@ pub fn write_exr_with_sensor(
     if let Some(fog) = &output.fog {
         channels.push((FOG, fog.clone()));
     }
+    if let Some(object) = &output.object {
+        channels.push((OBJECT, object.iter().map(|&n| n as f32).collect()));
+    }
     streaks_image::exr::write_exr(path, img.width, img.height, channels)
 }
 
 /// Reads a layer written by [`write_exr`]: `"albedo"`, `"specular"`, `"sensor"` (RGB),
 /// `"normal"` (XYZ into the RGB slots), `"depth"` (Z), `"spp"` (samples per pixel), `"rain"`
-/// (rain share) or `"fog"` (fog transmittance; the last four one channel, repeated into all
-/// three slots).
+/// (rain share), `"fog"` (fog transmittance) or `"object"` (object slot; the last five one
+/// channel, repeated into all three slots).
 pub fn read_exr_layer(path: &Path, name: &str) -> Result<RgbImage, ImageError> {
     match name {
         "albedo" => read_exr_rgb_channels(path, ALBEDO),
         "specular" => read_exr_rgb_channels(path, SPECULAR),
         "sensor" => read_exr_rgb_channels(path, SENSOR),
         "normal" => read_exr_rgb_channels(path, NORMAL),
-        "depth" | "spp" | "rain" | "fog" => {
+        "depth" | "spp" | "rain" | "fog" | "object" => {
             let channel = match name {
                 "depth" => DEPTH,
                 "spp" => SPP,
                 "rain" => RAIN,
+                "object" => OBJECT,
                 _ => FOG,
             };
             let (w, h, planes) = read_exr_channels(path, &[channel])?;
@@ -107,7 +116,7 @@ pub fn read_exr_layer(path: &Path, name: &str) -> Result<RgbImage, ImageError> {
         other => Err(ImageError::MissingChannels {
             path: path.to_path_buf(),
             what: format!(
-                "layer {other:?} (the layers are albedo, specular, normal, depth, spp, rain, fog, sensor)"
+                "layer {other:?} (the layers are albedo, specular, normal, depth, spp, rain, fog, object, sensor)"
             ),
         }),
     }
@@ -138,6 +147,7 @@ mod tests {
             albedo: None,
             specular: Some(gradient(w, h)),
             material: None,
+            object: Some((0..w * h).map(|i| 3 * i).collect()),
             spp: Some((0..w * h).map(|i| 16 + 8 * i).collect()),
             rain: Some((0..w * h).map(|i| i as f32 / 16.0).collect()),
             fog: Some((0..w * h).map(|i| 1.0 / (1 + i) as f32).collect()),
@@ -167,6 +177,8 @@ mod tests {
         assert_eq!(rain.get(2, 1).y, 7.0 / 16.0);
         let fog = read_exr_layer(&path, "fog").unwrap();
         assert_eq!(fog.get(2, 1).y, 1.0 / 8.0);
+        let object = read_exr_layer(&path, "object").unwrap();
+        assert_eq!(object.get(2, 1).z, 21.0);
         let err = read_exr_layer(&path, "albedo").unwrap_err();
         assert!(err.to_string().contains("albedo.R"), "{err}");
         let err = read_exr_layer(&path, "beauty").unwrap_err();

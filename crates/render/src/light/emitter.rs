@@ -664,6 +664,7 @@ mod tests {
                     attributes: VertexAttributes::from_uv(Vec2::ZERO),
                     triangle: 0,
                     material: 0,
+                    object: crate::scene::UNLABELLED_OBJECT,
                 };
                 let pdf = m.pdf_li(p, 0, &hit);
                 assert!((pdf - ls.pdf).abs() <= 1e-4 * ls.pdf, "{pdf} {}", ls.pdf);

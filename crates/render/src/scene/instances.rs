@@ -33,6 +33,9 @@ pub struct Instance {
     pub world_from_object_normal: Mat3A,
     /// Whether the transform mirrors (negative determinant).
     pub mirrored: bool,
+    /// The slot in [`super::Scene::objects`] of this placement's triangles
+    /// ([`super::UNLABELLED_OBJECT`] unless set).
+    pub object: u32,
 }
 
 impl Instance {
@@ -51,6 +54,7 @@ impl Instance {
             object_from_world: inverse,
             world_from_object_normal: inverse.matrix3.transpose(),
             mirrored: det < 0.0,
+            object: super::UNLABELLED_OBJECT,
         })
     }
 

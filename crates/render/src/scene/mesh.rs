@@ -41,13 +41,24 @@ pub struct TriangleMesh {
     pub triangles: Vec<[u32; 3]>,
     /// Material index of each triangle.
     pub triangle_materials: Vec<u32>,
+    /// The slot in [`super::Scene::objects`] of each triangle (what it is part of, for the
+    /// segmentation layers), or empty for all unlabelled ([`super::UNLABELLED_OBJECT`],
+    /// filled when checked). An instanced mesh's are not read: each of its placements has
+    /// its own ([`super::Instance::object`]).
+    pub triangle_objects: Vec<u32>,
 }
 
 impl TriangleMesh {
-    /// Checks every array length and index against the vertex count and `material_count`,
-    /// normalises the normals and fills absent normals and uvs (zeros). Errors name the
-    /// element, prefixed by the mesh's name if it has one.
-    pub(super) fn check(&mut self, source: &Path, material_count: usize) -> Result<(), SceneError> {
+    /// Checks every array length and index against the vertex count, `material_count` and
+    /// `object_count`, normalises the normals and fills absent normals and uvs (zeros) and
+    /// object slots ([`super::UNLABELLED_OBJECT`]). Errors name the element, prefixed by the
+    /// mesh's name if it has one.
+    pub(super) fn check(
+        &mut self,
+        source: &Path,
+        material_count: usize,
+        object_count: usize,
+    ) -> Result<(), SceneError> {
         let prefix = if self.name.is_empty() {
             String::new()
         } else {
@@ -110,6 +121,31 @@ impl TriangleMesh {
                 ),
             ));
         }
+        if self.triangle_objects.is_empty() {
+            self.triangle_objects = vec![super::UNLABELLED_OBJECT; self.triangles.len()];
+        } else if self.triangle_objects.len() != self.triangles.len() {
+            return Err(bad(
+                "triangle objects".into(),
+                format!(
+                    "{} object slots for {} triangles",
+                    self.triangle_objects.len(),
+                    self.triangles.len()
+                ),
+            ));
+        }
+        if let Some(i) = self
+            .triangle_objects
+            .iter()
+            .position(|&o| o as usize >= object_count)
+        {
+            return Err(bad(
+                format!("triangle {i}"),
+                format!(
+                    "object slot {} out of range ({object_count} objects)",
+                    self.triangle_objects[i],
+                ),
+            ));
+        }
         if nv > u32::MAX as usize {
             return Err(bad("vertices".into(), "more than 2^32 - 1 vertices".into()));
         }
@@ -147,6 +183,7 @@ impl TriangleMesh {
             + std::mem::size_of_val(self.colors.as_slice())
             + std::mem::size_of_val(self.triangles.as_slice())
             + std::mem::size_of_val(self.triangle_materials.as_slice())
+            + std::mem::size_of_val(self.triangle_objects.as_slice())
     }
 
     /// The mesh's triangles with their vertex attributes and `materials`, as the emitters and

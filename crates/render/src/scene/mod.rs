@@ -179,6 +179,7 @@ mod gltf;
 mod instances;
 mod mesh;
 mod obj;
+mod objects;
 mod tangents;
 mod validate;
 
@@ -188,6 +189,7 @@ pub use gltf::extensions;
 pub use gltf::{MAX_PLACEMENTS, MAX_TRIANGLES};
 pub use instances::{Instance, InstancedMesh, Instances};
 pub use mesh::TriangleMesh;
+pub use objects::{base_table, ObjectTable, SceneObject, SKY_OBJECT, UNLABELLED_OBJECT};
 pub use validate::MAX_COORDINATE;
 
 use crate::accel::Accel;
@@ -260,6 +262,10 @@ pub struct Scene {
     /// Rain in the air (`scenes[i].extras.streaks.rain`, [`crate::rain`]): its drops are
     /// placed for a view by [`Scene::place_rain`]; `None` for a dry scene.
     pub rain: Option<Rain>,
+    /// What the triangles are part of, by slot ([`TriangleMesh::triangle_objects`],
+    /// [`Instance::object`]): the sky and the unlabelled object first ([`base_table`]), then
+    /// one slot per distinct (class, instance) of the glTF nodes' tags.
+    pub objects: Vec<SceneObject>,
 }
 
 /// The in-memory ingredients of a [`Scene`], for [`Scene::from_parts`].
@@ -290,6 +296,9 @@ pub struct SceneParts {
     pub fog: Option<Fog>,
     /// Warnings to pass on.
     pub warnings: Vec<String>,
+    /// The objects the triangles' and instances' slots index; empty for [`base_table`] (all
+    /// unlabelled). Otherwise it must start with [`base_table`].
+    pub objects: Vec<SceneObject>,
 }
 
 impl Scene {
@@ -334,9 +343,20 @@ impl Scene {
             environment,
             fog,
             mut warnings,
+            objects,
         } = parts;
         let bad = |element: String, reason: String| SceneError::invalid(&source, element, reason);
-        mesh.check(&source, materials.len())?;
+        let objects = if objects.is_empty() {
+            base_table()
+        } else if objects.starts_with(&base_table()) {
+            objects
+        } else {
+            return Err(bad(
+                "objects".into(),
+                "the table must start with the sky and the unlabelled object".into(),
+            ));
+        };
+        mesh.check(&source, materials.len(), objects.len())?;
         for m in &materials {
             if let Some(t) = m.texture_ids().find(|&t| t as usize >= textures.len()) {
                 return Err(bad(
@@ -348,7 +368,7 @@ impl Scene {
         let alpha_tested = |m: u32| !materials[m as usize].alpha.is_opaque();
         let mut meshes = Vec::with_capacity(instanced_meshes.len());
         for mut m in instanced_meshes {
-            m.check(&source, materials.len())?;
+            m.check(&source, materials.len(), objects.len())?;
             if let Some(&e) = m
                 .triangle_materials
                 .iter()
@@ -367,6 +387,20 @@ impl Scene {
                 alpha_tested(m.triangle_materials[t])
             });
             meshes.push(InstancedMesh { mesh: m, accel });
+        }
+        if let Some((i, inst)) = instances
+            .iter()
+            .enumerate()
+            .find(|(_, inst)| inst.object as usize >= objects.len())
+        {
+            return Err(bad(
+                format!("instance {i}"),
+                format!(
+                    "object slot {} out of range ({} objects)",
+                    inst.object,
+                    objects.len()
+                ),
+            ));
         }
         if let Some((i, inst)) = instances
             .iter()
@@ -418,6 +452,7 @@ impl Scene {
             fog,
             warnings,
             rain: None,
+            objects,
         })
     }
 
@@ -568,6 +603,7 @@ impl Scene {
                 attributes: VertexAttributes::from_uv(Vec2::ZERO),
                 triangle: crate::rain::RAIN_TRIANGLE,
                 material: rain.material,
+                object: UNLABELLED_OBJECT,
             }),
             None => surface,
         }
@@ -658,7 +694,8 @@ impl Scene {
                     ..local
                 };
                 let tangent = || inst.tangent_to_world(geometry.tangent_at(h.hit.triangle, b));
-                return Some(self.shade(ray, h.hit.t, INSTANCED_TRIANGLE, world, tangent));
+                let at = (INSTANCED_TRIANGLE, inst.object);
+                return Some(self.shade(ray, h.hit.t, at, world, tangent));
             }
         }
         let hit = flat?;
@@ -666,11 +703,15 @@ impl Scene {
         let b = hit.barycentrics;
         let surface = geometry.surface_at(hit.triangle, b);
         let tangent = || geometry.tangent_at(hit.triangle, b);
-        Some(self.shade(ray, hit.t, hit.triangle, surface, tangent))
+        let at = (
+            hit.triangle,
+            self.mesh.triangle_objects[hit.triangle as usize],
+        );
+        Some(self.shade(ray, hit.t, at, surface, tangent))
     }
 
     /// The [`SurfaceHit`] at parameter `t` of `ray` on the world-space point `s` of
-    /// triangle `triangle`, with the normal map applied (`tangent` gives the interpolated
+    /// triangle `triangle` of object slot `object` (`at`), with the normal map applied (`tangent` gives the interpolated
     /// world-space tangent, asked only for a normal-mapped material), with the smooth and the
     /// mapped normal for the diffuse lobe where the map applied.
     #[inline]
@@ -678,7 +719,7 @@ impl Scene {
         &self,
         ray: &Ray,
         t: f32,
-        triangle: u32,
+        (triangle, object): (u32, u32),
         s: LocalSurface,
         tangent: impl FnOnce() -> Vec4,
     ) -> SurfaceHit {
@@ -730,6 +771,7 @@ impl Scene {
             attributes: s.attributes,
             triangle,
             material: s.material,
+            object,
         }
     }
 

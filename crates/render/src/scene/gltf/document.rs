@@ -7,7 +7,7 @@ use super::extensions::{self, light_units};
 use super::nodes::count_visits;
 use super::{compression, node_label, Loader};
 use crate::scene::files::Files;
-use crate::scene::{Scene, SceneError, SceneParts};
+use crate::scene::{ObjectTable, Scene, SceneError, SceneObject, SceneParts};
 use glam::{Mat4, Vec4};
 use std::collections::HashMap;
 use std::path::Path;
@@ -194,6 +194,7 @@ pub(in crate::scene) fn load(path: &Path, files: &Files) -> Result<Scene, SceneE
         default_material: None,
         light_units,
         placements: Vec::new(),
+        objects: ObjectTable::default(),
         primitive_boxes: Vec::new(),
         warnings,
         node_worlds: vec![None; document.nodes().len()],
@@ -225,10 +226,13 @@ pub(in crate::scene) fn load(path: &Path, files: &Files) -> Result<Scene, SceneE
             // Depth-first in file order with an explicit stack; a depth beyond the node count
             // can only come from a cycle.
             let node_count = document.nodes().len();
-            let mut stack: Vec<(gltf::Node, Mat4, usize)> =
-                scene.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
+            // Each entry carries its parent's world transform and tag.
+            let mut stack: Vec<(gltf::Node, Mat4, usize, SceneObject)> = scene
+                .nodes()
+                .map(|n| (n, Mat4::IDENTITY, 0, SceneObject::UNLABELLED))
+                .collect();
             stack.reverse();
-            while let Some((node, parent, depth)) = stack.pop() {
+            while let Some((node, parent, depth, parent_tag)) = stack.pop() {
                 if depth > node_count {
                     return Err(SceneError::invalid(
                         path,
@@ -236,9 +240,11 @@ pub(in crate::scene) fn load(path: &Path, files: &Files) -> Result<Scene, SceneE
                         "the node hierarchy has a cycle",
                     ));
                 }
-                let world = loader.node(&node, parent, &document)?;
+                let tag = loader.node_tag(&node, parent_tag)?;
+                let object = loader.objects.slot(tag);
+                let world = loader.node(&node, parent, object, &document)?;
                 let first_child = stack.len();
-                stack.extend(node.children().map(|c| (c, world, depth + 1)));
+                stack.extend(node.children().map(|c| (c, world, depth + 1, tag)));
                 stack[first_child..].reverse();
             }
         }
@@ -252,6 +258,7 @@ pub(in crate::scene) fn load(path: &Path, files: &Files) -> Result<Scene, SceneE
     let lines = loader.warnings.lines(path);
     loader.parts.warnings.extend(lines);
     let boxes = std::mem::take(&mut loader.primitive_boxes);
+    loader.parts.objects = std::mem::take(&mut loader.objects).into_objects();
     let mut scene = Scene::from_parts(loader.parts)?;
     scene.framing_bounds = crate::camera::union_bounds(boxes);
     if let Some(rain) = rain {

@@ -34,6 +34,8 @@
 //! - `environment`: the scene's environment light, `scenes[i].extras.streaks.environment`;
 //! - `rain`: the scene's rain, `scenes[i].extras.streaks.rain` ([`crate::rain`]);
 //! - `fog`: the scene's fog, `scenes[i].extras.streaks.fog` ([`crate::medium::Fog`]);
+//! - `tags`: the nodes' semantic tags, `extras.streaks.class` and `instance`, inherited
+//!   through the hierarchy ([`crate::scene::SceneObject`]);
 //! - `textures`: texture infos, KHR_texture_transform, samplers, images;
 //! - [`extensions`]: which extensions are honoured, and the ones that are not a material's
 //!   field: KHR_lights_punctual (and the file's light units), EXT_mesh_gpu_instancing;
@@ -52,6 +54,7 @@ mod materials;
 mod meshes;
 mod nodes;
 mod rain;
+mod tags;
 #[cfg(test)]
 mod test_docs;
 mod textures;
@@ -61,7 +64,7 @@ pub(super) use document::load;
 pub use nodes::{MAX_PLACEMENTS, MAX_TRIANGLES};
 
 use super::files::Files;
-use super::{SceneError, SceneParts};
+use super::{ObjectTable, SceneError, SceneParts};
 use crate::texture::{ColorSpace, TextureId};
 use extensions::LightUnits;
 use glam::{Mat4, Vec3};
@@ -106,9 +109,11 @@ struct Loader<'a> {
     default_material: Option<u32>,
     /// What KHR_lights_punctual's intensities are in.
     light_units: LightUnits,
-    /// Every placement of a mesh in the walk's order: mesh index, world transform and the
-    /// index of the node that places it (whose morph weights apply).
-    placements: Vec<(usize, Mat4, usize)>,
+    /// Every placement of a mesh in the walk's order: mesh index, world transform, the
+    /// index of the node that places it (whose morph weights apply) and its object slot.
+    placements: Vec<(usize, Mat4, usize, u32)>,
+    /// The objects the nodes' tags name, one slot each.
+    objects: ObjectTable,
     /// What the file uses that is skipped or rendered differently, by feature.
     warnings: Warnings,
     /// Each node's world transform, once the walk has reached it (joints of skins).

@@ -114,12 +114,14 @@ pub(super) fn primitive_triangles(prim: &gltf::Primitive) -> usize {
 }
 
 impl Loader<'_> {
-    /// Adds what `node` carries (camera, light; its mesh's placements are recorded for
-    /// [`Loader::place_meshes`]); returns its world transform.
+    /// Adds what `node` carries (camera, light; its mesh's placements, with the object slot
+    /// `object` of its tag, are recorded for [`Loader::place_meshes`]); returns its world
+    /// transform.
     pub(super) fn node(
         &mut self,
         node: &gltf::Node,
         parent: Mat4,
+        object: u32,
         document: &gltf::Document,
     ) -> Result<Mat4, SceneError> {
         let local = match node.transform() {
@@ -166,14 +168,16 @@ impl Loader<'_> {
                                 format!("world transform is not invertible or not finite: {w:?}"),
                             ));
                         }
-                        self.placements.push((mesh.index(), w, node.index()));
+                        self.placements
+                            .push((mesh.index(), w, node.index(), object));
                     }
                 }
                 None => {
                     if self.placements.len() >= MAX_PLACEMENTS {
                         return Err(too_many_placements(self.path, node));
                     }
-                    self.placements.push((mesh.index(), world, node.index()));
+                    self.placements
+                        .push((mesh.index(), world, node.index(), object));
                 }
             }
         }
@@ -194,7 +198,7 @@ impl Loader<'_> {
     pub(super) fn place_meshes(&mut self, document: &gltf::Document) -> Result<(), SceneError> {
         let meshes: Vec<gltf::Mesh> = document.meshes().collect();
         let mut count = vec![0usize; meshes.len()];
-        for &(m, _, _) in &self.placements {
+        for &(m, _, _, _) in &self.placements {
             count[m] += 1;
         }
         // Meshes flattened at every placement: emissive ones (emitters are world triangles),
@@ -211,7 +215,7 @@ impl Loader<'_> {
             })
             .collect();
         let nodes: Vec<gltf::Node> = document.nodes().collect();
-        for &(m, _, node) in &self.placements {
+        for &(m, _, node, _) in &self.placements {
             flattened[m] |= nodes[node].skin().is_some();
         }
         // Triangles stored: a flattened mesh's at each placement, an instanced one's once.
@@ -238,7 +242,7 @@ impl Loader<'_> {
         let mut instanced: Vec<Option<u32>> = vec![None; meshes.len()];
         // The object-space boxes of each instanced mesh's primitives.
         let mut object_boxes: Vec<Vec<[Vec3; 2]>> = Vec::new();
-        for (m, world, node) in std::mem::take(&mut self.placements) {
+        for (m, world, node, object) in std::mem::take(&mut self.placements) {
             let mesh = &meshes[m];
             if count[m] < 2 || flattened[m] {
                 let node = &nodes[node];
@@ -254,6 +258,8 @@ impl Loader<'_> {
                     joints: &joints,
                 };
                 self.mesh(mesh, world, pose)?;
+                let n = self.parts.mesh.triangles.len();
+                self.parts.mesh.triangle_objects.resize(n, object);
                 continue;
             }
             let index = match instanced[m] {
@@ -278,7 +284,7 @@ impl Loader<'_> {
             }
             // The walk checked that the transform is invertible.
             if let Some(instance) = Instance::new(index, world) {
-                self.parts.instances.push(instance);
+                self.parts.instances.push(Instance { object, ..instance });
             }
         }
         Ok(())

@@ -507,6 +507,10 @@ pub(super) fn assert_same_hits(a: &Scene, b: &Scene, n: usize) -> usize {
                     a.materials[x.material as usize].name,
                     b.materials[y.material as usize].name
                 );
+                assert_eq!(
+                    a.objects[x.object as usize], b.objects[y.object as usize],
+                    "ray {k}"
+                );
             }
             _ => mismatches += 1,
         }
