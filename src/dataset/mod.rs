@@ -7,13 +7,15 @@
 //!   and `splits/`;
 //! - [`preview`]: `streaks dataset preview SAMPLE -o PNG` writes a sample's left image beside
 //!   its ground-truth disparity (and rain mask) for a person to look at;
-//! - [`sample`]: rendering and writing one sample.
+//! - [`sample`]: rendering and writing one sample;
+//! - [`flow`]: a sample's flow ground truth, from the scene of the next frame of its drive.
 //!
 //! The folder layout, `dataset.json`, `meta.json`, the manifest, the locks, the shards and the
 //! checks of the samples are the `streaks-dataset` crate's.
 //!
 //! docs/datasets.md describes the layout and the conventions for users.
 
+pub mod flow;
 pub mod generate;
 pub mod index;
 pub mod preview;
