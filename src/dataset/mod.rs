@@ -10,12 +10,15 @@
 //! - [`stats`]: `streaks dataset stats DIR` writes an HTML page of histograms of the drawn
 //!   parameters, with thumbnails, and a contact sheet;
 //! - [`sample`]: rendering and writing one sample.
+//! - [`sample`]: rendering and writing one sample;
+//! - [`flow`]: a sample's flow ground truth, from the scene of the next frame of its drive.
 //!
 //! The folder layout, `dataset.json`, `meta.json`, the manifest, the locks, the shards and the
 //! checks of the samples are the `streaks-dataset` crate's.
 //!
 //! docs/datasets.md describes the layout and the conventions for users.
 
+pub mod flow;
 pub mod generate;
 pub mod index;
 pub mod preview;

@@ -3,7 +3,10 @@
 //! (`disp0.pfm`, turbo colours from 0 px to the sample's largest disparity, no value black)
 //! and, when the sample has them, its rain mask (`rain0.png`, stretched so that its brightest
 //! pixel is white: most drops cover a pixel for a small share of the shutter) or else its fog
-//! transmittance (`fog0.pfm`, white = clear, black = hidden) as a third panel.
+//! transmittance (`fog0.pfm`, white = clear, black = hidden) as a third panel, and its flow to
+//! the next frame (`flow0.pfm`, the Middlebury colour wheel normalised by the largest flow
+//! shown; pixels without a flow in the next image, `flowmask0.png` below 128, black) as the
+//! last.
 
 use anyhow::{bail, Context, Result};
 use image::{imageops, Rgb, RgbImage};
@@ -11,7 +14,8 @@ use std::path::PathBuf;
 use streaks_analysis::sgm::disparity_preview;
 use streaks_dataset::files::SampleDir;
 use streaks_image::input::load_image;
-use streaks_image::pfm::read_pfm;
+use streaks_image::flow_color::flow_color;
+use streaks_image::pfm::{read_pfm, read_pfm_rgb};
 use streaks_image::png::write_png_buffer;
 use streaks_stereo::rig::Eye;
 
@@ -80,21 +84,25 @@ pub fn run(args: Args) -> Result<()> {
     } else {
         None
     };
+    let flow = if files.flow_pfm().is_file() {
+        Some(flow_panel(&files)?)
+    } else {
+        None
+    };
     let (w, h) = left.dimensions();
-    if let Some(panel) = &third {
+    for panel in third.iter().chain(&flow) {
         if panel.dimensions() != (w, h) {
             bail!(
-                "the rain or fog mask of {} is not {w}x{h}",
+                "the rain, fog or flow map of {} is not {w}x{h}",
                 args.sample.display()
             );
         }
     }
-    let panels = if third.is_some() { 3 } else { 2 };
-    let mut out = RgbImage::from_pixel(panels * w, h, Rgb([0, 0, 0]));
-    imageops::replace(&mut out, &left, 0, 0);
-    imageops::replace(&mut out, &colours, i64::from(w), 0);
-    if let Some(panel) = &third {
-        imageops::replace(&mut out, panel, 2 * i64::from(w), 0);
+    let panels = [Some(&left), Some(&colours), third.as_ref(), flow.as_ref()];
+    let shown: Vec<&RgbImage> = panels.into_iter().flatten().collect();
+    let mut out = RgbImage::from_pixel(shown.len() as u32 * w, h, Rgb([0, 0, 0]));
+    for (i, panel) in shown.into_iter().enumerate() {
+        imageops::replace(&mut out, panel, i as i64 * i64::from(w), 0);
     }
     if let Some(parent) = args.output.parent().filter(|p| !p.as_os_str().is_empty()) {
         std::fs::create_dir_all(parent)
@@ -103,4 +111,37 @@ pub fn run(args: Args) -> Result<()> {
     write_png_buffer(&args.output, &out)
         .with_context(|| format!("cannot write {}", args.output.display()))?;
     Ok(())
+}
+
+/// The sample's flow in the Middlebury colours, normalised by its largest flow shown; black
+/// where the point is not in the next image (`flowmask0.png` below 128).
+fn flow_panel(files: &SampleDir) -> Result<RgbImage> {
+    let path = files.flow_pfm();
+    let flow = read_pfm_rgb(&path)
+        .with_context(|| format!("cannot read the flow {}", path.display()))?;
+    let mask_path = files.flow_mask();
+    let mask = load_image(&mask_path)
+        .with_context(|| format!("cannot read the flow mask {}", mask_path.display()))?
+        .to_luma8();
+    if mask.dimensions() != (flow.width, flow.height) {
+        bail!("{} is not the size of {}", mask_path.display(), path.display());
+    }
+    let shown = |i: usize| mask.as_raw()[i] >= 128;
+    let largest = flow
+        .pixels
+        .iter()
+        .enumerate()
+        .filter(|&(i, _)| shown(i))
+        .map(|(_, f)| f.x.hypot(f.y))
+        .filter(|r| r.is_finite())
+        .fold(0.0f32, f32::max);
+    Ok(RgbImage::from_fn(flow.width, flow.height, |x, y| {
+        let i = (y * flow.width + x) as usize;
+        let f = flow.pixels[i];
+        if shown(i) {
+            Rgb(flow_color(f.x, f.y, largest.max(1e-3)))
+        } else {
+            Rgb([0, 0, 0])
+        }
+    }))
 }

@@ -9,16 +9,20 @@ use streaks_dataset::files::{SampleDir, SCENE_GLTF};
 use streaks_dataset::kitti::write_kitti;
 use streaks_dataset::layout::{sample_id, Layout};
 use streaks_dataset::meta::{
-    render_seed, FogMeta, RenderMeta, RigMeta, SampleMeta, SampleStats, WeatherMeta,
+    kitti_pose, matrix_rows, render_seed, FlowShares, FogMeta, RenderMeta, RigMeta, SampleMeta,
+    SampleStats, SequenceMeta, WeatherMeta,
 };
 use streaks_dataset::settings::Settings;
 use streaks_dataset::write::{
-    disparity_range, instance_numbering, write_calib, write_views, GroundTruth,
+    disparity_range, instance_numbering, write_calib, write_flow, write_views, GroundTruth,
 };
 use streaks_image::write_bytes_atomically;
 use streaks_render::motion::Motion;
 use streaks_render::scene::Scene;
-use streaks_scenes::procedural::{sample, GeneratorConfig, GENERATOR_VERSION};
+use glam::{DAffine3, DVec3};
+use streaks_scenes::procedural::{sample, street_frame, GeneratorConfig, GENERATOR_VERSION};
+use streaks_stereo::flow::to_f64;
+use streaks_stereo::rig::Eye;
 use streaks_sensor::SensorProfile;
 use streaks_stereo::render::{
     expose_pair, light_records, render_pair, rig_from_camera, scene_has_road, PairSettings,
@@ -158,6 +162,27 @@ fn write_sample(
     let files = SampleDir::new(dir);
     write_views(&files, &scene, &views, s.exposure_ev, GroundTruth::Left)?;
     let instances = instance_numbering(&files, &scene)?.records().to_vec();
+    // The flow to the next frame of the drive: its scene built and loaded, never rendered.
+    let next = super::flow::next_frame(
+        &settings.config,
+        settings.seed,
+        &s,
+        &dir.join(super::flow::NEXT_FRAME_DIR),
+        render.width,
+        render.height,
+    )?;
+    let now = super::flow::Frame {
+        sample: s,
+        scene,
+        rig,
+    };
+    let flow = super::flow::frame_flow(&now, &next)?;
+    write_flow(&files, &flow)?;
+    let super::flow::Frame {
+        sample: s,
+        scene,
+        rig,
+    } = now;
     let has_road = scene_has_road(&scene);
 
     let pixels = left.disparity.data.len().max(1) as f64;
@@ -177,6 +202,31 @@ fn write_sample(
     };
     let i = rig.intrinsics();
     let pp = i.principal_point();
+    let (pitch, roll) = rig.pitch_roll();
+    let world_from_left = to_f64(rig.world_from_eye(Eye::Left));
+    // The first frame's left camera, from the generator's pose of it (the rendered camera is
+    // the glTF's, rounded to 1e-7).
+    let first = if s.frame == 0 {
+        world_from_left
+    } else {
+        let rig0 = street_frame(&settings.config, settings.seed, s.street, 0)?.world_from_rig;
+        to_f64(rig0) * DAffine3::from_translation(DVec3::new(-0.5 * f64::from(rig.baseline()), 0.0, 0.0))
+    };
+    let shares = flow.shares();
+    let sequence = SequenceMeta {
+        frame: s.frame,
+        time_s: s.time_s,
+        fps: settings.config.sequence.fps,
+        world_from_left: matrix_rows(&world_from_left),
+        world_from_rig: matrix_rows(&to_f64(rig.world_from_rig())),
+        kitti_pose: kitti_pose(&first, &world_from_left),
+        flow_shares: FlowShares {
+            no_surface: shares[0],
+            out_of_view: shares[1],
+            occluded: shares[2],
+            visible: shares[3],
+        },
+    };
     let meta = SampleMeta {
         id: sample_id(index),
         index,
@@ -198,6 +248,8 @@ fn write_sample(
             principal_point: [pp.x, pp.y],
             world_from_rig: PoseRecord::from_affine(&rig.world_from_rig()),
             rig_height_m: rig.height(),
+            pitch_deg: Some(pitch.to_degrees()),
+            roll_deg: Some(roll.to_degrees()),
         },
         lights: light_records(&scene, rig.road_frame().ok().as_ref()),
         stats: stats.clone(),
@@ -222,6 +274,7 @@ fn write_sample(
             rig_velocity: w.rig_velocity,
         }),
         instances: Some(instances),
+        sequence: Some(sequence),
     };
     write_bytes_atomically(&files.meta(), &meta.to_bytes())?;
     write_kitti(layout, index, &files, &left.disparity)?;

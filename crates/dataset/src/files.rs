@@ -14,12 +14,23 @@
 //!                         (road1.png: the right view's)
 //! semantic0.png, semantic1.png   8-bit label ids (Cityscapes labelIds; see segmentation)
 //! instance0.png, instance1.png   16-bit instance ids (Cityscapes instanceIds)
+//! flow0.png               the left view's forward optical flow to the next frame, KITTI
+//!                         flow_occ style: 16-bit RGB, u x 64 + 2^15, v x 64 + 2^15, valid
+//! flow0.pfm               the same flow as float (PF: u, v, 0; inf where it has none)
+//! dispchange0.pfm         the left view's disparity change to the next frame (SceneFlow's)
+//! flowmask0.png           what each pixel's flow is: 255 visible in the next frame,
+//!                         128 occluded in it, 64 out of its view, 0 no surface (the sky)
 //! calib.txt               Middlebury 2014 calibration
 //! meta.json               a dataset sample's metadata (rig, lights, seeds, statistics)
 //! rig.json                a pair's rig and lights (`streaks stereo`)
 //! anaglyph.png, side_by_side.png   a pair's viewing aids (`streaks stereo`)
 //! scene.gltf, scene.bin, scene_*.png   a dataset sample's scene
 //! ```
+//!
+//! A dataset folder also has, per street, `sequences/SSSSSS/poses.txt` (KITTI odometry: the
+//! left camera's pose in the first frame's camera frame, 12 numbers a line, one line per
+//! frame) and `times.txt` (each frame's time, seconds), written by `streaks dataset index`
+//! from the samples' `meta.json`.
 //!
 //! A dataset sample has the left view's depth and masks only; a `streaks stereo` folder has
 //! both views'. Folders that `streaks stereo` wrote before it used this layout (`left.exr`,
@@ -60,6 +71,25 @@ pub const KITTI_IMAGE_3: &str = "image_3";
 pub const KITTI_DISP_OCC_0: &str = "disp_occ_0";
 /// The suffix of a KITTI file name after the sample id (`NNNNNN_10.png`).
 pub const KITTI_SUFFIX: &str = "_10.png";
+
+/// A dataset's per-street sequence folders (`sequences/SSSSSS/`).
+pub const SEQUENCES_DIR: &str = "sequences";
+/// A sequence's camera poses (KITTI odometry format).
+pub const POSES: &str = "poses.txt";
+/// A sequence's frame times, seconds.
+pub const TIMES: &str = "times.txt";
+
+/// The left view's optical flow to the next frame as a KITTI 2015 16-bit flow PNG.
+pub const FLOW_PNG: &str = "flow0.png";
+/// The left view's optical flow to the next frame as a three-channel PFM (u, v, 0).
+pub const FLOW_PFM: &str = "flow0.pfm";
+/// The left view's disparity change to the next frame, PFM.
+pub const DISPARITY_CHANGE: &str = "dispchange0.pfm";
+/// What each left pixel's flow is (visible, occluded, out of view, no surface), 8-bit PNG.
+pub const FLOW_MASK: &str = "flowmask0.png";
+/// The flow files of a sample of a sequence (every generated sample with a `sequence`
+/// record in its `meta.json`), sorted.
+pub const FLOW_FILES: [&str; 4] = [DISPARITY_CHANGE, FLOW_PFM, FLOW_PNG, FLOW_MASK];
 
 /// `calib.txt`: the Middlebury 2014 calibration.
 pub const CALIB: &str = "calib.txt";
@@ -309,6 +339,26 @@ impl SampleDir {
     /// `scene.gltf`.
     pub fn scene(&self) -> PathBuf {
         self.dir.join(SCENE_GLTF)
+    }
+
+    /// The left view's flow as a KITTI flow PNG.
+    pub fn flow_png(&self) -> PathBuf {
+        self.dir.join(FLOW_PNG)
+    }
+
+    /// The left view's flow as a float PFM.
+    pub fn flow_pfm(&self) -> PathBuf {
+        self.dir.join(FLOW_PFM)
+    }
+
+    /// The left view's disparity change.
+    pub fn disparity_change(&self) -> PathBuf {
+        self.dir.join(DISPARITY_CHANGE)
+    }
+
+    /// The left view's flow mask.
+    pub fn flow_mask(&self) -> PathBuf {
+        self.dir.join(FLOW_MASK)
     }
 
     /// A file of the folder by its name (a name of this module).

@@ -114,6 +114,17 @@ impl Layout {
         self.root.join(SPLITS_DIR)
     }
 
+    /// `sequences/`: per street, the drive's `poses.txt` and `times.txt`.
+    pub fn sequences_dir(&self) -> PathBuf {
+        self.root.join(crate::files::SEQUENCES_DIR)
+    }
+
+    /// The sequence folder of street `street`: `sequences/SSSSSS/` (six digits, as sample
+    /// ids).
+    pub fn sequence_dir(&self, street: u64) -> PathBuf {
+        self.sequences_dir().join(sample_id(street))
+    }
+
     /// `samples/`.
     pub fn samples_dir(&self) -> PathBuf {
         self.root.join(SAMPLES_DIR)
@@ -280,6 +291,10 @@ pub struct Conventions {
     pub calib: String,
     /// The KITTI view.
     pub kitti: String,
+    /// The flow, the disparity change and the poses of a drive (empty in a `dataset.json`
+    /// written before they existed).
+    #[serde(default)]
+    pub flow: String,
     /// The splits.
     pub splits: String,
     /// Seeds.
@@ -313,6 +328,7 @@ impl Conventions {
                  doffs = 0, baseline in mm, ndisp a multiple of 16 above the largest disparity, vmin/vmax the finite disparity range"),
             kitti: s("KITTI 2015: image_2 = im0.png, image_3 = im1.png, disp_occ_0 = disp0 as uint16 PNG of round(256 d), 0 = no value \
                  (also disparities that do not fit in 1..65535)"),
+            flow: s("the left view's forward flow to the next frame of the street's drive (frame k at k / fps), of the surfaces                  (no rain, no blur): flow0.png KITTI 2015 flow_occ (16-bit RGB, u x 64 + 2^15, v x 64 + 2^15, valid = the point is in                  the next image, visible or occluded), flow0.pfm 'PF' (u, v, 0), inf where the point has no projection;                  dispchange0.pfm f b / Z' - f b / Z; flowmask0.png 255 visible, 128 occluded, 64 out of view, 0 no surface;                  sequences/SSSSSS/poses.txt KITTI odometry (the left camera in the first frame's left camera frame, x right,                  y down, z forward, 3x4 row by row), times.txt seconds"),
             splits: s("by street: every sample of one street is in the same split (splits/{train,val,test}.txt, sample ids)"),
             seeds: s("each sample is reproducible from (config, seed, index); its render seed is derived from (seed, index), \
                  the right eye uses render seed + 1"),
@@ -360,6 +376,10 @@ impl FileList {
                 (
                     "semantic0.png, semantic1.png, instance0.png, instance1.png".to_owned(),
                     "the sample has segmentation maps (meta.json instances)".to_owned(),
+                ),
+                (
+                    crate::files::FLOW_FILES.join(", "),
+                    "the sample is a frame of a drive (meta.json sequence)".to_owned(),
                 ),
             ]),
             scene: vec![

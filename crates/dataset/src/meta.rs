@@ -39,6 +39,76 @@ pub struct RigMeta {
     pub world_from_rig: PoseRecord,
     /// Height of the rig centre above the road, metres.
     pub rig_height_m: f32,
+    /// Pitch of the optical axis below the horizon, degrees (absent in samples written
+    /// before the field existed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pitch_deg: Option<f32>,
+    /// Roll about the optical axis, degrees, positive with the camera's right side down
+    /// (absent in samples written before the field existed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub roll_deg: Option<f32>,
+}
+
+/// A sample as a frame of its street's drive: its time, the left camera's and the rig's world
+/// poses, the KITTI odometry pose and the flow's statistics.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SequenceMeta {
+    /// The frame's number in the street's drive (0 first).
+    pub frame: u64,
+    /// The frame's time, seconds (`frame / fps`).
+    pub time_s: f64,
+    /// Frames per second.
+    pub fps: f64,
+    /// The left camera's world pose, a 4x4 matrix row by row (the project's camera axes: x
+    /// right, y up, looking along -z).
+    pub world_from_left: [[f64; 4]; 4],
+    /// The rig centre's world pose, a 4x4 matrix row by row.
+    pub world_from_rig: [[f64; 4]; 4],
+    /// The left camera's pose in the left camera frame of the street's first frame, KITTI
+    /// odometry style: the top 3x4 of the matrix row by row, camera axes x right, y down, z
+    /// forward (the line of `poses.txt`).
+    pub kitti_pose: [f64; 12],
+    /// Share of the left pixels whose flow is visible, occluded, out of view and without a
+    /// surface (the flow mask's classes).
+    pub flow_shares: FlowShares,
+}
+
+/// Shares of the left pixels by flow class.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FlowShares {
+    /// Visible in the next frame.
+    pub visible: f64,
+    /// Occluded in the next frame.
+    pub occluded: f64,
+    /// Out of the next frame's view.
+    pub out_of_view: f64,
+    /// No surface (the sky).
+    pub no_surface: f64,
+}
+
+/// A rigid pose as a 4x4 matrix, row by row.
+pub fn matrix_rows(pose: &glam::DAffine3) -> [[f64; 4]; 4] {
+    let m = glam::DMat4::from(*pose).transpose();
+    [
+        m.x_axis.to_array(),
+        m.y_axis.to_array(),
+        m.z_axis.to_array(),
+        m.w_axis.to_array(),
+    ]
+}
+
+/// The KITTI odometry pose of a camera at `world_from_camera` relative to the camera of the
+/// first frame at `world_from_first` (both in the project's camera axes: x right, y up,
+/// looking along -z): `S first_from_world world_from_camera S` with `S = diag(1, -1, -1)`,
+/// which turns the axes into KITTI's (x right, y down, z forward); the top 3x4, row by row.
+pub fn kitti_pose(world_from_first: &glam::DAffine3, world_from_camera: &glam::DAffine3) -> [f64; 12] {
+    let s = glam::DAffine3::from_scale(glam::DVec3::new(1.0, -1.0, -1.0));
+    let rows = matrix_rows(&(s * world_from_first.inverse() * *world_from_camera * s));
+    let mut out = [0.0; 12];
+    for (r, row) in rows.iter().take(3).enumerate() {
+        out[4 * r..4 * r + 4].copy_from_slice(row);
+    }
+    out
 }
 
 /// A sample's statistics.
@@ -215,6 +285,10 @@ pub struct SampleMeta {
     /// (no key) in samples written before the segmentation maps, which have none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub instances: Option<Vec<InstanceRecord>>,
+    /// The sample as a frame of its street's drive (`None`: written before sequences
+    /// existed; the file then has no `sequence` key, and the sample no flow files).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sequence: Option<SequenceMeta>,
 }
 
 impl SampleMeta {
@@ -243,6 +317,25 @@ mod tests {
 
     /// A sample's meta.json with a weather record reads back equal; one without the key (an
     /// old file, or a config without weather) reads as `None` and is written without it.
+    /// A camera that moved 2 m forward and turned left by 90 degrees, in KITTI axes: its
+    /// position is z = +2 (forward), its x axis (right) is the first camera's +z (forward),
+    /// its z axis (forward) the first camera's -x (left), its y axis (down) unchanged.
+    #[test]
+    fn kitti_poses_are_relative_to_the_first_camera_in_kittis_axes() {
+        use glam::{DAffine3, DVec3};
+        let first = DAffine3::from_translation(DVec3::new(5.0, 1.2, -3.0));
+        let turned = DAffine3::from_translation(DVec3::new(5.0, 1.2, -5.0))
+            * DAffine3::from_rotation_y(std::f64::consts::FRAC_PI_2);
+        let p = kitti_pose(&first, &turned);
+        let expected = [0.0, 0.0, -1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 2.0];
+        for (a, b) in p.iter().zip(expected) {
+            assert!((a - b).abs() < 1e-12, "{p:?}");
+        }
+        let same = kitti_pose(&turned, &turned);
+        assert_eq!(same, [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]);
+        assert_eq!(matrix_rows(&first)[0], [1.0, 0.0, 0.0, 5.0]);
+    }
+
     #[test]
     fn weather_round_trips_and_old_files_read() {
         let weather = WeatherMeta {

@@ -24,7 +24,8 @@
 
 use crate::error::DatasetError;
 use crate::files::{
-    SampleDir, SAMPLES_DIR, SAMPLE_FILES, SAMPLE_LOCK_PREFIX, SCENE_GLTF, TMP_PREFIX,
+    SampleDir, FLOW_FILES, FLOW_MASK, POSES, SAMPLES_DIR, SAMPLE_FILES, SAMPLE_LOCK_PREFIX,
+    SCENE_GLTF, TIMES, TMP_PREFIX,
 };
 use crate::kitti::write_kitti;
 use crate::layout::{sample_id, DatasetInfo, Layout, SPLITS};
@@ -36,8 +37,9 @@ use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use streaks_image::exr::read_exr_rgb;
-use streaks_image::kitti::read_kitti_disparity;
-use streaks_image::pfm::read_pfm;
+use streaks_image::kitti::{read_kitti_disparity, read_kitti_flow};
+use streaks_image::pfm::{read_pfm, read_pfm_rgb};
+use streaks_stereo::flow::FlowState;
 use streaks_image::{write_bytes_atomically, GrayImage};
 use streaks_stereo::rig::Eye;
 
@@ -69,6 +71,10 @@ pub struct ManifestLine {
     pub files: BTreeMap<String, String>,
     /// The sample's statistics.
     pub stats: SampleStats,
+    /// Its frame and time in its street's drive and its KITTI pose line, for the street's
+    /// `poses.txt` and `times.txt` (not in the manifest).
+    #[serde(skip)]
+    pub sequence: Option<(u64, f64, [f64; 12])>,
 }
 
 /// What [`index_dir`] found.
@@ -259,6 +265,8 @@ pub fn index_dir(layout: &Layout, done: &(dyn Fn() + Sync)) -> Result<IndexRepor
             result
         })
         .collect();
+    // street -> frame -> (time, pose) of the good samples.
+    let mut sequences: BTreeMap<u64, BTreeMap<u64, (f64, [f64; 12])>> = BTreeMap::new();
     for (index, result) in (0..info.count).zip(checked) {
         let Some((result, repaired)) = result else {
             report.missing.push(index);
@@ -281,6 +289,12 @@ pub fn index_dir(layout: &Layout, done: &(dyn Fn() + Sync)) -> Result<IndexRepor
                 };
                 list.push_str(&line.id);
                 list.push('\n');
+                if let Some((frame, time, pose)) = line.sequence {
+                    sequences
+                        .entry(line.street)
+                        .or_default()
+                        .insert(frame, (time, pose));
+                }
                 manifest
                     .push_str(&serde_json::to_string(&line).expect("a manifest line serialises"));
                 manifest.push('\n');
@@ -296,7 +310,34 @@ pub fn index_dir(layout: &Layout, done: &(dyn Fn() + Sync)) -> Result<IndexRepor
     for (split, ids) in &splits {
         write_bytes_atomically(&layout.split_file(split), ids.as_bytes())?;
     }
+    write_sequences(layout, &sequences)?;
     Ok(report)
+}
+
+/// Writes `sequences/SSSSSS/poses.txt` and `times.txt` of every street whose good samples
+/// are frames 0, 1, ... without a gap (a street with a missing or bad frame gets none: its
+/// lines would not match the frame numbers).
+fn write_sequences(
+    layout: &Layout,
+    sequences: &BTreeMap<u64, BTreeMap<u64, (f64, [f64; 12])>>,
+) -> Result<(), DatasetError> {
+    for (street, frames) in sequences {
+        if !frames.keys().copied().eq(0..frames.len() as u64) {
+            continue;
+        }
+        let (mut poses, mut times) = (String::new(), String::new());
+        for (time, pose) in frames.values() {
+            let line: Vec<String> = pose.iter().map(|v| format!("{:.9e}", v + 0.0)).collect();
+            poses.push_str(&line.join(" "));
+            poses.push('\n');
+            times.push_str(&format!("{:.6e}\n", time));
+        }
+        let dir = layout.sequence_dir(*street);
+        std::fs::create_dir_all(&dir).map_err(|e| DatasetError::io("create the folder", &dir, e))?;
+        write_bytes_atomically(&dir.join(POSES), poses.as_bytes())?;
+        write_bytes_atomically(&dir.join(TIMES), times.as_bytes())?;
+    }
+    Ok(())
 }
 
 /// The files a sample's `scene.gltf` refers to (buffers and images with a relative `uri`).
@@ -383,6 +424,46 @@ fn check_size(
     DatasetError::check_size(path, (img.width, img.height), size, DATASET_SIZE)
 }
 
+/// Checks a sample's flow files: each decodes at `size`, the flow mask holds only the
+/// classes' values, and the KITTI PNG has a flow exactly where the mask says visible or
+/// occluded.
+fn check_flow(sample: &SampleDir, size: (usize, usize)) -> Result<(), DatasetError> {
+    let png = sample.flow_png();
+    let (w, h, kitti) = read_kitti_flow(&png)?;
+    DatasetError::check_size(&png, (w, h), size, DATASET_SIZE)?;
+    let pfm = sample.flow_pfm();
+    let flow = read_pfm_rgb(&pfm)?;
+    DatasetError::check_size(
+        &pfm,
+        (flow.width as usize, flow.height as usize),
+        size,
+        DATASET_SIZE,
+    )?;
+    let change = sample.disparity_change();
+    check_size(&change, size, read_pfm(&change))?;
+    let mask_path = sample.flow_mask();
+    let mask = streaks_image::input::load_image(&mask_path)?.to_luma8();
+    let mask_size = (mask.width() as usize, mask.height() as usize);
+    DatasetError::check_size(&mask_path, mask_size, size, DATASET_SIZE)?;
+    for (i, (&m, k)) in mask.as_raw().iter().zip(&kitti).enumerate() {
+        let Some(state) = FlowState::from_mask_value(m) else {
+            return Err(DatasetError::Invalid {
+                path: mask_path,
+                reason: format!("pixel {i} holds {m}, not a flow class (0, 64, 128, 255)"),
+            });
+        };
+        if state.has_flow() && k.is_none() && flow.pixels[i].x.abs() < 511.0 && flow.pixels[i].y.abs() < 511.0
+            || !state.has_flow() && k.is_some()
+        {
+            return Err(DatasetError::Invalid {
+                path: png,
+                reason: format!("pixel {i}: its valid flag disagrees with {FLOW_MASK} ({m})"),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// What the size of a sample's files is checked against, in messages.
 const DATASET_SIZE: &str = "the dataset's images are";
 
@@ -439,6 +520,9 @@ pub fn check_sample(
     if has_segmentation {
         expected.extend(semantic.iter().chain(&instance).map(|p| file_name(p)));
     }
+    if meta.sequence.is_some() {
+        expected.extend(FLOW_FILES.map(String::from));
+    }
     expected.push(SCENE_GLTF.to_owned());
     if sample.scene().is_file() {
         expected.extend(scene_files(&sample.scene())?);
@@ -492,6 +576,9 @@ pub fn check_sample(
     .chain(has_fog.then_some(fog_maps).into_iter().flatten())
     {
         check_size(&p, size, read_pfm(&p))?;
+    }
+    if meta.sequence.is_some() {
+        check_flow(&sample, size)?;
     }
     for p in Eye::BOTH.map(|eye| sample.exr(eye)) {
         let img = read_exr_rgb(&p)?;
@@ -566,6 +653,10 @@ pub fn check_sample(
         render_seed: meta.render_seed,
         files,
         stats: meta.stats,
+        sequence: meta
+            .sequence
+            .as_ref()
+            .map(|q| (q.frame, q.time_s, q.kitti_pose)),
     })
 }
 

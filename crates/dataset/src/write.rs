@@ -7,12 +7,14 @@ use crate::files::SampleDir;
 use crate::segmentation::{InstanceNumbering, MAX_INSTANCES_PER_CLASS};
 use image::RgbImage;
 use streaks_image::develop;
-use streaks_image::pfm::write_pfm;
+use streaks_image::kitti::write_kitti_flow;
+use streaks_image::pfm::{write_pfm, write_pfm_rgb};
 use streaks_image::png::write_png_buffer;
 use streaks_image::GrayImage;
 use streaks_render::output::write_exr_with_sensor;
 use streaks_render::scene::Scene;
 use streaks_stereo::calib::MiddleburyCalib;
+use streaks_stereo::flow::FlowField;
 use streaks_stereo::pair::write_pair_views;
 use streaks_stereo::render::{light_records, scene_has_road, EyeView};
 use streaks_stereo::rig::{Eye, Rig};
@@ -134,6 +136,47 @@ pub fn write_pair(
     let road = rig.road_frame().ok();
     RigFile::new(rig, light_records(scene, road.as_ref())).save(&files.rig_json())?;
     write_calib(&files, rig, &views[0])
+}
+
+/// Writes the left view's flow to the next frame into `files`: `flow0.png` (KITTI flow_occ
+/// style: a value where the point is in the next image, visible or occluded), `flow0.pfm`
+/// (u, v, 0; `inf` where the point has no projection), `dispchange0.pfm` and `flowmask0.png`
+/// (the [`FlowState`] of each pixel).
+pub fn write_flow(files: &SampleDir, flow: &FlowField) -> Result<(), DatasetError> {
+    let (w, h) = (flow.width, flow.height);
+    let kitti: Vec<Option<[f32; 2]>> = flow
+        .flow
+        .iter()
+        .zip(&flow.state)
+        .map(|(f, s)| s.has_flow().then_some(*f))
+        .collect();
+    write_kitti_flow(&files.flow_png(), w, h, &kitti)?;
+    let rgb = streaks_image::RgbImage {
+        width: w as u32,
+        height: h as u32,
+        pixels: flow
+            .flow
+            .iter()
+            .map(|f| {
+                let z = if f[0].is_finite() { 0.0 } else { f32::INFINITY };
+                glam::Vec3::new(f[0], f[1], z)
+            })
+            .collect(),
+    };
+    write_pfm_rgb(&files.flow_pfm(), &rgb)?;
+    write_pfm(
+        &files.disparity_change(),
+        &GrayImage::from_vec(w, h, flow.disparity_change.clone())?,
+    )?;
+    let mask: Vec<u8> = flow.state.iter().map(|s| s.mask_value()).collect();
+    let img = image::GrayImage::from_raw(w as u32, h as u32, mask).ok_or_else(|| {
+        DatasetError::Invalid {
+            path: files.flow_mask(),
+            reason: format!("{w}x{h} flow mask of {} pixels", flow.state.len()),
+        }
+    })?;
+    write_png_buffer(&files.flow_mask(), &img)?;
+    Ok(())
 }
 
 /// The range `(min, max)` of a view's finite ground-truth disparities; `None` when there is

@@ -18,6 +18,8 @@
 //! - [`input`]: reading files that may be hostile: regular files only, capped reads, images
 //!   checked against a pixel limit from their header ([`input::MAX_PIXELS`]);
 //! - [`kitti`]: disparity maps in the KITTI 2015 encoding (16-bit PNG, disparity x 256);
+//!   optical flow in KITTI's (16-bit RGB, flow x 64 + 2^15, valid);
+//! - [`flow_color`]: the Middlebury colour coding of optical flow;
 //! - [`stats`]: quantiles and medians of pixel values (nearest rank, and the two other
 //!   definitions the project's numbers depend on);
 //! - [`compare`]: statistics of the difference between two images (relative RMSE, bias, the
@@ -48,6 +50,7 @@ pub mod compare;
 pub mod develop;
 pub mod error;
 pub mod exr;
+pub mod flow_color;
 pub mod gray;
 pub mod input;
 pub mod kitti;

@@ -789,11 +789,42 @@ impl Doc {
 
     /// Adds a perspective camera node named `name` at `eye` looking at `target` (+Y up).
     pub fn add_camera(&mut self, name: &str, eye: Vec3, target: Vec3, yfov_deg: f64, aspect: f64) {
+        self.add_camera_up(name, eye, target, Vec3::Y, yfov_deg, aspect);
+    }
+
+    /// Adds a perspective camera node named `name` at `eye` looking at `target`, its image's
+    /// up direction as close to `up` as the view allows (a rolled camera has an `up` tilted
+    /// about the view direction).
+    pub fn add_camera_up(
+        &mut self,
+        name: &str,
+        eye: Vec3,
+        target: Vec3,
+        up: Vec3,
+        yfov_deg: f64,
+        aspect: f64,
+    ) {
         let forward = (target - eye).normalize();
-        // Right-handed basis with local -Z = forward, local +Y as close to world +Y as possible.
-        let right = forward.cross(Vec3::Y).normalize();
+        // Right-handed basis with local -Z = forward, local +Y as close to `up` as possible.
+        let right = forward.cross(up).normalize();
         let up = right.cross(forward);
-        let q = Quat::from_mat3(&glam::Mat3::from_cols(right, up, -forward));
+        let pose = glam::Affine3A::from_mat3_translation(
+            glam::Mat3::from_cols(right, up, -forward),
+            eye,
+        );
+        self.add_camera_pose(name, pose, yfov_deg, aspect);
+    }
+
+    /// Adds a perspective camera node named `name` with the rigid pose `world_from_camera`
+    /// (the camera looks along its local -Z with local +Y up).
+    pub fn add_camera_pose(
+        &mut self,
+        name: &str,
+        world_from_camera: glam::Affine3A,
+        yfov_deg: f64,
+        aspect: f64,
+    ) {
+        let q = Quat::from_mat3a(&world_from_camera.matrix3).normalize();
         self.cameras.push(json!({
             "name": name,
             "type": "perspective",
@@ -806,7 +837,7 @@ impl Doc {
         self.nodes.push(json!({
             "name": name,
             "camera": self.cameras.len() - 1,
-            "translation": round_vec(eye),
+            "translation": round_vec(Vec3::from(world_from_camera.translation)),
             "rotation": round_quat(q),
         }));
     }

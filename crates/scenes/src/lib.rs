@@ -21,6 +21,7 @@
 pub mod albedo;
 pub mod buildings;
 pub mod crosscheck;
+pub mod drive;
 pub mod estimate;
 pub mod gltf_writer;
 pub mod light_sources;

@@ -39,7 +39,7 @@ use std::path::Path;
 pub const GENERATOR_VERSION: &str = concat!(
     "streaks-scenes ",
     env!("CARGO_PKG_VERSION"),
-    " procedural/2"
+    " procedural/3"
 );
 
 /// A closed range `[min, max]` of a real parameter, written `[min, max]` in TOML.
@@ -247,34 +247,89 @@ impl Default for WetnessConfig {
     }
 }
 
-/// The stereo rig (its centre is the glTF camera `driver`).
+/// The vehicle a rig is mounted on: how often it is drawn and how high it carries the rig.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct MountConfig {
+    /// Relative weight of this vehicle class among the rig's vehicles.
+    pub weight: f64,
+    /// Height of the rig centre above the road on this vehicle, metres.
+    pub height: Range,
+}
+
+impl Default for MountConfig {
+    fn default() -> Self {
+        Self {
+            weight: 1.0,
+            height: [1.1, 1.5],
+        }
+    }
+}
+
+/// The stereo rig (its centre is the glTF camera `driver`), drawn once per street: a drive
+/// keeps its vehicle, lane and mounting.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct RigConfig {
-    /// Height of the rig above the road, metres.
-    pub height: Range,
-    /// Offset from the driver's lane centre to the right, metres.
+    /// Weights of the lanes in the driving direction the rig drives in, the rightmost lane
+    /// first; lanes the street does not have are dropped (a street always has one).
+    pub lanes: Vec<f64>,
+    /// The vehicle classes the rig is mounted on (`car`, `van`, `truck`, or any name), each
+    /// with its weight and mounting height.
+    pub vehicles: BTreeMap<String, MountConfig>,
+    /// Offset from the lane centre to the right, metres.
     pub lateral: Range,
     /// Pitch below the horizon, degrees.
     pub pitch_deg: Range,
+    /// Roll about the viewing direction, degrees (positive: clockwise as the camera sees it,
+    /// the horizon's right end low).
+    pub roll_deg: Range,
     /// Stereo baseline, metres.
     pub baseline: Range,
     /// Focal length as a 35 mm-equivalent (24 mm image height), mm: the vertical field of
     /// view is `2 atan(12 / f)`.
     pub focal_mm35: Range,
-    /// Distance between the rigs of consecutive pairs of one street, metres.
-    pub pair_spacing: f64,
 }
 
 impl Default for RigConfig {
     fn default() -> Self {
+        let mount = |weight, height| MountConfig { weight, height };
         Self {
-            height: [1.1, 1.7],
-            lateral: [-0.5, 0.3],
+            lanes: vec![0.7, 0.3],
+            vehicles: BTreeMap::from([
+                ("car".to_owned(), mount(0.65, [1.1, 1.5])),
+                ("van".to_owned(), mount(0.25, [1.6, 2.2])),
+                ("truck".to_owned(), mount(0.1, [2.2, 3.0])),
+            ]),
+            lateral: [-0.3, 0.3],
             pitch_deg: [0.0, 4.0],
+            roll_deg: [-2.0, 2.0],
             baseline: [0.1, 0.4],
             focal_mm35: [24.0, 45.0],
-            pair_spacing: 7.0,
+        }
+    }
+}
+
+/// A drive: the frame rate of a street's sequence and the speeds of the rig and of the
+/// traffic. Frame `k` of a street is at time `k / fps` seconds.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SequenceConfig {
+    /// Frames per second.
+    pub fps: f64,
+    /// The rig's speed along its lane, km/h, drawn per street.
+    pub speed_kmh: Range,
+    /// Speed of each leading and oncoming car along its lane, km/h, drawn per car (parked
+    /// cars stay).
+    pub traffic_speed_kmh: Range,
+}
+
+impl Default for SequenceConfig {
+    fn default() -> Self {
+        Self {
+            fps: 10.0,
+            speed_kmh: [0.0, 50.0],
+            traffic_speed_kmh: [10.0, 50.0],
         }
     }
 }
@@ -319,7 +374,8 @@ impl Default for SplitConfig {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct DatasetConfig {
-    /// Consecutive samples rendered from one street (the rig moves along the road).
+    /// Consecutive samples rendered from one street: the frames of a drive along it, at
+    /// `[sequence]`'s frame rate.
     pub pairs_per_street: u32,
     /// Shares of the streets in the train, val and test splits.
     pub split: SplitConfig,
@@ -355,6 +411,8 @@ pub struct GeneratorConfig {
     pub exposure: ExposureConfig,
     /// Streets and splits.
     pub dataset: DatasetConfig,
+    /// Drives: frame rate and speeds.
+    pub sequence: SequenceConfig,
     /// The night sky's glow, an environment light.
     pub sky: SkyConfig,
     /// Rain, fog, sensor, exposure time and motion.
@@ -510,17 +568,41 @@ impl GeneratorConfig {
         real("wetness.ripple_strength", w.ripple_strength, 0.0, 2.0)?;
         real("wetness.ripple_tile", w.ripple_tile, 0.05, 20.0)?;
         let r = &self.rig;
-        real("rig.height", r.height, 0.2, 10.0)?;
-        real("rig.lateral", r.lateral, -3.0, 3.0)?;
-        real("rig.pitch_deg", r.pitch_deg, -30.0, 30.0)?;
-        real("rig.baseline", r.baseline, 0.001, 5.0)?;
-        real("rig.focal_mm35", r.focal_mm35, 8.0, 400.0)?;
-        if !(r.pair_spacing.is_finite() && (0.0..=50.0).contains(&r.pair_spacing)) {
+        if r.lanes.is_empty() || r.lanes.iter().any(|w| !(w.is_finite() && *w >= 0.0)) {
             return Err(format!(
-                "rig.pair_spacing = {} must be in [0, 50]",
-                r.pair_spacing
+                "rig.lanes = {:?} must give at least one lane weight, each >= 0",
+                r.lanes
             ));
         }
+        if r.lanes[0] <= 0.0 {
+            return Err(format!(
+                "rig.lanes = {:?}: the rightmost lane's weight must be > 0 (every street has it)",
+                r.lanes
+            ));
+        }
+        if r.vehicles.is_empty() || r.vehicles.values().all(|m| m.weight <= 0.0) {
+            return Err("rig.vehicles must give at least one vehicle with a weight > 0".into());
+        }
+        for (name, m) in &r.vehicles {
+            if !(m.weight.is_finite() && m.weight >= 0.0) {
+                return Err(format!(
+                    "rig.vehicles.{name}.weight = {} must be >= 0",
+                    m.weight
+                ));
+            }
+            real(&format!("rig.vehicles.{name}.height"), m.height, 0.2, 10.0)?;
+        }
+        real("rig.lateral", r.lateral, -3.0, 3.0)?;
+        real("rig.pitch_deg", r.pitch_deg, -30.0, 30.0)?;
+        real("rig.roll_deg", r.roll_deg, -30.0, 30.0)?;
+        real("rig.baseline", r.baseline, 0.001, 5.0)?;
+        real("rig.focal_mm35", r.focal_mm35, 8.0, 400.0)?;
+        let q = &self.sequence;
+        if !(q.fps.is_finite() && (0.1..=1000.0).contains(&q.fps)) {
+            return Err(format!("sequence.fps = {} must be in [0.1, 1000]", q.fps));
+        }
+        real("sequence.speed_kmh", q.speed_kmh, 0.0, 250.0)?;
+        real("sequence.traffic_speed_kmh", q.traffic_speed_kmh, 0.0, 250.0)?;
         real("exposure.ev", self.exposure.ev, -20.0, 20.0)?;
         let d = &self.dataset;
         if d.pairs_per_street == 0 || d.pairs_per_street > 100 {
@@ -615,6 +697,16 @@ pub struct SampleScene {
     /// in the scene's extras; the sensor preset, exposure time and rig velocity are for the
     /// render and `meta.json`.
     pub weather: Option<Weather>,
+    /// The frame of the street's drive this sample is (`index % pairs_per_street`).
+    pub frame: u64,
+    /// The frame's time in the drive, seconds (`frame / fps`).
+    pub time_s: f64,
+    /// The rig centre's world pose at the frame's time (the camera `driver`, before the
+    /// glTF's rounding).
+    pub world_from_rig: glam::Affine3A,
+    /// The objects that move during the drive (leading and oncoming cars), with their poses at
+    /// the frame's time.
+    pub objects: Vec<crate::drive::MovingObject>,
 }
 
 /// Camera node name of generated streets.
@@ -636,6 +728,7 @@ const SPLIT_STREAM: u64 = 3;
 const SKY_STREAM: u64 = 4;
 const WEATHER_STREAM: u64 = 5;
 const CAMERA_STREAM: u64 = 6;
+const MOTION_STREAM: u64 = 7;
 
 /// The lamps' beam: a spot light straight down, full intensity to 60 degrees from the nadir,
 /// none beyond 85 (a road luminaire's wide, cut-off distribution).
@@ -692,42 +785,114 @@ fn spaced(rng: &mut ChaCha8Rng, n: u32, lo: f32, hi: f32, gap: f32) -> Vec<f32> 
     out
 }
 
-/// Builds sample `index` of the dataset `(config, seed)`.
+/// Builds sample `index` of the dataset `(config, seed)`: frame `index % pairs_per_street`
+/// of street `index / pairs_per_street` ([`street_frame`]).
 pub fn sample(config: &GeneratorConfig, seed: u64, index: u64) -> Result<SampleScene, Error> {
+    let per_street = u64::from(config.dataset.pairs_per_street.max(1));
+    street_frame(config, seed, index / per_street, index % per_street)
+}
+
+/// The lane centres in the driving direction, rightmost first: the lanes whose centre is
+/// right of (or on) the road's centre line.
+fn driving_lanes(lanes: u32, lane_width: f32) -> Vec<f32> {
+    let road_half = lanes as f32 * lane_width * 0.5;
+    (0..lanes)
+        .map(|i| road_half - (i as f32 + 0.5) * lane_width)
+        .filter(|x| *x >= -1e-4)
+        .collect()
+}
+
+/// Builds frame `frame` of street `street_id` of the dataset `(config, seed)`: the street at
+/// time `frame / fps` with the rig and the moving cars where the drive puts them
+/// ([`crate::drive`]). Any frame can be built, also beyond `pairs_per_street` (the flow of a
+/// street's last sample needs the scene of the frame after it), and each from
+/// `(config, seed, street, frame)` alone.
+pub fn street_frame(
+    config: &GeneratorConfig,
+    seed: u64,
+    street_id: u64,
+    frame: u64,
+) -> Result<SampleScene, Error> {
     config.validate().map_err(|reason| Error::Config {
         origin: "the generator config".into(),
         reason,
     })?;
     let per_street = u64::from(config.dataset.pairs_per_street.max(1));
-    let street_id = index / per_street;
-    let pair_in_street = index % per_street;
+    let index = street_id * per_street + frame;
     let mut rng = ChaCha8Rng::seed_from_u64(mix(seed, STREET_STREAM, street_id));
-    let (street, mut params) = random_street(config, &mut rng, seed, street_id)?;
-    let mut rig_rng = ChaCha8Rng::seed_from_u64(mix(seed, RIG_STREAM, index));
+    let (mut street, mut params) = random_street(config, &mut rng, seed, street_id)?;
+    // The rig, drawn once per street: a drive keeps its vehicle, lane and mounting.
+    let mut rig_rng = ChaCha8Rng::seed_from_u64(mix(seed, RIG_STREAM, street_id));
     let rig = &config.rig;
-    let height = uniform(&mut rig_rng, rig.height) as f32;
+    let vehicle = weighted(
+        &mut rig_rng,
+        &rig.vehicles
+            .iter()
+            .map(|(name, m)| (name.as_str(), m.weight))
+            .collect(),
+    );
+    let height = uniform(&mut rig_rng, rig.vehicles[vehicle].height) as f32;
+    let lanes = params["street"]["lanes"].as_u64().unwrap_or(1) as u32;
+    let lane_width = params["street"]["lane_width"].as_f64().unwrap_or(3.0) as f32;
+    let centres = driving_lanes(lanes, lane_width);
+    let lane = crate::weather::pick(
+        rig.lanes.iter().take(centres.len()).copied(),
+        rig_rng.random::<f64>(),
+    );
     let lateral = uniform(&mut rig_rng, rig.lateral) as f32;
     let pitch_deg = uniform(&mut rig_rng, rig.pitch_deg);
+    let roll_deg = uniform(&mut rig_rng, rig.roll_deg);
     let baseline = uniform(&mut rig_rng, rig.baseline) as f32;
     let focal = uniform(&mut rig_rng, rig.focal_mm35);
     let yfov_deg = (2.0 * (12.0 / focal).atan()).to_degrees();
     let exposure_ev = uniform(&mut rig_rng, config.exposure.ev) as f32;
-    let lane_centre = params["street"]["driver_lane_x"].as_f64().unwrap_or(0.0) as f32;
-    let eye = Vec3::new(
-        lane_centre + lateral,
-        height,
-        -(pair_in_street as f32) * rig.pair_spacing as f32,
-    );
-    let mut street = street;
+    // The drive's speeds in a stream of their own.
+    let sq = &config.sequence;
+    let mut motion_rng = ChaCha8Rng::seed_from_u64(mix(seed, MOTION_STREAM, street_id));
+    let speed_kmh = uniform(&mut motion_rng, sq.speed_kmh);
+    let drive = crate::drive::Drive {
+        lateral: centres.get(lane).copied().unwrap_or(0.0) + lateral,
+        start: 0.0,
+        mount: crate::drive::mount(
+            height,
+            pitch_deg.to_radians() as f32,
+            roll_deg.to_radians() as f32,
+        ),
+        speed_m_s: speed_kmh / 3.6,
+    };
+    let time = crate::drive::frame_time(frame, sq.fps);
+    let world_from_rig = crate::drive::rig_pose_at(&drive, time);
+    let rig_velocity = crate::drive::rig_velocity_at(&drive, time);
+    let mut objects = Vec::new();
+    let mut car_speeds = Vec::new();
+    for (k, car) in street.cars.iter_mut().enumerate() {
+        let speed_m_s = uniform(&mut motion_rng, sq.traffic_speed_kmh) / 3.6;
+        car_speeds.push(if car.parked { 0.0 } else { speed_m_s });
+        if car.parked {
+            continue;
+        }
+        let pose = crate::drive::car_pose_at(car, speed_m_s, time);
+        car.x = pose.translation.x;
+        car.z = pose.translation.z;
+        objects.push(crate::drive::MovingObject {
+            instance: car_instance(k),
+            world_from_object: pose,
+            bounds: crate::drive::CAR_BOUNDS,
+        });
+    }
+    let eye = Vec3::from(world_from_rig.translation);
     street.style.eye = eye;
     street.style.pitch_tan = pitch_deg.to_radians().tan() as f32;
+    street.style.camera_pose = Some(world_from_rig);
     street.style.yfov_deg = yfov_deg;
     // The weather in its own streams: a config with weather draws every other parameter as
     // one without; the rain then sets the road's wetness and ripples.
     let weather = config.weather.enabled.then(|| {
         let mut street_rng = ChaCha8Rng::seed_from_u64(mix(seed, WEATHER_STREAM, street_id));
         let mut sample_rng = ChaCha8Rng::seed_from_u64(mix(seed, CAMERA_STREAM, index));
-        let w = crate::weather::draw(&config.weather, &mut street_rng, &mut sample_rng);
+        let mut w = crate::weather::draw(&config.weather, &mut street_rng, &mut sample_rng);
+        // Motion blur is the drive's own motion.
+        w.rig_velocity = rig_velocity.to_array().map(|v| crate::gltf_writer::round7(f64::from(v)));
         let wc = &config.wetness;
         street.style.wetness = w.wetness_level(wc.level) as f32;
         street.style.ripples = w
@@ -744,6 +909,14 @@ pub fn sample(config: &GeneratorConfig, seed: u64, index: u64) -> Result<SampleS
             .map(|r| json!({"strength": r.strength, "tile_m": r.tile_m})));
         w
     });
+    for (c, speed) in params["cars"]
+        .as_array_mut()
+        .into_iter()
+        .flatten()
+        .zip(&car_speeds)
+    {
+        c["speed_m_s"] = json!(speed);
+    }
     let mut doc = street.build()?;
     let sky = &config.sky;
     if sky.enabled && sky.glow[1] > 0.0 {
@@ -770,13 +943,22 @@ pub fn sample(config: &GeneratorConfig, seed: u64, index: u64) -> Result<SampleS
     let split = split_of(config, seed, street_id);
     params["rig"] = json!({
         "eye": eye.to_array(),
+        "vehicle": vehicle,
         "height": height,
+        "lane": lane,
         "lateral": lateral,
         "pitch_deg": pitch_deg,
+        "roll_deg": roll_deg,
         "baseline": baseline,
         "focal_mm35": focal,
         "yfov_deg": yfov_deg,
-        "pair_in_street": pair_in_street,
+        "pair_in_street": frame,
+    });
+    params["sequence"] = json!({
+        "frame": frame,
+        "time_s": time,
+        "fps": sq.fps,
+        "speed_kmh": speed_kmh,
     });
     params["exposure_ev"] = json!(exposure_ev);
     Ok(SampleScene {
@@ -788,7 +970,16 @@ pub fn sample(config: &GeneratorConfig, seed: u64, index: u64) -> Result<SampleS
         split,
         params,
         weather,
+        frame,
+        time_s: time,
+        world_from_rig,
+        objects,
     })
+}
+
+/// The instance id of car `k` of a street (ids are > 0; 0 is the static world).
+pub fn car_instance(k: usize) -> u32 {
+    k as u32 + 1
 }
 
 /// The split of street `street_id`: a uniform number from `(seed, street)` against the
@@ -1169,8 +1360,7 @@ mod tests {
                 + street.lamps_left.len()
                 + street.traffic_lights.len()
                 + 2 * street.cars.iter().filter(|c| !c.parked).count();
-            let mut rig_rng = ChaCha8Rng::seed_from_u64(mix(1, RIG_STREAM, i));
-            let baseline = uniform(&mut rig_rng, config.rig.baseline) as f32;
+            let baseline = sample(&config, 1, i).unwrap().baseline;
             lanes.insert(p["street"]["lanes"].as_u64().unwrap());
             ripples += usize::from(!p["wetness"]["ripples"].is_null());
             parked += p["cars"]

@@ -189,6 +189,9 @@ pub struct StreetStyle {
     pub eye: Vec3,
     /// Camera pitch: tangent of the angle below the horizon.
     pub pitch_tan: f32,
+    /// The camera's full world pose (looking along its local -Z, +Y up), which replaces `eye`
+    /// and `pitch_tan` when set: a rig with roll, or one driving along the road.
+    pub camera_pose: Option<glam::Affine3A>,
     /// Vertical field of view in degrees.
     pub yfov_deg: f64,
 }
@@ -222,6 +225,7 @@ impl StreetStyle {
         facade_kd: [[0.16, 0.09, 0.07], [0.3, 0.28, 0.24], [0.18, 0.18, 0.19]],
         eye: EYE,
         pitch_tan: 0.035,
+        camera_pose: None,
         yfov_deg: 45.0,
     };
 }
@@ -410,13 +414,16 @@ impl Street {
             add_signs(&mut doc, &self.signs, st)?;
         }
         self.buildings(&mut doc, &tex)?;
-        doc.add_camera(
-            "driver",
-            st.eye,
-            st.eye + Vec3::new(0.0, -st.pitch_tan, -1.0),
-            st.yfov_deg,
-            16.0 / 9.0,
-        );
+        match st.camera_pose {
+            Some(pose) => doc.add_camera_pose("driver", pose, st.yfov_deg, 16.0 / 9.0),
+            None => doc.add_camera(
+                "driver",
+                st.eye,
+                st.eye + Vec3::new(0.0, -st.pitch_tan, -1.0),
+                st.yfov_deg,
+                16.0 / 9.0,
+            ),
+        }
         Ok(doc)
     }
 

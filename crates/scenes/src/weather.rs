@@ -1,9 +1,10 @@
-//! The generator's weather: rain rate, fog, the camera's sensor preset, exposure time and the
-//! rig's speed, each drawn from a documented distribution ([`WeatherConfig`], the `[weather]`
+//! The generator's weather: rain rate, fog, the camera's sensor preset and exposure time,
+//! each drawn from a documented distribution ([`WeatherConfig`], the `[weather]`
 //! table of the generator config), and what the rain does to the road.
 //!
 //! [`draw`] turns a config and two random streams (one per street: rain, fog, sensor; one per
-//! sample: exposure, speed, the rain drops' seed) into a [`Weather`]. The procedural generator
+//! sample: exposure, the rain drops' seed) into a [`Weather`]; the rig's velocity, for the
+//! motion blur, is the drive's ([`crate::drive`]). The procedural generator
 //! writes its fog and rain into the scene's extras (`scenes[0].extras.streaks.fog` and
 //! `.rain`, the renderer's scene contract), drives the road's wetness from the rain rate
 //! ([`Weather::wetness_level`], [`Weather::ripple_strength`]) and returns the draw for
@@ -84,8 +85,6 @@ pub struct WeatherConfig {
     pub sensor: BTreeMap<String, f64>,
     /// Exposure (shutter) time, seconds.
     pub exposure_s: Range,
-    /// The rig's speed forward along the street, m/s.
-    pub speed: Range,
 }
 
 impl Default for WeatherConfig {
@@ -105,7 +104,6 @@ impl Default for WeatherConfig {
                 ("automotive_linear".to_owned(), 0.3),
             ]),
             exposure_s: [1.0 / 120.0, 1.0 / 30.0],
-            speed: [0.0, 15.0],
         }
     }
 }
@@ -140,7 +138,8 @@ pub struct Weather {
     pub sensor: String,
     /// Exposure time, seconds.
     pub exposure_s: f64,
-    /// The rig's velocity in world space, m/s (forward along the street is -Z).
+    /// The rig's velocity in world space, m/s: the drive's ([`crate::drive::rig_velocity_at`];
+    /// [`draw`] leaves it at rest and the generator sets it).
     pub rig_velocity: [f64; 3],
 }
 
@@ -221,7 +220,8 @@ fn r7(x: f64) -> f64 {
 }
 
 /// Draws a sample's weather: rain, fog and sensor from `street` (the street's stream: every
-/// pair of a street has the same weather), exposure, speed and the drops' seed from `sample`.
+/// pair of a street has the same weather), exposure and the drops' seed from `sample`; the
+/// rig's velocity is left at rest for the generator to set.
 pub fn draw(config: &WeatherConfig, street: &mut ChaCha8Rng, sample: &mut ChaCha8Rng) -> Weather {
     let class = &config.rain[pick(
         config.rain.iter().map(|c| c.probability),
@@ -239,7 +239,6 @@ pub fn draw(config: &WeatherConfig, street: &mut ChaCha8Rng, sample: &mut ChaCha
     let sensor_names: Vec<&String> = config.sensor.keys().collect();
     let sensor = sensor_names[pick(config.sensor.values().copied(), street.random::<f64>())];
     let exposure_s = r7(uniform(sample, config.exposure_s));
-    let speed = r7(uniform(sample, config.speed));
     let rain_seed: u32 = sample.random();
     Weather {
         rain_class: class.name.clone(),
@@ -249,7 +248,7 @@ pub fn draw(config: &WeatherConfig, street: &mut ChaCha8Rng, sample: &mut ChaCha
         fog: foggy.then_some(fog_draw),
         sensor: sensor.clone(),
         exposure_s,
-        rig_velocity: [0.0, 0.0, if speed > 0.0 { -speed } else { 0.0 }],
+        rig_velocity: [0.0; 3],
     }
 }
 
@@ -314,7 +313,6 @@ impl WeatherConfig {
             return Err("weather.sensor weights add up to 0".into());
         }
         real("exposure_s", self.exposure_s, 1e-5, 1.0)?;
-        real("speed", self.speed, 0.0, 70.0)?;
         Ok(())
     }
 }
@@ -364,8 +362,7 @@ mod tests {
         assert!(all.iter().any(|w| w.sensor == "automotive_linear"));
         for w in &all {
             assert!((1.0 / 120.0..=1.0 / 30.0 + 1e-7).contains(&w.exposure_s));
-            assert!(w.rig_velocity[0] == 0.0 && w.rig_velocity[1] == 0.0);
-            assert!((-15.0..=0.0).contains(&w.rig_velocity[2]));
+            assert_eq!(w.rig_velocity, [0.0; 3]);
             assert_eq!(w.rain_extras().is_some(), w.rain_mm_h > 0.0);
         }
     }
@@ -415,7 +412,6 @@ mod tests {
             (|c| c.fog.probability = 2.0, "weather.fog.probability"),
             (|c| c.sensor.clear(), "weather.sensor"),
             (|c| c.exposure_s = [0.0, 0.1], "weather.exposure_s"),
-            (|c| c.speed = [0.0, f64::NAN], "weather.speed"),
             (|c| c.rain_radius = 0.0, "weather.rain_radius"),
         ] {
             let mut c = WeatherConfig::default();

@@ -16,6 +16,7 @@
 //! - [`pair`]: side-by-side and anaglyph views; the paper's Fig. 7 treatment of photographs.
 //! - [`streak_mask`]: which pixels are specular streaks, from the renderer's specular layer.
 //! - [`texture_map`]: the paper's Fig. 3 ground-plane texture map.
+//! - [`flow`]: exact optical flow and disparity change of the left eye between two frames.
 //! - [`font`]: the bundled plot font (plotters + `ab_glyph`, no system fonts).
 //! - [`render`] (feature `render`): rendering a pair with ground-truth disparity and depth.
 //!
@@ -37,6 +38,7 @@
 
 pub mod calib;
 pub mod error;
+pub mod flow;
 pub mod font;
 pub mod pair;
 #[cfg(feature = "render")]

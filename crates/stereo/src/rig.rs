@@ -313,6 +313,16 @@ impl Rig {
         })
     }
 
+    /// The rig's attitude against world up (+Y), radians: the pitch of the optical axis below
+    /// the horizon, `asin(-forward.y)`, and the roll about it, positive with the camera's
+    /// right side down, `atan2(-right.y, up.y)` (the angles the generator mounts the rig with:
+    /// roll about the view direction, then pitch about the level right axis).
+    pub fn pitch_roll(&self) -> (f32, f32) {
+        let m = self.world_from_rig.matrix3;
+        let pitch = (-self.forward().y).clamp(-1.0, 1.0).asin();
+        (pitch, (-m.x_axis.y).atan2(m.y_axis.y))
+    }
+
     /// The rig in `f64` road coordinates, for the analysis: its centre at `(0, height, 0)`,
     /// pitched down by `asin(-forward.y)`, with the rig's focal length, principal point and
     /// baseline. The same errors as [`Rig::road_frame`]. The rig's roll is not represented:
@@ -664,6 +674,21 @@ mod tests {
     /// A road rig with a 6.5 cm baseline, pitched down by `pitch_deg`.
     fn pitched(centre: DVec3, pitch_deg: f64, focal_px: f64, principal: DVec2) -> RoadRig {
         RoadRig::new(centre, pitch_deg.to_radians(), focal_px, principal, 0.065).unwrap()
+    }
+
+    /// A rig rolled about its view direction, then pitched about the level right axis, and
+    /// yawed: its attitude gives back the pitch and roll, whatever the yaw.
+    #[test]
+    fn pitch_and_roll_come_back_from_the_pose() {
+        for (pitch, roll, yaw) in [(0.05f32, -0.03f32, 0.0f32), (-0.1, 0.02, 1.2), (0.0, 0.0, -2.0)] {
+            let m = glam::Mat3::from_rotation_y(yaw)
+                * glam::Mat3::from_rotation_x(-pitch)
+                * glam::Mat3::from_rotation_z(-roll);
+            let pose = Affine3A::from_mat3_translation(m, Vec3::new(1.0, 1.4, -3.0));
+            let rig = Rig::new(Intrinsics::new(64, 48, 50.0).unwrap(), 0.2, pose).unwrap();
+            let (p, r) = rig.pitch_roll();
+            assert!((p - pitch).abs() < 1e-5 && (r - roll).abs() < 1e-5, "{p} {r}");
+        }
     }
 
     #[test]

@@ -1,0 +1,178 @@
+//! A drive along a street: where the stereo rig and the moving cars are at a time.
+//!
+//! Frame `k` of a street's sequence is at time `k / fps` seconds ([`frame_time`]). The rig
+//! follows its lane at a constant speed with a fixed mounting (height, pitch, roll:
+//! [`Drive`]); leading and oncoming cars follow theirs at their own speeds; parked cars stay.
+//! Every pose is a rigid `world_from_local` transform: the rig's local frame looks along -Z
+//! with +Y up (the glTF camera's), a car's is its model frame (+X right, +Y up, -Z forward,
+//! the origin on the ground at the centre of its footprint, see [`crate::model`]).
+//!
+//! Each pose is one call to a road-frame function, [`road_pose`]: the pose of a frame at a
+//! lateral offset and a distance along the road. The road here is the straight, flat street
+//! of [`crate::street`] (driving direction -Z, lateral +X, up +Y); a curved or sloped road
+//! changes [`road_pose`] and nothing else.
+
+use crate::street::Car;
+use glam::{Affine3A, Mat3, Quat, Vec3};
+
+/// The pose of a frame on the road: `lateral` metres right of the road's centre line,
+/// `along` metres from the street's origin in the driving direction, facing the driving
+/// direction (or against it when `reverse`, as oncoming traffic does). Its local -Z is the
+/// lane's direction of travel, +Y the road's normal, +X the right of travel.
+pub fn road_pose(lateral: f32, along: f64, reverse: bool) -> Affine3A {
+    let rotation = if reverse {
+        Quat::from_rotation_y(std::f32::consts::PI)
+    } else {
+        Quat::IDENTITY
+    };
+    Affine3A::from_rotation_translation(rotation, Vec3::new(lateral, 0.0, -(along as f32)))
+}
+
+/// The rig's mounting on its vehicle: height of the rig centre above the road, pitch below the
+/// horizon and roll (positive: the camera's right side down), as the local pose of the rig in
+/// the road frame of its lane ([`road_pose`]).
+pub fn mount(height: f32, pitch_rad: f32, roll_rad: f32) -> Affine3A {
+    let rotation = Mat3::from_rotation_x(-pitch_rad) * Mat3::from_rotation_z(-roll_rad);
+    Affine3A::from_mat3_translation(rotation, Vec3::new(0.0, height, 0.0))
+}
+
+/// The rig's drive: its lateral position (lane centre plus offset), its mounting, and its
+/// speed along the lane.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Drive {
+    /// Metres right of the road's centre line.
+    pub lateral: f32,
+    /// Where the rig is along the road at time 0, metres.
+    pub start: f64,
+    /// The rig in its lane's road frame ([`mount`]).
+    pub mount: Affine3A,
+    /// Speed along the lane, m/s.
+    pub speed_m_s: f64,
+}
+
+/// The time of frame `frame` at `fps` frames per second, seconds.
+pub fn frame_time(frame: u64, fps: f64) -> f64 {
+    frame as f64 / fps
+}
+
+/// The rig centre's world pose at `time` (seconds): looking along its local -Z, +Y up.
+pub fn rig_pose_at(drive: &Drive, time: f64) -> Affine3A {
+    road_pose(drive.lateral, drive.start + drive.speed_m_s * time, false) * drive.mount
+}
+
+/// The rig's velocity in world space at `time`, m/s: its speed along the lane's direction.
+pub fn rig_velocity_at(drive: &Drive, time: f64) -> Vec3 {
+    let lane = road_pose(drive.lateral, drive.start + drive.speed_m_s * time, false);
+    lane.transform_vector3(Vec3::NEG_Z) * drive.speed_m_s as f32
+}
+
+/// A car's world pose at `time` (seconds) when it drives at `speed_m_s` along its lane from
+/// where `car` puts it at time 0 (a parked car stays there): its model frame in the world.
+pub fn car_pose_at(car: &Car, speed_m_s: f64, time: f64) -> Affine3A {
+    let moved = if car.parked { 0.0 } else { speed_m_s * time };
+    let direction = if car.oncoming { -1.0 } else { 1.0 };
+    road_pose(car.x, f64::from(-car.z) + direction * moved, car.oncoming)
+}
+
+/// The bounds of a generated car in its model frame, metres (body, cabin, wheels and the lamp
+/// lenses 2 mm proud of the body).
+pub const CAR_BOUNDS: [Vec3; 2] = [Vec3::new(-0.9, 0.0, -2.21), Vec3::new(0.9, 1.45, 2.21)];
+
+/// An object that moves during a drive: its instance id (the `extras.streaks.instance` of its
+/// nodes), its world pose at the frame's time and its bounds in its own frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MovingObject {
+    /// The object's instance id (> 0).
+    pub instance: u32,
+    /// Its world pose at the frame's time.
+    pub world_from_object: Affine3A,
+    /// Its bounds in its own frame (min, max).
+    pub bounds: [Vec3; 2],
+}
+
+impl MovingObject {
+    /// Whether the world point `p` lies on this object: within its bounds (grown by 1 cm) and
+    /// above the ground it stands on (1 mm up, so that the road under it is not counted).
+    pub fn contains(&self, p: Vec3) -> bool {
+        let q = self.world_from_object.inverse().transform_point3(p);
+        let grow = Vec3::splat(0.01);
+        q.cmpge(self.bounds[0] - grow).all()
+            && q.cmple(self.bounds[1] + grow).all()
+            && q.y > self.bounds[0].y + 1e-3
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn close(a: Vec3, b: Vec3) -> bool {
+        (a - b).length() < 1e-5
+    }
+
+    /// A rig at speed v covers v / fps per frame along -Z, at its mounting height, looking
+    /// down by the pitch with its right side lowered by the roll.
+    #[test]
+    fn the_rig_drives_along_its_lane_at_its_mounting() {
+        let (pitch, roll) = (3f32.to_radians(), 1.5f32.to_radians());
+        let drive = Drive {
+            lateral: 1.7,
+            start: 2.0,
+            mount: mount(1.3, pitch, roll),
+            speed_m_s: 12.5,
+        };
+        let t = frame_time(3, 10.0);
+        assert!((t - 0.3).abs() < 1e-12);
+        let pose = rig_pose_at(&drive, t);
+        let expected_z = -(2.0 + 12.5 * 0.3) as f32;
+        assert!(close(pose.translation.into(), Vec3::new(1.7, 1.3, expected_z)));
+        let forward = pose.transform_vector3(Vec3::NEG_Z);
+        assert!(close(
+            forward,
+            Vec3::new(0.0, -pitch.sin(), -pitch.cos())
+        ));
+        // Rolled about the view direction, then pitched about the level right axis: the right
+        // axis is R_x(-p) (cos r, -sin r, 0).
+        let right = pose.transform_vector3(Vec3::X);
+        let expected = Vec3::new(roll.cos(), -roll.sin() * pitch.cos(), -roll.sin() * pitch.sin());
+        assert!(close(right, expected), "{right} vs {expected}");
+        assert!(close(
+            rig_velocity_at(&drive, t),
+            Vec3::new(0.0, 0.0, -12.5)
+        ));
+    }
+
+    /// Leading cars move away along -Z, oncoming ones towards +Z facing the rig, parked ones
+    /// stay; an oncoming car's model -Z (its front) points along world +Z.
+    #[test]
+    fn cars_follow_their_lanes() {
+        let car = |oncoming, parked| Car {
+            x: -2.0,
+            z: -30.0,
+            oncoming,
+            color: [0.5; 3],
+            headlights: true,
+            parked,
+        };
+        let at = |c: &Car| Vec3::from(car_pose_at(c, 10.0, 0.5).translation);
+        assert!(close(at(&car(false, false)), Vec3::new(-2.0, 0.0, -35.0)));
+        assert!(close(at(&car(true, false)), Vec3::new(-2.0, 0.0, -25.0)));
+        assert!(close(at(&car(true, true)), Vec3::new(-2.0, 0.0, -30.0)));
+        let front = car_pose_at(&car(true, false), 10.0, 0.5).transform_vector3(Vec3::NEG_Z);
+        assert!(close(front, Vec3::Z));
+    }
+
+    /// A point on a moving car is on it, the road below it and a point beside it are not.
+    #[test]
+    fn a_moving_object_contains_its_points_only() {
+        let o = MovingObject {
+            instance: 3,
+            world_from_object: road_pose(2.0, 20.0, true),
+            bounds: CAR_BOUNDS,
+        };
+        assert!(o.contains(Vec3::new(2.5, 0.8, -21.5)));
+        assert!(!o.contains(Vec3::new(2.5, 0.0, -21.5)));
+        assert!(!o.contains(Vec3::new(3.5, 0.8, -21.5)));
+        assert!(!o.contains(Vec3::new(2.5, 0.8, -23.0)));
+    }
+}
