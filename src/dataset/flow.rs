@@ -163,7 +163,14 @@ pub(crate) mod tests {
         let dir = tempfile::tempdir()?;
         let s = streaks_scenes::procedural::sample(config, seed, index)?;
         let now = load_frame(s, &dir.path().join("now"), width, height)?;
-        let next = next_frame(config, seed, &now.sample, &dir.path().join("next"), width, height)?;
+        let next = next_frame(
+            config,
+            seed,
+            &now.sample,
+            &dir.path().join("next"),
+            width,
+            height,
+        )?;
         let flow = frame_flow(&now, &next)?;
         let mut report = Rederived::default();
         let (w, h) = (width as usize, height as usize);
@@ -180,7 +187,10 @@ pub(crate) mod tests {
             let pixel = Vec2::new((k % w) as f32 + 0.5, (k / w) as f32 + 0.5);
             // X from this frame's ray and its object's poses, as the generator placed them.
             let dir0 = eye0.ray_direction(pixel);
-            let t0 = now.scene.first_hit(eye0.position(), dir0).expect("a flow has a hit");
+            let t0 = now
+                .scene
+                .first_hit(eye0.position(), dir0)
+                .expect("a flow has a hit");
             let p = (eye0.position() + dir0 * t0).as_dvec3();
             let id = instance_at(&now.sample.objects, p.as_vec3());
             let moved = match now.sample.objects.iter().find(|o| o.instance == id) {

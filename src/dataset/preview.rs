@@ -13,8 +13,8 @@ use image::{imageops, Rgb, RgbImage};
 use std::path::PathBuf;
 use streaks_analysis::sgm::disparity_preview;
 use streaks_dataset::files::SampleDir;
-use streaks_image::input::load_image;
 use streaks_image::flow_color::flow_color;
+use streaks_image::input::load_image;
 use streaks_image::pfm::{read_pfm, read_pfm_rgb};
 use streaks_image::png::write_png_buffer;
 use streaks_stereo::rig::Eye;
@@ -117,14 +117,18 @@ pub fn run(args: Args) -> Result<()> {
 /// where the point is not in the next image (`flowmask0.png` below 128).
 fn flow_panel(files: &SampleDir) -> Result<RgbImage> {
     let path = files.flow_pfm();
-    let flow = read_pfm_rgb(&path)
-        .with_context(|| format!("cannot read the flow {}", path.display()))?;
+    let flow =
+        read_pfm_rgb(&path).with_context(|| format!("cannot read the flow {}", path.display()))?;
     let mask_path = files.flow_mask();
     let mask = load_image(&mask_path)
         .with_context(|| format!("cannot read the flow mask {}", mask_path.display()))?
         .to_luma8();
     if mask.dimensions() != (flow.width, flow.height) {
-        bail!("{} is not the size of {}", mask_path.display(), path.display());
+        bail!(
+            "{} is not the size of {}",
+            mask_path.display(),
+            path.display()
+        );
     }
     let shown = |i: usize| mask.as_raw()[i] >= 128;
     let largest = flow

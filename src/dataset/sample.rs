@@ -3,6 +3,7 @@
 
 use anyhow::{Context, Result};
 use glam::Vec3;
+use glam::{DAffine3, DVec3};
 use std::path::Path;
 use std::time::Instant;
 use streaks_dataset::files::{SampleDir, SCENE_GLTF};
@@ -19,14 +20,13 @@ use streaks_dataset::write::{
 use streaks_image::write_bytes_atomically;
 use streaks_render::motion::Motion;
 use streaks_render::scene::Scene;
-use glam::{DAffine3, DVec3};
 use streaks_scenes::procedural::{sample, street_frame, GeneratorConfig, GENERATOR_VERSION};
-use streaks_stereo::flow::to_f64;
-use streaks_stereo::rig::Eye;
 use streaks_sensor::SensorProfile;
+use streaks_stereo::flow::to_f64;
 use streaks_stereo::render::{
     expose_pair, light_records, render_pair, rig_from_camera, scene_has_road, PairSettings,
 };
+use streaks_stereo::rig::Eye;
 use streaks_stereo::rigfile::PoseRecord;
 use streaks_stereo::streak_mask::StreakMaskParams;
 
@@ -210,7 +210,8 @@ fn write_sample(
         world_from_left
     } else {
         let rig0 = street_frame(&settings.config, settings.seed, s.street, 0)?.world_from_rig;
-        to_f64(rig0) * DAffine3::from_translation(DVec3::new(-0.5 * f64::from(rig.baseline()), 0.0, 0.0))
+        to_f64(rig0)
+            * DAffine3::from_translation(DVec3::new(-0.5 * f64::from(rig.baseline()), 0.0, 0.0))
     };
     let shares = flow.shares();
     let sequence = SequenceMeta {

@@ -101,7 +101,10 @@ pub fn matrix_rows(pose: &glam::DAffine3) -> [[f64; 4]; 4] {
 /// first frame at `world_from_first` (both in the project's camera axes: x right, y up,
 /// looking along -z): `S first_from_world world_from_camera S` with `S = diag(1, -1, -1)`,
 /// which turns the axes into KITTI's (x right, y down, z forward); the top 3x4, row by row.
-pub fn kitti_pose(world_from_first: &glam::DAffine3, world_from_camera: &glam::DAffine3) -> [f64; 12] {
+pub fn kitti_pose(
+    world_from_first: &glam::DAffine3,
+    world_from_camera: &glam::DAffine3,
+) -> [f64; 12] {
     let s = glam::DAffine3::from_scale(glam::DVec3::new(1.0, -1.0, -1.0));
     let rows = matrix_rows(&(s * world_from_first.inverse() * *world_from_camera * s));
     let mut out = [0.0; 12];
@@ -332,7 +335,10 @@ mod tests {
             assert!((a - b).abs() < 1e-12, "{p:?}");
         }
         let same = kitti_pose(&turned, &turned);
-        assert_eq!(same, [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]);
+        assert_eq!(
+            same,
+            [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+        );
         assert_eq!(matrix_rows(&first)[0], [1.0, 0.0, 0.0, 5.0]);
     }
 

@@ -39,8 +39,8 @@ use std::path::{Path, PathBuf};
 use streaks_image::exr::read_exr_rgb;
 use streaks_image::kitti::{read_kitti_disparity, read_kitti_flow};
 use streaks_image::pfm::{read_pfm, read_pfm_rgb};
-use streaks_stereo::flow::FlowState;
 use streaks_image::{write_bytes_atomically, GrayImage};
+use streaks_stereo::flow::FlowState;
 use streaks_stereo::rig::Eye;
 
 /// The largest `scene.gltf` read to find the files it refers to: the renderer's limit on a
@@ -333,7 +333,8 @@ fn write_sequences(
             times.push_str(&format!("{:.6e}\n", time));
         }
         let dir = layout.sequence_dir(*street);
-        std::fs::create_dir_all(&dir).map_err(|e| DatasetError::io("create the folder", &dir, e))?;
+        std::fs::create_dir_all(&dir)
+            .map_err(|e| DatasetError::io("create the folder", &dir, e))?;
         write_bytes_atomically(&dir.join(POSES), poses.as_bytes())?;
         write_bytes_atomically(&dir.join(TIMES), times.as_bytes())?;
     }
@@ -452,7 +453,10 @@ fn check_flow(sample: &SampleDir, size: (usize, usize)) -> Result<(), DatasetErr
                 reason: format!("pixel {i} holds {m}, not a flow class (0, 64, 128, 255)"),
             });
         };
-        if state.has_flow() && k.is_none() && flow.pixels[i].x.abs() < 511.0 && flow.pixels[i].y.abs() < 511.0
+        if state.has_flow()
+            && k.is_none()
+            && flow.pixels[i].x.abs() < 511.0
+            && flow.pixels[i].y.abs() < 511.0
             || !state.has_flow() && k.is_some()
         {
             return Err(DatasetError::Invalid {

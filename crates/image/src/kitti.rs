@@ -140,9 +140,13 @@ pub fn write_kitti_flow(
     write_png_buffer(path, &img)
 }
 
+/// A flow map as read from a file: width, height and the vectors, rows top to bottom, `None`
+/// where it has no value.
+pub type FlowMap = (usize, usize, Vec<Option<[f32; 2]>>);
+
 /// Reads a KITTI 2015 flow PNG (16-bit RGB): its size and its vectors, rows top to bottom,
 /// `None` where it has no value.
-pub fn read_kitti_flow(path: &Path) -> Result<(usize, usize, Vec<Option<[f32; 2]>>), ImageError> {
+pub fn read_kitti_flow(path: &Path) -> Result<FlowMap, ImageError> {
     let img = crate::input::load_image(path)?;
     let image::DynamicImage::ImageRgb16(img) = img else {
         return Err(ImageError::Read {
@@ -154,10 +158,7 @@ pub fn read_kitti_flow(path: &Path) -> Result<(usize, usize, Vec<Option<[f32; 2]
         });
     };
     let (w, h) = (img.width() as usize, img.height() as usize);
-    let flow = img
-        .pixels()
-        .map(|p| decode_kitti_flow(p.0))
-        .collect();
+    let flow = img.pixels().map(|p| decode_kitti_flow(p.0)).collect();
     Ok((w, h, flow))
 }
 
@@ -188,7 +189,10 @@ mod tests {
         assert_eq!(encode_kitti_flow(Some([600.0, 0.0])), [0, 0, 0]);
         assert_eq!(encode_kitti_flow(Some([f32::INFINITY, 0.0])), [0, 0, 0]);
         assert_eq!(encode_kitti_flow(None), [0, 0, 0]);
-        assert_eq!(decode_kitti_flow([32768 + 96, 32768 - 32, 1]), Some([1.5, -0.5]));
+        assert_eq!(
+            decode_kitti_flow([32768 + 96, 32768 - 32, 1]),
+            Some([1.5, -0.5])
+        );
         assert_eq!(decode_kitti_flow([32768, 32768, 0]), None);
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("f.png");

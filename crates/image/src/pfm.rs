@@ -169,12 +169,18 @@ mod tests {
         assert!(raw.starts_with(b"PF\n3 2\n-1.0\n"));
         // The first stored pixel is the bottom row's first: (-1.5, 2, inf).
         let body = &raw[raw.len() - 72..];
-        assert_eq!(f32::from_le_bytes([body[4], body[5], body[6], body[7]]), 2.0);
+        assert_eq!(
+            f32::from_le_bytes([body[4], body[5], body[6], body[7]]),
+            2.0
+        );
         assert_eq!(read_pfm_rgb(&p).unwrap(), img);
         assert!(read_pfm(&p).unwrap_err().to_string().contains("greyscale"));
         let grey = dir.path().join("g.pfm");
         write_pfm(&grey, &GrayImage::new(2, 2, 1.0).unwrap()).unwrap();
-        assert!(read_pfm_rgb(&grey).unwrap_err().to_string().contains("colour"));
+        assert!(read_pfm_rgb(&grey)
+            .unwrap_err()
+            .to_string()
+            .contains("colour"));
     }
 
     #[test]

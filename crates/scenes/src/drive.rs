@@ -125,16 +125,20 @@ mod tests {
         assert!((t - 0.3).abs() < 1e-12);
         let pose = rig_pose_at(&drive, t);
         let expected_z = -(2.0 + 12.5 * 0.3) as f32;
-        assert!(close(pose.translation.into(), Vec3::new(1.7, 1.3, expected_z)));
-        let forward = pose.transform_vector3(Vec3::NEG_Z);
         assert!(close(
-            forward,
-            Vec3::new(0.0, -pitch.sin(), -pitch.cos())
+            pose.translation.into(),
+            Vec3::new(1.7, 1.3, expected_z)
         ));
+        let forward = pose.transform_vector3(Vec3::NEG_Z);
+        assert!(close(forward, Vec3::new(0.0, -pitch.sin(), -pitch.cos())));
         // Rolled about the view direction, then pitched about the level right axis: the right
         // axis is R_x(-p) (cos r, -sin r, 0).
         let right = pose.transform_vector3(Vec3::X);
-        let expected = Vec3::new(roll.cos(), -roll.sin() * pitch.cos(), -roll.sin() * pitch.sin());
+        let expected = Vec3::new(
+            roll.cos(),
+            -roll.sin() * pitch.cos(),
+            -roll.sin() * pitch.sin(),
+        );
         assert!(close(right, expected), "{right} vs {expected}");
         assert!(close(
             rig_velocity_at(&drive, t),

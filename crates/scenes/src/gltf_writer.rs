@@ -808,10 +808,8 @@ impl Doc {
         // Right-handed basis with local -Z = forward, local +Y as close to `up` as possible.
         let right = forward.cross(up).normalize();
         let up = right.cross(forward);
-        let pose = glam::Affine3A::from_mat3_translation(
-            glam::Mat3::from_cols(right, up, -forward),
-            eye,
-        );
+        let pose =
+            glam::Affine3A::from_mat3_translation(glam::Mat3::from_cols(right, up, -forward), eye);
         self.add_camera_pose(name, pose, yfov_deg, aspect);
     }
 

@@ -602,7 +602,12 @@ impl GeneratorConfig {
             return Err(format!("sequence.fps = {} must be in [0.1, 1000]", q.fps));
         }
         real("sequence.speed_kmh", q.speed_kmh, 0.0, 250.0)?;
-        real("sequence.traffic_speed_kmh", q.traffic_speed_kmh, 0.0, 250.0)?;
+        real(
+            "sequence.traffic_speed_kmh",
+            q.traffic_speed_kmh,
+            0.0,
+            250.0,
+        )?;
         real("exposure.ev", self.exposure.ev, -20.0, 20.0)?;
         let d = &self.dataset;
         if d.pairs_per_street == 0 || d.pairs_per_street > 100 {
@@ -892,7 +897,9 @@ pub fn street_frame(
         let mut sample_rng = ChaCha8Rng::seed_from_u64(mix(seed, CAMERA_STREAM, index));
         let mut w = crate::weather::draw(&config.weather, &mut street_rng, &mut sample_rng);
         // Motion blur is the drive's own motion.
-        w.rig_velocity = rig_velocity.to_array().map(|v| crate::gltf_writer::round7(f64::from(v)));
+        w.rig_velocity = rig_velocity
+            .to_array()
+            .map(|v| crate::gltf_writer::round7(f64::from(v)));
         let wc = &config.wetness;
         street.style.wetness = w.wetness_level(wc.level) as f32;
         street.style.ripples = w

@@ -379,10 +379,7 @@ mod tests {
                 }
                 let got = flow.flow[i];
                 let err = (DVec2::new(f64::from(got[0]), f64::from(got[1])) - expected).length();
-                assert!(
-                    err < 1e-3,
-                    "({x}, {y}): {got:?} vs {expected} ({err} px)"
-                );
+                assert!(err < 1e-3, "({x}, {y}): {got:?} vs {expected} ({err} px)");
                 checked += 1;
             }
         }
@@ -431,8 +428,8 @@ mod tests {
         let half = Vec3::new(1.0, 0.8, 0.5);
         let (yaw, shift) = (0.2f32, Vec3::new(1.2, 0.1, -0.3));
         let box_now = Affine3A::from_translation(Vec3::new(-0.5, 0.0, -8.0));
-        let box_next =
-            Affine3A::from_translation(Vec3::new(-0.5, 0.0, -8.0) + shift) * Affine3A::from_rotation_y(yaw);
+        let box_next = Affine3A::from_translation(Vec3::new(-0.5, 0.0, -8.0) + shift)
+            * Affine3A::from_rotation_y(yaw);
         let scene_now = BoxOnWall {
             world_from_box: box_now,
             half,
@@ -506,7 +503,11 @@ mod tests {
                         -1.0,
                     );
                     let p = o + dir * ((-20.0 - o.z) / dir.z);
-                    if scene_now.first_hit(o.as_vec3(), dir.normalize().as_vec3()).unwrap() < 11.0 {
+                    if scene_now
+                        .first_hit(o.as_vec3(), dir.normalize().as_vec3())
+                        .unwrap()
+                        < 11.0
+                    {
                         continue; // the box's side faces
                     }
                     let expected = project(p) - px;
@@ -519,7 +520,9 @@ mod tests {
                         (m.abs() - half.as_dvec3() + DVec3::splat(margin)).max_element() < 0.0
                     };
                     let crosses = |margin: f64| {
-                        (1..2000).any(|k| in_box(left_next + (p - left_next) * (k as f64 / 2000.0), margin))
+                        (1..2000).any(|k| {
+                            in_box(left_next + (p - left_next) * (k as f64 / 2000.0), margin)
+                        })
                     };
                     if crosses(0.03) {
                         assert_eq!(flow.state[i], FlowState::Occluded, "wall ({x}, {y})");

@@ -680,14 +680,21 @@ mod tests {
     /// yawed: its attitude gives back the pitch and roll, whatever the yaw.
     #[test]
     fn pitch_and_roll_come_back_from_the_pose() {
-        for (pitch, roll, yaw) in [(0.05f32, -0.03f32, 0.0f32), (-0.1, 0.02, 1.2), (0.0, 0.0, -2.0)] {
+        for (pitch, roll, yaw) in [
+            (0.05f32, -0.03f32, 0.0f32),
+            (-0.1, 0.02, 1.2),
+            (0.0, 0.0, -2.0),
+        ] {
             let m = glam::Mat3::from_rotation_y(yaw)
                 * glam::Mat3::from_rotation_x(-pitch)
                 * glam::Mat3::from_rotation_z(-roll);
             let pose = Affine3A::from_mat3_translation(m, Vec3::new(1.0, 1.4, -3.0));
             let rig = Rig::new(Intrinsics::new(64, 48, 50.0).unwrap(), 0.2, pose).unwrap();
             let (p, r) = rig.pitch_roll();
-            assert!((p - pitch).abs() < 1e-5 && (r - roll).abs() < 1e-5, "{p} {r}");
+            assert!(
+                (p - pitch).abs() < 1e-5 && (r - roll).abs() < 1e-5,
+                "{p} {r}"
+            );
         }
     }
 
