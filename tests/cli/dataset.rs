@@ -867,7 +867,8 @@ fn adaptive_datasets_record_their_target_and_are_deterministic() {
 
 /// A sample in heavy rain and fog has its per-eye rain masks and fog transmittance, the
 /// sensor's raw layer, a weather record, and passes `index`; `dataset preview` draws it as
-/// three panels (image, disparity, rain mask), a missing sample is an error naming the file.
+/// four panels (image, disparity, rain mask, flow to the next frame), a missing sample is an
+/// error naming the file.
 #[test]
 fn weather_samples_have_rain_and_fog_masks_and_a_preview() {
     let t = TestDir::new();
@@ -906,7 +907,7 @@ fn weather_samples_have_rain_and_fog_masks_and_a_preview() {
     ])
     .assert_success();
     let preview = image::open(t.join("p/preview.png")).unwrap();
-    assert_eq!((preview.width(), preview.height()), (3 * 64, 40));
+    assert_eq!((preview.width(), preview.height()), (4 * 64, 40));
     t.streaks(&["dataset", "preview", "ds/samples/000009", "-o", "q.png"])
         .assert_failure_mentioning("im0.png");
     assert!(!t.join("q.png").exists());

@@ -137,8 +137,9 @@ mod tests {
         let expected = Vec3::new(
             roll.cos(),
             -roll.sin() * pitch.cos(),
-            -roll.sin() * pitch.sin(),
+            roll.sin() * pitch.sin(),
         );
+        assert!(right.dot(forward).abs() < 1e-6);
         assert!(close(right, expected), "{right} vs {expected}");
         assert!(close(
             rig_velocity_at(&drive, t),
