@@ -1054,18 +1054,6 @@ mod tests {
     }
 
     #[test]
-    fn the_documented_snippet_is_the_default() {
-        #[derive(Deserialize)]
-        #[serde(deny_unknown_fields)]
-        struct Snippet {
-            buildings: BuildingsConfig,
-        }
-        let text = include_str!("../config/buildings.toml.snippet");
-        let s: Snippet = toml::from_str(text).unwrap();
-        assert_eq!(s.buildings, BuildingsConfig::default());
-    }
-
-    #[test]
     fn dimensions_fall_within_the_config() {
         let c = BuildingsConfig::default();
         let within = |v: f32, r: Range| v as f64 >= r[0] - 1e-5 && v as f64 <= r[1] + 1e-5;

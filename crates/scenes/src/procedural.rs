@@ -417,6 +417,9 @@ pub struct GeneratorConfig {
     pub sky: SkyConfig,
     /// Rain, fog, sensor, exposure time and motion.
     pub weather: WeatherConfig,
+    /// The buildings along the street: storeys, setbacks, windows, balconies, shop fronts,
+    /// wall materials.
+    pub buildings: crate::buildings::BuildingsConfig,
 }
 
 /// The night sky's glow: a constant environment light of radiance `color * glow` (W/(m^2 sr)),
@@ -630,6 +633,7 @@ impl GeneratorConfig {
             ));
         }
         self.weather.validate()?;
+        self.buildings.validate()?;
         {
             let sky = &self.sky;
             real("sky.glow", sky.glow, 0.0, 100.0)?;
@@ -1238,6 +1242,13 @@ fn random_street(
         seed: texture_seed,
         texture: (64, along_texels.next_power_of_two().min(2048)),
         style,
+        drawn_buildings: Some(crate::street::DrawnBuildings {
+            config: config.buildings.clone(),
+            // Derived rather than drawn, so that the draws after it keep their values.
+            seed: u64::from(texture_seed) ^ 0x6275_696c_6469_6e67,
+            window_cd: window_luminance,
+            shop_cd: shop_luminance,
+        }),
     };
     let params = json!({
         "generator": GENERATOR_VERSION,

@@ -4,9 +4,11 @@
 //! [`Street::full`] is `rainy_street`; [`Street::small`] is `rainy_street_small` for tests.
 
 use crate::albedo::{albedo_png, Pattern};
+use crate::buildings::{facade, placement, BuildingSpec, BuildingsConfig, Palette};
 use crate::estimate::Brdf;
 use crate::gltf_writer::{
-    quantise, round7, Doc, Dryness, Light, LightKind, Material, NormalTexture, PaperBsdf,
+    quantise, round7, Class, Doc, Dryness, Light, LightKind, Material, NormalTexture, PaperBsdf,
+    Tag,
 };
 use crate::mesh::Mesh;
 use crate::wetness::{dryness_png, ripple_normal_png, Wetness, RIPPLE_TEXELS};
@@ -264,6 +266,24 @@ pub struct Street {
     pub texture: (u32, u32),
     /// Sizes, lamps, wetness, windows and the camera.
     pub style: StreetStyle,
+    /// Buildings drawn from a config ([`crate::buildings`]) on the blocks' frontages; `None`,
+    /// the shipped streets' boxes with flat windows.
+    pub drawn_buildings: Option<DrawnBuildings>,
+}
+
+/// How a street's buildings are drawn from a [`BuildingsConfig`]: one [`BuildingSpec`] per
+/// block frontage (the lengths of [`Street::blocks`]), from a generator seeded by `seed`, lit
+/// with the street's window and shop shares.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DrawnBuildings {
+    /// The distribution of the buildings.
+    pub config: BuildingsConfig,
+    /// Seed of the draw and of the wall textures.
+    pub seed: u64,
+    /// Luminance of a lit upper window, cd/m^2.
+    pub window_cd: f64,
+    /// Luminance of a lit shop window, cd/m^2.
+    pub shop_cd: f64,
 }
 
 /// A tiling albedo image in a [`Doc`] and its mean linear value.
@@ -355,6 +375,7 @@ impl Street {
             seed: 2024,
             texture: (64, 1024),
             style: StreetStyle::SHIPPED,
+            drawn_buildings: None,
         }
     }
 
@@ -388,6 +409,7 @@ impl Street {
             seed: 2024,
             texture: (64, 512),
             style: StreetStyle::SHIPPED,
+            drawn_buildings: None,
         }
     }
 
@@ -494,7 +516,7 @@ impl Street {
             ],
             Vec3::Y,
         );
-        doc.add_mesh("road", &road, &asphalt)?;
+        doc.add_tagged_mesh("road", &road, &asphalt, Tag::stuff(Class::Road))?;
 
         // Markings: a dashed centre line (3 m dashes, 9 m gaps) and solid edge lines, 2 mm
         // above the asphalt.
@@ -521,7 +543,7 @@ impl Street {
                 Vec3::X * 0.06,
             );
         }
-        doc.add_mesh("lane_markings", &marks, &paint)?;
+        doc.add_tagged_mesh("lane_markings", &marks, &paint, Tag::stuff(Class::Marking))?;
 
         // Kerbs and sidewalks (top at 0.15 m) up to the facades.
         let stone = tex.stone.paper(
@@ -550,8 +572,8 @@ impl Street {
         }
         kerbs.scale_uvs(TILE_FINE);
         walks.scale_uvs(TILE_COARSE);
-        doc.add_mesh("kerbs", &kerbs, &stone)?;
-        doc.add_mesh("sidewalks", &walks, &pavement)?;
+        doc.add_tagged_mesh("kerbs", &kerbs, &stone, Tag::stuff(Class::Sidewalk))?;
+        doc.add_tagged_mesh("sidewalks", &walks, &pavement, Tag::stuff(Class::Sidewalk))?;
         Ok(())
     }
 
@@ -612,10 +634,15 @@ impl Street {
             return Ok(());
         }
         poles.scale_uvs(TILE_FINE);
-        doc.add_mesh("lamp_posts", &poles, &metal)?;
+        doc.add_tagged_mesh("lamp_posts", &poles, &metal, Tag::stuff(Class::Pole))?;
         // rect(c, Z, X) faces Z x X = +Y; the lens must face down.
         flip(&mut lenses);
-        doc.add_mesh("lamp_lenses", &lenses, &lens)?;
+        doc.add_tagged_mesh(
+            "lamp_lenses",
+            &lenses,
+            &lens,
+            Tag::stuff(Class::LightSource),
+        )?;
         Ok(())
     }
 
@@ -638,13 +665,75 @@ impl Street {
         }
         m.scale_uvs(TILE_FINE);
         if !self.poles.is_empty() {
-            doc.add_mesh("telephone_poles", &m, &wood)?;
+            doc.add_tagged_mesh("telephone_poles", &m, &wood, Tag::stuff(Class::Pole))?;
+        }
+        Ok(())
+    }
+
+    /// The buildings on both sides as drawn models ([`crate::buildings`]): block frontages
+    /// from [`Street::blocks`] as the boxes have them (the left side offset by three blocks),
+    /// each a [`BuildingSpec`] placed with its lot line on the facade line.
+    fn drawn_buildings(&self, doc: &mut Doc, drawn: &DrawnBuildings) -> Result<(), Error> {
+        use rand::SeedableRng;
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(drawn.seed);
+        let (warm, lit) = self.style.lit_windows;
+        let cool = if lit > 0.0 { 1.0 - warm / lit } else { 0.0 };
+        let mut rows = Vec::new();
+        for side in [1.0f32, -1.0] {
+            let mut z0 = self.near;
+            for k in 0..self.blocks.len() {
+                let k = if side < 0.0 {
+                    (k + 3) % self.blocks.len()
+                } else {
+                    k
+                };
+                let z1 = (z0 - self.blocks[k].0).max(self.far);
+                let frontage = z0 - z1;
+                if frontage > 1.0 {
+                    let spec = BuildingSpec::draw(
+                        &mut rng,
+                        &drawn.config,
+                        frontage,
+                        (lit, cool, self.style.lit_shops),
+                    );
+                    rows.push((side, 0.5 * (z0 + z1), spec));
+                }
+                z0 = z1;
+                if z0 <= self.far {
+                    break;
+                }
+            }
+        }
+        let specs: Vec<BuildingSpec> = rows.iter().map(|r| r.2.clone()).collect();
+        let palette = Palette::new(
+            doc,
+            &specs,
+            drawn.seed as u32,
+            (drawn.window_cd, drawn.shop_cd),
+            self.style.wetness,
+        )?;
+        for (k, (side, z, spec)) in rows.iter().enumerate() {
+            let model = facade(spec, &palette)?;
+            doc.add_model(
+                &format!("building_{k}"),
+                &model,
+                placement(*side, self.style.facade_x, *z),
+                None,
+            )?;
         }
         Ok(())
     }
 
     fn buildings(&self, doc: &mut Doc, tex: &Albedos) -> Result<(), Error> {
         let st = &self.style;
+        // Drawn buildings replace the boxes on both sides; the block closing the far end stays.
+        let sides: &[f32] = match &self.drawn_buildings {
+            Some(drawn) => {
+                self.drawn_buildings(doc, drawn)?;
+                &[]
+            }
+            None => &[1.0, -1.0],
+        };
         let facades = [
             tex.brick.paper(
                 "facade_brick",
@@ -681,7 +770,7 @@ impl Street {
         let (mut dark, mut lit_warm, mut lit_cool) = (Mesh::new(), Mesh::new(), Mesh::new());
         let mut lit_shop = Mesh::new();
         let mut counter = 0u32;
-        for side in [1.0f32, -1.0] {
+        for &side in sides {
             let mut z0 = self.near;
             for (k, &(len, height)) in self.blocks.iter().enumerate() {
                 // Offset the two sides so blocks do not line up.
@@ -765,7 +854,12 @@ impl Street {
         for (k, m) in by_material.iter_mut().enumerate() {
             m.scale_uvs(TILE_COARSE);
             if !m.indices.is_empty() {
-                doc.add_mesh(&format!("buildings_{k}"), m, &facades[k])?;
+                doc.add_tagged_mesh(
+                    &format!("buildings_{k}"),
+                    m,
+                    &facades[k],
+                    Tag::stuff(Class::Building),
+                )?;
             }
         }
         for (name, m, mat) in [
@@ -775,7 +869,7 @@ impl Street {
             ("shop_windows_lit", &lit_shop, &shop),
         ] {
             if !m.indices.is_empty() {
-                doc.add_mesh(name, m, mat)?;
+                doc.add_tagged_mesh(name, m, mat, Tag::stuff(Class::Building))?;
             }
         }
         Ok(())
@@ -812,6 +906,11 @@ fn flip(m: &mut Mesh) {
 /// the front, emissive red tail lights at the back; a parked car's lenses are unlit.
 fn add_car(doc: &mut Doc, k: usize, car: &Car, st: &StreetStyle) -> Result<(), Error> {
     let dir = if car.oncoming { 1.0f32 } else { -1.0 }; // direction the car faces, along Z
+    let instance = crate::procedural::car_instance(k);
+    let (body_tag, lamp_tag) = (
+        Tag::object(Class::Car, instance),
+        Tag::object(Class::LightSource, instance),
+    );
     let (x, z) = (car.x, car.z);
     let paint = Material::paper(
         &format!("car_paint_{k}"),
@@ -831,7 +930,7 @@ fn add_car(doc: &mut Doc, k: usize, car: &Car, st: &StreetStyle) -> Result<(), E
         Vec3::new(x - 0.8, 1.0, cz - 1.2),
         Vec3::new(x + 0.8, 1.45, cz + 1.2),
     );
-    doc.add_mesh(&format!("car_{k}_body"), &body, &paint)?;
+    doc.add_tagged_mesh(&format!("car_{k}_body"), &body, &paint, body_tag)?;
     let mut wheels = Mesh::new();
     for sx in [-1.0f32, 1.0] {
         for sz in [-1.0f32, 1.0] {
@@ -842,7 +941,7 @@ fn add_car(doc: &mut Doc, k: usize, car: &Car, st: &StreetStyle) -> Result<(), E
             );
         }
     }
-    doc.add_mesh(&format!("car_{k}_wheels"), &wheels, &rubber)?;
+    doc.add_tagged_mesh(&format!("car_{k}_wheels"), &wheels, &rubber, body_tag)?;
     let front = z + dir * 2.2;
     let back = z - dir * 2.2;
     let mut heads = Mesh::new();
@@ -895,8 +994,13 @@ fn add_car(doc: &mut Doc, k: usize, car: &Car, st: &StreetStyle) -> Result<(), E
             Material::emitter("tail_light", [6.0, 0.3, 0.15]),
         )
     };
-    doc.add_mesh(&format!("car_{k}_headlamps"), &heads, &head_lens)?;
-    doc.add_mesh(&format!("car_{k}_tail_lights"), &tails, &tail_lens)?;
+    doc.add_tagged_mesh(&format!("car_{k}_headlamps"), &heads, &head_lens, lamp_tag)?;
+    doc.add_tagged_mesh(
+        &format!("car_{k}_tail_lights"),
+        &tails,
+        &tail_lens,
+        lamp_tag,
+    )?;
     Ok(())
 }
 
@@ -922,7 +1026,9 @@ fn add_traffic_light(
         Vec3::new(x - 0.17, 3.2, z - 0.25),
         Vec3::new(x + 0.17, 4.2, z),
     );
-    doc.add_mesh(
+    // Traffic lights are numbered after the cars' instance ids.
+    let signal_instance = 1000 + k as u32;
+    doc.add_tagged_mesh(
         &format!("traffic_light{suffix}"),
         &m,
         &Material::paper(
@@ -931,6 +1037,7 @@ fn add_traffic_light(
             [0.02; 3],
             [0.04; 3],
         ),
+        Tag::object(Class::TrafficLight, signal_instance),
     )?;
     // (signal, name, height, lit radiance, dark radiance, spot colour)
     let lenses = [
@@ -972,7 +1079,12 @@ fn add_traffic_light(
         };
         let mut q = Mesh::new();
         q.rect(Vec3::new(x, y, z + 0.002), Vec3::X * 0.1, Vec3::Y * 0.1);
-        doc.add_mesh(&name, &q, &Material::emitter(&name, radiance))?;
+        doc.add_tagged_mesh(
+            &name,
+            &q,
+            &Material::emitter(&name, radiance),
+            Tag::object(Class::LightSource, signal_instance),
+        )?;
     }
     let light_name = match t.signal {
         Signal::Red => "red",
@@ -1009,7 +1121,12 @@ fn add_signs(doc: &mut Doc, signs: &[Sign], st: &StreetStyle) -> Result<(), Erro
         let name = format!("sign_{k}");
         let plate_material =
             Material::paper(&name, PaperBsdf::Ggx { alpha: 0.25 }, s.color, [0.08; 3]);
-        doc.add_mesh(&name, &plate, &plate_material)?;
+        doc.add_tagged_mesh(
+            &name,
+            &plate,
+            &plate_material,
+            Tag::stuff(Class::TrafficSign),
+        )?;
     }
     let metal = Material::paper(
         "sign_post",
@@ -1017,7 +1134,7 @@ fn add_signs(doc: &mut Doc, signs: &[Sign], st: &StreetStyle) -> Result<(), Erro
         [0.15; 3],
         [0.05; 3],
     );
-    doc.add_mesh("sign_posts", &posts, &metal)
+    doc.add_tagged_mesh("sign_posts", &posts, &metal, Tag::stuff(Class::Pole))
 }
 
 #[cfg(test)]

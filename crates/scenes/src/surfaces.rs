@@ -274,13 +274,15 @@ impl Texture {
         })
     }
 
-    /// A dry paper material of mean albedo `kd` (linear RGB) with this texture.
+    /// A dry paper material of mean albedo `kd` (linear RGB) with this texture. glTF's
+    /// base colour factor is at most 1, so a channel brighter than the texture's mean gets
+    /// the texture as it is (its mean, within a few per cent for the drawn albedos).
     pub fn material(&self, name: &str, kd: [f64; 3]) -> Material {
         let (ks, alpha) = self.surface.dry_gloss();
         Material::paper(
             name,
             PaperBsdf::Ggx { alpha },
-            kd.map(|k| round7(k / self.mean)),
+            kd.map(|k| round7((k / self.mean).min(1.0))),
             [ks; 3],
         )
         .with_albedo(self.image)
