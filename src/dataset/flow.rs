@@ -3,18 +3,17 @@
 //! that one is derived from both scenes and the moving objects' poses
 //! ([`streaks_stereo::flow::left_flow`]).
 //!
-//! The instance map here is a stand-in: the pixel-centre ray's first hit is on a moving
-//! object when it lies within that object's bounds ([`instance_map`]); everything else is the
-//! static world (0). The renderer's `object` layer, once it exists, gives the same map from
-//! the glTF's `extras.streaks.instance`; only [`instance_map`]'s caller changes then.
+//! Which pixel sees which moving object comes from the rendered left view's instance map (the
+//! glTF's `extras.streaks.instance` of the pixel-centre ray's first hit, [`moving_ids`]), so a
+//! car's flow ends exactly at its silhouette. The re-derivation test, which does not render, takes
+//! the moving object whose bounds hold the first hit instead.
 
 use anyhow::{Context, Result};
-use glam::{Vec2, Vec3};
 use std::path::Path;
 use streaks_render::scene::Scene;
 use streaks_scenes::drive::MovingObject;
 use streaks_scenes::procedural::{street_frame, GeneratorConfig, SampleScene};
-use streaks_stereo::flow::{left_flow, left_ray, FlowField, ObjectMotion, Surfaces};
+use streaks_stereo::flow::{left_flow, FlowField, ObjectMotion};
 use streaks_stereo::render::rig_from_camera;
 use streaks_stereo::rig::Rig;
 
@@ -69,35 +68,6 @@ pub fn next_frame(
     frame
 }
 
-/// The instance of the moving object a world point lies on, 0 for the static world.
-pub fn instance_at(objects: &[MovingObject], p: Vec3) -> u32 {
-    objects
-        .iter()
-        .find(|o| o.contains(p))
-        .map_or(0, |o| o.instance)
-}
-
-/// The stand-in instance map of the left view of `rig` in `scene`: per pixel (rows top to
-/// bottom) the moving object the pixel-centre ray's first hit lies on, 0 otherwise (see the
-/// module documentation).
-pub fn instance_map(rig: &Rig, scene: &Scene, objects: &[MovingObject]) -> Vec<u32> {
-    let i = rig.intrinsics();
-    let (w, h) = (i.width() as usize, i.height() as usize);
-    let mut out = vec![0u32; w * h];
-    if objects.is_empty() {
-        return out;
-    }
-    for y in 0..h {
-        for x in 0..w {
-            let (o, d) = left_ray(rig, Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
-            if let Some(t) = scene.first_hit(o, d) {
-                out[y * w + x] = instance_at(objects, o + d * t);
-            }
-        }
-    }
-    out
-}
-
 /// How the moving objects of `now` move to `next` (matched by instance id; an object that is
 /// not in `next` is an error).
 pub fn object_motion(now: &SampleScene, next: &SampleScene) -> Result<ObjectMotion> {
@@ -116,16 +86,31 @@ pub fn object_motion(now: &SampleScene, next: &SampleScene) -> Result<ObjectMoti
     Ok(motion)
 }
 
-/// The left eye's flow from the frame `now` to the frame `next`.
-pub fn frame_flow(now: &Frame, next: &Frame) -> Result<FlowField> {
-    let ids = instance_map(&now.rig, &now.scene, &now.sample.objects);
+/// A rendered instance map (the scene's instance ids per pixel) with every id that is not
+/// one of `objects` (the static world's: parked cars, traffic lights) set to 0.
+pub fn moving_ids(instances: &[u32], objects: &[MovingObject]) -> Vec<u32> {
+    instances
+        .iter()
+        .map(|&id| {
+            if objects.iter().any(|o| o.instance == id) {
+                id
+            } else {
+                0
+            }
+        })
+        .collect()
+}
+
+/// The left eye's flow from the frame `now` to the frame `next`, with `ids` the moving object
+/// each pixel of `now`'s left view sees (0: the static world).
+pub fn frame_flow(now: &Frame, next: &Frame, ids: &[u32]) -> Result<FlowField> {
     let motion = object_motion(&now.sample, &next.sample)?;
     Ok(left_flow(
         &now.rig,
         &next.rig,
         &now.scene,
         &next.scene,
-        &ids,
+        ids,
         &motion,
     )?)
 }
@@ -133,6 +118,37 @@ pub fn frame_flow(now: &Frame, next: &Frame) -> Result<FlowField> {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+    use glam::{Vec2, Vec3};
+    use streaks_stereo::flow::{left_ray, Surfaces};
+
+    /// The instance of the moving object a world point lies on, 0 for the static world.
+    pub(crate) fn instance_at(objects: &[MovingObject], p: Vec3) -> u32 {
+        objects
+            .iter()
+            .find(|o| o.contains(p))
+            .map_or(0, |o| o.instance)
+    }
+
+    /// An instance map of the left view of `rig` in `scene` without rendering: per pixel (rows
+    /// top to bottom) the moving object whose bounds hold the pixel-centre ray's first hit, 0
+    /// otherwise.
+    pub(crate) fn instance_map(rig: &Rig, scene: &Scene, objects: &[MovingObject]) -> Vec<u32> {
+        let i = rig.intrinsics();
+        let (w, h) = (i.width() as usize, i.height() as usize);
+        let mut out = vec![0u32; w * h];
+        if objects.is_empty() {
+            return out;
+        }
+        for y in 0..h {
+            for x in 0..w {
+                let (o, d) = left_ray(rig, Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+                if let Some(t) = scene.first_hit(o, d) {
+                    out[y * w + x] = instance_at(objects, o + d * t);
+                }
+            }
+        }
+        out
+    }
     use streaks_stereo::flow::{FlowState, OCCLUSION_TOLERANCE};
     use streaks_stereo::rig::Eye;
 
@@ -171,7 +187,8 @@ pub(crate) mod tests {
             width,
             height,
         )?;
-        let flow = frame_flow(&now, &next)?;
+        let ids = instance_map(&now.rig, &now.scene, &now.sample.objects);
+        let flow = frame_flow(&now, &next, &ids)?;
         let mut report = Rederived::default();
         let (w, h) = (width as usize, height as usize);
         let eye0 = now.rig.eye(Eye::Left);

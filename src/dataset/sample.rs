@@ -176,7 +176,8 @@ fn write_sample(
         scene,
         rig,
     };
-    let flow = super::flow::frame_flow(&now, &next)?;
+    let ids = super::flow::moving_ids(&left.instance, &now.sample.objects);
+    let flow = super::flow::frame_flow(&now, &next, &ids)?;
     write_flow(&files, &flow)?;
     let super::flow::Frame {
         sample: s,
