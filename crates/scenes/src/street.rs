@@ -670,6 +670,29 @@ impl Street {
         Ok(())
     }
 
+    /// The block frontages on the side `side` (+1 right, -1 left) from the near end towards
+    /// the far end, as `(k, z0, z1)` with `z0 > z1`: block `k`'s frontage, its length taken
+    /// from block `k + 3` on the left so that the two sides do not line up; the last one is cut
+    /// at the far end.
+    fn frontages(&self, side: f32) -> Vec<(usize, f32, f32)> {
+        let mut out = Vec::new();
+        let mut z0 = self.near;
+        for k in 0..self.blocks.len() {
+            let len = if side < 0.0 {
+                self.blocks[(k + 3) % self.blocks.len()].0
+            } else {
+                self.blocks[k].0
+            };
+            let z1 = (z0 - len).max(self.far);
+            out.push((k, z0, z1));
+            z0 = z1;
+            if z0 <= self.far {
+                break;
+            }
+        }
+        out
+    }
+
     /// The buildings on both sides as drawn models ([`crate::buildings`]): block frontages
     /// from [`Street::blocks`] as the boxes have them (the left side offset by three blocks),
     /// each a [`BuildingSpec`] placed with its lot line on the facade line.
@@ -680,14 +703,7 @@ impl Street {
         let cool = if lit > 0.0 { 1.0 - warm / lit } else { 0.0 };
         let mut rows = Vec::new();
         for side in [1.0f32, -1.0] {
-            let mut z0 = self.near;
-            for k in 0..self.blocks.len() {
-                let k = if side < 0.0 {
-                    (k + 3) % self.blocks.len()
-                } else {
-                    k
-                };
-                let z1 = (z0 - self.blocks[k].0).max(self.far);
+            for (_, z0, z1) in self.frontages(side) {
                 let frontage = z0 - z1;
                 if frontage > 1.0 {
                     let spec = BuildingSpec::draw(
@@ -697,10 +713,6 @@ impl Street {
                         (lit, cool, self.style.lit_shops),
                     );
                     rows.push((side, 0.5 * (z0 + z1), spec));
-                }
-                z0 = z1;
-                if z0 <= self.far {
-                    break;
                 }
             }
         }
@@ -771,15 +783,8 @@ impl Street {
         let mut lit_shop = Mesh::new();
         let mut counter = 0u32;
         for &side in sides {
-            let mut z0 = self.near;
-            for (k, &(len, height)) in self.blocks.iter().enumerate() {
-                // Offset the two sides so blocks do not line up.
-                let len = if side < 0.0 {
-                    self.blocks[(k + 3) % self.blocks.len()].0
-                } else {
-                    len
-                };
-                let z1 = (z0 - len).max(self.far);
+            for (k, z0, z1) in self.frontages(side) {
+                let height = self.blocks[k].1;
                 let (xa, xb) = (side * facade_x, side * (facade_x + 10.0));
                 by_material[k % 3].cuboid(
                     Vec3::new(xa.min(xb), 0.0, z1),
@@ -821,10 +826,6 @@ impl Street {
                         target.rect(Vec3::new(x, 1.5, zc), normal_u * 1.3, Vec3::Y * 0.9);
                         zc -= 5.0;
                     }
-                }
-                z0 = z1;
-                if z0 <= self.far {
-                    break;
                 }
             }
         }
