@@ -7,30 +7,17 @@
 //! with +Y up (the glTF camera's), a car's is its model frame (+X right, +Y up, -Z forward,
 //! the origin on the ground at the centre of its footprint, see [`crate::model`]).
 //!
-//! Each pose is one call to a road-frame function, [`road_pose`]: the pose of a frame at a
-//! lateral offset and a distance along the road. The road here is the straight, flat street
-//! of [`crate::street`] (driving direction -Z, lateral +X, up +Y); a curved or sloped road
-//! changes [`road_pose`] and nothing else.
+//! Each pose is one call to the road's frame function, [`Road::pose`]: the pose of a frame
+//! standing on the road's surface at a lateral offset and a distance along the road, so that
+//! the rig and the cars follow its curves, climb its grades and lean with its cross-fall.
 
+use crate::road::Road;
 use crate::street::Car;
-use glam::{Affine3A, Mat3, Quat, Vec3};
-
-/// The pose of a frame on the road: `lateral` metres right of the road's centre line,
-/// `along` metres from the street's origin in the driving direction, facing the driving
-/// direction (or against it when `reverse`, as oncoming traffic does). Its local -Z is the
-/// lane's direction of travel, +Y the road's normal, +X the right of travel.
-pub fn road_pose(lateral: f32, along: f64, reverse: bool) -> Affine3A {
-    let rotation = if reverse {
-        Quat::from_rotation_y(std::f32::consts::PI)
-    } else {
-        Quat::IDENTITY
-    };
-    Affine3A::from_rotation_translation(rotation, Vec3::new(lateral, 0.0, -(along as f32)))
-}
+use glam::{Affine3A, Mat3, Vec3};
 
 /// The rig's mounting on its vehicle: height of the rig centre above the road, pitch below the
 /// horizon and roll (positive: the camera's right side down), as the local pose of the rig in
-/// the road frame of its lane ([`road_pose`]).
+/// the road frame of its lane ([`Road::pose`]).
 pub fn mount(height: f32, pitch_rad: f32, roll_rad: f32) -> Affine3A {
     let rotation = Mat3::from_rotation_x(-pitch_rad) * Mat3::from_rotation_z(-roll_rad);
     Affine3A::from_mat3_translation(rotation, Vec3::new(0.0, height, 0.0))
@@ -56,27 +43,34 @@ pub fn frame_time(frame: u64, fps: f64) -> f64 {
 }
 
 /// The rig centre's world pose at `time` (seconds): looking along its local -Z, +Y up.
-pub fn rig_pose_at(drive: &Drive, time: f64) -> Affine3A {
-    road_pose(drive.lateral, drive.start + drive.speed_m_s * time, false) * drive.mount
+pub fn rig_pose_at(road: &Road, drive: &Drive, time: f64) -> Affine3A {
+    road.pose(drive.lateral, drive.start + drive.speed_m_s * time, false) * drive.mount
 }
 
 /// The rig's velocity in world space at `time`, m/s: its speed along the lane's direction.
-pub fn rig_velocity_at(drive: &Drive, time: f64) -> Vec3 {
-    let lane = road_pose(drive.lateral, drive.start + drive.speed_m_s * time, false);
+pub fn rig_velocity_at(road: &Road, drive: &Drive, time: f64) -> Vec3 {
+    let lane = road.pose(drive.lateral, drive.start + drive.speed_m_s * time, false);
     lane.transform_vector3(Vec3::NEG_Z) * drive.speed_m_s as f32
 }
 
-/// A car's world pose at `time` (seconds) when it drives at `speed_m_s` along its lane from
-/// where `car` puts it at time 0 (a parked car stays there): its model frame in the world.
-pub fn car_pose_at(car: &Car, speed_m_s: f64, time: f64) -> Affine3A {
+/// Where along the road (straight frame Z, as [`Car::z`]) a car is at `time` (seconds) when it
+/// drives at `speed_m_s` along its lane from where `car` puts it at time 0 (a parked car stays
+/// there).
+pub fn car_z_at(car: &Car, speed_m_s: f64, time: f64) -> f32 {
     let moved = if car.parked { 0.0 } else { speed_m_s * time };
     let direction = if car.oncoming { -1.0 } else { 1.0 };
-    road_pose(car.x, f64::from(-car.z) + direction * moved, car.oncoming)
+    -(f64::from(-car.z) + direction * moved) as f32
 }
 
-/// The bounds of a generated car in its model frame, metres (body, cabin, wheels and the lamp
-/// lenses 2 mm proud of the body).
-pub const CAR_BOUNDS: [Vec3; 2] = [Vec3::new(-0.9, 0.0, -2.21), Vec3::new(0.9, 1.45, 2.21)];
+/// A car's world pose: its model frame on the road at its lane offset [`Car::x`] and
+/// straight-frame [`Car::z`], facing its direction of travel. The street draws it there.
+pub fn car_pose(road: &Road, car: &Car) -> Affine3A {
+    road.pose(car.x, f64::from(-car.z), car.oncoming)
+}
+
+/// The bounds of a generated car in its model frame, metres (body, cabin, the wheels 2 cm
+/// proud of the body's sides and the lamp lenses 2 mm proud of its ends).
+pub const CAR_BOUNDS: [Vec3; 2] = [Vec3::new(-0.92, 0.0, -2.21), Vec3::new(0.92, 1.45, 2.21)];
 
 /// An object that moves during a drive: its instance id (the `extras.streaks.instance` of its
 /// nodes), its world pose at the frame's time and its bounds in its own frame.
@@ -123,7 +117,8 @@ mod tests {
         };
         let t = frame_time(3, 10.0);
         assert!((t - 0.3).abs() < 1e-12);
-        let pose = rig_pose_at(&drive, t);
+        let road = Road::straight();
+        let pose = rig_pose_at(&road, &drive, t);
         let expected_z = -(2.0 + 12.5 * 0.3) as f32;
         assert!(close(
             pose.translation.into(),
@@ -142,7 +137,7 @@ mod tests {
         assert!(right.dot(forward).abs() < 1e-6);
         assert!(close(right, expected), "{right} vs {expected}");
         assert!(close(
-            rig_velocity_at(&drive, t),
+            rig_velocity_at(&road, &drive, t),
             Vec3::new(0.0, 0.0, -12.5)
         ));
     }
@@ -159,11 +154,19 @@ mod tests {
             headlights: true,
             parked,
         };
-        let at = |c: &Car| Vec3::from(car_pose_at(c, 10.0, 0.5).translation);
+        let road = Road::straight();
+        let pose_at = |c: &Car| {
+            let moved = Car {
+                z: car_z_at(c, 10.0, 0.5),
+                ..*c
+            };
+            car_pose(&road, &moved)
+        };
+        let at = |c: &Car| Vec3::from(pose_at(c).translation);
         assert!(close(at(&car(false, false)), Vec3::new(-2.0, 0.0, -35.0)));
         assert!(close(at(&car(true, false)), Vec3::new(-2.0, 0.0, -25.0)));
         assert!(close(at(&car(true, true)), Vec3::new(-2.0, 0.0, -30.0)));
-        let front = car_pose_at(&car(true, false), 10.0, 0.5).transform_vector3(Vec3::NEG_Z);
+        let front = pose_at(&car(true, false)).transform_vector3(Vec3::NEG_Z);
         assert!(close(front, Vec3::Z));
     }
 
@@ -172,7 +175,7 @@ mod tests {
     fn a_moving_object_contains_its_points_only() {
         let o = MovingObject {
             instance: 3,
-            world_from_object: road_pose(2.0, 20.0, true),
+            world_from_object: Road::straight().pose(2.0, 20.0, true),
             bounds: CAR_BOUNDS,
         };
         assert!(o.contains(Vec3::new(2.5, 0.8, -21.5)));

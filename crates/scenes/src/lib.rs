@@ -30,6 +30,7 @@ pub mod model;
 pub mod objects;
 pub mod paper;
 pub mod procedural;
+pub mod road;
 pub mod street;
 pub mod surfaces;
 pub mod weather;

@@ -77,6 +77,30 @@ impl Mesh {
         self.quad_uv(p, uv, u.cross(v).normalize());
     }
 
+    /// A smooth `nu x nv` grid of quads: `at(i, j)` gives the vertex (position, normal,
+    /// texture coordinates) at column `i` in `0..=nu` and row `j` in `0..=nv`; each triangle
+    /// faces its vertices' mean normal. Tessellated surfaces (a crowned road, strips that
+    /// follow a curve) are grids.
+    pub fn grid(&mut self, nu: usize, nv: usize, at: impl Fn(usize, usize) -> (Vec3, Vec3, Vec2)) {
+        let first = self.positions.len() as u32;
+        for j in 0..=nv {
+            for i in 0..=nu {
+                let (p, n, uv) = at(i, j);
+                self.vertex(p, n, uv);
+            }
+        }
+        let id = |i: usize, j: usize| first + (j * (nu + 1) + i) as u32;
+        for j in 0..nv {
+            for i in 0..nu {
+                let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+                let mean = |v: [u32; 3]| v.iter().map(|&k| self.normals[k as usize]).sum();
+                let (n0, n1): (Vec3, Vec3) = (mean([a, b, c]), mean([a, c, d]));
+                self.triangle(a, b, c, n0);
+                self.triangle(a, c, d, n1);
+            }
+        }
+    }
+
     /// An axis-aligned box from `min` to `max` with outward faces.
     pub fn cuboid(&mut self, min: Vec3, max: Vec3) {
         let c = (min + max) * 0.5;

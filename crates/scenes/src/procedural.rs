@@ -420,6 +420,9 @@ pub struct GeneratorConfig {
     /// The buildings along the street: storeys, setbacks, windows, balconies, shop fronts,
     /// wall materials.
     pub buildings: crate::buildings::BuildingsConfig,
+    /// The road's layout (bends, grades, cross profile) and surface (potholes, ruts, tram
+    /// tracks, crossings, paint).
+    pub road: crate::road::RoadConfig,
 }
 
 /// The night sky's glow: a constant environment light of radiance `color * glow` (W/(m^2 sr)),
@@ -634,6 +637,7 @@ impl GeneratorConfig {
         }
         self.weather.validate()?;
         self.buildings.validate()?;
+        self.road.validate()?;
         {
             let sky = &self.sky;
             real("sky.glow", sky.glow, 0.0, 100.0)?;
@@ -738,6 +742,7 @@ const SKY_STREAM: u64 = 4;
 const WEATHER_STREAM: u64 = 5;
 const CAMERA_STREAM: u64 = 6;
 const MOTION_STREAM: u64 = 7;
+const ROAD_STREAM: u64 = 8;
 
 /// The lamps' beam: a spot light straight down, full intensity to 60 degrees from the nadir,
 /// none beyond 85 (a road luminaire's wide, cut-off distribution).
@@ -870,8 +875,9 @@ pub fn street_frame(
         speed_m_s: speed_kmh / 3.6,
     };
     let time = crate::drive::frame_time(frame, sq.fps);
-    let world_from_rig = crate::drive::rig_pose_at(&drive, time);
-    let rig_velocity = crate::drive::rig_velocity_at(&drive, time);
+    let road = street.road.clone();
+    let world_from_rig = crate::drive::rig_pose_at(&road, &drive, time);
+    let rig_velocity = crate::drive::rig_velocity_at(&road, &drive, time);
     let mut objects = Vec::new();
     let mut car_speeds = Vec::new();
     for (k, car) in street.cars.iter_mut().enumerate() {
@@ -880,9 +886,8 @@ pub fn street_frame(
         if car.parked {
             continue;
         }
-        let pose = crate::drive::car_pose_at(car, speed_m_s, time);
-        car.x = pose.translation.x;
-        car.z = pose.translation.z;
+        car.z = crate::drive::car_z_at(car, speed_m_s, time);
+        let pose = crate::drive::car_pose(&road, car);
         objects.push(crate::drive::MovingObject {
             instance: car_instance(k),
             world_from_object: pose,
@@ -1224,6 +1229,10 @@ fn random_street(
         facade_kd,
         ..StreetStyle::SHIPPED
     };
+    // The road in its own stream: a config with another road draws every other parameter as
+    // this one.
+    let mut road_rng = ChaCha8Rng::seed_from_u64(mix(seed, ROAD_STREAM, street_id));
+    let drawn_road = config.road.draw(&mut road_rng, lanes, lane_width, far);
     let street = Street {
         name: "scene",
         description: format!(
@@ -1249,6 +1258,8 @@ fn random_street(
             window_cd: window_luminance,
             shop_cd: shop_luminance,
         }),
+        road: drawn_road.road,
+        features: drawn_road.features,
     };
     let params = json!({
         "generator": GENERATOR_VERSION,
@@ -1307,6 +1318,7 @@ fn random_street(
             "alpha_dry": dry.1,
             "ripples": ripples.map(|r| json!({"strength": r.strength, "tile_m": r.tile_m})),
         },
+        "road": drawn_road.params,
     });
     Ok((street, params))
 }

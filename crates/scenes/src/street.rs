@@ -11,9 +11,11 @@ use crate::gltf_writer::{
     Tag,
 };
 use crate::mesh::Mesh;
+use crate::model::{transformed, transformed_light};
+use crate::road::{Road, RoadFeatures, GAUGE, RAIL_GROOVE, RAIL_HEAD};
 use crate::wetness::{dryness_png, ripple_normal_png, Wetness, RIPPLE_TEXELS};
 use crate::Error;
-use glam::{Vec2, Vec3};
+use glam::{Affine3A, Vec2, Vec3};
 
 /// Half width of the carriageway (two 3.5 m lanes).
 pub const ROAD_HALF: f32 = 3.5;
@@ -269,6 +271,11 @@ pub struct Street {
     /// Buildings drawn from a config ([`crate::buildings`]) on the blocks' frontages; `None`,
     /// the shipped streets' boxes with flat windows.
     pub drawn_buildings: Option<DrawnBuildings>,
+    /// Where the street's straight frame lies in the world: curves, grades, cross profile.
+    /// Everything above is laid out in the straight frame and bent onto it.
+    pub road: Road,
+    /// Potholes, ruts, tracks, crossings and the markings' paint.
+    pub features: RoadFeatures,
 }
 
 /// How a street's buildings are drawn from a [`BuildingsConfig`]: one [`BuildingSpec`] per
@@ -376,6 +383,8 @@ impl Street {
             texture: (64, 1024),
             style: StreetStyle::SHIPPED,
             drawn_buildings: None,
+            road: Road::straight(),
+            features: RoadFeatures::default(),
         }
     }
 
@@ -410,6 +419,8 @@ impl Street {
             texture: (64, 512),
             style: StreetStyle::SHIPPED,
             drawn_buildings: None,
+            road: Road::straight(),
+            features: RoadFeatures::default(),
         }
     }
 
@@ -427,13 +438,13 @@ impl Street {
         self.poles(&mut doc, &tex)?;
         let st = &self.style;
         for (k, car) in self.cars.iter().enumerate() {
-            add_car(&mut doc, k, car, st)?;
+            add_car(self, &mut doc, k, car)?;
         }
         for (k, t) in self.traffic_lights.iter().enumerate() {
-            add_traffic_light(&mut doc, k, t, st)?;
+            add_traffic_light(self, &mut doc, k, t)?;
         }
         if !self.signs.is_empty() {
-            add_signs(&mut doc, &self.signs, st)?;
+            add_signs(self, &mut doc, &self.signs)?;
         }
         self.buildings(&mut doc, &tex)?;
         match st.camera_pose {
@@ -500,6 +511,28 @@ impl Street {
                 tiles,
             });
         }
+        let p = self.features.paint;
+        let paint = Material::paper(
+            "road_paint",
+            PaperBsdf::Ggx { alpha: p.alpha },
+            [p.kd; 3],
+            [p.ks; 3],
+        );
+        let stone = tex.stone.paper(
+            "kerb_granite",
+            PaperBsdf::Ggx { alpha: 0.25 },
+            [0.22; 3],
+            [0.04; 3],
+        );
+        let pavement = tex.stone.paper(
+            "wet_pavement",
+            PaperBsdf::Ggx { alpha: 0.12 },
+            [0.1; 3],
+            [0.06; 3],
+        );
+        if !(self.road.is_straight() && self.features.is_plain()) {
+            return self.shaped_road(doc, [&asphalt, &paint, &stone, &pavement]);
+        }
         let mut road = Mesh::new();
         road.quad_uv(
             [
@@ -520,12 +553,6 @@ impl Street {
 
         // Markings: a dashed centre line (3 m dashes, 9 m gaps) and solid edge lines, 2 mm
         // above the asphalt.
-        let paint = Material::paper(
-            "road_paint",
-            PaperBsdf::Ggx { alpha: 0.15 },
-            [0.55; 3],
-            [0.05; 3],
-        );
         let mut marks = Mesh::new();
         let y = 0.002;
         for k in 1..st.lanes.max(1) {
@@ -546,18 +573,6 @@ impl Street {
         doc.add_tagged_mesh("lane_markings", &marks, &paint, Tag::stuff(Class::Marking))?;
 
         // Kerbs and sidewalks (top at 0.15 m) up to the facades.
-        let stone = tex.stone.paper(
-            "kerb_granite",
-            PaperBsdf::Ggx { alpha: 0.25 },
-            [0.22; 3],
-            [0.04; 3],
-        );
-        let pavement = tex.stone.paper(
-            "wet_pavement",
-            PaperBsdf::Ggx { alpha: 0.12 },
-            [0.1; 3],
-            [0.06; 3],
-        );
         let mut kerbs = Mesh::new();
         let mut walks = Mesh::new();
         for side in [-1.0f32, 1.0] {
@@ -575,6 +590,265 @@ impl Street {
         doc.add_tagged_mesh("kerbs", &kerbs, &stone, Tag::stuff(Class::Sidewalk))?;
         doc.add_tagged_mesh("sidewalks", &walks, &pavement, Tag::stuff(Class::Sidewalk))?;
         Ok(())
+    }
+
+    /// The carriageway, markings, tracks, kerbs and pavements of a road that is curved, sloped
+    /// or crowned, or has potholes, ruts, tracks, crossings or worn paint: every long surface a
+    /// grid over the same stations ([`RoadFeatures::stations`]), laid out in the straight frame
+    /// and bent onto [`Street::road`]. The materials are `[asphalt, paint, kerb, pavement]`.
+    fn shaped_road(&self, doc: &mut Doc, materials: [&Material; 4]) -> Result<(), Error> {
+        let [asphalt, paint, stone, pavement] = materials;
+        let st = &self.style;
+        let feat = &self.features;
+        let (h, n, f) = (st.road_half, self.near, self.far);
+        let zs = feat.stations(n, f, 1.0);
+        let depth = |x: f32, z: f32| feat.depth(x, z, h, st.lanes);
+        // The surface's normal in the straight frame (the bowl's and ruts' slopes).
+        let normal = |x: f32, z: f32| {
+            let e = 0.01;
+            let dx = (depth(x + e, z) - depth(x - e, z)) / (2.0 * e);
+            let dz = (depth(x, z + e) - depth(x, z - e)) / (2.0 * e);
+            Vec3::new(dx, 1.0, dz).normalize()
+        };
+        // The stations strictly between z0 > z1, with both ends.
+        let between = |z0: f32, z1: f32| -> Vec<f32> {
+            let mut v = vec![z0];
+            v.extend(
+                zs.iter()
+                    .copied()
+                    .filter(|z| *z < z0 - 1e-3 && *z > z1 + 1e-3),
+            );
+            v.push(z1);
+            v
+        };
+        // A strip on the carriageway from x0 to x1 and z0 down to z1, `lift` above it.
+        let strip = |m: &mut Mesh, x: [f32; 2], z0: f32, z1: f32, lift: f32| {
+            let rows = between(z0, z1);
+            m.grid(1, rows.len() - 1, |i, j| {
+                let (x, z) = (x[i], rows[j]);
+                (
+                    Vec3::new(x, lift - depth(x, z), z),
+                    normal(x, z),
+                    Vec2::new(x, z),
+                )
+            });
+        };
+
+        // The carriageway, 20 cm across for the crown, ruts and potholes.
+        let cols = (2.0 * h / 0.2).ceil() as usize;
+        let mut road = Mesh::new();
+        road.grid(cols, zs.len() - 1, |i, j| {
+            let (x, z) = (-h + 2.0 * h * i as f32 / cols as f32, zs[j]);
+            (
+                Vec3::new(x, -depth(x, z), z),
+                normal(x, z),
+                Vec2::new((x + h) / (2.0 * h), (n - z) / (n - f)),
+            )
+        });
+        self.add_bent(doc, "road", &road, asphalt, Tag::stuff(Class::Road))?;
+
+        // Water in the potholes: flat, 1 cm below the rim's lowest point.
+        let mut water = Mesh::new();
+        for p in &feat.potholes {
+            let rim: Vec<Vec3> = (0..=32)
+                .map(|k| {
+                    let phi = std::f32::consts::TAU * k as f32 / 32.0;
+                    let r = 0.98 * p.rim(phi);
+                    let (x, z) = (p.x + r * phi.cos(), p.z + r * phi.sin());
+                    self.road.world(Vec3::new(x, -depth(x, z), z))
+                })
+                .collect();
+            let level = rim.iter().map(|q| q.y).fold(f32::INFINITY, f32::min) - 0.01;
+            let mut fan = vec![self.road.world(Vec3::new(p.x, 0.0, p.z))];
+            fan.extend(rim);
+            for q in &mut fan {
+                q.y = level;
+            }
+            water.polygon(&fan, Vec3::Y);
+        }
+        if !water.indices.is_empty() {
+            let still = Material::paper(
+                "pothole_water",
+                PaperBsdf::Ggx { alpha: st.wet.1 },
+                [st.asphalt_kd; 3],
+                [st.wet.0; 3],
+            )
+            .as_road();
+            doc.add_tagged_mesh("pothole_water", &water, &still, Tag::stuff(Class::Road))?;
+        }
+
+        // Markings, worn away in 25 cm pieces: lane dividers (3 m dashes, 9 m gaps), edge
+        // lines, zebra bars (50 cm wide, 50 cm apart).
+        let mut marks = Mesh::new();
+        let mut piece = 0u32;
+        let mut painted = |m: &mut Mesh, x: [f32; 2], z0: f32, z1: f32| {
+            let pieces = ((z0 - z1) / 0.25).ceil().max(1.0) as usize;
+            let len = (z0 - z1) / pieces as f32;
+            for k in 0..pieces {
+                piece += 1;
+                if f64::from(hash01(piece, self.seed ^ 0x7061_696e)) >= feat.paint.wear {
+                    let a = z0 - k as f32 * len;
+                    strip(m, x, a, a - len, 0.002);
+                }
+            }
+        };
+        let crossing = |z: f32, margin: f32| {
+            feat.crosswalks
+                .iter()
+                .any(|c| (z - c.z).abs() < 0.5 * c.length + margin)
+        };
+        for k in 1..st.lanes.max(1) {
+            let x = -h + k as f32 * (2.0 * h / st.lanes as f32);
+            let mut z = n - 2.0;
+            while z - 3.0 > f {
+                if !crossing(z, 1.0) && !crossing(z - 3.0, 1.0) {
+                    painted(&mut marks, [x - 0.06, x + 0.06], z, z - 3.0);
+                }
+                z -= 12.0;
+            }
+        }
+        for side in [-1.0f32, 1.0] {
+            let x = side * (h - 0.2);
+            painted(&mut marks, [x - 0.06, x + 0.06], n, f);
+        }
+        for c in &feat.crosswalks {
+            let mut x = -h + 0.5;
+            while x + 0.5 <= h - 0.4 {
+                painted(
+                    &mut marks,
+                    [x, x + 0.5],
+                    c.z + 0.5 * c.length,
+                    c.z - 0.5 * c.length,
+                );
+                x += 1.0;
+            }
+        }
+        if !marks.indices.is_empty() {
+            self.add_bent(
+                doc,
+                "lane_markings",
+                &marks,
+                paint,
+                Tag::stuff(Class::Marking),
+            )?;
+        }
+
+        // Tram tracks: grooved rails flush with the road, standard gauge.
+        if !feat.tracks.is_empty() {
+            let (mut heads, mut grooves) = (Mesh::new(), Mesh::new());
+            for &xt in &feat.tracks {
+                for side in [-1.0f32, 1.0] {
+                    let inner = xt + side * 0.5 * GAUGE;
+                    let head = [inner, inner + side * RAIL_HEAD];
+                    let groove = [inner - side * RAIL_GROOVE, inner];
+                    strip(
+                        &mut heads,
+                        [head[0].min(head[1]), head[0].max(head[1])],
+                        n,
+                        f,
+                        0.001,
+                    );
+                    strip(
+                        &mut grooves,
+                        [groove[0].min(groove[1]), groove[0].max(groove[1])],
+                        n,
+                        f,
+                        0.001,
+                    );
+                }
+            }
+            let steel = Material::paper(
+                "rail_steel",
+                PaperBsdf::Ggx { alpha: 0.08 },
+                [0.04; 3],
+                [0.55; 3],
+            );
+            let gap = Material::paper(
+                "rail_groove",
+                PaperBsdf::Ggx { alpha: 0.3 },
+                [0.01; 3],
+                [0.02; 3],
+            );
+            self.add_bent(
+                doc,
+                "rail_heads",
+                &heads,
+                &steel,
+                Tag::stuff(Class::RailTrack),
+            )?;
+            self.add_bent(
+                doc,
+                "rail_grooves",
+                &grooves,
+                &gap,
+                Tag::stuff(Class::RailTrack),
+            )?;
+        }
+
+        // Kerbs (dropped beside the crossings) and pavements up to the facades.
+        let kerb = |z: f32| feat.kerb_at(st.kerb, z);
+        let mut kerbs = Mesh::new();
+        let mut walks = Mesh::new();
+        for side in [-1.0f32, 1.0] {
+            let (a, b) = (side * h, side * (h + st.kerb));
+            let (c, d) = (side * (h + st.kerb), side * st.facade_x);
+            let ys = |m: &mut Mesh, x: [f32; 2]| {
+                let (x0, x1) = (x[0].min(x[1]), x[0].max(x[1]));
+                m.grid(1, zs.len() - 1, |i, j| {
+                    let x = [x0, x1][i];
+                    (
+                        Vec3::new(x, kerb(zs[j]), zs[j]),
+                        Vec3::Y,
+                        Vec2::new(x, zs[j]),
+                    )
+                });
+            };
+            ys(&mut kerbs, [a, b]);
+            ys(&mut walks, [c, d]);
+            // The kerb's face towards the road.
+            kerbs.grid(1, zs.len() - 1, |i, j| {
+                let y = [0.0, kerb(zs[j])][i];
+                (Vec3::new(a, y, zs[j]), Vec3::X * -side, Vec2::new(y, zs[j]))
+            });
+        }
+        kerbs.scale_uvs(TILE_FINE);
+        walks.scale_uvs(TILE_COARSE);
+        self.add_bent(doc, "kerbs", &kerbs, stone, Tag::stuff(Class::Sidewalk))?;
+        self.add_bent(
+            doc,
+            "sidewalks",
+            &walks,
+            pavement,
+            Tag::stuff(Class::Sidewalk),
+        )?;
+        Ok(())
+    }
+
+    /// Adds `mesh`, laid out in the straight frame, bent onto the road.
+    fn add_bent(
+        &self,
+        doc: &mut Doc,
+        name: &str,
+        mesh: &Mesh,
+        material: &Material,
+        tag: Tag,
+    ) -> Result<(), Error> {
+        doc.add_tagged_mesh(name, &self.road.bend_mesh(mesh), material, tag)
+    }
+
+    /// `light`, placed in the straight frame, on the road.
+    fn bent_light(&self, light: Light) -> Light {
+        let (position, direction) = self.road.bend_ray(light.position, light.direction);
+        Light {
+            position,
+            direction,
+            ..light
+        }
+    }
+
+    /// The height of the pavement at `z` (the kerb's, dropped beside crossings).
+    fn pavement_y(&self, z: f32) -> f32 {
+        self.features.kerb_at(self.style.kerb, z)
     }
 
     fn lamps(&self, doc: &mut Doc, tex: &Albedos) -> Result<(), Error> {
@@ -600,7 +874,8 @@ impl Street {
         for (k, (side, z)) in sides.enumerate() {
             let pole_x = side * (half + kerb + 0.5);
             let head_x = side * (half - 0.9);
-            poles.cylinder(Vec3::new(pole_x, kerb, z), 0.09, (6.5 + up) - kerb, 12);
+            let base = self.pavement_y(z);
+            poles.cylinder(Vec3::new(pole_x, base, z), 0.09, (6.5 + up) - base, 12);
             let (a, b) = (pole_x, head_x);
             poles.cuboid(
                 Vec3::new(a.min(b), 6.3 + up, z - 0.05),
@@ -618,7 +893,7 @@ impl Street {
                 Vec3::Z * st.lens_half.0,
                 Vec3::X * st.lens_half.1,
             );
-            doc.add_light(&Light {
+            doc.add_light(&self.bent_light(Light {
                 name: format!("street_lamp_{k}"),
                 kind: match st.lamp_cone {
                     None => LightKind::Point,
@@ -628,16 +903,17 @@ impl Street {
                 intensity: st.lamp_intensity,
                 position: Vec3::new(head_x, st.lamp_height, z),
                 direction: Vec3::NEG_Y,
-            });
+            }));
         }
         if poles.indices.is_empty() {
             return Ok(());
         }
         poles.scale_uvs(TILE_FINE);
-        doc.add_tagged_mesh("lamp_posts", &poles, &metal, Tag::stuff(Class::Pole))?;
+        self.add_bent(doc, "lamp_posts", &poles, &metal, Tag::stuff(Class::Pole))?;
         // rect(c, Z, X) faces Z x X = +Y; the lens must face down.
         flip(&mut lenses);
-        doc.add_tagged_mesh(
+        self.add_bent(
+            doc,
             "lamp_lenses",
             &lenses,
             &lens,
@@ -657,7 +933,7 @@ impl Street {
         let st = &self.style;
         let x = -(st.road_half + st.kerb + 0.9);
         for &z in &self.poles {
-            m.cylinder(Vec3::new(x, st.kerb, z), 0.13, 9.0, 12);
+            m.cylinder(Vec3::new(x, self.pavement_y(z), z), 0.13, 9.0, 12);
             m.cuboid(
                 Vec3::new(x - 0.9, 8.3, z - 0.06),
                 Vec3::new(x + 0.9, 8.42, z + 0.06),
@@ -665,7 +941,7 @@ impl Street {
         }
         m.scale_uvs(TILE_FINE);
         if !self.poles.is_empty() {
-            doc.add_tagged_mesh("telephone_poles", &m, &wood, Tag::stuff(Class::Pole))?;
+            self.add_bent(doc, "telephone_poles", &m, &wood, Tag::stuff(Class::Pole))?;
         }
         Ok(())
     }
@@ -712,7 +988,7 @@ impl Street {
                         frontage,
                         (lit, cool, self.style.lit_shops),
                     );
-                    rows.push((side, 0.5 * (z0 + z1), spec));
+                    rows.push((side, (z0, z1), spec));
                 }
             }
         }
@@ -724,12 +1000,32 @@ impl Street {
             (drawn.window_cd, drawn.shop_cd),
             self.style.wetness,
         )?;
-        for (k, (side, z, spec)) in rows.iter().enumerate() {
+        for (k, (side, (z0, z1), spec)) in rows.iter().enumerate() {
             let model = facade(spec, &palette)?;
+            // Level on its lot at the frontage's lowest ground (it sinks into the pavement
+            // where the road climbs), turned to the road's heading at its middle, and moved
+            // back off the pavement where the facade line curves towards the road.
+            let fx = self.style.facade_x;
+            let x = side * fx;
+            let (s0, s1) = (f64::from(-z0), f64::from(-z1));
+            let lift = self.road.lowest_ground(x, s0, s1);
+            let z = 0.5 * (z0 + z1);
+            let mut on_road = self.road.level_pose(f64::from(-z), lift);
+            if !self.road.is_straight() {
+                let inverse = on_road.inverse();
+                let intrusion = (0..=8)
+                    .map(|i| {
+                        let s = s0 + (s1 - s0) * f64::from(i) / 8.0;
+                        let w = self.road.world(Vec3::new(x, 0.0, -s as f32));
+                        side * inverse.transform_point3(w).x - fx
+                    })
+                    .fold(0.0f32, f32::max);
+                on_road *= Affine3A::from_translation(Vec3::X * side * intrusion);
+            }
             doc.add_model(
                 &format!("building_{k}"),
                 &model,
-                placement(*side, self.style.facade_x, *z),
+                on_road * placement(*side, fx, z),
                 None,
             )?;
         }
@@ -855,7 +1151,8 @@ impl Street {
         for (k, m) in by_material.iter_mut().enumerate() {
             m.scale_uvs(TILE_COARSE);
             if !m.indices.is_empty() {
-                doc.add_tagged_mesh(
+                self.add_bent(
+                    doc,
                     &format!("buildings_{k}"),
                     m,
                     &facades[k],
@@ -870,7 +1167,7 @@ impl Street {
             ("shop_windows_lit", &lit_shop, &shop),
         ] {
             if !m.indices.is_empty() {
-                doc.add_tagged_mesh(name, m, mat, Tag::stuff(Class::Building))?;
+                self.add_bent(doc, name, m, mat, Tag::stuff(Class::Building))?;
             }
         }
         Ok(())
@@ -905,7 +1202,23 @@ fn flip(m: &mut Mesh) {
 
 /// A car: body, cabin and wheels as boxes; headlights (spot lights and emissive lenses) at
 /// the front, emissive red tail lights at the back; a parked car's lenses are unlit.
-fn add_car(doc: &mut Doc, k: usize, car: &Car, st: &StreetStyle) -> Result<(), Error> {
+///
+/// On a straight road the car is modelled in place; on any other it is modelled at the origin
+/// facing -Z and placed with its pose on the road ([`crate::drive::car_pose`]).
+fn add_car(street: &Street, doc: &mut Doc, k: usize, car: &Car) -> Result<(), Error> {
+    let st = &street.style;
+    let place = (!street.road.is_straight()).then(|| crate::drive::car_pose(&street.road, car));
+    let local = Car {
+        x: 0.0,
+        z: 0.0,
+        oncoming: false,
+        ..*car
+    };
+    let car = if place.is_some() { &local } else { car };
+    let put = |m: &Mesh| match place {
+        Some(pose) => transformed(m, pose),
+        None => m.clone(),
+    };
     let dir = if car.oncoming { 1.0f32 } else { -1.0 }; // direction the car faces, along Z
     let instance = crate::procedural::car_instance(k);
     let (body_tag, lamp_tag) = (
@@ -931,7 +1244,7 @@ fn add_car(doc: &mut Doc, k: usize, car: &Car, st: &StreetStyle) -> Result<(), E
         Vec3::new(x - 0.8, 1.0, cz - 1.2),
         Vec3::new(x + 0.8, 1.45, cz + 1.2),
     );
-    doc.add_tagged_mesh(&format!("car_{k}_body"), &body, &paint, body_tag)?;
+    doc.add_tagged_mesh(&format!("car_{k}_body"), &put(&body), &paint, body_tag)?;
     let mut wheels = Mesh::new();
     for sx in [-1.0f32, 1.0] {
         for sz in [-1.0f32, 1.0] {
@@ -942,7 +1255,7 @@ fn add_car(doc: &mut Doc, k: usize, car: &Car, st: &StreetStyle) -> Result<(), E
             );
         }
     }
-    doc.add_tagged_mesh(&format!("car_{k}_wheels"), &wheels, &rubber, body_tag)?;
+    doc.add_tagged_mesh(&format!("car_{k}_wheels"), &put(&wheels), &rubber, body_tag)?;
     let front = z + dir * 2.2;
     let back = z - dir * 2.2;
     let mut heads = Mesh::new();
@@ -962,7 +1275,7 @@ fn add_car(doc: &mut Doc, k: usize, car: &Car, st: &StreetStyle) -> Result<(), E
         if !car.headlights || car.parked {
             continue;
         }
-        doc.add_light(&Light {
+        let light = Light {
             name: format!("car_{k}_headlight_{j}"),
             kind: LightKind::Spot {
                 inner: 0.15,
@@ -972,6 +1285,10 @@ fn add_car(doc: &mut Doc, k: usize, car: &Car, st: &StreetStyle) -> Result<(), E
             intensity: st.headlight_intensity,
             position: Vec3::new(hx, 0.72, front + dir * 0.05),
             direction: Vec3::new(0.0, -0.03, dir),
+        };
+        doc.add_light(&match place {
+            Some(pose) => transformed_light(&light, pose),
+            None => light,
         });
     }
     let (head_lens, tail_lens) = if car.parked {
@@ -995,10 +1312,15 @@ fn add_car(doc: &mut Doc, k: usize, car: &Car, st: &StreetStyle) -> Result<(), E
             Material::emitter("tail_light", [6.0, 0.3, 0.15]),
         )
     };
-    doc.add_tagged_mesh(&format!("car_{k}_headlamps"), &heads, &head_lens, lamp_tag)?;
+    doc.add_tagged_mesh(
+        &format!("car_{k}_headlamps"),
+        &put(&heads),
+        &head_lens,
+        lamp_tag,
+    )?;
     doc.add_tagged_mesh(
         &format!("car_{k}_tail_lights"),
-        &tails,
+        &put(&tails),
         &tail_lens,
         lamp_tag,
     )?;
@@ -1009,11 +1331,12 @@ fn add_car(doc: &mut Doc, k: usize, car: &Car, st: &StreetStyle) -> Result<(), E
 /// and a spot light, the other two lenses are dark. The first one keeps the shipped scenes'
 /// names (`traffic_light`, `signal_red`, ...); later ones get the index appended.
 fn add_traffic_light(
+    street: &Street,
     doc: &mut Doc,
     k: usize,
     t: &TrafficLight,
-    st: &StreetStyle,
 ) -> Result<(), Error> {
+    let st = &street.style;
     let z = t.z;
     let x = t.side * (st.road_half + st.kerb + 0.6);
     let suffix = if k == 0 {
@@ -1022,14 +1345,15 @@ fn add_traffic_light(
         format!("_{k}")
     };
     let mut m = Mesh::new();
-    m.cylinder(Vec3::new(x, st.kerb, z), 0.07, 3.2, 12);
+    m.cylinder(Vec3::new(x, street.pavement_y(z), z), 0.07, 3.2, 12);
     m.cuboid(
         Vec3::new(x - 0.17, 3.2, z - 0.25),
         Vec3::new(x + 0.17, 4.2, z),
     );
     // Traffic lights are numbered after the cars' instance ids.
     let signal_instance = 1000 + k as u32;
-    doc.add_tagged_mesh(
+    street.add_bent(
+        doc,
         &format!("traffic_light{suffix}"),
         &m,
         &Material::paper(
@@ -1080,7 +1404,8 @@ fn add_traffic_light(
         };
         let mut q = Mesh::new();
         q.rect(Vec3::new(x, y, z + 0.002), Vec3::X * 0.1, Vec3::Y * 0.1);
-        doc.add_tagged_mesh(
+        street.add_bent(
+            doc,
             &name,
             &q,
             &Material::emitter(&name, radiance),
@@ -1092,7 +1417,7 @@ fn add_traffic_light(
         Signal::Amber => "amber",
         Signal::Green => "green",
     };
-    doc.add_light(&Light {
+    doc.add_light(&street.bent_light(Light {
         name: format!("signal_{light_name}_light{suffix}"),
         kind: LightKind::Spot {
             inner: 0.3,
@@ -1102,16 +1427,22 @@ fn add_traffic_light(
         intensity: st.signal_intensity,
         position: Vec3::new(x, lit_height, z + 0.06),
         direction: Vec3::new(-0.05 * t.side, -0.1, 1.0),
-    });
+    }));
     Ok(())
 }
 
 /// Road signs: a grey post and a plate 2 cm in front of it, facing the driver (+Z).
-fn add_signs(doc: &mut Doc, signs: &[Sign], st: &StreetStyle) -> Result<(), Error> {
+fn add_signs(street: &Street, doc: &mut Doc, signs: &[Sign]) -> Result<(), Error> {
+    let st = &street.style;
     let mut posts = Mesh::new();
     for (k, s) in signs.iter().enumerate() {
         let x = s.side * (st.road_half + st.kerb + 0.4);
-        posts.cylinder(Vec3::new(x, st.kerb, s.z), 0.04, s.height + s.half, 8);
+        posts.cylinder(
+            Vec3::new(x, street.pavement_y(s.z), s.z),
+            0.04,
+            s.height + s.half,
+            8,
+        );
         let mut plate = Mesh::new();
         // rect(c, u, v) faces u x v = X x Y = +Z: towards the driver.
         plate.rect(
@@ -1122,7 +1453,8 @@ fn add_signs(doc: &mut Doc, signs: &[Sign], st: &StreetStyle) -> Result<(), Erro
         let name = format!("sign_{k}");
         let plate_material =
             Material::paper(&name, PaperBsdf::Ggx { alpha: 0.25 }, s.color, [0.08; 3]);
-        doc.add_tagged_mesh(
+        street.add_bent(
+            doc,
             &name,
             &plate,
             &plate_material,
@@ -1135,7 +1467,7 @@ fn add_signs(doc: &mut Doc, signs: &[Sign], st: &StreetStyle) -> Result<(), Erro
         [0.15; 3],
         [0.05; 3],
     );
-    doc.add_tagged_mesh("sign_posts", &posts, &metal, Tag::stuff(Class::Pole))
+    street.add_bent(doc, "sign_posts", &posts, &metal, Tag::stuff(Class::Pole))
 }
 
 #[cfg(test)]
