@@ -197,9 +197,10 @@ fn analyze_reads_a_dataset_sample() {
 #[test]
 fn analyze_says_when_the_road_is_not_a_plane() {
     let t = TestDir::new();
+    let flat = t.write_flat_street_config();
     t.streaks(&[
-        "dataset", "generate", "-o", "ds", "--count", "1", "--width", "96", "--height", "64",
-        "--spp", "2",
+        "dataset", "generate", "--config", &flat, "-o", "ds", "--count", "1", "--width", "96",
+        "--height", "64", "--spp", "2",
     ])
     .assert_success();
     let sample = t.join("ds/samples/000000");
@@ -241,4 +242,51 @@ fn analyze_says_when_the_road_is_not_a_plane() {
             assert!(row["predicted_px"].is_null(), "{row}");
         }
     }
+}
+
+/// A generated street over a crest is not a plane: `streaks analyze` says so from the sample's
+/// own depth, untouched.
+#[test]
+fn analyze_finds_a_crest_off_the_road_plane() {
+    let t = TestDir::new();
+    std::fs::write(
+        t.join("crest.toml"),
+        "[road]\ncurve = 0.0\nhill = 1.0\ngrade = [0.05, 0.06]\ngrade_change = [-0.12, -0.1]\n\
+         vertical_curve_start = [5.0, 8.0]\nvertical_curve_length = [25.0, 30.0]\n",
+    )
+    .unwrap();
+    t.streaks(&[
+        "dataset",
+        "generate",
+        "--config",
+        "crest.toml",
+        "-o",
+        "ds",
+        "--count",
+        "1",
+        "--width",
+        "96",
+        "--height",
+        "64",
+        "--spp",
+        "2",
+    ])
+    .assert_success();
+    let run = t.streaks(&["analyze", "ds/samples/000000"]);
+    run.assert_success();
+    assert!(
+        run.stderr()
+            .contains("warning: road-plane assumption violated"),
+        "{}",
+        run.stderr()
+    );
+    let report: serde_json::Value = serde_json::from_slice(
+        &std::fs::read(t.join("ds/samples/000000/analysis/report.json")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(
+        report["road_plane"]["violated"], true,
+        "{}",
+        report["road_plane"]
+    );
 }

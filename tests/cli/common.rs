@@ -50,6 +50,20 @@ impl TestDir {
         names
     }
 
+    /// Writes `flat.toml`, a generator config whose streets are straight, level and flat,
+    /// without trees, and returns its path (as a string for the command line): tests that
+    /// need a road plane or an open sky use it.
+    pub fn write_flat_street_config(&self) -> String {
+        let path = self.join("flat.toml");
+        std::fs::write(
+            &path,
+            "[road]\ncurve = 0.0\nhill = 0.0\ngrade = [0.0, 0.0]\n\
+             cross_fall = [0.0, 0.0]\ncrown = [0.0, 0.0]\n[objects]\ntrees = [0.0, 0.0]\n",
+        )
+        .unwrap();
+        path.display().to_string()
+    }
+
     /// Writes `scene.gltf` + `scene.bin`: a 10 m x 10 m diffuse floor at Y = 0 (front face up),
     /// a point light of intensity 20 W/sr (13660 cd) 2 m above its centre, a small emissive quad facing
     /// the camera, and a camera (aspect 1.5) at (0, 1, 4) tilted 0.1 rad down.

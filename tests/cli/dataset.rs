@@ -794,10 +794,14 @@ fn bad_dataset_arguments_are_refused() {
 #[test]
 fn adaptive_datasets_record_their_target_and_are_deterministic() {
     let t = TestDir::new();
+    // A straight, flat street, so that the sky shows in the top tiles.
+    let flat = t.write_flat_street_config();
     let adaptive = |dir: &str, threads: &str| {
         t.streaks(&[
             "dataset",
             "generate",
+            "--config",
+            &flat,
             "-o",
             dir,
             "--count",

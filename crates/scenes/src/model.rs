@@ -48,6 +48,20 @@ impl Model {
         });
     }
 
+    /// The bounds (min, max) of the vertices of every part, moved by `pose`.
+    pub fn bounds(&self, pose: Affine3A) -> (glam::Vec3, glam::Vec3) {
+        let mut lo = glam::Vec3::splat(f32::INFINITY);
+        let mut hi = glam::Vec3::splat(f32::NEG_INFINITY);
+        for p in &self.parts {
+            for &q in &p.mesh.positions {
+                let q = pose.transform_point3(q);
+                lo = lo.min(q);
+                hi = hi.max(q);
+            }
+        }
+        (lo, hi)
+    }
+
     /// Adds every part and light of `other`, placed in this model's frame by `pose`.
     pub fn merge(&mut self, other: &Model, pose: Affine3A) {
         for p in &other.parts {

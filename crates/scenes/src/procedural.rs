@@ -423,6 +423,8 @@ pub struct GeneratorConfig {
     /// The road's layout (bends, grades, cross profile) and surface (potholes, ruts, tram
     /// tracks, crossings, paint).
     pub road: crate::road::RoadConfig,
+    /// Vehicles and street furniture as models, and the user's own glTF assets.
+    pub objects: crate::objects::ObjectsConfig,
 }
 
 /// The night sky's glow: a constant environment light of radiance `color * glow` (W/(m^2 sr)),
@@ -476,7 +478,15 @@ impl GeneratorConfig {
                 path: path.to_path_buf(),
                 source,
             })?;
-        Self::from_toml_str(&text, &path.display().to_string())
+        let mut config = Self::from_toml_str(&text, &path.display().to_string())?;
+        // Asset paths are relative to the config file.
+        let dir = crate::objects::assets::config_dir(path);
+        for a in &mut config.objects.assets {
+            if a.path.is_relative() {
+                a.path = dir.join(&a.path);
+            }
+        }
+        Ok(config)
     }
 
     /// The config as TOML (every key, no comments).
@@ -638,6 +648,7 @@ impl GeneratorConfig {
         self.weather.validate()?;
         self.buildings.validate()?;
         self.road.validate()?;
+        self.objects.validate()?;
         {
             let sky = &self.sky;
             real("sky.glow", sky.glow, 0.0, 100.0)?;
@@ -743,6 +754,7 @@ const WEATHER_STREAM: u64 = 5;
 const CAMERA_STREAM: u64 = 6;
 const MOTION_STREAM: u64 = 7;
 const ROAD_STREAM: u64 = 8;
+const OBJECTS_STREAM: u64 = 9;
 
 /// The lamps' beam: a spot light straight down, full intensity to 60 degrees from the nadir,
 /// none beyond 85 (a road luminaire's wide, cut-off distribution).
@@ -891,7 +903,13 @@ pub fn street_frame(
         objects.push(crate::drive::MovingObject {
             instance: car_instance(k),
             world_from_object: pose,
-            bounds: crate::drive::CAR_BOUNDS,
+            bounds: street
+                .car_models
+                .get(k)
+                .map_or(crate::drive::CAR_BOUNDS, |m| {
+                    let (lo, hi) = m.bounds(glam::Affine3A::IDENTITY);
+                    [lo, hi]
+                }),
         });
     }
     let eye = Vec3::from(world_from_rig.translation);
@@ -1233,7 +1251,7 @@ fn random_street(
     // this one.
     let mut road_rng = ChaCha8Rng::seed_from_u64(mix(seed, ROAD_STREAM, street_id));
     let drawn_road = config.road.draw(&mut road_rng, lanes, lane_width, far);
-    let street = Street {
+    let mut street = Street {
         name: "scene",
         description: format!(
             "Procedural rainy night street {street_id} of seed {seed} ({GENERATOR_VERSION})"
@@ -1260,7 +1278,28 @@ fn random_street(
         }),
         road: drawn_road.road,
         features: drawn_road.features,
+        car_models: Vec::new(),
+        furniture: Vec::new(),
     };
+    // Car models and pavement furniture in their own stream.
+    let mut objects_rng = ChaCha8Rng::seed_from_u64(mix(seed, OBJECTS_STREAM, street_id));
+    let lighting = crate::objects::vehicle::TrafficLighting {
+        headlights: crate::objects::vehicle::Headlights {
+            source: headlight_type,
+            intensity: headlight_intensity,
+            lens_luminance: luminance(StreetStyle::SHIPPED.headlamp_radiance),
+        },
+    };
+    let (_, mut objects_params) = crate::objects::placement::place(
+        &config.objects,
+        &mut objects_rng,
+        &mut street,
+        &lighting,
+    )?;
+    let car_models = objects_params
+        .as_object_mut()
+        .and_then(|o| o.remove("cars"))
+        .unwrap_or_default();
     let params = json!({
         "generator": GENERATOR_VERSION,
         "street_id": street_id,
@@ -1294,12 +1333,13 @@ fn random_street(
             "right": lamps_right,
             "left": lamps_left,
         },
-        "cars": cars.iter().map(|c| json!({
+        "cars": street.cars.iter().zip(car_models.as_array().into_iter().flatten()).map(|(c, m)| json!({
             "x": c.x,
             "z": c.z,
             "kind": if c.parked { "parked" } else if c.oncoming { "oncoming" } else { "ahead" },
-            "color": c.color,
+            "model": m,
         })).collect::<Vec<_>>(),
+        "objects": objects_params,
         "headlight_intensity_w_sr": headlight_intensity,
         "headlight_type": headlight_type,
         "traffic_lights": traffic_lights.iter().map(|t| json!({

@@ -11,7 +11,7 @@ use crate::gltf_writer::{
     Tag,
 };
 use crate::mesh::Mesh;
-use crate::model::{transformed, transformed_light};
+use crate::model::{transformed, transformed_light, Model};
 use crate::road::{Road, RoadFeatures, GAUGE, RAIL_GROOVE, RAIL_HEAD};
 use crate::wetness::{dryness_png, ripple_normal_png, Wetness, RIPPLE_TEXELS};
 use crate::Error;
@@ -276,6 +276,24 @@ pub struct Street {
     pub road: Road,
     /// Potholes, ruts, tracks, crossings and the markings' paint.
     pub features: RoadFeatures,
+    /// Models of the cars, one per [`Street::cars`] entry, drawn at each car's pose with its
+    /// instance id; empty: the cars are boxes.
+    pub car_models: Vec<Model>,
+    /// Street furniture on the pavements (trees, bus stops, bollards, the user's assets).
+    pub furniture: Vec<Furniture>,
+}
+
+/// A model standing on a pavement: its foot at straight-frame `(x, z)`, on the pavement.
+#[derive(Clone, Debug)]
+pub struct Furniture {
+    /// Node name prefix.
+    pub name: String,
+    /// The model (its -Z, the side it shows to traffic, is turned to face the road).
+    pub model: Model,
+    /// Across the road, metres (straight frame X; the sign gives the side).
+    pub x: f32,
+    /// Along the road (straight frame Z).
+    pub z: f32,
 }
 
 /// How a street's buildings are drawn from a [`BuildingsConfig`]: one [`BuildingSpec`] per
@@ -385,6 +403,8 @@ impl Street {
             drawn_buildings: None,
             road: Road::straight(),
             features: RoadFeatures::default(),
+            car_models: Vec::new(),
+            furniture: Vec::new(),
         }
     }
 
@@ -421,6 +441,8 @@ impl Street {
             drawn_buildings: None,
             road: Road::straight(),
             features: RoadFeatures::default(),
+            car_models: Vec::new(),
+            furniture: Vec::new(),
         }
     }
 
@@ -438,7 +460,23 @@ impl Street {
         self.poles(&mut doc, &tex)?;
         let st = &self.style;
         for (k, car) in self.cars.iter().enumerate() {
-            add_car(self, &mut doc, k, car)?;
+            match self.car_models.get(k) {
+                Some(model) => doc.add_model(
+                    &format!("car_{k}"),
+                    model,
+                    crate::drive::car_pose(&self.road, car),
+                    Some(crate::procedural::car_instance(k)),
+                )?,
+                None => add_car(self, &mut doc, k, car)?,
+            }
+        }
+        for f in &self.furniture {
+            // Level on the pavement, its -Z turned towards the road.
+            let ground = self.road.world(Vec3::new(f.x, self.pavement_y(f.z), f.z)).y;
+            let face = glam::Quat::from_rotation_y(f.x.signum() * std::f32::consts::FRAC_PI_2);
+            let pose = self.road.level_pose(f64::from(-f.z), ground)
+                * Affine3A::from_rotation_translation(face, Vec3::new(f.x, 0.0, f.z));
+            doc.add_model(&f.name, &f.model, pose, None)?;
         }
         for (k, t) in self.traffic_lights.iter().enumerate() {
             add_traffic_light(self, &mut doc, k, t)?;

@@ -157,7 +157,7 @@ impl Asset {
         let scale = entry.scale.unwrap_or(1.0) as f32;
         let turn = Affine3A::from_scale(Vec3::splat(scale))
             * Affine3A::from_rotation_y(std::f32::consts::PI);
-        let (lo, hi) = bounds(&model, turn);
+        let (lo, hi) = model.bounds(turn);
         let centre = Vec3::new(0.5 * (lo.x + hi.x), lo.y, 0.5 * (lo.z + hi.z));
         let pose = Affine3A::from_translation(-centre) * turn;
         let mut placed = Model::new();
@@ -180,20 +180,6 @@ impl Asset {
             "attribution": self.entry.attribution,
         })
     }
-}
-
-/// The bounds of `model`'s vertices moved by `pose`.
-fn bounds(model: &Model, pose: Affine3A) -> (Vec3, Vec3) {
-    let mut lo = Vec3::splat(f32::INFINITY);
-    let mut hi = Vec3::splat(f32::NEG_INFINITY);
-    for p in &model.parts {
-        for &q in &p.mesh.positions {
-            let q = pose.transform_point3(q);
-            lo = lo.min(q);
-            hi = hi.max(q);
-        }
-    }
-    (lo, hi)
 }
 
 struct Loader<'a> {
