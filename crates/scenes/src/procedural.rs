@@ -1281,6 +1281,20 @@ fn random_street(
         car_models: Vec::new(),
         furniture: Vec::new(),
     };
+    // Nothing stands in a side street's mouth.
+    {
+        let f = &street.features;
+        street.lamps_right.retain(|&z| !f.in_mouth(1.0, z, 1.0));
+        street.lamps_left.retain(|&z| !f.in_mouth(-1.0, z, 1.0));
+        street.poles.retain(|&z| !f.in_mouth(-1.0, z, 1.0));
+        street.signs.retain(|s| !f.in_mouth(s.side, s.z, 1.0));
+        street
+            .traffic_lights
+            .retain(|t| !f.in_mouth(t.side, t.z, 1.0));
+        street
+            .cars
+            .retain(|c| !(c.parked && f.in_mouth(c.x.signum(), c.z, 3.0)));
+    }
     // Car models and pavement furniture in their own stream.
     let mut objects_rng = ChaCha8Rng::seed_from_u64(mix(seed, OBJECTS_STREAM, street_id));
     let lighting = crate::objects::vehicle::TrafficLighting {
@@ -1318,7 +1332,7 @@ fn random_street(
             "lit_shops": lit_shops,
             "window_luminance_cd_m2": window_luminance,
             "shop_luminance_cd_m2": shop_luminance,
-            "poles": poles,
+            "poles": street.poles,
         },
         "lamps": {
             "spacing": spacing,
@@ -1330,8 +1344,8 @@ fn random_street(
             "intensity_w_sr": lamp_intensity,
             "intensity_cd": lamp_intensity * lm,
             "lens_radiance": lens_radiance,
-            "right": lamps_right,
-            "left": lamps_left,
+            "right": street.lamps_right,
+            "left": street.lamps_left,
         },
         "cars": street.cars.iter().zip(car_models.as_array().into_iter().flatten()).map(|(c, m)| json!({
             "x": c.x,
@@ -1342,11 +1356,11 @@ fn random_street(
         "objects": objects_params,
         "headlight_intensity_w_sr": headlight_intensity,
         "headlight_type": headlight_type,
-        "traffic_lights": traffic_lights.iter().map(|t| json!({
+        "traffic_lights": street.traffic_lights.iter().map(|t| json!({
             "z": t.z, "side": t.side, "signal": t.signal,
         })).collect::<Vec<_>>(),
         "signal_intensity_w_sr": signal_intensity,
-        "signs": signs.iter().map(|s| json!({
+        "signs": street.signs.iter().map(|s| json!({
             "z": s.z, "side": s.side, "height": s.height, "half_size": s.half, "color": s.color,
         })).collect::<Vec<_>>(),
         "wetness": {

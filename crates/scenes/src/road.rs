@@ -386,6 +386,36 @@ pub struct Crosswalk {
     pub length: f32,
 }
 
+/// A side street joining at a T junction: its carriageway leaves the main road's edge at a
+/// right angle (in the straight frame), with kerbs and pavements along it and a block closing
+/// it; the main road's kerb, pavement, edge line and buildings leave the mouth open.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Junction {
+    /// Centre of the mouth along the road (straight frame Z), metres.
+    pub z: f32,
+    /// Side: 1 right, -1 left.
+    pub side: f32,
+    /// Width of the side street's carriageway, metres.
+    pub width: f32,
+    /// Width of its pavements, metres.
+    pub pavement: f32,
+    /// How far it is modelled beyond the main street's facade line, metres.
+    pub length: f32,
+}
+
+impl Junction {
+    /// The mouth's extent along the main road, `(z0, z1)` with `z0 > z1`.
+    pub fn mouth(&self) -> (f32, f32) {
+        (self.z + 0.5 * self.width, self.z - 0.5 * self.width)
+    }
+
+    /// The gap in the main street's frontage: the mouth and the side street's pavements.
+    pub fn gap(&self) -> (f32, f32) {
+        let half = 0.5 * self.width + self.pavement;
+        (self.z + half, self.z - half)
+    }
+}
+
 /// The road markings' paint.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Paint {
@@ -422,11 +452,14 @@ pub struct RoadFeatures {
     pub crosswalks: Vec<Crosswalk>,
     /// The markings' paint.
     pub paint: Paint,
+    /// Side streets.
+    pub junctions: Vec<Junction>,
 }
 
 impl Default for RoadFeatures {
     fn default() -> Self {
         Self {
+            junctions: Vec::new(),
             potholes: Vec::new(),
             rut_depth: 0.0,
             tracks: Vec::new(),
@@ -474,6 +507,15 @@ impl RoadFeatures {
         d
     }
 
+    /// Whether `z` on side `side` lies in a side street's mouth (no kerb, no pavement), widened
+    /// by `margin` metres.
+    pub fn in_mouth(&self, side: f32, z: f32, margin: f32) -> bool {
+        self.junctions.iter().any(|j| {
+            let (a, b) = j.mouth();
+            j.side == side && z < a + margin && z > b - margin
+        })
+    }
+
     /// The kerb's height at `z` for a street whose kerbs are `kerb` high: dropped to
     /// [`DROPPED_KERB`] beside each crossing, with [`KERB_RAMP`] ramps.
     pub fn kerb_at(&self, kerb: f32, z: f32) -> f32 {
@@ -501,6 +543,11 @@ impl RoadFeatures {
             for k in 0..=m {
                 z.push(p.z - r + 2.0 * r * k as f32 / m as f32);
             }
+        }
+        for j in &self.junctions {
+            let (a, b) = j.mouth();
+            let (c, d) = j.gap();
+            z.extend([a, b, c, d]);
         }
         for c in &self.crosswalks {
             for d in [0.0, KERB_RAMP] {
@@ -555,6 +602,10 @@ pub struct RoadConfig {
     pub rut_depth: Range,
     /// Probability of tram tracks (one in each direction's innermost lane).
     pub tracks: f64,
+    /// Number of side streets joining at a T junction.
+    pub junctions: CountRange,
+    /// Width of a side street's carriageway, metres.
+    pub junction_width: Range,
     /// Number of zebra crossings.
     pub crosswalks: CountRange,
     /// Length of a crossing's bars along the road, metres.
@@ -586,6 +637,8 @@ impl Default for RoadConfig {
             pothole_depth: [0.04, 0.09],
             rut_depth: [0.0, 0.015],
             tracks: 0.15,
+            junctions: [0, 2],
+            junction_width: [5.5, 8.0],
             crosswalks: [0, 2],
             crosswalk_length: [3.0, 5.0],
             paint_albedo: [0.3, 0.65],
@@ -662,6 +715,8 @@ impl RoadConfig {
         real("pothole_depth", self.pothole_depth, 0.0, 0.3)?;
         real("rut_depth", self.rut_depth, 0.0, 0.05)?;
         prob("tracks", self.tracks)?;
+        count("junctions", self.junctions, 6)?;
+        real("junction_width", self.junction_width, 3.0, 20.0)?;
         count("crosswalks", self.crosswalks, 10)?;
         real("crosswalk_length", self.crosswalk_length, 1.0, 10.0)?;
         real("paint_albedo", self.paint_albedo, 0.0, 1.0)?;
@@ -757,13 +812,37 @@ impl RoadConfig {
             };
         }
         params.insert("tracks".into(), json!(features.tracks.len()));
+        let n_junctions = rng.random_range(self.junctions[0]..=self.junctions[1]);
+        for _ in 0..n_junctions {
+            let width = uniform(rng, self.junction_width) as f32;
+            let side = if rng.random_bool(0.5) { 1.0 } else { -1.0 };
+            let pavement = rng.random_range(1.5f32..=3.0);
+            let lo = (far + 30.0).max(-100.0);
+            let z = rng.random_range(lo.min(-15.0)..=-15.0);
+            // Keep junctions 30 m apart.
+            if features.junctions.iter().all(|j| (j.z - z).abs() > 30.0) {
+                features.junctions.push(Junction {
+                    z,
+                    side,
+                    width,
+                    pavement,
+                    length: 15.0,
+                });
+            }
+        }
+        params.insert("junctions".into(), json!(features.junctions.len()));
         let n_cross = rng.random_range(self.crosswalks[0]..=self.crosswalks[1]);
         for _ in 0..n_cross {
             let length = uniform(rng, self.crosswalk_length) as f32;
             let lo = (far + 15.0).max(-90.0);
             let z = rng.random_range(lo.min(-8.0)..=-8.0);
-            // Keep crossings 20 m apart.
-            if features.crosswalks.iter().all(|c| (c.z - z).abs() > 20.0) {
+            // Keep crossings 20 m apart and clear of the junctions' mouths.
+            let clear = features.crosswalks.iter().all(|c| (c.z - z).abs() > 20.0)
+                && features
+                    .junctions
+                    .iter()
+                    .all(|j| (j.z - z).abs() > 0.5 * (j.width + length) + j.pavement + 1.0);
+            if clear {
                 features.crosswalks.push(Crosswalk { z, length });
             }
         }

@@ -747,7 +747,10 @@ impl Street {
         }
         for side in [-1.0f32, 1.0] {
             let x = side * (h - 0.2);
-            painted(&mut marks, [x - 0.06, x + 0.06], n, f);
+            for rows in self.runs(&zs, side) {
+                let (a, b) = (rows[0], rows[rows.len() - 1]);
+                painted(&mut marks, [x - 0.06, x + 0.06], a, b);
+            }
         }
         for c in &feat.crosswalks {
             let mut x = -h + 0.5;
@@ -823,31 +826,126 @@ impl Street {
             )?;
         }
 
-        // Kerbs (dropped beside the crossings) and pavements up to the facades.
+        // Kerbs (dropped beside the crossings) and pavements up to the facades, open at the
+        // side streets' mouths.
         let kerb = |z: f32| feat.kerb_at(st.kerb, z);
         let mut kerbs = Mesh::new();
         let mut walks = Mesh::new();
         for side in [-1.0f32, 1.0] {
             let (a, b) = (side * h, side * (h + st.kerb));
             let (c, d) = (side * (h + st.kerb), side * st.facade_x);
-            let ys = |m: &mut Mesh, x: [f32; 2]| {
-                let (x0, x1) = (x[0].min(x[1]), x[0].max(x[1]));
-                m.grid(1, zs.len() - 1, |i, j| {
-                    let x = [x0, x1][i];
+            for rows in self.runs(&zs, side) {
+                let ys = |m: &mut Mesh, x: [f32; 2]| {
+                    let (x0, x1) = (x[0].min(x[1]), x[0].max(x[1]));
+                    m.grid(1, rows.len() - 1, |i, j| {
+                        let x = [x0, x1][i];
+                        (
+                            Vec3::new(x, kerb(rows[j]), rows[j]),
+                            Vec3::Y,
+                            Vec2::new(x, rows[j]),
+                        )
+                    });
+                };
+                ys(&mut kerbs, [a, b]);
+                ys(&mut walks, [c, d]);
+                // The kerb's face towards the road.
+                kerbs.grid(1, rows.len() - 1, |i, j| {
+                    let y = [0.0, kerb(rows[j])][i];
                     (
-                        Vec3::new(x, kerb(zs[j]), zs[j]),
-                        Vec3::Y,
-                        Vec2::new(x, zs[j]),
+                        Vec3::new(a, y, rows[j]),
+                        Vec3::X * -side,
+                        Vec2::new(y, rows[j]),
                     )
                 });
-            };
-            ys(&mut kerbs, [a, b]);
-            ys(&mut walks, [c, d]);
-            // The kerb's face towards the road.
-            kerbs.grid(1, zs.len() - 1, |i, j| {
-                let y = [0.0, kerb(zs[j])][i];
-                (Vec3::new(a, y, zs[j]), Vec3::X * -side, Vec2::new(y, zs[j]))
+            }
+        }
+
+        // The side streets: carriageway, a stop line, kerbs and pavements along them.
+        let mut side_road = Mesh::new();
+        let mut marks_side = Mesh::new();
+        for jn in &feat.junctions {
+            let side = jn.side;
+            let (z0, z1) = jn.mouth();
+            let rows = between(z0, z1);
+            let far_x = st.facade_x + jn.length;
+            side_road.grid(1, rows.len() - 1, |i, j| {
+                let x = side * [h, far_x][i];
+                (
+                    Vec3::new(x, 0.0, rows[j]),
+                    Vec3::Y,
+                    Vec2::new((x + h) / (2.0 * h), (n - rows[j]) / (n - f)),
+                )
             });
+            let stop = side * (h + 0.6);
+            strip(
+                &mut marks_side,
+                [stop.min(stop + side * 0.3), stop.max(stop + side * 0.3)],
+                z0,
+                z1,
+                0.002,
+            );
+            for (edge, out) in [(z0, 1.0f32), (z1, -1.0)] {
+                // Kerb face (towards the side street), kerb top and pavement, along X.
+                let (x0, x1) = (side * h, side * far_x);
+                let (xa, xb) = (x0.min(x1), x0.max(x1));
+                kerbs.quad_uv(
+                    [
+                        Vec3::new(xa, 0.0, edge),
+                        Vec3::new(xb, 0.0, edge),
+                        Vec3::new(xb, st.kerb, edge),
+                        Vec3::new(xa, st.kerb, edge),
+                    ],
+                    [
+                        Vec2::new(xa, 0.0),
+                        Vec2::new(xb, 0.0),
+                        Vec2::new(xb, st.kerb),
+                        Vec2::new(xa, st.kerb),
+                    ],
+                    Vec3::Z * -out,
+                );
+                let (f0, f1) = (side * st.facade_x, side * far_x);
+                let (fa, fb) = (f0.min(f1), f0.max(f1));
+                let (k0, k1) = (edge, edge + out * st.kerb);
+                let (w0, w1) = (k1, edge + out * jn.pavement);
+                for (m, za, zb, xs) in [
+                    (&mut kerbs, k0, k1, [fa, fb]),
+                    (&mut walks, w0, w1, [fa, fb]),
+                ] {
+                    m.quad_uv(
+                        [
+                            Vec3::new(xs[0], st.kerb, za),
+                            Vec3::new(xs[1], st.kerb, za),
+                            Vec3::new(xs[1], st.kerb, zb),
+                            Vec3::new(xs[0], st.kerb, zb),
+                        ],
+                        [
+                            Vec2::new(xs[0], za),
+                            Vec2::new(xs[1], za),
+                            Vec2::new(xs[1], zb),
+                            Vec2::new(xs[0], zb),
+                        ],
+                        Vec3::Y,
+                    );
+                }
+            }
+        }
+        if !side_road.indices.is_empty() {
+            self.add_bent(
+                doc,
+                "side_roads",
+                &side_road,
+                asphalt,
+                Tag::stuff(Class::Road),
+            )?;
+        }
+        if !marks_side.indices.is_empty() {
+            self.add_bent(
+                doc,
+                "stop_lines",
+                &marks_side,
+                paint,
+                Tag::stuff(Class::Marking),
+            )?;
         }
         kerbs.scale_uvs(TILE_FINE);
         walks.scale_uvs(TILE_COARSE);
@@ -860,6 +958,31 @@ impl Street {
             Tag::stuff(Class::Sidewalk),
         )?;
         Ok(())
+    }
+
+    /// The runs of `zs` (stations, descending) on side `side` outside the side streets'
+    /// mouths, each with at least two stations.
+    fn runs(&self, zs: &[f32], side: f32) -> Vec<Vec<f32>> {
+        let mut out: Vec<Vec<f32>> = Vec::new();
+        let mut run: Vec<f32> = Vec::new();
+        for w in zs.windows(2) {
+            let mid = 0.5 * (w[0] + w[1]);
+            if self.features.in_mouth(side, mid, 0.0) {
+                if run.len() >= 2 {
+                    out.push(std::mem::take(&mut run));
+                }
+                run.clear();
+                continue;
+            }
+            if run.is_empty() {
+                run.push(w[0]);
+            }
+            run.push(w[1]);
+        }
+        if run.len() >= 2 {
+            out.push(run);
+        }
+        out
     }
 
     /// Adds `mesh`, laid out in the straight frame, bent onto the road.
@@ -987,7 +1110,8 @@ impl Street {
     /// The block frontages on the side `side` (+1 right, -1 left) from the near end towards
     /// the far end, as `(k, z0, z1)` with `z0 > z1`: block `k`'s frontage, its length taken
     /// from block `k + 3` on the left so that the two sides do not line up; the last one is cut
-    /// at the far end.
+    /// at the far end, and a side street's gap ([`crate::road::Junction::gap`]) cuts the ones it
+    /// crosses.
     fn frontages(&self, side: f32) -> Vec<(usize, f32, f32)> {
         let mut out = Vec::new();
         let mut z0 = self.near;
@@ -1003,6 +1127,24 @@ impl Street {
             if z0 <= self.far {
                 break;
             }
+        }
+        // A side street's mouth and pavements leave a gap.
+        for j in self.features.junctions.iter().filter(|j| j.side == side) {
+            let (g0, g1) = j.gap();
+            out = out
+                .into_iter()
+                .flat_map(|(k, a, b)| {
+                    let mut pieces = Vec::new();
+                    if a > g0 {
+                        pieces.push((k, a, b.max(g0)));
+                    }
+                    if b < g1 {
+                        pieces.push((k, a.min(g1), b));
+                    }
+                    pieces
+                })
+                .filter(|(_, a, b)| a > b)
+                .collect();
         }
         out
     }
@@ -1162,6 +1304,16 @@ impl Street {
                     }
                 }
             }
+        }
+        // A block closes each side street.
+        for j in &self.features.junctions {
+            let (g0, g1) = j.gap();
+            let x0 = j.side * (facade_x + j.length);
+            let x1 = x0 + j.side * 10.0;
+            by_material[1].cuboid(
+                Vec3::new(x0.min(x1), 0.0, g1 - 6.0),
+                Vec3::new(x0.max(x1), 14.0, g0 + 6.0),
+            );
         }
         // A block across the far end closes the street.
         let end = self.far;
@@ -1534,6 +1686,50 @@ mod tests {
         let small = Street::small().build().unwrap();
         assert!(small.triangle_count() < 2_000, "{}", small.triangle_count());
         assert!((2..=3).contains(&small.light_count()));
+    }
+
+    /// A side street cuts the right frontage and the right kerb's runs at its mouth, leaves
+    /// the left side as it was, and brings its own carriageway and stop line.
+    #[test]
+    fn a_junction_opens_the_street() {
+        let mut s = Street::small();
+        s.features.junctions.push(crate::road::Junction {
+            z: -30.0,
+            side: 1.0,
+            width: 7.0,
+            pavement: 2.0,
+            length: 15.0,
+        });
+        let (g0, g1) = s.features.junctions[0].gap();
+        let right = s.frontages(1.0);
+        assert!(right.len() > Street::small().frontages(1.0).len());
+        for (_, a, b) in right {
+            assert!(b >= g0 - 1e-4 || a <= g1 + 1e-4, "{a}..{b} crosses the gap");
+        }
+        assert_eq!(s.frontages(-1.0), Street::small().frontages(-1.0));
+        let zs = s.features.stations(s.near, s.far, 1.0);
+        let runs = s.runs(&zs, 1.0);
+        assert_eq!(runs.len(), 2);
+        for z in runs.iter().flatten() {
+            assert!(*z >= -26.5 - 1e-4 || *z <= -33.5 + 1e-4, "kerb at {z}");
+        }
+        assert_eq!(s.runs(&zs, -1.0), vec![zs.clone()]);
+        let dir = tempfile::tempdir().unwrap();
+        s.build().unwrap().write(dir.path()).unwrap();
+        let gltf: serde_json::Value = serde_json::from_slice(
+            &std::fs::read(dir.path().join("rainy_street_small.gltf")).unwrap(),
+        )
+        .unwrap();
+        let names: Vec<&str> = gltf["meshes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter_map(|m| m["name"].as_str())
+            .collect();
+        assert!(
+            names.contains(&"side_roads") && names.contains(&"stop_lines"),
+            "{names:?}"
+        );
     }
 
     #[test]

@@ -130,7 +130,9 @@ pub fn place(
         let free = |taken: &mut Vec<(f32, f32)>, rng: &mut ChaCha8Rng, half: f32| {
             for _ in 0..40 {
                 let z = rng.random_range(lo.min(hi)..=hi);
-                if taken.iter().all(|&(t, e)| (t - z).abs() > e + half + 0.5) {
+                if taken.iter().all(|&(t, e)| (t - z).abs() > e + half + 0.5)
+                    && !street.features.in_mouth(side, z, half + 0.5)
+                {
                     taken.push((z, half));
                     return Some(z);
                 }
