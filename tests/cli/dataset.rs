@@ -148,6 +148,11 @@ fn datasets_are_byte_identical_across_runs_threads_and_shards() {
         assert_eq!(sha.len(), 64);
         assert_eq!(files[&format!("kitti/training/image_2/{id}_10.png")], sha);
         assert!(files.contains_key(&format!("kitti/training/disp_occ_0/{id}_10.png")));
+        assert_eq!(
+            files[&format!("kitti/training/semantic/{id}_10.png")],
+            files[&format!("samples/{id}/semantic0.png")]
+        );
+        assert!(files.contains_key(&format!("kitti/training/instance/{id}_10.png")));
     }
     let info: serde_json::Value =
         serde_json::from_slice(&std::fs::read(t.join("a/dataset.json")).unwrap()).unwrap();
@@ -179,6 +184,19 @@ fn ground_truth_reads_back_as_stereo_loaders_read_it() {
     let disp = read_pfm(&dir.join("disp0.pfm")).unwrap();
     let depth = read_pfm(&dir.join("depth0.pfm")).unwrap();
     assert_eq!((disp.width, disp.height), (64, 40));
+    // KITTI's instances: labelId * 256 + k for Cityscapes' labelId * 1000 + k.
+    let load16 = |p: &str| image::open(t.join(p)).unwrap().into_luma16();
+    let cityscapes = load16("ds/samples/000000/instance0.png");
+    let kitti_ids = load16("ds/kitti/training/instance/000000_10.png");
+    for (c, k) in cityscapes.pixels().zip(kitti_ids.pixels()) {
+        let (c, k) = (c.0[0], k.0[0]);
+        let expected = if c < 1000 {
+            c * 256
+        } else {
+            c / 1000 * 256 + c % 1000
+        };
+        assert_eq!(k, expected);
+    }
     // KITTI: uint16 / 256 equals the PFM within 1/256 px; 0 where the PFM has no value.
     let kitti =
         read_kitti_disparity(&t.join("ds/kitti/training/disp_occ_0/000000_10.png")).unwrap();

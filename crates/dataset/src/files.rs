@@ -69,6 +69,10 @@ pub const KITTI_IMAGE_2: &str = "image_2";
 pub const KITTI_IMAGE_3: &str = "image_3";
 /// The KITTI view's left disparities.
 pub const KITTI_DISP_OCC_0: &str = "disp_occ_0";
+/// KITTI's semantic maps (its semantics benchmark's `semantic/`: label ids, 8 bit).
+pub const KITTI_SEMANTIC: &str = "semantic";
+/// KITTI's instance maps (`instance/`: `labelId * 256 + k`, 16 bit).
+pub const KITTI_INSTANCE: &str = "instance";
 /// The suffix of a KITTI file name after the sample id (`NNNNNN_10.png`).
 pub const KITTI_SUFFIX: &str = "_10.png";
 

@@ -16,9 +16,9 @@
 use crate::error::DatasetError;
 use crate::files::SampleDir;
 use crate::files::{
-    DATASET_JSON, KITTI_DIR, KITTI_DISP_OCC_0, KITTI_IMAGE_2, KITTI_IMAGE_3, KITTI_SUFFIX, LOCK,
-    MANIFEST, ROAD_MASK, SAMPLES_DIR, SAMPLE_FILES, SAMPLE_LOCK_PREFIX, SCENE_BIN, SCENE_GLTF,
-    SPLITS_DIR, SPLIT_EXTENSION, TMP_PREFIX,
+    DATASET_JSON, KITTI_DIR, KITTI_DISP_OCC_0, KITTI_IMAGE_2, KITTI_IMAGE_3, KITTI_INSTANCE,
+    KITTI_SEMANTIC, KITTI_SUFFIX, LOCK, MANIFEST, ROAD_MASK, SAMPLES_DIR, SAMPLE_FILES,
+    SAMPLE_LOCK_PREFIX, SCENE_BIN, SCENE_GLTF, SPLITS_DIR, SPLIT_EXTENSION, TMP_PREFIX,
 };
 use crate::segmentation::ClassRecord;
 use crate::settings::Settings;
@@ -54,12 +54,23 @@ pub struct KittiFiles {
     pub image_3: PathBuf,
     /// `disp_occ_0/NNNNNN_10.png`: the left disparity, uint16 x 256.
     pub disp_occ_0: PathBuf,
+    /// `semantic/NNNNNN_10.png`: the left view's label ids (`semantic0.png`).
+    pub semantic: PathBuf,
+    /// `instance/NNNNNN_10.png`: the left view's instances as `labelId * 256 + k`.
+    pub instance: PathBuf,
 }
 
 impl KittiFiles {
     /// The three paths with their names relative to the dataset folder.
-    pub fn named(&self, layout: &Layout) -> [(String, &Path); 3] {
-        [&self.image_2, &self.image_3, &self.disp_occ_0].map(|p| (layout.relative(p), p.as_path()))
+    pub fn named(&self, layout: &Layout) -> [(String, &Path); 5] {
+        [
+            &self.image_2,
+            &self.image_3,
+            &self.disp_occ_0,
+            &self.semantic,
+            &self.instance,
+        ]
+        .map(|p| (layout.relative(p), p.as_path()))
     }
 }
 
@@ -207,6 +218,8 @@ impl Layout {
             image_2: dir.join(KITTI_IMAGE_2).join(&name),
             image_3: dir.join(KITTI_IMAGE_3).join(&name),
             disp_occ_0: dir.join(KITTI_DISP_OCC_0).join(&name),
+            semantic: dir.join(KITTI_SEMANTIC).join(&name),
+            instance: dir.join(KITTI_INSTANCE).join(&name),
         }
     }
 

@@ -356,8 +356,8 @@ impl<R: BufRead> Lines<R> {
 struct OwnFiles {
     /// `samples/NNNNNN/`.
     folder: String,
-    /// Its three KITTI files.
-    kitti: [String; 3],
+    /// Its KITTI files.
+    kitti: [String; 5],
 }
 
 impl OwnFiles {

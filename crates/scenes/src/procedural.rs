@@ -1390,6 +1390,20 @@ mod tests {
         assert_eq!(again, parsed);
     }
 
+    /// The configs the docs' galleries are made with still read.
+    #[test]
+    fn gallery_configs_read() {
+        for (name, text) in [
+            ("dry", include_str!("../../../tools/gallery/dry.toml")),
+            ("drizzle", include_str!("../../../tools/gallery/drizzle.toml")),
+            ("heavy", include_str!("../../../tools/gallery/heavy.toml")),
+            ("fog", include_str!("../../../tools/gallery/fog.toml")),
+        ] {
+            let c = GeneratorConfig::from_toml_str(text, name).unwrap();
+            assert_eq!(c.sequence.speed_kmh, [28.8, 28.8], "{name}");
+        }
+    }
+
     #[test]
     fn partial_configs_keep_defaults_and_bad_ones_say_why() {
         let c = GeneratorConfig::from_toml_str("[lamps]\nspacing = [30, 30]\n", "x.toml").unwrap();
