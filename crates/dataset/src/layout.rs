@@ -678,7 +678,9 @@ mod tests {
             [
                 "kitti/training/image_2/000003_10.png",
                 "kitti/training/image_3/000003_10.png",
-                "kitti/training/disp_occ_0/000003_10.png"
+                "kitti/training/disp_occ_0/000003_10.png",
+                "kitti/training/semantic/000003_10.png",
+                "kitti/training/instance/000003_10.png"
             ]
         );
     }
