@@ -39,7 +39,7 @@ use std::path::Path;
 pub const GENERATOR_VERSION: &str = concat!(
     "streaks-scenes ",
     env!("CARGO_PKG_VERSION"),
-    " procedural/3"
+    " procedural/4"
 );
 
 /// A closed range `[min, max]` of a real parameter, written `[min, max]` in TOML.
@@ -1395,7 +1395,10 @@ mod tests {
     fn gallery_configs_read() {
         for (name, text) in [
             ("dry", include_str!("../../../tools/gallery/dry.toml")),
-            ("drizzle", include_str!("../../../tools/gallery/drizzle.toml")),
+            (
+                "drizzle",
+                include_str!("../../../tools/gallery/drizzle.toml"),
+            ),
             ("heavy", include_str!("../../../tools/gallery/heavy.toml")),
             ("fog", include_str!("../../../tools/gallery/fog.toml")),
         ] {

@@ -26,8 +26,8 @@ const CAR_GAP: f32 = 0.8;
 /// Draws the models of `street`'s cars and its pavement furniture into `street`
 /// ([`Street::car_models`], [`Street::furniture`]); a car that would overlap the one before it
 /// in its lane (a bus is 12 m long) is left out. Returns, per kept car, its index in the cars
-/// given, and the parameters of what was drawn (with each used asset's path, license and
-/// attribution).
+/// given, and the parameters of what was drawn (the counts placed, per car its model, and each used
+/// asset's path, license and attribution).
 pub fn place(
     config: &ObjectsConfig,
     rng: &mut ChaCha8Rng,
@@ -239,10 +239,10 @@ pub fn place(
         kept,
         json!({
             "cars": car_params,
-            "trees": trees,
-            "bus_stops": stops,
-            "bollards": bollards,
-            "furniture": others,
+            "trees_placed": trees,
+            "bus_stops_placed": stops,
+            "bollards_placed": bollards,
+            "furniture_placed": others,
             "assets": assets_used,
         }),
     ))
