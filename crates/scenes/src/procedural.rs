@@ -1325,7 +1325,7 @@ fn random_street(
             "pavement": pavement,
             "length": length,
             "driver_lane_x": driver_lane_x,
-            "blocks": blocks.iter().map(|b| [b.0, b.1]).collect::<Vec<_>>(),
+            "block_lengths": blocks.iter().map(|b| b.0).collect::<Vec<_>>(),
             "facade_brightness": brightness,
             "lit_windows": lit,
             "cool_windows": cool,
@@ -1373,6 +1373,19 @@ fn random_street(
             "ripples": ripples.map(|r| json!({"strength": r.strength, "tile_m": r.tile_m})),
         },
         "road": drawn_road.params,
+        "buildings": street.building_specs().iter().map(|(side, _, b)| json!({
+            "side": side,
+            "frontage": b.frontage,
+            "storeys": b.storeys,
+            "height": b.ground_height + b.storeys as f32 * b.storey_height,
+            "depth": b.depth,
+            "recess": b.recess,
+            "bays": b.bays,
+            "shop_front": b.shop.is_some(),
+            "balconies": b.balconies.is_some(),
+            "cornice": b.cornice,
+            "wall": format!("{:?}", b.surface),
+        })).collect::<Vec<_>>(),
     });
     Ok((street, params))
 }

@@ -1149,11 +1149,14 @@ impl Street {
         out
     }
 
-    /// The buildings on both sides as drawn models ([`crate::buildings`]): block frontages
-    /// from [`Street::blocks`] as the boxes have them (the left side offset by three blocks),
-    /// each a [`BuildingSpec`] placed with its lot line on the facade line.
-    fn drawn_buildings(&self, doc: &mut Doc, drawn: &DrawnBuildings) -> Result<(), Error> {
+    /// The buildings [`Street::drawn_buildings`] draws, as `(side, (z0, z1), spec)`: one per
+    /// block frontage longer than 1 m ([`Street::frontages`]), right side first; none for a
+    /// street of boxes.
+    pub fn building_specs(&self) -> Vec<(f32, (f32, f32), BuildingSpec)> {
         use rand::SeedableRng;
+        let Some(drawn) = &self.drawn_buildings else {
+            return Vec::new();
+        };
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(drawn.seed);
         let (warm, lit) = self.style.lit_windows;
         let cool = if lit > 0.0 { 1.0 - warm / lit } else { 0.0 };
@@ -1172,6 +1175,14 @@ impl Street {
                 }
             }
         }
+        rows
+    }
+
+    /// The buildings on both sides as drawn models ([`crate::buildings`]): block frontages
+    /// from [`Street::blocks`] as the boxes have them (the left side offset by three blocks),
+    /// each a [`BuildingSpec`] placed with its lot line on the facade line.
+    fn drawn_buildings(&self, doc: &mut Doc, drawn: &DrawnBuildings) -> Result<(), Error> {
+        let rows = self.building_specs();
         let specs: Vec<BuildingSpec> = rows.iter().map(|r| r.2.clone()).collect();
         let palette = Palette::new(
             doc,
