@@ -496,7 +496,8 @@ impl RoadFeatures {
                 .floor()
                 .clamp(0.0, lanes.max(1) as f32 - 1.0);
             let centre = -half + (lane + 0.5) * width;
-            for wheel in [-0.85f32, 0.85] {
+            // The wheel tracks of the dryness map (crate::wetness), which then hold water.
+            for wheel in [-0.8f32, 0.8] {
                 let t = (x - centre - wheel) / 0.28;
                 d += self.rut_depth * (-t * t).exp();
             }

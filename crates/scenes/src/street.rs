@@ -503,6 +503,7 @@ impl Street {
         let wet = Wetness {
             level: st.wetness,
             lanes: st.lanes,
+            ruts: self.features.rut_depth,
         };
         let (png, _, _) = dryness_png(
             st.road_half,

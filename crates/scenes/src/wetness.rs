@@ -1,6 +1,7 @@
 //! The road's dryness map: deterministic value noise (fixed seed) shaped into puddles (w = 0),
 //! ordinary wet asphalt (w ~ 0.2) and drier patches (w -> 1), with wetter gutters along the
-//! kerbs and drier wheel tracks, as on a real street after rain. Stored in the green channel
+//! kerbs and drier wheel tracks, as on a real street after rain; where the wheel tracks are
+//! worn into ruts, they hold water instead. Stored in the green channel
 //! of an RGB PNG (the material's metallicRoughnessTexture; see scenes/README.md).
 
 use crate::Error;
@@ -68,7 +69,8 @@ fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
     t * t * (3.0 - 2.0 * t)
 }
 
-/// How wet a road is: the global wetness and the lanes whose wheel tracks are drier.
+/// How wet a road is: the global wetness, the lanes whose wheel tracks are drier, and how deep
+/// those tracks are rutted.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Wetness {
     /// Global wetness in [0, 1]: 0.5 is the shipped streets' balance; 1 floods the road
@@ -76,13 +78,18 @@ pub struct Wetness {
     pub level: f32,
     /// Number of lanes across the road (equal widths).
     pub lanes: u32,
+    /// Depth of the ruts in the wheel tracks, metres ([`crate::road::RoadFeatures`]): from 0
+    /// (the tracks drier than the asphalt around them) to 1 cm and more (water stands in them,
+    /// as in the gutters).
+    pub ruts: f32,
 }
 
 impl Wetness {
-    /// The shipped streets' wetness: two lanes, level 0.5.
+    /// The shipped streets' wetness: two lanes, level 0.5, no ruts.
     pub const SHIPPED: Self = Self {
         level: 0.5,
         lanes: 2,
+        ruts: 0.0,
     };
 }
 
@@ -92,7 +99,7 @@ pub fn dryness(x: f32, z: f32, half_width: f32, seed: u32, wet: Wetness) -> f32 
     let n = 0.6 * value_noise(x / 2.5, z / 4.0, seed)
         + 0.3 * value_noise(x / 1.0, z / 1.4, seed.wrapping_add(1))
         + 0.1 * value_noise(x / 0.35, z / 0.35, seed.wrapping_add(2));
-    // Wheel tracks 0.8 m either side of each lane centre are drier.
+    // Wheel tracks 0.8 m either side of each lane centre are drier, unless rutted.
     let lanes = wet.lanes.max(1);
     let lane_width = 2.0 * half_width / lanes as f32;
     let track_dist = (0..lanes)
@@ -105,7 +112,8 @@ pub fn dryness(x: f32, z: f32, half_width: f32, seed: u32, wet: Wetness) -> f32 
     let gutter = (-((half_width - x.abs()) / 0.6).powi(2)).exp();
     // Wetness shifts the noise against the fixed thresholds below (no shift at 0.5).
     let shift = 0.5 * (0.5 - wet.level.clamp(0.0, 1.0));
-    let s = n + 0.22 * track - 0.3 * gutter + shift;
+    let rutted = (wet.ruts / 0.01).clamp(0.0, 1.0);
+    let s = n + (0.22 - 0.57 * rutted) * track - 0.3 * gutter + shift;
     WET_ROAD_W * smoothstep(0.33, 0.37, s) + (1.0 - WET_ROAD_W) * smoothstep(0.56, 0.8, s)
 }
 
@@ -229,10 +237,35 @@ mod tests {
         assert!(mean_at(3.4) < mean_at(2.55));
     }
 
+    /// Unrutted wheel tracks are drier than the asphalt between them; rutted ones hold water:
+    /// wetter than it, and mostly puddles.
+    #[test]
+    fn rutted_wheel_tracks_hold_water() {
+        let mean_at = |x: f32, ruts: f32| {
+            let wet = Wetness {
+                ruts,
+                ..Wetness::SHIPPED
+            };
+            (0..400)
+                .map(|k| dryness(x, -k as f32 * 0.15, 3.5, 4, wet))
+                .sum::<f32>()
+                / 400.0
+        };
+        // The right lane's centre is x = 1.75; its wheel tracks are at 0.95 and 2.55.
+        let (track, between) = (2.55, 1.75);
+        assert!(mean_at(track, 0.0) > mean_at(between, 0.0));
+        assert!(mean_at(track, 0.015) < mean_at(between, 0.015));
+        assert!(mean_at(track, 0.015) < 0.5 * mean_at(track, 0.0));
+    }
+
     #[test]
     fn wetness_moves_puddles_and_dry_patches() {
         let share = |level: f32| {
-            let wet = Wetness { level, lanes: 3 };
+            let wet = Wetness {
+                level,
+                lanes: 3,
+                ruts: 0.0,
+            };
             let (_, puddle, dry) = dryness_png(5.0, 10.0, -60.0, (64, 512), 9, wet).unwrap();
             (puddle, dry)
         };
