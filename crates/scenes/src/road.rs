@@ -386,9 +386,10 @@ pub struct Crosswalk {
     pub length: f32,
 }
 
-/// A side street joining at a T junction: its carriageway leaves the main road's edge at a
-/// right angle (in the straight frame), with kerbs and pavements along it and a block closing
-/// it; the main road's kerb, pavement, edge line and buildings leave the mouth open.
+/// A side street joining at a T junction (or, with one at the same place on the other side, at
+/// a crossroads): its carriageway leaves the main road's edge at a right angle (in the straight
+/// frame), with kerbs and pavements along it and a block closing it; the main road's kerb,
+/// pavement, edge line and buildings leave the mouth open.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Junction {
     /// Centre of the mouth along the road (straight frame Z), metres.
@@ -607,6 +608,8 @@ pub struct RoadConfig {
     pub junctions: CountRange,
     /// Width of a side street's carriageway, metres.
     pub junction_width: Range,
+    /// Probability that a side street continues across the main street: a crossroads.
+    pub crossroads: f64,
     /// Number of zebra crossings.
     pub crosswalks: CountRange,
     /// Length of a crossing's bars along the road, metres.
@@ -640,6 +643,7 @@ impl Default for RoadConfig {
             tracks: 0.15,
             junctions: [0, 2],
             junction_width: [5.5, 8.0],
+            crossroads: 0.4,
             crosswalks: [0, 2],
             crosswalk_length: [3.0, 5.0],
             paint_albedo: [0.3, 0.65],
@@ -718,6 +722,7 @@ impl RoadConfig {
         prob("tracks", self.tracks)?;
         count("junctions", self.junctions, 6)?;
         real("junction_width", self.junction_width, 3.0, 20.0)?;
+        prob("crossroads", self.crossroads)?;
         count("crosswalks", self.crosswalks, 10)?;
         real("crosswalk_length", self.crosswalk_length, 1.0, 10.0)?;
         real("paint_albedo", self.paint_albedo, 0.0, 1.0)?;
@@ -820,15 +825,20 @@ impl RoadConfig {
             let pavement = rng.random_range(1.5f32..=3.0);
             let lo = (far + 30.0).max(-100.0);
             let z = rng.random_range(lo.min(-15.0)..=-15.0);
-            // Keep junctions 30 m apart.
+            let across = rng.random_bool(self.crossroads);
+            // Keep junctions 30 m apart; a crossroads is a side street on either side.
             if features.junctions.iter().all(|j| (j.z - z).abs() > 30.0) {
-                features.junctions.push(Junction {
+                let j = Junction {
                     z,
                     side,
                     width,
                     pavement,
                     length: 15.0,
-                });
+                };
+                features.junctions.push(j);
+                if across {
+                    features.junctions.push(Junction { side: -side, ..j });
+                }
             }
         }
         params.insert("junctions".into(), json!(features.junctions.len()));
@@ -975,6 +985,25 @@ mod tests {
             assert!(up.dot(side.normalize()).abs() < 1e-4);
             assert!(up.dot(tangent).abs() < 1e-4);
             assert!(up.y > 0.99);
+        }
+    }
+
+    /// With crossroads certain, every side street has its twin across the main street.
+    #[test]
+    fn crossroads_have_side_streets_on_both_sides() {
+        use rand::SeedableRng;
+        let config = RoadConfig {
+            junctions: [2, 2],
+            crossroads: 1.0,
+            ..RoadConfig::default()
+        };
+        for seed in 0..8 {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            let f = config.draw(&mut rng, 2, 3.5, -150.0).features;
+            assert!(!f.junctions.is_empty() && f.junctions.len() % 2 == 0);
+            for pair in f.junctions.chunks(2) {
+                assert_eq!((pair[0].z, pair[0].side), (pair[1].z, -pair[1].side));
+            }
         }
     }
 
