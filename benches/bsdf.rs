@@ -12,7 +12,9 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Through
 use glam::{Vec2, Vec3};
 use std::hint::black_box;
 use std::path::Path;
-use streaks_render::bsdf::{BlinnPhong, Bsdf, BsdfSample, Diffuse, Ggx, GltfPbr, Ward};
+use streaks_render::bsdf::{
+    BlinnPhong, Bsdf, BsdfSample, Diffuse, Ggx, GltfPbr, Retroreflective, Ward,
+};
 use streaks_render::geometry::Frame;
 use streaks_render::light::Receiver;
 use streaks_render::sampling::{square_to_cosine_hemisphere, Pcg32, Sampler};
@@ -211,6 +213,7 @@ dyn_model!(Ggx);
 dyn_model!(Ward);
 dyn_model!(BlinnPhong);
 dyn_model!(GltfPbr);
+dyn_model!(Retroreflective);
 
 fn boxed(bsdf: Bsdf) -> Box<dyn BsdfDyn> {
     match bsdf {
@@ -219,6 +222,7 @@ fn boxed(bsdf: Bsdf) -> Box<dyn BsdfDyn> {
         Bsdf::Ward(m) => Box::new(m),
         Bsdf::BlinnPhong(m) => Box::new(m),
         Bsdf::GltfPbr(m) => Box::new(m),
+        Bsdf::Retroreflective(m) => Box::new(m),
     }
 }
 

@@ -75,7 +75,8 @@
 //! fog's analytic transmittance (to infinity for the environment). On the camera segment the
 //! light of point and spot lights scattered once by the fog is estimated instead by
 //! equiangular sampling (Kulla and Fajardo 2012, `equiangular_direct`: two more random numbers,
-//! a full surface search and one shadow ray), which stays bounded where the ray passes close
+//! a full surface search and one shadow ray) over the part of the segment each light can
+//! reach (a spot light's cone, `lit_interval`), which stays bounded where the ray passes close
 //! to a lamp; collisions on that segment then leave these lights out of their next-event
 //! estimate.
 //!
@@ -1107,25 +1108,101 @@ fn light_position(light: &Light) -> Option<(Vec3, f32)> {
 }
 
 /// The equiangular parameters of a light at `position` seen along the ray `o + t d`, `t` in
-/// `[0, t_seg]`: the distance `h` of the ray's closest approach (at least 1e-4), its parameter
-/// `delta`, and the angles `(theta_a, theta_b)` under which the segment's ends are seen.
+/// `[t0, t1]` (`t1` may be infinite): the distance `h` of the ray's closest approach (at least
+/// 1e-4), its parameter `delta`, and the angles `(theta_a, theta_b)` under which the
+/// interval's ends are seen.
 #[inline]
-fn equiangular_frame(o: Vec3, d: Vec3, t_seg: f32, position: Vec3) -> (f32, f32, f32, f32) {
+fn equiangular_frame(
+    o: Vec3,
+    d: Vec3,
+    (t0, t1): (f32, f32),
+    position: Vec3,
+) -> (f32, f32, f32, f32) {
     let delta = (position - o).dot(d);
     let h = (position - (o + d * delta)).length().max(1e-4);
-    let theta_a = (-delta).atan2(h);
-    let theta_b = if t_seg.is_finite() {
-        (t_seg - delta).atan2(h)
+    let theta_a = (t0 - delta).atan2(h);
+    let theta_b = if t1.is_finite() {
+        (t1 - delta).atan2(h)
     } else {
         std::f32::consts::FRAC_PI_2
     };
     (h, delta, theta_a, theta_b)
 }
 
+/// The part `[t0, t1]` of the segment `o + t d`, `t` in `[0, t_seg]`, that a light can
+/// reach: all of it for a point light; for a spot light the part inside its outer cone,
+/// widened by a thousandth of its cosine so rounding never cuts lit points off (the wider
+/// part is unlit and adds nothing). `None` when no point of the segment is lit. Equiangular
+/// sampling over the lit part alone: a headlight's beam seen from just behind the lamp (a
+/// rig's own headlights, which every camera ray passes within a metre or two) would
+/// otherwise draw most distances near the lamp, outside its beam.
+#[inline]
+fn lit_interval(light: &Light, o: Vec3, d: Vec3, t_seg: f32) -> Option<(f32, f32)> {
+    let Light::Spot {
+        position,
+        direction: axis,
+        cos_outer,
+        ..
+    } = *light
+    else {
+        return Some((0.0, t_seg));
+    };
+    // Inside the cone: g(t) = (x - p).a >= c |x - p|, i.e. g >= 0 and q(t) = g^2 - c^2
+    // |x - p|^2 >= 0, a quadratic in t. A line meets a convex cone in one interval, and
+    // whether t is inside changes only at the roots of q.
+    let c = (cos_outer - 1e-3).max(0.0);
+    let v = o - position;
+    let (da, va) = (d.dot(axis), v.dot(axis));
+    let c2 = c * c;
+    let qa = da * da - c2 * d.length_squared();
+    let qb = 2.0 * (da * va - c2 * d.dot(v));
+    let qc = va * va - c2 * v.length_squared();
+    let inside = |t: f32| {
+        let g = va + t * da;
+        g >= 0.0 && g * g >= c2 * (v + d * t).length_squared()
+    };
+    let mut cuts = [0.0f32; 4];
+    let mut n = 0;
+    let mut push = |t: f32| {
+        if t > 0.0 && t < t_seg && t.is_finite() {
+            cuts[n] = t;
+            n += 1;
+        }
+    };
+    if qa.abs() > 1e-12 {
+        let disc = qb * qb - 4.0 * qa * qc;
+        if disc >= 0.0 {
+            let r = disc.sqrt();
+            push((-qb - r) / (2.0 * qa));
+            push((-qb + r) / (2.0 * qa));
+        }
+    } else if qb != 0.0 {
+        push(-qc / qb);
+    }
+    let cuts = &mut cuts[..n];
+    cuts.sort_by(f32::total_cmp);
+    // The pieces between 0, the roots and t_seg; the lit ones form one interval.
+    let mut lit: Option<(f32, f32)> = None;
+    let mut start = 0.0f32;
+    for end in cuts.iter().copied().chain(std::iter::once(t_seg)) {
+        let mid = if end.is_finite() {
+            0.5 * (start + end)
+        } else {
+            2.0 * start + 1.0
+        };
+        if inside(mid) {
+            lit = Some(lit.map_or((start, end), |(a, _)| (a, end)));
+        }
+        start = end;
+    }
+    lit
+}
+
 /// The fog's single scattering of the point and spot lights along one whole segment
 /// (`ray` up to `t_seg`, in the fog), estimated by equiangular sampling (Kulla and Fajardo
 /// 2012): a light is chosen in proportion to `I (theta_b - theta_a) / h`, the integral of its
-/// `I / r^2` over the segment, and a distance with density proportional to `1 / r^2` toward it;
+/// `I / r^2` over the part of the segment it can light ([`lit_interval`]: a spot light's
+/// cone), and a distance there with density proportional to `1 / r^2` toward it;
 /// the estimate is `T(t) sigma_s(t) p(wo, wi) L_i T_light / (pmf pdf(t))`, bounded however
 /// close the ray passes the light (a collision near a lamp would carry `1 / r^2`). It replaces
 /// next-event estimation toward these lights at collisions ([`scatter_in_fog`]); directional
@@ -1146,7 +1223,10 @@ fn equiangular_direct(
     let (o, d) = (ray.origin, ray.direction);
     let weight = |light: &Light| {
         light_position(light).map_or(0.0, |(position, lum)| {
-            let (h, _, a, b) = equiangular_frame(o, d, t_seg, position);
+            let Some(lit) = lit_interval(light, o, d, t_seg) else {
+                return 0.0;
+            };
+            let (h, _, a, b) = equiangular_frame(o, d, lit, position);
             let w = lum * (b - a) / h;
             if w.is_finite() && w > 0.0 {
                 w
@@ -1174,11 +1254,13 @@ fn equiangular_direct(
     let Some((light, w)) = chosen else {
         return 0;
     };
-    let Some((position, _)) = light_position(light) else {
+    let (Some((position, _)), Some(lit)) =
+        (light_position(light), lit_interval(light, o, d, t_seg))
+    else {
         return 0;
     };
-    let (h, delta, a, b) = equiangular_frame(o, d, t_seg, position);
-    let t = (delta + h * (a + u.y * (b - a)).tan()).clamp(0.0, t_seg);
+    let (h, delta, a, b) = equiangular_frame(o, d, lit, position);
+    let t = (delta + h * (a + u.y * (b - a)).tan()).clamp(lit.0, lit.1);
     let off = t - delta;
     let pdf_t = h / ((b - a) * (h * h + off * off));
     let p = o + d * t;
@@ -2340,6 +2422,96 @@ pub(crate) mod tests {
             ..parts
         })
         .unwrap()
+    }
+
+    /// A spot light's lit part of a segment holds every point of the segment inside its
+    /// cone, and little else; a spot facing away from the segment lights none of it; a point
+    /// light lights all of it.
+    #[test]
+    fn lit_interval_is_the_part_of_a_segment_inside_the_cone() {
+        let mut rng = crate::sampling::Pcg32::new(5, 9);
+        let mut lit_rays = 0;
+        for k in 0..3000 {
+            let dir = |r: &mut crate::sampling::Pcg32| {
+                crate::sampling::square_to_uniform_sphere(r.next_2d())
+            };
+            let position = dir(&mut rng) * 3.0 * rng.next_f32();
+            let axis = dir(&mut rng);
+            let cos_outer = (0.1 + 1.4 * rng.next_f32()).cos();
+            let light = Light::Spot {
+                position,
+                direction: axis,
+                intensity: Vec3::ONE,
+                cos_inner: 1.0,
+                cos_outer,
+                range: None,
+            };
+            let (o, d) = (dir(&mut rng) * 2.0, dir(&mut rng));
+            let t_seg = if k % 2 == 0 { 20.0 } else { f32::INFINITY };
+            let got = lit_interval(&light, o, d, t_seg);
+            let inside = |t: f32| {
+                let x = o + d * t - position;
+                x.dot(axis) >= cos_outer * x.length()
+            };
+            let probe = 20.0f32.min(t_seg);
+            let mut any = false;
+            for i in 0..=2000 {
+                let t = probe * i as f32 / 2000.0;
+                if inside(t) {
+                    any = true;
+                    let (t0, t1) = got.unwrap_or_else(|| panic!("{k}: {t} is lit"));
+                    assert!(
+                        t >= t0 - 1e-3 && t <= t1 + 1e-3,
+                        "{k}: {t} not in {t0}..{t1}"
+                    );
+                }
+            }
+            if let Some((t0, t1)) = got {
+                assert!(0.0 <= t0 && t0 <= t1 && t1 <= t_seg, "{k}: {t0}..{t1}");
+                lit_rays += usize::from(any);
+                // The ends are on the (slightly widened) cone.
+                let widened = |t: f32| {
+                    let x = o + d * t - position;
+                    x.dot(axis) >= (cos_outer - 2e-3).max(0.0) * x.length() - 1e-4
+                };
+                assert!(widened(t0) && (t1.is_infinite() || widened(t1)), "{k}");
+            }
+        }
+        assert!(lit_rays > 300, "{lit_rays}");
+        let away = Light::Spot {
+            position: Vec3::ZERO,
+            direction: Vec3::Z,
+            intensity: Vec3::ONE,
+            cos_inner: 1.0,
+            cos_outer: 0.5f32.cos(),
+            range: None,
+        };
+        assert_eq!(
+            lit_interval(&away, Vec3::new(0.0, 1.0, -1.0), Vec3::NEG_Z, 50.0),
+            None
+        );
+        // A rig's headlight seen from the camera just behind and above it: lit only from
+        // where the ray enters the beam, metres ahead.
+        let headlight = Light::Spot {
+            position: Vec3::new(0.7, 0.65, -1.8),
+            direction: Vec3::new(0.0, -0.052, -1.0).normalize(),
+            intensity: Vec3::ONE,
+            cos_inner: 0.12f32.cos(),
+            cos_outer: 0.35f32.cos(),
+            range: None,
+        };
+        let (t0, t1) =
+            lit_interval(&headlight, Vec3::new(0.0, 1.3, 0.0), Vec3::NEG_Z, 100.0).expect("lit");
+        assert!(t0 > 3.0 && t1 == 100.0, "{t0}..{t1}");
+        let point = Light::Point {
+            position: Vec3::ZERO,
+            intensity: Vec3::ONE,
+            range: None,
+        };
+        assert_eq!(
+            lit_interval(&point, Vec3::Y, Vec3::X, 7.0),
+            Some((0.0, 7.0))
+        );
     }
 
     #[test]

@@ -44,6 +44,16 @@ pub enum PaperModel {
     BlinnPhong,
 }
 
+/// Glass beads in a paper `ggx` material (`extras.streaks.kr`, `retro_width`): the
+/// retroreflective cone of [`bsdf::Retroreflective`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Retro {
+    /// The cone's reflectance.
+    pub kr: Vec3,
+    /// The cone's exponent (its width is `1 / sqrt(exponent)` radians).
+    pub exponent: f32,
+}
+
 /// How a material reflects light.
 // The glTF variant holds eleven texture references; a scene has few materials and `bsdf_at`
 // reads them by reference, so boxing it would only add an indirection per hit.
@@ -73,6 +83,9 @@ pub enum Reflectance {
         kd_texture: Option<TextureRef>,
         /// Optional wet/dry modulation (see [`Wetness`] and the `scene` module documentation).
         wetness: Option<Wetness>,
+        /// Glass beads (ggx only): the retroreflective cone of [`bsdf::Retroreflective`]; the
+        /// dryness map does not change it.
+        retro: Option<Retro>,
     },
     /// glTF metallic-roughness with its extensions' parameters.
     GltfPbr(GltfPbrParams),
@@ -353,6 +366,7 @@ impl Material {
                 shininess: 0.0,
                 kd_texture: None,
                 wetness: None,
+                retro: None,
             },
             road: true,
             ..Self::diffuse(name, Vec3::ZERO)
@@ -437,6 +451,7 @@ impl Material {
                 shininess,
                 kd_texture,
                 wetness,
+                retro,
             } => {
                 let kd = *kd * sample_or_one(*kd_texture, at, textures).truncate() * vertex_color;
                 let (mut ks, mut alpha, mut shininess) = (*ks, *alpha, *shininess);
@@ -451,7 +466,16 @@ impl Material {
                     }
                 }
                 match model {
-                    PaperModel::Ggx => Bsdf::Ggx(bsdf::Ggx { kd, ks, alpha }),
+                    PaperModel::Ggx => match retro {
+                        Some(r) => Bsdf::Retroreflective(bsdf::Retroreflective {
+                            kd,
+                            ks,
+                            alpha,
+                            kr: r.kr,
+                            exponent: r.exponent,
+                        }),
+                        None => Bsdf::Ggx(bsdf::Ggx { kd, ks, alpha }),
+                    },
                     PaperModel::Ward => Bsdf::Ward(bsdf::Ward { kd, ks, alpha }),
                     PaperModel::BlinnPhong => {
                         Bsdf::BlinnPhong(bsdf::BlinnPhong { kd, ks, shininess })
@@ -605,6 +629,7 @@ mod tests {
                     alpha_dry: 0.45,
                     ks_dry: Vec3::splat(0.1),
                 }),
+                retro: None,
             },
             emission: Vec3::ZERO,
             emission_texture: None,

@@ -613,7 +613,15 @@ impl<'a> MaterialWriter<'a> {
                 shininess,
                 kd_texture,
                 wetness,
+                retro,
             } => {
+                if retro.is_some() {
+                    self.warnings.push(format!(
+                        "material {:?}: Mitsuba has no retroreflective model; exported \
+                         without its glass beads' cone (darker under lights near the camera)",
+                        m.name
+                    ));
+                }
                 // Mitsuba's alpha for our alpha (or, for blinn_phong, shininess).
                 let to_alpha = |a: f32| match model {
                     PaperModel::Ggx | PaperModel::Ward => a,
@@ -1177,6 +1185,7 @@ mod tests {
                     alpha_dry: 0.5,
                     ks_dry: Vec3::splat(0.02),
                 }),
+                retro: None,
             };
             let lamp = Reflectance::Diffuse {
                 kd: Vec3::ZERO,
@@ -1190,6 +1199,7 @@ mod tests {
                 shininess: 0.0,
                 kd_texture: None,
                 wetness: None,
+                retro: None,
             };
             Fixture {
                 mesh: TriangleMesh {

@@ -11,6 +11,8 @@
 //! standing on the road's surface at a lateral offset and a distance along the road, so that
 //! the rig and the cars follow its curves, climb its grades and lean with its cross-fall.
 
+use crate::gltf_writer::{Light, LightKind};
+use crate::model::transformed_light;
 use crate::road::Road;
 use crate::street::Car;
 use glam::{Affine3A, Mat3, Vec3};
@@ -45,6 +47,39 @@ pub fn frame_time(frame: u64, fps: f64) -> f64 {
 /// The rig centre's world pose at `time` (seconds): looking along its local -Z, +Y up.
 pub fn rig_pose_at(road: &Road, drive: &Drive, time: f64) -> Affine3A {
     road.pose(drive.lateral, drive.start + drive.speed_m_s * time, false) * drive.mount
+}
+
+/// The rig vehicle's dipped headlights at `time`: two spot lights 1.4 m apart, 1.8 m ahead of
+/// the rig and at about half its height (0.6 m on a car, up to 1.2 m on a truck), aimed 3
+/// degrees down its lane with a 20 degree cone, named `ego_headlight_0` and `_1`. What they
+/// light most is the road just ahead, seen from behind them: the wet asphalt's mirror sends
+/// their light away from the camera, and bead paint sends it back.
+pub fn ego_headlights(
+    road: &Road,
+    drive: &Drive,
+    time: f64,
+    color: [f64; 3],
+    intensity: f64,
+) -> [Light; 2] {
+    let lane = road.pose(drive.lateral, drive.start + drive.speed_m_s * time, false);
+    let height = (0.5 * drive.mount.translation.y).clamp(0.6, 1.2);
+    std::array::from_fn(|j| {
+        let side = if j == 0 { -0.7 } else { 0.7 };
+        transformed_light(
+            &Light {
+                name: format!("ego_headlight_{j}"),
+                kind: LightKind::Spot {
+                    inner: 0.12,
+                    outer: 0.35,
+                },
+                color,
+                intensity,
+                position: Vec3::new(side, height, -1.8),
+                direction: Vec3::new(0.0, -0.052, -1.0).normalize(),
+            },
+            lane,
+        )
+    })
 }
 
 /// The rig's velocity in world space at `time`, m/s: its speed along the lane's direction.
@@ -168,6 +203,42 @@ mod tests {
         assert!(close(at(&car(true, true)), Vec3::new(-2.0, 0.0, -30.0)));
         let front = pose_at(&car(true, false)).transform_vector3(Vec3::NEG_Z);
         assert!(close(front, Vec3::Z));
+    }
+
+    /// The rig's headlights ride with it: ahead of the camera, below it, either side of its
+    /// lane, aimed down the lane at the road a few tens of metres ahead; on a truck higher.
+    #[test]
+    fn ego_headlights_ride_with_the_rig() {
+        let road = Road::straight();
+        let drive = Drive {
+            lateral: 1.5,
+            start: 0.0,
+            mount: mount(1.3, 0.02, 0.0),
+            speed_m_s: 10.0,
+        };
+        let lights = ego_headlights(&road, &drive, 0.5, [1.0; 3], 2000.0);
+        let eye = Vec3::from(rig_pose_at(&road, &drive, 0.5).translation);
+        for (j, l) in lights.iter().enumerate() {
+            assert_eq!(l.name, format!("ego_headlight_{j}"));
+            let d = l.position - eye;
+            assert!(
+                (d.z + 1.8).abs() < 1e-5 && (d.x.abs() - 0.7).abs() < 1e-5,
+                "{d}"
+            );
+            assert!((l.position.y - 0.65).abs() < 1e-5, "{}", l.position);
+            // The beam's axis meets the road 12.5 m ahead of the lamps.
+            let t = l.position.y / -l.direction.y;
+            let ground = l.position + t * l.direction;
+            assert!((ground.z - (l.position.z - 12.5)).abs() < 0.1, "{ground}");
+            assert!((ground.x - l.position.x).abs() < 1e-5);
+        }
+        assert!(lights[0].position.x < lights[1].position.x);
+        let truck = Drive {
+            mount: mount(2.8, 0.02, 0.0),
+            ..drive
+        };
+        let high = ego_headlights(&road, &truck, 0.5, [1.0; 3], 2000.0);
+        assert!((high[0].position.y - 1.2).abs() < 1e-5);
     }
 
     /// A point on a moving car is on it, the road below it and a point beside it are not.

@@ -102,6 +102,9 @@ pub enum Reflect {
         albedo: Option<usize>,
         /// Optional normal map (rain ripples on the road).
         normal: Option<NormalTexture>,
+        /// Optional glass beads (a `ggx` material only): `extras.streaks.kr` (grey) and
+        /// `retro_width` (radians), bead paint's retroreflective cone.
+        beads: Option<Beads>,
     },
     /// A black, non-reflecting surface (glTF metallic-roughness with base colour 0): used
     /// for emitters, whose look is their emission.
@@ -109,6 +112,32 @@ pub enum Reflect {
     /// glTF metallic-roughness, with an optional clear coat and transmission: car paint,
     /// glass, rubber, metal, and the materials of the user's assets.
     Pbr(Pbr),
+}
+
+/// Glass beads in road-marking paint: the renderer's retroreflective cone
+/// (`streaks_render::bsdf::Retroreflective`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Beads {
+    /// The cone's reflectance (grey).
+    pub kr: f64,
+    /// The cone's width, radians.
+    pub width: f64,
+}
+
+impl Beads {
+    /// Beads of the renderer's default cone width that measure `rl_mcd` (mcd m^-2 lx^-1) at
+    /// EN 1436's geometry.
+    pub fn for_rl(rl_mcd: f64) -> Self {
+        use streaks_render::bsdf::{Retroreflective, BEAD_CONE_WIDTH};
+        let n = Retroreflective::exponent_for_width(BEAD_CONE_WIDTH);
+        Self {
+            kr: round7(f64::from(Retroreflective::kr_for_rl(
+                (rl_mcd / 1000.0) as f32,
+                n,
+            ))),
+            width: round7(f64::from(BEAD_CONE_WIDTH)),
+        }
+    }
 }
 
 /// glTF metallic-roughness parameters (`pbrMetallicRoughness`), with
@@ -217,6 +246,7 @@ impl Material {
                 dryness: None,
                 albedo: None,
                 normal: None,
+                beads: None,
             },
             emission: None,
             double_sided: false,
@@ -237,6 +267,15 @@ impl Material {
     pub fn with_albedo(mut self, image: usize) -> Self {
         if let Reflect::Paper { albedo, .. } = &mut self.reflect {
             *albedo = Some(image);
+        }
+        self
+    }
+
+    /// The same paper material with glass beads (no effect on other reflectances; the
+    /// renderer takes them for a `ggx` material only).
+    pub fn with_beads(mut self, b: Beads) -> Self {
+        if let Reflect::Paper { beads, .. } = &mut self.reflect {
+            *beads = Some(b);
         }
         self
     }
@@ -680,8 +719,13 @@ impl Doc {
                 dryness,
                 albedo,
                 normal,
+                beads,
             } => {
                 let mut s = json!({ "kd": kd, "ks": ks });
+                if let Some(b) = beads {
+                    s["kr"] = json!([b.kr, b.kr, b.kr]);
+                    s["retro_width"] = json!(b.width);
+                }
                 // glTF fallback for other viewers: roughness = sqrt(alpha).
                 let fallback_alpha = match bsdf {
                     PaperBsdf::Ggx { alpha } => {
@@ -1077,6 +1121,41 @@ mod tests {
         assert!((v.sigma_a.y - want).abs() < 1e-4, "{} {want}", v.sigma_a.y);
         let (_, e) = get("lit");
         assert_eq!(e, glam::Vec3::new(4.0, 2.0, 1.0));
+    }
+
+    /// Paint with beads made for an `R_L` loads as bead paint that measures it at EN 1436's
+    /// geometry (to the rounding of `kr`).
+    #[test]
+    fn bead_paint_loads_and_measures_its_rl() {
+        use streaks_render::bsdf::{Bsdf, RL_ILLUMINATION_DEG, RL_OBSERVATION_DEG};
+        let mut d = Doc::new("beads", "");
+        let paint = Material::paper("paint", PaperBsdf::Ggx { alpha: 0.2 }, [0.5; 3], [0.05; 3])
+            .with_beads(Beads::for_rl(250.0));
+        let mut m = Mesh::new();
+        m.cuboid(Vec3::ZERO, Vec3::ONE);
+        d.add_tagged_mesh("marks", &m, &paint, Tag::stuff(Class::Marking))
+            .unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        d.write(dir.path()).unwrap();
+        let scene = streaks_render::scene::Scene::load(&dir.path().join("beads.gltf")).unwrap();
+        assert!(
+            scene.warnings.iter().all(|w| !w.contains("paint")),
+            "{:?}",
+            scene.warnings
+        );
+        let at = streaks_render::geometry::VertexAttributes::from_uv(glam::Vec2::ZERO);
+        let b = scene.materials[0].bsdf_at(&at, &scene.textures);
+        assert!(matches!(b, Bsdf::Retroreflective(_)), "{b:?}");
+        let dir_at = |deg: f32| {
+            let (s, c) = deg.to_radians().sin_cos();
+            Vec3::new(c, 0.0, s)
+        };
+        let wi = dir_at(RL_ILLUMINATION_DEG);
+        let wo = dir_at(RL_ILLUMINATION_DEG + RL_OBSERVATION_DEG);
+        // R_L = f cos(theta_i), less the Lambertian and GGX parts' share.
+        let rl =
+            (b.eval(wo, wi).x - b.eval_lobes(wo, wi).glossy.x - 0.5 / std::f32::consts::PI) * wi.z;
+        assert!((rl - 0.25).abs() < 2e-3, "R_L {rl}");
     }
 
     #[test]

@@ -39,7 +39,7 @@ use std::path::Path;
 pub const GENERATOR_VERSION: &str = concat!(
     "streaks-scenes ",
     env!("CARGO_PKG_VERSION"),
-    " procedural/4"
+    " procedural/5"
 );
 
 /// A closed range `[min, max]` of a real parameter, written `[min, max]` in TOML.
@@ -289,6 +289,9 @@ pub struct RigConfig {
     /// Focal length as a 35 mm-equivalent (24 mm image height), mm: the vertical field of
     /// view is `2 atan(12 / f)`.
     pub focal_mm35: Range,
+    /// Probability that the rig's vehicle drives with its dipped headlights on (a street's
+    /// headlight type and intensity, see [`crate::drive::ego_headlights`]).
+    pub headlights: f64,
 }
 
 impl Default for RigConfig {
@@ -306,6 +309,7 @@ impl Default for RigConfig {
             roll_deg: [-2.0, 2.0],
             baseline: [0.1, 0.4],
             focal_mm35: [24.0, 45.0],
+            headlights: 1.0,
         }
     }
 }
@@ -613,6 +617,7 @@ impl GeneratorConfig {
         real("rig.roll_deg", r.roll_deg, -30.0, 30.0)?;
         real("rig.baseline", r.baseline, 0.001, 5.0)?;
         real("rig.focal_mm35", r.focal_mm35, 8.0, 400.0)?;
+        prob("rig.headlights", r.headlights)?;
         let q = &self.sequence;
         if !(q.fps.is_finite() && (0.1..=1000.0).contains(&q.fps)) {
             return Err(format!("sequence.fps = {} must be in [0.1, 1000]", q.fps));
@@ -872,6 +877,7 @@ pub fn street_frame(
     let focal = uniform(&mut rig_rng, rig.focal_mm35);
     let yfov_deg = (2.0 * (12.0 / focal).atan()).to_degrees();
     let exposure_ev = uniform(&mut rig_rng, config.exposure.ev) as f32;
+    let ego_lit = rig_rng.random::<f64>() < rig.headlights;
     // The drive's speeds in a stream of their own.
     let sq = &config.sequence;
     let mut motion_rng = ChaCha8Rng::seed_from_u64(mix(seed, MOTION_STREAM, street_id));
@@ -952,6 +958,18 @@ pub fn street_frame(
         c["speed_m_s"] = json!(speed);
     }
     let mut doc = street.build()?;
+    if ego_lit {
+        let st = &street.style;
+        for light in crate::drive::ego_headlights(
+            &road,
+            &drive,
+            time,
+            st.headlight_color,
+            st.headlight_intensity,
+        ) {
+            doc.add_light(&light);
+        }
+    }
     let sky = &config.sky;
     if sky.enabled && sky.glow[1] > 0.0 {
         // Its own stream: a config with a sky draws every other parameter as one without.
@@ -986,6 +1004,7 @@ pub fn street_frame(
         "baseline": baseline,
         "focal_mm35": focal,
         "yfov_deg": yfov_deg,
+        "headlights": ego_lit,
         "pair_in_street": frame,
     });
     params["sequence"] = json!({

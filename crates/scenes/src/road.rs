@@ -428,6 +428,10 @@ pub struct Paint {
     pub alpha: f64,
     /// Share of the paint worn away, in 25 cm pieces.
     pub wear: f64,
+    /// The glass beads' coefficient of retroreflected luminance `R_L` as the paint is (wet
+    /// or dry), mcd m^-2 lx^-1 at EN 1436's geometry; 0: no beads.
+    #[serde(default)]
+    pub rl_mcd: f64,
 }
 
 impl Paint {
@@ -437,6 +441,7 @@ impl Paint {
         ks: 0.05,
         alpha: 0.15,
         wear: 0.0,
+        rl_mcd: 0.0,
     };
 }
 
@@ -620,6 +625,10 @@ pub struct RoadConfig {
     pub paint_wear: Range,
     /// How wet the paint is, 0 (dry, matte) to 1 (a film of water: glossy).
     pub paint_wet: Range,
+    /// The paint's glass beads: their coefficient of retroreflected luminance `R_L` when dry,
+    /// mcd m^-2 lx^-1 (EN 1436; 0: no beads). Water over the beads takes up to three
+    /// quarters of it: `R_L = R_L,dry (1 - 0.75 wet)`.
+    pub paint_rl_mcd: Range,
 }
 
 impl Default for RoadConfig {
@@ -649,6 +658,7 @@ impl Default for RoadConfig {
             paint_albedo: [0.3, 0.65],
             paint_wear: [0.0, 0.4],
             paint_wet: [0.0, 1.0],
+            paint_rl_mcd: [100.0, 300.0],
         }
     }
 }
@@ -727,7 +737,8 @@ impl RoadConfig {
         real("crosswalk_length", self.crosswalk_length, 1.0, 10.0)?;
         real("paint_albedo", self.paint_albedo, 0.0, 1.0)?;
         real("paint_wear", self.paint_wear, 0.0, 1.0)?;
-        real("paint_wet", self.paint_wet, 0.0, 1.0)
+        real("paint_wet", self.paint_wet, 0.0, 1.0)?;
+        real("paint_rl_mcd", self.paint_rl_mcd, 0.0, 2000.0)
     }
 
     /// Draws a street's road for a carriageway of `lanes` lanes `lane_width` wide, modelled
@@ -861,15 +872,19 @@ impl RoadConfig {
         let kd = uniform(rng, self.paint_albedo);
         let wear = uniform(rng, self.paint_wear);
         let wet = uniform(rng, self.paint_wet);
+        let rl_dry = uniform(rng, self.paint_rl_mcd);
+        let rl = crate::gltf_writer::round7(rl_dry * (1.0 - 0.75 * wet));
         features.paint = Paint {
             kd: crate::gltf_writer::round7(kd),
             ks: crate::gltf_writer::round7(0.04 + 0.06 * wet),
             alpha: crate::gltf_writer::round7(0.3 - 0.25 * wet),
             wear,
+            rl_mcd: rl,
         };
         params.insert("paint_albedo".into(), json!(kd));
         params.insert("paint_wear".into(), json!(wear));
         params.insert("paint_wet".into(), json!(wet));
+        params.insert("paint_rl_mcd".into(), json!(rl));
         DrawnRoad {
             road: Road::new(layout),
             features,

@@ -551,12 +551,15 @@ impl Street {
             });
         }
         let p = self.features.paint;
-        let paint = Material::paper(
+        let mut paint = Material::paper(
             "road_paint",
             PaperBsdf::Ggx { alpha: p.alpha },
             [p.kd; 3],
             [p.ks; 3],
         );
+        if p.rl_mcd > 0.0 {
+            paint = paint.with_beads(crate::gltf_writer::Beads::for_rl(p.rl_mcd));
+        }
         let stone = tex.stone.paper(
             "kerb_granite",
             PaperBsdf::Ggx { alpha: 0.25 },

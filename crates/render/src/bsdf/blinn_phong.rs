@@ -63,6 +63,7 @@ impl Model for BlinnPhong {
             diffuse: self.kd,
             glossy: self.ks,
             sheen: Vec3::ZERO,
+            retro: Vec3::ZERO,
         }
     }
 

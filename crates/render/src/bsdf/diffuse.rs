@@ -37,6 +37,7 @@ impl Model for Diffuse {
             diffuse: self.kd,
             glossy: Vec3::ZERO,
             sheen: Vec3::ZERO,
+            retro: Vec3::ZERO,
         }
     }
 

@@ -45,6 +45,7 @@ impl Model for Ggx {
             diffuse: self.kd,
             glossy: self.ks,
             sheen: Vec3::ZERO,
+            retro: Vec3::ZERO,
         }
     }
 

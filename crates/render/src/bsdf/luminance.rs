@@ -7,7 +7,9 @@
 //! no formula.
 
 use super::numbers::Lanes;
-use super::{BlinnPhong, Bsdf, Diffuse, Ggx, GltfPbr, Lobes, Model, Reflectances, Ward};
+use super::{
+    BlinnPhong, Bsdf, Diffuse, Ggx, GltfPbr, Lobes, Model, Reflectances, Retroreflective, Ward,
+};
 use glam::Vec3;
 use streaks_image::luminance;
 
@@ -37,6 +39,7 @@ enum AtWo {
     Ward(<Ward as Model>::AtWo),
     BlinnPhong(<BlinnPhong as Model>::AtWo),
     GltfPbr(<GltfPbr as Model>::AtWo),
+    Retroreflective(<Retroreflective as Model>::AtWo),
 }
 
 impl LuminanceEval {
@@ -71,6 +74,7 @@ impl LuminanceEval {
                 AtWo::Ward(at) => Ward::lobes(at, r, wo, wi),
                 AtWo::BlinnPhong(at) => BlinnPhong::lobes(at, r, wo, wi),
                 AtWo::GltfPbr(at) => GltfPbr::lobes(at, r, wo, wi),
+                AtWo::Retroreflective(at) => Retroreflective::lobes(at, r, wo, wi),
             };
             part(lobes).where_positive(wi[2])
         } else {
@@ -80,13 +84,17 @@ impl LuminanceEval {
 }
 
 impl LuminanceEval {
-    /// Whether its lobes call the C library per lane (Ward's `exp`, Blinn-Phong's `pow`):
+    /// Whether its lobes call the C library per lane (Ward's `exp`, Blinn-Phong's and the
+    /// retroreflective cone's `pow`):
     /// such a model is evaluated four lanes at a time even where wider lanes exist, since a
     /// call per lane from a wide kernel costs more than the lanes save
     /// (docs/decisions/0003-light-choice-in-simd-lanes.md).
     #[inline]
     pub(crate) fn calls_libm(&self) -> bool {
-        matches!(self.at, AtWo::Ward(_) | AtWo::BlinnPhong(_))
+        matches!(
+            self.at,
+            AtWo::Ward(_) | AtWo::BlinnPhong(_) | AtWo::Retroreflective(_)
+        )
     }
 
     /// Whether the model has a glossy lobe, whose peak lies near the mirror direction of `wo`
@@ -114,6 +122,7 @@ impl Bsdf {
             Bsdf::Ward(m) => (AtWo::Ward(m.at_wo(wo)), m.reflectances()),
             Bsdf::BlinnPhong(m) => (AtWo::BlinnPhong(m.at_wo(wo)), m.reflectances()),
             Bsdf::GltfPbr(m) => (AtWo::GltfPbr(m.at_wo(wo)), m.reflectances()),
+            Bsdf::Retroreflective(m) => (AtWo::Retroreflective(m.at_wo(wo)), m.reflectances()),
         };
         LuminanceEval {
             wo,

@@ -653,6 +653,7 @@ impl Model for GltfPbr {
             diffuse: self.diffuse_color(),
             glossy: self.glossy_f0(),
             sheen: self.sheen_color,
+            retro: Vec3::ZERO,
         }
     }
 

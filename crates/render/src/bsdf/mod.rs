@@ -1,5 +1,5 @@
-//! Reflectance models: Lambertian, the paper's `ggx`, `ward` and `blinn_phong`, and the glTF 2.0
-//! metallic-roughness BRDF, as one closed enum [`Bsdf`] with `eval`, `pdf` and `sample`.
+//! Reflectance models: Lambertian, the paper's `ggx`, `ward` and `blinn_phong`, bead paint
+//! (`ggx` with a retroreflective cone) and the glTF 2.0 metallic-roughness BRDF, as one closed enum [`Bsdf`] with `eval`, `pdf` and `sample`.
 //!
 //! Direction convention, stated once for the whole crate: every direction points *away* from
 //! the surface point. `wo` points toward the viewer (where the path came from), `wi` toward the
@@ -54,7 +54,8 @@
 //!   et al. 2007) it uses for a volume's boundary; `sheen.rs`: KHR_materials_sheen's lobe
 //!   (Charlie distribution, fitted visibility, directional albedo) that [`GltfPbr`] layers
 //!   over its base, with its albedo table in `sheen_table.rs`; `iridescence.rs`:
-//!   KHR_materials_iridescence's thin-film Fresnel term;
+//!   KHR_materials_iridescence's thin-film Fresnel term; `retroreflective.rs`: bead paint's
+//!   retroreflective cone and [`Retroreflective`], the paper's GGX with it;
 //! - `luminance.rs`: [`LuminanceEval`], the light choice's `luminance(f(wo, wi))`: the
 //!   luminances of a model's reflectances and its `Model::AtWo`, taken once per `wo`, and
 //!   its lobes.
@@ -76,6 +77,7 @@ mod iridescence;
 mod luminance;
 mod metallic_roughness;
 pub(crate) mod numbers;
+mod retroreflective;
 mod sheen;
 mod sheen_table;
 mod ward;
@@ -85,6 +87,9 @@ pub use diffuse::Diffuse;
 pub use ggx::Ggx;
 pub use luminance::LuminanceEval;
 pub use metallic_roughness::{ior_f0, GltfPbr};
+pub use retroreflective::{
+    Retroreflective, BEAD_CONE_WIDTH, RL_ILLUMINATION_DEG, RL_OBSERVATION_DEG,
+};
 pub use ward::Ward;
 
 use crate::sampling::{square_to_cosine_hemisphere, square_to_cosine_hemisphere_pdf};
@@ -96,7 +101,9 @@ use std::f32::consts::TAU;
 /// Which part of a model produced a sampled or evaluated contribution.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Lobe {
-    /// The Lambertian part (`kd / pi`), with a glTF material's sheen (sampled with it).
+    /// The Lambertian part (`kd / pi`), with a glTF material's sheen (sampled with it) and
+    /// bead paint's retroreflective cone (sampled with the glossy lobe; see
+    /// [`Retroreflective`]).
     Diffuse,
     /// The glossy (microfacet or Phong-like) part; streaks come from it.
     Glossy,
@@ -107,7 +114,8 @@ pub enum Lobe {
 /// BRDF values split by lobe, so the integrator can attribute glossy light to the specular layer.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct LobeValues {
-    /// Diffuse part of `f(wo, wi)` (a glTF material's sheen included).
+    /// Diffuse part of `f(wo, wi)` (a glTF material's sheen and bead paint's
+    /// retroreflective cone included).
     pub diffuse: Vec3,
     /// Glossy part of `f(wo, wi)`.
     pub glossy: Vec3,
@@ -169,6 +177,8 @@ pub enum Bsdf {
     BlinnPhong(BlinnPhong),
     /// glTF metallic-roughness.
     GltfPbr(GltfPbr),
+    /// Bead paint: the paper's GGX with a retroreflective cone.
+    Retroreflective(Retroreflective),
 }
 
 /// Smallest microfacet alpha the models use: a smaller (or zero) alpha is raised to it, so a
@@ -180,14 +190,16 @@ pub const MIN_ALPHA: f32 = 1e-4;
 
 /// A model's reflectances, the colours its lobes scale: the diffuse lobe's and the glossy
 /// lobe's (`kd` and `ks` for the paper models; `c_diff` and the glossy colour at normal
-/// incidence for glTF), and a glTF material's sheen colour (KHR_materials_sheen; black for
-/// every other model), as RGB or as luminances. [`LuminanceEval`] takes their luminances once
+/// incidence for glTF), a glTF material's sheen colour (KHR_materials_sheen; black for
+/// every other model) and bead paint's retroreflective colour (`kr` of [`Retroreflective`];
+/// black for every other model), as RGB or as luminances. [`LuminanceEval`] takes their luminances once
 /// per `wo`.
 #[derive(Clone, Copy, Debug)]
 struct Reflectances<S> {
     diffuse: S,
     glossy: S,
     sheen: S,
+    retro: S,
 }
 
 impl<S> Reflectances<S> {
@@ -198,12 +210,13 @@ impl<S> Reflectances<S> {
             diffuse: f(self.diffuse),
             glossy: f(self.glossy),
             sheen: f(self.sheen),
+            retro: f(self.retro),
         }
     }
 }
 
 /// A model's lobes at one `wo` and one or four `wi`: `f(wo, wi)` split by lobe, as reflectances
-/// `S` (RGB, or luminance in lanes), and the glossy lobe's own sampling density of `wi`.
+/// `S` (RGB, or luminance in lanes), and the glossy sampling strategy's density of `wi`.
 struct Lobes<S, L> {
     diffuse: S,
     glossy: S,
@@ -362,6 +375,7 @@ impl Bsdf {
             Bsdf::Ward(m) => m.glossy_probability(wo),
             Bsdf::BlinnPhong(m) => m.glossy_probability(wo),
             Bsdf::GltfPbr(m) => m.glossy_probability(wo),
+            Bsdf::Retroreflective(m) => m.glossy_probability(wo),
         };
         debug_assert!((0.0..=1.0).contains(&p), "glossy probability {p}");
         p
@@ -376,6 +390,7 @@ impl Bsdf {
             Bsdf::Ward(m) => m.sample_glossy(wo, u),
             Bsdf::BlinnPhong(m) => m.sample_glossy(wo, u),
             Bsdf::GltfPbr(m) => m.sample_glossy(wo, u),
+            Bsdf::Retroreflective(m) => m.sample_glossy(wo, u),
         }
     }
 
@@ -389,6 +404,7 @@ impl Bsdf {
             Bsdf::Ward(m) => m.albedo(),
             Bsdf::BlinnPhong(m) => m.albedo(),
             Bsdf::GltfPbr(m) => m.albedo(),
+            Bsdf::Retroreflective(m) => m.albedo(),
         }
     }
 
@@ -405,6 +421,7 @@ impl Bsdf {
             Bsdf::Ward(m) => rgb_lobes(m, wo, wi),
             Bsdf::BlinnPhong(m) => rgb_lobes(m, wo, wi),
             Bsdf::GltfPbr(m) => rgb_lobes(m, wo, wi),
+            Bsdf::Retroreflective(m) => rgb_lobes(m, wo, wi),
         }
     }
 
@@ -497,7 +514,10 @@ impl Bsdf {
     ///   `min_alpha` (roughness at least `sqrt(min_alpha)`);
     /// - [`Diffuse`] and a transmissive [`GltfPbr`] are returned unchanged (the latter's
     ///   roughness is also its transmission's: roughening it would turn a smooth pane's delta
-    ///   transmission into a rough one).
+    ///   transmission into a rough one);
+    /// - [`Retroreflective`]: its GGX lobe as [`Ggx`]'s, and its cone at least `2 min_alpha`
+    ///   radians wide (a GGX lobe of alpha `a` is about `2 a` wide about the mirror
+    ///   direction).
     #[inline]
     pub fn roughened(self, min_alpha: f32) -> Self {
         match self {
@@ -514,6 +534,14 @@ impl Bsdf {
                 let a = min_alpha.max(MIN_ALPHA);
                 Bsdf::BlinnPhong(BlinnPhong {
                     shininess: m.shininess.min(2.0 / (a * a) - 2.0),
+                    ..m
+                })
+            }
+            Bsdf::Retroreflective(m) => {
+                let a = min_alpha.max(MIN_ALPHA);
+                Bsdf::Retroreflective(Retroreflective {
+                    alpha: m.alpha.max(min_alpha),
+                    exponent: m.exponent.min(Retroreflective::exponent_for_width(2.0 * a)),
                     ..m
                 })
             }
@@ -571,6 +599,10 @@ mod tests {
     pub(super) const ANGLES: [f32; 5] = [0.0, 45.0, 75.0, 85.0, 88.0];
     pub(super) const ALPHAS: [f32; 4] = [0.02, 0.1, 0.3, 0.7];
     pub(super) const SHININESS: [f32; 3] = [10.0, 100.0, 1000.0];
+    /// [`Retroreflective`]'s exponents: a wide cone, and one 1.8 degrees wide.
+    pub(super) const RETRO_EXPONENTS: [f32; 2] = [30.0, 1000.0];
+    /// [`Retroreflective`]'s chi-square materials.
+    pub(super) const RETRO_MATERIALS: usize = 2;
     pub(super) const MIXED_ANGLES: [f32; 3] = [0.0, 75.0, 88.0];
     pub(super) const GLTF_ROUGHNESS: [f32; 3] = [0.15, 0.5, 1.0];
     pub(super) const GLTF_ANGLES: [f32; 4] = [0.0, 45.0, 85.0, 88.0];
@@ -583,7 +615,9 @@ mod tests {
         + GLTF_VARIANTS * GLTF_VARIANT_ANGLES.len()
         + 2
         + ROUGHENED_MODELS * ROUGHENED_ANGLES.len()
-        + COAT_NORMALS * COAT_NORMAL_ANGLES.len();
+        + COAT_NORMALS * COAT_NORMAL_ANGLES.len()
+        + RETRO_MATERIALS * RETRO_EXPONENTS.len() * MIXED_ANGLES.len()
+        + 1;
     /// The tilted coat normals' chi-square tests: materials and angles.
     pub(super) const COAT_NORMALS: usize = 2;
     pub(super) const COAT_NORMAL_ANGLES: [f32; 3] = [0.0, 50.0, 80.0];
@@ -731,6 +765,15 @@ mod tests {
         v.extend(gltf_variants().map(Bsdf::GltfPbr));
         for shininess in [5.0, 200.0] {
             v.push(Bsdf::BlinnPhong(BlinnPhong { kd, ks, shininess }));
+        }
+        for (alpha, exponent) in [(0.05, 2000.0), (0.3, 40.0)] {
+            v.push(Bsdf::Retroreflective(Retroreflective {
+                kd,
+                ks: ks * 0.3,
+                alpha,
+                kr: Vec3::new(0.1, 0.2, 0.05),
+                exponent,
+            }));
         }
         v
     }
@@ -913,7 +956,7 @@ mod tests {
                     assert!((m.clearcoat_roughness.powi(2) - alpha).abs() < 1e-6);
                 }
             }
-            Bsdf::Diffuse(_) => unreachable!(),
+            Bsdf::Diffuse(_) | Bsdf::Retroreflective(_) => unreachable!(),
         };
         for b in sharp_models() {
             check(b.roughened(0.41), 0.41);

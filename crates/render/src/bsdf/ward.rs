@@ -60,6 +60,7 @@ impl Model for Ward {
             diffuse: self.kd,
             glossy: self.ks,
             sheen: Vec3::ZERO,
+            retro: Vec3::ZERO,
         }
     }
 

@@ -75,7 +75,10 @@
 //!   A specularFactor of 0 (Blender's Specular IOR Level 0) is exactly Lambertian. Unless
 //!   `extras.streaks` chooses one of the paper's models: `{"bsdf": "ggx" | "ward" | "blinn_phong", "kd": [r,g,b], "ks": [r,g,b],
 //!   "alpha": a, "shininess": s}` (`alpha` for ggx and ward, `shininess` for blinn_phong;
-//!   `kd` and `ks` default to black). The baseColorTexture, if any, multiplies `kd`.
+//!   `kd` and `ks` default to black). The baseColorTexture, if any, multiplies `kd`. A `ggx`
+//!   material may add glass beads, `"kr": [r,g,b]` (each at most 1) and `"retro_width": w`
+//!   (radians, in (0, 1], default 0.026): bead paint, [`crate::bsdf::Retroreflective`], whose
+//!   cone of width `w` sends light back toward its source (road markings under headlights).
 //!   `extras.streaks.road: true` (with a paper model, or alone on a metallic-roughness
 //!   material) flags the road surface ([`crate::material::Material::road`]), which the
 //!   integrator's `material` layer lets datasets mask; it changes no pixel.

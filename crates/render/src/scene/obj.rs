@@ -304,6 +304,7 @@ fn convert_material(
             shininess,
             kd_texture,
             wetness: None,
+            retro: None,
         }
     } else {
         Reflectance::Diffuse { kd, kd_texture }

@@ -5,7 +5,7 @@
 use super::textures::{JsonTextureInfo, UvTransform};
 use super::Loader;
 use crate::material::{
-    Alpha, AlphaMode, GltfPbrParams, Material, PaperModel, Reflectance, Volume, Wetness,
+    Alpha, AlphaMode, GltfPbrParams, Material, PaperModel, Reflectance, Retro, Volume, Wetness,
 };
 use crate::normal_map::NormalMap;
 use crate::scene::{validate, SceneError};
@@ -38,6 +38,13 @@ pub(super) struct StreaksExtras {
     alpha_dry: Option<f32>,
     #[serde(default)]
     ks_dry: Option<[f32; 3]>,
+    /// Glass beads' retroreflectance (ggx only; see [`crate::bsdf::Retroreflective`]).
+    #[serde(default)]
+    kr: Option<[f32; 3]>,
+    /// The beads' retroreflective cone's width, radians (default
+    /// [`crate::bsdf::BEAD_CONE_WIDTH`]).
+    #[serde(default)]
+    retro_width: Option<f32>,
 }
 
 #[derive(Clone, Copy, Debug, Deserialize)]
@@ -677,6 +684,8 @@ impl Loader<'_> {
             ("shininess", x.shininess.is_some()),
             ("alpha_dry", x.alpha_dry.is_some()),
             ("ks_dry", x.ks_dry.is_some()),
+            ("kr", x.kr.is_some()),
+            ("retro_width", x.retro_width.is_some()),
         ];
         if x.bsdf.is_none() {
             if let Some((key, _)) = paper_keys.iter().find(|(_, given)| *given) {
@@ -731,6 +740,33 @@ impl Loader<'_> {
                 None => return Err(bad("blinn_phong needs \"shininess\"".into())),
             },
         };
+        let retro = match (x.kr, x.retro_width) {
+            (None, None) => None,
+            (None, Some(_)) => return Err(bad("retro_width needs \"kr\"".into())),
+            (Some(_), _) if model != PaperModel::Ggx => {
+                return Err(bad(format!(
+                    "kr (glass beads) is only for \"ggx\", not {model:?}"
+                )));
+            }
+            (Some(kr), width) => {
+                let kr = colour(Some(kr), "kr")?;
+                let width = width.unwrap_or(crate::bsdf::BEAD_CONE_WIDTH);
+                if !(width.is_finite() && width > 0.0 && width <= 1.0) {
+                    return Err(bad(format!(
+                        "retro_width {width} must be in (0, 1] radians"
+                    )));
+                }
+                if kr.max_element() > 1.0 {
+                    return Err(bad(format!(
+                        "kr {kr} must be at most 1 (the cone's albedo)"
+                    )));
+                }
+                Some(Retro {
+                    kr,
+                    exponent: crate::bsdf::Retroreflective::exponent_for_width(width),
+                })
+            }
+        };
         let wetness = match x.alpha_dry {
             None => None,
             Some(a)
@@ -760,6 +796,7 @@ impl Loader<'_> {
             shininess,
             kd_texture,
             wetness,
+            retro,
         })
     }
 }
@@ -887,6 +924,54 @@ mod tests {
         doc["materials"][0]["extras"]["streaks"]["alpha_dry"] = json!(0.3);
         let err = load_err(doc, &bin);
         assert!(err.contains("metallicRoughnessTexture"), "{err}");
+    }
+
+    /// `kr` gives a ggx material glass beads (bead paint), with the cone's width from
+    /// `retro_width`; bad values and other models are errors that say why.
+    #[test]
+    fn glass_beads_make_bead_paint() {
+        let (mut doc, bin) = test_doc();
+        doc["materials"][0]["extras"]["streaks"]["kr"] = json!([0.002, 0.002, 0.0015]);
+        doc["materials"][0]["extras"]["streaks"]["retro_width"] = json!(0.02);
+        let dir = tempfile::tempdir().unwrap();
+        let scene = Scene::load(&write_embedded(dir.path(), doc, &bin)).unwrap();
+        let at = VertexAttributes::from_uv(Vec2::new(0.5, 0.5));
+        let crate::bsdf::Bsdf::Retroreflective(paint) =
+            scene.materials[0].bsdf_at(&at, &scene.textures)
+        else {
+            panic!("not bead paint")
+        };
+        assert_eq!(paint.kr, Vec3::new(0.002, 0.002, 0.0015));
+        assert!((paint.exponent - 2500.0).abs() < 0.5, "{}", paint.exponent);
+        assert_eq!(paint.alpha, 0.05);
+        let paper = "/materials/0/extras/streaks";
+        rejects(&[
+            (
+                "/materials/0/extras/streaks/kr",
+                json!([0.1, -0.1, 0.1]),
+                &["asphalt", "kr", "non-negative"],
+            ),
+            (
+                "/materials/0/extras/streaks/kr",
+                json!([2.0, 0.1, 0.1]),
+                &["asphalt", "kr", "at most 1"],
+            ),
+            (
+                "/materials/0/extras/streaks/retro_width",
+                json!(0.1),
+                &["asphalt", "retro_width needs \"kr\""],
+            ),
+            (
+                paper,
+                json!({"bsdf": "ward", "alpha": 0.1, "kr": [0.01, 0.01, 0.01]}),
+                &["asphalt", "only for \"ggx\""],
+            ),
+            (
+                paper,
+                json!({"bsdf": "ggx", "alpha": 0.1, "kr": [0.01, 0.01, 0.01], "retro_width": 0}),
+                &["asphalt", "retro_width 0"],
+            ),
+        ]);
     }
 
     #[test]
