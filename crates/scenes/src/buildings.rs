@@ -120,38 +120,15 @@ impl Default for BuildingsConfig {
 impl BuildingsConfig {
     /// Checks every value; the error names the key (`buildings.storeys`, ...).
     pub fn validate(&self) -> Result<(), String> {
-        let real = |name: &str, r: Range, lo: f64, hi: f64| -> Result<(), String> {
-            if r.iter().all(|v| v.is_finite() && (lo..=hi).contains(v)) && r[0] <= r[1] {
-                Ok(())
-            } else {
-                Err(format!(
-                    "buildings.{name} = [{}, {}] must be a range within [{lo}, {hi}]",
-                    r[0], r[1]
-                ))
-            }
-        };
-        let prob = |name: &str, p: f64| -> Result<(), String> {
-            if p.is_finite() && (0.0..=1.0).contains(&p) {
-                Ok(())
-            } else {
-                Err(format!(
-                    "buildings.{name} = {p} must be a probability in [0, 1]"
-                ))
-            }
-        };
-        real("storey_height", self.storey_height, 2.4, 6.0)?;
-        real("ground_floor_height", self.ground_floor_height, 2.6, 8.0)?;
-        let s = self.storeys;
-        if s[0] > s[1] || s[1] > 40 {
-            return Err(format!(
-                "buildings.storeys = {s:?} must be [min, max] with min <= max <= 40"
-            ));
-        }
-        real("depth", self.depth, 3.0, 100.0)?;
-        prob("recess", self.recess)?;
-        real("recess_depth", self.recess_depth, 0.0, 10.0)?;
-        prob("upper_setback", self.upper_setback)?;
-        real("upper_setback_depth", self.upper_setback_depth, 0.5, 10.0)?;
+        let check = crate::check::Section("buildings");
+        check.range("storey_height", self.storey_height, 2.4, 6.0)?;
+        check.range("ground_floor_height", self.ground_floor_height, 2.6, 8.0)?;
+        check.count("storeys", self.storeys, 40)?;
+        check.range("depth", self.depth, 3.0, 100.0)?;
+        check.prob("recess", self.recess)?;
+        check.range("recess_depth", self.recess_depth, 0.0, 10.0)?;
+        check.prob("upper_setback", self.upper_setback)?;
+        check.range("upper_setback_depth", self.upper_setback_depth, 0.5, 10.0)?;
         if self.upper_setback_depth[1] > self.depth[0] - 2.0 {
             return Err(format!(
                 "buildings.upper_setback_depth = {:?} must leave 2 m of the shallowest block \
@@ -159,17 +136,17 @@ impl BuildingsConfig {
                 self.upper_setback_depth, self.depth[0]
             ));
         }
-        real("bay_width", self.bay_width, 1.2, 10.0)?;
-        real("window_width", self.window_width, 0.3, 9.0)?;
-        real("window_height", self.window_height, 0.3, 5.0)?;
-        real("window_depth", self.window_depth, 0.02, 1.0)?;
-        prob("mullions", self.mullions)?;
-        prob("balconies", self.balconies)?;
-        prob("shop_fronts", self.shop_fronts)?;
-        prob("awnings", self.awnings)?;
-        prob("lit_signs", self.lit_signs)?;
-        real("sign_luminance", self.sign_luminance, 0.0, 1e5)?;
-        prob("cornice", self.cornice)?;
+        check.range("bay_width", self.bay_width, 1.2, 10.0)?;
+        check.range("window_width", self.window_width, 0.3, 9.0)?;
+        check.range("window_height", self.window_height, 0.3, 5.0)?;
+        check.range("window_depth", self.window_depth, 0.02, 1.0)?;
+        check.prob("mullions", self.mullions)?;
+        check.prob("balconies", self.balconies)?;
+        check.prob("shop_fronts", self.shop_fronts)?;
+        check.prob("awnings", self.awnings)?;
+        check.prob("lit_signs", self.lit_signs)?;
+        check.range("sign_luminance", self.sign_luminance, 0.0, 1e5)?;
+        check.prob("cornice", self.cornice)?;
         let w = &self.materials;
         if w.is_empty() || w.values().any(|v| !(v.is_finite() && *v >= 0.0)) {
             return Err(

@@ -20,6 +20,7 @@
 
 pub mod albedo;
 pub mod buildings;
+mod check;
 pub mod crosscheck;
 pub mod drive;
 pub mod estimate;

@@ -505,32 +505,7 @@ impl GeneratorConfig {
 
     /// Checks every range (`min <= max`, finite, within physical bounds) and probability.
     pub fn validate(&self) -> Result<(), String> {
-        let real = |name: &str, r: Range, lo: f64, hi: f64| -> Result<(), String> {
-            if !(r[0].is_finite() && r[1].is_finite() && r[0] <= r[1]) {
-                return Err(format!(
-                    "{name} = {r:?} is not a range [min, max] with min <= max"
-                ));
-            }
-            if r[0] < lo || r[1] > hi {
-                return Err(format!("{name} = {r:?} must lie within [{lo}, {hi}]"));
-            }
-            Ok(())
-        };
-        let count = |name: &str, r: CountRange, hi: u32| -> Result<(), String> {
-            if r[0] > r[1] || r[1] > hi {
-                return Err(format!(
-                    "{name} = {r:?} must be [min, max] with min <= max <= {hi}"
-                ));
-            }
-            Ok(())
-        };
-        let prob = |name: &str, p: f64| -> Result<(), String> {
-            if (0.0..=1.0).contains(&p) {
-                Ok(())
-            } else {
-                Err(format!("{name} = {p} must be a probability in [0, 1]"))
-            }
-        };
+        let check = crate::check::Section("");
         let weights = |name: &str, w: &BTreeMap<LightSource, f64>| -> Result<(), String> {
             if w.is_empty() || w.values().any(|v| !(v.is_finite() && *v >= 0.0)) {
                 return Err(format!(
@@ -543,50 +518,50 @@ impl GeneratorConfig {
             Ok(())
         };
         let s = &self.street;
-        count("street.lanes", s.lanes, 8)?;
+        check.count("street.lanes", s.lanes, 8)?;
         if s.lanes[0] == 0 {
             return Err("street.lanes must be at least 1".into());
         }
-        real("street.lane_width", s.lane_width, 2.0, 6.0)?;
-        real("street.kerb", s.kerb, 0.02, 0.5)?;
-        real("street.pavement", s.pavement, 0.5, 20.0)?;
-        real("street.length", s.length, 30.0, 500.0)?;
-        real("street.block_length", s.block_length, 3.0, 200.0)?;
-        real("street.block_height", s.block_height, 2.5, 200.0)?;
-        real("street.facade_brightness", s.facade_brightness, 0.0, 3.0)?;
-        real("street.lit_windows", s.lit_windows, 0.0, 1.0)?;
-        real("street.cool_windows", s.cool_windows, 0.0, 1.0)?;
-        real("street.lit_shops", s.lit_shops, 0.0, 1.0)?;
-        real("street.window_luminance", s.window_luminance, 0.0, 1e5)?;
-        real("street.shop_luminance", s.shop_luminance, 0.0, 1e5)?;
-        prob("street.poles", s.poles)?;
+        check.range("street.lane_width", s.lane_width, 2.0, 6.0)?;
+        check.range("street.kerb", s.kerb, 0.02, 0.5)?;
+        check.range("street.pavement", s.pavement, 0.5, 20.0)?;
+        check.range("street.length", s.length, 30.0, 500.0)?;
+        check.range("street.block_length", s.block_length, 3.0, 200.0)?;
+        check.range("street.block_height", s.block_height, 2.5, 200.0)?;
+        check.range("street.facade_brightness", s.facade_brightness, 0.0, 3.0)?;
+        check.range("street.lit_windows", s.lit_windows, 0.0, 1.0)?;
+        check.range("street.cool_windows", s.cool_windows, 0.0, 1.0)?;
+        check.range("street.lit_shops", s.lit_shops, 0.0, 1.0)?;
+        check.range("street.window_luminance", s.window_luminance, 0.0, 1e5)?;
+        check.range("street.shop_luminance", s.shop_luminance, 0.0, 1e5)?;
+        check.prob("street.poles", s.poles)?;
         let l = &self.lamps;
-        real("lamps.spacing", l.spacing, 5.0, 500.0)?;
-        real("lamps.height", l.height, 3.0, 20.0)?;
-        real("lamps.lens", l.lens, 0.02, 1.0)?;
+        check.range("lamps.spacing", l.spacing, 5.0, 500.0)?;
+        check.range("lamps.height", l.height, 3.0, 20.0)?;
+        check.range("lamps.lens", l.lens, 0.02, 1.0)?;
         weights("lamps.types", &l.types)?;
-        real("lamps.intensity", l.intensity, 0.0, 1e6)?;
-        prob("lamps.both_sides", l.both_sides)?;
+        check.range("lamps.intensity", l.intensity, 0.0, 1e6)?;
+        check.prob("lamps.both_sides", l.both_sides)?;
         let c = &self.cars;
-        count("cars.parked", c.parked, 40)?;
-        count("cars.ahead", c.ahead, 8)?;
-        count("cars.oncoming", c.oncoming, 8)?;
-        real("cars.headlight_intensity", c.headlight_intensity, 0.0, 1e5)?;
+        check.count("cars.parked", c.parked, 40)?;
+        check.count("cars.ahead", c.ahead, 8)?;
+        check.count("cars.oncoming", c.oncoming, 8)?;
+        check.range("cars.headlight_intensity", c.headlight_intensity, 0.0, 1e5)?;
         weights("cars.headlight_types", &c.headlight_types)?;
         let t = &self.traffic;
-        count("traffic.traffic_lights", t.traffic_lights, 8)?;
-        real("traffic.signal_intensity", t.signal_intensity, 0.0, 1e5)?;
-        count("traffic.signs", t.signs, 20)?;
+        check.count("traffic.traffic_lights", t.traffic_lights, 8)?;
+        check.range("traffic.signal_intensity", t.signal_intensity, 0.0, 1e5)?;
+        check.count("traffic.signs", t.signs, 20)?;
         let w = &self.wetness;
-        real("wetness.level", w.level, 0.0, 1.0)?;
-        real("wetness.asphalt_kd", w.asphalt_kd, 0.0, 1.0)?;
-        real("wetness.ks_wet", w.ks_wet, 0.0, 1.0)?;
-        real("wetness.alpha_wet", w.alpha_wet, 0.001, 1.0)?;
-        real("wetness.ks_dry", w.ks_dry, 0.0, 1.0)?;
-        real("wetness.alpha_dry", w.alpha_dry, 0.001, 1.0)?;
-        prob("wetness.ripples", w.ripples)?;
-        real("wetness.ripple_strength", w.ripple_strength, 0.0, 2.0)?;
-        real("wetness.ripple_tile", w.ripple_tile, 0.05, 20.0)?;
+        check.range("wetness.level", w.level, 0.0, 1.0)?;
+        check.range("wetness.asphalt_kd", w.asphalt_kd, 0.0, 1.0)?;
+        check.range("wetness.ks_wet", w.ks_wet, 0.0, 1.0)?;
+        check.range("wetness.alpha_wet", w.alpha_wet, 0.001, 1.0)?;
+        check.range("wetness.ks_dry", w.ks_dry, 0.0, 1.0)?;
+        check.range("wetness.alpha_dry", w.alpha_dry, 0.001, 1.0)?;
+        check.prob("wetness.ripples", w.ripples)?;
+        check.range("wetness.ripple_strength", w.ripple_strength, 0.0, 2.0)?;
+        check.range("wetness.ripple_tile", w.ripple_tile, 0.05, 20.0)?;
         let r = &self.rig;
         if r.lanes.is_empty() || r.lanes.iter().any(|w| !(w.is_finite() && *w >= 0.0)) {
             return Err(format!(
@@ -610,26 +585,26 @@ impl GeneratorConfig {
                     m.weight
                 ));
             }
-            real(&format!("rig.vehicles.{name}.height"), m.height, 0.2, 10.0)?;
+            check.range(&format!("rig.vehicles.{name}.height"), m.height, 0.2, 10.0)?;
         }
-        real("rig.lateral", r.lateral, -3.0, 3.0)?;
-        real("rig.pitch_deg", r.pitch_deg, -30.0, 30.0)?;
-        real("rig.roll_deg", r.roll_deg, -30.0, 30.0)?;
-        real("rig.baseline", r.baseline, 0.001, 5.0)?;
-        real("rig.focal_mm35", r.focal_mm35, 8.0, 400.0)?;
-        prob("rig.headlights", r.headlights)?;
+        check.range("rig.lateral", r.lateral, -3.0, 3.0)?;
+        check.range("rig.pitch_deg", r.pitch_deg, -30.0, 30.0)?;
+        check.range("rig.roll_deg", r.roll_deg, -30.0, 30.0)?;
+        check.range("rig.baseline", r.baseline, 0.001, 5.0)?;
+        check.range("rig.focal_mm35", r.focal_mm35, 8.0, 400.0)?;
+        check.prob("rig.headlights", r.headlights)?;
         let q = &self.sequence;
         if !(q.fps.is_finite() && (0.1..=1000.0).contains(&q.fps)) {
             return Err(format!("sequence.fps = {} must be in [0.1, 1000]", q.fps));
         }
-        real("sequence.speed_kmh", q.speed_kmh, 0.0, 250.0)?;
-        real(
+        check.range("sequence.speed_kmh", q.speed_kmh, 0.0, 250.0)?;
+        check.range(
             "sequence.traffic_speed_kmh",
             q.traffic_speed_kmh,
             0.0,
             250.0,
         )?;
-        real("exposure.ev", self.exposure.ev, -20.0, 20.0)?;
+        check.range("exposure.ev", self.exposure.ev, -20.0, 20.0)?;
         let d = &self.dataset;
         if d.pairs_per_street == 0 || d.pairs_per_street > 100 {
             return Err(format!(
@@ -656,7 +631,7 @@ impl GeneratorConfig {
         self.objects.validate()?;
         {
             let sky = &self.sky;
-            real("sky.glow", sky.glow, 0.0, 100.0)?;
+            check.range("sky.glow", sky.glow, 0.0, 100.0)?;
             if !sky
                 .color
                 .iter()
@@ -1299,6 +1274,7 @@ fn random_street(
         features: drawn_road.features,
         car_models: Vec::new(),
         furniture: Vec::new(),
+        lamp_models: Vec::new(),
     };
     // Nothing stands in a side street's mouth.
     {
@@ -1563,6 +1539,65 @@ mod tests {
         (json, s)
     }
 
+    /// A generated street's lamps are library designs (each counted in `meta.json`, each with
+    /// its lights), its markings bead paint measuring the drawn `R_L`, and the rig's vehicle
+    /// has its two headlights; with `rig.headlights = 0` it has none, and every other light
+    /// is the same.
+    #[test]
+    fn generated_streets_have_lamp_designs_bead_paint_and_headlights() {
+        let config = GeneratorConfig::default();
+        let (gltf, s) = read(&config);
+        let names: Vec<&str> = gltf["extensions"]["KHR_lights_punctual"]["lights"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|l| l["name"].as_str().unwrap())
+            .collect();
+        let designs = s.params["objects"]["lamp_designs"].as_object().unwrap();
+        let lamps: u64 = designs.values().map(|v| v.as_u64().unwrap()).sum();
+        let twin = designs.get("twin_arm").map_or(0, |v| v.as_u64().unwrap());
+        let lamp_lights = names
+            .iter()
+            .filter(|n| n.starts_with("street_lamp_"))
+            .count();
+        assert!(lamps > 0);
+        assert_eq!(lamp_lights as u64, lamps + twin, "{names:?}");
+        let ego: Vec<_> = names
+            .iter()
+            .filter(|n| n.starts_with("ego_headlight_"))
+            .collect();
+        assert_eq!(ego.len(), 2, "{names:?}");
+        assert_eq!(s.params["rig"]["headlights"], true);
+        let paint = gltf["materials"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|m| m["name"] == "road_paint")
+            .expect("painted markings");
+        let rl = s.params["road"]["paint_rl_mcd"].as_f64().unwrap();
+        let kr = paint["extras"]["streaks"]["kr"][0].as_f64().unwrap();
+        let want = crate::gltf_writer::Beads::for_rl(rl).kr;
+        assert!(rl > 0.0 && (kr - want).abs() < 1e-9, "{kr} vs {want}");
+        let dark = GeneratorConfig {
+            rig: RigConfig {
+                headlights: 0.0,
+                ..RigConfig::default()
+            },
+            ..GeneratorConfig::default()
+        };
+        let (gltf_dark, s_dark) = read(&dark);
+        let dark_names: Vec<&str> = gltf_dark["extensions"]["KHR_lights_punctual"]["lights"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|l| l["name"].as_str().unwrap())
+            .collect();
+        let others: Vec<&&str> = names.iter().filter(|n| !n.starts_with("ego_")).collect();
+        assert_eq!(dark_names.iter().collect::<Vec<_>>(), others);
+        assert_eq!(s_dark.params["rig"]["headlights"], false);
+        assert_eq!(s_dark.params["road"], s.params["road"]);
+    }
+
     /// Removes `scenes[0].extras.streaks.KEY`.
     fn without(mut gltf: serde_json::Value, key: &str) -> serde_json::Value {
         if let Some(streaks) = gltf["scenes"][0]["extras"]["streaks"].as_object_mut() {
@@ -1720,8 +1755,8 @@ mod tests {
                 "{lens_intensity} vs {i_y}"
             );
         }
-        // In the file: every street lamp a downward spot whose candela times its colour's
-        // luminance is the drawn intensity x 683.
+        // In the file: every street lamp a downward spot (a post-top lantern: a point light)
+        // whose candela times its colour's luminance is the drawn intensity x 683.
         let (gltf, s) = read(&config);
         let i_cd = s.params["lamps"]["intensity_cd"].as_f64().unwrap();
         let lights = gltf["extensions"]["KHR_lights_punctual"]["lights"]
@@ -1733,9 +1768,12 @@ mod tests {
             .collect();
         assert!(!lamps.is_empty());
         for l in lamps {
-            assert_eq!(l["type"], "spot");
-            let outer = l["spot"]["outerConeAngle"].as_f64().unwrap();
-            assert!((outer.to_degrees() - 85.0).abs() < 1e-4, "{outer}");
+            if l["type"] == "spot" {
+                let outer = l["spot"]["outerConeAngle"].as_f64().unwrap();
+                assert!((outer.to_degrees() - 85.0).abs() < 1e-4, "{outer}");
+            } else {
+                assert_eq!(l["type"], "point");
+            }
             let color: [f64; 3] = serde_json::from_value(l["color"].clone()).unwrap();
             let cd = l["intensity"].as_f64().unwrap() * luminance(color);
             assert!((cd / i_cd - 1.0).abs() < 1e-5, "{cd} cd vs {i_cd}");

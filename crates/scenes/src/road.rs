@@ -677,68 +677,43 @@ pub struct DrawnRoad {
 impl RoadConfig {
     /// Checks every range and probability.
     pub fn validate(&self) -> Result<(), String> {
-        let real = |name: &str, r: Range, lo: f64, hi: f64| -> Result<(), String> {
-            if r.iter().all(|v| v.is_finite() && (lo..=hi).contains(v)) && r[0] <= r[1] {
-                Ok(())
-            } else {
-                Err(format!(
-                    "road.{name} = [{}, {}] must be a range within [{lo}, {hi}]",
-                    r[0], r[1]
-                ))
-            }
-        };
-        let prob = |name: &str, p: f64| -> Result<(), String> {
-            if p.is_finite() && (0.0..=1.0).contains(&p) {
-                Ok(())
-            } else {
-                Err(format!("road.{name} = {p} must be a probability in [0, 1]"))
-            }
-        };
-        let count = |name: &str, r: CountRange, hi: u32| -> Result<(), String> {
-            if r[0] <= r[1] && r[1] <= hi {
-                Ok(())
-            } else {
-                Err(format!(
-                    "road.{name} = {r:?} must be [min, max] with min <= max <= {hi}"
-                ))
-            }
-        };
-        prob("curve", self.curve)?;
+        let check = crate::check::Section("road");
+        check.prob("curve", self.curve)?;
         // Tighter than 40 m and the buildings' backs (up to ~25 m out) fold over.
-        real("radius", self.radius, 40.0, 1e5)?;
-        real("curve_start", self.curve_start, -50.0, 500.0)?;
-        real("transition", self.transition, 0.0, 500.0)?;
-        prob("hill", self.hill)?;
-        real("grade", self.grade, -0.15, 0.15)?;
-        real("grade_change", self.grade_change, -0.2, 0.2)?;
-        real(
+        check.range("radius", self.radius, 40.0, 1e5)?;
+        check.range("curve_start", self.curve_start, -50.0, 500.0)?;
+        check.range("transition", self.transition, 0.0, 500.0)?;
+        check.prob("hill", self.hill)?;
+        check.range("grade", self.grade, -0.15, 0.15)?;
+        check.range("grade_change", self.grade_change, -0.2, 0.2)?;
+        check.range(
             "vertical_curve_start",
             self.vertical_curve_start,
             -50.0,
             500.0,
         )?;
-        real(
+        check.range(
             "vertical_curve_length",
             self.vertical_curve_length,
             1.0,
             1000.0,
         )?;
-        real("cross_fall", self.cross_fall, -0.08, 0.08)?;
-        real("crown", self.crown, 0.0, 0.08)?;
-        count("potholes", self.potholes, 50)?;
-        real("pothole_radius", self.pothole_radius, 0.05, 1.5)?;
-        real("pothole_depth", self.pothole_depth, 0.0, 0.3)?;
-        real("rut_depth", self.rut_depth, 0.0, 0.05)?;
-        prob("tracks", self.tracks)?;
-        count("junctions", self.junctions, 6)?;
-        real("junction_width", self.junction_width, 3.0, 20.0)?;
-        prob("crossroads", self.crossroads)?;
-        count("crosswalks", self.crosswalks, 10)?;
-        real("crosswalk_length", self.crosswalk_length, 1.0, 10.0)?;
-        real("paint_albedo", self.paint_albedo, 0.0, 1.0)?;
-        real("paint_wear", self.paint_wear, 0.0, 1.0)?;
-        real("paint_wet", self.paint_wet, 0.0, 1.0)?;
-        real("paint_rl_mcd", self.paint_rl_mcd, 0.0, 2000.0)
+        check.range("cross_fall", self.cross_fall, -0.08, 0.08)?;
+        check.range("crown", self.crown, 0.0, 0.08)?;
+        check.count("potholes", self.potholes, 50)?;
+        check.range("pothole_radius", self.pothole_radius, 0.05, 1.5)?;
+        check.range("pothole_depth", self.pothole_depth, 0.0, 0.3)?;
+        check.range("rut_depth", self.rut_depth, 0.0, 0.05)?;
+        check.prob("tracks", self.tracks)?;
+        check.count("junctions", self.junctions, 6)?;
+        check.range("junction_width", self.junction_width, 3.0, 20.0)?;
+        check.prob("crossroads", self.crossroads)?;
+        check.count("crosswalks", self.crosswalks, 10)?;
+        check.range("crosswalk_length", self.crosswalk_length, 1.0, 10.0)?;
+        check.range("paint_albedo", self.paint_albedo, 0.0, 1.0)?;
+        check.range("paint_wear", self.paint_wear, 0.0, 1.0)?;
+        check.range("paint_wet", self.paint_wet, 0.0, 1.0)?;
+        check.range("paint_rl_mcd", self.paint_rl_mcd, 0.0, 2000.0)
     }
 
     /// Draws a street's road for a carriageway of `lanes` lanes `lane_width` wide, modelled

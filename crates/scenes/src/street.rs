@@ -281,6 +281,10 @@ pub struct Street {
     pub car_models: Vec<Model>,
     /// Street furniture on the pavements (trees, bus stops, bollards, the user's assets).
     pub furniture: Vec<Furniture>,
+    /// Models of the street lamps, one per lamp of [`Street::lamps_right`] then
+    /// [`Street::lamps_left`], each standing where that lamp's post is and reaching over the
+    /// road, with its lights; empty: the lamps are the shipped streets' boxes.
+    pub lamp_models: Vec<Model>,
 }
 
 /// A model standing on a pavement: its foot at straight-frame `(x, z)`, on the pavement.
@@ -405,6 +409,7 @@ impl Street {
             features: RoadFeatures::default(),
             car_models: Vec::new(),
             furniture: Vec::new(),
+            lamp_models: Vec::new(),
         }
     }
 
@@ -443,6 +448,7 @@ impl Street {
             features: RoadFeatures::default(),
             car_models: Vec::new(),
             furniture: Vec::new(),
+            lamp_models: Vec::new(),
         }
     }
 
@@ -471,12 +477,7 @@ impl Street {
             }
         }
         for f in &self.furniture {
-            // Level on the pavement, its -Z turned towards the road.
-            let ground = self.road.world(Vec3::new(f.x, self.pavement_y(f.z), f.z)).y;
-            let face = glam::Quat::from_rotation_y(f.x.signum() * std::f32::consts::FRAC_PI_2);
-            let pose = self.road.level_pose(f64::from(-f.z), ground)
-                * Affine3A::from_rotation_translation(face, Vec3::new(f.x, 0.0, f.z));
-            doc.add_model(&f.name, &f.model, pose, None)?;
+            self.add_standing(&mut doc, &f.name, &f.model, f.x, f.z)?;
         }
         for (k, t) in self.traffic_lights.iter().enumerate() {
             add_traffic_light(self, &mut doc, k, t)?;
@@ -1036,6 +1037,18 @@ impl Street {
             .iter()
             .map(|&z| (1.0f32, z))
             .chain(self.lamps_left.iter().map(|&z| (-1.0f32, z)));
+        if !self.lamp_models.is_empty() {
+            for (k, ((side, z), model)) in sides.zip(&self.lamp_models).enumerate() {
+                self.add_standing(
+                    doc,
+                    &format!("street_lamp_{k}"),
+                    model,
+                    side * (half + kerb + 0.5),
+                    z,
+                )?;
+            }
+            return Ok(());
+        }
         for (k, (side, z)) in sides.enumerate() {
             let pole_x = side * (half + kerb + 0.5);
             let head_x = side * (half - 0.9);
@@ -1085,6 +1098,23 @@ impl Street {
             Tag::stuff(Class::LightSource),
         )?;
         Ok(())
+    }
+
+    /// Adds `model` standing level on the pavement at straight-frame `(x, z)`, its -Z (the
+    /// side it shows to traffic, a lamp's arm) turned towards the road.
+    fn add_standing(
+        &self,
+        doc: &mut Doc,
+        name: &str,
+        model: &Model,
+        x: f32,
+        z: f32,
+    ) -> Result<(), Error> {
+        let ground = self.road.world(Vec3::new(x, self.pavement_y(z), z)).y;
+        let face = glam::Quat::from_rotation_y(x.signum() * std::f32::consts::FRAC_PI_2);
+        let pose = self.road.level_pose(f64::from(-z), ground)
+            * Affine3A::from_rotation_translation(face, Vec3::new(x, 0.0, z));
+        doc.add_model(name, model, pose, None)
     }
 
     fn poles(&self, doc: &mut Doc, tex: &Albedos) -> Result<(), Error> {

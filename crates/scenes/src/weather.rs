@@ -255,28 +255,17 @@ pub fn draw(config: &WeatherConfig, street: &mut ChaCha8Rng, sample: &mut ChaCha
 impl WeatherConfig {
     /// Checks every value; the error names the key (`weather.fog.g`, ...).
     pub fn validate(&self) -> Result<(), String> {
-        let real = |name: &str, r: Range, lo: f64, hi: f64| -> Result<(), String> {
-            if r.iter().all(|v| v.is_finite() && (lo..=hi).contains(v)) && r[0] <= r[1] {
-                Ok(())
-            } else {
-                Err(format!(
-                    "weather.{name} = [{}, {}] must be a range within [{lo}, {hi}]",
-                    r[0], r[1]
-                ))
-            }
-        };
+        let check = crate::check::Section("weather");
         if self.rain.is_empty() {
             return Err("weather.rain must list at least one class".into());
         }
         let mut sum = 0.0;
         for (i, c) in self.rain.iter().enumerate() {
-            if !(c.probability.is_finite() && (0.0..=1.0).contains(&c.probability)) {
-                return Err(format!(
-                    "weather.rain[{i}] ({}).probability = {} must be in [0, 1]",
-                    c.name, c.probability
-                ));
-            }
-            real(&format!("rain[{i}] ({}).mm_h", c.name), c.mm_h, 0.0, 500.0)?;
+            check.prob(
+                &format!("rain[{i}] ({}).probability", c.name),
+                c.probability,
+            )?;
+            check.range(&format!("rain[{i}] ({}).mm_h", c.name), c.mm_h, 0.0, 500.0)?;
             sum += c.probability;
         }
         if (sum - 1.0).abs() > 1e-6 {
@@ -289,16 +278,11 @@ impl WeatherConfig {
             ));
         }
         let f = &self.fog;
-        if !(f.probability.is_finite() && (0.0..=1.0).contains(&f.probability)) {
-            return Err(format!(
-                "weather.fog.probability = {} must be in [0, 1]",
-                f.probability
-            ));
-        }
-        real("fog.sigma_t", f.sigma_t, 0.0, 10.0)?;
-        real("fog.albedo", f.albedo, 0.0, 1.0)?;
-        real("fog.g", f.g, -0.99, 0.99)?;
-        real("fog.height_falloff", f.height_falloff, 0.0, 10.0)?;
+        check.prob("fog.probability", f.probability)?;
+        check.range("fog.sigma_t", f.sigma_t, 0.0, 10.0)?;
+        check.range("fog.albedo", f.albedo, 0.0, 1.0)?;
+        check.range("fog.g", f.g, -0.99, 0.99)?;
+        check.range("fog.height_falloff", f.height_falloff, 0.0, 10.0)?;
         if self.sensor.is_empty() {
             return Err("weather.sensor must name at least one preset".into());
         }
@@ -312,7 +296,7 @@ impl WeatherConfig {
         if self.sensor.values().sum::<f64>() <= 0.0 {
             return Err("weather.sensor weights add up to 0".into());
         }
-        real("exposure_s", self.exposure_s, 1e-5, 1.0)?;
+        check.range("exposure_s", self.exposure_s, 1e-5, 1.0)?;
         Ok(())
     }
 }

@@ -127,8 +127,6 @@ pub struct ObjectsConfig {
     pub bus_stops: f64,
     /// Bollards per 100 m of street side.
     pub bollards: Range,
-    /// Share of the shop fronts that have a lit sign.
-    pub shop_signs: f64,
     /// Luminance of a lit shop sign, cd/m^2.
     pub shop_sign_luminance: Range,
     /// The user's glTF assets added to the pool.
@@ -169,7 +167,6 @@ impl Default for ObjectsConfig {
             trees: [0.0, 8.0],
             bus_stops: 0.2,
             bollards: [0.0, 4.0],
-            shop_signs: 0.5,
             shop_sign_luminance: [100.0, 600.0],
             assets: Vec::new(),
         }
@@ -180,40 +177,18 @@ impl ObjectsConfig {
     /// Checks every range, probability and weight table, and each asset entry (not the
     /// files: [`assets::AssetPool::load`] reads them).
     pub fn validate(&self) -> Result<(), String> {
-        let real = |name: &str, r: Range, lo: f64, hi: f64| -> Result<(), String> {
-            if !(r[0].is_finite() && r[1].is_finite() && r[0] <= r[1]) {
-                return Err(format!(
-                    "objects.{name} = {r:?} is not a range [min, max] with min <= max"
-                ));
-            }
-            if r[0] < lo || r[1] > hi {
-                return Err(format!(
-                    "objects.{name} = {r:?} must lie within [{lo}, {hi}]"
-                ));
-            }
-            Ok(())
-        };
-        let prob = |name: &str, p: f64| -> Result<(), String> {
-            if (0.0..=1.0).contains(&p) {
-                Ok(())
-            } else {
-                Err(format!(
-                    "objects.{name} = {p} must be a probability in [0, 1]"
-                ))
-            }
-        };
+        let check = crate::check::Section("objects");
         check_weights("body_types", &self.body_types)?;
         check_weights("paints", &self.paints)?;
         check_weights("lamp_designs", &self.lamp_designs)?;
-        prob("metallic_paint", self.metallic_paint)?;
-        prob("brake_lights", self.brake_lights)?;
-        real("tail_light_cd", self.tail_light_cd, 0.0, 1e3)?;
-        real("brake_light_cd", self.brake_light_cd, 0.0, 1e4)?;
-        real("trees", self.trees, 0.0, 100.0)?;
-        prob("bus_stops", self.bus_stops)?;
-        real("bollards", self.bollards, 0.0, 200.0)?;
-        prob("shop_signs", self.shop_signs)?;
-        real("shop_sign_luminance", self.shop_sign_luminance, 0.0, 1e5)?;
+        check.prob("metallic_paint", self.metallic_paint)?;
+        check.prob("brake_lights", self.brake_lights)?;
+        check.range("tail_light_cd", self.tail_light_cd, 0.0, 1e3)?;
+        check.range("brake_light_cd", self.brake_light_cd, 0.0, 1e4)?;
+        check.range("trees", self.trees, 0.0, 100.0)?;
+        check.prob("bus_stops", self.bus_stops)?;
+        check.range("bollards", self.bollards, 0.0, 200.0)?;
+        check.range("shop_sign_luminance", self.shop_sign_luminance, 0.0, 1e5)?;
         for (k, a) in self.assets.iter().enumerate() {
             a.validate()
                 .map_err(|e| format!("objects.assets[{k}] ({}): {e}", a.path.display()))?;

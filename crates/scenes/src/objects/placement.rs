@@ -1,13 +1,14 @@
 //! Where the generator puts a street's objects: a model for every car (a body type, size, paint
-//! and lamps by its role, or one of the user's assets for a parked car), and trees, bus stops,
+//! and lamps by its role, or one of the user's assets for a parked car), trees, bus stops,
 //! bollards and the user's furniture on the pavements, clear of the lamps, poles, signs and
-//! traffic lights already there.
+//! traffic lights already there, and a design for every street lamp (cobra, post top, twin
+//! arm; `lamp_designs`) standing where the street put it, in the street's lamp light.
 //!
 //! Everything is drawn from one seeded stream per street, so that a config without objects
 //! draws every other parameter as one with them.
 
 use super::assets::{AssetPool, AssetRole};
-use super::furniture::{BollardSpec, BusStopSpec, TreeSpec};
+use super::furniture::{BollardSpec, BusStopSpec, LampDesign, LampLight, StreetLampSpec, TreeSpec};
 use super::vehicle::{Role, TrafficLighting, VehicleSpec};
 use super::ObjectsConfig;
 use crate::model::Model;
@@ -18,6 +19,7 @@ use glam::Affine3A;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use serde_json::{json, Value};
+use std::collections::BTreeMap;
 use std::path::Path;
 
 /// Gap kept between two cars in one lane, metres.
@@ -235,6 +237,21 @@ pub fn place(
         }
     }
     street.furniture = furniture;
+
+    // The street lamps' designs, last in the stream: every draw above keeps its value.
+    let light = LampLight::from(&street.style);
+    // The library's lens is `lens x lens/2` half sizes: the same area as the street's square.
+    let lens = std::f32::consts::SQRT_2 * street.style.lens_half.1;
+    // The lights stand `lamp_height` above the road, the posts on the pavement.
+    let height = street.style.lamp_height - street.style.kerb;
+    let mut designs: BTreeMap<LampDesign, usize> = BTreeMap::new();
+    street.lamp_models = (0..street.lamps_right.len() + street.lamps_left.len())
+        .map(|_| {
+            let spec = StreetLampSpec::draw(rng, config, height, lens, Some(light));
+            *designs.entry(spec.design).or_default() += 1;
+            spec.build()
+        })
+        .collect();
     Ok((
         kept,
         json!({
@@ -243,6 +260,7 @@ pub fn place(
             "bus_stops_placed": stops,
             "bollards_placed": bollards,
             "furniture_placed": others,
+            "lamp_designs": designs,
             "assets": assets_used,
         }),
     ))
