@@ -76,6 +76,7 @@ fn fig2_and_3(args: &Args, out: &Path, index: &mut String) -> Result<()> {
             exposure_ev: 0.0,
             mask: StreakMaskParams::default(),
             motion: Default::default(),
+            albedo: false,
         };
         let bar = crate::cli::progress_bar(w as u64 * h as u64 * args.fig2_spp as u64);
         let view = render_eye(&scene, &rig, Eye::Left, &settings, &|n| bar.inc(n))?;
@@ -234,6 +235,7 @@ fn fig6(args: &Args, out: &Path, index: &mut String) -> Result<Report> {
         exposure_ev: 0.0,
         mask: StreakMaskParams::default(),
         motion: Default::default(),
+        albedo: false,
     };
     let bar = crate::cli::progress_bar(2 * w as u64 * h as u64 * args.fig6_spp as u64);
     let views = render_pair(&scene, &rig, &settings, &|n| bar.inc(n))?;

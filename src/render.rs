@@ -97,10 +97,13 @@ pub fn run(args: Args) -> Result<()> {
     let opts = &args.render;
     opts.check()?;
     let sensor = opts.sensor_profile()?;
+    // The denoiser's guides come with --denoise.
+    let denoiser = opts.denoiser()?;
+    let guides = denoiser.is_some();
     let layers = Layers {
         depth: args.layers.contains(&Layer::Depth),
-        normal: args.layers.contains(&Layer::Normal),
-        albedo: args.layers.contains(&Layer::Albedo),
+        normal: guides || args.layers.contains(&Layer::Normal),
+        albedo: guides || args.layers.contains(&Layer::Albedo),
         specular: args.layers.contains(&Layer::Specular),
         material: args.road_mask.is_some(),
         object: args.layers.contains(&Layer::Object),
@@ -155,9 +158,13 @@ pub fn run(args: Args) -> Result<()> {
     // Phase 3: render and write.
     let pool = opts.thread_pool()?;
     let bar = opts.progress(1, width, height)?;
-    let out: RenderOutput =
+    let mut out: RenderOutput =
         pool.install(|| integrator::render(&scene, &camera, &job, &|n| bar.inc(n)));
     bar.finish_and_clear();
+    if let Some(d) = &denoiser {
+        output::denoise(&mut out, d)
+            .with_context(|| format!("denoising the render of {}", args.scene.display()))?;
+    }
 
     let raw = match &sensor {
         Some(profile) => Some(expose(profile, &out.image, &camera, opts)?),

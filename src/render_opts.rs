@@ -84,6 +84,13 @@ pub struct RenderOpts {
         allow_negative_numbers = true
     )]
     pub rig_velocity: Option<Vec<f32>>,
+    /// Denoise the render with Intel Open Image Denoise, guided by the albedo and normal
+    /// layers (rendered for it): the EXR's `R`, `G`, `B` and the PNGs are the denoised image,
+    /// the EXR's `raw` layer the render before; depth, disparity, masks and the specular
+    /// layer are never denoised. Needs the library: `pip install pyoidn`, or OIDN_LIBRARY
+    /// set to libOpenImageDenoise.so.
+    #[arg(long)]
+    pub denoise: bool,
 }
 
 /// The environment light flags of `streaks render`, `streaks stereo` and `streaks
@@ -173,6 +180,14 @@ impl RenderOpts {
         self.sensor_profile()?;
         self.motion()?;
         self.env.check()
+    }
+
+    /// The denoiser `--denoise` asks for, loaded before anything is rendered (so a missing
+    /// library fails at once); `None` without the flag.
+    pub fn denoiser(&self) -> Result<Option<streaks_image::denoise::Denoiser>> {
+        self.denoise
+            .then(|| streaks_image::denoise::Denoiser::load().context("--denoise"))
+            .transpose()
     }
 
     /// The camera profile of `--sensor`, if given.

@@ -6,7 +6,9 @@ use anyhow::{bail, Context, Result};
 use std::path::PathBuf;
 use streaks_analysis::report::AnalyzeParams;
 use streaks_dataset::write::write_pair;
-use streaks_stereo::render::{expose_pair, render_pair, rig_from_camera, PairSettings};
+use streaks_stereo::render::{
+    denoise_pair, expose_pair, render_pair, rig_from_camera, PairSettings,
+};
 use streaks_stereo::rig::Rig;
 use streaks_stereo::streak_mask::StreakMaskParams;
 
@@ -52,18 +54,24 @@ pub fn run(args: Args) -> Result<()> {
         .with_context(|| format!("the stereo rig of {}", args.scene.display()))?;
     std::fs::create_dir_all(&args.output)
         .with_context(|| format!("cannot create the folder {}", args.output.display()))?;
+    let denoiser = opts.denoiser()?;
     let settings = PairSettings {
         render: opts.settings(),
         seed: opts.seed,
         exposure_ev: opts.exposure,
         mask: StreakMaskParams::default(),
         motion: opts.motion()?,
+        albedo: denoiser.is_some(),
     };
     // Phase 3: render both eyes under one progress bar and write everything.
     let pool = opts.thread_pool()?;
     let bar = opts.progress(2, width, height)?;
     let mut views = pool.install(|| render_pair(&scene, &rig, &settings, &|n| bar.inc(n)))?;
     bar.finish_and_clear();
+    if let Some(d) = &denoiser {
+        denoise_pair(&mut views, d)
+            .with_context(|| format!("denoising the pair of {}", args.scene.display()))?;
+    }
     if let Some(profile) = &sensor {
         pool.install(|| expose_pair(&mut views, &rig, profile, opts.seed, opts.exposure))?;
     }

@@ -83,12 +83,14 @@ def test_arguments_pass_every_flag_through():
         max_depth=5,
         noise_target="0.15",
         no_regularize=True,
+        denoise="on",
+        keep_raw=True,
     )
     assert flags.arguments(Shard(3, 4), 2) == [
         "dataset", "generate", "-o", "/data/set", "--count", "10", "--seed", "7",
         "--config", "/data/street.toml", "--width", "64", "--height", "40", "--spp", "2",
-        "--max-depth", "5", "--noise-target", "0.15", "--no-regularize", "--shard", "3/4",
-        "--threads", "2",
+        "--max-depth", "5", "--noise-target", "0.15", "--denoise", "on", "--no-regularize",
+        "--keep-raw", "--shard", "3/4", "--threads", "2",
     ]  # fmt: skip
 
 

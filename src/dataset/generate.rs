@@ -34,6 +34,7 @@ use streaks_dataset::manifest::{sha256_hex, verify_entry, Difference, Manifest};
 use streaks_dataset::settings::Settings;
 use streaks_dataset::shard::Shard;
 use streaks_dataset::verify::check_sample;
+use streaks_image::denoise::Denoiser;
 use streaks_image::stats::quantile_sorted;
 use streaks_image::write_bytes_atomically;
 use streaks_scenes::procedural::{GeneratorConfig, GENERATOR_VERSION};
@@ -82,6 +83,42 @@ pub struct Args {
     /// in indirect light; see `streaks render --regularize`).
     #[arg(long)]
     pub no_regularize: bool,
+    /// Denoise each eye's image with Intel Open Image Denoise (`streaks render --denoise`):
+    /// `auto` when the library is installed (`pip install pyoidn`, or OIDN_LIBRARY), with a
+    /// warning when it is not; `on` fails without it; `off` keeps the renders as they are.
+    /// Ground truth, masks and the specular layer are never denoised; `dataset.json` and each
+    /// `meta.json` record whether the images are.
+    #[arg(long, value_enum, default_value_t = DenoiseMode::Auto)]
+    pub denoise: DenoiseMode,
+    /// Keep the render before denoising in each EXR (its `raw` layer; dropped by default).
+    #[arg(long)]
+    pub keep_raw: bool,
+}
+
+/// `--denoise`: whether a dataset's images are denoised.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum DenoiseMode {
+    /// When Intel Open Image Denoise is installed.
+    Auto,
+    /// Always; an error without the library.
+    On,
+    /// Never.
+    Off,
+}
+
+/// The denoiser of `--denoise` (`None`: no denoising), loaded before anything is written.
+fn denoiser(mode: DenoiseMode) -> Result<Option<Denoiser>> {
+    match mode {
+        DenoiseMode::Off => Ok(None),
+        DenoiseMode::On => Ok(Some(Denoiser::load().context("--denoise on")?)),
+        DenoiseMode::Auto => match Denoiser::load() {
+            Ok(d) => Ok(Some(d)),
+            Err(e) => {
+                eprintln!("warning: the images are not denoised: {e}");
+                Ok(None)
+            }
+        },
+    }
 }
 
 /// The default cap of samples per pixel per eye (see docs/decisions/0013).
@@ -141,6 +178,10 @@ pub fn run(args: Args) -> Result<()> {
         noise_target: args.noise_target.0,
     };
     render.check().map_err(flag_error)?;
+    let denoiser = denoiser(args.denoise)?;
+    if args.keep_raw && denoiser.is_none() {
+        bail!("--keep-raw keeps the render beside its denoised image: it needs denoising");
+    }
     let config = match &args.config {
         Some(path) => GeneratorConfig::from_toml_file(path)
             .with_context(|| format!("cannot use the config {}", path.display()))?,
@@ -158,6 +199,8 @@ pub fn run(args: Args) -> Result<()> {
             width: args.width,
             height: args.height,
             render,
+            denoise: denoiser.is_some(),
+            keep_raw: args.keep_raw,
         },
         files: FileList::current(),
         conventions: Conventions::current(),
@@ -205,6 +248,7 @@ pub fn run(args: Args) -> Result<()> {
         config_hash,
         seed: args.seed,
         settings: info.settings,
+        denoiser: denoiser.map(std::sync::Arc::new),
     };
     let check = |index: u64| health(&layout, &info, index, manifest.as_ref());
     let bar = progress_bar(indices.len() as u64);

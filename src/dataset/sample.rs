@@ -24,7 +24,8 @@ use streaks_scenes::procedural::{sample, street_frame, GeneratorConfig, GENERATO
 use streaks_sensor::SensorProfile;
 use streaks_stereo::flow::to_f64;
 use streaks_stereo::render::{
-    expose_pair, light_records, render_pair, rig_from_camera, scene_has_road, PairSettings,
+    denoise_pair, expose_pair, light_records, render_pair, rig_from_camera, scene_has_road,
+    PairSettings,
 };
 use streaks_stereo::rig::Eye;
 use streaks_stereo::rigfile::PoseRecord;
@@ -41,6 +42,8 @@ pub struct SampleSettings {
     pub seed: u64,
     /// How the samples are rendered (as `dataset.json` records it).
     pub settings: Settings,
+    /// The denoiser, when [`Settings::denoise`].
+    pub denoiser: Option<std::sync::Arc<streaks_image::denoise::Denoiser>>,
 }
 
 /// What one rendered sample reports.
@@ -150,8 +153,17 @@ fn write_sample(
         exposure_ev: s.exposure_ev,
         mask: StreakMaskParams::default(),
         motion,
+        albedo: settings.denoiser.is_some(),
     };
     let mut views = render_pair(&scene, &rig, &pair, &|_| {})?;
+    if let Some(d) = &settings.denoiser {
+        denoise_pair(&mut views, d)?;
+        if !render.keep_raw {
+            for v in &mut views {
+                v.output.raw = None;
+            }
+        }
+    }
     if let Some(weather) = &s.weather {
         let profile = sample_sensor(&weather.sensor, weather.exposure_s)?;
         // The generator's lights are physical: the radiance goes to the sensor unscaled.
@@ -260,6 +272,7 @@ fn write_sample(
             seed_left: seed,
             seed_right: seed.wrapping_add(1),
             mean_spp: Some([left, right].map(|v| v.output.stats.samples as f64 / pixels)),
+            denoised: settings.denoiser.is_some(),
         },
         weather: s.weather.as_ref().map(|w| WeatherMeta {
             rain_class: w.rain_class.clone(),

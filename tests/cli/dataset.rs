@@ -997,3 +997,56 @@ fn stats_page_shows_the_parameters_and_escapes_what_it_reads() {
     // The page is outside the dataset: its links are file URLs.
     assert!(page.contains("href=\"file:///"));
 }
+
+/// `--denoise`: `on` denoises both eyes (recorded in `dataset.json` and `meta.json`, the EXR
+/// without its raw render unless `--keep-raw`), the disparity and masks are those of `off`,
+/// a dataset is continued only with its own choice, and `--keep-raw` without denoising is
+/// refused. Needs the library (see the render test); skipped without it.
+#[test]
+fn denoised_datasets_record_it_and_keep_their_ground_truth() {
+    if let Err(e) = streaks_image::denoise::Denoiser::load() {
+        assert!(std::env::var_os("STREAKS_REQUIRE_OIDN").is_none(), "{e}");
+        eprintln!("skipped: {e}");
+        return;
+    }
+    let t = TestDir::new();
+    generate_n(&t, "on", "1", &["--denoise", "on"]).assert_success();
+    generate_n(&t, "off", "1", &["--denoise", "off"]).assert_success();
+    generate_n(&t, "raw", "1", &["--denoise", "on", "--keep-raw"]).assert_success();
+    let json = |path: &str| -> serde_json::Value {
+        serde_json::from_slice(&std::fs::read(t.join(path)).unwrap()).unwrap()
+    };
+    for (dir, denoised, keep) in [
+        ("on", true, false),
+        ("off", false, false),
+        ("raw", true, true),
+    ] {
+        let info = json(&format!("{dir}/dataset.json"));
+        assert_eq!(info["denoise"], denoised, "{dir}");
+        assert_eq!(info["keep_raw"], keep, "{dir}");
+        let meta = json(&format!("{dir}/samples/000000/meta.json"));
+        assert_eq!(meta["render"]["denoised"], denoised, "{dir}");
+        let exr = t.join(&format!("{dir}/samples/000000/im0.exr"));
+        assert_eq!(
+            streaks_render::output::read_exr_layer(&exr, "raw").is_ok(),
+            keep,
+            "{dir}"
+        );
+    }
+    let sample = |dir: &str, file: &str| {
+        std::fs::read(t.join(&format!("{dir}/samples/000000/{file}"))).unwrap()
+    };
+    for file in ["disp0.pfm", "streaks0.png", "semantic0.png"] {
+        assert_eq!(sample("on", file), sample("off", file), "{file}");
+    }
+    assert_ne!(sample("on", "im0.png"), sample("off", "im0.png"));
+    // The raw layer is the render of `off`.
+    let raw = streaks_render::output::read_exr_layer(&t.join("raw/samples/000000/im0.exr"), "raw")
+        .unwrap();
+    let plain = streaks_image::exr::read_exr_rgb(&t.join("off/samples/000000/im0.exr")).unwrap();
+    assert_eq!(raw.pixels, plain.pixels);
+    // Continued only with its own choice.
+    generate_n(&t, "on", "1", &["--denoise", "off"]).assert_failure_mentioning("denoise");
+    generate_n(&t, "x", "1", &["--denoise", "off", "--keep-raw"])
+        .assert_failure_mentioning("--keep-raw");
+}

@@ -709,3 +709,84 @@ fn bad_fog_fails_naming_the_key() {
     t.streaks(&["render", "scene.gltf", "-o", "img.exr", "--spp", "1"])
         .assert_failure_mentioning("extras.streaks.fog");
 }
+
+/// `--denoise`: the EXR's `R`, `G`, `B` are the denoised image and its `raw` layer the render,
+/// which the denoiser smooths (less difference between neighbouring pixels of the lit floor)
+/// while keeping its brightness; the depth layer is as rendered. With OIDN_LIBRARY pointing
+/// nowhere, the command fails naming the file and writes nothing. Needs the library (CI
+/// installs it and sets STREAKS_REQUIRE_OIDN); skipped without it.
+#[test]
+fn render_denoise_keeps_the_raw_render() {
+    if let Err(e) = streaks_image::denoise::Denoiser::load() {
+        assert!(std::env::var_os("STREAKS_REQUIRE_OIDN").is_none(), "{e}");
+        eprintln!("skipped: {e}");
+        return;
+    }
+    let t = TestDir::new();
+    t.write_tiny_gltf();
+    let args = |out: &str| {
+        vec![
+            "render".to_owned(),
+            "scene.gltf".into(),
+            "-o".into(),
+            out.into(),
+            "--spp".into(),
+            "2".into(),
+            "--height".into(),
+            "40".into(),
+            "--layers".into(),
+            "depth".into(),
+            "--denoise".into(),
+        ]
+    };
+    let a = args("out/img.exr");
+    t.streaks(&a.iter().map(String::as_str).collect::<Vec<_>>())
+        .assert_success();
+    let path = t.join("out/img.exr");
+    let denoised = read_exr_rgb(&path).unwrap();
+    let raw = read_exr_layer(&path, "raw").unwrap();
+    assert_eq!((raw.width, raw.height), (denoised.width, denoised.height));
+    // The floor: the bottom third, away from the sign.
+    let roughness = |img: &streaks_image::RgbImage| {
+        let (mut sum, mut n) = (0.0f64, 0);
+        for y in 2 * img.height / 3..img.height {
+            for x in 1..img.width {
+                sum += f64::from((img.get(x, y) - img.get(x - 1, y)).abs().element_sum());
+                n += 1;
+            }
+        }
+        sum / f64::from(n)
+    };
+    let mean = |img: &streaks_image::RgbImage| {
+        img.pixels
+            .iter()
+            .map(|p| f64::from(p.element_sum()))
+            .sum::<f64>()
+            / img.pixels.len() as f64
+    };
+    assert!(
+        roughness(&denoised) < 0.7 * roughness(&raw),
+        "{} vs raw {}",
+        roughness(&denoised),
+        roughness(&raw)
+    );
+    assert!((mean(&denoised) / mean(&raw) - 1.0).abs() < 0.1);
+    let depth = read_exr_layer(&path, "depth").unwrap();
+    assert_eq!(depth.get(0, 0).x, f32::INFINITY);
+
+    let b = args("bad/img.exr");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_streaks"))
+        .args(&b)
+        .current_dir(t.path())
+        .env("CI", "true")
+        .env("OIDN_LIBRARY", "/nonexistent/libOpenImageDenoise.so")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("--denoise") && err.contains("/nonexistent/libOpenImageDenoise.so"),
+        "{err}"
+    );
+    assert!(!t.join("bad").exists());
+}

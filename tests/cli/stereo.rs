@@ -278,6 +278,7 @@ fn settings(spp: u32) -> PairSettings {
         exposure_ev: 0.0,
         mask: StreakMaskParams::default(),
         motion: Default::default(),
+        albedo: false,
     }
 }
 
@@ -548,5 +549,54 @@ fn the_road_surface_mask_is_the_first_hit_of_road_materials() {
         // The flag changes no pixel of the images or masks.
         assert_eq!(a.output.image, b.output.image);
         assert_eq!(a.streak_mask, b.streak_mask);
+    }
+}
+
+/// `stereo --denoise`: each eye's EXR holds the denoised image and the raw render (`raw`),
+/// and the ground truth and the streak masks are those of the pair without it (never
+/// denoised). Needs the library (see the render test); skipped without it.
+#[test]
+fn stereo_denoise_changes_the_images_only() {
+    if let Err(e) = streaks_image::denoise::Denoiser::load() {
+        assert!(std::env::var_os("STREAKS_REQUIRE_OIDN").is_none(), "{e}");
+        eprintln!("skipped: {e}");
+        return;
+    }
+    let t = TestDir::new();
+    t.write_tiny_gltf();
+    for (out, extra) in [("plain", None), ("denoised", Some("--denoise"))] {
+        let mut args = vec![
+            "stereo",
+            "scene.gltf",
+            "-o",
+            out,
+            "--spp",
+            "2",
+            "--height",
+            "20",
+            "--baseline",
+            "0.1",
+        ];
+        args.extend(extra);
+        t.streaks(&args).assert_success();
+    }
+    for eye in ["0", "1"] {
+        let exr = t.join(&format!("denoised/im{eye}.exr"));
+        let raw = streaks_render::output::read_exr_layer(&exr, "raw").unwrap();
+        let plain =
+            streaks_image::exr::read_exr_rgb(&t.join(&format!("plain/im{eye}.exr"))).unwrap();
+        assert_eq!(
+            raw.pixels, plain.pixels,
+            "eye {eye}: the raw render is the plain one"
+        );
+        let denoised = streaks_image::exr::read_exr_rgb(&exr).unwrap();
+        assert_ne!(denoised.pixels, plain.pixels);
+        for file in [format!("disp{eye}.pfm"), format!("streaks{eye}.png")] {
+            assert_eq!(
+                std::fs::read(t.join(&format!("plain/{file}"))).unwrap(),
+                std::fs::read(t.join(&format!("denoised/{file}"))).unwrap(),
+                "{file}"
+            );
+        }
     }
 }

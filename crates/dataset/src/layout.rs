@@ -488,6 +488,10 @@ impl DatasetInfo {
         let mut existing = existing.clone();
         let (mut unrecorded, mut target_unrecorded) = (false, false);
         if let Value::Object(map) = &mut existing {
+            // Before denoising existed: not denoised.
+            for key in ["denoise", "keep_raw"] {
+                map.entry(key).or_insert(Value::Bool(false));
+            }
             if !map.contains_key("regularize") {
                 map.insert("regularize".into(), Value::Bool(false));
                 unrecorded = true;
@@ -515,6 +519,13 @@ impl DatasetInfo {
                      --noise-target off to continue it)"
                 }
                 "noise_target" => " (give its --noise-target to continue it)",
+                "denoise" if self.settings.denoise => " (add --denoise off to continue it)",
+                "denoise" => {
+                    " (it was denoised: add --denoise on, with Intel Open Image Denoise \
+                     installed, to continue it)"
+                }
+                "keep_raw" if self.settings.keep_raw => " (drop --keep-raw to continue it)",
+                "keep_raw" => " (add --keep-raw to continue it)",
                 _ => "",
             };
             return Err(DatasetError::OtherDataset {
@@ -610,6 +621,8 @@ mod tests {
                     regularize,
                     ..RenderSettings::new(2, 8)
                 },
+                denoise: false,
+                keep_raw: false,
             },
             files: FileList::current(),
             conventions: Conventions::current(),

@@ -181,6 +181,8 @@ pub struct RenderMeta {
     /// Mean samples per pixel actually taken, left and right eye (`spp` at fixed spp; absent
     /// in samples written before the field existed).
     pub mean_spp: Option<[f64; 2]>,
+    /// Whether the images were denoised (false in samples written before the field existed).
+    pub denoised: bool,
 }
 
 /// `meta.json`'s `render` object as the file holds it: the render settings' fields with the
@@ -206,6 +208,9 @@ struct RenderRecord {
     /// Mean samples per pixel actually taken, left and right eye.
     #[serde(default)]
     mean_spp: Option<[f64; 2]>,
+    /// Whether the images were denoised.
+    #[serde(default)]
+    denoised: bool,
 }
 
 impl From<RenderRecord> for RenderMeta {
@@ -220,6 +225,7 @@ impl From<RenderRecord> for RenderMeta {
             seed_left: r.seed_left,
             seed_right: r.seed_right,
             mean_spp: r.mean_spp,
+            denoised: r.denoised,
         }
     }
 }
@@ -240,6 +246,7 @@ impl From<RenderMeta> for RenderRecord {
             regularize,
             noise_target,
             mean_spp: m.mean_spp,
+            denoised: m.denoised,
         }
     }
 }
@@ -423,11 +430,12 @@ mod tests {
             seed_left: 7,
             seed_right: 8,
             mean_spp: Some([20.5, 21.0]),
+            denoised: true,
         };
         let text = serde_json::to_string(&meta).unwrap();
         assert_eq!(
             text,
-            r#"{"spp":64,"max_depth":8,"seed_left":7,"seed_right":8,"regularize":true,"noise_target":0.1,"mean_spp":[20.5,21.0]}"#
+            r#"{"spp":64,"max_depth":8,"seed_left":7,"seed_right":8,"regularize":true,"noise_target":0.1,"mean_spp":[20.5,21.0],"denoised":true}"#
         );
         assert_eq!(serde_json::from_str::<RenderMeta>(&text).unwrap(), meta);
         let old: RenderMeta =
@@ -440,6 +448,7 @@ mod tests {
                 seed_left: 1,
                 seed_right: 2,
                 mean_spp: None,
+                denoised: false,
             }
         );
     }

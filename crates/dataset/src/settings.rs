@@ -7,9 +7,10 @@ use streaks_settings::RenderSettings;
 /// The image size and render settings every sample of a dataset shares.
 ///
 /// In `dataset.json` the fields are the file's own, in this order: `width`, `height`, then the
-/// render settings' (`spp`, `max_depth`, `regularize`, `noise_target`). A `dataset.json`
-/// written before `regularize` or `noise_target` existed has none and was rendered without
-/// path regularisation or at fixed spp: it reads so ([`RenderSettings`]).
+/// render settings' (`spp`, `max_depth`, `regularize`, `noise_target`), then `denoise` and
+/// `keep_raw`. A `dataset.json` written before `regularize`, `noise_target` or `denoise`
+/// existed has none and was rendered without path regularisation, at fixed spp or without
+/// denoising: it reads so ([`RenderSettings`]).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Settings {
     /// Image width in pixels.
@@ -20,4 +21,11 @@ pub struct Settings {
     /// `--noise-target`).
     #[serde(flatten)]
     pub render: RenderSettings,
+    /// Whether each eye's image is denoised (Intel Open Image Denoise; ground truth, masks
+    /// and the specular layer never are).
+    #[serde(default)]
+    pub denoise: bool,
+    /// Whether a denoised sample's EXR keeps the render before denoising (its `raw` layer).
+    #[serde(default)]
+    pub keep_raw: bool,
 }

@@ -22,6 +22,8 @@
 //! - [`flow_color`]: the Middlebury colour coding of optical flow;
 //! - [`stats`]: quantiles and medians of pixel values (nearest rank, and the two other
 //!   definitions the project's numbers depend on);
+//! - [`denoise`]: [`denoise::Denoiser`], Intel Open Image Denoise loaded at run time, which
+//!   denoises a render guided by its albedo and normal layers;
 //! - [`compare`]: statistics of the difference between two images (relative RMSE, bias, the
 //!   noise test), per region;
 //! - [`size`]: [`ensure_same_size`] and its [`SizeMismatch`], the one size check that the
@@ -47,6 +49,7 @@
 pub mod atomic;
 pub mod color;
 pub mod compare;
+pub mod denoise;
 pub mod develop;
 pub mod error;
 pub mod exr;

@@ -317,8 +317,10 @@ pub struct RenderStats {
 /// A rendered image with its requested layers.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderOutput {
-    /// Linear RGB radiance.
+    /// Linear RGB radiance (denoised after [`crate::output::denoise`]).
     pub image: RgbImage,
+    /// The render before denoising, when [`crate::output::denoise`] replaced `image`.
+    pub raw: Option<RgbImage>,
     /// View-space depth per pixel, row-major (if requested).
     pub depth: Option<Vec<f32>>,
     /// Shading normals (if requested).
@@ -444,6 +446,7 @@ pub fn render(
     let layers = job.layers;
     RenderOutput {
         image: film.image(),
+        raw: None,
         depth: layers.depth.then(|| film.depth()),
         normal: layers.normal.then(|| film.normal()),
         albedo: layers.albedo.then(|| film.albedo()),

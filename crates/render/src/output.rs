@@ -2,6 +2,7 @@
 //!
 //! Channels: `R`, `G`, `B` (the beauty image, linear) plus, when present, `depth.Z`,
 //! `normal.X`/`normal.Y`/`normal.Z`, `albedo.R`/`.G`/`.B`, `specular.R`/`.G`/`.B` and
+//! `raw.R`/`.G`/`.B` (the render before denoising, when `R`, `G`, `B` are denoised),
 //! `spp.Y` (samples taken per pixel, as float32: exact up to 2^24), `rain.Y` (the share of
 //! the pixel's camera samples whose first hit was a rain drop) and `fog.Y` (the fog's
 //! transmittance to the pixel-centre ray's first hit, 1 without fog) and `object.Y` (the
@@ -40,6 +41,28 @@ pub const FOG: &str = "fog.Y";
 /// The object layer's channel: the slot in the scene's objects of the pixel-centre ray's
 /// first hit.
 pub const OBJECT: &str = "object.Y";
+/// The raw layer's channels: the render before denoising, beside the denoised `R`, `G`, `B`.
+pub const RAW: [&str; 3] = ["raw.R", "raw.G", "raw.B"];
+
+/// Denoises `output.image` with `denoiser` (Intel Open Image Denoise), guided by its
+/// `albedo` and `normal` layers when it has them, and keeps the render before in
+/// [`RenderOutput::raw`] (the EXR's `raw` layer). Only the beauty image changes: depth,
+/// normals, albedo, the specular layer and every mask stay as rendered.
+pub fn denoise(
+    output: &mut RenderOutput,
+    denoiser: &streaks_image::denoise::Denoiser,
+) -> Result<(), streaks_image::denoise::DenoiseError> {
+    let guides = output
+        .albedo
+        .as_ref()
+        .map(|albedo| streaks_image::denoise::Guides {
+            albedo,
+            normal: output.normal.as_ref(),
+        });
+    let denoised = denoiser.denoise(&output.image, guides)?;
+    output.raw = Some(std::mem::replace(&mut output.image, denoised));
+    Ok(())
+}
 
 /// Writes the render as a float32 EXR: the beauty image and the layers present in `output`
 /// (see the module documentation), atomically.
@@ -62,7 +85,11 @@ pub fn write_exr_with_sensor(
         }
     };
     push_rgb(BEAUTY, img);
-    for (names, layer) in [(ALBEDO, &output.albedo), (SPECULAR, &output.specular)] {
+    for (names, layer) in [
+        (RAW, &output.raw),
+        (ALBEDO, &output.albedo),
+        (SPECULAR, &output.specular),
+    ] {
         if let Some(layer) = layer {
             push_rgb(names, layer);
         }
@@ -98,6 +125,7 @@ pub fn write_exr_with_sensor(
 pub fn read_exr_layer(path: &Path, name: &str) -> Result<RgbImage, ImageError> {
     match name {
         "albedo" => read_exr_rgb_channels(path, ALBEDO),
+        "raw" => read_exr_rgb_channels(path, RAW),
         "specular" => read_exr_rgb_channels(path, SPECULAR),
         "sensor" => read_exr_rgb_channels(path, SENSOR),
         "normal" => read_exr_rgb_channels(path, NORMAL),
@@ -116,7 +144,7 @@ pub fn read_exr_layer(path: &Path, name: &str) -> Result<RgbImage, ImageError> {
         other => Err(ImageError::MissingChannels {
             path: path.to_path_buf(),
             what: format!(
-                "layer {other:?} (the layers are albedo, specular, normal, depth, spp, rain, fog, object, sensor)"
+                "layer {other:?} (the layers are albedo, specular, normal, depth, spp, rain, fog, object, sensor, raw)"
             ),
         }),
     }
@@ -139,6 +167,7 @@ mod tests {
     fn output(w: u32, h: u32) -> RenderOutput {
         RenderOutput {
             image: gradient(w, h),
+            raw: None,
             depth: Some((0..w * h).map(|i| i as f32 + 0.25).collect()),
             normal: Some(RgbImage {
                 pixels: vec![Vec3::Y; (w * h) as usize],

@@ -101,6 +101,8 @@ pub struct PairSettings {
     pub mask: StreakMaskParams,
     /// The shutter and the rig's motion (the same for both eyes).
     pub motion: Motion,
+    /// Render the albedo layer too (a denoiser's guide, [`denoise_pair`]).
+    pub albedo: bool,
 }
 
 /// One rendered eye with its ground truth.
@@ -176,7 +178,7 @@ pub fn render_eye(
         layers: Layers {
             depth: true,
             normal: true,
-            albedo: false,
+            albedo: settings.albedo,
             specular: true,
             material: true,
             object: true,
@@ -310,6 +312,21 @@ pub fn expose_pair(
         )
         .map_err(|e| StereoError::Render(format!("the {eye} eye's sensor: {e}")))?;
         view.sensor = Some(raw);
+    }
+    Ok(())
+}
+
+/// Denoises both eyes' images ([`streaks_render::output::denoise`], guided by their albedo
+/// and normal layers), after their ground truth and streak masks were taken from the render
+/// and before a camera model exposes them: the raw renders stay in each
+/// [`RenderOutput::raw`].
+pub fn denoise_pair(
+    views: &mut [EyeView; 2],
+    denoiser: &streaks_image::denoise::Denoiser,
+) -> Result<(), StereoError> {
+    for (eye, view) in Eye::BOTH.into_iter().zip(views.iter_mut()) {
+        streaks_render::output::denoise(&mut view.output, denoiser)
+            .map_err(|e| StereoError::Render(format!("denoising the {eye} eye: {e}")))?;
     }
     Ok(())
 }
@@ -486,6 +503,7 @@ mod tests {
             exposure_ev: 0.0,
             mask: StreakMaskParams::default(),
             motion: Motion::default(),
+            albedo: false,
         };
         let views = render_pair(&scene, &rig, &settings, &|_| {}).unwrap();
         for (eye, view) in Eye::BOTH.into_iter().zip(&views) {

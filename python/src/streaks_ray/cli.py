@@ -133,6 +133,15 @@ def parser() -> argparse.ArgumentParser:
         "--no-regularize", action="store_true", help="render without path regularisation"
     )
     flags.add_argument(
+        "--denoise",
+        choices=["auto", "on", "off"],
+        help="denoise the images with Intel Open Image Denoise (default auto: when installed; "
+        "on a cluster give on or off, so that every node denoises alike)",
+    )
+    flags.add_argument(
+        "--keep-raw", action="store_true", help="keep the render before denoising in each EXR"
+    )
+    flags.add_argument(
         "--shard",
         type=_shard,
         default=Shard(0, 1),
@@ -160,6 +169,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             max_depth=args.max_depth,
             noise_target=args.noise_target,
             no_regularize=args.no_regularize,
+            denoise=args.denoise,
+            keep_raw=args.keep_raw,
         ),
         shard=args.shard,
         num_cpus=args.num_cpus,

@@ -301,6 +301,8 @@ def generate(job: Job) -> int:
         max_depth=job.flags.max_depth,
         noise_target=job.flags.noise_target,
         no_regularize=job.flags.no_regularize,
+        denoise=job.flags.denoise,
+        keep_raw=job.flags.keep_raw,
     )
     job = Job(job.address, binary, flags, job.shard, job.num_cpus, job.chunk, job.max_retries)
     chunks = plan_chunks(flags.count, job.shard, job.chunk)

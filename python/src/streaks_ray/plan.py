@@ -117,6 +117,10 @@ class GenerateFlags:
     noise_target: str | None = None
     """Adaptive sampling's target: a positive number as text, or `off`."""
     no_regularize: bool = False
+    denoise: str | None = None
+    """`auto`, `on` or `off` (`streaks dataset generate --denoise`); on a cluster give `on` or
+    `off`, so that every node denoises alike."""
+    keep_raw: bool = False
 
     def arguments(self, shard: Shard, threads: int) -> list[str]:
         """The arguments after the binary: `dataset generate -o DIR --count N ... --shard K/N`."""
@@ -129,12 +133,15 @@ class GenerateFlags:
             ("--spp", self.spp),
             ("--max-depth", self.max_depth),
             ("--noise-target", self.noise_target),
+            ("--denoise", self.denoise),
         ]
         for flag, value in optional:
             if value is not None:
                 args += [flag, str(value)]
         if self.no_regularize:
             args.append("--no-regularize")
+        if self.keep_raw:
+            args.append("--keep-raw")
         return args + ["--shard", str(shard), "--threads", str(threads)]
 
 
