@@ -169,3 +169,16 @@ impl Run {
         self
     }
 }
+
+/// Whether Intel Open Image Denoise can be loaded, for the denoising tests: without it they
+/// are skipped (saying so), unless STREAKS_REQUIRE_OIDN is set (as CI does), which fails them.
+pub fn denoiser_available() -> bool {
+    match streaks_image::denoise::Denoiser::load() {
+        Ok(_) => true,
+        Err(e) => {
+            assert!(std::env::var_os("STREAKS_REQUIRE_OIDN").is_none(), "{e}");
+            eprintln!("skipped: {e}");
+            false
+        }
+    }
+}

@@ -1004,9 +1004,7 @@ fn stats_page_shows_the_parameters_and_escapes_what_it_reads() {
 /// refused. Needs the library (see the render test); skipped without it.
 #[test]
 fn denoised_datasets_record_it_and_keep_their_ground_truth() {
-    if let Err(e) = streaks_image::denoise::Denoiser::load() {
-        assert!(std::env::var_os("STREAKS_REQUIRE_OIDN").is_none(), "{e}");
-        eprintln!("skipped: {e}");
+    if !crate::common::denoiser_available() {
         return;
     }
     let t = TestDir::new();

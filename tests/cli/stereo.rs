@@ -557,9 +557,7 @@ fn the_road_surface_mask_is_the_first_hit_of_road_materials() {
 /// denoised). Needs the library (see the render test); skipped without it.
 #[test]
 fn stereo_denoise_changes_the_images_only() {
-    if let Err(e) = streaks_image::denoise::Denoiser::load() {
-        assert!(std::env::var_os("STREAKS_REQUIRE_OIDN").is_none(), "{e}");
-        eprintln!("skipped: {e}");
+    if !crate::common::denoiser_available() {
         return;
     }
     let t = TestDir::new();
