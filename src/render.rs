@@ -110,6 +110,7 @@ pub fn run(args: Args) -> Result<()> {
         spp: args.layers.contains(&Layer::Spp),
         rain: false,
         fog: false,
+        emission: guides,
     };
     if let Some(mask) = &args.road_mask {
         if format_of(mask)? != Format::Png {

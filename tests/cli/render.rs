@@ -769,6 +769,20 @@ fn render_denoise_keeps_the_raw_render() {
         roughness(&raw)
     );
     assert!((mean(&denoised) / mean(&raw) - 1.0).abs() < 0.1);
+    // The emissive sign seen directly is added back as rendered, not spread: where a pixel
+    // sees only the sign, the denoised pixel is the sign's radiance.
+    let sign = glam::Vec3::new(4.0, 2.0, 0.8);
+    let mut seen = 0;
+    for (d, r) in denoised.pixels.iter().zip(&raw.pixels) {
+        if (*r - sign).abs().max_element() < 1e-4 {
+            seen += 1;
+            assert!(
+                (*d - sign).abs().max_element() < 0.05 * 4.0,
+                "{d} vs {sign}"
+            );
+        }
+    }
+    assert!(seen > 0, "the sign is not seen whole in any pixel");
     let depth = read_exr_layer(&path, "depth").unwrap();
     assert_eq!(depth.get(0, 0).x, f32::INFINITY);
 

@@ -27,6 +27,9 @@ pub struct Pixel {
     pub radiance: Vec3,
     /// Sum of the kept samples' specular part (see [`crate::integrator`]).
     pub specular: Vec3,
+    /// Sum of the kept samples' light seen directly: emission or the environment met by the
+    /// camera ray's first segment (see [`crate::integrator`]).
+    pub emission: Vec3,
     /// Number of kept samples.
     pub kept: u32,
     /// Number of dropped (non-finite) samples.
@@ -64,6 +67,7 @@ impl Default for Pixel {
         Self {
             radiance: Vec3::ZERO,
             specular: Vec3::ZERO,
+            emission: Vec3::ZERO,
             kept: 0,
             dropped: 0,
             lum_mean: 0.0,
@@ -134,6 +138,16 @@ impl Pixel {
             self.specular / self.kept as f32
         }
     }
+
+    /// The box-filtered light seen directly.
+    #[inline]
+    pub fn mean_emission(&self) -> Vec3 {
+        if self.kept == 0 {
+            Vec3::ZERO
+        } else {
+            self.emission / self.kept as f32
+        }
+    }
 }
 
 /// A `width` x `height` grid of [`Pixel`]s, row-major, top row first.
@@ -187,6 +201,11 @@ impl Film {
     /// The box-filtered specular layer.
     pub fn specular(&self) -> RgbImage {
         self.map(Pixel::mean_specular)
+    }
+
+    /// The box-filtered layer of the light seen directly.
+    pub fn emission(&self) -> RgbImage {
+        self.map(Pixel::mean_emission)
     }
 
     /// The normal layer.
@@ -248,6 +267,12 @@ impl Film {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The memory per pixel that docs/benchmarks.md gives ("Targets").
+    #[test]
+    fn a_pixel_is_96_bytes() {
+        assert_eq!(std::mem::size_of::<Pixel>(), 96);
+    }
 
     #[test]
     fn box_filter_means_kept_samples_and_drops_non_finite() {

@@ -166,6 +166,10 @@
 //!   unbiased estimate of the single-glossy-bounce direct light, the same quantity the
 //!   next-event part estimates. It is box-filtered like the beauty image; a streak mask is a
 //!   threshold on it.
+//! - `emission`: the part of the pixel's radiance that the camera ray's first segment met as
+//!   emission or environment (in full, as the beauty image adds it; with fog, with the
+//!   segment's pass weight), box-filtered like the beauty image: the light seen directly,
+//!   which a denoiser leaves alone ([`crate::output::denoise`]).
 //! - `spp`: the number of samples the pixel took (kept and dropped), `spp` everywhere unless
 //!   adaptive sampling stopped its tile earlier.
 //! - `rain`: the mean over the pixel's camera samples (kept and dropped) of the share of the
@@ -250,6 +254,9 @@ pub struct Layers {
     pub rain: bool,
     /// The fog's transmittance to the pixel-centre ray's first hit.
     pub fog: bool,
+    /// The light seen directly: the emission (or environment) the camera ray's first segment
+    /// meets, box-filtered as the beauty image (a part of it, which a denoiser leaves alone).
+    pub emission: bool,
 }
 
 /// One image to render: its size, seed and layers, and how to sample it.
@@ -329,6 +336,9 @@ pub struct RenderOutput {
     pub albedo: Option<RgbImage>,
     /// Specular part (if requested).
     pub specular: Option<RgbImage>,
+    /// The light seen directly, the part of `image` the camera ray's first segment met as
+    /// emission or environment (if requested).
+    pub emission: Option<RgbImage>,
     /// First-hit material index per pixel, row-major (if requested; see the module
     /// documentation).
     pub material: Option<Vec<u32>>,
@@ -352,6 +362,8 @@ pub struct RenderOutput {
 struct PathResult {
     radiance: Vec3,
     specular: Vec3,
+    /// The part of `radiance` seen directly (the first segment's emitter or environment).
+    emission: Vec3,
     rays: u64,
     /// Whether the camera ray's first hit was a rain drop.
     rain: bool,
@@ -451,6 +463,7 @@ pub fn render(
         normal: layers.normal.then(|| film.normal()),
         albedo: layers.albedo.then(|| film.albedo()),
         specular: layers.specular.then(|| film.specular()),
+        emission: layers.emission.then(|| film.emission()),
         material: layers.material.then(|| film.material()),
         object: layers.object.then(|| film.object()),
         spp: layers.spp.then(|| film.spp()),
@@ -593,13 +606,17 @@ fn take_sample(
     };
     let Some(swept) = swept else {
         let path = trace_path(scene, ray, sampler, job, RainPath::camera(rain));
-        pixel.add_sample(path.radiance, path.specular);
+        if pixel.add_sample(path.radiance, path.specular) {
+            pixel.emission += path.emission;
+        }
         pixel.rain += f32::from(u8::from(path.rain));
         return path.rays;
     };
     if swept.is_empty() {
         let path = trace_path(scene, ray, sampler, job, RainPath::camera(None));
-        pixel.add_sample(path.radiance, path.specular);
+        if pixel.add_sample(path.radiance, path.specular) {
+            pixel.emission += path.emission;
+        }
         return path.rays;
     }
     // The time integral split on whether a drop covers the ray: the background (no drop) at
@@ -631,10 +648,12 @@ fn take_sample(
         PathResult::default()
     };
     let w = swept.total() / shutter / swept.covering(drop_ray.time).max(1) as f32 / q.max(1e-30);
-    pixel.add_sample(
+    if pixel.add_sample(
         background.radiance * (1.0 - covered) + drop.radiance * w,
         background.specular * (1.0 - covered) + drop.specular * w,
-    );
+    ) {
+        pixel.emission += background.emission * (1.0 - covered) + drop.emission * w;
+    }
     pixel.rain += covered;
     background.rays + drop.rays
 }
@@ -722,6 +741,9 @@ impl Arrival {
     ) {
         if self.depth == 0 || self.prev_delta {
             out.radiance += throughput * le;
+            if self.depth == 0 {
+                out.emission += throughput * le;
+            }
         } else {
             let weight = power_heuristic(1.0, self.prev_bsdf_pdf, 1.0, light_pdf());
             out.radiance += throughput * le * weight;
@@ -1543,6 +1565,27 @@ pub(crate) mod tests {
         }
     }
 
+    /// The emission layer is the light seen directly: in the furnace box (walls of albedo
+    /// 0.5 emitting `Le`) every pixel's is exactly `Le`, the rest of the image (`Le a / (1 -
+    /// a)` on average) is light that bounced; the layer is no part of the beauty image's sums.
+    #[test]
+    fn the_emission_layer_is_the_light_seen_directly() {
+        let le = Vec3::new(1.0, 0.5, 0.25);
+        let scene = furnace_box(Vec3::splat(0.5), le);
+        let cam = camera(Vec3::new(0.1, -0.2, 0.3), 0.3, 1.2);
+        let mut job = settings(12, 8, 16, u32::MAX);
+        let plain = render(&scene, &cam, &job, &|_| {});
+        job.layers.emission = true;
+        let out = render(&scene, &cam, &job, &|_| {});
+        assert_eq!(out.image, plain.image);
+        assert!(plain.emission.is_none());
+        let emission = out.emission.expect("the emission layer");
+        for (e, p) in emission.pixels.iter().zip(&out.image.pixels) {
+            assert!((*e - le).abs().max_element() < 1e-6, "{e}");
+            assert!(p.cmpge(*e).all(), "{p} < {e}");
+        }
+    }
+
     /// A wall of emission `le` at z = -2 in front of a camera at the origin, whose front faces
     /// the camera if `facing`, and a floor of material 0.
     fn emitter_scene(le: Vec3, facing: bool, double_sided: bool) -> Scene {
@@ -1715,6 +1758,7 @@ pub(crate) mod tests {
             spp: true,
             rain: true,
             fog: true,
+            emission: true,
         };
         let run = |threads| {
             rayon::ThreadPoolBuilder::new()

@@ -15,6 +15,7 @@
 //! file itself is written by [`streaks_image::exr`] (atomically).
 
 use crate::integrator::RenderOutput;
+use glam::Vec3;
 use std::path::Path;
 use streaks_image::exr::{read_exr_channels, read_exr_rgb_channels, ExrChannel};
 use streaks_image::{ImageError, RgbImage};
@@ -46,8 +47,11 @@ pub const RAW: [&str; 3] = ["raw.R", "raw.G", "raw.B"];
 
 /// Denoises `output.image` with `denoiser` (Intel Open Image Denoise), guided by its
 /// `albedo` and `normal` layers when it has them, and keeps the render before in
-/// [`RenderOutput::raw`] (the EXR's `raw` layer). Only the beauty image changes: depth,
-/// normals, albedo, the specular layer and every mask stay as rendered.
+/// [`RenderOutput::raw`] (the EXR's `raw` layer). With an `emission` layer, only the rest is
+/// denoised and the light seen directly (lamp lenses, lit windows, the sky: exact once each
+/// sample's first hit is known) is added back as rendered, so the denoiser does not spread
+/// small bright emitters. Only the beauty image changes: depth, normals, albedo, the specular
+/// layer and every mask stay as rendered.
 pub fn denoise(
     output: &mut RenderOutput,
     denoiser: &streaks_image::denoise::Denoiser,
@@ -59,7 +63,21 @@ pub fn denoise(
             albedo,
             normal: output.normal.as_ref(),
         });
-    let denoised = denoiser.denoise(&output.image, guides)?;
+    let mut denoised = match &output.emission {
+        Some(emission) => {
+            let mut rest = output.image.clone();
+            for (p, e) in rest.pixels.iter_mut().zip(&emission.pixels) {
+                *p = (*p - *e).max(Vec3::ZERO);
+            }
+            denoiser.denoise(&rest, guides)?
+        }
+        None => denoiser.denoise(&output.image, guides)?,
+    };
+    if let Some(emission) = &output.emission {
+        for (p, e) in denoised.pixels.iter_mut().zip(&emission.pixels) {
+            *p += *e;
+        }
+    }
     output.raw = Some(std::mem::replace(&mut output.image, denoised));
     Ok(())
 }
@@ -175,6 +193,7 @@ mod tests {
             }),
             albedo: None,
             specular: Some(gradient(w, h)),
+            emission: None,
             material: None,
             object: Some((0..w * h).map(|i| 3 * i).collect()),
             spp: Some((0..w * h).map(|i| 16 + 8 * i).collect()),

@@ -101,7 +101,7 @@ pub struct PairSettings {
     pub mask: StreakMaskParams,
     /// The shutter and the rig's motion (the same for both eyes).
     pub motion: Motion,
-    /// Render the albedo layer too (a denoiser's guide, [`denoise_pair`]).
+    /// Render the albedo and emission layers too (what the denoiser needs, [`denoise_pair`]).
     pub albedo: bool,
 }
 
@@ -185,6 +185,7 @@ pub fn render_eye(
             spp: false,
             rain: scene.rain.is_some(),
             fog: scene.fog.is_some(),
+            emission: settings.albedo,
         },
         settings: settings.render,
         motion: settings.motion,
