@@ -15,7 +15,9 @@
 //! counting global allocator wraps the system one), for the "< 300 MB" target in docs/benchmarks.md.
 //!
 //! Run: `cargo bench --bench bvh` (`cargo bench --bench bvh -- coherent` for the coherent rays
-//! alone). The ray benches are skipped, with a message, when the scene file is missing.
+//! alone). With `STREAKS_BVH_RAYS_OUT=DIR`, the coherent benches also write each street's
+//! triangles and four of its ray sets to `DIR/<street>/` (`write_rays`), which
+//! `tools/embree/race.py` traces with Embree. The ray benches are skipped, with a message, when the scene file is missing.
 //! Instruction counts of the coherent sets: run the bench binary under
 //! `valgrind --tool=callgrind` with `--bench coherent_<street> --profile-time 1` and
 //! `STREAKS_COHERENT_HEIGHT=60` (a smaller image, so that making the rays takes minutes, not
@@ -455,6 +457,19 @@ fn bench_coherent(c: &mut Criterion) {
             100.0 * hit(&sets.bounce),
             sets.bounce_pixel_samples.len(),
         );
+        if let Some(dir) = std::env::var_os("STREAKS_BVH_RAYS_OUT") {
+            let dir = Path::new(&dir).join(name);
+            let sets = [
+                ("primary_scanline", &sets.scanline),
+                ("primary_spp8", &sets.pixel_samples),
+                ("bounce_scanline", &sets.bounce),
+                ("bounce_spp8", &sets.bounce_pixel_samples),
+            ];
+            match write_rays(&dir, &scene, &sets) {
+                Ok(()) => eprintln!("{name}: triangles and rays written to {}", dir.display()),
+                Err(e) => eprintln!("{name}: writing {}: {e}", dir.display()),
+            }
+        }
         let mut group = c.benchmark_group(format!("coherent_{name}"));
         group.sample_size(20);
         let mut single = |id: &str, rays: &[Ray], trace: fn(&Accel, &[Ray]) -> u32| {
@@ -483,6 +498,35 @@ fn bench_coherent(c: &mut Criterion) {
         });
         group.finish();
     }
+}
+
+/// Writes the triangles the street's BVH holds and ray sets to `dir`, for tracing the same
+/// rays with another library (`tools/embree/race.py` reads them): `triangles.f32` (each
+/// triangle's three vertices, 9 little-endian `f32`), and per set `NAME.f32` (origin,
+/// direction and `t_max` of each ray, 7 `f32`) and `NAME.hits` (how many of them this BVH hits,
+/// in decimal).
+fn write_rays(dir: &Path, scene: &Scene, sets: &[(&str, &Vec<Ray>)]) -> std::io::Result<()> {
+    std::fs::create_dir_all(dir)?;
+    let floats = |v: &mut Vec<u8>, xs: &[f32]| xs.iter().for_each(|x| v.extend(x.to_le_bytes()));
+    let mut tris = Vec::new();
+    for t in &scene.mesh.triangles {
+        for &i in t {
+            floats(&mut tris, &scene.mesh.positions[i as usize].to_array());
+        }
+    }
+    std::fs::write(dir.join("triangles.f32"), tris)?;
+    for (name, rays) in sets {
+        let mut out = Vec::new();
+        for r in rays.iter() {
+            floats(&mut out, &r.origin.to_array());
+            floats(&mut out, &r.direction.to_array());
+            floats(&mut out, &[r.t_max]);
+        }
+        std::fs::write(dir.join(format!("{name}.f32")), out)?;
+        let hits = trace_single::<0>(&scene.accel, rays);
+        std::fs::write(dir.join(format!("{name}.hits")), hits.to_string())?;
+    }
+    Ok(())
 }
 
 criterion_group!(benches, bench_build, bench_rays, bench_coherent);

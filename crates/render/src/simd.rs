@@ -4,8 +4,9 @@
 //! 2009. Three kernels also exist compiled for wider vectors and are chosen at run time from
 //! what the CPU has ([`level`]):
 //!
-//! - the BVH's node test ([`crate::accel::NodeTest`]): eight child boxes in one AVX2 pass
-//!   (AVX2 and AVX-512 CPUs alike: a CWBVH node has eight children);
+//! - the BVH traversal ([`crate::accel::Kernel`]): a node's 8 child boxes in one AVX2 pass
+//!   (two in SSE), or, where the CPU has AVX-512, 16 children in one pass (the BVH is then
+//!   built 16 wide);
 //! - the light choice's weights of a tree node's children and the BSDF toward them
 //!   ([`crate::light`]'s node lanes): 4 children at a time in SSE, 8 in AVX2, all 16 in one
 //!   AVX-512 pass.
