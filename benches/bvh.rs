@@ -1,5 +1,5 @@
-//! BVH benchmarks: building the obvhs CWBVH over 10k, 100k and 1M triangles, and closest-hit
-//! and shadow rays per second on `scenes/rainy_street.gltf` for primary (coherent) and
+//! BVH benchmarks: building the BVH (obvhs' binary tree collapsed into the project's wide one)
+//! over 10k, 100k and 1M triangles, and closest-hit and shadow rays per second on `scenes/rainy_street.gltf` for primary (coherent) and
 //! diffuse-bounce (incoherent) rays.
 //!
 //! Coherent rays (`coherent_<street>` groups; docs/decisions/0006): primary rays and the road's
