@@ -303,6 +303,8 @@ pub(crate) trait WideLanes: Lanes {
     fn select(m: Self::Mask, a: Self, b: Self) -> Self;
     /// SSE's `maxps`, lane by lane: `self` where `self > o`, else `o`.
     fn max(self, o: Self) -> Self;
+    /// Whether any lane of `m` is set.
+    fn any(m: Self::Mask) -> bool;
 }
 
 impl WideLanes for Vec4 {
@@ -335,6 +337,10 @@ impl WideLanes for Vec4 {
     #[inline(always)]
     fn max(self, o: Self) -> Self {
         Vec4::max(self, o)
+    }
+    #[inline(always)]
+    fn any(m: BVec4A) -> bool {
+        m.any()
     }
 }
 
@@ -403,6 +409,10 @@ impl<const N: usize> WideLanes for Wide<N> {
     #[inline(always)]
     fn max(self, o: Self) -> Self {
         self.zip(o, sse_max)
+    }
+    #[inline(always)]
+    fn any(m: WideMask<N>) -> bool {
+        m.0.iter().fold(0, |a, &b| a | b) != 0
     }
 }
 

@@ -24,6 +24,10 @@
 //!   [`SHARP_LOBE_CONE_RATIO`] times as wide as the lobe is at least the lobe's reflectance
 //!   over the cone's solid angle (see [`super::choice`]).
 //!
+//! A set skips the terms that are the identity for all of its children (no range window
+//! without a range, no spot falloff without spots, ...: [`Holds`]), and `F` where no child
+//! gives `E > 0`, with the same bits as computing them.
+//!
 //! The sums `sum E` and `sum E F` are taken child by child in order, so the weights and the
 //! choice are bit for bit the same at every width (tested on every width this CPU has).
 
@@ -87,6 +91,32 @@ pub(crate) struct NodeLanes {
     hard_edge: Slots,
     /// 1 for directional lights.
     directional: Slots,
+    /// Which kinds of child the set holds.
+    holds: Holds,
+}
+
+/// Which kinds of child a sibling set holds. The weights skip the terms that are the identity
+/// for every child of the set (a set of emitter meshes and groups without spot lights has no
+/// spot falloff, range window or beam; a set without groups or directional lights looks at
+/// `F` from where it measures `E`), with the same bits as computing them.
+#[derive(Clone, Copy, Debug, Default)]
+struct Holds {
+    /// Point or spot lights.
+    punctual: bool,
+    /// Spot lights.
+    spot: bool,
+    /// Lights with a `range`.
+    range: bool,
+    /// Groups with spot lights (a [`super::tree::GroupBeam`]).
+    beam: bool,
+    /// Flat one-sided meshes.
+    plane: bool,
+    /// Directional lights.
+    directional: bool,
+    /// Groups (whose `F` looks at their anchor, not at their centre).
+    group: bool,
+    /// Groups or meshes (a bounding radius, for the glossy lobe's mean over their cone).
+    bounded: bool,
 }
 
 impl NodeLanes {
@@ -114,6 +144,7 @@ impl NodeLanes {
             spot: [0.0; BRANCHING],
             hard_edge: [0.0; BRANCHING],
             directional: [0.0; BRANCHING],
+            holds: Holds::default(),
         };
         let set3 = |a: &mut [Slots; 3], c: usize, v: glam::Vec3| {
             [a[0][c], a[1][c], a[2][c]] = v.to_array();
@@ -121,11 +152,14 @@ impl NodeLanes {
         for (c, node) in tree.nodes()[nodes].iter().enumerate() {
             match *node {
                 Node::Group(g) => {
+                    l.holds.group = true;
+                    l.holds.bounded = true;
                     set3(&mut l.pos, c, g.centre);
                     set3(&mut l.look, c, g.anchor);
                     l.radius2[c] = g.radius * g.radius;
                     l.scale[c] = g.isotropic_power / (4.0 * PI);
                     if let Some(b) = g.beam {
+                        l.holds.beam = true;
                         set3(&mut l.axis, c, b.axis);
                         l.beam_scale[c] = b.intensity;
                         l.beam_cos[c] = b.cos;
@@ -134,11 +168,13 @@ impl NodeLanes {
                 }
                 Node::Emitter(e) => match emitters.get(e as usize) {
                     Emitter::Mesh(m) => {
+                        l.holds.bounded = true;
                         set3(&mut l.pos, c, m.centre());
                         set3(&mut l.look, c, m.centre());
                         l.radius2[c] = m.radius() * m.radius();
                         l.scale[c] = m.power() / (4.0 * PI);
                         if let Some((n, offset)) = m.front_plane() {
+                            l.holds.plane = true;
                             let [x, y, z] = n.to_array();
                             [l.plane[0][c], l.plane[1][c], l.plane[2][c]] = [x, y, z];
                             l.plane[3][c] = offset;
@@ -155,6 +191,8 @@ impl NodeLanes {
                             l.scale[c] = luminance(intensity);
                             l.range[c] = range_or_infinite(range);
                             l.punctual[c] = 1.0;
+                            l.holds.punctual = true;
+                            l.holds.range |= l.range[c].is_finite();
                         }
                         Light::Spot {
                             position,
@@ -171,6 +209,9 @@ impl NodeLanes {
                             l.range[c] = range_or_infinite(range);
                             l.punctual[c] = 1.0;
                             l.spot[c] = 1.0;
+                            l.holds.punctual = true;
+                            l.holds.spot = true;
+                            l.holds.range |= l.range[c].is_finite();
                             l.cos_outer[c] = cos_outer;
                             // `spot_falloff`'s cases: a smooth ramp, or a hard edge.
                             let width = cos_inner - cos_outer;
@@ -187,6 +228,7 @@ impl NodeLanes {
                             set3(&mut l.look, c, -direction);
                             l.scale[c] = luminance(irradiance);
                             l.directional[c] = 1.0;
+                            l.holds.directional = true;
                         }
                     },
                 },
@@ -212,11 +254,14 @@ impl NodeLanes {
             )
         });
         let f = &w.f;
+        let h = self.holds;
         for k in (0..n).step_by(L::WIDTH) {
             let at = |s: &Slots| L::load(&s[k..]);
             let flag = |s: &Slots| at(s).gt(zero);
 
-            // E.
+            // E. Each term the set's children do not need is skipped ([`Holds`]): where it
+            // is skipped it would be the identity (a window of 1 without a range, a falloff
+            // of 1 without spots, no beam's intensity to add).
             let sp = [L::splat(p[0]), L::splat(p[1]), L::splat(p[2])];
             let d = [
                 at(&self.pos[0]) - sp[0],
@@ -225,45 +270,82 @@ impl NodeLanes {
             ];
             let d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
             let dist = d2.sqrt();
-            let x = dist / at(&self.range);
-            let window = (one - (x * x) * (x * x)).saturate();
-            let cos =
-                -(at(&self.axis[0]) * d[0] + at(&self.axis[1]) * d[1] + at(&self.axis[2]) * d[2])
-                    / dist;
-            let cos_outer = at(&self.cos_outer);
-            let t = L::select(
-                flag(&self.hard_edge),
-                L::select(cos.ge(cos_outer), one, zero),
-                ((cos - cos_outer) / at(&self.cone_width)).saturate(),
-            );
-            let falloff = L::select(flag(&self.spot), t * t, one);
             let scale = at(&self.scale);
+            let r2 = at(&self.radius2);
+            // The cosine of the direction from the light to the point with a spot's axis
+            // (or a group beam's).
+            let cos = if h.spot || h.beam {
+                -(at(&self.axis[0]) * d[0] + at(&self.axis[1]) * d[1] + at(&self.axis[2]) * d[2])
+                    / dist
+            } else {
+                zero
+            };
             // A group's beam: the point may see its spots if its direction from the centre
             // (`cos` to the axis, as for a spot) is within the beam's half-angle plus the
             // group's angular radius `asin(r / d)`, or if it is inside the group's sphere.
-            let r2 = at(&self.radius2);
-            let sin_r2 = (r2 / d2).saturate();
-            let edge =
-                at(&self.beam_cos) * (one - sin_r2).sqrt() - at(&self.beam_sin) * sin_r2.sqrt();
-            let edge = L::select(r2.ge(d2), L::splat(-2.0), edge);
-            let in_beam = cos.ge(edge);
-            let bounded = scale + L::select(in_beam, at(&self.beam_scale), zero);
-            let e = L::select(
-                flag(&self.punctual),
-                scale * (falloff * window) / d2,
-                L::select(flag(&self.directional), scale, bounded / d2.max(r2)),
-            );
-            let front =
-                at(&self.plane[0]) * p[0] + at(&self.plane[1]) * p[1] + at(&self.plane[2]) * p[2];
-            let e = L::select(front.gt(at(&self.plane[3])) & e.positive_finite(), e, zero);
+            let bounded = if h.beam {
+                let sin_r2 = (r2 / d2).saturate();
+                let edge =
+                    at(&self.beam_cos) * (one - sin_r2).sqrt() - at(&self.beam_sin) * sin_r2.sqrt();
+                let edge = L::select(r2.ge(d2), L::splat(-2.0), edge);
+                let in_beam = cos.ge(edge);
+                scale + L::select(in_beam, at(&self.beam_scale), zero)
+            } else {
+                scale
+            };
+            let e = if h.punctual || h.directional {
+                let window = if h.range {
+                    let x = dist / at(&self.range);
+                    (one - (x * x) * (x * x)).saturate()
+                } else {
+                    one
+                };
+                let falloff = if h.spot {
+                    let cos_outer = at(&self.cos_outer);
+                    let t = L::select(
+                        flag(&self.hard_edge),
+                        L::select(cos.ge(cos_outer), one, zero),
+                        ((cos - cos_outer) / at(&self.cone_width)).saturate(),
+                    );
+                    L::select(flag(&self.spot), t * t, one)
+                } else {
+                    one
+                };
+                L::select(
+                    flag(&self.punctual),
+                    scale * (falloff * window) / d2,
+                    L::select(flag(&self.directional), scale, bounded / d2.max(r2)),
+                )
+            } else {
+                bounded / d2.max(r2)
+            };
+            let e = if h.plane {
+                let front = at(&self.plane[0]) * p[0]
+                    + at(&self.plane[1]) * p[1]
+                    + at(&self.plane[2]) * p[2];
+                L::select(front.gt(at(&self.plane[3])) & e.positive_finite(), e, zero)
+            } else {
+                L::select(e.positive_finite(), e, zero)
+            };
+            e.store(&mut e_w[k..]);
+            if !L::any(e.gt(zero)) {
+                // No child lights the point: `E F` is 0 whatever `F` is.
+                zero.store(&mut ef_w[k..]);
+                continue;
+            }
 
-            // The direction F looks in, normalised (`normalize_or_zero`, lane by lane).
-            let directional = flag(&self.directional);
-            let look = [at(&self.look[0]), at(&self.look[1]), at(&self.look[2])];
-            let x = L::select(directional, look[0], look[0] - sp[0]);
-            let y = L::select(directional, look[1], look[1] - sp[1]);
-            let z = L::select(directional, look[2], look[2] - sp[2]);
-            let r = one / (x * x + y * y + z * z).sqrt();
+            // The direction F looks in, normalised (`normalize_or_zero`, lane by lane): `d`
+            // itself where the children look where they are measured from.
+            let [x, y, z, r] = if h.group || h.directional {
+                let directional = flag(&self.directional);
+                let look = [at(&self.look[0]), at(&self.look[1]), at(&self.look[2])];
+                let x = L::select(directional, look[0], look[0] - sp[0]);
+                let y = L::select(directional, look[1], look[1] - sp[1]);
+                let z = L::select(directional, look[2], look[2] - sp[2]);
+                [x, y, z, one / (x * x + y * y + z * z).sqrt()]
+            } else {
+                [d[0], d[1], d[2], one / dist]
+            };
             let r = L::select(r.positive_finite(), r, zero);
             let [x, y, z] = [x * r, y * r, z * r];
             // `Frame::to_local` and the geometric normal's side.
@@ -274,8 +356,14 @@ impl NodeLanes {
             ];
             let geometric = x * ng.x + y * ng.y + z * ng.z;
             let lit = geometric.gt(zero) & local[2].gt(zero);
-            let cos = L::select(lit, local[2], zero);
-            let fc = f.eval_lanes([local[0], local[1], cos]) * cos;
+            let fc = if L::any(lit) {
+                let cos = L::select(lit, local[2], zero);
+                f.eval_lanes([local[0], local[1], cos]) * cos
+            } else {
+                // Every child is below the surface: `f cos` is 0 (the glossy lobe's mean over
+                // a bounded child's cone may still raise it below).
+                zero
+            };
             let fc = match lobe {
                 // A bounded child (group or mesh) whose cone holds the glossy lobe's mirror
                 // direction and is much wider than the lobe: at least the lobe's mean over
@@ -285,7 +373,7 @@ impl NodeLanes {
                 // `rho (1 + cos) / sin^2` (with `rho` over 2 pi), is `rho (d^2 + t dist) / r^2`,
                 // or `rho` inside the sphere. One division, where the angles' sines and
                 // cosines took three.
-                Some((m, peak_over_ratio, rho)) => {
+                Some((m, peak_over_ratio, rho)) if h.bounded => {
                     let t = (d2 - r2).max(zero).sqrt();
                     let dm = d[0] * m[0] + d[1] * m[1] + d[2] * m[2];
                     let mean = rho * ((d2 + t * dist) / r2).max(one);
@@ -293,10 +381,9 @@ impl NodeLanes {
                         dm.ge(t) & peak_over_ratio.gt(mean) & r2.gt(zero) & dist.positive_finite();
                     fc.max(L::select(holds, mean, zero))
                 }
-                None => fc,
+                _ => fc,
             };
             let fc = L::select(fc.positive_finite(), fc, zero);
-            e.store(&mut e_w[k..]);
             (e * fc).store(&mut ef_w[k..]);
         }
         let (mut e_sum, mut ef_sum) = (0.0f32, 0.0f32);
@@ -547,6 +634,29 @@ mod tests {
             Node::Emitter(_) => None,
         }));
         assert!(sets.len() > 1, "a two-level tree");
+        // The same sets computing every term, as if each held every kind of child.
+        let mut every_term = lanes.clone();
+        for set in &mut every_term.sets {
+            set.holds = Holds {
+                punctual: true,
+                spot: true,
+                range: true,
+                beam: true,
+                plane: true,
+                directional: true,
+                group: true,
+                bounded: true,
+            };
+        }
+        // Sets that skip terms: the groups' sets have no group among their children (their
+        // `F` looks where `E` is measured from), some have no spot light or no range. (Sets
+        // of meshes alone, which skip every punctual term, are in the street of
+        // docs/decisions/0055-light-choice-lanes-skip-and-the-tree-stays.md, rendered the same
+        // to the bit.)
+        let h = |s: &NodeLanes| s.holds;
+        let skipping = lanes.sets.iter().filter(|s| !h(s).group).count();
+        assert!(skipping > 0 && skipping < lanes.sets.len(), "{skipping}");
+        assert!(lanes.sets.iter().any(|s| !h(s).spot || !h(s).range));
         let models = [
             Bsdf::Diffuse(Diffuse {
                 kd: Vec3::splat(0.5),
@@ -598,17 +708,20 @@ mod tests {
                 for set in &sets {
                     let want = lanes.weights_at_level(SimdLevel::Sse, &rx, &f, set.clone());
                     positive += want.0.iter().filter(|&&e| e > 0.0).count();
+                    let bits = |w: &Weights| {
+                        (
+                            w.0.map(f32::to_bits),
+                            w.1.map(f32::to_bits),
+                            w.2.to_bits(),
+                            w.3.to_bits(),
+                        )
+                    };
                     for level in levels() {
                         let got = lanes.weights_at_level(level, &rx, &f, set.clone());
-                        let bits = |w: &Weights| {
-                            (
-                                w.0.map(f32::to_bits),
-                                w.1.map(f32::to_bits),
-                                w.2.to_bits(),
-                                w.3.to_bits(),
-                            )
-                        };
                         assert_eq!(bits(&got), bits(&want), "{level:?} at {p}");
+                        // The terms a set skips change no bit.
+                        let full = every_term.weights_at_level(level, &rx, &f, set.clone());
+                        assert_eq!(bits(&full), bits(&want), "{level:?} at {p}, every term");
                     }
                 }
             }
