@@ -1134,24 +1134,29 @@ fn light_position(light: &Light) -> Option<(Vec3, f32)> {
 
 /// The equiangular parameters of a light at `position` seen along the ray `o + t d`, `t` in
 /// `[t0, t1]` (`t1` may be infinite): the distance `h` of the ray's closest approach (at least
-/// 1e-4), its parameter `delta`, and the angles `(theta_a, theta_b)` under which the
-/// interval's ends are seen.
+/// 1e-4), its parameter `delta`, and the angle `theta_b - theta_a` the interval spans as seen
+/// from the light (the angles under which its ends are seen, from the closest approach). One
+/// arc tangent: with `x_a = t0 - delta` and `x_b = t1 - delta`, `tan(theta_b - theta_a) =
+/// h (x_b - x_a) / (h^2 + x_a x_b)`, and `pi / 2 - theta_a = atan2(h, x_a)` for an unbounded
+/// interval; [`equiangular_start`] gives `theta_a` for the light that is sampled.
 #[inline]
-fn equiangular_frame(
-    o: Vec3,
-    d: Vec3,
-    (t0, t1): (f32, f32),
-    position: Vec3,
-) -> (f32, f32, f32, f32) {
+fn equiangular_frame(o: Vec3, d: Vec3, (t0, t1): (f32, f32), position: Vec3) -> (f32, f32, f32) {
     let delta = (position - o).dot(d);
     let h = (position - (o + d * delta)).length().max(1e-4);
-    let theta_a = (t0 - delta).atan2(h);
-    let theta_b = if t1.is_finite() {
-        (t1 - delta).atan2(h)
+    let (xa, xb) = (t0 - delta, t1 - delta);
+    let span = if t1.is_finite() {
+        (h * (xb - xa)).atan2(h * h + xa * xb)
     } else {
-        std::f32::consts::FRAC_PI_2
+        h.atan2(xa)
     };
-    (h, delta, theta_a, theta_b)
+    (h, delta, span)
+}
+
+/// `theta_a`, the angle under which the start `t0` of the interval is seen from the light, for
+/// [`equiangular_frame`]'s `h` and `delta`.
+#[inline]
+fn equiangular_start(t0: f32, h: f32, delta: f32) -> f32 {
+    (t0 - delta).atan2(h)
 }
 
 /// The part `[t0, t1]` of the segment `o + t d`, `t` in `[0, t_seg]`, that a light can
@@ -1223,6 +1228,10 @@ fn lit_interval(light: &Light, o: Vec3, d: Vec3, t_seg: f32) -> Option<(f32, f32
     lit
 }
 
+/// How many lights' weights [`equiangular_direct`]'s first walk keeps on the stack for its
+/// second (the lights past them are weighed again).
+const KEPT_EQUIANGULAR_WEIGHTS: usize = 64;
+
 /// The fog's single scattering of the point and spot lights along one whole segment
 /// (`ray` up to `t_seg`, in the fog), estimated by equiangular sampling (Kulla and Fajardo
 /// 2012): a light is chosen in proportion to `I (theta_b - theta_a) / h`, the integral of its
@@ -1233,7 +1242,7 @@ fn lit_interval(light: &Light, o: Vec3, d: Vec3, t_seg: f32) -> Option<(f32, f32
 /// next-event estimation toward these lights at collisions ([`scatter_in_fog`]); directional
 /// lights, emitter meshes and the environment stay there. `throughput` is the path's at the
 /// segment's start; draws nothing (`u` is given); returns the rays traced. Walks the lights
-/// twice: no allocation.
+/// twice, the second time reading the first walk's weights: no allocation.
 #[allow(clippy::too_many_arguments)]
 #[inline]
 fn equiangular_direct(
@@ -1251,8 +1260,8 @@ fn equiangular_direct(
             let Some(lit) = lit_interval(light, o, d, t_seg) else {
                 return 0.0;
             };
-            let (h, _, a, b) = equiangular_frame(o, d, lit, position);
-            let w = lum * (b - a) / h;
+            let (h, _, span) = equiangular_frame(o, d, lit, position);
+            let w = lum * span / h;
             if w.is_finite() && w > 0.0 {
                 w
             } else {
@@ -1260,14 +1269,24 @@ fn equiangular_direct(
             }
         })
     };
-    let total: f32 = scene.lights.iter().map(weight).sum();
+    // The first walk keeps the weights of the first lights for the second (each costs two
+    // arc tangents and the spot cone's interval).
+    let mut kept = [0.0f32; KEPT_EQUIANGULAR_WEIGHTS];
+    let mut total = 0.0f32;
+    for (i, light) in scene.lights.iter().enumerate() {
+        let w = weight(light);
+        if let Some(k) = kept.get_mut(i) {
+            *k = w;
+        }
+        total += w;
+    }
     if !(total > 0.0 && total.is_finite()) {
         return 0;
     }
     let target = u.x * total;
     let (mut acc, mut chosen) = (0.0f32, None);
-    for light in &scene.lights {
-        let w = weight(light);
+    for (i, light) in scene.lights.iter().enumerate() {
+        let w = kept.get(i).copied().unwrap_or_else(|| weight(light));
         if w > 0.0 {
             chosen = Some((light, w));
             acc += w;
@@ -1284,10 +1303,11 @@ fn equiangular_direct(
     else {
         return 0;
     };
-    let (h, delta, a, b) = equiangular_frame(o, d, lit, position);
-    let t = (delta + h * (a + u.y * (b - a)).tan()).clamp(lit.0, lit.1);
+    let (h, delta, span) = equiangular_frame(o, d, lit, position);
+    let a = equiangular_start(lit.0, h, delta);
+    let t = (delta + h * (a + u.y * span).tan()).clamp(lit.0, lit.1);
     let off = t - delta;
-    let pdf_t = h / ((b - a) * (h * h + off * off));
+    let pdf_t = h / (span * (h * h + off * off));
     let p = o + d * t;
     let Some(ls) = light.sample_li(p) else {
         return 0;
@@ -2469,6 +2489,51 @@ pub(crate) mod tests {
             ..parts
         })
         .unwrap()
+    }
+
+    /// The one-arc-tangent span of [`equiangular_frame`] is `theta_b - theta_a` computed in
+    /// f64 from the two angles, to a few float roundings, for intervals before, around and
+    /// after the closest approach, unbounded ones, and rays that pass the light within its
+    /// 1e-4 floor; and `theta_a` plus the span reaches the interval's end.
+    #[test]
+    fn equiangular_span_is_the_difference_of_the_angles() {
+        let mut rng = crate::sampling::Pcg32::new(11, 3);
+        for k in 0..20_000 {
+            let o = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 40.0 - 20.0;
+            let d = Vec3::new(
+                rng.next_f32() - 0.5,
+                rng.next_f32() - 0.5,
+                rng.next_f32() - 0.5,
+            )
+            .normalize();
+            let t0 = rng.next_f32() * 30.0;
+            let t1 = match k % 4 {
+                0 => f32::INFINITY,
+                _ => t0 + rng.next_f32() * 60.0 + 1e-3,
+            };
+            // Every fifth light sits on the ray's line (h at its floor).
+            let position = if k % 5 == 0 {
+                o + d * (rng.next_f32() * 80.0 - 10.0)
+            } else {
+                Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 40.0 - 20.0
+            };
+            let (h, delta, span) = equiangular_frame(o, d, (t0, t1), position);
+            let (h64, delta64) = (h as f64, delta as f64);
+            let a = (t0 as f64 - delta64).atan2(h64);
+            let b = if t1.is_finite() {
+                (t1 as f64 - delta64).atan2(h64)
+            } else {
+                std::f64::consts::FRAC_PI_2
+            };
+            let err = (span as f64 - (b - a)).abs();
+            assert!(
+                err <= 1e-5 * (b - a).max(1e-2),
+                "{o} {d} {t0} {t1} {position}: {span} vs {}",
+                b - a
+            );
+            let start = equiangular_start(t0, h, delta) as f64;
+            assert!((start - a).abs() < 1e-6, "{start} vs {a}");
+        }
     }
 
     /// A spot light's lit part of a segment holds every point of the segment inside its
