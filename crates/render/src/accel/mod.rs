@@ -459,8 +459,8 @@ impl Tree {
     #[inline(always)]
     fn closest(&self, kernel: Kernel, ray: &TraceRay, visit: impl FnMut(u32, f32) -> f32) -> f32 {
         match self {
-            Self::Eight(w) => wide::closest(kernel, w, ray, visit),
-            Self::Sixteen(w) => wide::closest(kernel, w, ray, visit),
+            Self::Eight(w) => wide::run(kernel, w, ray, wide::Closest(visit)),
+            Self::Sixteen(w) => wide::run(kernel, w, ray, wide::Closest(visit)),
         }
     }
 
@@ -468,8 +468,8 @@ impl Tree {
     #[inline(always)]
     fn any(&self, kernel: Kernel, ray: &TraceRay, visit: impl FnMut(u32) -> bool) -> bool {
         match self {
-            Self::Eight(w) => wide::any(kernel, w, ray, visit),
-            Self::Sixteen(w) => wide::any(kernel, w, ray, visit),
+            Self::Eight(w) => wide::run(kernel, w, ray, wide::AnyHit(visit)),
+            Self::Sixteen(w) => wide::run(kernel, w, ray, wide::AnyHit(visit)),
         }
     }
 }

@@ -529,86 +529,74 @@ impl Kernel {
     }
 }
 
-/// [`Wide::closest`] compiled for `kernel` (the baseline where the CPU lacks it).
-#[inline(always)]
-pub(super) fn closest<const W: usize>(
-    kernel: Kernel,
-    wide: &Wide<W>,
-    ray: &TraceRay,
-    visit: impl FnMut(u32, f32) -> f32,
-) -> f32 {
-    #[cfg(target_arch = "x86_64")]
-    {
-        #[target_feature(enable = "avx2")]
-        unsafe fn avx2<const W: usize>(
-            wide: &Wide<W>,
-            ray: &TraceRay,
-            visit: impl FnMut(u32, f32) -> f32,
-        ) -> f32 {
-            wide.closest(ray, visit)
-        }
-        #[target_feature(enable = "avx512f")]
-        unsafe fn avx512<const W: usize>(
-            wide: &Wide<W>,
-            ray: &TraceRay,
-            visit: impl FnMut(u32, f32) -> f32,
-        ) -> f32 {
-            wide.closest(ray, visit)
-        }
-        match kernel {
-            Kernel::Avx512 if std::arch::is_x86_feature_detected!("avx512f") => {
-                // SAFETY: the CPU has AVX-512F (checked just above).
-                return unsafe { avx512(wide, ray, visit) };
-            }
-            Kernel::Avx2 if std::arch::is_x86_feature_detected!("avx2") => {
-                // SAFETY: the CPU has AVX2 (checked just above).
-                return unsafe { avx2(wide, ray, visit) };
-            }
-            _ => {}
-        }
-    }
-    let _ = kernel;
-    wide.closest(ray, visit)
+/// A walk of a [`Wide`] BVH with its leaf visit, which [`run`] compiles for a kernel.
+pub(super) trait Walk<const W: usize> {
+    /// What the walk returns.
+    type Output;
+    /// Walks `wide` with `ray`.
+    fn walk(self, wide: &Wide<W>, ray: &TraceRay) -> Self::Output;
 }
 
-/// [`Wide::any`] compiled for `kernel` (the baseline where the CPU lacks it).
+/// [`Wide::closest`] with its visit.
+pub(super) struct Closest<F>(pub F);
+
+impl<const W: usize, F: FnMut(u32, f32) -> f32> Walk<W> for Closest<F> {
+    type Output = f32;
+    #[inline(always)]
+    fn walk(self, wide: &Wide<W>, ray: &TraceRay) -> f32 {
+        wide.closest(ray, self.0)
+    }
+}
+
+/// [`Wide::any`] with its visit.
+pub(super) struct AnyHit<F>(pub F);
+
+impl<const W: usize, F: FnMut(u32) -> bool> Walk<W> for AnyHit<F> {
+    type Output = bool;
+    #[inline(always)]
+    fn walk(self, wide: &Wide<W>, ray: &TraceRay) -> bool {
+        wide.any(ray, self.0)
+    }
+}
+
+/// `walk` compiled for `kernel` (the baseline where the CPU lacks it).
 #[inline(always)]
-pub(super) fn any<const W: usize>(
+pub(super) fn run<const W: usize, K: Walk<W>>(
     kernel: Kernel,
     wide: &Wide<W>,
     ray: &TraceRay,
-    visit: impl FnMut(u32) -> bool,
-) -> bool {
+    walk: K,
+) -> K::Output {
     #[cfg(target_arch = "x86_64")]
     {
         #[target_feature(enable = "avx2")]
-        unsafe fn avx2<const W: usize>(
+        unsafe fn avx2<const W: usize, K: Walk<W>>(
             wide: &Wide<W>,
             ray: &TraceRay,
-            visit: impl FnMut(u32) -> bool,
-        ) -> bool {
-            wide.any(ray, visit)
+            walk: K,
+        ) -> K::Output {
+            walk.walk(wide, ray)
         }
         #[target_feature(enable = "avx512f")]
-        unsafe fn avx512<const W: usize>(
+        unsafe fn avx512<const W: usize, K: Walk<W>>(
             wide: &Wide<W>,
             ray: &TraceRay,
-            visit: impl FnMut(u32) -> bool,
-        ) -> bool {
-            wide.any(ray, visit)
+            walk: K,
+        ) -> K::Output {
+            walk.walk(wide, ray)
         }
         match kernel {
             Kernel::Avx512 if std::arch::is_x86_feature_detected!("avx512f") => {
                 // SAFETY: the CPU has AVX-512F (checked just above).
-                return unsafe { avx512(wide, ray, visit) };
+                return unsafe { avx512(wide, ray, walk) };
             }
             Kernel::Avx2 if std::arch::is_x86_feature_detected!("avx2") => {
                 // SAFETY: the CPU has AVX2 (checked just above).
-                return unsafe { avx2(wide, ray, visit) };
+                return unsafe { avx2(wide, ray, walk) };
             }
             _ => {}
         }
     }
     let _ = kernel;
-    wide.any(ray, visit)
+    walk.walk(wide, ray)
 }
