@@ -105,6 +105,11 @@ fn methods(args: &Args) -> Result<Vec<Method>> {
         .map(|s| Method::command(s))
         .chain(args.predictions.iter().map(|s| Method::predictions(s)))
         .collect::<Result<Vec<_>>>()?;
+    for (i, c) in commands.iter().enumerate() {
+        if commands[..i].iter().any(|o| o.name() == c.name()) {
+            bail!("the method name {} is given twice", c.name());
+        }
+    }
     let mut out: Vec<Method> = Vec::new();
     for name in &args.methods {
         let m = Method::built_in(name)
@@ -126,9 +131,6 @@ fn methods(args: &Args) -> Result<Vec<Method>> {
     }
     for c in commands {
         if !args.methods.iter().any(|n| n == c.name()) {
-            if out.iter().any(|o| o.name() == c.name()) {
-                bail!("the method name {} is given twice", c.name());
-            }
             out.push(c);
         }
     }
