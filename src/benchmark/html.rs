@@ -97,6 +97,16 @@ fn region_cell(e: Option<&DisparityErrors>, text: impl Fn(&DisparityErrors) -> S
     }
 }
 
+/// The phantom-hole rate cell of a score: `n/a` without road masks, `–` without values (a
+/// failure).
+fn phantom_cell(m: &MethodScore) -> String {
+    match (m.phantom_hole_rate, m.errors.road_surface) {
+        (Some(v), _) => format!("<td>{}</td>", pct(v)),
+        (None, None) => region_cell(None, |_| String::new()),
+        (None, Some(_)) => "<td class=\"none\" title=\"no values\">–</td>".to_string(),
+    }
+}
+
 /// A time cell: `not timed` for maps made beforehand.
 fn seconds_cell(v: Option<f64>) -> String {
     match v {
@@ -340,7 +350,7 @@ pub fn page(report: &Report, thumbs: &[SampleThumbs]) -> String {
         let _ = write!(
             o,
             "<tr><td><span class=\"swatch\" style=\"background:{}\"></span>{}</td>{}{}{}\
-             <td>{}</td>{}<td>{}</td>{}{}</tr>",
+             <td>{}</td>{}{}{}{}</tr>",
             colour(i),
             esc(&m.method),
             cell(&e.all, format!("{:.3}", e.all.mean_abs)),
@@ -348,7 +358,7 @@ pub fn page(report: &Report, thumbs: &[SampleThumbs]) -> String {
             cell(&e.all, pct(e.all.d1)),
             pct(e.all.density),
             region_cell(e.streak.as_ref(), |s| format!("{:.3}", s.mean_abs)),
-            m.phantom_hole_rate.map(pct).unwrap_or_else(|| "–".into()),
+            phantom_cell(m),
             seconds_cell(m.seconds_per_megapixel),
             failed_cell(m)
         );
@@ -468,14 +478,14 @@ pub fn page(report: &Report, thumbs: &[SampleThumbs]) -> String {
             };
             let _ = write!(
                 o,
-                "<tr>{first}<td class=\"l\">{}</td>{}{}{}<td>{}</td><td>{}</td>{}{}\
+                "<tr>{first}<td class=\"l\">{}</td>{}{}{}<td>{}</td>{}{}{}\
                  {status}</tr>",
                 esc(&r.method),
                 cell(&e.all, format!("{:.3}", e.all.mean_abs)),
                 cell(&e.all, pct(e.all.bad_2)),
                 region_cell(e.streak.as_ref(), |s| format!("{:.3}", s.mean_abs)),
                 pct(e.all.density),
-                r.phantom_hole_rate.map(pct).unwrap_or_else(|| "–".into()),
+                phantom_cell(r),
                 seconds_cell(r.seconds),
                 seconds_cell(r.seconds_per_megapixel)
             );

@@ -369,7 +369,11 @@ fn summary_table(report: &Report) -> String {
                 Some(streak) => valued(streak, format!("{:.3}", streak.mean_abs)),
                 None => "n/a".to_string(),
             },
-            m.phantom_hole_rate.map(pct).unwrap_or_else(|| "-".into()),
+            match (m.phantom_hole_rate, e.road_surface) {
+                (Some(v), _) => pct(v),
+                (None, None) => "n/a".into(),
+                (None, Some(_)) => "-".into(),
+            },
             m.seconds_per_megapixel
                 .map(|v| format!("{v:.2}"))
                 .unwrap_or_else(|| "-".into())
