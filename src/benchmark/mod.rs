@@ -42,7 +42,8 @@ use streaks_image::pfm::read_pfm;
 use streaks_image::{write_bytes_atomically, GrayImage};
 use streaks_stereo::rig::Eye;
 
-/// Score stereo methods against a dataset's or pair folders' ground truth.
+/// Score stereo methods against the ground truth of a dataset, pair folders, a KITTI 2015 or a
+/// Middlebury 2014 folder.
 #[derive(clap::Args, Debug)]
 pub struct Args {
     /// A dataset (`streaks dataset generate`), a `streaks stereo` pair folder, a folder of
