@@ -466,6 +466,28 @@ fn hostile_folder_names_reach_a_method_as_literal_paths() {
             "the private folder is left behind"
         );
         assert_eq!(summary(&r, "recorder")["failed"], 2);
+        // A batch command reads the same paths from its list file, blanks, quotes and braces
+        // as they are; a newline cannot be written in it: refused before anything runs.
+        let _ = std::fs::remove_dir_all(t.join("batch_out"));
+        let run = t.streaks(&[
+            "benchmark",
+            name,
+            "--method-cmd",
+            &batch(),
+            "-o",
+            "batch_out",
+        ]);
+        if name.contains('\n') {
+            run.assert_failure_mentioning("tab, newline or carriage return");
+            assert!(!t.join("batch_out").exists());
+        } else {
+            run.assert_success();
+            let b = report(&t, "batch_out");
+            assert_eq!(summary(&b, "batch")["errors"], summary(&r, "sgm")["errors"]);
+        }
+        for k in 1..=5 {
+            assert!(!t.join(&format!("PWNED{k}")).exists(), "{name:?}: PWNED{k}");
+        }
     }
 }
 
