@@ -16,22 +16,26 @@
 //! summary[]          per method: pooled errors by region, phantom-hole rate, seconds,
 //!                    megapixels, seconds per megapixel (`null` for predictions: not
 //!                    timed), samples, failed (how many of them the method failed on)
-//! samples[]          per sample: id, folder, size, which masks it has, and per
-//!                    method the same figures for that sample alone, with `failure` (kind,
-//!                    reason, stderr_tail, stdout_tail) when the method failed on it
+//! samples[]          per sample: id, folder, size, which masks it has (streak_mask,
+//!                    road_mask, occlusion_mask), the road-plane check, and per method the
+//!                    same figures for that sample alone, with `failure` (kind, reason,
+//!                    stderr_tail, stdout_tail) when the method failed on it
 //! failure_scoring    how a failed sample counts in the scores
+//! unavailable        what a `null` region means
 //! ```
 //!
 //! A method that fails on a sample (a command that exits non-zero, runs past its time limit, is
-//! killed by a signal, writes no map or an unreadable one or one of the wrong size) is left out
-//! of its summary, which covers the samples it succeeded on ([`FAILURE_SCORING`]).
+//! killed by a signal, writes no map or an unreadable one or one of the wrong size; a
+//! prediction folder without the sample's map or with a bad one) is left out of its summary,
+//! which covers the samples it succeeded on ([`FAILURE_SCORING`]).
 //!
 //! Errors by region are [`RegionErrors`]: `all`, `streak`, `non_streak`, `road` (road surface
 //! off the streaks), `off_road`, `road_surface` (the whole road, whose `below_1px` is the
 //! phantom-hole rate) and `non_occluded`; a region whose masks a sample lacks is `null` (not
-//! available: KITTI and Middlebury data have no streak or road masks), never zeros. Each is a [`crate::sgm::DisparityErrors`]
-//! (`truth_pixels`, `valid_pixels`, `density` = the valid share, `mean_abs` = EPE, `rms`,
-//! `bad_1`, `bad_2`, `bad_3`, `d1` (KITTI), `bad` and `bad_all` at `threshold`, `below_1px`).
+//! available: KITTI and Middlebury data have no streak or road masks), never zeros
+//! ([`UNAVAILABLE`]). Each is a [`crate::sgm::DisparityErrors`] (`truth_pixels`,
+//! `valid_pixels`, `density` = the valid share, `mean_abs` = EPE, `rms`, `bad_1`, `bad_2`,
+//! `bad_3`, `d1` (KITTI), `bad` and `bad_all` at `threshold`, `below_1px`).
 
 use super::RegionErrors;
 use serde::Serialize;
