@@ -66,7 +66,8 @@ enum Command {
     TrainDetector(train_detector::Args),
     /// Generate stereo datasets of procedural rainy streets (generate), and index them (index).
     Dataset(dataset::Args),
-    /// Score stereo methods (built-in and external) against a dataset's ground truth by region.
+    /// Score stereo methods (built-in, external, predictions) against the ground truth of a
+    /// dataset, pair folders, KITTI 2015 or Middlebury 2014, by region.
     Benchmark(benchmark::Args),
 }
 

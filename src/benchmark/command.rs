@@ -5,7 +5,9 @@
 //! - [`Template`]: `--method-cmd NAME=TEMPLATE`'s TEMPLATE, split into argv words by shell word
 //!   rules (`shlex`, quotes and backslashes; no expansion, no operators) before any path is
 //!   known; [`Template::argv`] then replaces `{left}`, `{right}` and `{out}` inside each word in
-//!   a single left-to-right pass, so a path that itself reads `{out}` stays literal.
+//!   a single left-to-right pass, so a path that itself reads `{out}` stays literal. A *batch*
+//!   template names `{list}` instead ([`Template::is_batch`]): one run for all samples, given
+//!   a list file ([`write_list`]) by [`Template::batch_argv`].
 //! - [`run`]: runs the words as a program (stdin from `/dev/null`, the paths also in the
 //!   environment as [`ENV_LEFT`], [`ENV_RIGHT`], [`ENV_OUT`]) in a fresh process group; on the
 //!   time limit the whole group is killed, and once the program ends its group is killed too,
@@ -30,6 +32,11 @@ pub const ENV_LEFT: &str = "STREAKS_LEFT";
 pub const ENV_RIGHT: &str = "STREAKS_RIGHT";
 /// The environment variable holding the absolute path of the PFM the command must write.
 pub const ENV_OUT: &str = "STREAKS_OUT";
+/// The environment variable holding a batch command's list file ([`write_list`]).
+pub const ENV_LIST: &str = "STREAKS_LIST";
+
+/// A batch command's list placeholder.
+const LIST: &str = "{list}";
 
 /// How much of each of a command's output streams is kept: its last 64 KiB.
 pub const TAIL_BYTES: usize = 64 * 1024;
@@ -38,7 +45,7 @@ pub const TAIL_BYTES: usize = 64 * 1024;
 /// process that left the group (its own session) can keep a pipe open longer.
 const DRAIN_GRACE: Duration = Duration::from_secs(2);
 
-/// The placeholders, in the order of [`Paths`]' fields.
+/// The per-sample placeholders, in the order of [`Paths`]' fields.
 const PLACEHOLDERS: [&str; 3] = ["{left}", "{right}", "{out}"];
 
 /// Programs whose `-c` or `-e` option takes code: a placeholder inside that code would put a
@@ -60,9 +67,13 @@ pub struct Paths<'a> {
 }
 
 impl Paths<'_> {
-    /// The value of placeholder `k` of [`PLACEHOLDERS`].
-    fn value(&self, k: usize) -> &OsStr {
-        [self.left, self.right, self.out][k].as_os_str()
+    /// Each placeholder of [`PLACEHOLDERS`] with its value.
+    fn values(&self) -> [(&'static str, &OsStr); 3] {
+        [
+            (PLACEHOLDERS[0], self.left.as_os_str()),
+            (PLACEHOLDERS[1], self.right.as_os_str()),
+            (PLACEHOLDERS[2], self.out.as_os_str()),
+        ]
     }
 
     /// The environment the command gets: [`ENV_LEFT`], [`ENV_RIGHT`], [`ENV_OUT`].
@@ -82,11 +93,13 @@ pub struct Template {
     text: String,
     /// Its words, placeholders still in them.
     words: Vec<String>,
+    /// Whether it names `{list}` (or [`ENV_LIST`]): one run for all samples.
+    batch: bool,
 }
 
-/// Whether `word` holds a placeholder.
+/// Whether `word` holds a placeholder, `{list}` included.
 fn has_placeholder(word: &str) -> bool {
-    PLACEHOLDERS.iter().any(|p| word.contains(p))
+    PLACEHOLDERS.iter().chain([&LIST]).any(|p| word.contains(p))
 }
 
 /// The program name of `word` without its folder and a version suffix (`python3.12` ->
@@ -124,9 +137,14 @@ impl Template {
     /// variable, command or glob expansion, no `;`, `|`, `>` operators: those are plain
     /// characters of a word). `name` is the method's, for errors.
     ///
+    /// A template that names `{list}` or [`ENV_LIST`] is a batch template, run once for all
+    /// samples; it cannot also name `{left}`, `{right}` or `{out}`.
+    ///
     /// Refused: unbalanced quotes, no words, a placeholder in the program word, a template
-    /// naming neither `{out}` nor [`ENV_OUT`], and a placeholder inside the code an interpreter
-    /// runs (`sh -c '... {left} ...'`), which would put a path into program text.
+    /// naming neither `{out}` nor [`ENV_OUT`] (nor, for a batch, `{list}` or [`ENV_LIST`]), a
+    /// batch template with a per-sample placeholder, and a placeholder inside the code an
+    /// interpreter runs (`sh -c '... {left} ...'`), which would put a path into program
+    /// text.
     pub fn parse(name: &str, text: &str) -> Result<Template> {
         let Some(words) = shlex::split(text) else {
             bail!(
@@ -143,10 +161,23 @@ impl Template {
                  word is the program to run"
             );
         }
-        if !words.iter().any(|w| w.contains("{out}")) && !text.contains(ENV_OUT) {
+        let batch = words.iter().any(|w| w.contains(LIST)) || text.contains(ENV_LIST);
+        if batch {
+            if let Some(w) = words
+                .iter()
+                .find(|w| PLACEHOLDERS.iter().any(|p| w.contains(p)))
+            {
+                bail!(
+                    "--method-cmd {name}: the template names {{list}} (one run for all samples) \
+                     and also {w:?}: a batch command reads each sample's paths from the list \
+                     file, a per-sample command gets {{left}}, {{right}} and {{out}}; not both"
+                );
+            }
+        } else if !words.iter().any(|w| w.contains("{out}")) && !text.contains(ENV_OUT) {
             bail!(
                 "--method-cmd {name}: the template {text:?} has no {{out}} (nor ${ENV_OUT}), the \
-                 PFM the command must write (use {{left}}, {{right}} and {{out}})"
+                 PFM the command must write (use {{left}}, {{right}} and {{out}}, or {{list}} \
+                 for one run over all samples)"
             );
         }
         for (i, w) in words.iter().enumerate() {
@@ -164,7 +195,8 @@ impl Template {
                             "--method-cmd {name}: a placeholder inside the code {w} {flag} runs \
                              ({code:?}) would make a path part of program text; read the paths \
                              from the environment instead (\"${ENV_LEFT}\", \"${ENV_RIGHT}\", \
-                             \"${ENV_OUT}\"), or pass them as arguments after the code \
+                             \"${ENV_OUT}\", \"${ENV_LIST}\"), or pass them as arguments \
+                             after the code \
                              (sh -c '... \"$1\" \"$2\" \"$3\"' sh {{left}} {{right}} {{out}})"
                         );
                     }
@@ -175,7 +207,13 @@ impl Template {
         Ok(Template {
             text: text.to_string(),
             words,
+            batch,
         })
+    }
+
+    /// Whether it is a batch template (`{list}`): one run for all samples.
+    pub fn is_batch(&self) -> bool {
+        self.batch
     }
 
     /// The template as given.
@@ -187,21 +225,66 @@ impl Template {
     /// in one left-to-right pass. A replacement is never scanned again, so a path holding
     /// `{out}` or quotes stays exactly itself; any other brace is left as it is.
     pub fn argv(&self, paths: &Paths) -> Vec<OsString> {
-        self.words.iter().map(|w| substitute(w, paths)).collect()
+        let values = paths.values();
+        self.words.iter().map(|w| substitute(w, &values)).collect()
+    }
+
+    /// The argv of a batch run: each word with `{list}` replaced by `list`, as
+    /// [`Template::argv`] replaces the per-sample placeholders.
+    pub fn batch_argv(&self, list: &Path) -> Vec<OsString> {
+        let values = [(LIST, list.as_os_str())];
+        self.words.iter().map(|w| substitute(w, &values)).collect()
     }
 }
 
-/// `word` with its placeholders replaced in one pass.
-fn substitute(word: &str, paths: &Paths) -> OsString {
+/// One line of a batch command's list file: the three absolute paths, tab-separated, or why a
+/// path cannot be written in it (not UTF-8, or holding a tab, newline or carriage return).
+fn list_line(paths: &Paths) -> std::result::Result<String, String> {
+    let mut fields = Vec::with_capacity(3);
+    for p in [paths.left, paths.right, paths.out] {
+        let Some(text) = p.to_str() else {
+            return Err(format!("{} is not UTF-8 text", p.display()));
+        };
+        if text.contains(['\t', '\n', '\r']) {
+            return Err(format!(
+                "{text:?} holds a tab, newline or carriage return, which separate the list's \
+                 fields and lines"
+            ));
+        }
+        fields.push(text);
+    }
+    Ok(format!("{}\n", fields.join("\t")))
+}
+
+/// Writes a batch command's list file `list`: one line per sample, `left<TAB>right<TAB>out`,
+/// absolute paths in UTF-8, each line ended by a newline. A path that cannot be written so
+/// ([`list_line`]) is refused with the path and the reason, before the file is written.
+pub fn write_list(list: &Path, samples: &[Paths]) -> Result<()> {
+    let mut text = String::new();
+    for p in samples {
+        match list_line(p) {
+            Ok(line) => text.push_str(&line),
+            Err(reason) => bail!(
+                "a batch command's list file cannot hold this sample's paths: {reason}; rename \
+                 the folder or use a per-sample template ({{left}} {{right}} {{out}})"
+            ),
+        }
+    }
+    streaks_image::write_bytes_atomically(list, text.as_bytes())?;
+    Ok(())
+}
+
+/// `word` with the placeholders of `values` replaced in one pass.
+fn substitute(word: &str, values: &[(&str, &OsStr)]) -> OsString {
     let mut out = OsString::with_capacity(word.len());
     let mut rest = word;
     while let Some(i) = rest.find('{') {
         out.push(&rest[..i]);
         let from = &rest[i..];
-        match PLACEHOLDERS.iter().position(|p| from.starts_with(p)) {
-            Some(k) => {
-                out.push(paths.value(k));
-                rest = &from[PLACEHOLDERS[k].len()..];
+        match values.iter().find(|(p, _)| from.starts_with(p)) {
+            Some((p, value)) => {
+                out.push(value);
+                rest = &from[p.len()..];
             }
             None => {
                 out.push("{");
@@ -575,6 +658,53 @@ mod tests {
             "tool -c {left} {out}",
         ] {
             assert!(Template::parse("m", t).is_ok(), "{t}");
+        }
+    }
+
+    #[test]
+    fn batch_templates_and_their_list_file() {
+        let t = Template::parse("b", "net --list={list} -v").unwrap();
+        assert!(t.is_batch());
+        assert_eq!(
+            t.batch_argv(Path::new("/w/{out} list.tsv")),
+            strings(&["net", "--list=/w/{out} list.tsv", "-v"])
+        );
+        assert!(Template::parse("b", "sh -c 'net \"$STREAKS_LIST\"'")
+            .unwrap()
+            .is_batch());
+        assert!(!Template::parse("b", "net {left} {right} {out}")
+            .unwrap()
+            .is_batch());
+        let err = |t: &str| format!("{:#}", Template::parse("b", t).unwrap_err());
+        assert!(err("net {list} {out}").contains("not both"));
+        assert!(err("sh -c 'net {list}'").contains("program text"));
+        assert!(err("{list}").contains("cannot be a placeholder"));
+        // The list: tab-separated absolute paths, one sample a line; blanks and quotes kept.
+        let dir = tempfile::tempdir().unwrap();
+        let list = dir.path().join("list.tsv");
+        let (l, r, o) = (
+            PathBuf::from("/d/it's a {left}/im0.png"),
+            PathBuf::from("/d/im1.png"),
+            PathBuf::from("/w/000000-net.pfm"),
+        );
+        let p = Paths {
+            left: &l,
+            right: &r,
+            out: &o,
+        };
+        write_list(&list, &[p, p]).unwrap();
+        let line = "/d/it's a {left}/im0.png\t/d/im1.png\t/w/000000-net.pfm\n";
+        assert_eq!(
+            std::fs::read_to_string(&list).unwrap(),
+            format!("{line}{line}")
+        );
+        // A tab or a newline in a path cannot be written: refused, nothing written.
+        for bad in ["/d/a\tb/im0.png", "/d/a\nb/im0.png"] {
+            let l = PathBuf::from(bad);
+            let other = dir.path().join("other.tsv");
+            let e = write_list(&other, &[Paths { left: &l, ..p }]).unwrap_err();
+            assert!(format!("{e:#}").contains("tab, newline"), "{e:#}");
+            assert!(!other.exists());
         }
     }
 

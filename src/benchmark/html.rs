@@ -86,6 +86,35 @@ fn esc_code(s: &str) -> String {
         .collect()
 }
 
+/// A cell of a figure of a region a sample may lack: `n/a` when the samples have no mask for
+/// it (not available, not zero), else as [`cell`].
+fn region_cell(e: Option<&DisparityErrors>, text: impl Fn(&DisparityErrors) -> String) -> String {
+    match e {
+        None => "<td class=\"none\" title=\"not available: the samples have no mask for this \
+                 region\">n/a</td>"
+            .to_string(),
+        Some(e) => cell(e, text(e)),
+    }
+}
+
+/// The phantom-hole rate cell of a score: `n/a` without road masks, `–` without values (a
+/// failure).
+fn phantom_cell(m: &MethodScore) -> String {
+    match (m.phantom_hole_rate, m.errors.road_surface) {
+        (Some(v), _) => format!("<td>{}</td>", pct(v)),
+        (None, None) => region_cell(None, |_| String::new()),
+        (None, Some(_)) => "<td class=\"none\" title=\"no values\">–</td>".to_string(),
+    }
+}
+
+/// A time cell: `not timed` for maps made beforehand.
+fn seconds_cell(v: Option<f64>) -> String {
+    match v {
+        Some(v) => format!("<td>{v:.2}</td>"),
+        None => "<td class=\"none\" title=\"maps made beforehand\">not timed</td>".to_string(),
+    }
+}
+
 /// The failed-samples cell of a summary row: `–` when none.
 fn failed_cell(m: &MethodScore) -> String {
     match m.failed {
@@ -169,11 +198,12 @@ fn region_of<'a>(m: &'a MethodScore, region: &str) -> Option<&'a DisparityErrors
     let e = &m.errors;
     match region {
         "all" => Some(&e.all),
-        "streak" => Some(&e.streak),
-        "non_streak" => Some(&e.non_streak),
+        "streak" => e.streak.as_ref(),
+        "non_streak" => e.non_streak.as_ref(),
         "road" => e.road.as_ref(),
         "off_road" => e.off_road.as_ref(),
         "road_surface" => e.road_surface.as_ref(),
+        "non_occluded" => e.non_occluded.as_ref(),
         _ => None,
     }
 }
@@ -264,16 +294,17 @@ pub fn page(report: &Report, thumbs: &[SampleThumbs]) -> String {
         esc(report.aggregation)
     );
     // Methods.
-    o.push_str("<section><h2>Methods</h2><table class=\"methods\" id=\"methods\"><tr><th>method</th><th>kind</th><th>what it is</th></tr>");
+    o.push_str("<section><h2>Methods</h2><table class=\"methods\" id=\"methods\"><tr><th>method</th><th>kind</th><th>what it is</th><th>its time</th></tr>");
     for (i, m) in report.methods.iter().enumerate() {
         let _ = write!(
             o,
             "<tr><td><span class=\"swatch\" style=\"background:{}\"></span><b>{}</b></td>\
-             <td>{}</td><td>{}</td></tr>",
+             <td>{}</td><td>{}</td><td>{}</td></tr>",
             colour(i),
             esc(&m.name),
             m.kind,
-            esc_code(&m.description)
+            esc_code(&m.description),
+            esc(m.timing)
         );
     }
     o.push_str(
@@ -282,8 +313,9 @@ pub fn page(report: &Report, thumbs: &[SampleThumbs]) -> String {
          over the pixels a method gives a value (its valid share is beside them), so a method \
          with few values (<code>lk</code>, which measures only along detected streaks) is \
          scored where it applies, not over the whole image; a dash means no values at all \
-         (for <code>lk</code>: no streak detected). Time is the method's wall time \
-         (built-ins: reading the PNGs and estimating; commands: the whole process), not the \
+         (for <code>lk</code>: no streak detected); <i>n/a</i> means the samples have no mask \
+         for that region (KITTI and Middlebury folders have no streak or road masks): not \
+         available, not zero. Time is the method's wall time as its row above says, never the \
          scoring.</p></section>\n",
     );
     // Headline: phantom holes and time, and the charts.
@@ -318,16 +350,16 @@ pub fn page(report: &Report, thumbs: &[SampleThumbs]) -> String {
         let _ = write!(
             o,
             "<tr><td><span class=\"swatch\" style=\"background:{}\"></span>{}</td>{}{}{}\
-             <td>{}</td>{}<td>{}</td><td>{:.2}</td>{}</tr>",
+             <td>{}</td>{}{}{}{}</tr>",
             colour(i),
             esc(&m.method),
             cell(&e.all, format!("{:.3}", e.all.mean_abs)),
             cell(&e.all, pct(e.all.bad_2)),
             cell(&e.all, pct(e.all.d1)),
             pct(e.all.density),
-            cell(&e.streak, format!("{:.3}", e.streak.mean_abs)),
-            m.phantom_hole_rate.map(pct).unwrap_or_else(|| "–".into()),
-            m.seconds_per_megapixel,
+            region_cell(e.streak.as_ref(), |s| format!("{:.3}", s.mean_abs)),
+            phantom_cell(m),
+            seconds_cell(m.seconds_per_megapixel),
             failed_cell(m)
         );
     }
@@ -342,7 +374,7 @@ pub fn page(report: &Report, thumbs: &[SampleThumbs]) -> String {
             .filter_map(|(i, m)| f(m).map(|v| (m.method.clone(), colour(i).to_string(), v)))
             .collect()
     };
-    let charts: [(&str, Vec<Bar>, bool); 5] = [
+    let charts: [(&str, Vec<Bar>, bool); 6] = [
         (
             "Phantom-hole rate (road)",
             bars(&|m| m.phantom_hole_rate),
@@ -354,8 +386,13 @@ pub fn page(report: &Report, thumbs: &[SampleThumbs]) -> String {
             true,
         ),
         (
+            "D1, non-occluded pixels",
+            bars(&|m| m.errors.non_occluded.map(|e| e.d1)),
+            true,
+        ),
+        (
             "EPE on streak pixels, px",
-            bars(&|m| Some(m.errors.streak.mean_abs)),
+            bars(&|m| m.errors.streak.map(|e| e.mean_abs)),
             false,
         ),
         (
@@ -365,7 +402,7 @@ pub fn page(report: &Report, thumbs: &[SampleThumbs]) -> String {
         ),
         (
             "Seconds per megapixel",
-            bars(&|m| Some(m.seconds_per_megapixel)),
+            bars(&|m| m.seconds_per_megapixel),
             false,
         ),
     ];
@@ -407,9 +444,9 @@ pub fn page(report: &Report, thumbs: &[SampleThumbs]) -> String {
         }
         o.push_str("</table>");
     }
-    o.push_str("<p class=\"note\">D1 is KITTI 2015's: off by more than 3 px and by more than 5 % of the true disparity. Without road masks (pair folders of scenes that flag no road) the road regions are left out.</p></section>\n");
+    o.push_str("<p class=\"note\">D1 is KITTI 2015's: off by more than 3 px and by more than 5 % of the true disparity. A region is left out where no sample has its masks: the road regions without road masks (pair folders of scenes that flag no road, KITTI, Middlebury), the streak regions without streak masks (KITTI, Middlebury), the non-occluded pixels without an occlusion mask (KITTI's disp_noc_0, Middlebury's mask0nocc.png).</p></section>\n");
     // Per-sample table.
-    o.push_str("<section><h2>Per sample</h2><table id=\"samples\"><tr><th>sample</th><th class=\"l\">method</th><th>EPE px</th><th>bad-2</th><th>streak EPE px</th><th>valid</th><th>phantom-hole rate</th><th>seconds</th><th class=\"l\">status</th></tr>");
+    o.push_str("<section><h2>Per sample</h2><table id=\"samples\"><tr><th>sample</th><th class=\"l\">method</th><th>EPE px</th><th>bad-2</th><th>streak EPE px</th><th>valid</th><th>phantom-hole rate</th><th>seconds</th><th>s / megapixel</th><th class=\"l\">status</th></tr>");
     for s in &report.samples {
         for (j, r) in s.results.iter().enumerate() {
             let first = if j == 0 {
@@ -441,15 +478,16 @@ pub fn page(report: &Report, thumbs: &[SampleThumbs]) -> String {
             };
             let _ = write!(
                 o,
-                "<tr>{first}<td class=\"l\">{}</td>{}{}{}<td>{}</td><td>{}</td><td>{:.2}</td>\
+                "<tr>{first}<td class=\"l\">{}</td>{}{}{}<td>{}</td>{}{}{}\
                  {status}</tr>",
                 esc(&r.method),
                 cell(&e.all, format!("{:.3}", e.all.mean_abs)),
                 cell(&e.all, pct(e.all.bad_2)),
-                cell(&e.streak, format!("{:.3}", e.streak.mean_abs)),
+                region_cell(e.streak.as_ref(), |s| format!("{:.3}", s.mean_abs)),
                 pct(e.all.density),
-                r.phantom_hole_rate.map(pct).unwrap_or_else(|| "–".into()),
-                r.seconds
+                phantom_cell(r),
+                seconds_cell(r.seconds),
+                seconds_cell(r.seconds_per_megapixel)
             );
         }
     }

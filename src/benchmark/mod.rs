@@ -1,18 +1,22 @@
-//! `streaks benchmark DIR --method NAME... [--method-cmd NAME=TEMPLATE]... -o OUT`: stereo
-//! methods scored against the ground truth of a dataset or of `streaks stereo` pair folders,
-//! by region (streak, road, off-road), with `OUT/report.json` ([`report`]) and a
+//! `streaks benchmark DIR --method NAME... [--method-cmd NAME=TEMPLATE]... [--predictions
+//! NAME=DIR]... -o OUT`: stereo methods scored against the ground truth of a dataset, of
+//! `streaks stereo` pair folders, or of a KITTI 2015 or Middlebury 2014 folder, by region
+//! (streak, road, off-road, non-occluded), with `OUT/report.json` ([`report`]) and a
 //! self-contained `OUT/index.html` ([`html`]).
 //!
 //! - [`input`]: the samples of DIR;
 //! - [`method`]: the built-in methods (`sgm`, `sgm-streaks`, `lk`, the analysis crate's
-//!   [`streaks_analysis::benchmark::method`]) and external commands;
+//!   [`streaks_analysis::benchmark::method`]), external commands (per sample or one batch)
+//!   and prediction folders;
 //! - [`command`]: an external command's template and process, run without a shell;
+//! - [`maps`]: disparity maps on disk (PFM or KITTI PNG by extension);
 //! - [`report`]: the report's top level (its parts are
 //!   [`streaks_analysis::benchmark::report`]'s);
 //! - [`html`]: the page.
 //!
-//! Scoring and pooling are [`streaks_analysis::benchmark`]. Every method runs on every sample (a progress
-//! bar over samples x methods). A method that fails on a sample (see [`report::FailureKind`])
+//! Scoring and pooling are [`streaks_analysis::benchmark`]. Batch commands run first, once
+//! each; then every method gives its map of every sample (a progress bar over samples x
+//! methods). A method that fails on a sample (see [`report::FailureKind`])
 //! is recorded as failed there with its reason and output tails, left out of its summary
 //! ([`report::FAILURE_SCORING`]), and the run goes on; at the end both outputs are written
 //! atomically, the failures listed, and the command exits non-zero unless
@@ -22,6 +26,7 @@
 pub mod command;
 pub mod html;
 pub mod input;
+pub mod maps;
 pub mod method;
 pub mod report;
 
@@ -32,28 +37,36 @@ use std::path::PathBuf;
 use std::time::Duration;
 use streaks_analysis::benchmark::{error_map, score_regions, BAD_THRESHOLD_PX};
 use streaks_analysis::road_plane::RoadPlaneCheck;
-use streaks_dataset::files::{load_mask, SampleDir};
+use streaks_dataset::files::SampleDir;
 use streaks_image::pfm::read_pfm;
 use streaks_image::{write_bytes_atomically, GrayImage};
 use streaks_stereo::rig::Eye;
 
-/// Score stereo methods against a dataset's or pair folders' ground truth.
+/// Score stereo methods against the ground truth of a dataset, pair folders, a KITTI 2015 or a
+/// Middlebury 2014 folder.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// A dataset (`streaks dataset generate`), a `streaks stereo` pair folder, or a folder of
-    /// pair folders.
+    /// A dataset (`streaks dataset generate`), a `streaks stereo` pair folder, a folder of
+    /// pair folders, a KITTI 2015 folder (`training/image_2`, `image_3`, `disp_occ_0`), or a
+    /// Middlebury 2014 scene folder (`im0.png`, `im1.png`, `disp0GT.pfm`) or folder of them.
     pub dir: PathBuf,
-    /// Methods to run: built-in `sgm`, `sgm-streaks`, `lk`, or the name of a --method-cmd
-    /// (every --method-cmd runs, named here or not).
+    /// Methods to run: built-in `sgm`, `sgm-streaks`, `lk`, or the name of a --method-cmd or
+    /// --predictions (every --method-cmd and --predictions runs, named here or not).
     #[arg(long = "method", value_name = "NAME", num_args = 1..)]
     pub methods: Vec<String>,
     /// An external method: NAME=TEMPLATE, a program and its arguments (split into words like a
     /// shell would, but run without one) in which `{left}`, `{right}` and `{out}` are replaced
     /// by the absolute paths of the left and right PNGs and of the PFM disparity map it must
     /// write (inf, NaN or <= 0: no value); the paths are also in $STREAKS_LEFT,
-    /// $STREAKS_RIGHT and $STREAKS_OUT.
+    /// $STREAKS_RIGHT and $STREAKS_OUT. A TEMPLATE with `{list}` runs once for all samples:
+    /// `{list}` ($STREAKS_LIST) is a file of `left<TAB>right<TAB>out` lines. NAME:png makes
+    /// the outputs KITTI uint16 PNGs.
     #[arg(long = "method-cmd", value_name = "NAME=TEMPLATE")]
     pub method_cmds: Vec<String>,
+    /// Maps made beforehand: NAME=DIR, DIR holding `<sample id>.pfm` or `<sample id>.png`
+    /// (KITTI uint16) per sample; a missing or bad map fails that sample.
+    #[arg(long = "predictions", value_name = "NAME=DIR")]
+    pub predictions: Vec<String>,
     /// Time limit of an external method on one sample, seconds: past it the command and its
     /// whole process group are killed and the sample is recorded as failed.
     #[arg(long, value_name = "SECONDS", default_value = "600", value_parser = parse_timeout)]
@@ -84,13 +97,20 @@ fn parse_timeout(s: &str) -> std::result::Result<Duration, String> {
     Duration::try_from_secs_f64(secs).map_err(|_| format!("{s} s is too long a time limit"))
 }
 
-/// The methods of the arguments, in order: `--method` names, then the other `--method-cmd`s.
+/// The methods of the arguments, in order: `--method` names, then the other `--method-cmd`s
+/// and `--predictions`.
 fn methods(args: &Args) -> Result<Vec<Method>> {
     let commands = args
         .method_cmds
         .iter()
         .map(|s| Method::command(s))
+        .chain(args.predictions.iter().map(|s| Method::predictions(s)))
         .collect::<Result<Vec<_>>>()?;
+    for (i, c) in commands.iter().enumerate() {
+        if commands[..i].iter().any(|o| o.name() == c.name()) {
+            bail!("the method name {} is given twice", c.name());
+        }
+    }
     let mut out: Vec<Method> = Vec::new();
     for name in &args.methods {
         let m = Method::built_in(name)
@@ -98,7 +118,8 @@ fn methods(args: &Args) -> Result<Vec<Method>> {
             .with_context(|| {
                 format!(
                     "unknown method {name:?}: the built-in methods are {}; an external one \
-                     needs --method-cmd {name}=TEMPLATE",
+                     needs --method-cmd {name}=TEMPLATE, maps made beforehand --predictions \
+                     {name}=DIR",
                     streaks_analysis::benchmark::method::BUILT_INS
                         .map(|(n, _)| n)
                         .join(", ")
@@ -111,14 +132,14 @@ fn methods(args: &Args) -> Result<Vec<Method>> {
     }
     for c in commands {
         if !args.methods.iter().any(|n| n == c.name()) {
-            if out.iter().any(|o| o.name() == c.name()) {
-                bail!("--method-cmd {} is given twice", c.name());
-            }
             out.push(c);
         }
     }
     if out.is_empty() {
-        bail!("no method: give --method sgm (or sgm-streaks, lk) or --method-cmd NAME=TEMPLATE");
+        bail!(
+            "no method: give --method sgm (or sgm-streaks, lk), --method-cmd NAME=TEMPLATE or \
+             --predictions NAME=DIR"
+        );
     }
     Ok(out)
 }
@@ -151,40 +172,55 @@ pub fn run(args: Args) -> Result<()> {
         .prefix("streaks-benchmark-")
         .tempdir()
         .context("cannot create a temporary folder")?;
+    let mut batches = Vec::with_capacity(methods.len());
+    for m in &methods {
+        if matches!(m, Method::Command { template, .. } if template.is_batch()) {
+            eprintln!(
+                "running the batch command {} on all {} samples",
+                m.name(),
+                samples.len()
+            );
+        }
+        batches.push(m.run_batch(&samples, work.path(), args.method_timeout)?);
+    }
     let bar = crate::cli::progress_bar((samples.len() * methods.len()) as u64);
     let mut sample_reports = Vec::new();
     let mut thumbs = Vec::new();
     for (k, sample) in samples.iter().enumerate() {
-        let truth = read_pfm(&sample.truth)
-            .with_context(|| format!("reading the ground truth {}", sample.truth.display()))?;
+        let truth = sample.read_truth()?;
         let size = (truth.width, truth.height);
-        let streaks = load_mask(&sample.streaks, size, "the ground truth")?;
-        let road = match &sample.road {
-            Some(p) => Some(load_mask(p, size, "the ground truth")?),
-            None => None,
-        };
+        let masks = sample.masks(size)?;
+        let road = masks.road.as_ref();
         let megapixels = (size.0 * size.1) as f64 / 1e6;
         let mut results = Vec::new();
         let mut maps = Vec::new();
-        for m in &methods {
+        for (m, batch) in methods.iter().zip(&batches) {
             let what = || format!("method {} on sample {}", m.name(), sample.id);
-            let (result, seconds) = m.run(sample, k, work.path(), args.method_timeout);
-            let (disp, failure) = match result {
+            let outcome = m.run(
+                sample,
+                k,
+                size,
+                work.path(),
+                args.method_timeout,
+                batch.as_ref(),
+            );
+            let (disp, failure) = match outcome.result {
                 Ok(disp) => (disp, None),
                 Err(f) => {
-                    bar.suspend(|| eprintln!("{}", failure_line(m.name(), &sample.id, &f)));
+                    if outcome.announce {
+                        bar.suspend(|| eprintln!("{}", failure_line(m.name(), &sample.id, &f)));
+                    }
                     (GrayImage::new(size.0, size.1, f32::INFINITY)?, Some(f))
                 }
             };
-            let errors =
-                score_regions(&disp, &truth, &streaks, road.as_ref()).with_context(what)?;
+            let errors = score_regions(&disp, &truth, &masks.as_masks()).with_context(what)?;
             if k < args.thumbnails {
                 maps.push((m.name().to_string(), error_map(&disp, &truth)?));
             }
             results.push(MethodScore::new(
                 m.name(),
                 errors,
-                seconds,
+                outcome.seconds,
                 megapixels,
                 failure,
             ));
@@ -196,7 +232,7 @@ pub fn run(args: Args) -> Result<()> {
                 .to_rgb8();
             thumbs.push(html::SampleThumbs::new(&sample.id, &left, &maps)?);
         }
-        let road_plane = match &road {
+        let road_plane = match road {
             Some(road) => road_plane(sample, road)?,
             None => None,
         };
@@ -208,7 +244,9 @@ pub fn run(args: Args) -> Result<()> {
             dir: sample.dir.display().to_string(),
             width: size.0,
             height: size.1,
+            streak_mask: masks.streaks.is_some(),
             road_mask: road.is_some(),
+            occlusion_mask: masks.non_occluded.is_some(),
             road_plane,
             results,
         });
@@ -233,16 +271,15 @@ pub fn run(args: Args) -> Result<()> {
             .iter()
             .map(|m| MethodInfo {
                 name: m.name().to_string(),
-                kind: match m {
-                    Method::Command { .. } => "command",
-                    _ => "built-in",
-                },
+                kind: m.kind(),
                 description: m.description(),
+                timing: m.timing(),
             })
             .collect(),
         summary,
         samples: sample_reports,
         failure_scoring: report::FAILURE_SCORING,
+        unavailable: report::UNAVAILABLE,
     };
     let page = html::page(&report, &thumbs);
     let mut json = serde_json::to_string_pretty(&report)?;
@@ -323,15 +360,24 @@ fn summary_table(report: &Report) -> String {
             }
         };
         s.push_str(&format!(
-            "{:<16} {:>8} {:>8} {:>8} {:>8} {:>10} {:>8} {:>8.2}\n",
+            "{:<16} {:>8} {:>8} {:>8} {:>8} {:>10} {:>8} {:>8}\n",
             m.method,
             valued(&e.all, format!("{:.3}", e.all.mean_abs)),
             valued(&e.all, pct(e.all.bad_2)),
             valued(&e.all, pct(e.all.d1)),
             pct(e.all.density),
-            valued(&e.streak, format!("{:.3}", e.streak.mean_abs)),
-            m.phantom_hole_rate.map(pct).unwrap_or_else(|| "-".into()),
+            match &e.streak {
+                Some(streak) => valued(streak, format!("{:.3}", streak.mean_abs)),
+                None => "n/a".to_string(),
+            },
+            match (m.phantom_hole_rate, e.road_surface) {
+                (Some(v), _) => pct(v),
+                (None, None) => "n/a".into(),
+                (None, Some(_)) => "-".into(),
+            },
             m.seconds_per_megapixel
+                .map(|v| format!("{v:.2}"))
+                .unwrap_or_else(|| "-".into())
         ));
         if m.failed > 0 {
             notes.push_str(&format!(

@@ -4,7 +4,7 @@
 use serde::Serialize;
 pub use streaks_analysis::benchmark::report::{
     summary, Failure, FailureKind, MethodInfo, MethodScore, SampleReport, AGGREGATION,
-    FAILURE_SCORING, FORMAT, REGIONS,
+    FAILURE_SCORING, FORMAT, REGIONS, UNAVAILABLE,
 };
 
 /// The whole report.
@@ -28,6 +28,8 @@ pub struct Report {
     pub samples: Vec<SampleReport>,
     /// [`FAILURE_SCORING`].
     pub failure_scoring: &'static str,
+    /// [`UNAVAILABLE`]: what a `null` region means.
+    pub unavailable: &'static str,
 }
 
 /// The input folder.

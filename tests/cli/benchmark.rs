@@ -29,6 +29,15 @@ fn again() -> String {
     )
 }
 
+/// The same as one batch command: `streaks disparity` on each line of the list.
+fn batch() -> String {
+    format!(
+        "batch=sh -c 'tab=$(printf \"\\t\"); while IFS=\"$tab\" read -r l r o; do \
+         \"$0\" disparity \"$l\" \"$r\" -o \"$o\" || exit 1; done < \"$1\"' {} {{list}}",
+        env!("CARGO_BIN_EXE_streaks")
+    )
+}
+
 #[test]
 fn dataset_benchmark_scores_every_method_and_a_command_like_sgm() {
     let t = TestDir::new();
@@ -37,7 +46,7 @@ fn dataset_benchmark_scores_every_method_and_a_command_like_sgm() {
         "--spp", "4",
     ])
     .assert_success();
-    let cmd = again();
+    let (cmd, batch) = (again(), batch());
     t.streaks(&[
         "benchmark",
         "ds",
@@ -47,12 +56,14 @@ fn dataset_benchmark_scores_every_method_and_a_command_like_sgm() {
         "lk",
         "--method-cmd",
         &cmd,
+        "--method-cmd",
+        &batch,
         "-o",
         "out",
     ])
     .assert_success();
     let r = report(&t, "out");
-    assert_eq!(r["format"], "streaks-benchmark/1");
+    assert_eq!(r["format"], "streaks-benchmark/2");
     assert_eq!(r["input"]["kind"], "dataset");
     let names: Vec<&str> = r["methods"]
         .as_array()
@@ -60,7 +71,7 @@ fn dataset_benchmark_scores_every_method_and_a_command_like_sgm() {
         .iter()
         .map(|m| m["name"].as_str().unwrap())
         .collect();
-    assert_eq!(names, ["sgm", "sgm-streaks", "lk", "again"]);
+    assert_eq!(names, ["sgm", "sgm-streaks", "lk", "again", "batch"]);
     let samples = r["samples"].as_array().unwrap();
     assert_eq!(samples.len(), 2);
     for s in samples {
@@ -70,8 +81,9 @@ fn dataset_benchmark_scores_every_method_and_a_command_like_sgm() {
         );
         assert_eq!(s["road_mask"], true);
         let res = s["results"].as_array().unwrap();
-        // The command's map is `sgm`'s, bit for bit, so are its scores.
+        // The commands' maps are `sgm`'s, bit for bit, so are their scores.
         assert_eq!(res[3]["errors"], res[0]["errors"], "sample {}", s["id"]);
+        assert_eq!(res[4]["errors"], res[0]["errors"], "sample {}", s["id"]);
         for m in res {
             let e = &m["errors"];
             let n = |k: &str| e[k]["truth_pixels"].as_u64().unwrap();
@@ -81,6 +93,7 @@ fn dataset_benchmark_scores_every_method_and_a_command_like_sgm() {
             assert!(n("all") > 0 && n("road_surface") > 0);
             assert_eq!(m["phantom_hole_rate"], e["road_surface"]["below_1px"]);
             assert!(m["seconds"].as_f64().unwrap() > 0.0);
+            assert!(m["seconds_per_megapixel"].as_f64().unwrap() > 0.0);
             for k in ["bad_1", "bad_2", "bad_3", "d1", "density"] {
                 let v = e["all"][k].as_f64().unwrap();
                 assert!((0.0..=1.0).contains(&v), "{k} = {v}");
@@ -101,6 +114,8 @@ fn dataset_benchmark_scores_every_method_and_a_command_like_sgm() {
         .sum();
     assert_eq!(sgm["errors"]["all"]["truth_pixels"].as_u64(), Some(total));
     assert_eq!(summary(&r, "again")["errors"], sgm["errors"]);
+    assert_eq!(summary(&r, "batch")["errors"], sgm["errors"]);
+    assert_eq!(r["methods"][4]["kind"], "batch-command");
     // LK measures only along detected streaks: far fewer values than SGM.
     let density = |m: &str| summary(&r, m)["errors"]["all"]["density"].as_f64().unwrap();
     assert!(density("lk") < 0.2 * density("sgm"), "{}", density("lk"));
@@ -119,7 +134,7 @@ fn dataset_benchmark_scores_every_method_and_a_command_like_sgm() {
     for m in names {
         assert!(page.contains(m), "{m}");
     }
-    assert_eq!(page.matches("src=\"data:image/png;base64,").count(), 2 * 5);
+    assert_eq!(page.matches("src=\"data:image/png;base64,").count(), 2 * 6);
     assert!(page.contains("<svg") && page.contains("phantom-hole rate"));
     // A split: exactly its samples.
     let split = ["train", "val", "test"]
@@ -270,7 +285,18 @@ fn bad_benchmark_input_fails_clearly_without_a_report() {
     );
     fails(&["pair", "--method-cmd", "sgm=run {out}"], "built-in");
     fails(&["pair"], "no method");
-    fails(&["empty", "--method", "sgm"], "neither a dataset");
+    fails(
+        &[
+            "pair",
+            "--method-cmd",
+            "a=run {out}",
+            "--predictions",
+            "a=.",
+        ],
+        "given twice",
+    );
+    fails(&["pair", "--method-cmd", "b=run {list} {out}"], "not both");
+    fails(&["empty", "--method", "sgm"], "not a dataset");
     fails(&["nowhere", "--method", "sgm"], "nowhere");
     fails(
         &["pair", "--split", "test", "--method", "sgm"],
@@ -440,6 +466,28 @@ fn hostile_folder_names_reach_a_method_as_literal_paths() {
             "the private folder is left behind"
         );
         assert_eq!(summary(&r, "recorder")["failed"], 2);
+        // A batch command reads the same paths from its list file, blanks, quotes and braces
+        // as they are; a newline cannot be written in it: refused before anything runs.
+        let _ = std::fs::remove_dir_all(t.join("batch_out"));
+        let run = t.streaks(&[
+            "benchmark",
+            name,
+            "--method-cmd",
+            &batch(),
+            "-o",
+            "batch_out",
+        ]);
+        if name.contains('\n') {
+            run.assert_failure_mentioning("tab, newline or carriage return");
+            assert!(!t.join("batch_out").exists());
+        } else {
+            run.assert_success();
+            let b = report(&t, "batch_out");
+            assert_eq!(summary(&b, "batch")["errors"], summary(&r, "sgm")["errors"]);
+        }
+        for k in 1..=5 {
+            assert!(!t.join(&format!("PWNED{k}")).exists(), "{name:?}: PWNED{k}");
+        }
     }
 }
 
@@ -572,4 +620,362 @@ fn a_terminated_benchmark_takes_its_running_method_with_it() {
         std::thread::sleep(std::time::Duration::from_millis(50));
     }
     assert!(!t.join("out/report.json").exists());
+}
+
+/// An 8x4 test image (any content: the maps below are made beforehand, not estimated).
+fn write_rgb(path: &std::path::Path, seed: u8) {
+    std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+    let img = image::RgbImage::from_fn(8, 4, |x, y| {
+        let v = (x * 29 + y * 53 + u32::from(seed)) as u8;
+        image::Rgb([v, v / 2, 255 - v])
+    });
+    streaks_image::png::write_png_buffer(path, &img).unwrap();
+}
+
+/// An 8x4 disparity map from its 32 values, row by row.
+fn map(values: [f32; 32]) -> streaks_image::GrayImage {
+    streaks_image::GrayImage::from_vec(8, 4, values.to_vec()).unwrap()
+}
+
+const INF: f32 = f32::INFINITY;
+
+/// The first sample's ground truth: 16 px everywhere but the first four pixels (no value).
+fn truth_a() -> streaks_image::GrayImage {
+    let mut v = [16.0; 32];
+    v[..4].fill(INF);
+    map(v)
+}
+
+/// The first sample's estimate: pixels 8-11 off by +2.5 px, 12-13 by -4 px, 14 no value.
+fn estimate_a() -> streaks_image::GrayImage {
+    let mut e = truth_a();
+    e.data[8..12].fill(18.5);
+    e.data[12..14].fill(12.0);
+    e.data[14] = INF;
+    e
+}
+
+/// Its non-occluded pixels: all with a truth but pixels 4-7.
+fn non_occluded_a() -> streaks_image::GrayImage {
+    let mut n = truth_a();
+    n.data[4..8].fill(INF);
+    n
+}
+
+/// The second sample's ground truth (8 px everywhere) and estimate (pixel 20 off by 1.5 px).
+fn truth_b() -> streaks_image::GrayImage {
+    map([8.0; 32])
+}
+
+fn estimate_b() -> streaks_image::GrayImage {
+    let mut e = truth_b();
+    e.data[20] = 9.5;
+    e
+}
+
+/// Asserts that the number `v` is `want` up to rounding (the scorer divides counts in its own
+/// order).
+fn close(v: &Value, want: f64) {
+    let got = v.as_f64().unwrap_or_else(|| panic!("{v} is not a number"));
+    assert!(
+        (got - want).abs() <= 1e-12 * want.abs().max(1.0),
+        "{got} != {want}"
+    );
+}
+
+/// Checks the scores of the first sample against the values counted by hand: of 28 truth
+/// pixels, 27 have a value; errors 4 x 2.5 + 2 x 4 = 18 px; bad-1 = bad-2 = 6, bad-3 = D1 = 2
+/// (4 px is more than 5 % of 16); of the 24 non-occluded pixels 23 have a value, same errors.
+fn assert_scores_a(errors: &Value, non_occluded: bool) {
+    let all = &errors["all"];
+    assert_eq!(all["truth_pixels"], 28);
+    assert_eq!(all["valid_pixels"], 27);
+    close(&all["density"], 27.0 / 28.0);
+    close(&all["mean_abs"], 18.0 / 27.0);
+    for (k, n) in [("bad_1", 6.0), ("bad_2", 6.0), ("bad_3", 2.0), ("d1", 2.0)] {
+        close(&all[k], n / 27.0);
+    }
+    // No streak or road masks: those regions are not available, not zero.
+    for region in ["streak", "non_streak", "road", "off_road", "road_surface"] {
+        assert!(errors[region].is_null(), "{region}: {}", errors[region]);
+    }
+    let noc = &errors["non_occluded"];
+    if non_occluded {
+        assert_eq!(
+            (noc["truth_pixels"].as_u64(), noc["valid_pixels"].as_u64()),
+            (Some(24), Some(23))
+        );
+        close(&noc["mean_abs"], 18.0 / 23.0);
+        close(&noc["bad_2"], 6.0 / 23.0);
+    } else {
+        assert!(noc.is_null(), "{noc}");
+    }
+}
+
+/// Checks the second sample's scores: 32 truth pixels, all valid, one off by 1.5 px.
+fn assert_scores_b(errors: &Value) {
+    let all = &errors["all"];
+    assert_eq!(
+        (all["truth_pixels"].as_u64(), all["valid_pixels"].as_u64()),
+        (Some(32), Some(32))
+    );
+    close(&all["mean_abs"], 1.5 / 32.0);
+    close(&all["bad_1"], 1.0 / 32.0);
+    close(&all["bad_2"], 0.0);
+    assert!(errors["streak"].is_null() && errors["non_occluded"].is_null());
+}
+
+/// The per-sample results of `method`, in sample order.
+fn results<'a>(r: &'a Value, method: &str) -> Vec<&'a Value> {
+    r["samples"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| {
+            s["results"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .find(|x| x["method"] == method)
+                .unwrap()
+        })
+        .collect()
+}
+
+#[test]
+fn a_kitti_folder_is_scored_with_predictions_and_a_batch_command() {
+    use streaks_image::kitti::write_kitti_disparity;
+    use streaks_image::pfm::write_pfm;
+    let t = TestDir::new();
+    let root = t.join("kitti/training");
+    let at = |dir: &str, name: &str| root.join(dir).join(name);
+    for (k, name) in ["000000_10.png", "000001_10.png", "000002_10.png"]
+        .iter()
+        .enumerate()
+    {
+        write_rgb(&at("image_2", name), k as u8);
+        write_rgb(&at("image_3", name), k as u8 + 1);
+    }
+    // A second frame has no ground truth: not a sample.
+    write_rgb(&at("image_2", "000000_11.png"), 9);
+    std::fs::create_dir_all(root.join("disp_occ_0")).unwrap();
+    std::fs::create_dir_all(root.join("disp_noc_0")).unwrap();
+    write_kitti_disparity(&at("disp_occ_0", "000000_10.png"), &truth_a()).unwrap();
+    write_kitti_disparity(&at("disp_noc_0", "000000_10.png"), &non_occluded_a()).unwrap();
+    write_kitti_disparity(&at("disp_occ_0", "000001_10.png"), &truth_b()).unwrap();
+    write_kitti_disparity(&at("disp_occ_0", "000002_10.png"), &truth_b()).unwrap();
+    // Predictions: KITTI PNG, PFM, and a wrongly sized one; the batch command copies them.
+    std::fs::create_dir(t.join("pred")).unwrap();
+    write_kitti_disparity(&t.join("pred/000000_10.png"), &estimate_a()).unwrap();
+    write_pfm(&t.join("pred/000001_10.pfm"), &estimate_b()).unwrap();
+    write_pfm(
+        &t.join("pred/000002_10.pfm"),
+        &streaks_image::GrayImage::new(4, 4, 8.0).unwrap(),
+    )
+    .unwrap();
+    // The batch command: for each `left<TAB>right<TAB>out` line, the left image's stem's
+    // KITTI PNG prediction becomes `out` (`:png`); a line without one is recorded.
+    let batch = format!(
+        "copier:png=sh -c 'tab=$(printf \"\\t\"); while IFS=\"$tab\" read -r l r o; do \
+         s=$(basename \"$l\" .png); if [ -f \"$0/$s.png\" ]; then cp \"$0/$s.png\" \"$o\"; \
+         else printf \"%s\\t%s\\t%s\\n\" \"$l\" \"$r\" \"$o\" >> \"$0/seen.tsv\"; fi; done < \"$1\"' \
+         {} {{list}}",
+        t.join("pred").display()
+    );
+    let args = [
+        "benchmark",
+        "kitti",
+        "--predictions",
+        "mine=pred",
+        "--method-cmd",
+        &batch,
+        "-o",
+        "out",
+    ];
+    let run = t.streaks(&args);
+    run.assert_failure_mentioning("method runs failed");
+    let err = run.stderr();
+    assert!(
+        err.contains("000002_10.pfm is a 4x4 disparity map, the sample is 8x4"),
+        "{err}"
+    );
+    let r = report(&t, "out");
+    assert_eq!(r["format"], "streaks-benchmark/2");
+    assert_eq!(r["input"]["kind"], "kitti");
+    let ids: Vec<&str> = r["samples"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["id"].as_str().unwrap())
+        .collect();
+    assert_eq!(ids, ["000000_10", "000001_10", "000002_10"]);
+    let s0 = &r["samples"][0];
+    assert_eq!(
+        (&s0["streak_mask"], &s0["road_mask"], &s0["occlusion_mask"]),
+        (&Value::Bool(false), &Value::Bool(false), &Value::Bool(true))
+    );
+    assert_eq!(r["samples"][1]["occlusion_mask"], false);
+    let mine = results(&r, "mine");
+    assert_scores_a(&mine[0]["errors"], true);
+    assert_scores_b(&mine[1]["errors"]);
+    assert!(mine[0]["seconds"].is_null() && mine[0]["seconds_per_megapixel"].is_null());
+    assert_eq!(mine[2]["failure"]["kind"], "bad_output");
+    // The batch command copied the KITTI PNG only: the other two samples' outputs are missing,
+    // and its list held the three samples' absolute paths.
+    let copier = results(&r, "copier");
+    assert_scores_a(&copier[0]["errors"], true);
+    for s in &copier[1..] {
+        assert_eq!(s["failure"]["kind"], "no_output", "{s}");
+    }
+    let seen = std::fs::read_to_string(t.join("pred/seen.tsv")).unwrap();
+    let lines: Vec<Vec<&str>> = seen.lines().map(|l| l.split('\t').collect()).collect();
+    assert_eq!(lines.len(), 2);
+    let root_abs = root.canonicalize().unwrap();
+    assert_eq!(
+        std::path::Path::new(lines[0][0]).canonicalize().unwrap(),
+        root_abs.join("image_2/000001_10.png")
+    );
+    assert_eq!(
+        std::path::Path::new(lines[1][1]).canonicalize().unwrap(),
+        root_abs.join("image_3/000002_10.png")
+    );
+    assert!(
+        lines[0][2].ends_with("000001-copier.png"),
+        "{}",
+        lines[0][2]
+    );
+    // The batch's time is shared by pixels: the same seconds per megapixel on every sample.
+    let spm: Vec<f64> = copier
+        .iter()
+        .map(|s| s["seconds_per_megapixel"].as_f64().unwrap())
+        .collect();
+    assert!(
+        spm[0] > 0.0 && (spm[0] - spm[2]).abs() < 1e-9 * spm[0],
+        "{spm:?}"
+    );
+    // The summary pools the samples each method succeeded on; predictions are not timed.
+    let m = summary(&r, "mine");
+    assert_eq!(
+        (m["samples"].as_u64(), m["failed"].as_u64()),
+        (Some(3), Some(1))
+    );
+    assert_eq!(m["errors"]["all"]["truth_pixels"], 60);
+    assert_eq!(m["errors"]["all"]["valid_pixels"], 59);
+    let pooled_epe = m["errors"]["all"]["mean_abs"].as_f64().unwrap();
+    assert!((pooled_epe - 19.5 / 59.0).abs() < 1e-12, "{pooled_epe}");
+    assert_eq!(m["errors"]["non_occluded"]["truth_pixels"], 24);
+    assert!(m["errors"]["streak"].is_null() && m["phantom_hole_rate"].is_null());
+    assert!(m["seconds_per_megapixel"].is_null());
+    assert!(
+        summary(&r, "copier")["seconds_per_megapixel"]
+            .as_f64()
+            .unwrap()
+            > 0.0
+    );
+    let kinds: Vec<&str> = r["methods"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["kind"].as_str().unwrap())
+        .collect();
+    assert_eq!(kinds, ["batch-command", "predictions"]);
+    let page = std::fs::read_to_string(t.join("out/index.html")).unwrap();
+    assert!(page.contains("n/a") && page.contains("not timed"));
+    assert!(page.contains("region-non_occluded"));
+    // Pointing at `training/` itself is the same folder; --allow-failures exits 0.
+    let mut again = args.to_vec();
+    again[1] = "kitti/training";
+    again.push("--allow-failures");
+    t.streaks(&again).assert_success();
+    assert_eq!(report(&t, "out")["samples"].as_array().unwrap().len(), 3);
+}
+
+#[test]
+fn middlebury_scenes_are_scored_with_their_occlusion_masks() {
+    use streaks_image::kitti::write_kitti_disparity;
+    use streaks_image::pfm::write_pfm;
+    let t = TestDir::new();
+    // A MiddEval3 scene (disp0GT.pfm, mask0nocc.png) and a 2014 scene (disp0.pfm).
+    let a = t.join("mb/Adirondack");
+    write_rgb(&a.join("im0.png"), 1);
+    write_rgb(&a.join("im1.png"), 2);
+    write_pfm(&a.join("disp0GT.pfm"), &truth_a()).unwrap();
+    // 255 non-occluded, 128 occluded, 0 no truth.
+    let nocc = image::GrayImage::from_fn(8, 4, |x, y| {
+        image::Luma([match y * 8 + x {
+            0..4 => 0,
+            4..8 => 128,
+            _ => 255,
+        }])
+    });
+    streaks_image::png::write_png_buffer(&a.join("mask0nocc.png"), &nocc).unwrap();
+    std::fs::write(a.join("calib.txt"), "not read\n").unwrap();
+    let b = t.join("mb/Motorcycle");
+    write_rgb(&b.join("im0.png"), 3);
+    write_rgb(&b.join("im1.png"), 4);
+    write_pfm(&b.join("disp0.pfm"), &truth_b()).unwrap();
+    std::fs::create_dir(t.join("mb/notes")).unwrap();
+    std::fs::create_dir(t.join("pred")).unwrap();
+    write_pfm(&t.join("pred/Adirondack.pfm"), &estimate_a()).unwrap();
+    write_kitti_disparity(&t.join("pred/Motorcycle.png"), &estimate_b()).unwrap();
+    t.streaks(&["benchmark", "mb", "--predictions", "mine=pred", "-o", "out"])
+        .assert_success();
+    let r = report(&t, "out");
+    assert_eq!(r["input"]["kind"], "middlebury");
+    let mine = results(&r, "mine");
+    assert_eq!(r["samples"][0]["id"], "Adirondack");
+    assert_scores_a(&mine[0]["errors"], true);
+    assert_scores_b(&mine[1]["errors"]);
+    // One scene folder; predictions named with --method too, beside a built-in.
+    t.streaks(&[
+        "benchmark",
+        "mb/Motorcycle",
+        "--method",
+        "mine",
+        "--predictions",
+        "mine=pred",
+        "-o",
+        "one",
+    ])
+    .assert_success();
+    let one = report(&t, "one");
+    assert_eq!(one["input"]["kind"], "middlebury");
+    assert_scores_b(&results(&one, "mine")[0]["errors"]);
+    // A missing prediction fails its sample, naming the files looked for; the report is
+    // written all the same.
+    std::fs::remove_file(t.join("pred/Motorcycle.png")).unwrap();
+    let run = t.streaks(&["benchmark", "mb", "--predictions", "mine=pred", "-o", "two"]);
+    run.assert_failure_mentioning("1 method runs failed");
+    assert!(
+        run.stderr().contains("Motorcycle.pfm nor"),
+        "{}",
+        run.stderr()
+    );
+    let two = report(&t, "two");
+    assert_eq!(results(&two, "mine")[1]["failure"]["kind"], "missing");
+    let pooled = &summary(&two, "mine")["errors"];
+    assert_eq!(pooled["all"]["truth_pixels"], 28);
+    assert_eq!(pooled["non_occluded"]["valid_pixels"], 23);
+    // Neither layout: a clear error naming both.
+    std::fs::create_dir(t.join("junk")).unwrap();
+    std::fs::write(t.join("junk/im0.png"), "x").unwrap();
+    t.streaks(&[
+        "benchmark",
+        "junk",
+        "--predictions",
+        "mine=pred",
+        "-o",
+        "three",
+    ])
+    .assert_failure_mentioning("not a KITTI 2015 folder");
+    assert!(!t.join("three").exists());
+    t.streaks(&[
+        "benchmark",
+        "mb",
+        "--predictions",
+        "mine=nowhere",
+        "-o",
+        "three",
+    ])
+    .assert_failure_mentioning("nowhere is not a folder");
 }

@@ -13,8 +13,13 @@
 //!
 //! `road_surface` is the whole road mask, streaks included: its
 //! [`DisparityErrors::below_1px`] is the **phantom-hole rate**, the share of the road that an
-//! estimate puts more than 1 px beneath the road. Without a road mask only `all` and `streak`
-//! (and `non_streak`, the rest) are scored.
+//! estimate puts more than 1 px beneath the road. `non_occluded` is the pixels the right view
+//! also sees (KITTI's `disp_noc_0`, Middlebury's `mask0nocc.png`).
+//!
+//! A region needs its masks ([`Masks`]): without a streak mask (KITTI or Middlebury data)
+//! `streak`, `non_streak`, `road` and `off_road` are not available (`None`, never a zero);
+//! without a road mask `road`, `off_road` and `road_surface` are not; without an occlusion
+//! mask `non_occluded` is not. `all` is always scored.
 //!
 //! The errors of each region are [`DisparityErrors`] (EPE, bad-1/2/3, KITTI D1, valid share,
 //! below-1-px share), computed by the one scorer [`compare_disparity_where`];
@@ -41,22 +46,26 @@ use streaks_image::{ensure_same_size, GrayImage, ImageError};
 /// The threshold of [`DisparityErrors::bad`] in the benchmark (bad-2.0, as `streaks disparity`).
 pub const BAD_THRESHOLD_PX: f32 = 2.0;
 
-/// The errors of one estimate by region (see the module documentation).
+/// The errors of one estimate by region (see the module documentation); a region whose
+/// masks the sample lacks is `None`: not available, never a zero.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct RegionErrors {
     /// Every pixel with a ground truth.
     pub all: DisparityErrors,
-    /// The renderer's streak pixels.
-    pub streak: DisparityErrors,
-    /// Every pixel off the streaks.
-    pub non_streak: DisparityErrors,
-    /// Road-surface pixels off the streaks (`None` without a road mask).
+    /// The renderer's streak pixels (`None` without a streak mask).
+    pub streak: Option<DisparityErrors>,
+    /// Every pixel off the streaks (`None` without a streak mask).
+    pub non_streak: Option<DisparityErrors>,
+    /// Road-surface pixels off the streaks (`None` without a road and a streak mask).
     pub road: Option<DisparityErrors>,
-    /// Pixels neither streak nor road (`None` without a road mask).
+    /// Pixels neither streak nor road (`None` without a road and a streak mask).
     pub off_road: Option<DisparityErrors>,
     /// The whole road surface, streaks included: its `below_1px` is the phantom-hole rate
     /// (`None` without a road mask).
     pub road_surface: Option<DisparityErrors>,
+    /// The pixels the right view also sees (`None` without an occlusion mask).
+    #[serde(default)]
+    pub non_occluded: Option<DisparityErrors>,
 }
 
 impl RegionErrors {
@@ -66,59 +75,69 @@ impl RegionErrors {
         self.road_surface.map(|r| r.below_1px)
     }
 
-    /// The errors of several images together, pixel-weighted. The road regions are pooled
-    /// over the images that have a road mask (`None` if none has). `None` for an empty list.
+    /// The errors of several images together, pixel-weighted. Each region but `all` is pooled
+    /// over the images that have it (`None` if none has). `None` for an empty list.
     pub fn pooled(parts: &[RegionErrors]) -> Option<RegionErrors> {
-        let pool = |f: fn(&RegionErrors) -> DisparityErrors| {
-            DisparityErrors::pooled(&parts.iter().map(f).collect::<Vec<_>>())
-        };
         let pool_opt = |f: fn(&RegionErrors) -> Option<DisparityErrors>| {
             DisparityErrors::pooled(&parts.iter().filter_map(f).collect::<Vec<_>>())
         };
         Some(RegionErrors {
-            all: pool(|r| r.all)?,
-            streak: pool(|r| r.streak)?,
-            non_streak: pool(|r| r.non_streak)?,
+            all: DisparityErrors::pooled(&parts.iter().map(|r| r.all).collect::<Vec<_>>())?,
+            streak: pool_opt(|r| r.streak),
+            non_streak: pool_opt(|r| r.non_streak),
             road: pool_opt(|r| r.road),
             off_road: pool_opt(|r| r.off_road),
             road_surface: pool_opt(|r| r.road_surface),
+            non_occluded: pool_opt(|r| r.non_occluded),
         })
     }
 }
 
-/// Scores `estimate` against `truth` by region: `streaks` is the streak mask and `road` the
-/// road mask (non-zero = in the mask), both of the truth's size.
+/// The masks of one sample that define its regions, each of the ground truth's size (non-zero
+/// = in the mask); a mask the sample lacks is `None`, and so are the regions that need it.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Masks<'a> {
+    /// The renderer's streak mask.
+    pub streaks: Option<&'a GrayImage>,
+    /// The road-surface mask.
+    pub road: Option<&'a GrayImage>,
+    /// The pixels the right view also sees.
+    pub non_occluded: Option<&'a GrayImage>,
+}
+
+/// Scores `estimate` against `truth` by region, with the regions `masks` define (see the
+/// module documentation).
 pub fn score_regions(
     estimate: &GrayImage,
     truth: &GrayImage,
-    streaks: &GrayImage,
-    road: Option<&GrayImage>,
+    masks: &Masks,
 ) -> Result<RegionErrors, SgmError> {
-    for mask in std::iter::once(streaks).chain(road) {
+    for mask in [masks.streaks, masks.road, masks.non_occluded]
+        .into_iter()
+        .flatten()
+    {
         ensure_same_size("the mask", mask.size(), "the ground truth", truth.size())?;
     }
     let t = BAD_THRESHOLD_PX;
-    let streak = |i: usize| streaks.data[i] > 0.0;
     let score =
         |select: &dyn Fn(usize) -> bool| compare_disparity_where(estimate, truth, t, select);
-    let (road_errors, off_road, road_surface) = match road {
-        None => (None, None, None),
-        Some(road) => {
-            let on = |i: usize| road.data[i] > 0.0;
-            (
-                Some(score(&|i| on(i) && !streak(i))?),
-                Some(score(&|i| !on(i) && !streak(i))?),
-                Some(score(&on)?),
-            )
-        }
+    let within = |mask: Option<&GrayImage>, select: &dyn Fn(&GrayImage, usize) -> bool| {
+        mask.map(|m| score(&|i| select(m, i))).transpose()
     };
+    let on = |m: &GrayImage, i: usize| m.data[i] > 0.0;
+    let (mut road, mut off_road) = (None, None);
+    if let (Some(s), Some(r)) = (masks.streaks, masks.road) {
+        road = Some(score(&|i| on(r, i) && !on(s, i))?);
+        off_road = Some(score(&|i| !on(r, i) && !on(s, i))?);
+    }
     Ok(RegionErrors {
         all: score(&|_| true)?,
-        streak: score(&streak)?,
-        non_streak: score(&|i| !streak(i))?,
-        road: road_errors,
+        streak: within(masks.streaks, &on)?,
+        non_streak: within(masks.streaks, &|m, i| !on(m, i))?,
+        road,
         off_road,
-        road_surface,
+        road_surface: within(masks.road, &on)?,
+        non_occluded: within(masks.non_occluded, &on)?,
     })
 }
 
@@ -309,14 +328,19 @@ mod tests {
         let streaks =
             GrayImage::from_vec(4, 2, vec![1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]).unwrap();
         let road = GrayImage::from_vec(4, 2, vec![1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0]).unwrap();
-        let r = score_regions(&est, &truth, &streaks, Some(&road)).unwrap();
+        let masks = Masks {
+            streaks: Some(&streaks),
+            road: Some(&road),
+            non_occluded: None,
+        };
+        let r = score_regions(&est, &truth, &masks).unwrap();
         assert_eq!(r.all.truth_pixels, 7);
         let (road_e, off) = (r.road.unwrap(), r.off_road.unwrap());
         assert_eq!(
-            r.streak.truth_pixels + road_e.truth_pixels + off.truth_pixels,
+            r.streak.unwrap().truth_pixels + road_e.truth_pixels + off.truth_pixels,
             7
         );
-        assert_eq!(r.streak.mean_abs, 3.5);
+        assert_eq!(r.streak.unwrap().mean_abs, 3.5);
         // Road pixels 3 and 8.5 are below 10 by more than 1 px: 2 of 4.
         assert_eq!(r.phantom_hole_rate(), Some(0.5));
         assert_eq!(off.density, 2.0 / 3.0);
@@ -324,13 +348,60 @@ mod tests {
         let pooled = RegionErrors::pooled(&[r, r]).unwrap();
         assert_eq!(pooled.all.truth_pixels, 14);
         assert_eq!(pooled.phantom_hole_rate(), Some(0.5));
-        let no_road = score_regions(&est, &truth, &streaks, None).unwrap();
+        let streaks_only = Masks {
+            road: None,
+            ..masks
+        };
+        let no_road = score_regions(&est, &truth, &streaks_only).unwrap();
         assert!(no_road.road.is_none() && no_road.phantom_hole_rate().is_none());
+        assert_eq!(no_road.streak, r.streak);
         // A pooled list keeps the road of the images that have one.
         let mixed = RegionErrors::pooled(&[r, no_road]).unwrap();
         assert_eq!(mixed.road_surface.unwrap().truth_pixels, 4);
         let small = GrayImage::new(3, 2, 0.0).unwrap();
-        assert!(score_regions(&est, &truth, &small, None).is_err());
+        let bad = Masks {
+            non_occluded: Some(&small),
+            ..Masks::default()
+        };
+        assert!(score_regions(&est, &truth, &bad).is_err());
+    }
+
+    #[test]
+    fn missing_masks_leave_their_regions_unavailable() {
+        // 3x1: the last pixel occluded; no streak or road mask (KITTI, Middlebury).
+        let truth = GrayImage::from_vec(3, 1, vec![10.0, 20.0, 30.0]).unwrap();
+        let est = GrayImage::from_vec(3, 1, vec![10.5, 17.0, f32::INFINITY]).unwrap();
+        let noc = GrayImage::from_vec(3, 1, vec![1.0, 1.0, 0.0]).unwrap();
+        let masks = Masks {
+            non_occluded: Some(&noc),
+            ..Masks::default()
+        };
+        let r = score_regions(&est, &truth, &masks).unwrap();
+        assert_eq!(
+            (r.streak, r.non_streak, r.road, r.off_road),
+            (None, None, None, None)
+        );
+        assert_eq!(r.phantom_hole_rate(), None);
+        assert_eq!(r.all.mean_abs, 1.75);
+        assert_eq!(r.all.density, 2.0 / 3.0);
+        let n = r.non_occluded.unwrap();
+        assert_eq!((n.truth_pixels, n.valid_pixels, n.mean_abs), (2, 2, 1.75));
+        assert_eq!((n.bad_1, n.bad_2, n.bad_3, n.d1), (0.5, 0.5, 0.0, 0.0));
+        // Pooled with a sample that has a streak mask: the streak region is that sample's.
+        let streaks = GrayImage::from_vec(3, 1, vec![1.0, 0.0, 0.0]).unwrap();
+        let with = score_regions(
+            &est,
+            &truth,
+            &Masks {
+                streaks: Some(&streaks),
+                ..Masks::default()
+            },
+        )
+        .unwrap();
+        let pooled = RegionErrors::pooled(&[r, with]).unwrap();
+        assert_eq!(pooled.streak, with.streak);
+        assert_eq!(pooled.non_occluded, r.non_occluded);
+        assert_eq!(pooled.all.truth_pixels, 6);
     }
 
     #[test]

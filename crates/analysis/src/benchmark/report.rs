@@ -1,40 +1,47 @@
 //! The parts of a benchmark report (`report.json` of `streaks benchmark`, format
-//! `streaks-benchmark/1`) that do not depend on where the samples came from: a method's
+//! `streaks-benchmark/2`) that do not depend on where the samples came from: a method's
 //! figures on a sample and pooled over samples, its failures, and what the report states
 //! about them. The report's top level (`format`, `input`) is the command's, with the reading
 //! of its input. The whole schema:
 //!
 //! ```text
-//! format             "streaks-benchmark/1"
-//! input              the folder benchmarked, its kind (dataset, pair, pairs) and split
+//! format             "streaks-benchmark/2"
+//! input              the folder benchmarked, its kind (dataset, pair, pairs, kitti,
+//!                    middlebury) and split
 //! aggregation        how the summary pools samples (pixel-weighted)
 //! bad_threshold_px   the threshold of `bad` (2.0; bad_1/2/3 are always given)
 //! regions            what each region means
-//! methods[]          name, kind (built-in, command), description
+//! methods[]          name, kind (built-in, command, batch-command, predictions),
+//!                    description, timing (what its seconds cover)
 //! summary[]          per method: pooled errors by region, phantom-hole rate, seconds,
-//!                    megapixels, seconds per megapixel, samples, failed (how many of them
-//!                    the method failed on)
-//! samples[]          per sample: id, folder, size, whether it has a road mask, and per
-//!                    method the same figures for that sample alone, with `failure` (kind,
-//!                    reason, stderr_tail, stdout_tail) when the method failed on it
+//!                    megapixels, seconds per megapixel (`null` for predictions: not
+//!                    timed), samples, failed (how many of them the method failed on)
+//! samples[]          per sample: id, folder, size, which masks it has (streak_mask,
+//!                    road_mask, occlusion_mask), the road-plane check, and per method the
+//!                    same figures for that sample alone, with `failure` (kind, reason,
+//!                    stderr_tail, stdout_tail) when the method failed on it
 //! failure_scoring    how a failed sample counts in the scores
+//! unavailable        what a `null` region means
 //! ```
 //!
 //! A method that fails on a sample (a command that exits non-zero, runs past its time limit, is
-//! killed by a signal, writes no map or an unreadable one or one of the wrong size) is left out
-//! of its summary, which covers the samples it succeeded on ([`FAILURE_SCORING`]).
+//! killed by a signal, writes no map or an unreadable one or one of the wrong size; a
+//! prediction folder without the sample's map or with a bad one) is left out of its summary,
+//! which covers the samples it succeeded on ([`FAILURE_SCORING`]).
 //!
-//! Errors by region are [`RegionErrors`]: `all`, `streak`, `non_streak`, and with a road mask
-//! `road` (road surface off the streaks), `off_road` and `road_surface` (the whole road, whose
-//! `below_1px` is the phantom-hole rate); each is a [`crate::sgm::DisparityErrors`]
-//! (`truth_pixels`, `valid_pixels`, `density` = the valid share, `mean_abs` = EPE, `rms`,
-//! `bad_1`, `bad_2`, `bad_3`, `d1` (KITTI), `bad` and `bad_all` at `threshold`, `below_1px`).
+//! Errors by region are [`RegionErrors`]: `all`, `streak`, `non_streak`, `road` (road surface
+//! off the streaks), `off_road`, `road_surface` (the whole road, whose `below_1px` is the
+//! phantom-hole rate) and `non_occluded`; a region whose masks a sample lacks is `null` (not
+//! available: KITTI and Middlebury data have no streak or road masks), never zeros
+//! ([`UNAVAILABLE`]). Each is a [`crate::sgm::DisparityErrors`] (`truth_pixels`,
+//! `valid_pixels`, `density` = the valid share, `mean_abs` = EPE, `rms`, `bad_1`, `bad_2`,
+//! `bad_3`, `d1` (KITTI), `bad` and `bad_all` at `threshold`, `below_1px`).
 
 use super::RegionErrors;
 use serde::Serialize;
 
 /// The report's format.
-pub const FORMAT: &str = "streaks-benchmark/1";
+pub const FORMAT: &str = "streaks-benchmark/2";
 
 /// How the summary pools samples.
 pub const AGGREGATION: &str = "pixel-weighted: every pixel of every sample counts once (the \
@@ -49,7 +56,7 @@ pub const FAILURE_SCORING: &str = "a method's summary covers the samples it succ
     values in its summary";
 
 /// The regions, as the report states them.
-pub const REGIONS: [(&str, &str); 6] = [
+pub const REGIONS: [(&str, &str); 7] = [
     ("all", "every pixel with a ground truth"),
     ("streak", "the renderer's streak mask"),
     ("non_streak", "every pixel off the streak mask"),
@@ -62,7 +69,16 @@ pub const REGIONS: [(&str, &str); 6] = [
         "road_surface",
         "the whole road mask, streaks included; its below_1px is the phantom-hole rate",
     ),
+    (
+        "non_occluded",
+        "the pixels the right view also sees (KITTI disp_noc_0, Middlebury mask0nocc.png)",
+    ),
 ];
+
+/// What a `null` region means, as the report states it.
+pub const UNAVAILABLE: &str = "a region is null where the samples lack its masks (KITTI and \
+    Middlebury folders have no streak or road masks): not available, not zero; a pooled region \
+    covers the samples that have it";
 
 /// Why a method failed on a sample.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -78,7 +94,10 @@ pub enum FailureKind {
     Timeout,
     /// It exited with status 0 but wrote no map.
     NoOutput,
-    /// Its map is not a regular file, not a readable PFM, too large, or of the wrong size.
+    /// A prediction folder (`--predictions`) has no map for the sample.
+    Missing,
+    /// Its map is not a regular file, not a readable PFM or KITTI PNG, too large, or of the
+    /// wrong size.
     BadOutput,
     /// A built-in method's error, or the run could not prepare the command.
     Error,
@@ -103,10 +122,13 @@ pub struct Failure {
 pub struct MethodInfo {
     /// Its name.
     pub name: String,
-    /// `built-in` or `command`.
+    /// `built-in`, `command` (a process per sample), `batch-command` (one process for all
+    /// samples) or `predictions` (maps read from a folder).
     pub kind: &'static str,
-    /// What it does (for a command: its template).
+    /// What it does (for a command: its template; for predictions: the folder).
     pub description: String,
+    /// What its seconds cover.
+    pub timing: &'static str,
 }
 
 /// One method's figures over some pixels (a sample, or all of them).
@@ -119,12 +141,12 @@ pub struct MethodScore {
     /// The phantom-hole rate (`errors.road_surface.below_1px`; `null` without road masks, and
     /// for a failure).
     pub phantom_hole_rate: Option<f64>,
-    /// The method's wall time, seconds.
-    pub seconds: f64,
+    /// The method's wall time, seconds (`None` for predictions: not timed).
+    pub seconds: Option<f64>,
     /// Megapixels estimated.
     pub megapixels: f64,
-    /// `seconds / megapixels`.
-    pub seconds_per_megapixel: f64,
+    /// `seconds / megapixels` (`None` when not timed).
+    pub seconds_per_megapixel: Option<f64>,
     /// Samples the method ran on.
     pub samples: usize,
     /// How many of them it failed on; the other figures leave them out (see
@@ -142,7 +164,7 @@ impl MethodScore {
     pub fn new(
         method: &str,
         errors: RegionErrors,
-        seconds: f64,
+        seconds: Option<f64>,
         megapixels: f64,
         failure: Option<Failure>,
     ) -> Self {
@@ -155,11 +177,13 @@ impl MethodScore {
             errors,
             seconds,
             megapixels,
-            seconds_per_megapixel: if megapixels > 0.0 {
-                seconds / megapixels
-            } else {
-                0.0
-            },
+            seconds_per_megapixel: seconds.map(|s| {
+                if megapixels > 0.0 {
+                    s / megapixels
+                } else {
+                    0.0
+                }
+            }),
         }
     }
 
@@ -180,7 +204,7 @@ impl MethodScore {
         let pooled = Self::new(
             method,
             RegionErrors::pooled(&errors)?,
-            scored.iter().map(|p| p.seconds).sum(),
+            scored.iter().map(|p| p.seconds).sum::<Option<f64>>(),
             scored.iter().map(|p| p.megapixels).sum(),
             None,
         );
@@ -222,8 +246,12 @@ pub struct SampleReport {
     pub width: usize,
     /// Height in pixels.
     pub height: usize,
+    /// Whether it has a streak mask (else the streak regions are `null`).
+    pub streak_mask: bool,
     /// Whether it has a road mask (else the road regions are `null`).
     pub road_mask: bool,
+    /// Whether it has an occlusion mask (else `non_occluded` is `null`).
+    pub occlusion_mask: bool,
     /// How far its road departs from the plane `Y = 0` the analysis assumes, when it has a
     /// road mask and a ground-truth depth ([`crate::road_plane`]).
     pub road_plane: Option<crate::road_plane::RoadPlaneCheck>,
@@ -234,7 +262,7 @@ pub struct SampleReport {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::benchmark::score_regions;
+    use crate::benchmark::{score_regions, Masks};
     use streaks_image::GrayImage;
 
     #[test]
@@ -244,7 +272,12 @@ mod tests {
         let road = GrayImage::new(4, 2, 255.0).unwrap();
         let score = |estimate: f32| {
             let est = GrayImage::new(4, 2, estimate).unwrap();
-            score_regions(&est, &truth, &streaks, Some(&road)).unwrap()
+            let masks = Masks {
+                streaks: Some(&streaks),
+                road: Some(&road),
+                non_occluded: None,
+            };
+            score_regions(&est, &truth, &masks).unwrap()
         };
         let failure = || Failure {
             kind: FailureKind::Timeout,
@@ -253,14 +286,22 @@ mod tests {
             stdout_tail: String::new(),
         };
         // Below the road everywhere where it succeeded; no value where it failed.
-        let ok = MethodScore::new("m", score(1.0), 2.0, 1.0, None);
-        let failed = MethodScore::new("m", score(f32::INFINITY), 600.0, 1.0, Some(failure()));
+        let ok = MethodScore::new("m", score(1.0), Some(2.0), 1.0, None);
+        let failed = MethodScore::new("m", score(f32::INFINITY), Some(600.0), 1.0, Some(failure()));
         assert_eq!((failed.failed, failed.phantom_hole_rate), (1, None));
         let pooled = MethodScore::pooled("m", &[&ok, &failed]).unwrap();
         assert_eq!((pooled.samples, pooled.failed), (2, 1));
         assert_eq!(pooled.errors, ok.errors);
         assert_eq!(pooled.phantom_hole_rate, Some(1.0));
-        assert_eq!((pooled.seconds, pooled.seconds_per_megapixel), (2.0, 2.0));
+        assert_eq!(
+            (pooled.seconds, pooled.seconds_per_megapixel),
+            (Some(2.0), Some(2.0))
+        );
+        // Predictions are not timed: no time, pooled or not.
+        let untimed = MethodScore::new("p", score(1.0), None, 0.5, None);
+        let pooled = MethodScore::pooled("p", &[&untimed, &untimed]).unwrap();
+        assert_eq!((pooled.seconds, pooled.seconds_per_megapixel), (None, None));
+        assert_eq!(pooled.megapixels, 1.0);
         assert!(pooled.failure.is_none());
         // Every sample failed: no values, no phantom-hole rate.
         let all = MethodScore::pooled("m", &[&failed, &failed]).unwrap();
