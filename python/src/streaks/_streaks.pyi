@@ -1,18 +1,29 @@
 """Type stubs of the native module streaks._streaks (crates/python)."""
 
 from os import PathLike
-from typing import Any, TypedDict
+from pathlib import Path
+from typing import Any, TypedDict, final
 
 import numpy as np
 import numpy.typing as npt
 from typing_extensions import Unpack
+
+__all__ = [
+    "DEFAULT_BASELINE",
+    "Pair",
+    "Scene",
+    "StreaksError",
+    "read_exr",
+    "read_pfm",
+    "read_png",
+]
 
 _Path = str | PathLike[str]
 
 DEFAULT_BASELINE: float
 """The default baseline of `Scene.render_pair`, metres."""
 
-class RenderOptions(TypedDict, total=False):
+class _RenderOptions(TypedDict, total=False):
     """The keywords of `Scene.render` (the flags of `streaks render`), all optional."""
 
     width: int | None
@@ -30,7 +41,7 @@ class RenderOptions(TypedDict, total=False):
     rig_velocity: tuple[float, float, float] | None
     denoise: bool
 
-class PairOptions(RenderOptions, total=False):
+class _PairOptions(_RenderOptions, total=False):
     """The keywords of `Scene.render_pair` (the flags of `streaks stereo`), all optional."""
 
     baseline: float
@@ -39,6 +50,7 @@ class StreaksError(ValueError):
     """An error of the streaks library: a scene, image or option it cannot use. The message
     names the file (where there is one) and the reason."""
 
+@final
 class Scene:
     """A scene loaded from a .gltf, .glb or .obj file, ready to render."""
 
@@ -53,7 +65,7 @@ class Scene:
     ) -> Scene:
         """Loads a scene with the checks for untrusted files of `streaks render`."""
     @property
-    def path(self) -> str:
+    def path(self) -> Path:
         """The file the scene was loaded from."""
     @property
     def warnings(self) -> list[str]:
@@ -61,11 +73,12 @@ class Scene:
     @property
     def cameras(self) -> list[str]:
         """The names of the scene's cameras, in the order `camera=` numbers them."""
-    def render(self, **options: Unpack[RenderOptions]) -> dict[str, npt.NDArray[np.float32]]:
+    def render(self, **options: Unpack[_RenderOptions]) -> dict[str, npt.NDArray[np.float32]]:
         """Renders one view: a dict of float32 arrays by EXR layer name (`rgb`, `depth`, ...)."""
-    def render_pair(self, **options: Unpack[PairOptions]) -> Pair:
+    def render_pair(self, **options: Unpack[_PairOptions]) -> Pair:
         """Renders a rectified stereo pair with ground truth, as `streaks stereo` does."""
 
+@final
 class Pair:
     """A rendered stereo pair: images, ground truth and metadata as numpy arrays."""
 
@@ -95,7 +108,7 @@ class Pair:
     """The right camera's raw DN with `sensor=`, else None."""
     meta: dict[str, Any]
     """scene, camera, seed, rig (the rig.json record), settings, timings, stats."""
-    def save(self, dir: _Path) -> str:
+    def save(self, dir: _Path) -> Path:
         """Writes the pair as `streaks stereo -o DIR` does; returns the folder."""
 
 def read_pfm(path: _Path) -> npt.NDArray[np.float32]:
