@@ -21,6 +21,7 @@ use pyo3::create_exception;
 use pyo3::prelude::*;
 
 mod arrays;
+mod dataset;
 mod io;
 mod options;
 mod pair;
@@ -54,13 +55,14 @@ pub(crate) fn chain(e: &(dyn std::error::Error + 'static)) -> String {
     message
 }
 
-/// The native module: the classes `Scene` and `Pair`, the exception `StreaksError` and the
+/// The native module: the classes `Scene`, `Pair` and `Dataset`, the exception `StreaksError` and the
 /// readers `read_pfm`, `read_png` and `read_exr`.
 #[pymodule]
 fn _streaks(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("StreaksError", m.py().get_type::<StreaksError>())?;
     m.add_class::<scene::Scene>()?;
     m.add_class::<pair::Pair>()?;
+    m.add_class::<dataset::Dataset>()?;
     m.add_function(wrap_pyfunction!(io::read_pfm, m)?)?;
     m.add_function(wrap_pyfunction!(io::read_png, m)?)?;
     m.add_function(wrap_pyfunction!(io::read_exr, m)?)?;

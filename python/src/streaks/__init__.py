@@ -14,9 +14,9 @@ the numbers the `streaks stereo` command writes::
 docs/python.md.
 """
 
-from streaks import io
+from streaks import dataset, io
 from streaks._streaks import DEFAULT_BASELINE, Pair, Scene, StreaksError
 
 __version__ = "0.1.0"
 
-__all__ = ["DEFAULT_BASELINE", "Pair", "Scene", "StreaksError", "io"]
+__all__ = ["DEFAULT_BASELINE", "Pair", "Scene", "StreaksError", "dataset", "io"]

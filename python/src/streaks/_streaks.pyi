@@ -10,6 +10,7 @@ from typing_extensions import Unpack
 
 __all__ = [
     "DEFAULT_BASELINE",
+    "Dataset",
     "Pair",
     "Scene",
     "StreaksError",
@@ -119,3 +120,16 @@ def read_png(path: _Path) -> npt.NDArray[np.uint8] | npt.NDArray[np.uint16]:
 
 def read_exr(path: _Path) -> dict[str, npt.NDArray[np.float32]]:
     """Reads a renderer EXR as a dict of float32 arrays by layer."""
+
+@final
+class Dataset:
+    """A dataset's samples (all, or one split's), in the order of their ids."""
+
+    def __new__(cls, root: _Path, *, split: str | None = None) -> Dataset:
+        """Opens the dataset in `root` (optionally one split: train, val, test)."""
+    @property
+    def ids(self) -> list[str]:
+        """The sample ids (folder names), in order."""
+    def __len__(self) -> int: ...
+    def __getitem__(self, index: int, /) -> dict[str, Any]:
+        """Sample `index` as a dict of arrays (left, right, disparity, ...), id and meta."""
