@@ -76,10 +76,12 @@ impl Dataset {
         self.ids.clone()
     }
 
+    /// The number of samples.
     fn __len__(&self) -> usize {
         self.ids.len()
     }
 
+    /// Sample `index` (negative counts from the end) read from its files, as a dict.
     fn __getitem__<'py>(&self, py: Python<'py>, index: isize) -> PyResult<Bound<'py, PyDict>> {
         let n = self.ids.len() as isize;
         let i = if index < 0 { index + n } else { index };
@@ -115,6 +117,7 @@ impl Dataset {
         Ok(sample)
     }
 
+    /// The dataset's folder and its number of samples.
     fn __repr__(&self) -> String {
         format!(
             "<streaks.dataset {} ({} samples)>",

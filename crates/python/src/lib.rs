@@ -17,6 +17,8 @@
 //! The module is tested from pytest (`python/tests`): an extension module cannot link a Rust
 //! test binary against libpython.
 
+#![deny(missing_docs)]
+
 use pyo3::create_exception;
 use pyo3::prelude::*;
 

@@ -220,6 +220,7 @@ impl Pair {
         Ok(dir)
     }
 
+    /// The pair's size, focal length and baseline.
     fn __repr__(&self) -> String {
         let i = self.rig.intrinsics();
         format!(

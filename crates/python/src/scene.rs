@@ -182,6 +182,7 @@ impl Scene {
         self.scene.cameras.iter().map(|c| c.name.clone()).collect()
     }
 
+    /// How the scene was loaded.
     fn __repr__(&self) -> String {
         format!("Scene.load({:?})", self.path.display().to_string())
     }
