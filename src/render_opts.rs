@@ -9,10 +9,11 @@ use streaks_render::camera::{Camera, FRAMING_WARNING};
 use streaks_render::light::Environment;
 use streaks_render::motion::Motion;
 use streaks_render::scene::Scene;
+use streaks_render::view::{frame_view, View};
 use streaks_sensor::SensorProfile;
 use streaks_settings::{RenderSettings, SettingsError};
 
-use crate::cli::{image_size, load_scene, progress_bar};
+use crate::cli::{load_scene, progress_bar};
 
 /// The rendering flags that `streaks render` and `streaks stereo` share.
 #[derive(clap::Args, Debug)]
@@ -236,31 +237,29 @@ impl RenderOpts {
     }
 
     /// Phase 2: loads the scene (with the environment of `--env` or `--env-color`, if given;
-    /// printing its warnings), picks the camera, sizes the image, and places the scene's
-    /// rain drops (if it has rain) around that camera for the shutter of the flags.
+    /// printing its warnings) and frames the view of the flags ([`frame_view`]: the camera, the
+    /// image size, the rain drops for the shutter of the flags).
     pub fn load(&self, path: &Path) -> Result<Loaded> {
         let mut scene = self.env.load_scene(path, self.allow_outside_scene)?;
         for warning in &scene.warnings {
             eprintln!("warning: {warning}");
         }
-        let found = scene
-            .find_camera(self.camera.as_deref())
-            .with_context(|| format!("in the scene {}", path.display()))?;
-        let (width, height) = image_size(
+        let View {
+            camera,
+            width,
+            height,
+            framed,
+        } = frame_view(
+            &mut scene,
+            self.camera.as_deref(),
             self.width,
             self.height,
-            found.and_then(Camera::aspect_ratio),
-        )?;
-        let camera = match found {
-            Some(camera) => camera.clone(),
-            None => {
-                eprintln!("warning: {}: {FRAMING_WARNING}", path.display());
-                scene.default_camera(width as f32 / height as f32)
-            }
-        };
-        scene
-            .place_rain(&camera, width, height, self.motion()?)
-            .with_context(|| format!("the rain of the scene {}", path.display()))?;
+            self.motion()?,
+        )
+        .with_context(|| format!("in the scene {}", path.display()))?;
+        if framed {
+            eprintln!("warning: {}: {FRAMING_WARNING}", path.display());
+        }
         Ok(Loaded {
             scene,
             camera,

@@ -6,7 +6,7 @@ import time
 
 import pytest
 from conftest import TINY, free_port, ray_env, streaks_ray
-from streaks_ray.cli import main
+from streaks.ray.cli import main
 
 
 def _generate(*args):

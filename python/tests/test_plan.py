@@ -1,9 +1,9 @@
-"""Tests of the work division (streaks_ray.plan): shards, chunks, the arguments of a task."""
+"""Tests of the work division (streaks.ray.plan): shards, chunks, the arguments of a task."""
 
 from pathlib import Path
 
 import pytest
-from streaks_ray.plan import (
+from streaks.ray.plan import (
     WHOLE,
     GenerateFlags,
     Shard,

@@ -1,9 +1,9 @@
-"""Tests of one task's run (streaks_ray.task.run_renderer) with small shell scripts as renderer."""
+"""Tests of one task's run (streaks.ray.task.run_renderer) with small shell scripts as renderer."""
 
 import stat
 from pathlib import Path
 
-from streaks_ray.task import STDERR_LINES, run_renderer
+from streaks.ray.task import STDERR_LINES, run_renderer
 
 
 def _script(folder: Path, body: str) -> str:

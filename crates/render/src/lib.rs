@@ -23,6 +23,7 @@
 //! - [`scene`]: loading glTF 2.0 and OBJ into a [`scene::Scene`], with errors that name the file
 //!   and the element.
 //! - [`camera`]: the pinhole camera of docs/design.md (pixel centres at `i + 0.5`, `f = (H/2)/tan(yfov/2)`).
+//!   [`view`]: framing a view of a loaded scene (the camera, the image size, the rain drops).
 //! - [`integrator`]: unidirectional path tracing with next-event estimation and MIS; one image
 //!   is a [`integrator::RenderJob`]: its size, seed and layers, and how to sample it
 //!   ([`streaks_settings::RenderSettings`], the `streaks-settings` crate's one type, which pairs
@@ -98,3 +99,4 @@ pub mod scene;
 pub mod simd;
 pub mod testing;
 pub mod texture;
+pub mod view;

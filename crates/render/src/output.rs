@@ -17,7 +17,7 @@
 use crate::integrator::RenderOutput;
 use glam::Vec3;
 use std::path::Path;
-use streaks_image::exr::{read_exr_channels, read_exr_rgb_channels, ExrChannel};
+use streaks_image::exr::{read_exr_channels, ExrChannel};
 use streaks_image::{ImageError, RgbImage};
 
 /// The beauty image's channels.
@@ -136,36 +136,64 @@ pub fn write_exr_with_sensor(
     streaks_image::exr::write_exr(path, img.width, img.height, channels)
 }
 
+/// Every layer [`write_exr`] may write besides the beauty image ([`BEAUTY`]), by the name
+/// [`read_exr_layer`] takes, with its channels: three for an RGB or XYZ layer, one otherwise.
+pub const LAYERS: [(&str, &[&str]); 10] = [
+    ("albedo", &ALBEDO),
+    ("raw", &RAW),
+    ("specular", &SPECULAR),
+    ("sensor", &SENSOR),
+    ("normal", &NORMAL),
+    ("depth", &[DEPTH]),
+    ("spp", &[SPP]),
+    ("rain", &[RAIN]),
+    ("fog", &[FOG]),
+    ("object", &[OBJECT]),
+];
+
 /// Reads a layer written by [`write_exr`]: `"albedo"`, `"specular"`, `"sensor"` (RGB),
 /// `"normal"` (XYZ into the RGB slots), `"depth"` (Z), `"spp"` (samples per pixel), `"rain"`
 /// (rain share), `"fog"` (fog transmittance) or `"object"` (object slot; the last five one
-/// channel, repeated into all three slots).
+/// channel, repeated into all three slots); see [`LAYERS`].
 pub fn read_exr_layer(path: &Path, name: &str) -> Result<RgbImage, ImageError> {
-    match name {
-        "albedo" => read_exr_rgb_channels(path, ALBEDO),
-        "raw" => read_exr_rgb_channels(path, RAW),
-        "specular" => read_exr_rgb_channels(path, SPECULAR),
-        "sensor" => read_exr_rgb_channels(path, SENSOR),
-        "normal" => read_exr_rgb_channels(path, NORMAL),
-        "depth" | "spp" | "rain" | "fog" | "object" => {
-            let channel = match name {
-                "depth" => DEPTH,
-                "spp" => SPP,
-                "rain" => RAIN,
-                "object" => OBJECT,
-                _ => FOG,
-            };
-            let (w, h, planes) = read_exr_channels(path, &[channel])?;
-            let z = &planes[0];
-            Ok(RgbImage::from_planes(w, h, [z, z, z]))
-        }
-        other => Err(ImageError::MissingChannels {
+    let Some((_, channels)) = LAYERS.iter().find(|(n, _)| *n == name) else {
+        let names: Vec<&str> = LAYERS.iter().map(|(n, _)| *n).collect();
+        return Err(ImageError::MissingChannels {
             path: path.to_path_buf(),
-            what: format!(
-                "layer {other:?} (the layers are albedo, specular, normal, depth, spp, rain, fog, object, sensor, raw)"
-            ),
-        }),
+            what: format!("layer {name:?} (the layers are {})", names.join(", ")),
+        });
+    };
+    let (w, h, planes) = read_exr_channels(path, channels)?;
+    Ok(match planes.as_slice() {
+        [r, g, b] => RgbImage::from_planes(w, h, [r, g, b]),
+        _ => RgbImage::from_planes(w, h, [&planes[0], &planes[0], &planes[0]]),
+    })
+}
+
+/// Every layer of a file [`write_exr`] wrote, as `(width, height, layers)`: first `"rgb"`, the
+/// beauty image's channels `R`, `G`, `B` (required), then each layer of [`LAYERS`] the file
+/// has, each with its channels' planes (row-major, three or one). The file is read once per
+/// layer, each read as checked as [`read_exr_channels`]'s.
+#[allow(clippy::type_complexity)]
+pub fn read_exr_layers(
+    path: &Path,
+) -> Result<(u32, u32, Vec<(&'static str, Vec<Vec<f32>>)>), ImageError> {
+    let (w, h, beauty) = read_exr_channels(path, &BEAUTY)?;
+    let mut layers = vec![("rgb", beauty)];
+    for (name, channels) in LAYERS {
+        match read_exr_channels(path, channels) {
+            Ok((lw, lh, planes)) if (lw, lh) == (w, h) => layers.push((name, planes)),
+            Ok((lw, lh, _)) => {
+                return Err(ImageError::Read {
+                    path: path.to_path_buf(),
+                    reason: format!("its layer {name} is {lw}x{lh}, its image {w}x{h}"),
+                })
+            }
+            Err(ImageError::MissingChannels { .. }) => {}
+            Err(e) => return Err(e),
+        }
     }
+    Ok((w, h, layers))
 }
 
 #[cfg(test)]

@@ -8,9 +8,9 @@ import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
-from streaks_ray import __version__
-from streaks_ray.driver import DriverError, Job, generate
-from streaks_ray.plan import GenerateFlags, Shard, parse_shard
+from streaks.ray import __version__
+from streaks.ray.driver import DriverError, Job, generate
+from streaks.ray.plan import GenerateFlags, Shard, parse_shard
 
 DESCRIPTION = """\
 Run `streaks dataset generate` on a Ray cluster: the samples are split into Ray tasks of

@@ -23,8 +23,8 @@ from typing import Any
 
 from tqdm import tqdm
 
-from streaks_ray.plan import WHOLE, Chunk, GenerateFlags, Shard, plan_chunks, sample_folder
-from streaks_ray.task import RunResult, run_renderer
+from streaks.ray.plan import WHOLE, Chunk, GenerateFlags, Shard, plan_chunks, sample_folder
+from streaks.ray.task import RunResult, run_renderer
 
 POLL_SECONDS = 0.5
 """How often the progress bar counts the published samples."""

@@ -1,0 +1,128 @@
+//! `streaks.dataset.open`: a dataset written by `streaks dataset generate` as a sequence of
+//! samples, each a dict of numpy arrays under the names of `streaks.Pair`. The files are named
+//! by the dataset crate ([`streaks_dataset::layout::Layout`],
+//! [`streaks_dataset::files::SampleDir`]) and read with the project's readers.
+
+use crate::{arrays, error, StreaksError};
+use pyo3::exceptions::PyIndexError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::path::PathBuf;
+use streaks_dataset::files::{load_mask, SampleDir};
+use streaks_dataset::layout::Layout;
+use streaks_image::pfm::read_pfm;
+use streaks_image::GrayImage;
+use streaks_stereo::rig::Eye;
+
+/// A dataset's samples (all, or one split's), in the order of their ids.
+///
+/// `len(ds)` is the number of samples; `ds[i]` (negative indices count from the end) reads
+/// sample i as a dict: `left`, `right` (float32 H x W x 3, linear, from the EXRs),
+/// `disparity`, `disparity_right` (float32 H x W, `inf` where there is none), `depth`
+/// (float32 H x W, `inf` on a miss), `streak_mask`, `road_mask` (bool H x W; no `road_mask`
+/// when the scene flags no road), `id` (the sample's folder name) and `meta` (its `meta.json`).
+#[pyclass(module = "streaks._streaks", frozen, sequence)]
+pub struct Dataset {
+    /// The dataset's folders.
+    layout: Layout,
+    /// The sample ids, sorted.
+    ids: Vec<String>,
+}
+
+/// A sample's 0/255 mask PNG as a bool array, checked to be `size` (width, height) as the
+/// sample's rig says ([`load_mask`]).
+fn mask_png<'py>(
+    py: Python<'py>,
+    path: &std::path::Path,
+    size: (usize, usize),
+) -> PyResult<Bound<'py, PyAny>> {
+    let img = py
+        .detach(|| load_mask(path, size, "the sample's rig"))
+        .map_err(|e| error(&e))?;
+    let data = img.data.iter().map(|&v| v > 0.5).collect();
+    arrays::plane(py, img.width, img.height, data)
+}
+
+/// A PFM as a float32 array.
+fn pfm<'py>(py: Python<'py>, path: &std::path::Path) -> PyResult<Bound<'py, PyAny>> {
+    let img: GrayImage = py.detach(|| read_pfm(path)).map_err(|e| error(&e))?;
+    arrays::gray(py, &img)
+}
+
+/// The linear RGB of an eye's EXR.
+fn exr<'py>(py: Python<'py>, path: &std::path::Path) -> PyResult<Bound<'py, PyAny>> {
+    let img = py
+        .detach(|| streaks_image::exr::read_exr_rgb(path))
+        .map_err(|e| error(&e))?;
+    arrays::rgb(py, &img)
+}
+
+#[pymethods]
+impl Dataset {
+    /// Opens the dataset in `root`: every complete sample, or with `split` (`train`, `val`,
+    /// `test`) those `streaks dataset index` listed in `splits/SPLIT.txt`. Raises
+    /// `StreaksError` for an unknown or missing split or a dataset without samples.
+    #[new]
+    #[pyo3(signature = (root, *, split=None))]
+    fn new(root: PathBuf, split: Option<String>) -> PyResult<Self> {
+        let layout = Layout::new(&root);
+        let ids = layout.sample_ids(split.as_deref()).map_err(|e| error(&e))?;
+        Ok(Self { layout, ids })
+    }
+
+    /// The sample ids (folder names), in order.
+    #[getter]
+    fn ids(&self) -> Vec<String> {
+        self.ids.clone()
+    }
+
+    /// The number of samples.
+    fn __len__(&self) -> usize {
+        self.ids.len()
+    }
+
+    /// Sample `index` (negative counts from the end) read from its files, as a dict.
+    fn __getitem__<'py>(&self, py: Python<'py>, index: isize) -> PyResult<Bound<'py, PyDict>> {
+        let n = self.ids.len() as isize;
+        let i = if index < 0 { index + n } else { index };
+        if !(0..n).contains(&i) {
+            return Err(PyIndexError::new_err(format!(
+                "sample {index} out of range (the dataset has {n})"
+            )));
+        }
+        let id = &self.ids[i as usize];
+        let files: SampleDir = self.layout.sample_by_id(id);
+        let meta = files.load_meta().map_err(|e| error(&e))?;
+        let text = serde_json::to_string(&meta)
+            .map_err(|e| StreaksError::new_err(format!("{}: {e}", files.meta().display())))?;
+        let size = (meta.rig.width as usize, meta.rig.height as usize);
+        let sample = PyDict::new(py);
+        sample.set_item("id", id)?;
+        sample.set_item("left", exr(py, &files.exr(Eye::Left))?)?;
+        sample.set_item("right", exr(py, &files.exr(Eye::Right))?)?;
+        sample.set_item("disparity", pfm(py, &files.disparity(Eye::Left))?)?;
+        sample.set_item("disparity_right", pfm(py, &files.disparity(Eye::Right))?)?;
+        sample.set_item("depth", pfm(py, &files.depth(Eye::Left))?)?;
+        sample.set_item(
+            "streak_mask",
+            mask_png(py, &files.streak_mask(Eye::Left), size)?,
+        )?;
+        if meta.road_mask {
+            sample.set_item(
+                "road_mask",
+                mask_png(py, &files.road_mask(Eye::Left), size)?,
+            )?;
+        }
+        sample.set_item("meta", py.import("json")?.call_method1("loads", (text,))?)?;
+        Ok(sample)
+    }
+
+    /// The dataset's folder and its number of samples.
+    fn __repr__(&self) -> String {
+        format!(
+            "<streaks.dataset {} ({} samples)>",
+            self.layout.root().display(),
+            self.ids.len()
+        )
+    }
+}
