@@ -269,6 +269,7 @@ pub fn run(args: Args) -> Result<()> {
     let bar = progress_bar(indices.len() as u64);
     let start = Instant::now();
     let mut shares = Vec::new();
+    let mut bytes = 0u64;
     let mut skipped = 0usize;
     let mut repaired = 0usize;
     let warned_no_road = Cell::new(false);
@@ -332,6 +333,7 @@ pub fn run(args: Args) -> Result<()> {
         }
         let share = rendered.stats.streak_share;
         shares.push(share);
+        bytes += rendered.bytes;
         bar.suspend(|| {
             eprintln!(
                 "sample {id}: {:.2} s, streak share {:.3} %",
@@ -381,6 +383,10 @@ pub fn run(args: Args) -> Result<()> {
             100.0 * shares[0],
             100.0 * quantile_sorted(&shares, 0.5).unwrap_or(f64::NAN),
             100.0 * shares[shares.len() - 1]
+        );
+        summary += &format!(
+            "; {:.0} bytes per sample (its folder and its KITTI and SceneFlow files)",
+            bytes as f64 / shares.len() as f64
         );
     }
     eprintln!("{summary}");

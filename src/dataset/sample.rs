@@ -13,6 +13,7 @@ use streaks_dataset::meta::{
     kitti_pose, matrix_rows, render_seed, FlowShares, FogMeta, RenderMeta, RigMeta, SampleMeta,
     SampleStats, SequenceMeta, WeatherMeta,
 };
+use streaks_dataset::sceneflow::write_sceneflow;
 use streaks_dataset::settings::Settings;
 use streaks_dataset::write::{
     disparity_range, instance_numbering, write_calib, write_flow, write_views, GroundTruth,
@@ -55,6 +56,9 @@ pub struct Rendered {
     pub road_mask: bool,
     /// Seconds from scene building to publishing.
     pub seconds: f64,
+    /// The bytes it takes on disk: its folder's files and its files of the KITTI and
+    /// SceneFlow views.
+    pub bytes: u64,
 }
 
 /// Renders sample `index` into a temporary folder, writes its KITTI files and publishes it as
@@ -292,10 +296,23 @@ fn write_sample(
         sequence: Some(sequence),
     };
     write_bytes_atomically(&files.meta(), &meta.to_bytes())?;
-    write_kitti(layout, index, &files, &left.disparity)?;
+    write_kitti(layout, index, &files)?;
+    write_sceneflow(layout, index, &meta.split, meta.street, &files)?;
+    let views = layout.view_files(index, &meta.split, meta.street);
+    let mut paths: Vec<std::path::PathBuf> = std::fs::read_dir(dir)
+        .and_then(|entries| entries.map(|e| e.map(|e| e.path())).collect())
+        .with_context(|| format!("cannot list {}", dir.display()))?;
+    paths.extend(views.into_iter().map(|(_, p)| p));
+    let mut bytes = 0;
+    for p in paths {
+        bytes += std::fs::metadata(&p)
+            .with_context(|| format!("cannot read {}", p.display()))?
+            .len();
+    }
     Ok(Rendered {
         stats,
         road_mask: has_road,
         seconds: 0.0,
+        bytes,
     })
 }

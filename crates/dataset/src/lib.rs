@@ -11,6 +11,7 @@
 //! - [`layout`]: the dataset folder, `dataset.json` and the conventions it states, and its
 //!   Middlebury-style sample folders;
 //! - [`kitti`]: the KITTI 2015 view of a sample;
+//! - [`sceneflow`]: the SceneFlow (FlyingThings3D) view of a sample;
 //! - [`segmentation`]: the semantic and instance maps, the class table and the instance
 //!   numbering (Cityscapes' label convention);
 //! - [`manifest`]: reading `manifest.jsonl` back and checking files against it;
@@ -30,6 +31,7 @@ pub mod layout;
 pub mod lock;
 pub mod manifest;
 pub mod meta;
+pub mod sceneflow;
 pub mod segmentation;
 pub mod settings;
 pub mod shard;

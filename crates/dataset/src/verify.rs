@@ -31,6 +31,7 @@ use crate::kitti::write_kitti;
 use crate::layout::{sample_id, DatasetInfo, Layout, SPLITS};
 use crate::manifest::{sha256_hex, verify_batch, Difference, Entry, Lines};
 use crate::meta::SampleStats;
+use crate::sceneflow::write_sceneflow;
 use crate::segmentation::{check_instance, check_semantic};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -382,8 +383,12 @@ fn kind(m: &std::fs::Metadata) -> &'static str {
 }
 
 /// Fails unless the sample folder `dir` is a folder (not a symbolic link) whose entries, and
-/// the sample's KITTI files that exist, are all regular files.
-fn only_regular_files(layout: &Layout, index: u64, dir: &Path) -> Result<(), DatasetError> {
+/// the files of its views `views` that exist, are all regular files.
+fn only_regular_files(
+    layout: &Layout,
+    dir: &Path,
+    views: &[(String, PathBuf)],
+) -> Result<(), DatasetError> {
     let m = std::fs::symlink_metadata(dir).map_err(|e| DatasetError::io("read", dir, e))?;
     if !m.is_dir() {
         return Err(DatasetError::NotRegular {
@@ -392,8 +397,7 @@ fn only_regular_files(layout: &Layout, index: u64, dir: &Path) -> Result<(), Dat
         });
     }
     let mut paths = list(dir)?;
-    let kitti = layout.kitti(index);
-    paths.extend(kitti.named(layout).map(|(_, p)| p.to_path_buf()));
+    paths.extend(views.iter().map(|(_, p)| p.clone()));
     for path in paths {
         match std::fs::symlink_metadata(&path) {
             Ok(m) if !m.is_file() => {
@@ -490,9 +494,11 @@ pub fn check_sample(
     kitti_repaired: Option<&mut usize>,
 ) -> Result<ManifestLine, DatasetError> {
     // Nothing is read through a symbolic link or from a special file (a FIFO would block).
-    only_regular_files(layout, index, dir)?;
+    only_regular_files(layout, dir, &[])?;
     let sample = SampleDir::new(dir);
     let meta = sample.load_meta()?;
+    let views = layout.view_files(index, &meta.split, meta.street);
+    only_regular_files(layout, dir, &views)?;
     if meta.index != index || meta.seed != info.seed || meta.config_hash != info.config_hash {
         return Err(DatasetError::Invalid {
             path: sample.meta(),
@@ -547,6 +553,8 @@ pub fn check_sample(
         sample.png(Eye::Left),
         sample.png(Eye::Right),
         sample.streak_mask(Eye::Left),
+        sample.occlusion(Eye::Left),
+        sample.occlusion(Eye::Right),
     ];
     if meta.road_mask {
         pngs.push(road_mask);
@@ -575,6 +583,7 @@ pub fn check_sample(
         sample.disparity(Eye::Left),
         sample.disparity(Eye::Right),
         sample.depth(Eye::Left),
+        sample.depth(Eye::Right),
     ]
     .into_iter()
     .chain(has_fog.then_some(fog_maps).into_iter().flatten())
@@ -601,10 +610,9 @@ pub fn check_sample(
         DATASET_SIZE,
     )?;
 
-    // The KITTI view: written again where missing.
+    // The KITTI and SceneFlow views: written again where missing.
     let kitti = layout.kitti(index);
-    let named = kitti.named(layout);
-    let missing: Vec<String> = named
+    let missing: Vec<String> = views
         .iter()
         .filter(|(_, p)| !p.is_file())
         .map(|(rel, _)| rel.clone())
@@ -613,23 +621,17 @@ pub fn check_sample(
         let Some(repaired) = kitti_repaired else {
             return Err(DatasetError::MissingFiles {
                 dir: dir.to_path_buf(),
-                what: "KITTI files",
+                what: "files of its KITTI or SceneFlow view",
                 files: missing,
             });
         };
-        write_kitti(
-            layout,
-            index,
-            &sample,
-            &read_pfm(&sample.disparity(Eye::Left))?,
-        )?;
+        write_kitti(layout, index, &sample)?;
+        write_sceneflow(layout, index, &meta.split, meta.street, &sample)?;
         *repaired += missing.len();
     }
-    check_size(
-        &kitti.disp_occ_0,
-        size,
-        read_kitti_disparity(&kitti.disp_occ_0),
-    )?;
+    for p in [&kitti.disp_occ_0, &kitti.disp_occ_1, &kitti.disp_noc_0] {
+        check_size(p, size, read_kitti_disparity(p))?;
+    }
 
     let mut files = BTreeMap::new();
     let mut entries = list(dir)?;
@@ -637,7 +639,7 @@ pub fn check_sample(
     for path in entries
         .iter()
         .map(PathBuf::as_path)
-        .chain(named.iter().map(|(_, p)| *p))
+        .chain(views.iter().map(|(_, p)| p.as_path()))
     {
         if !path.is_file() {
             return Err(DatasetError::NotRegular {
