@@ -430,6 +430,77 @@ fn per_eye_ground_truth_and_the_kitti_and_sceneflow_views() {
     t.streaks(&["dataset", "index", "ds"]).assert_success();
 }
 
+/// `--outputs` keeps only the chosen groups: the sample folder holds those files (and
+/// `calib.txt`, `meta.json`), the views chosen are made all the same, the manifest lists
+/// exactly the files written and `dataset index` verifies them; a rerun with other groups is
+/// refused with a hint, and an unknown group names the groups there are.
+#[test]
+fn outputs_keep_only_the_chosen_groups() {
+    let t = TestDir::new();
+    let run = generate_n(&t, "ds", "1", &["--outputs", "gt,kitti"]);
+    run.assert_success();
+    assert!(
+        run.stderr().contains(" bytes per sample"),
+        "{}",
+        run.stderr()
+    );
+    assert_eq!(
+        t.files_in("ds/samples/000000"),
+        [
+            "calib.txt",
+            "depth0.pfm",
+            "depth1.pfm",
+            "disp0.pfm",
+            "disp1.pfm",
+            "meta.json",
+            "occ0.png",
+            "occ1.png"
+        ]
+    );
+    assert!(!t.join("ds/SceneFlow").exists());
+    assert!(t.join("ds/kitti/training/image_2/000000_10.png").is_file());
+    assert!(t.join("ds/kitti/training/semantic/000000_10.png").is_file());
+    let manifest = std::fs::read_to_string(t.join("ds/manifest.jsonl")).unwrap();
+    let line: serde_json::Value = serde_json::from_str(manifest.lines().next().unwrap()).unwrap();
+    let mut listed: Vec<String> = line["files"].as_object().unwrap().keys().cloned().collect();
+    let mut on_disk: Vec<String> = tree(&t.join("ds"))
+        .into_keys()
+        .filter(|f| f.starts_with("samples/") || f.starts_with("kitti/"))
+        .collect();
+    listed.sort();
+    on_disk.sort();
+    assert_eq!(listed, on_disk);
+    assert_eq!(listed.len(), 8 + 8);
+    let info: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(t.join("ds/dataset.json")).unwrap()).unwrap();
+    assert_eq!(info["outputs"], serde_json::json!(["gt", "kitti"]));
+    let verified = t.streaks(&["dataset", "index", "ds"]);
+    verified.assert_success();
+    assert!(
+        verified.stderr().contains("16 files match manifest.jsonl"),
+        "{}",
+        verified.stderr()
+    );
+    // A rerun skips the sample; one with other groups is refused.
+    let again = generate_n(&t, "ds", "1", &["--outputs", "kitti,gt"]);
+    again.assert_success();
+    assert!(again
+        .stderr()
+        .contains("0 samples rendered, 1 already done"));
+    generate_n(&t, "ds", "1", &[])
+        .assert_failure_mentioning("outputs")
+        .assert_failure_mentioning("give --outputs");
+    let bad = generate_n(&t, "bad", "1", &["--outputs", "gt,png"]);
+    assert!(!bad.output.status.success());
+    assert!(
+        bad.stderr().contains("unknown output group \"png\"")
+            && bad.stderr().contains("images, exr, gt"),
+        "{}",
+        bad.stderr()
+    );
+    assert!(!t.join("bad").exists());
+}
+
 #[test]
 fn interrupted_and_damaged_datasets_are_reported_then_repaired() {
     let t = TestDir::new();

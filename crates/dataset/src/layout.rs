@@ -25,13 +25,13 @@ use crate::files::{
     SAMPLE_LOCK_PREFIX, SCENEFLOW_DIR, SCENEFLOW_DISPARITY, SCENEFLOW_IMAGES, SCENEFLOW_OCCLUSION,
     SCENE_BIN, SCENE_GLTF, SPLITS_DIR, SPLIT_EXTENSION, TMP_PREFIX,
 };
+use crate::outputs::{Output, Outputs};
 use crate::segmentation::ClassRecord;
 use crate::settings::Settings;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use streaks_stereo::rig::Eye;
 
 /// The format of `dataset.json` and of the folder it describes.
 pub const FORMAT: &str = "streaks-dataset/1";
@@ -217,18 +217,17 @@ impl Layout {
             .join(format!("{}{}", Self::tmp_prefix(index), std::process::id()))
     }
 
-    /// Whether sample `index` is published and has all its files (a cheap check: the files are
-    /// there and `meta.json` names the index; `streaks dataset index` checks their contents).
-    pub fn is_complete(&self, index: u64) -> bool {
+    /// Whether sample `index` is published and has all the files of the groups `outputs`
+    /// (a cheap check: the files are there and `meta.json` names the index; `streaks dataset
+    /// index` checks their contents).
+    pub fn is_complete(&self, index: u64, outputs: &Outputs) -> bool {
         let sample = self.sample(index);
-        let present = |name: &str| sample.file(name).is_file();
+        let present = |name: &str| !outputs.keeps(name) || sample.file(name).is_file();
         if !SAMPLE_FILES.iter().all(|f| present(f)) || !present(SCENE_GLTF) {
             return false;
         }
         match sample.load_meta() {
-            Ok(meta) => {
-                meta.index == index && (!meta.road_mask || sample.road_mask(Eye::Left).is_file())
-            }
+            Ok(meta) => meta.index == index && (!meta.road_mask || present(ROAD_MASK)),
             Err(_) => false,
         }
     }
@@ -299,16 +298,25 @@ impl Layout {
         })
     }
 
-    /// Every file of the dataset's views (KITTI and SceneFlow) of sample `index` of split
-    /// `split` and street `street`, with its name relative to the dataset folder.
-    pub fn view_files(&self, index: u64, split: &str, street: u64) -> Vec<(String, PathBuf)> {
-        let kitti = self.kitti(index);
-        let mut out: Vec<(String, PathBuf)> = kitti
-            .named(self)
-            .into_iter()
-            .map(|(n, p)| (n, p.to_path_buf()))
-            .collect();
-        if let Some(sf) = self.sceneflow(index, split, street) {
+    /// The files of the dataset's views (KITTI and SceneFlow, those of `outputs`) of sample
+    /// `index` of split `split` and street `street`, with their names relative to the dataset
+    /// folder.
+    pub fn view_files(
+        &self,
+        index: u64,
+        split: &str,
+        street: u64,
+        outputs: &Outputs,
+    ) -> Vec<(String, PathBuf)> {
+        let mut out: Vec<(String, PathBuf)> = Vec::new();
+        if outputs.has(Output::Kitti) {
+            let kitti = self.kitti(index);
+            out.extend(kitti.named(self).map(|(n, p)| (n, p.to_path_buf())));
+        }
+        if let Some(sf) = self
+            .sceneflow(index, split, street)
+            .filter(|_| outputs.has(Output::Sceneflow))
+        {
             out.extend(
                 sf.named(self)
                     .into_iter()
@@ -634,6 +642,10 @@ impl DatasetInfo {
             for key in ["denoise", "keep_raw"] {
                 map.entry(key).or_insert(Value::Bool(false));
             }
+            // Before --outputs existed: every group.
+            map.entry("outputs").or_insert_with(|| {
+                serde_json::to_value(crate::outputs::Outputs::default()).expect("outputs serialise")
+            });
             if !map.contains_key("regularize") {
                 map.insert("regularize".into(), Value::Bool(false));
                 unrecorded = true;
@@ -668,6 +680,10 @@ impl DatasetInfo {
                 }
                 "keep_raw" if self.settings.keep_raw => " (drop --keep-raw to continue it)",
                 "keep_raw" => " (add --keep-raw to continue it)",
+                "outputs" => {
+                    " (give --outputs the groups its dataset.json lists under outputs to \
+                     continue it)"
+                }
                 _ => "",
             };
             return Err(DatasetError::OtherDataset {
@@ -765,6 +781,7 @@ mod tests {
                 },
                 denoise: false,
                 keep_raw: false,
+                outputs: Default::default(),
             },
             files: FileList::current(),
             conventions: Conventions::current(),

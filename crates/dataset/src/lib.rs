@@ -8,6 +8,7 @@
 //!   folder alike, also in the older pair layout);
 //! - [`meta`]: a sample's `meta.json`, and its render seed;
 //! - [`settings`]: the render settings a dataset's samples share ([`settings::Settings`]);
+//! - [`outputs`]: the groups of files a dataset's samples keep (`--outputs`);
 //! - [`layout`]: the dataset folder, `dataset.json` and the conventions it states, and its
 //!   Middlebury-style sample folders;
 //! - [`kitti`]: the KITTI 2015 view of a sample;
@@ -31,6 +32,7 @@ pub mod layout;
 pub mod lock;
 pub mod manifest;
 pub mod meta;
+pub mod outputs;
 pub mod sceneflow;
 pub mod segmentation;
 pub mod settings;

@@ -385,7 +385,7 @@ fn own_files(layout: &Layout, index: u64, split: &str, street: u64) -> OwnFiles 
     OwnFiles {
         folder: format!("samples/{}/", sample_id(index)),
         views: layout
-            .view_files(index, split, street)
+            .view_files(index, split, street, &Default::default())
             .into_iter()
             .map(|(rel, _)| rel)
             .collect(),
@@ -530,7 +530,10 @@ pub fn verify_entry(layout: &Layout, entry: &Entry) -> Vec<Difference> {
             on_disk.insert(format!("{folder}/{}", e.file_name().to_string_lossy()));
         }
     }
-    for (rel, path) in layout.view_files(entry.index, &entry.split, entry.street) {
+    // Every view's files, also those of groups the dataset does not keep: a view's file on
+    // disk that the manifest does not list is reported either way.
+    let all = crate::outputs::Outputs::default();
+    for (rel, path) in layout.view_files(entry.index, &entry.split, entry.street, &all) {
         if std::fs::symlink_metadata(path).is_ok() {
             on_disk.insert(rel);
         }

@@ -30,7 +30,8 @@ use crate::files::{
 use crate::kitti::write_kitti;
 use crate::layout::{sample_id, DatasetInfo, Layout, SPLITS};
 use crate::manifest::{sha256_hex, verify_batch, Difference, Entry, Lines};
-use crate::meta::SampleStats;
+use crate::meta::{SampleMeta, SampleStats};
+use crate::outputs::{Output, Outputs};
 use crate::sceneflow::write_sceneflow;
 use crate::segmentation::{check_instance, check_semantic};
 use rayon::prelude::*;
@@ -472,6 +473,24 @@ fn check_flow(sample: &SampleDir, size: (usize, usize)) -> Result<(), DatasetErr
     Ok(())
 }
 
+/// Writes the views `outputs` has (KITTI, SceneFlow) of sample `index`, whose `meta.json` is
+/// `meta`, from the files of its folder `sample`.
+pub fn write_views(
+    layout: &Layout,
+    index: u64,
+    meta: &SampleMeta,
+    sample: &SampleDir,
+    outputs: &Outputs,
+) -> Result<(), DatasetError> {
+    if outputs.has(Output::Kitti) {
+        write_kitti(layout, index, sample)?;
+    }
+    if outputs.has(Output::Sceneflow) {
+        write_sceneflow(layout, index, &meta.split, meta.street, sample)?;
+    }
+    Ok(())
+}
+
 /// What the size of a sample's files is checked against, in messages.
 const DATASET_SIZE: &str = "the dataset's images are";
 
@@ -497,7 +516,9 @@ pub fn check_sample(
     only_regular_files(layout, dir, &[])?;
     let sample = SampleDir::new(dir);
     let meta = sample.load_meta()?;
-    let views = layout.view_files(index, &meta.split, meta.street);
+    let outputs = &info.settings.outputs;
+    let kept = |p: &Path| outputs.keeps(&file_name(p));
+    let views = layout.view_files(index, &meta.split, meta.street, outputs);
     only_regular_files(layout, dir, &views)?;
     if meta.index != index || meta.seed != info.seed || meta.config_hash != info.config_hash {
         return Err(DatasetError::Invalid {
@@ -524,7 +545,7 @@ pub fn check_sample(
     if has_fog {
         expected.extend(fog_maps.iter().map(|p| file_name(p)));
     }
-    let has_segmentation = meta.instances.is_some();
+    let has_segmentation = meta.instances.is_some() && outputs.has(Output::Segmentation);
     let semantic = Eye::BOTH.map(|eye| sample.semantic(eye));
     let instance = Eye::BOTH.map(|eye| sample.instance(eye));
     if has_segmentation {
@@ -533,9 +554,12 @@ pub fn check_sample(
     if meta.sequence.is_some() {
         expected.extend(FLOW_FILES.map(String::from));
     }
-    expected.push(SCENE_GLTF.to_owned());
-    if sample.scene().is_file() {
-        expected.extend(scene_files(&sample.scene())?);
+    expected.retain(|f| outputs.keeps(f));
+    if outputs.has(Output::Scene) {
+        expected.push(SCENE_GLTF.to_owned());
+        if sample.scene().is_file() {
+            expected.extend(scene_files(&sample.scene())?);
+        }
     }
     let absent: Vec<String> = expected
         .into_iter()
@@ -562,7 +586,7 @@ pub fn check_sample(
     if has_rain {
         pngs.extend(rain_masks);
     }
-    for p in pngs {
+    for p in pngs.into_iter().filter(|p| kept(p)) {
         check_size(&p, size, GrayImage::load(&p))?;
     }
     if has_segmentation {
@@ -587,13 +611,18 @@ pub fn check_sample(
     ]
     .into_iter()
     .chain(has_fog.then_some(fog_maps).into_iter().flatten())
+    .filter(|p| kept(p))
     {
         check_size(&p, size, read_pfm(&p))?;
     }
-    if meta.sequence.is_some() {
+    if meta.sequence.is_some() && outputs.has(Output::Flow) {
         check_flow(&sample, size)?;
     }
-    for p in Eye::BOTH.map(|eye| sample.exr(eye)) {
+    for p in Eye::BOTH
+        .map(|eye| sample.exr(eye))
+        .into_iter()
+        .filter(|p| kept(p))
+    {
         let img = read_exr_rgb(&p)?;
         DatasetError::check_size(
             &p,
@@ -625,12 +654,13 @@ pub fn check_sample(
                 files: missing,
             });
         };
-        write_kitti(layout, index, &sample)?;
-        write_sceneflow(layout, index, &meta.split, meta.street, &sample)?;
+        write_views(layout, index, &meta, &sample, outputs)?;
         *repaired += missing.len();
     }
-    for p in [&kitti.disp_occ_0, &kitti.disp_occ_1, &kitti.disp_noc_0] {
-        check_size(p, size, read_kitti_disparity(p))?;
+    if outputs.has(Output::Kitti) {
+        for p in [&kitti.disp_occ_0, &kitti.disp_occ_1, &kitti.disp_noc_0] {
+            check_size(p, size, read_kitti_disparity(p))?;
+        }
     }
 
     let mut files = BTreeMap::new();
