@@ -1179,6 +1179,19 @@ fn stats_page_shows_the_parameters_and_escapes_what_it_reads() {
     generate(&t, "ds", &[]).assert_success();
     t.streaks(&["dataset", "stats", "ds"]).assert_success();
     let page = std::fs::read_to_string(t.join("ds/stats.html")).unwrap();
+    // The bytes per sample are those of the files the manifest lists.
+    let manifest = std::fs::read_to_string(t.join("ds/manifest.jsonl")).unwrap();
+    let mut bytes = 0u64;
+    for line in manifest.lines() {
+        let line: serde_json::Value = serde_json::from_str(line).unwrap();
+        for file in line["files"].as_object().unwrap().keys() {
+            bytes += std::fs::metadata(t.join(&format!("ds/{file}")))
+                .unwrap()
+                .len();
+        }
+    }
+    let per_sample = format!("{:.0} bytes per sample", bytes as f64 / 3.0);
+    assert!(page.contains(&per_sample), "{per_sample}");
     let config: serde_json::Value =
         serde_json::from_slice(&std::fs::read(t.join("ds/dataset.json")).unwrap()).unwrap();
     let height = config["config"]["lamps"]["height"].to_string();
