@@ -215,7 +215,7 @@ pub fn run(args: Args) -> Result<()> {
             keep_raw: args.keep_raw,
             outputs: Outputs(args.outputs.iter().copied().collect()),
         },
-        files: FileList::current(),
+        files: FileList::current().kept(&Outputs(args.outputs.iter().copied().collect())),
         conventions: Conventions::current(),
         classes: streaks_dataset::segmentation::class_table(),
     };

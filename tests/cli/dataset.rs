@@ -474,6 +474,16 @@ fn outputs_keep_only_the_chosen_groups() {
     let info: serde_json::Value =
         serde_json::from_slice(&std::fs::read(t.join("ds/dataset.json")).unwrap()).unwrap();
     assert_eq!(info["outputs"], serde_json::json!(["gt", "kitti"]));
+    // dataset.json lists the files kept.
+    let list = &info["files"];
+    assert_eq!(
+        list["sample"],
+        serde_json::json!(t.files_in("ds/samples/000000"))
+    );
+    assert_eq!(list["scene"], serde_json::json!([]));
+    assert!(list.get("sceneflow").is_none());
+    assert_eq!(list["kitti"].as_array().unwrap().len(), 8);
+    assert!(list["optional"].as_object().unwrap().is_empty(), "{list}");
     let verified = t.streaks(&["dataset", "index", "ds"]);
     verified.assert_success();
     assert!(

@@ -555,6 +555,24 @@ impl FileList {
             .collect(),
         }
     }
+
+    /// The files of this list that a dataset keeping the groups `outputs` writes.
+    pub fn kept(mut self, outputs: &Outputs) -> Self {
+        self.sample.retain(|f| outputs.keeps(f));
+        // An optional entry names its files `a, b`: one group each.
+        self.optional
+            .retain(|files, _| outputs.keeps(files.split(", ").next().unwrap_or(files)));
+        for (group, list) in [
+            (Output::Scene, &mut self.scene),
+            (Output::Kitti, &mut self.kitti),
+            (Output::Sceneflow, &mut self.sceneflow),
+        ] {
+            if !outputs.has(group) {
+                list.clear();
+            }
+        }
+        self
+    }
 }
 
 /// The contents of `dataset.json`: everything that makes two runs the same dataset (nothing
@@ -658,7 +676,12 @@ impl DatasetInfo {
         // The value of the bytes this run would write (a value made from `self` directly would
         // hold `noise_target` widened from f32, 0.10000000149011612 for the file's 0.1).
         let new = serde_json::from_slice(&self.to_bytes()).expect("dataset.json reads back");
-        if let Some((field, old, new)) = first_difference("", &existing, &new) {
+        // The groups first: they also change the file list, whose difference says less.
+        let null = Value::Null;
+        let outputs = |v: &Value| v.get("outputs").unwrap_or(&null).clone();
+        let differs = first_difference("outputs", &outputs(&existing), &outputs(&new))
+            .or_else(|| first_difference("", &existing, &new));
+        if let Some((field, old, new)) = differs {
             let hint = match field.as_str() {
                 "regularize" if unrecorded => {
                     " (it predates the setting and was rendered without path regularisation: \
