@@ -31,6 +31,7 @@ use streaks_dataset::layout::{
 };
 use streaks_dataset::lock::{Lock, Mode};
 use streaks_dataset::manifest::{sha256_hex, verify_entry, Difference, Manifest};
+use streaks_dataset::outputs::{Output, Outputs};
 use streaks_dataset::settings::Settings;
 use streaks_dataset::shard::Shard;
 use streaks_dataset::verify::check_sample;
@@ -93,6 +94,17 @@ pub struct Args {
     /// Keep the render before denoising in each EXR (its `raw` layer; dropped by default).
     #[arg(long)]
     pub keep_raw: bool,
+    /// The groups of files each sample keeps, comma-separated: images (im0/im1.png), exr,
+    /// gt (disparity, depth, occlusion), masks (streak, road, rain, fog), segmentation, flow,
+    /// scene, kitti (the KITTI view), sceneflow (the SceneFlow view); calib.txt and meta.json
+    /// always. Part of the dataset: a rerun must give the same groups.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        value_name = "GROUP,...",
+        default_value = "images,exr,gt,masks,segmentation,flow,scene,kitti,sceneflow"
+    )]
+    pub outputs: Vec<Output>,
 }
 
 /// `--denoise`: whether a dataset's images are denoised.
@@ -201,8 +213,9 @@ pub fn run(args: Args) -> Result<()> {
             render,
             denoise: denoiser.is_some(),
             keep_raw: args.keep_raw,
+            outputs: Outputs(args.outputs.iter().copied().collect()),
         },
-        files: FileList::current(),
+        files: FileList::current().kept(&Outputs(args.outputs.iter().copied().collect())),
         conventions: Conventions::current(),
         classes: streaks_dataset::segmentation::class_table(),
     };
@@ -247,7 +260,7 @@ pub fn run(args: Args) -> Result<()> {
         config,
         config_hash,
         seed: args.seed,
-        settings: info.settings,
+        settings: info.settings.clone(),
         denoiser: denoiser.map(std::sync::Arc::new),
     };
     let check = |index: u64| health(&layout, &info, index, manifest.as_ref());
@@ -269,6 +282,7 @@ pub fn run(args: Args) -> Result<()> {
     let bar = progress_bar(indices.len() as u64);
     let start = Instant::now();
     let mut shares = Vec::new();
+    let mut bytes = 0u64;
     let mut skipped = 0usize;
     let mut repaired = 0usize;
     let warned_no_road = Cell::new(false);
@@ -332,6 +346,7 @@ pub fn run(args: Args) -> Result<()> {
         }
         let share = rendered.stats.streak_share;
         shares.push(share);
+        bytes += rendered.bytes;
         bar.suspend(|| {
             eprintln!(
                 "sample {id}: {:.2} s, streak share {:.3} %",
@@ -382,6 +397,10 @@ pub fn run(args: Args) -> Result<()> {
             100.0 * quantile_sorted(&shares, 0.5).unwrap_or(f64::NAN),
             100.0 * shares[shares.len() - 1]
         );
+        summary += &format!(
+            "; {:.0} bytes per sample (its folder and its KITTI and SceneFlow files)",
+            bytes as f64 / shares.len() as f64
+        );
     }
     eprintln!("{summary}");
 
@@ -423,7 +442,7 @@ fn health(layout: &Layout, info: &DatasetInfo, index: u64, manifest: Option<&Man
             let diffs = verify_entry(layout, entry);
             if !diffs.is_empty() {
                 Health::Damaged(describe(&diffs))
-            } else if !layout.is_complete(index) {
+            } else if !layout.is_complete(index, &info.settings.outputs) {
                 Health::Damaged("its files match manifest.jsonl, which lists too few".into())
             } else {
                 Health::Good

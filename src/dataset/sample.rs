@@ -7,13 +7,13 @@ use glam::{DAffine3, DVec3};
 use std::path::Path;
 use std::time::Instant;
 use streaks_dataset::files::{SampleDir, SCENE_GLTF};
-use streaks_dataset::kitti::write_kitti;
 use streaks_dataset::layout::{sample_id, Layout};
 use streaks_dataset::meta::{
     kitti_pose, matrix_rows, render_seed, FlowShares, FogMeta, RenderMeta, RigMeta, SampleMeta,
     SampleStats, SequenceMeta, WeatherMeta,
 };
 use streaks_dataset::settings::Settings;
+use streaks_dataset::verify::write_views as write_dataset_views;
 use streaks_dataset::write::{
     disparity_range, instance_numbering, write_calib, write_flow, write_views, GroundTruth,
 };
@@ -55,6 +55,9 @@ pub struct Rendered {
     pub road_mask: bool,
     /// Seconds from scene building to publishing.
     pub seconds: f64,
+    /// The bytes it takes on disk: its folder's files and its files of the KITTI and
+    /// SceneFlow views.
+    pub bytes: u64,
 }
 
 /// Renders sample `index` into a temporary folder, writes its KITTI files and publishes it as
@@ -85,7 +88,7 @@ pub fn render_sample(
     if let Err(e) = std::fs::rename(&tmp, &dest) {
         let _ = std::fs::remove_dir_all(&tmp);
         // Another writer of the same index published first: its sample is the same.
-        if !layout.is_complete(index) {
+        if !layout.is_complete(index, &settings.settings.outputs) {
             return Err(e).with_context(|| {
                 format!("cannot publish {} as {}", tmp.display(), dest.display())
             });
@@ -292,10 +295,34 @@ fn write_sample(
         sequence: Some(sequence),
     };
     write_bytes_atomically(&files.meta(), &meta.to_bytes())?;
-    write_kitti(layout, index, &files, &left.disparity)?;
+    let outputs = &render.outputs;
+    write_dataset_views(layout, index, &meta, &files, outputs)?;
+    // The groups not kept go, now that the views are made from them.
+    let mut paths: Vec<std::path::PathBuf> = std::fs::read_dir(dir)
+        .and_then(|entries| entries.map(|e| e.map(|e| e.path())).collect())
+        .with_context(|| format!("cannot list {}", dir.display()))?;
+    let mut kept = Vec::with_capacity(paths.len());
+    for p in paths.drain(..) {
+        let name = p.file_name().unwrap_or_default().to_string_lossy();
+        if outputs.keeps(&name) {
+            kept.push(p);
+        } else {
+            std::fs::remove_file(&p).with_context(|| format!("cannot remove {}", p.display()))?;
+        }
+    }
+    let mut paths = kept;
+    let views = layout.view_files(index, &meta.split, meta.street, outputs);
+    paths.extend(views.into_iter().map(|(_, p)| p));
+    let mut bytes = 0;
+    for p in paths {
+        bytes += std::fs::metadata(&p)
+            .with_context(|| format!("cannot read {}", p.display()))?
+            .len();
+    }
     Ok(Rendered {
         stats,
         road_mask: has_road,
         seconds: 0.0,
+        bytes,
     })
 }

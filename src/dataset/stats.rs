@@ -322,6 +322,8 @@ struct Sample {
     street: Option<u64>,
     caption: String,
     leaves: Vec<(String, Leaf)>,
+    /// The bytes of its folder's files and of its files in the dataset's views.
+    bytes: u64,
 }
 
 /// A string at `path` of a JSON value, or `–`.
@@ -341,8 +343,9 @@ fn text_at(v: &Value, path: &[&str]) -> String {
 }
 
 /// Reads one sample's `meta.json`: its id, split, street, caption and flattened parameters
-/// (the generator's `params` and the rendered `stats`).
-fn read_sample(id: &str, dir: &SampleDir) -> Result<Sample> {
+/// (the generator's `params` and the rendered `stats`), and the bytes its files take (those of
+/// its folder and of the views of `layout`; sizes only, nothing is opened).
+fn read_sample(layout: &Layout, id: &str, dir: &SampleDir) -> Result<Sample> {
     let path = dir.meta();
     let text = read_text(&path, MAX_TEXT_BYTES)
         .with_context(|| format!("cannot read {}", path.display()))?;
@@ -360,12 +363,32 @@ fn read_sample(id: &str, dir: &SampleDir) -> Result<Sample> {
     let split = text_at(&meta, &["split"]);
     let weather = text_at(params, &["weather", "rain_class"]);
     let lamp = text_at(params, &["lamps", "type"]);
+    let street = meta.get("street").and_then(Value::as_u64);
+    let mut files: Vec<std::path::PathBuf> = std::fs::read_dir(dir.path())
+        .map(|entries| entries.filter_map(|e| e.ok().map(|e| e.path())).collect())
+        .unwrap_or_default();
+    if let (Ok(index), Some(street)) = (id.parse::<u64>(), street) {
+        let all = Default::default();
+        files.extend(
+            layout
+                .view_files(index, &split, street, &all)
+                .into_iter()
+                .map(|(_, p)| p),
+        );
+    }
+    let bytes = files
+        .iter()
+        .filter_map(|p| std::fs::symlink_metadata(p).ok())
+        .filter(|m| m.is_file())
+        .map(|m| m.len())
+        .sum();
     Ok(Sample {
         id: id.to_owned(),
         caption: format!("{weather} · {lamp} · {split}"),
         split,
-        street: meta.get("street").and_then(Value::as_u64),
+        street,
         leaves,
+        bytes,
     })
 }
 
@@ -454,7 +477,7 @@ pub fn run(args: Args) -> Result<()> {
     let bar = progress_bar(ids.len() as u64);
     let mut samples = Vec::new();
     for id in &ids {
-        match read_sample(id, &layout.sample_by_id(id)) {
+        match read_sample(&layout, id, &layout.sample_by_id(id)) {
             Ok(s) => samples.push(s),
             Err(e) => {
                 bar.suspend(|| eprintln!("warning: sample {id} skipped: {e:#}"));
@@ -636,10 +659,12 @@ fn page(
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\
          <title>streaks dataset stats: {d}</title><style>{CSS}{STATS_CSS}</style></head><body>\n\
          <header><h1>Dataset statistics</h1><p>{d}</p><p>{n} samples read, {p} missing or \
-         skipped</p></header><main>\n",
+         skipped; {b:.0} bytes per sample (its folder and its KITTI and SceneFlow files)</p>\
+         </header><main>\n",
         d = esc(&root.display().to_string()),
         n = samples.len(),
-        p = problems.len()
+        p = problems.len(),
+        b = samples.iter().map(|s| s.bytes as f64).sum::<f64>() / samples.len().max(1) as f64
     );
 
     // Splits and streets.

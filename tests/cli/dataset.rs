@@ -110,6 +110,7 @@ fn datasets_are_byte_identical_across_runs_threads_and_shards() {
     for f in [
         "calib.txt",
         "depth0.pfm",
+        "depth1.pfm",
         "disp0.pfm",
         "disp1.pfm",
         "im0.exr",
@@ -117,6 +118,8 @@ fn datasets_are_byte_identical_across_runs_threads_and_shards() {
         "im1.exr",
         "im1.png",
         "meta.json",
+        "occ0.png",
+        "occ1.png",
         "road0.png",
         "scene.bin",
         "scene.gltf",
@@ -269,6 +272,243 @@ fn ground_truth_reads_back_as_stereo_loaders_read_it() {
     assert!(weather["fog"].is_null() || weather["fog"]["sigma_t"].as_f64().unwrap() > 0.0);
     assert!(weather["sensor"].is_string() && weather["exposure_s"].as_f64().unwrap() > 0.0);
     assert_eq!(weather["rig_velocity"].as_array().unwrap().len(), 3);
+}
+
+/// Each eye's depth, its occlusion mask, and the KITTI and SceneFlow views of a sample hold
+/// what their documented rules say, read as the loaders read them: KITTI's uint16 / 256 with 0
+/// for no value, its calibration's baseline as `(P_rect_02[0][3] - P_rect_03[0][3]) / f`,
+/// SceneFlow's paths as torchvision's and RAFT-Stereo's globs find them.
+#[test]
+fn per_eye_ground_truth_and_the_kitti_and_sceneflow_views() {
+    let t = TestDir::new();
+    generate_n(&t, "ds", "1", &[]).assert_success();
+    let dir = t.join("ds/samples/000000");
+    let calib = MiddleburyCalib::load(&dir.join("calib.txt")).unwrap();
+    let fb = calib.focal_px * calib.baseline_mm / 1000.0;
+    let (w, h) = (64usize, 40usize);
+    let pfm = |name: &str| read_pfm(&dir.join(name)).unwrap();
+    let mask = |path: &Path| {
+        let m = image::open(path).unwrap().into_luma8();
+        assert!(m.pixels().all(|p| p.0[0] == 0 || p.0[0] == 255));
+        m.into_raw()
+            .iter()
+            .map(|&v| v == 255)
+            .collect::<Vec<bool>>()
+    };
+    let disp = [pfm("disp0.pfm"), pfm("disp1.pfm")];
+    let depth = [pfm("depth0.pfm"), pfm("depth1.pfm")];
+    let occ = [mask(&dir.join("occ0.png")), mask(&dir.join("occ1.png"))];
+    for eye in 0..2 {
+        // The right eye's depth is its disparity's: d = f b / Z.
+        for (d, z) in disp[eye].data.iter().zip(&depth[eye].data) {
+            assert_eq!(d.is_finite(), z.is_finite());
+            if d.is_finite() {
+                let expect = fb / f64::from(*z);
+                assert!((f64::from(*d) - expect).abs() <= 1e-4 * expect.max(1.0));
+            }
+        }
+        // Occlusion: the sky never; a point outside the other image always; and the points
+        // both eyes see agree with the other eye's disparity there (left-right consistency)
+        // but for thin objects' edges.
+        let sign = if eye == 0 { -1.0 } else { 1.0 };
+        let (mut seen, mut consistent, mut occluded) = (0, 0, 0);
+        for y in 0..h {
+            for x in 0..w {
+                let i = y * w + x;
+                let d = f64::from(disp[eye].data[i]);
+                if !d.is_finite() {
+                    assert!(!occ[eye][i], "eye {eye} pixel ({x}, {y}): sky is occluded");
+                    continue;
+                }
+                let at = x as f64 + 0.5 + sign * d;
+                if !(0.0..w as f64).contains(&at) {
+                    assert!(occ[eye][i], "eye {eye} pixel ({x}, {y}) is out of view");
+                }
+                if occ[eye][i] {
+                    occluded += 1;
+                    continue;
+                }
+                seen += 1;
+                let j = ((at - 0.5).floor().max(0.0) as usize).min(w - 1);
+                let other = &disp[1 - eye].data[y * w..y * w + w];
+                let near = [j, (j + 1).min(w - 1)]
+                    .iter()
+                    .any(|&k| (f64::from(other[k]) - d).abs() <= 1.0);
+                consistent += usize::from(near);
+            }
+        }
+        assert!(occluded > 0, "eye {eye}: no occluded pixel");
+        assert!(
+            consistent as f64 >= 0.95 * seen as f64,
+            "eye {eye}: {consistent} of {seen} visible pixels consistent"
+        );
+    }
+
+    // KITTI: disp_occ_1 is disp1, disp_noc_0 is disp0 where occ0 is 0 and no value elsewhere.
+    let kitti = |name: &str| {
+        read_kitti_disparity(&t.join(&format!("ds/kitti/training/{name}/000000_10.png"))).unwrap()
+    };
+    let (occ0, occ1, noc0) = (
+        kitti("disp_occ_0"),
+        kitti("disp_occ_1"),
+        kitti("disp_noc_0"),
+    );
+    for (i, &occluded) in occ[0].iter().enumerate() {
+        for (k, d) in [
+            (occ0.data[i], disp[0].data[i]),
+            (occ1.data[i], disp[1].data[i]),
+        ] {
+            if d.is_finite() && d * 256.0 >= 0.5 {
+                assert!((k - d).abs() <= 1.0 / 256.0, "{k} {d}");
+            } else {
+                assert_eq!(k, f32::INFINITY);
+            }
+        }
+        if occluded {
+            assert_eq!(
+                noc0.data[i],
+                f32::INFINITY,
+                "occluded pixel {i} in disp_noc_0"
+            );
+        } else {
+            assert_eq!(noc0.data[i].to_bits(), occ0.data[i].to_bits(), "pixel {i}");
+        }
+    }
+    let text =
+        std::fs::read_to_string(t.join("ds/kitti/training/calib_cam_to_cam/000000.txt")).unwrap();
+    let row = |key: &str| -> Vec<f64> {
+        let line = text
+            .lines()
+            .find_map(|l| l.strip_prefix(&format!("{key}: ")))
+            .unwrap_or_else(|| panic!("no {key} in {text}"));
+        line.split(' ').map(|v| v.parse().unwrap()).collect()
+    };
+    let (p2, p3) = (row("P_rect_02"), row("P_rect_03"));
+    let baseline = (p2[3] - p3[3]) / p3[0];
+    let meta: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("meta.json")).unwrap()).unwrap();
+    let b = meta["rig"]["baseline_m"].as_f64().unwrap();
+    assert!((baseline - b).abs() <= 1e-6 * b, "{baseline} {b}");
+    assert!((p2[0] - calib.focal_px).abs() <= 1e-6 * calib.focal_px);
+    assert_eq!([p2[2], p2[6]], [calib.cx, calib.cy]);
+
+    // SceneFlow: where torchvision's (SceneFlow/FlyingThings3D/frames_cleanpass/*/*/*/left)
+    // and RAFT-Stereo's (FlyingThings3D/frames_cleanpass/TRAIN|TEST/*/*/left) globs look, the
+    // disparity path RAFT-Stereo derives from the image's; disparities positive, 0 on the sky.
+    let split = meta["split"].as_str().unwrap();
+    let set = match split {
+        "train" => "TRAIN/A",
+        "val" => "TEST/B",
+        _ => "TEST/C",
+    };
+    let street = meta["street"].as_u64().unwrap();
+    let root = "ds/SceneFlow/FlyingThings3D";
+    for (k, eye) in ["left", "right"].into_iter().enumerate() {
+        let image = format!("{root}/frames_cleanpass/{set}/{street:04}/{eye}/0000000.png");
+        assert_eq!(
+            std::fs::read(t.join(&image)).unwrap(),
+            std::fs::read(dir.join(format!("im{k}.png"))).unwrap()
+        );
+        let disparity = image
+            .replace("frames_cleanpass", "disparity")
+            .replace(".png", ".pfm");
+        let sf = read_pfm(&t.join(&disparity)).unwrap();
+        for (s, d) in sf.data.iter().zip(&disp[k].data) {
+            let expect = if d.is_finite() { *d } else { 0.0 };
+            assert_eq!(s.to_bits(), expect.to_bits());
+        }
+        let occlusion = image.replace("frames_cleanpass", "disparity_occlusions");
+        assert_eq!(mask(&t.join(&occlusion)), occ[k]);
+    }
+    let manifest = std::fs::read_to_string(t.join("ds/manifest.jsonl")).unwrap();
+    let line: serde_json::Value = serde_json::from_str(manifest.lines().next().unwrap()).unwrap();
+    let listed = line["files"].as_object().unwrap();
+    assert!(listed.contains_key(&format!(
+        "SceneFlow/FlyingThings3D/disparity/{set}/{street:04}/right/0000000.pfm"
+    )));
+    assert!(listed.contains_key("kitti/training/calib_cam_to_cam/000000.txt"));
+    t.streaks(&["dataset", "index", "ds"]).assert_success();
+}
+
+/// `--outputs` keeps only the chosen groups: the sample folder holds those files (and
+/// `calib.txt`, `meta.json`), the views chosen are made all the same, the manifest lists
+/// exactly the files written and `dataset index` verifies them; a rerun with other groups is
+/// refused with a hint, and an unknown group names the groups there are.
+#[test]
+fn outputs_keep_only_the_chosen_groups() {
+    let t = TestDir::new();
+    let run = generate_n(&t, "ds", "1", &["--outputs", "gt,kitti"]);
+    run.assert_success();
+    assert!(
+        run.stderr().contains(" bytes per sample"),
+        "{}",
+        run.stderr()
+    );
+    assert_eq!(
+        t.files_in("ds/samples/000000"),
+        [
+            "calib.txt",
+            "depth0.pfm",
+            "depth1.pfm",
+            "disp0.pfm",
+            "disp1.pfm",
+            "meta.json",
+            "occ0.png",
+            "occ1.png"
+        ]
+    );
+    assert!(!t.join("ds/SceneFlow").exists());
+    assert!(t.join("ds/kitti/training/image_2/000000_10.png").is_file());
+    assert!(t.join("ds/kitti/training/semantic/000000_10.png").is_file());
+    let manifest = std::fs::read_to_string(t.join("ds/manifest.jsonl")).unwrap();
+    let line: serde_json::Value = serde_json::from_str(manifest.lines().next().unwrap()).unwrap();
+    let mut listed: Vec<String> = line["files"].as_object().unwrap().keys().cloned().collect();
+    let mut on_disk: Vec<String> = tree(&t.join("ds"))
+        .into_keys()
+        .filter(|f| f.starts_with("samples/") || f.starts_with("kitti/"))
+        .collect();
+    listed.sort();
+    on_disk.sort();
+    assert_eq!(listed, on_disk);
+    assert_eq!(listed.len(), 8 + 8);
+    let info: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(t.join("ds/dataset.json")).unwrap()).unwrap();
+    assert_eq!(info["outputs"], serde_json::json!(["gt", "kitti"]));
+    // dataset.json lists the files kept.
+    let list = &info["files"];
+    assert_eq!(
+        list["sample"],
+        serde_json::json!(t.files_in("ds/samples/000000"))
+    );
+    assert_eq!(list["scene"], serde_json::json!([]));
+    assert!(list.get("sceneflow").is_none());
+    assert_eq!(list["kitti"].as_array().unwrap().len(), 8);
+    assert!(list["optional"].as_object().unwrap().is_empty(), "{list}");
+    let verified = t.streaks(&["dataset", "index", "ds"]);
+    verified.assert_success();
+    assert!(
+        verified.stderr().contains("16 files match manifest.jsonl"),
+        "{}",
+        verified.stderr()
+    );
+    // A rerun skips the sample; one with other groups is refused.
+    let again = generate_n(&t, "ds", "1", &["--outputs", "kitti,gt"]);
+    again.assert_success();
+    assert!(again
+        .stderr()
+        .contains("0 samples rendered, 1 already done"));
+    generate_n(&t, "ds", "1", &[])
+        .assert_failure_mentioning("outputs")
+        .assert_failure_mentioning("give --outputs");
+    let bad = generate_n(&t, "bad", "1", &["--outputs", "gt,png"]);
+    assert!(!bad.output.status.success());
+    assert!(
+        bad.stderr().contains("unknown output group \"png\"")
+            && bad.stderr().contains("images, exr, gt"),
+        "{}",
+        bad.stderr()
+    );
+    assert!(!t.join("bad").exists());
 }
 
 #[test]
@@ -949,6 +1189,19 @@ fn stats_page_shows_the_parameters_and_escapes_what_it_reads() {
     generate(&t, "ds", &[]).assert_success();
     t.streaks(&["dataset", "stats", "ds"]).assert_success();
     let page = std::fs::read_to_string(t.join("ds/stats.html")).unwrap();
+    // The bytes per sample are those of the files the manifest lists.
+    let manifest = std::fs::read_to_string(t.join("ds/manifest.jsonl")).unwrap();
+    let mut bytes = 0u64;
+    for line in manifest.lines() {
+        let line: serde_json::Value = serde_json::from_str(line).unwrap();
+        for file in line["files"].as_object().unwrap().keys() {
+            bytes += std::fs::metadata(t.join(&format!("ds/{file}")))
+                .unwrap()
+                .len();
+        }
+    }
+    let per_sample = format!("{:.0} bytes per sample", bytes as f64 / 3.0);
+    assert!(page.contains(&per_sample), "{per_sample}");
     let config: serde_json::Value =
         serde_json::from_slice(&std::fs::read(t.join("ds/dataset.json")).unwrap()).unwrap();
     let height = config["config"]["lamps"]["height"].to_string();

@@ -35,6 +35,8 @@ fn stereo_writes_the_pair_ground_truth_and_rig_then_maps_and_prepares_it() {
             "im1.png",
             "instance0.png",
             "instance1.png",
+            "occ0.png",
+            "occ1.png",
             "rig.json",
             "semantic0.png",
             "semantic1.png",

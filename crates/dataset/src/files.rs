@@ -8,7 +8,9 @@
 //! im0.exr, im1.exr        linear float32 RGB with the depth, normal and specular layers
 //! im0.png, im1.png        8-bit sRGB of the render times 2^exposure
 //! disp0.pfm, disp1.pfm    ground-truth disparity of the left and right view
-//! depth0.pfm              ground-truth depth of the left view (depth1.pfm: the right view's)
+//! depth0.pfm, depth1.pfm  ground-truth depth of the left and right view
+//! occ0.png, occ1.png      occlusion masks: 255 where the pixel's point is hidden from the other
+//!                         eye or outside its image
 //! streaks0.png            streak mask of the left view (streaks1.png: the right view's)
 //! road0.png               road-surface mask of the left view, when the scene flags a road
 //!                         (road1.png: the right view's)
@@ -32,8 +34,8 @@
 //! frame) and `times.txt` (each frame's time, seconds), written by `streaks dataset index`
 //! from the samples' `meta.json`.
 //!
-//! A dataset sample has the left view's depth and masks only; a `streaks stereo` folder has
-//! both views'. Folders that `streaks stereo` wrote before it used this layout (`left.exr`,
+//! A dataset sample has the left view's streak and road masks only; a `streaks stereo` folder
+//! has both views'. Folders that `streaks stereo` wrote before it used this layout (`left.exr`,
 //! `disparity_left.pfm`, ...: [`PAIR_NAMES`]) are still read: [`SampleDir::open`] finds which
 //! layout a folder has.
 
@@ -69,10 +71,26 @@ pub const KITTI_IMAGE_2: &str = "image_2";
 pub const KITTI_IMAGE_3: &str = "image_3";
 /// The KITTI view's left disparities.
 pub const KITTI_DISP_OCC_0: &str = "disp_occ_0";
+/// The KITTI view's right-view disparities (as torchvision's `Kitti2015Stereo` reads them).
+pub const KITTI_DISP_OCC_1: &str = "disp_occ_1";
+/// The KITTI view's left disparities of the pixels both eyes see.
+pub const KITTI_DISP_NOC_0: &str = "disp_noc_0";
+/// The KITTI view's calibration files (`calib_cam_to_cam/NNNNNN.txt`).
+pub const KITTI_CALIB: &str = "calib_cam_to_cam";
+/// The extension of a KITTI calibration file.
+pub const KITTI_CALIB_EXTENSION: &str = "txt";
 /// KITTI's semantic maps (its semantics benchmark's `semantic/`: label ids, 8 bit).
 pub const KITTI_SEMANTIC: &str = "semantic";
 /// KITTI's instance maps (`instance/`: `labelId * 256 + k`, 16 bit).
 pub const KITTI_INSTANCE: &str = "instance";
+/// A dataset's SceneFlow view (`SceneFlow/FlyingThings3D/...`).
+pub const SCENEFLOW_DIR: [&str; 2] = ["SceneFlow", "FlyingThings3D"];
+/// The SceneFlow view's images (the clean pass: the render as the camera saw it).
+pub const SCENEFLOW_IMAGES: &str = "frames_cleanpass";
+/// The SceneFlow view's disparities.
+pub const SCENEFLOW_DISPARITY: &str = "disparity";
+/// The SceneFlow view's occlusion maps.
+pub const SCENEFLOW_OCCLUSION: &str = "disparity_occlusions";
 /// The suffix of a KITTI file name after the sample id (`NNNNNN_10.png`).
 pub const KITTI_SUFFIX: &str = "_10.png";
 
@@ -113,9 +131,10 @@ pub const SCENE_BIN: &str = "scene.bin";
 pub const ROAD_MASK: &str = "road0.png";
 
 /// The files of every dataset sample folder besides the scene's, sorted.
-pub const SAMPLE_FILES: [&str; 10] = [
+pub const SAMPLE_FILES: [&str; 13] = [
     CALIB,
     "depth0.pfm",
+    "depth1.pfm",
     "disp0.pfm",
     "disp1.pfm",
     "im0.exr",
@@ -123,6 +142,8 @@ pub const SAMPLE_FILES: [&str; 10] = [
     "im1.exr",
     "im1.png",
     META,
+    "occ0.png",
+    "occ1.png",
     "streaks0.png",
 ];
 
@@ -149,6 +170,8 @@ pub struct Names {
     pub semantic: [&'static str; 2],
     /// The instance map (Cityscapes instance ids).
     pub instance: [&'static str; 2],
+    /// The occlusion mask: the pixels whose point the other eye does not see.
+    pub occlusion: [&'static str; 2],
 }
 
 /// The sample layout (Middlebury style): `im0.png`, `disp0.pfm`, ...
@@ -163,6 +186,7 @@ pub const SAMPLE_NAMES: Names = Names {
     fog: ["fog0.pfm", "fog1.pfm"],
     semantic: ["semantic0.png", "semantic1.png"],
     instance: ["instance0.png", "instance1.png"],
+    occlusion: ["occ0.png", "occ1.png"],
 };
 
 /// The older pair layout of `streaks stereo`: `left.png`, `disparity_left.pfm`, ... (read,
@@ -178,6 +202,7 @@ pub const PAIR_NAMES: Names = Names {
     fog: ["fog_left.pfm", "fog_right.pfm"],
     semantic: ["semantic_left.png", "semantic_right.png"],
     instance: ["instance_left.png", "instance_right.png"],
+    occlusion: ["occlusion_left.png", "occlusion_right.png"],
 };
 
 fn eye_index(eye: Eye) -> usize {
@@ -313,6 +338,12 @@ impl SampleDir {
     /// [`crate::segmentation`]).
     pub fn instance(&self, eye: Eye) -> PathBuf {
         self.eye_file(self.names.instance, eye)
+    }
+
+    /// The occlusion mask (`occ0.png`, 0/255: 255 where the pixel's point is hidden from the
+    /// other eye or outside its image; see [`streaks_stereo::occlusion`]).
+    pub fn occlusion(&self, eye: Eye) -> PathBuf {
+        self.eye_file(self.names.occlusion, eye)
     }
 
     /// `calib.txt`.
@@ -461,7 +492,8 @@ mod tests {
                         SAMPLE_NAMES.png,
                         SAMPLE_NAMES.disparity,
                         SAMPLE_NAMES.depth,
-                        SAMPLE_NAMES.streak_mask
+                        SAMPLE_NAMES.streak_mask,
+                        SAMPLE_NAMES.occlusion
                     ]
                     .iter()
                     .any(|n| n.contains(&f)),

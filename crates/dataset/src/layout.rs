@@ -9,6 +9,9 @@
 //! DIR/kitti/training/image_2/NNNNNN_10.png       = im0.png
 //! DIR/kitti/training/image_3/NNNNNN_10.png       = im1.png
 //! DIR/kitti/training/disp_occ_0/NNNNNN_10.png    disp0 as uint16 x 256, 0 = no value
+//! DIR/kitti/training/disp_occ_1/NNNNNN_10.png    disp1 as uint16 x 256
+//! DIR/kitti/training/disp_noc_0/NNNNNN_10.png    disp0, 0 where occ0.png says occluded
+//! DIR/kitti/training/calib_cam_to_cam/NNNNNN.txt P_rect_02, P_rect_03 (KITTI's format)
 //! DIR/manifest.jsonl                    one line per good sample (`streaks dataset index`)
 //! DIR/splits/{train,val,test}.txt       sample ids, split by street
 //! ```
@@ -16,17 +19,19 @@
 use crate::error::DatasetError;
 use crate::files::SampleDir;
 use crate::files::{
-    DATASET_JSON, KITTI_DIR, KITTI_DISP_OCC_0, KITTI_IMAGE_2, KITTI_IMAGE_3, KITTI_INSTANCE,
+    DATASET_JSON, KITTI_CALIB, KITTI_CALIB_EXTENSION, KITTI_DIR, KITTI_DISP_NOC_0,
+    KITTI_DISP_OCC_0, KITTI_DISP_OCC_1, KITTI_IMAGE_2, KITTI_IMAGE_3, KITTI_INSTANCE,
     KITTI_SEMANTIC, KITTI_SUFFIX, LOCK, MANIFEST, ROAD_MASK, SAMPLES_DIR, SAMPLE_FILES,
-    SAMPLE_LOCK_PREFIX, SCENE_BIN, SCENE_GLTF, SPLITS_DIR, SPLIT_EXTENSION, TMP_PREFIX,
+    SAMPLE_LOCK_PREFIX, SCENEFLOW_DIR, SCENEFLOW_DISPARITY, SCENEFLOW_IMAGES, SCENEFLOW_OCCLUSION,
+    SCENE_BIN, SCENE_GLTF, SPLITS_DIR, SPLIT_EXTENSION, TMP_PREFIX,
 };
+use crate::outputs::{Output, Outputs};
 use crate::segmentation::ClassRecord;
 use crate::settings::Settings;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use streaks_stereo::rig::Eye;
 
 /// The format of `dataset.json` and of the folder it describes.
 pub const FORMAT: &str = "streaks-dataset/1";
@@ -45,7 +50,7 @@ pub fn sample_id(index: u64) -> String {
     format!("{index:06}")
 }
 
-/// The three KITTI 2015 files of one sample.
+/// The KITTI 2015 files of one sample.
 #[derive(Clone, Debug)]
 pub struct KittiFiles {
     /// `image_2/NNNNNN_10.png`: the left image.
@@ -54,6 +59,15 @@ pub struct KittiFiles {
     pub image_3: PathBuf,
     /// `disp_occ_0/NNNNNN_10.png`: the left disparity, uint16 x 256.
     pub disp_occ_0: PathBuf,
+    /// `disp_occ_1/NNNNNN_10.png`: the right view's disparity, uint16 x 256 (torchvision's
+    /// `Kitti2015Stereo` reads it as the right disparity).
+    pub disp_occ_1: PathBuf,
+    /// `disp_noc_0/NNNNNN_10.png`: the left disparity where the right eye sees the point too
+    /// (0 where `occ0.png` says occluded).
+    pub disp_noc_0: PathBuf,
+    /// `calib_cam_to_cam/NNNNNN.txt`: the rectified projection matrices `P_rect_02` and
+    /// `P_rect_03` (the baseline is `(P_rect_02[0][3] - P_rect_03[0][3]) / P_rect_03[0][0]`).
+    pub calib: PathBuf,
     /// `semantic/NNNNNN_10.png`: the left view's label ids (`semantic0.png`).
     pub semantic: PathBuf,
     /// `instance/NNNNNN_10.png`: the left view's instances as `labelId * 256 + k`.
@@ -61,16 +75,52 @@ pub struct KittiFiles {
 }
 
 impl KittiFiles {
-    /// The three paths with their names relative to the dataset folder.
-    pub fn named(&self, layout: &Layout) -> [(String, &Path); 5] {
+    /// The paths with their names relative to the dataset folder.
+    pub fn named(&self, layout: &Layout) -> [(String, &Path); 8] {
         [
             &self.image_2,
             &self.image_3,
             &self.disp_occ_0,
+            &self.disp_occ_1,
+            &self.disp_noc_0,
+            &self.calib,
             &self.semantic,
             &self.instance,
         ]
         .map(|p| (layout.relative(p), p.as_path()))
+    }
+}
+
+/// The SceneFlow (FlyingThings3D) files of one sample (see [`crate::sceneflow`]), left then
+/// right.
+#[derive(Clone, Debug)]
+pub struct SceneFlowFiles {
+    /// `frames_cleanpass/.../left|right/NNNNNNN.png`: the images.
+    pub images: [PathBuf; 2],
+    /// `disparity/.../left|right/NNNNNNN.pfm`: the disparities.
+    pub disparity: [PathBuf; 2],
+    /// `disparity_occlusions/.../left|right/NNNNNNN.png`: the occlusion maps.
+    pub occlusion: [PathBuf; 2],
+}
+
+impl SceneFlowFiles {
+    /// The paths with their names relative to the dataset folder.
+    pub fn named(&self, layout: &Layout) -> Vec<(String, &Path)> {
+        [&self.images, &self.disparity, &self.occlusion]
+            .into_iter()
+            .flatten()
+            .map(|p| (layout.relative(p), p.as_path()))
+            .collect()
+    }
+}
+
+/// The SceneFlow folders `SPLIT/L` of a dataset split (see [`crate::sceneflow`]).
+fn sceneflow_split(split: &str) -> Option<[&'static str; 2]> {
+    match split {
+        "train" => Some(["TRAIN", "A"]),
+        "val" => Some(["TEST", "B"]),
+        "test" => Some(["TEST", "C"]),
+        _ => None,
     }
 }
 
@@ -167,18 +217,17 @@ impl Layout {
             .join(format!("{}{}", Self::tmp_prefix(index), std::process::id()))
     }
 
-    /// Whether sample `index` is published and has all its files (a cheap check: the files are
-    /// there and `meta.json` names the index; `streaks dataset index` checks their contents).
-    pub fn is_complete(&self, index: u64) -> bool {
+    /// Whether sample `index` is published and has all the files of the groups `outputs`
+    /// (a cheap check: the files are there and `meta.json` names the index; `streaks dataset
+    /// index` checks their contents).
+    pub fn is_complete(&self, index: u64, outputs: &Outputs) -> bool {
         let sample = self.sample(index);
-        let present = |name: &str| sample.file(name).is_file();
+        let present = |name: &str| !outputs.keeps(name) || sample.file(name).is_file();
         if !SAMPLE_FILES.iter().all(|f| present(f)) || !present(SCENE_GLTF) {
             return false;
         }
         match sample.load_meta() {
-            Ok(meta) => {
-                meta.index == index && (!meta.road_mask || sample.road_mask(Eye::Left).is_file())
-            }
+            Ok(meta) => meta.index == index && (!meta.road_mask || present(ROAD_MASK)),
             Err(_) => false,
         }
     }
@@ -218,9 +267,63 @@ impl Layout {
             image_2: dir.join(KITTI_IMAGE_2).join(&name),
             image_3: dir.join(KITTI_IMAGE_3).join(&name),
             disp_occ_0: dir.join(KITTI_DISP_OCC_0).join(&name),
+            disp_occ_1: dir.join(KITTI_DISP_OCC_1).join(&name),
+            disp_noc_0: dir.join(KITTI_DISP_NOC_0).join(&name),
+            calib: dir
+                .join(KITTI_CALIB)
+                .join(format!("{}.{KITTI_CALIB_EXTENSION}", sample_id(index))),
             semantic: dir.join(KITTI_SEMANTIC).join(&name),
             instance: dir.join(KITTI_INSTANCE).join(&name),
         }
+    }
+
+    /// The SceneFlow view's files of sample `index` of split `split` and street `street`;
+    /// `None` for a split that is not the dataset's.
+    pub fn sceneflow(&self, index: u64, split: &str, street: u64) -> Option<SceneFlowFiles> {
+        let [set, letter] = sceneflow_split(split)?;
+        let root = self.root.join(SCENEFLOW_DIR[0]).join(SCENEFLOW_DIR[1]);
+        let part = |kind: &str, eye: &str, ext: &str| {
+            root.join(kind)
+                .join(set)
+                .join(letter)
+                .join(format!("{street:04}"))
+                .join(eye)
+                .join(format!("{index:07}.{ext}"))
+        };
+        let eyes = |kind: &str, ext: &str| ["left", "right"].map(|e| part(kind, e, ext));
+        Some(SceneFlowFiles {
+            images: eyes(SCENEFLOW_IMAGES, "png"),
+            disparity: eyes(SCENEFLOW_DISPARITY, "pfm"),
+            occlusion: eyes(SCENEFLOW_OCCLUSION, "png"),
+        })
+    }
+
+    /// The files of the dataset's views (KITTI and SceneFlow, those of `outputs`) of sample
+    /// `index` of split `split` and street `street`, with their names relative to the dataset
+    /// folder.
+    pub fn view_files(
+        &self,
+        index: u64,
+        split: &str,
+        street: u64,
+        outputs: &Outputs,
+    ) -> Vec<(String, PathBuf)> {
+        let mut out: Vec<(String, PathBuf)> = Vec::new();
+        if outputs.has(Output::Kitti) {
+            let kitti = self.kitti(index);
+            out.extend(kitti.named(self).map(|(n, p)| (n, p.to_path_buf())));
+        }
+        if let Some(sf) = self
+            .sceneflow(index, split, street)
+            .filter(|_| outputs.has(Output::Sceneflow))
+        {
+            out.extend(
+                sf.named(self)
+                    .into_iter()
+                    .map(|(n, p)| (n, p.to_path_buf())),
+            );
+        }
+        out
     }
 
     /// The ids of the dataset's samples, sorted: with `split`, those that `streaks dataset
@@ -304,6 +407,12 @@ pub struct Conventions {
     pub calib: String,
     /// The KITTI view.
     pub kitti: String,
+    /// The SceneFlow view (empty in datasets written before it).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub sceneflow: String,
+    /// The occlusion masks (empty in datasets written before them).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub occlusion: String,
     /// The flow, the disparity change and the poses of a drive (empty in a `dataset.json`
     /// written before they existed).
     #[serde(default)]
@@ -340,7 +449,17 @@ impl Conventions {
             calib: s("Middlebury 2014 calib.txt: cam0/cam1 = [f 0 cx; 0 f cy; 0 0 1] with the top-left pixel centre at (0, 0), \
                  doffs = 0, baseline in mm, ndisp a multiple of 16 above the largest disparity, vmin/vmax the finite disparity range"),
             kitti: s("KITTI 2015: image_2 = im0.png, image_3 = im1.png, disp_occ_0 = disp0 as uint16 PNG of round(256 d), 0 = no value \
-                 (also disparities that do not fit in 1..65535)"),
+                 (also disparities that do not fit in 1..65535), disp_occ_1 = disp1 likewise (the right view's, as torchvision reads it), \
+                 disp_noc_0 = disp0 with 0 where occ0 says occluded; calib_cam_to_cam/NNNNNN.txt: S_rect_0x, R_rect_0x (identity), \
+                 P_rect_02 = [f 0 cx 0; 0 f cy 0; 0 0 1 0] (the left eye, the reference) and P_rect_03 = [f 0 cx -f b; 0 f cy 0; 0 0 1 0], \
+                 b in metres, numbers as C's %e"),
+            sceneflow: s("SceneFlow/FlyingThings3D/{frames_cleanpass,disparity,disparity_occlusions}/SPLIT/L/SSSS/{left,right}/NNNNNNN: \
+                 SPLIT/L = TRAIN/A (train), TEST/B (val), TEST/C (test), SSSS the street, NNNNNNN the sample index; images = im0/im1.png, \
+                 disparity PFMs = disp0/disp1 (positive, 'Pf', rows bottom to top) with 0 on the sky (at infinity), \
+                 disparity_occlusions = occ0/occ1.png"),
+            occlusion: s("occ0/occ1.png, 0/255: 255 where the pixel's point (its pixel-centre ray's first hit) is not seen by the other eye: \
+                 it falls outside the other image (x - d < 0 from the left, x + d >= W from the right) or both of the other eye's pixels \
+                 whose centres bracket it see something nearer than its depth by more than 0.1 %; 0 elsewhere and on the sky"),
             flow: s("the left view's forward flow to the next frame of the street's drive (frame k at k / fps), of the surfaces                  (no rain, no blur): flow0.png KITTI 2015 flow_occ (16-bit RGB, u x 64 + 2^15, v x 64 + 2^15, valid = the point is in                  the next image, visible or occluded), flow0.pfm 'PF' (u, v, 0), inf where the point has no projection;                  dispchange0.pfm f b / Z' - f b / Z; flowmask0.png 255 visible, 128 occluded, 64 out of view, 0 no surface;                  sequences/SSSSSS/poses.txt KITTI odometry (the left camera in the first frame's left camera frame, x right,                  y down, z forward, 3x4 row by row), times.txt seconds"),
             splits: s("by street: every sample of one street is in the same split (splits/{train,val,test}.txt, sample ids)"),
             seeds: s("each sample is reproducible from (config, seed, index); its render seed is derived from (seed, index), \
@@ -366,6 +485,9 @@ pub struct FileList {
     pub scene: Vec<String>,
     /// The sample's KITTI files (NNNNNN = the sample id).
     pub kitti: Vec<String>,
+    /// The sample's SceneFlow files (empty in datasets written before the view existed).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub sceneflow: Vec<String>,
 }
 
 impl FileList {
@@ -400,10 +522,56 @@ impl FileList {
                 SCENE_BIN.to_owned(),
                 "scene_*.png (the textures scene.gltf refers to)".to_owned(),
             ],
-            kitti: [KITTI_IMAGE_2, KITTI_IMAGE_3, KITTI_DISP_OCC_0]
-                .map(|d| format!("{}/{}/{d}/NNNNNN{KITTI_SUFFIX}", KITTI_DIR[0], KITTI_DIR[1]))
-                .to_vec(),
+            kitti: [
+                KITTI_IMAGE_2,
+                KITTI_IMAGE_3,
+                KITTI_DISP_OCC_0,
+                KITTI_DISP_OCC_1,
+                KITTI_DISP_NOC_0,
+                KITTI_SEMANTIC,
+                KITTI_INSTANCE,
+            ]
+            .map(|d| format!("{}/{}/{d}/NNNNNN{KITTI_SUFFIX}", KITTI_DIR[0], KITTI_DIR[1]))
+            .into_iter()
+            .chain([format!(
+                "{}/{}/{KITTI_CALIB}/NNNNNN.{KITTI_CALIB_EXTENSION}",
+                KITTI_DIR[0], KITTI_DIR[1]
+            )])
+            .collect(),
+            sceneflow: [
+                (SCENEFLOW_IMAGES, "png"),
+                (SCENEFLOW_DISPARITY, "pfm"),
+                (SCENEFLOW_OCCLUSION, "png"),
+            ]
+            .into_iter()
+            .flat_map(|(kind, ext)| {
+                ["left", "right"].map(|eye| {
+                    format!(
+                        "{}/{}/{kind}/{{TRAIN/A,TEST/B,TEST/C}}/SSSS/{eye}/NNNNNNN.{ext}",
+                        SCENEFLOW_DIR[0], SCENEFLOW_DIR[1]
+                    )
+                })
+            })
+            .collect(),
         }
+    }
+
+    /// The files of this list that a dataset keeping the groups `outputs` writes.
+    pub fn kept(mut self, outputs: &Outputs) -> Self {
+        self.sample.retain(|f| outputs.keeps(f));
+        // An optional entry names its files `a, b`: one group each.
+        self.optional
+            .retain(|files, _| outputs.keeps(files.split(", ").next().unwrap_or(files)));
+        for (group, list) in [
+            (Output::Scene, &mut self.scene),
+            (Output::Kitti, &mut self.kitti),
+            (Output::Sceneflow, &mut self.sceneflow),
+        ] {
+            if !outputs.has(group) {
+                list.clear();
+            }
+        }
+        self
     }
 }
 
@@ -492,6 +660,10 @@ impl DatasetInfo {
             for key in ["denoise", "keep_raw"] {
                 map.entry(key).or_insert(Value::Bool(false));
             }
+            // Before --outputs existed: every group.
+            map.entry("outputs").or_insert_with(|| {
+                serde_json::to_value(crate::outputs::Outputs::default()).expect("outputs serialise")
+            });
             if !map.contains_key("regularize") {
                 map.insert("regularize".into(), Value::Bool(false));
                 unrecorded = true;
@@ -504,7 +676,12 @@ impl DatasetInfo {
         // The value of the bytes this run would write (a value made from `self` directly would
         // hold `noise_target` widened from f32, 0.10000000149011612 for the file's 0.1).
         let new = serde_json::from_slice(&self.to_bytes()).expect("dataset.json reads back");
-        if let Some((field, old, new)) = first_difference("", &existing, &new) {
+        // The groups first: they also change the file list, whose difference says less.
+        let null = Value::Null;
+        let outputs = |v: &Value| v.get("outputs").unwrap_or(&null).clone();
+        let differs = first_difference("outputs", &outputs(&existing), &outputs(&new))
+            .or_else(|| first_difference("", &existing, &new));
+        if let Some((field, old, new)) = differs {
             let hint = match field.as_str() {
                 "regularize" if unrecorded => {
                     " (it predates the setting and was rendered without path regularisation: \
@@ -526,6 +703,10 @@ impl DatasetInfo {
                 }
                 "keep_raw" if self.settings.keep_raw => " (drop --keep-raw to continue it)",
                 "keep_raw" => " (add --keep-raw to continue it)",
+                "outputs" => {
+                    " (give --outputs the groups its dataset.json lists under outputs to \
+                     continue it)"
+                }
                 _ => "",
             };
             return Err(DatasetError::OtherDataset {
@@ -623,6 +804,7 @@ mod tests {
                 },
                 denoise: false,
                 keep_raw: false,
+                outputs: Default::default(),
             },
             files: FileList::current(),
             conventions: Conventions::current(),
@@ -692,6 +874,9 @@ mod tests {
                 "kitti/training/image_2/000003_10.png",
                 "kitti/training/image_3/000003_10.png",
                 "kitti/training/disp_occ_0/000003_10.png",
+                "kitti/training/disp_occ_1/000003_10.png",
+                "kitti/training/disp_noc_0/000003_10.png",
+                "kitti/training/calib_cam_to_cam/000003.txt",
                 "kitti/training/semantic/000003_10.png",
                 "kitti/training/instance/000003_10.png"
             ]

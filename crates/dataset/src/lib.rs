@@ -8,9 +8,11 @@
 //!   folder alike, also in the older pair layout);
 //! - [`meta`]: a sample's `meta.json`, and its render seed;
 //! - [`settings`]: the render settings a dataset's samples share ([`settings::Settings`]);
+//! - [`outputs`]: the groups of files a dataset's samples keep (`--outputs`);
 //! - [`layout`]: the dataset folder, `dataset.json` and the conventions it states, and its
 //!   Middlebury-style sample folders;
 //! - [`kitti`]: the KITTI 2015 view of a sample;
+//! - [`sceneflow`]: the SceneFlow (FlyingThings3D) view of a sample;
 //! - [`segmentation`]: the semantic and instance maps, the class table and the instance
 //!   numbering (Cityscapes' label convention);
 //! - [`manifest`]: reading `manifest.jsonl` back and checking files against it;
@@ -30,6 +32,8 @@ pub mod layout;
 pub mod lock;
 pub mod manifest;
 pub mod meta;
+pub mod outputs;
+pub mod sceneflow;
 pub mod segmentation;
 pub mod settings;
 pub mod shard;

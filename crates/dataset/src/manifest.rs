@@ -135,6 +135,8 @@ struct RawLine {
     id: String,
     #[serde(default)]
     split: String,
+    #[serde(default)]
+    street: u64,
     files: BTreeMap<String, String>,
 }
 
@@ -147,6 +149,8 @@ pub struct Entry {
     pub index: u64,
     /// Its split, as the line names it.
     pub split: String,
+    /// Its street, as the line names it.
+    pub street: u64,
     /// sha256 of each file, by path relative to the dataset folder (validated).
     pub files: BTreeMap<String, String>,
 }
@@ -298,11 +302,11 @@ impl<R: BufRead> Lines<R> {
                 .map_err(json)?
                 .index;
             let kept = keep(index);
-            let (id, split, files) = if kept {
+            let (id, split, street, files) = if kept {
                 let raw: RawLine = serde_json::from_slice(&self.buf).map_err(json)?;
-                (raw.id, raw.split, raw.files)
+                (raw.id, raw.split, raw.street, raw.files)
             } else {
-                (sample_id(index), String::new(), BTreeMap::new())
+                (sample_id(index), String::new(), 0, BTreeMap::new())
             };
             if index >= count || id != sample_id(index) {
                 return Err(ManifestError::NotASample {
@@ -321,7 +325,7 @@ impl<R: BufRead> Lines<R> {
                     first,
                 });
             }
-            let own = own_files(&self.layout, index);
+            let own = own_files(&self.layout, index, &split, street);
             for (file, sha) in &files {
                 if !own.is_own(file) {
                     return Err(ManifestError::ForeignPath {
@@ -345,6 +349,7 @@ impl<R: BufRead> Lines<R> {
                     line,
                     index,
                     split,
+                    street,
                     files,
                 }));
             }
@@ -356,14 +361,14 @@ impl<R: BufRead> Lines<R> {
 struct OwnFiles {
     /// `samples/NNNNNN/`.
     folder: String,
-    /// Its KITTI files.
-    kitti: [String; 5],
+    /// Its files of the dataset's views (KITTI, SceneFlow).
+    views: Vec<String>,
 }
 
 impl OwnFiles {
-    /// Whether `file` is `samples/NNNNNN/NAME` (one plain name) or one of the KITTI files.
+    /// Whether `file` is `samples/NNNNNN/NAME` (one plain name) or one of the views' files.
     fn is_own(&self, file: &str) -> bool {
-        if self.kitti.iter().any(|k| k == file) {
+        if self.views.iter().any(|k| k == file) {
             return true;
         }
         file.strip_prefix(&self.folder).is_some_and(|name| {
@@ -376,11 +381,14 @@ impl OwnFiles {
     }
 }
 
-fn own_files(layout: &Layout, index: u64) -> OwnFiles {
-    let kitti = layout.kitti(index);
+fn own_files(layout: &Layout, index: u64, split: &str, street: u64) -> OwnFiles {
     OwnFiles {
         folder: format!("samples/{}/", sample_id(index)),
-        kitti: kitti.named(layout).map(|(rel, _)| rel),
+        views: layout
+            .view_files(index, split, street, &Default::default())
+            .into_iter()
+            .map(|(rel, _)| rel)
+            .collect(),
     }
 }
 
@@ -522,7 +530,10 @@ pub fn verify_entry(layout: &Layout, entry: &Entry) -> Vec<Difference> {
             on_disk.insert(format!("{folder}/{}", e.file_name().to_string_lossy()));
         }
     }
-    for (rel, path) in layout.kitti(entry.index).named(layout) {
+    // Every view's files, also those of groups the dataset does not keep: a view's file on
+    // disk that the manifest does not list is reported either way.
+    let all = crate::outputs::Outputs::default();
+    for (rel, path) in layout.view_files(entry.index, &entry.split, entry.street, &all) {
         if std::fs::symlink_metadata(path).is_ok() {
             on_disk.insert(rel);
         }

@@ -30,7 +30,9 @@ use crate::files::{
 use crate::kitti::write_kitti;
 use crate::layout::{sample_id, DatasetInfo, Layout, SPLITS};
 use crate::manifest::{sha256_hex, verify_batch, Difference, Entry, Lines};
-use crate::meta::SampleStats;
+use crate::meta::{SampleMeta, SampleStats};
+use crate::outputs::{Output, Outputs};
+use crate::sceneflow::write_sceneflow;
 use crate::segmentation::{check_instance, check_semantic};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -382,8 +384,12 @@ fn kind(m: &std::fs::Metadata) -> &'static str {
 }
 
 /// Fails unless the sample folder `dir` is a folder (not a symbolic link) whose entries, and
-/// the sample's KITTI files that exist, are all regular files.
-fn only_regular_files(layout: &Layout, index: u64, dir: &Path) -> Result<(), DatasetError> {
+/// the files of its views `views` that exist, are all regular files.
+fn only_regular_files(
+    layout: &Layout,
+    dir: &Path,
+    views: &[(String, PathBuf)],
+) -> Result<(), DatasetError> {
     let m = std::fs::symlink_metadata(dir).map_err(|e| DatasetError::io("read", dir, e))?;
     if !m.is_dir() {
         return Err(DatasetError::NotRegular {
@@ -392,8 +398,7 @@ fn only_regular_files(layout: &Layout, index: u64, dir: &Path) -> Result<(), Dat
         });
     }
     let mut paths = list(dir)?;
-    let kitti = layout.kitti(index);
-    paths.extend(kitti.named(layout).map(|(_, p)| p.to_path_buf()));
+    paths.extend(views.iter().map(|(_, p)| p.clone()));
     for path in paths {
         match std::fs::symlink_metadata(&path) {
             Ok(m) if !m.is_file() => {
@@ -468,6 +473,24 @@ fn check_flow(sample: &SampleDir, size: (usize, usize)) -> Result<(), DatasetErr
     Ok(())
 }
 
+/// Writes the views `outputs` has (KITTI, SceneFlow) of sample `index`, whose `meta.json` is
+/// `meta`, from the files of its folder `sample`.
+pub fn write_views(
+    layout: &Layout,
+    index: u64,
+    meta: &SampleMeta,
+    sample: &SampleDir,
+    outputs: &Outputs,
+) -> Result<(), DatasetError> {
+    if outputs.has(Output::Kitti) {
+        write_kitti(layout, index, sample)?;
+    }
+    if outputs.has(Output::Sceneflow) {
+        write_sceneflow(layout, index, &meta.split, meta.street, sample)?;
+    }
+    Ok(())
+}
+
 /// What the size of a sample's files is checked against, in messages.
 const DATASET_SIZE: &str = "the dataset's images are";
 
@@ -490,9 +513,13 @@ pub fn check_sample(
     kitti_repaired: Option<&mut usize>,
 ) -> Result<ManifestLine, DatasetError> {
     // Nothing is read through a symbolic link or from a special file (a FIFO would block).
-    only_regular_files(layout, index, dir)?;
+    only_regular_files(layout, dir, &[])?;
     let sample = SampleDir::new(dir);
     let meta = sample.load_meta()?;
+    let outputs = &info.settings.outputs;
+    let kept = |p: &Path| outputs.keeps(&file_name(p));
+    let views = layout.view_files(index, &meta.split, meta.street, outputs);
+    only_regular_files(layout, dir, &views)?;
     if meta.index != index || meta.seed != info.seed || meta.config_hash != info.config_hash {
         return Err(DatasetError::Invalid {
             path: sample.meta(),
@@ -518,7 +545,7 @@ pub fn check_sample(
     if has_fog {
         expected.extend(fog_maps.iter().map(|p| file_name(p)));
     }
-    let has_segmentation = meta.instances.is_some();
+    let has_segmentation = meta.instances.is_some() && outputs.has(Output::Segmentation);
     let semantic = Eye::BOTH.map(|eye| sample.semantic(eye));
     let instance = Eye::BOTH.map(|eye| sample.instance(eye));
     if has_segmentation {
@@ -527,9 +554,12 @@ pub fn check_sample(
     if meta.sequence.is_some() {
         expected.extend(FLOW_FILES.map(String::from));
     }
-    expected.push(SCENE_GLTF.to_owned());
-    if sample.scene().is_file() {
-        expected.extend(scene_files(&sample.scene())?);
+    expected.retain(|f| outputs.keeps(f));
+    if outputs.has(Output::Scene) {
+        expected.push(SCENE_GLTF.to_owned());
+        if sample.scene().is_file() {
+            expected.extend(scene_files(&sample.scene())?);
+        }
     }
     let absent: Vec<String> = expected
         .into_iter()
@@ -547,6 +577,8 @@ pub fn check_sample(
         sample.png(Eye::Left),
         sample.png(Eye::Right),
         sample.streak_mask(Eye::Left),
+        sample.occlusion(Eye::Left),
+        sample.occlusion(Eye::Right),
     ];
     if meta.road_mask {
         pngs.push(road_mask);
@@ -554,7 +586,7 @@ pub fn check_sample(
     if has_rain {
         pngs.extend(rain_masks);
     }
-    for p in pngs {
+    for p in pngs.into_iter().filter(|p| kept(p)) {
         check_size(&p, size, GrayImage::load(&p))?;
     }
     if has_segmentation {
@@ -575,16 +607,22 @@ pub fn check_sample(
         sample.disparity(Eye::Left),
         sample.disparity(Eye::Right),
         sample.depth(Eye::Left),
+        sample.depth(Eye::Right),
     ]
     .into_iter()
     .chain(has_fog.then_some(fog_maps).into_iter().flatten())
+    .filter(|p| kept(p))
     {
         check_size(&p, size, read_pfm(&p))?;
     }
-    if meta.sequence.is_some() {
+    if meta.sequence.is_some() && outputs.has(Output::Flow) {
         check_flow(&sample, size)?;
     }
-    for p in Eye::BOTH.map(|eye| sample.exr(eye)) {
+    for p in Eye::BOTH
+        .map(|eye| sample.exr(eye))
+        .into_iter()
+        .filter(|p| kept(p))
+    {
         let img = read_exr_rgb(&p)?;
         DatasetError::check_size(
             &p,
@@ -601,10 +639,9 @@ pub fn check_sample(
         DATASET_SIZE,
     )?;
 
-    // The KITTI view: written again where missing.
+    // The KITTI and SceneFlow views: written again where missing.
     let kitti = layout.kitti(index);
-    let named = kitti.named(layout);
-    let missing: Vec<String> = named
+    let missing: Vec<String> = views
         .iter()
         .filter(|(_, p)| !p.is_file())
         .map(|(rel, _)| rel.clone())
@@ -613,23 +650,18 @@ pub fn check_sample(
         let Some(repaired) = kitti_repaired else {
             return Err(DatasetError::MissingFiles {
                 dir: dir.to_path_buf(),
-                what: "KITTI files",
+                what: "files of its KITTI or SceneFlow view",
                 files: missing,
             });
         };
-        write_kitti(
-            layout,
-            index,
-            &sample,
-            &read_pfm(&sample.disparity(Eye::Left))?,
-        )?;
+        write_views(layout, index, &meta, &sample, outputs)?;
         *repaired += missing.len();
     }
-    check_size(
-        &kitti.disp_occ_0,
-        size,
-        read_kitti_disparity(&kitti.disp_occ_0),
-    )?;
+    if outputs.has(Output::Kitti) {
+        for p in [&kitti.disp_occ_0, &kitti.disp_occ_1, &kitti.disp_noc_0] {
+            check_size(p, size, read_kitti_disparity(p))?;
+        }
+    }
 
     let mut files = BTreeMap::new();
     let mut entries = list(dir)?;
@@ -637,7 +669,7 @@ pub fn check_sample(
     for path in entries
         .iter()
         .map(PathBuf::as_path)
-        .chain(named.iter().map(|(_, p)| *p))
+        .chain(views.iter().map(|(_, p)| p.as_path()))
     {
         if !path.is_file() {
             return Err(DatasetError::NotRegular {

@@ -15,18 +15,19 @@ use streaks_render::output::write_exr_with_sensor;
 use streaks_render::scene::Scene;
 use streaks_stereo::calib::MiddleburyCalib;
 use streaks_stereo::flow::FlowField;
+use streaks_stereo::occlusion::occlusion_mask;
 use streaks_stereo::pair::write_pair_views;
 use streaks_stereo::render::{light_records, scene_has_road, EyeView};
 use streaks_stereo::rig::{Eye, Rig};
 use streaks_stereo::rigfile::RigFile;
 
-/// Which views get their depth and masks written.
+/// Which views get their streak and road masks written (depth, disparity and occlusion are
+/// written for both).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum GroundTruth {
-    /// The left view's only (a dataset sample: `depth0.pfm`, `streaks0.png`, `road0.png`).
+    /// The left view's only (a dataset sample: `streaks0.png`, `road0.png`).
     Left,
-    /// Both views' (a `streaks stereo` folder: also `depth1.pfm`, `streaks1.png`,
-    /// `road1.png`).
+    /// Both views' (a `streaks stereo` folder: also `streaks1.png`, `road1.png`).
     Both,
 }
 
@@ -34,8 +35,9 @@ pub enum GroundTruth {
 /// EXR with its layers (and the `sensor` layer of a view exposed through a camera model), the
 /// 8-bit sRGB PNG (at `exposure_ev` stops, or developed from the camera's DN) and the ground-truth
 /// disparity, the rain mask (when the scene has rain) and the fog's transmittance (when it
-/// has fog), the segmentation maps ([`write_segmentation`]); the depth, streak mask and
-/// (when the scene flags a road material) road-surface mask of the views `truth` says.
+/// has fog), the segmentation maps ([`write_segmentation`]), the depth and the occlusion mask
+/// ([`occlusion_mask`]); the streak mask and (when the scene flags a road material)
+/// road-surface mask of the views `truth` says.
 /// Returns the two sRGB images.
 pub fn write_views(
     files: &SampleDir,
@@ -46,7 +48,7 @@ pub fn write_views(
 ) -> Result<[RgbImage; 2], DatasetError> {
     let has_road = scene_has_road(scene);
     let mut srgb = Vec::with_capacity(2);
-    for (eye, view) in Eye::BOTH.into_iter().zip(views) {
+    for ((eye, view), other) in Eye::BOTH.into_iter().zip(views).zip(views.iter().rev()) {
         let raw = view.sensor.as_ref();
         write_exr_with_sensor(&files.exr(eye), &view.output, raw.map(|c| &c.dn))?;
         let img = match raw {
@@ -63,8 +65,10 @@ pub fn write_views(
         if let Some(fog) = &view.output.fog {
             write_pfm(&files.fog(eye), &GrayImage::from_vec(w, h, fog.clone())?)?;
         }
+        write_pfm(&files.depth(eye), &view.depth)?;
+        occlusion_mask(eye, &view.depth, &view.disparity, &other.depth)?
+            .save_png(&files.occlusion(eye))?;
         if eye == Eye::Left || truth == GroundTruth::Both {
-            write_pfm(&files.depth(eye), &view.depth)?;
             view.streak_mask.save_png(&files.streak_mask(eye))?;
             if has_road {
                 view.road_surface_mask()?.save_png(&files.road_mask(eye))?;

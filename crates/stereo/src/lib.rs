@@ -17,6 +17,7 @@
 //! - [`streak_mask`]: which pixels are specular streaks, from the renderer's specular layer.
 //! - [`texture_map`]: the paper's Fig. 3 ground-plane texture map.
 //! - [`flow`]: exact optical flow and disparity change of the left eye between two frames.
+//! - [`occlusion`]: which pixels of each eye show a point the other eye does not see.
 //! - [`font`]: the bundled plot font (plotters + `ab_glyph`, no system fonts).
 //! - [`render`] (feature `render`): rendering a pair with ground-truth disparity and depth.
 //!
@@ -40,6 +41,7 @@ pub mod calib;
 pub mod error;
 pub mod flow;
 pub mod font;
+pub mod occlusion;
 pub mod pair;
 #[cfg(feature = "render")]
 pub mod render;
