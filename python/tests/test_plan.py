@@ -85,11 +85,13 @@ def test_arguments_pass_every_flag_through():
         no_regularize=True,
         denoise="on",
         keep_raw=True,
+        outputs="images,gt,kitti",
     )
     assert flags.arguments(Shard(3, 4), 2) == [
         "dataset", "generate", "-o", "/data/set", "--count", "10", "--seed", "7",
         "--config", "/data/street.toml", "--width", "64", "--height", "40", "--spp", "2",
-        "--max-depth", "5", "--noise-target", "0.15", "--denoise", "on", "--no-regularize",
+        "--max-depth", "5", "--noise-target", "0.15", "--denoise", "on",
+        "--outputs", "images,gt,kitti", "--no-regularize",
         "--keep-raw", "--shard", "3/4", "--threads", "2",
     ]  # fmt: skip
 

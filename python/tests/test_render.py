@@ -87,6 +87,10 @@ def test_a_pair_equals_the_command_file_for_file(
     same(pair.streak_mask, io.read_png(cli / "streaks0.png") == 255)
     same(pair.streak_mask_right, io.read_png(cli / "streaks1.png") == 255)
     same(pair.road_mask, io.read_png(cli / "road0.png") == 255)
+    same(pair.occlusion, io.read_png(cli / "occ0.png") == 255)
+    same(pair.occlusion_right, io.read_png(cli / "occ1.png") == 255)
+    same(pair.left_camera, io.read_png(cli / "im0.png"))
+    same(pair.right_camera, io.read_png(cli / "im1.png"))
     assert pair.meta["rig"] == json.loads((cli / "rig.json").read_text())
 
 
@@ -117,6 +121,8 @@ def test_every_option_renders_as_the_command_does(
     if "sensor" in options:
         assert pair.sensor is not None
         np.testing.assert_array_equal(pair.sensor, io.read_exr(cli / "im0.exr")["sensor"])
+        # The camera's image is developed from its DN, as the command's PNG is.
+        np.testing.assert_array_equal(pair.left_camera, io.read_png(cli / "im0.png"))
     if options.get("denoise"):
         exr = io.read_exr(cli / "im0.exr")
         np.testing.assert_array_equal(pair.left, exr["rgb"])

@@ -6,7 +6,6 @@ use crate::error::DatasetError;
 use crate::files::SampleDir;
 use crate::segmentation::{InstanceNumbering, MAX_INSTANCES_PER_CLASS};
 use image::RgbImage;
-use streaks_image::develop;
 use streaks_image::kitti::write_kitti_flow;
 use streaks_image::pfm::{write_pfm, write_pfm_rgb};
 use streaks_image::png::write_png_buffer;
@@ -51,10 +50,7 @@ pub fn write_views(
     for ((eye, view), other) in Eye::BOTH.into_iter().zip(views).zip(views.iter().rev()) {
         let raw = view.sensor.as_ref();
         write_exr_with_sensor(&files.exr(eye), &view.output, raw.map(|c| &c.dn))?;
-        let img = match raw {
-            Some(capture) => capture.develop(),
-            None => develop(&view.output.image, exposure_ev)?,
-        };
+        let img = view.camera_image(exposure_ev)?;
         write_png_buffer(&files.png(eye), &img)?;
         srgb.push(img);
         write_pfm(&files.disparity(eye), &view.disparity)?;

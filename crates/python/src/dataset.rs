@@ -7,9 +7,10 @@ use crate::{arrays, error, StreaksError};
 use pyo3::exceptions::PyIndexError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use streaks_dataset::files::{load_mask, SampleDir};
-use streaks_dataset::layout::Layout;
+use streaks_dataset::layout::{DatasetInfo, Layout};
+use streaks_dataset::outputs::Outputs;
 use streaks_image::pfm::read_pfm;
 use streaks_image::GrayImage;
 use streaks_stereo::rig::Eye;
@@ -18,15 +19,20 @@ use streaks_stereo::rig::Eye;
 ///
 /// `len(ds)` is the number of samples; `ds[i]` (negative indices count from the end) reads
 /// sample i as a dict: `left`, `right` (float32 H x W x 3, linear, from the EXRs),
-/// `disparity`, `disparity_right` (float32 H x W, `inf` where there is none), `depth`
-/// (float32 H x W, `inf` on a miss), `streak_mask`, `road_mask` (bool H x W; no `road_mask`
-/// when the scene flags no road), `id` (the sample's folder name) and `meta` (its `meta.json`).
+/// `left_camera`, `right_camera` (the PNGs as the camera sees them, uint8 H x W x 3),
+/// `disparity`, `disparity_right`, `depth`, `depth_right` (float32 H x W, `inf` where there is
+/// none), `streak_mask`, `road_mask`, `occlusion`, `occlusion_right` (bool H x W; no
+/// `road_mask` when the scene flags no road), `id` (the sample's folder name) and `meta` (its
+/// `meta.json`). The arrays of the groups of files the dataset did not keep (`dataset.json`'s
+/// `outputs`) are absent; those it keeps must be there.
 #[pyclass(module = "streaks._streaks", frozen, sequence)]
 pub struct Dataset {
     /// The dataset's folders.
     layout: Layout,
     /// The sample ids, sorted.
     ids: Vec<String>,
+    /// The groups of files its samples keep (`dataset generate --outputs`).
+    outputs: Outputs,
 }
 
 /// A sample's 0/255 mask PNG as a bool array, checked to be `size` (width, height) as the
@@ -66,8 +72,13 @@ impl Dataset {
     #[pyo3(signature = (root, *, split=None))]
     fn new(root: PathBuf, split: Option<String>) -> PyResult<Self> {
         let layout = Layout::new(&root);
+        let info = DatasetInfo::load(&layout.dataset_json()).map_err(|e| error(&e))?;
         let ids = layout.sample_ids(split.as_deref()).map_err(|e| error(&e))?;
-        Ok(Self { layout, ids })
+        Ok(Self {
+            layout,
+            ids,
+            outputs: info.settings.outputs,
+        })
     }
 
     /// The sample ids (folder names), in order.
@@ -98,20 +109,48 @@ impl Dataset {
         let size = (meta.rig.width as usize, meta.rig.height as usize);
         let sample = PyDict::new(py);
         sample.set_item("id", id)?;
-        sample.set_item("left", exr(py, &files.exr(Eye::Left))?)?;
-        sample.set_item("right", exr(py, &files.exr(Eye::Right))?)?;
-        sample.set_item("disparity", pfm(py, &files.disparity(Eye::Left))?)?;
-        sample.set_item("disparity_right", pfm(py, &files.disparity(Eye::Right))?)?;
-        sample.set_item("depth", pfm(py, &files.depth(Eye::Left))?)?;
-        sample.set_item(
-            "streak_mask",
-            mask_png(py, &files.streak_mask(Eye::Left), size)?,
-        )?;
-        if meta.road_mask {
-            sample.set_item(
-                "road_mask",
-                mask_png(py, &files.road_mask(Eye::Left), size)?,
-            )?;
+        let kept = |path: &Path| {
+            let name = path
+                .file_name()
+                .and_then(|n| n.to_str())
+                .unwrap_or_default();
+            self.outputs.keeps(name)
+        };
+        for (eye, suffix) in [(Eye::Left, ""), (Eye::Right, "_right")] {
+            let image = if suffix.is_empty() { "left" } else { "right" };
+            let (exr_path, png_path) = (files.exr(eye), files.png(eye));
+            if kept(&exr_path) {
+                sample.set_item(image, exr(py, &exr_path)?)?;
+            }
+            if kept(&png_path) {
+                sample.set_item(
+                    format!("{image}_camera"),
+                    crate::io::read_png(py, png_path)?,
+                )?;
+            }
+            for (name, path) in [
+                ("disparity", files.disparity(eye)),
+                ("depth", files.depth(eye)),
+            ] {
+                if kept(&path) && (eye == Eye::Left || path.is_file()) {
+                    sample.set_item(format!("{name}{suffix}"), pfm(py, &path)?)?;
+                }
+            }
+            let occlusion = files.occlusion(eye);
+            if kept(&occlusion) {
+                sample.set_item(
+                    format!("occlusion{suffix}"),
+                    mask_png(py, &occlusion, size)?,
+                )?;
+            }
+        }
+        let streaks = files.streak_mask(Eye::Left);
+        if kept(&streaks) {
+            sample.set_item("streak_mask", mask_png(py, &streaks, size)?)?;
+        }
+        let road = files.road_mask(Eye::Left);
+        if meta.road_mask && kept(&road) {
+            sample.set_item("road_mask", mask_png(py, &road, size)?)?;
         }
         sample.set_item("meta", py.import("json")?.call_method1("loads", (text,))?)?;
         Ok(sample)

@@ -28,6 +28,7 @@ mod io;
 mod options;
 mod pair;
 mod scene;
+mod stereo;
 
 create_exception!(
     streaks,
@@ -57,8 +58,9 @@ pub(crate) fn chain(e: &(dyn std::error::Error + 'static)) -> String {
     message
 }
 
-/// The native module: the classes `Scene`, `Pair` and `Dataset`, the exception `StreaksError` and the
-/// readers `read_pfm`, `read_png` and `read_exr`.
+/// The native module: the classes `Scene`, `Pair` and `Dataset`, the exception `StreaksError`,
+/// the readers `read_pfm`, `read_png` and `read_exr`, and the benchmark's `disparity` methods
+/// and `score`.
 #[pymodule]
 fn _streaks(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("StreaksError", m.py().get_type::<StreaksError>())?;
@@ -68,6 +70,8 @@ fn _streaks(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(io::read_pfm, m)?)?;
     m.add_function(wrap_pyfunction!(io::read_png, m)?)?;
     m.add_function(wrap_pyfunction!(io::read_exr, m)?)?;
+    m.add_function(wrap_pyfunction!(stereo::disparity, m)?)?;
+    m.add_function(wrap_pyfunction!(stereo::score, m)?)?;
     m.add(
         "DEFAULT_BASELINE",
         streaks_stereo::rig::Rig::DEFAULT_BASELINE,

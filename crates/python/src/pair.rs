@@ -10,8 +10,9 @@ use std::path::{Path, PathBuf};
 use streaks_dataset::write::write_pair;
 use streaks_image::GrayImage;
 use streaks_render::scene::Scene as RenderScene;
+use streaks_stereo::occlusion::occlusion_mask;
 use streaks_stereo::render::{light_records, EyeView};
-use streaks_stereo::rig::Rig;
+use streaks_stereo::rig::{Eye, Rig};
 use streaks_stereo::rigfile::RigFile;
 
 /// What a pair's metadata records besides the rig and the views.
@@ -35,7 +36,10 @@ pub struct Record<'a> {
 /// where the pixel sees no surface (the sky): mask it before a loss. For the left view a
 /// pixel's match in the right view is at `x - d`, for the right view (Middlebury's `disp1`)
 /// at `x + d` in the left. `depth`, `depth_right`: camera-space Z in metres (`inf` on a miss).
-/// `streak_mask`, `road_mask` (and their `_right`): bool H x W. `sensor`, `sensor_right`: the
+/// `streak_mask`, `road_mask`, `occlusion` (and their `_right`): bool H x W; `occlusion` marks
+/// the pixels whose point the other eye does not see (hidden there or outside its image).
+/// `left_camera`, `right_camera`: uint8 H x W x 3, the sRGB images as the camera sees them
+/// (the PNGs `save` writes). `sensor`, `sensor_right`: the
 /// camera model's raw DN (H x W x 3), `None` without `sensor=`. `meta`: a dict (see
 /// `docs/python.md`).
 #[pyclass(module = "streaks._streaks", frozen)]
@@ -78,6 +82,18 @@ pub struct Pair {
     /// The right view's road-surface mask.
     #[pyo3(get)]
     road_mask_right: Py<PyAny>,
+    /// The left view's occlusion mask.
+    #[pyo3(get)]
+    occlusion: Py<PyAny>,
+    /// The right view's occlusion mask.
+    #[pyo3(get)]
+    occlusion_right: Py<PyAny>,
+    /// The left image as the camera sees it (`im0.png`).
+    #[pyo3(get)]
+    left_camera: Py<PyAny>,
+    /// The right image as the camera sees it (`im1.png`).
+    #[pyo3(get)]
+    right_camera: Py<PyAny>,
     /// The left camera's raw DN, or None.
     #[pyo3(get)]
     sensor: Option<Py<PyAny>>,
@@ -172,7 +188,21 @@ impl Pair {
                 .map(|c| arrays::rgb(py, &c.dn).map(Bound::unbind))
                 .transpose()
         };
+        let occlusion = |eye: Eye, v: &EyeView, other: &EyeView| {
+            let img =
+                occlusion_mask(eye, &v.depth, &v.disparity, &other.depth).map_err(|e| error(&e))?;
+            mask(py, &img).map(Bound::unbind)
+        };
+        let camera = |v: &EyeView| {
+            let img = v.camera_image(exposure).map_err(|e| error(&e))?;
+            let (w, h) = (img.width() as usize, img.height() as usize);
+            arrays::channels(py, w, h, 3, img.into_raw()).map(Bound::unbind)
+        };
         Ok(Self {
+            occlusion: occlusion(Eye::Left, l, r)?,
+            occlusion_right: occlusion(Eye::Right, r, l)?,
+            left_camera: camera(l)?,
+            right_camera: camera(r)?,
             left: arrays::rgb(py, &l.output.image)?.unbind(),
             right: arrays::rgb(py, &r.output.image)?.unbind(),
             disparity: arrays::gray(py, &l.disparity)?.unbind(),

@@ -152,6 +152,17 @@ impl EyeView {
             data,
         )?)
     }
+
+    /// The 8-bit sRGB image as the eye's camera sees it: developed from the camera's raw DN
+    /// when the view went through a camera model ([`expose_pair`]), else the render at
+    /// `exposure_ev` stops ([`streaks_image::develop`]). The pair's and a sample's PNGs hold
+    /// exactly these pixels.
+    pub fn camera_image(&self, exposure_ev: f32) -> Result<image::RgbImage, StereoError> {
+        Ok(match &self.sensor {
+            Some(capture) => capture.develop(),
+            None => streaks_image::develop(&self.output.image, exposure_ev)?,
+        })
+    }
 }
 
 /// Renders one eye and derives its ground truth and streak mask.

@@ -14,9 +14,11 @@ __all__ = [
     "Pair",
     "Scene",
     "StreaksError",
+    "disparity",
     "read_exr",
     "read_pfm",
     "read_png",
+    "score",
 ]
 
 _Path = str | PathLike[str]
@@ -103,6 +105,14 @@ class Pair:
     """The left view's road-surface mask, H x W (all False without a road material)."""
     road_mask_right: npt.NDArray[np.bool_]
     """The right view's road-surface mask."""
+    occlusion: npt.NDArray[np.bool_]
+    """The left pixels whose point the right eye does not see (hidden or outside), H x W."""
+    occlusion_right: npt.NDArray[np.bool_]
+    """The right pixels whose point the left eye does not see."""
+    left_camera: npt.NDArray[np.uint8]
+    """The left image as the camera sees it (8-bit sRGB, H x W x 3: im0.png's pixels)."""
+    right_camera: npt.NDArray[np.uint8]
+    """The right image as the camera sees it (im1.png's pixels)."""
     sensor: npt.NDArray[np.float32] | None
     """The left camera's raw DN (H x W x 3) with `sensor=`, else None."""
     sensor_right: npt.NDArray[np.float32] | None
@@ -133,3 +143,23 @@ class Dataset:
     def __len__(self) -> int: ...
     def __getitem__(self, index: int, /) -> dict[str, Any]:
         """Sample `index` as a dict of arrays (left, right, disparity, ...), id and meta."""
+
+def disparity(
+    left: npt.NDArray[Any], right: npt.NDArray[Any], method: str = "sgm"
+) -> npt.NDArray[np.float32]:
+    """The left view's disparity by a built-in method of `streaks benchmark` (`sgm`,
+    `sgm-streaks`, `lk`): float32 H x W, `inf` where there is no value. `left`, `right`: H x W x 3
+    or H x W, uint8/uint16 (scaled to [0, 1]) or float."""
+
+def score(
+    estimate: npt.NDArray[np.floating[Any]],
+    truth: npt.NDArray[np.floating[Any]],
+    *,
+    streak_mask: npt.NDArray[Any] | None = None,
+    road_mask: npt.NDArray[Any] | None = None,
+    occlusion: npt.NDArray[Any] | None = None,
+) -> dict[str, Any]:
+    """The benchmark's scores of `estimate` against `truth` by region (`all`, `streak`,
+    `non_streak`, `road`, `off_road`, `road_surface`, `non_occluded`; None without their
+    masks), each a dict (`mean_abs`, `bad_2`, `d1`, `density`, `below_1px`, ...), and
+    `phantom_hole_rate`."""

@@ -142,6 +142,13 @@ def parser() -> argparse.ArgumentParser:
         "--keep-raw", action="store_true", help="keep the render before denoising in each EXR"
     )
     flags.add_argument(
+        "--outputs",
+        metavar="GROUPS",
+        help="the groups of files each sample keeps, comma-separated (images, exr, gt, masks, "
+        "segmentation, flow, scene, kitti, sceneflow; default all), as for `streaks dataset "
+        "generate`",
+    )
+    flags.add_argument(
         "--shard",
         type=_shard,
         default=Shard(0, 1),
@@ -171,6 +178,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             no_regularize=args.no_regularize,
             denoise=args.denoise,
             keep_raw=args.keep_raw,
+            outputs=args.outputs,
         ),
         shard=args.shard,
         num_cpus=args.num_cpus,

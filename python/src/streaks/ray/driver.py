@@ -303,6 +303,7 @@ def generate(job: Job) -> int:
         no_regularize=job.flags.no_regularize,
         denoise=job.flags.denoise,
         keep_raw=job.flags.keep_raw,
+        outputs=job.flags.outputs,
     )
     job = Job(job.address, binary, flags, job.shard, job.num_cpus, job.chunk, job.max_retries)
     chunks = plan_chunks(flags.count, job.shard, job.chunk)

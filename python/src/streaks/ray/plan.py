@@ -121,6 +121,9 @@ class GenerateFlags:
     """`auto`, `on` or `off` (`streaks dataset generate --denoise`); on a cluster give `on` or
     `off`, so that every node denoises alike."""
     keep_raw: bool = False
+    outputs: str | None = None
+    """The groups of files each sample keeps (`streaks dataset generate --outputs`), as the
+    comma-separated list the command takes; the command checks the names."""
 
     def arguments(self, shard: Shard, threads: int) -> list[str]:
         """The arguments after the binary: `dataset generate -o DIR --count N ... --shard K/N`."""
@@ -134,6 +137,7 @@ class GenerateFlags:
             ("--max-depth", self.max_depth),
             ("--noise-target", self.noise_target),
             ("--denoise", self.denoise),
+            ("--outputs", self.outputs),
         ]
         for flag, value in optional:
             if value is not None:
