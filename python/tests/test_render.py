@@ -277,3 +277,14 @@ def test_a_scene_without_cameras_is_framed_with_a_warning(tmp_path: Path) -> Non
     # A constant environment seen directly: every pixel is its radiance, depth inf.
     np.testing.assert_array_equal(view["rgb"], np.full((6, 8, 3), 0.5, np.float32))
     assert np.isinf(view["depth"]).all()
+
+
+def test_a_pair_gives_the_training_arrays_a_sample_gives(pair: streaks.Pair) -> None:
+    t = streaks.dataset.training_arrays(pair)
+    np.testing.assert_array_equal(
+        t["left"], pair.left_camera.transpose(2, 0, 1).astype(np.float32) / 255
+    )
+    np.testing.assert_array_equal(t["valid"], np.isfinite(pair.disparity))
+    np.testing.assert_array_equal(t["noc"], t["valid"] & ~pair.occlusion)
+    assert np.isfinite(t["disparity"]).all() and t["has_road"]
+    assert t["id"] == "seed3"

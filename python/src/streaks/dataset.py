@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from streaks._streaks import Dataset
+from streaks._streaks import Dataset, Pair
 
 IMAGES = ("camera", "linear")
 """The images `training_arrays` can take: the camera's PNGs or the linear render."""
@@ -59,15 +59,46 @@ def _disparity(sample: Mapping[str, Any], key: str) -> tuple[np.ndarray, np.ndar
     return np.where(valid, d, np.float32(0)), valid
 
 
-def training_arrays(sample: Mapping[str, Any], images: str = "camera") -> dict[str, Any]:
-    """A sample of `open(...)` as a training loop takes it: `left`, `right` float32 3 x H x W
-    (`images="camera"`: the PNGs in [0, 1]; `"linear"`: the EXRs' radiance); `disparity`,
-    `disparity_right` float32 H x W with 0 where there is no value and bool `valid`,
-    `valid_right` beside them; `noc`, `noc_right` (valid and not occluded; as `valid` without
-    occlusion masks); `streak_mask`, `road_mask` and `has_road`; `id`. Nothing it returns
-    holds `inf` or NaN."""
+PAIR_ARRAYS = (
+    "left",
+    "right",
+    "left_camera",
+    "right_camera",
+    "disparity",
+    "disparity_right",
+    "depth",
+    "depth_right",
+    "streak_mask",
+    "road_mask",
+    "occlusion",
+    "occlusion_right",
+)
+"""The arrays a `streaks.Pair` shares with a dataset sample, under the same names."""
+
+
+def sample_of(pair: Pair) -> dict[str, Any]:
+    """A pair rendered in-process as a dataset sample: its arrays under the sample's names
+    (`PAIR_ARRAYS`), `id` (`seedN`) and `meta`; `road_mask` left out when no pixel sees a
+    road material (as a sample of a scene that flags no road leaves it out)."""
+    sample: dict[str, Any] = {name: getattr(pair, name) for name in PAIR_ARRAYS}
+    if not sample["road_mask"].any():
+        del sample["road_mask"]
+    sample["id"] = f"seed{pair.meta['seed']}"
+    sample["meta"] = pair.meta
+    return sample
+
+
+def training_arrays(sample: Mapping[str, Any] | Pair, images: str = "camera") -> dict[str, Any]:
+    """A sample of `open(...)` (or a `streaks.Pair`) as a training loop takes it: `left`,
+    `right` float32 3 x H x W (`images="camera"`: the PNGs in [0, 1]; `"linear"`: the EXRs'
+    radiance); `disparity`, `disparity_right` float32 H x W with 0 where there is no value and
+    bool `valid`, `valid_right` beside them; `noc`, `noc_right` (valid and not occluded; as
+    `valid` without occlusion masks); `streak_mask`, `road_mask` and `has_road`; `id`.
+    Nothing it returns holds `inf` or NaN."""
     if images not in IMAGES:
         raise ValueError(f"images must be one of {IMAGES}, got {images!r}")
+    if isinstance(sample, Pair):
+        sample = sample_of(sample)
     disparity, valid = _disparity(sample, "disparity")
     disparity_right, valid_right = _disparity(sample, "disparity_right")
     shape = disparity.shape
@@ -92,4 +123,4 @@ def training_arrays(sample: Mapping[str, Any], images: str = "camera") -> dict[s
     }
 
 
-__all__ = ["IMAGES", "Dataset", "open", "training_arrays"]
+__all__ = ["IMAGES", "PAIR_ARRAYS", "Dataset", "open", "sample_of", "training_arrays"]
