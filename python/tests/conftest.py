@@ -68,6 +68,29 @@ def streaks_bin() -> str:
     return path
 
 
+def generate(
+    streaks_bin: str,
+    root: Path,
+    *,
+    count: int,
+    seed: int,
+    size: tuple[int, int],
+    spp: int = 1,
+    extra: tuple[str, ...] = (),
+) -> Path:
+    """A tiny dataset in `root`, as `streaks dataset generate` writes it on one machine (two
+    threads; `size` is width, height; `extra`: more flags). Returns `root`."""
+    subprocess.run(
+        [streaks_bin, "dataset", "generate", "-o", str(root), "--count", str(count)]
+        + ["--seed", str(seed), "--width", str(size[0]), "--height", str(size[1])]
+        + ["--spp", str(spp), "--threads", "2", *extra],
+        check=True,
+        capture_output=True,
+        timeout=300,
+    )
+    return root
+
+
 @dataclass(frozen=True)
 class RayCluster:
     """A running local Ray cluster."""

@@ -4,26 +4,19 @@ them, and the errors name the dataset."""
 
 from __future__ import annotations
 
-import subprocess
 from pathlib import Path
 
 import numpy as np
 import pytest
 import streaks
+from conftest import generate
 from streaks import io
 
 
 @pytest.fixture(scope="module")
 def dataset(streaks_bin: str, tmp_path_factory: pytest.TempPathFactory) -> Path:
     root = tmp_path_factory.mktemp("ds") / "ds"
-    subprocess.run(
-        [streaks_bin, "dataset", "generate", "-o", str(root), "--count", "3", "--seed", "1"]
-        + ["--width", "32", "--height", "24", "--spp", "1", "--threads", "2"],
-        check=True,
-        capture_output=True,
-        timeout=300,
-    )
-    return root
+    return generate(streaks_bin, root, count=3, seed=1, size=(32, 24))
 
 
 def test_samples_are_the_numbers_of_their_files(dataset: Path) -> None:
@@ -100,15 +93,10 @@ def test_training_arrays_hold_no_inf_and_say_where_values_are(dataset: Path) -> 
 
 
 def test_a_dataset_keeps_only_its_outputs(streaks_bin: str, tmp_path: Path) -> None:
-    root = tmp_path / "few"
-    subprocess.run(
-        [streaks_bin, "dataset", "generate", "-o", str(root), "--count", "1", "--seed", "2"]
-        + ["--width", "32", "--height", "24", "--spp", "1", "--threads", "2"]
-        + ["--outputs", "images,gt"],
-        check=True,
-        capture_output=True,
-        timeout=300,
-    )
+    root = generate(
+        streaks_bin, tmp_path / "few", count=1, seed=2, size=(32, 24),
+        extra=("--outputs", "images,gt"),
+    )  # fmt: skip
     sample = streaks.dataset.open(root)[0]
     assert {"left_camera", "right_camera", "disparity", "occlusion"} <= sample.keys()
     assert not {"left", "right", "streak_mask", "road_mask"} & sample.keys()

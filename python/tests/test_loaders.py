@@ -6,12 +6,12 @@ files by the loaders' documented rules everywhere."""
 
 from __future__ import annotations
 
-import subprocess
 from pathlib import Path
 
 import numpy as np
 import pytest
 import streaks
+from conftest import generate
 
 datasets = pytest.importorskip("torchvision.datasets", reason="torchvision is not installed")
 
@@ -19,14 +19,7 @@ datasets = pytest.importorskip("torchvision.datasets", reason="torchvision is no
 @pytest.fixture(scope="module")
 def dataset(streaks_bin: str, tmp_path_factory: pytest.TempPathFactory) -> Path:
     root = tmp_path_factory.mktemp("loaders") / "ds"
-    subprocess.run(
-        [streaks_bin, "dataset", "generate", "-o", str(root), "--count", "3", "--seed", "5"]
-        + ["--width", "48", "--height", "32", "--spp", "1", "--threads", "2"],
-        check=True,
-        capture_output=True,
-        timeout=300,
-    )
-    return root
+    return generate(streaks_bin, root, count=3, seed=5, size=(48, 32))
 
 
 def test_torchvision_reads_the_kitti_view(dataset: Path, tmp_path: Path) -> None:

@@ -10,20 +10,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 import streaks
+from conftest import generate
 from streaks import io
 
 
 @pytest.fixture(scope="module")
 def sample_dir(streaks_bin: str, tmp_path_factory: pytest.TempPathFactory) -> Path:
     root = tmp_path_factory.mktemp("stereo") / "ds"
-    subprocess.run(
-        [streaks_bin, "dataset", "generate", "-o", str(root), "--count", "1", "--seed", "4"]
-        + ["--width", "64", "--height", "40", "--spp", "2", "--threads", "2"],
-        check=True,
-        capture_output=True,
-        timeout=300,
-    )
-    return root / "samples" / "000000"
+    return generate(streaks_bin, root, count=1, seed=4, size=(64, 40), spp=2) / "samples" / "000000"
 
 
 def test_sgm_is_the_commands(sample_dir: Path, streaks_bin: str, tmp_path: Path) -> None:

@@ -18,23 +18,28 @@ fn values<T: Copy + Into<f64>>(view: &ArrayViewD<'_, T>, scale: f64) -> Vec<f32>
     view.iter().map(|&v| (v.into() * scale) as f32).collect()
 }
 
+/// The shape and values of a numpy array as `f32`: floats as they are, and with `integers`
+/// `uint8` and `uint16` scaled to [0, 1]; `None` for any other dtype.
+fn array_values(obj: &Bound<'_, PyAny>, integers: bool) -> Option<(Vec<usize>, Vec<f32>)> {
+    fn read<T: Copy + Into<f64> + numpy::Element>(
+        obj: &Bound<'_, PyAny>,
+        scale: f64,
+    ) -> Option<(Vec<usize>, Vec<f32>)> {
+        let a = obj.extract::<PyReadonlyArrayDyn<'_, T>>().ok()?;
+        let v = a.as_array();
+        Some((v.shape().to_vec(), values(&v, scale)))
+    }
+    read::<f32>(obj, 1.0)
+        .or_else(|| read::<f64>(obj, 1.0))
+        .or_else(|| integers.then(|| read::<u8>(obj, 1.0 / 255.0)).flatten())
+        .or_else(|| integers.then(|| read::<u16>(obj, 1.0 / 65535.0)).flatten())
+}
+
 /// An image array as a grey image: `H x W` as it is, `H x W x 3` as its luminance (of the
 /// stored values, as the benchmark reads PNGs); `uint8` and `uint16` scaled to [0, 1], floats
 /// as they are. `name` is the argument's name in errors.
 fn gray_of(name: &str, obj: &Bound<'_, PyAny>) -> PyResult<GrayImage> {
-    let (shape, data) = if let Ok(a) = obj.extract::<PyReadonlyArrayDyn<'_, u8>>() {
-        let v = a.as_array();
-        (v.shape().to_vec(), values(&v, 1.0 / 255.0))
-    } else if let Ok(a) = obj.extract::<PyReadonlyArrayDyn<'_, u16>>() {
-        let v = a.as_array();
-        (v.shape().to_vec(), values(&v, 1.0 / 65535.0))
-    } else if let Ok(a) = obj.extract::<PyReadonlyArrayDyn<'_, f32>>() {
-        let v = a.as_array();
-        (v.shape().to_vec(), values(&v, 1.0))
-    } else if let Ok(a) = obj.extract::<PyReadonlyArrayDyn<'_, f64>>() {
-        let v = a.as_array();
-        (v.shape().to_vec(), values(&v, 1.0))
-    } else {
+    let Some((shape, data)) = array_values(obj, true) else {
         return Err(PyTypeError::new_err(format!(
             "{name} must be a numpy array of uint8, uint16, float32 or float64"
         )));
@@ -65,13 +70,7 @@ fn gray_of(name: &str, obj: &Bound<'_, PyAny>) -> PyResult<GrayImage> {
 /// A float H x W disparity map (float32 or float64) as a grey image; `name` is the
 /// argument's name in errors.
 fn disparity_map(name: &str, obj: &Bound<'_, PyAny>) -> PyResult<GrayImage> {
-    let (shape, data) = if let Ok(a) = obj.extract::<PyReadonlyArrayDyn<'_, f32>>() {
-        let v = a.as_array();
-        (v.shape().to_vec(), values(&v, 1.0))
-    } else if let Ok(a) = obj.extract::<PyReadonlyArrayDyn<'_, f64>>() {
-        let v = a.as_array();
-        (v.shape().to_vec(), values(&v, 1.0))
-    } else {
+    let Some((shape, data)) = array_values(obj, false) else {
         return Err(PyTypeError::new_err(format!(
             "{name} must be a float disparity map (a float32 or float64 numpy array)"
         )));
