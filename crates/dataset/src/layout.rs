@@ -707,6 +707,10 @@ impl DatasetInfo {
                     " (give --outputs the groups its dataset.json lists under outputs to \
                      continue it)"
                 }
+                f if f == "format" || f.starts_with("conventions") || f.starts_with("files") => {
+                    " (it was written by another version of streaks, whose files differ: \
+                     continue it with that version, or write this run into a new folder)"
+                }
                 _ => "",
             };
             return Err(DatasetError::OtherDataset {
@@ -860,6 +864,24 @@ mod tests {
         adaptive.check_same(&new, path).unwrap();
         let err = info(true).check_same(&new, path).unwrap_err().to_string();
         assert!(err.contains("give its --noise-target"), "{err}");
+    }
+
+    /// A dataset.json of another version's files (its file list or conventions differ) is
+    /// refused with a message that says so.
+    #[test]
+    fn datasets_of_another_version_are_named_so() {
+        let path = Path::new("d/dataset.json");
+        let mut old = serde_json::to_value(info(true)).unwrap();
+        old["conventions"]["kitti"] = Value::String("KITTI 2015: image_2 only".into());
+        let err = info(true).check_same(&old, path).unwrap_err().to_string();
+        assert!(
+            err.contains("its conventions.kitti is") && err.contains("another version of streaks"),
+            "{err}"
+        );
+        let mut old = serde_json::to_value(info(true)).unwrap();
+        old["files"]["sample"] = serde_json::json!(["im0.png"]);
+        let err = info(true).check_same(&old, path).unwrap_err().to_string();
+        assert!(err.contains("another version of streaks"), "{err}");
     }
 
     #[test]
