@@ -108,6 +108,21 @@ def test_a_dataset_keeps_only_its_outputs(streaks_bin: str, tmp_path: Path) -> N
         streaks.dataset.training_arrays(sample, images="linear")
 
 
+def test_images16_reach_the_training_arrays(streaks_bin: str, tmp_path: Path) -> None:
+    root = generate(
+        streaks_bin, tmp_path / "wide", count=1, seed=2, size=(32, 24),
+        extra=("--outputs", "images,images16,gt,masks"),
+    )  # fmt: skip
+    sample = streaks.dataset.open(root)[0]
+    wide = sample["left_camera16"]
+    assert wide.dtype == np.uint16 and wide.shape == (24, 32, 3)
+    assert np.abs(wide / 257.0 - sample["left_camera"]).max() <= 0.5
+    t = streaks.dataset.training_arrays(sample)
+    np.testing.assert_array_equal(
+        t["left"], wide.transpose(2, 0, 1).astype(np.float32) / np.float32(65535)
+    )
+
+
 def test_the_torch_dataset_gives_tensors_a_loss_can_take(dataset: Path) -> None:
     torch = pytest.importorskip("torch", reason="PyTorch is not installed (pip install torch)")
     from streaks.torch import StereoDataset

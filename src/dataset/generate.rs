@@ -94,7 +94,8 @@ pub struct Args {
     /// Keep the render before denoising in each EXR (its `raw` layer; dropped by default).
     #[arg(long)]
     pub keep_raw: bool,
-    /// The groups of files each sample keeps, comma-separated: images (im0/im1.png), exr,
+    /// The groups of files each sample keeps, comma-separated: images (im0/im1.png), images16
+    /// (the same at 16 bits, im0_16/im1_16.png; not kept by default), exr,
     /// gt (disparity, depth, occlusion), masks (streak, road, rain, fog), segmentation, flow,
     /// scene, kitti (the KITTI view), sceneflow (the SceneFlow view); calib.txt and meta.json
     /// always. Part of the dataset: a rerun must give the same groups.

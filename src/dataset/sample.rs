@@ -12,11 +12,13 @@ use streaks_dataset::meta::{
     kitti_pose, matrix_rows, render_seed, FlowShares, FogMeta, RenderMeta, RigMeta, SampleMeta,
     SampleStats, SequenceMeta, WeatherMeta,
 };
+use streaks_dataset::outputs::Output;
 use streaks_dataset::settings::Settings;
 use streaks_dataset::verify::write_views as write_dataset_views;
 use streaks_dataset::write::{
     disparity_range, instance_numbering, write_calib, write_flow, write_views, GroundTruth,
 };
+use streaks_image::png::write_png_buffer;
 use streaks_image::write_bytes_atomically;
 use streaks_render::motion::Motion;
 use streaks_render::scene::Scene;
@@ -176,6 +178,11 @@ fn write_sample(
 
     let files = SampleDir::new(dir);
     write_views(&files, &scene, &views, s.exposure_ev, GroundTruth::Left)?;
+    if render.outputs.has(Output::Images16) {
+        for (eye, view) in Eye::BOTH.into_iter().zip(&views) {
+            write_png_buffer(&files.png16(eye), &view.camera_image16(s.exposure_ev)?)?;
+        }
+    }
     let instances = instance_numbering(&files, &scene)?.records().to_vec();
     // The flow to the next frame of the drive: its scene built and loaded, never rendered.
     let next = super::flow::next_frame(

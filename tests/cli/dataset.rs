@@ -504,11 +504,43 @@ fn outputs_keep_only_the_chosen_groups() {
     assert!(!bad.output.status.success());
     assert!(
         bad.stderr().contains("unknown output group \"png\"")
-            && bad.stderr().contains("images, exr, gt"),
+            && bad.stderr().contains("images, images16, exr, gt"),
         "{}",
         bad.stderr()
     );
     assert!(!t.join("bad").exists());
+}
+
+#[test]
+fn images16_keeps_the_images_at_16_bits() {
+    let t = TestDir::new();
+    generate_n(&t, "ds", "1", &["--outputs", "images,images16,gt"]).assert_success();
+    let dir = t.join("ds/samples/000000");
+    assert!(t
+        .files_in("ds/samples/000000")
+        .contains(&"im1_16.png".to_string()));
+    for eye in ["0", "1"] {
+        let wide = image::open(dir.join(format!("im{eye}_16.png"))).unwrap();
+        let narrow = image::open(dir.join(format!("im{eye}.png"))).unwrap();
+        let (wide, narrow) = (wide.as_rgb16().unwrap(), narrow.as_rgb8().unwrap());
+        assert_eq!(wide.dimensions(), narrow.dimensions());
+        // The same curve: the 8-bit value is the 16-bit one over 257, to within rounding.
+        for (&w, &n) in wide.as_raw().iter().zip(narrow.as_raw()) {
+            assert!(
+                (f64::from(w) / 257.0 - f64::from(n)).abs() <= 0.5,
+                "{w} {n}"
+            );
+        }
+        assert!(
+            wide.as_raw().iter().any(|&w| w % 257 != 0),
+            "16 bits carry more"
+        );
+    }
+    let verified = t.streaks(&["dataset", "index", "ds"]);
+    verified.assert_success();
+    // Without the group, no 16-bit images.
+    generate_n(&t, "plain", "1", &["--outputs", "images"]).assert_success();
+    assert!(!t.join("plain/samples/000000/im0_16.png").exists());
 }
 
 #[test]

@@ -131,7 +131,7 @@ pub const SCENE_BIN: &str = "scene.bin";
 pub const ROAD_MASK: &str = "road0.png";
 
 /// The files of every dataset sample folder besides the scene's, sorted.
-pub const SAMPLE_FILES: [&str; 13] = [
+pub const SAMPLE_FILES: [&str; 15] = [
     CALIB,
     "depth0.pfm",
     "depth1.pfm",
@@ -139,8 +139,10 @@ pub const SAMPLE_FILES: [&str; 13] = [
     "disp1.pfm",
     "im0.exr",
     "im0.png",
+    "im0_16.png",
     "im1.exr",
     "im1.png",
+    "im1_16.png",
     META,
     "occ0.png",
     "occ1.png",
@@ -154,6 +156,8 @@ pub struct Names {
     pub exr: [&'static str; 2],
     /// The 8-bit sRGB image.
     pub png: [&'static str; 2],
+    /// The same image at 16 bits (datasets with `--outputs images16`).
+    pub png16: [&'static str; 2],
     /// Ground-truth disparity.
     pub disparity: [&'static str; 2],
     /// Ground-truth depth.
@@ -178,6 +182,7 @@ pub struct Names {
 pub const SAMPLE_NAMES: Names = Names {
     exr: ["im0.exr", "im1.exr"],
     png: ["im0.png", "im1.png"],
+    png16: ["im0_16.png", "im1_16.png"],
     disparity: ["disp0.pfm", "disp1.pfm"],
     depth: ["depth0.pfm", "depth1.pfm"],
     streak_mask: ["streaks0.png", "streaks1.png"],
@@ -194,6 +199,7 @@ pub const SAMPLE_NAMES: Names = Names {
 pub const PAIR_NAMES: Names = Names {
     exr: ["left.exr", "right.exr"],
     png: ["left.png", "right.png"],
+    png16: ["left_16.png", "right_16.png"],
     disparity: ["disparity_left.pfm", "disparity_right.pfm"],
     depth: ["depth_left.pfm", "depth_right.pfm"],
     streak_mask: ["streak_mask_left.png", "streak_mask_right.png"],
@@ -284,6 +290,11 @@ impl SampleDir {
     /// The 8-bit sRGB image (`im0.png`).
     pub fn png(&self, eye: Eye) -> PathBuf {
         self.eye_file(self.names.png, eye)
+    }
+
+    /// The same image at 16 bits (`im0_16.png`), in datasets that keep it.
+    pub fn png16(&self, eye: Eye) -> PathBuf {
+        self.eye_file(self.names.png16, eye)
     }
 
     /// The eye's image to measure: the EXR if it exists, else the PNG.
@@ -490,6 +501,7 @@ mod tests {
                     || [
                         SAMPLE_NAMES.exr,
                         SAMPLE_NAMES.png,
+                        SAMPLE_NAMES.png16,
                         SAMPLE_NAMES.disparity,
                         SAMPLE_NAMES.depth,
                         SAMPLE_NAMES.streak_mask,

@@ -440,6 +440,7 @@ impl Conventions {
             pfm: s("Middlebury/SceneFlow: greyscale 'Pf', scale -1 (little-endian), rows stored bottom to top, inf = no value"),
             images: s("im0/im1.png: 8-bit sRGB developed from the camera's raw values (the sensor layer) through the sensor's \
                  tone curve (docs/sensor.md) when meta.json has weather, else the linear render times 2^exposure_ev (meta.json), clipped; \
+                 im0_16/im1_16.png (outputs images16): the same curve rounded to 16 bits; \
                  im0/im1.exr: linear float32 RGB (the exact render, no noise or glare) with the layers depth.Z, normal.X/Y/Z and \
                  specular.R/G/B, and sensor.R/G/B (raw DN), rain.Y and fog.Y when present"),
             masks: s("8-bit greyscale PNG, 0 or 255: streaks0.png the left view's streak pixels (specular layer threshold), \

@@ -12,6 +12,8 @@ use std::collections::BTreeSet;
 pub enum Output {
     /// `im0.png`, `im1.png`: the 8-bit images.
     Images,
+    /// `im0_16.png`, `im1_16.png`: the same images at 16 bits (not kept by default).
+    Images16,
     /// `im0.exr`, `im1.exr`: the linear renders with their layers.
     Exr,
     /// `disp0/1.pfm`, `depth0/1.pfm`, `occ0/1.png`: the ground truth.
@@ -33,8 +35,9 @@ pub enum Output {
 
 impl Output {
     /// Every group, in the order of `dataset.json`.
-    pub const ALL: [Output; 9] = [
+    pub const ALL: [Output; 10] = [
         Output::Images,
+        Output::Images16,
         Output::Exr,
         Output::Gt,
         Output::Masks,
@@ -49,6 +52,7 @@ impl Output {
     pub fn name(self) -> &'static str {
         match self {
             Output::Images => "images",
+            Output::Images16 => "images16",
             Output::Exr => "exr",
             Output::Gt => "gt",
             Output::Masks => "masks",
@@ -63,6 +67,9 @@ impl Output {
     /// The group of the sample-folder file `name`; `None` for `calib.txt` and `meta.json`,
     /// which every sample keeps.
     pub fn of_file(name: &str) -> Option<Output> {
+        if name.starts_with("im") && name.ends_with("_16.png") {
+            return Some(Output::Images16);
+        }
         let stem = name.split('.').next().unwrap_or(name);
         let base = stem.trim_end_matches(['0', '1']);
         Some(match (base, name.rsplit('.').next().unwrap_or("")) {
@@ -98,8 +105,16 @@ impl std::str::FromStr for Output {
 pub struct Outputs(pub BTreeSet<Output>);
 
 impl Default for Outputs {
+    /// Every group but [`Output::Images16`] (which doubles the images' size for a precision
+    /// most readers drop): what a dataset keeps without `--outputs`, and what one written
+    /// before the setting existed kept.
     fn default() -> Self {
-        Self(Output::ALL.into_iter().collect())
+        Self(
+            Output::ALL
+                .into_iter()
+                .filter(|&o| o != Output::Images16)
+                .collect(),
+        )
     }
 }
 
@@ -130,6 +145,9 @@ mod tests {
     fn every_file_has_its_group() {
         let group = |f: &str| Output::of_file(f);
         assert_eq!(group("im0.png"), Some(Output::Images));
+        assert_eq!(group("im1_16.png"), Some(Output::Images16));
+        assert!(!Outputs::default().has(Output::Images16));
+        assert!(Outputs::default().has(Output::Images));
         assert_eq!(group("im1.exr"), Some(Output::Exr));
         for f in [
             "disp0.pfm",
@@ -176,6 +194,9 @@ mod tests {
             assert_eq!(o.name().parse::<Output>(), Ok(o));
             assert_eq!(serde_json::to_value(o).unwrap(), o.name());
         }
-        assert!("png".parse::<Output>().unwrap_err().contains("images, exr"));
+        assert!("png"
+            .parse::<Output>()
+            .unwrap_err()
+            .contains("images, images16, exr"));
     }
 }

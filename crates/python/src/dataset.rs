@@ -19,7 +19,8 @@ use streaks_stereo::rig::Eye;
 ///
 /// `len(ds)` is the number of samples; `ds[i]` (negative indices count from the end) reads
 /// sample i as a dict: `left`, `right` (float32 H x W x 3, linear, from the EXRs),
-/// `left_camera`, `right_camera` (the PNGs as the camera sees them, uint8 H x W x 3),
+/// `left_camera`, `right_camera` (the PNGs as the camera sees them, uint8 H x W x 3; with
+/// `--outputs images16` also `left_camera16`, `right_camera16`, uint16),
 /// `disparity`, `disparity_right`, `depth`, `depth_right` (float32 H x W, `inf` where there is
 /// none), `streak_mask`, `road_mask`, `occlusion`, `occlusion_right` (bool H x W; no
 /// `road_mask` when the scene flags no road), `id` (the sample's folder name) and `meta` (its
@@ -126,6 +127,13 @@ impl Dataset {
                 sample.set_item(
                     format!("{image}_camera"),
                     crate::io::read_png(py, png_path)?,
+                )?;
+            }
+            let png16_path = files.png16(eye);
+            if kept(&png16_path) {
+                sample.set_item(
+                    format!("{image}_camera16"),
+                    crate::io::read_png(py, png16_path)?,
                 )?;
             }
             for (name, path) in [

@@ -26,6 +26,11 @@ impl Capture {
     pub fn develop(&self) -> image::RgbImage {
         crate::develop::develop(self)
     }
+
+    /// The capture developed as [`Capture::develop`] does, at 16 bits.
+    pub fn develop16(&self) -> image::ImageBuffer<image::Rgb<u16>, Vec<u16>> {
+        crate::develop::develop16(self)
+    }
 }
 
 /// Exposes `radiance` (linear RGB, W/(m^2 sr)) with `profile`: the radiance is scaled by

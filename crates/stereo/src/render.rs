@@ -163,6 +163,17 @@ impl EyeView {
             None => streaks_image::develop(&self.output.image, exposure_ev)?,
         })
     }
+
+    /// [`EyeView::camera_image`] at 16 bits: the same curve, rounded to 16 bits.
+    pub fn camera_image16(
+        &self,
+        exposure_ev: f32,
+    ) -> Result<image::ImageBuffer<image::Rgb<u16>, Vec<u16>>, StereoError> {
+        Ok(match &self.sensor {
+            Some(capture) => capture.develop16(),
+            None => streaks_image::develop::develop16(&self.output.image, exposure_ev)?,
+        })
+    }
 }
 
 /// Renders one eye and derives its ground truth and streak mask.

@@ -2,7 +2,8 @@
 
 `open(root, split=None)` returns a sequence of samples (`len`, indexing): each a dict with
 `left`, `right` (float32 H x W x 3, linear, from the EXRs), `left_camera`, `right_camera`
-(the 8- or 16-bit PNGs as the sample's camera sees them, H x W x 3 as stored), `disparity`,
+(the 8-bit PNGs as the sample's camera sees them, H x W x 3; `left_camera16`,
+`right_camera16` the same at 16 bits where the dataset keeps `images16`), `disparity`,
 `disparity_right`, `depth`, `depth_right` (float32 H x W, `inf` where there is no value: mask
 it before a loss), `streak_mask`, `road_mask`, `occlusion`, `occlusion_right` (bool H x W;
 `occlusion` marks the pixels the other eye does not see), `id` and `meta` (the sample's
@@ -39,6 +40,8 @@ def _image(sample: Mapping[str, Any], eye: str, images: str) -> np.ndarray:
     """An eye's image as float32 3 x H x W: the camera's PNG scaled to [0, 1] by its bit
     depth, or the linear render as stored."""
     key = f"{eye}_camera" if images == "camera" else eye
+    if images == "camera" and f"{key}16" in sample:
+        key = f"{key}16"  # the same image at 16 bits, where the dataset keeps it
     if key not in sample:
         kept = "the PNG images" if images == "camera" else "the EXR images"
         raise KeyError(
@@ -90,11 +93,12 @@ def sample_of(pair: Pair) -> dict[str, Any]:
 
 def training_arrays(sample: Mapping[str, Any] | Pair, images: str = "camera") -> dict[str, Any]:
     """A sample of `open(...)` (or a `streaks.Pair`) as a training loop takes it: `left`,
-    `right` float32 3 x H x W (`images="camera"`: the PNGs in [0, 1]; `"linear"`: the EXRs'
-    radiance); `disparity`, `disparity_right` float32 H x W with 0 where there is no value and
-    bool `valid`, `valid_right` beside them; `noc`, `noc_right` (valid and not occluded; as
-    `valid` without occlusion masks); `streak_mask`, `road_mask` and `has_road`; `id`.
-    Nothing it returns holds `inf` or NaN."""
+    `right` float32 3 x H x W (`images="camera"`: the PNGs in [0, 1], the 16-bit ones where
+    the dataset keeps them; `"linear"`: the EXRs' radiance); `disparity`, `disparity_right`
+    float32 H x W with 0 where there is no value and bool `valid`, `valid_right` beside them;
+    `noc`, `noc_right` (valid and not occluded; as `valid` without occlusion masks);
+    `streak_mask`, `road_mask` and `has_road`; `id`. Nothing it returns holds `inf` or
+    NaN."""
     if images not in IMAGES:
         raise ValueError(f"images must be one of {IMAGES}, got {images!r}")
     if isinstance(sample, Pair):

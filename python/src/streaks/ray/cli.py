@@ -144,9 +144,9 @@ def parser() -> argparse.ArgumentParser:
     flags.add_argument(
         "--outputs",
         metavar="GROUPS",
-        help="the groups of files each sample keeps, comma-separated (images, exr, gt, masks, "
-        "segmentation, flow, scene, kitti, sceneflow; default all), as for `streaks dataset "
-        "generate`",
+        help="the groups of files each sample keeps, comma-separated (images, images16, exr, "
+        "gt, masks, segmentation, flow, scene, kitti, sceneflow; default all but images16), as "
+        "for `streaks dataset generate`",
     )
     flags.add_argument(
         "--shard",
