@@ -1,0 +1,627 @@
+"""Builds the outside night streets in Blender (bpy) and exports them with Blender's own glTF
+exporter: evaluation-only inputs for streak-robust stereo (tools/streak_eval/README.md).
+
+    BLENDER_PYTHON tools/streak_eval/blender_streets.py OUT [--scenes hill_bend crossing]
+
+writes OUT/<scene>.glb (textures embedded) and OUT/<scene>.blend. The streets are not the
+generator's (crates/scenes): a road that bends and climbs over a crest, a crossroads with a
+crowned carriageway, their own textures (textures.py), lamps and cars.
+
+The export is the exporter's defaults plus three Include choices a user ticks: cameras,
+punctual lights and "Custom Properties" (`export_extras`): without the last one, the road
+material's custom property `streaks = {"road": True}` and the objects' `streaks = {"class":
+...}` are not written as glTF extras, and streaks cannot mask the road. After the export the
+script reads the .glb back and fails unless the road's extras are there.
+
+Blender is Z up; the exporter writes glTF's Y up (Blender (x, y, z) -> glTF (x, z, -y)).
+Light levels follow docs/decisions/0030: luminaires of 1.5-3.5 kcd, headlights of about
+14 kcd, tail lights of about 10 cd; a Blender spot or point lamp of P watts is exported as
+P / (4 pi) * 683 cd times its colour, so P = 4 pi I_cd / (683 Y(colour)).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+sys.path.insert(0, str(HERE.parent / "blender"))
+
+import bpy  # type: ignore[import-not-found]  # noqa: E402
+import numpy as np  # noqa: E402
+import textures  # noqa: E402
+from build import black_world, box_geometry, point_along, reset  # noqa: E402
+from glb import read_glb  # noqa: E402
+from levels import crown, hill_profile, radiance_for_luminance, watts_for_candela  # noqa: E402
+
+Vec3 = tuple[float, float, float]
+
+#: Lamp colours (linear sRGB, peak 1): low-pressure sodium as docs/decisions/0030 gives it,
+#: the others near their blackbody (high-pressure sodium 2050 K, LED 3000 K and 4000 K).
+LPS = (1.0, 0.22, 0.0)
+HPS = (1.0, 0.52, 0.17)
+LED_3000 = (1.0, 0.71, 0.42)
+LED_4000 = (1.0, 0.84, 0.66)
+HALOGEN = (1.0, 0.78, 0.52)
+RED = (1.0, 0.02, 0.01)
+
+
+# --- materials --------------------------------------------------------------------------------
+
+
+class Materials:
+    """The scene's materials, made once each; textures loaded from `tex_folder`."""
+
+    def __init__(self, tex_folder: Path):
+        self.paths = textures.write_all(tex_folder)
+        self.images: dict[str, bpy.types.Image] = {}
+        self.cache: dict[str, bpy.types.Material] = {}
+
+    def image(self, name: str) -> bpy.types.Image:
+        if name not in self.images:
+            img = bpy.data.images.load(str(self.paths[name]), check_existing=False)
+            if not textures.TEXTURES[name][1]:
+                img.colorspace_settings.name = "Non-Color"
+            self.images[name] = img
+        return self.images[name]
+
+    def principled(
+        self,
+        name: str,
+        colour: tuple[float, float, float] = (0.5, 0.5, 0.5),
+        roughness: float = 0.8,
+        metallic: float = 0.0,
+        albedo: str | None = None,
+        roughness_map: str | None = None,
+        coat: float = 0.0,
+        emission: tuple[float, float, float] | None = None,
+        strength: float = 0.0,
+        road: bool = False,
+    ) -> bpy.types.Material:
+        """A Principled BSDF material (cached by name). `albedo`: a colour texture for Base
+        Color; `roughness_map`: a metallicRoughness image wired as Blender's glTF importer
+        wires one (G roughness, B metallic); `road`: the custom property that the export
+        writes as `extras.streaks.road = true`."""
+        if name in self.cache:
+            return self.cache[name]
+        mat = bpy.data.materials.new(name)
+        if not mat.node_tree:
+            mat.use_nodes = True
+        nodes, links = mat.node_tree.nodes, mat.node_tree.links
+        bsdf = nodes["Principled BSDF"]
+        bsdf.inputs["Base Color"].default_value = (*colour, 1.0)
+        bsdf.inputs["Roughness"].default_value = roughness
+        bsdf.inputs["Metallic"].default_value = metallic
+        bsdf.inputs["Coat Weight"].default_value = coat
+        if albedo is not None:
+            node = nodes.new("ShaderNodeTexImage")
+            node.image = self.image(albedo)
+            node.location = (-500, 300)
+            links.new(node.outputs["Color"], bsdf.inputs["Base Color"])
+        if roughness_map is not None:
+            node = nodes.new("ShaderNodeTexImage")
+            node.image = self.image(roughness_map)
+            node.location = (-700, 0)
+            sep = nodes.new("ShaderNodeSeparateColor")
+            sep.location = (-300, 0)
+            links.new(node.outputs["Color"], sep.inputs["Color"])
+            links.new(sep.outputs["Green"], bsdf.inputs["Roughness"])
+            links.new(sep.outputs["Blue"], bsdf.inputs["Metallic"])
+        if emission is not None:
+            bsdf.inputs["Emission Color"].default_value = (*emission, 1.0)
+            bsdf.inputs["Emission Strength"].default_value = strength
+            bsdf.inputs["Base Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+        if road:
+            mat["streaks"] = {"road": True}
+        self.cache[name] = mat
+        return mat
+
+
+# --- geometry ---------------------------------------------------------------------------------
+
+
+def tag(obj: bpy.types.Object, cls: str, instance: int | None = None) -> None:
+    """The node's semantic class (and instance) as the custom property `streaks`."""
+    props: dict[str, object] = {"class": cls}
+    if instance is not None:
+        props["instance"] = instance
+    obj["streaks"] = props
+
+
+def mesh_object(name, verts, faces, uvs, mat) -> bpy.types.Object:
+    """A mesh object from vertices, faces and per-loop UVs (one (u, v) per face corner)."""
+    me = bpy.data.meshes.new(name)
+    me.from_pydata([tuple(map(float, v)) for v in verts], [], faces)
+    layer = me.uv_layers.new(name="UVMap")
+    k = 0
+    for poly in me.polygons:
+        for li in poly.loop_indices:
+            layer.data[li].uv = uvs[k]
+            k += 1
+    me.update()
+    obj = bpy.data.objects.new(name, me)
+    bpy.context.scene.collection.objects.link(obj)
+    obj.data.materials.append(mat)
+    return obj
+
+
+def box(name, lo: Vec3, hi: Vec3, mat, tile: float = 1.0, cls: str | None = None, inst=None):
+    """An axis-aligned box (in its own frame) with UVs projected per face in metres / `tile`
+    (vertical faces: along the face and up; horizontal faces: x and y)."""
+    verts, faces = box_geometry(lo, hi)
+    uvs = []
+    for face in faces:
+        pts = np.array([verts[i] for i in face])
+        normal = np.cross(pts[1] - pts[0], pts[2] - pts[0])
+        axis = int(np.argmax(np.abs(normal)))
+        keep = {0: (1, 2), 1: (0, 2), 2: (0, 1)}[axis]
+        uvs.extend((p[keep[0]] / tile, p[keep[1]] / tile) for p in pts)
+    obj = mesh_object(name, verts, faces, uvs, mat)
+    if cls is not None:
+        tag(obj, cls, inst)
+    return obj
+
+
+def place(obj: bpy.types.Object, location: Vec3, heading: float) -> bpy.types.Object:
+    """Puts `obj` at `location`, turned by `heading` radians about Z (0: its +Y along +Y)."""
+    obj.location = location
+    obj.rotation_euler = (0.0, 0.0, heading)
+    return obj
+
+
+def grid(name, xs, ys, height: Callable[[float, float], float], mat, tile: float):
+    """A height-field mesh over the grid xs x ys (world X, Y), UVs x / tile, y / tile; faces
+    wound to face up."""
+    verts = [(x, y, height(x, y)) for y in ys for x in xs]
+    nx = len(xs)
+    faces, uvs = [], []
+    for j in range(len(ys) - 1):
+        for i in range(nx - 1):
+            f = (j * nx + i, j * nx + i + 1, (j + 1) * nx + i + 1, (j + 1) * nx + i)
+            faces.append(f)
+            uvs.extend((verts[k][0] / tile, verts[k][1] / tile) for k in f)
+    return mesh_object(name, verts, faces, uvs, mat)
+
+
+class CentreLine:
+    """A road's centre line: straight, then a left-hand arc of radius `radius` from
+    `bend_start`; heights by `profile(s)`. `s` is the distance along it, from the camera."""
+
+    def __init__(self, radius: float, bend_start: float, profile: Callable[[float], float]):
+        self.radius, self.bend_start, self.profile = radius, bend_start, profile
+
+    def heading(self, s: float) -> float:
+        """Radians, anticlockwise from +Y (a left-hand bend turns towards -X)."""
+        return max(0.0, s - self.bend_start) / self.radius
+
+    def point(self, s: float) -> np.ndarray:
+        if s <= self.bend_start:
+            x, y = 0.0, s
+        else:
+            a = self.heading(s)
+            x = -self.radius * (1.0 - math.cos(a))
+            y = self.bend_start + self.radius * math.sin(a)
+        return np.array([x, y, self.profile(s)])
+
+    def right(self, s: float) -> np.ndarray:
+        a = self.heading(s)
+        return np.array([math.cos(a), math.sin(a), 0.0])
+
+    def along(self, s: float) -> np.ndarray:
+        a = self.heading(s)
+        return np.array([-math.sin(a), math.cos(a), 0.0])
+
+
+def ribbon(name, line: CentreLine, ss, profile, mat, tile: float, along_first: bool = False):
+    """A surface swept along `line`: at each s of `ss` the cross-section `profile`, a list of
+    (x to the right, height above the centre line) from left to right, so that the faces
+    face up (or towards the road, for a kerb or a facade). UVs in metres / `tile`: (across,
+    along), or (along, across) when `along_first` (facades: along, then up)."""
+    across = [0.0]
+    for (x0, h0), (x1, h1) in zip(profile, profile[1:], strict=False):
+        across.append(across[-1] + math.hypot(x1 - x0, h1 - h0))
+    verts, uv_of = [], []
+    for s in ss:
+        c, r = line.point(s), line.right(s)
+        for (x, h), a in zip(profile, across, strict=True):
+            verts.append(c + x * r + np.array([0.0, 0.0, h]))
+            uv_of.append((s / tile, a / tile) if along_first else (a / tile, s / tile))
+    m = len(profile)
+    faces, uvs = [], []
+    for j in range(len(ss) - 1):
+        for i in range(m - 1):
+            f = (j * m + i, j * m + i + 1, (j + 1) * m + i + 1, (j + 1) * m + i)
+            faces.append(f)
+            uvs.extend(uv_of[k] for k in f)
+    return mesh_object(name, verts, faces, uvs, mat)
+
+
+# --- lamps, cars, camera ----------------------------------------------------------------------
+
+
+def spot(name, location: Vec3, direction: Vec3, watts, colour, size_deg, blend) -> None:
+    """A punctual spot lamp (zero radius, no soft falloff)."""
+    lamp = bpy.data.lights.new(name, "SPOT")
+    lamp.color = colour
+    lamp.energy = watts
+    lamp.shadow_soft_size = 0.0
+    lamp.use_soft_falloff = False
+    lamp.spot_size = math.radians(size_deg)
+    lamp.spot_blend = blend
+    obj = bpy.data.objects.new(name, lamp)
+    obj.location = location
+    point_along(obj, direction)
+    bpy.context.scene.collection.objects.link(obj)
+
+
+def street_lamp(mats: Materials, name, foot: Vec3, heading: float, side: float, colour, cd):
+    """A street lamp standing at `foot` on the pavement: a 7.5 m post, an arm reaching 1.6 m
+    over the road (towards the side `-side`: side = +1 on the right of the street), a dark
+    housing with an emissive lens under it (luminance I / A, as the generator's luminaires)
+    and a spot light straight down, full to 60 degrees from the nadir, none past 85."""
+    metal = mats.principled("lamp_metal", (0.08, 0.08, 0.09), roughness=0.5, metallic=0.6)
+    post = box(f"{name}_post", (-0.07, -0.07, 0.0), (0.07, 0.07, 7.6), metal, cls="pole")
+    place(post, foot, heading)
+    reach = -side * 1.6
+    lo, hi = min(0.0, reach), max(0.0, reach)
+    arm = box(f"{name}_arm", (lo, -0.05, 7.45), (hi, 0.05, 7.55), metal, cls="pole")
+    place(arm, foot, heading)
+    head = box(f"{name}_head", (reach - 0.3, -0.18, 7.35), (reach + 0.3, 0.18, 7.5), metal)
+    tag(head, "light_source")
+    place(head, foot, heading)
+    lens_area = 0.5 * 0.28
+    lens = mats.principled(
+        f"lens_{name}",
+        emission=colour,
+        strength=radiance_for_luminance(cd / lens_area, colour),
+    )
+    # The lens: a quad facing down just under the housing.
+    z = 7.345
+    verts = [(reach - 0.25, -0.14, z), (reach - 0.25, 0.14, z), (reach + 0.25, 0.14, z)]
+    verts.append((reach + 0.25, -0.14, z))
+    q = mesh_object(f"{name}_lens", verts, [(0, 1, 2, 3)], [(0, 0), (0, 1), (1, 1), (1, 0)], lens)
+    tag(q, "light_source")
+    place(q, foot, heading)
+    c, s_ = math.cos(heading), math.sin(heading)
+    world = (foot[0] + c * reach, foot[1] + s_ * reach, foot[2] + 7.3)
+    spot(
+        f"{name}_light",
+        world,
+        (0.0, 0.0, -1.0),
+        watts_for_candela(cd, colour),
+        colour,
+        170.0,
+        1.0 - 60.0 / 85.0,
+    )
+
+
+def car(mats: Materials, name, centre: Vec3, heading: float, paint, instance: int):
+    """A car as two boxes (body and cabin) and four dark wheels' worth of skirt, 4.4 x 1.8 m,
+    its front along its local +Y; returns the world transform function of local points."""
+    body = box(f"{name}_body", (-0.9, -2.2, 0.3), (0.9, 2.2, 0.95), paint, cls="car", inst=instance)
+    place(body, centre, heading)
+    glass = mats.principled("car_glass", (0.02, 0.02, 0.025), roughness=0.05, coat=1.0)
+    cabin = box(
+        f"{name}_cabin", (-0.8, -1.2, 0.95), (0.8, 0.9, 1.45), glass, cls="car", inst=instance
+    )
+    place(cabin, centre, heading)
+    tyre = mats.principled("tyre", (0.02, 0.02, 0.02), roughness=0.9)
+    skirt = box(
+        f"{name}_wheels", (-0.85, -1.9, 0.0), (0.85, 1.9, 0.3), tyre, cls="car", inst=instance
+    )
+    place(skirt, centre, heading)
+
+    def to_world(p: Vec3) -> Vec3:
+        c, s = math.cos(heading), math.sin(heading)
+        return (centre[0] + c * p[0] - s * p[1], centre[1] + s * p[0] + c * p[1], centre[2] + p[2])
+
+    return to_world
+
+
+def car_light(
+    mats,
+    name,
+    to_world,
+    heading,
+    local: Vec3,
+    facing: float,
+    colour,
+    lens_cd_m2,
+    cd,
+    cone_deg,
+    instance,
+    pitch_deg=0.0,
+):
+    """A lamp of a car: an emissive 0.18 x 0.12 m lens facing along local +Y (`facing` = +1,
+    the front) or -Y (-1), and a spot light of `cd` candela on axis along the same way,
+    pitched down by `pitch_deg`."""
+    mat = mats.principled(
+        f"lens_{name}", emission=colour, strength=radiance_for_luminance(lens_cd_m2, colour)
+    )
+    x, y, z = local
+    y += 0.01 * facing
+    if facing > 0:
+        verts = [
+            (x - 0.09, y, z - 0.06),
+            (x + 0.09, y, z - 0.06),
+            (x + 0.09, y, z + 0.06),
+            (x - 0.09, y, z + 0.06),
+        ]
+    else:
+        verts = [
+            (x + 0.09, y, z - 0.06),
+            (x - 0.09, y, z - 0.06),
+            (x - 0.09, y, z + 0.06),
+            (x + 0.09, y, z + 0.06),
+        ]
+    q = mesh_object(
+        name, [to_world(v) for v in verts], [(0, 1, 2, 3)], [(0, 0), (1, 0), (1, 1), (0, 1)], mat
+    )
+    tag(q, "light_source", instance)
+    c, s = math.cos(heading), math.sin(heading)
+    d_local = (0.0, facing * math.cos(math.radians(pitch_deg)), -math.sin(math.radians(pitch_deg)))
+    d = (c * d_local[0] - s * d_local[1], s * d_local[0] + c * d_local[1], d_local[2])
+    spot(
+        f"{name}_light",
+        to_world((x, y + 0.05 * facing, z)),
+        d,
+        watts_for_candela(cd, colour),
+        colour,
+        2.0 * cone_deg,
+        0.5,
+    )
+
+
+def camera(name: str, location: Vec3, direction: Vec3, yfov_deg: float, w: int, h: int) -> None:
+    """The driver's camera (the stereo rig's centre), vertical field of view `yfov_deg`."""
+    cam = bpy.data.cameras.new(name)
+    cam.sensor_fit = "VERTICAL"
+    cam.angle_y = math.radians(yfov_deg)
+    cam.clip_start = 0.05
+    obj = bpy.data.objects.new(name, cam)
+    obj.location = location
+    point_along(obj, direction)
+    bpy.context.scene.collection.objects.link(obj)
+    bpy.context.scene.camera = obj
+    bpy.context.scene.render.resolution_x = w
+    bpy.context.scene.render.resolution_y = h
+
+
+def pitched(direction: np.ndarray, down_deg: float) -> Vec3:
+    """A horizontal `direction` tilted down by `down_deg`."""
+    d = direction / np.linalg.norm(direction)
+    t = math.radians(down_deg)
+    return (d[0] * math.cos(t), d[1] * math.cos(t), -math.sin(t))
+
+
+# --- the streets ------------------------------------------------------------------------------
+
+
+def build_hill_bend(mats: Materials) -> None:
+    """A two-lane road (7 m) bending left on a 50 m radius and climbing over a crest, with
+    12 cm kerbs, 2.5 m pavements, a terrace of facades following the bend, six street lamps
+    (LED 3000 K, 2.4 kcd) staggered along it and a parked car."""
+    line = CentreLine(radius=50.0, bend_start=12.0, profile=hill_profile)
+    ss = np.arange(-8.0, 110.0, 1.0)
+    road = mats.principled("wet_asphalt", albedo="asphalt", roughness_map="puddles", road=True)
+    ribbon("road", line, ss, [(x, 0.0) for x in np.linspace(-3.5, 3.5, 8)], road, 2.0)
+    tag(bpy.data.objects["road"], "road")
+    paint = mats.principled("road_paint", (0.55, 0.55, 0.52), roughness=0.2, road=True)
+    for k, s0 in enumerate(np.arange(2.0, 105.0, 6.0)):
+        dash = ribbon(
+            f"centre_dash_{k}",
+            line,
+            np.linspace(s0, s0 + 3.0, 4),
+            [(-0.06, 0.004), (0.06, 0.004)],
+            paint,
+            1.0,
+        )
+        tag(dash, "marking")
+    paving = mats.principled("paving", albedo="paving", roughness=0.35)
+    kerb_right = [(3.5, 0.0), (3.5, 0.12), (6.0, 0.12)]
+    kerb_left = [(-6.0, 0.12), (-3.5, 0.12), (-3.5, 0.0)]
+    tag(ribbon("pavement_right", line, ss, kerb_right, paving, 1.0), "sidewalk")
+    tag(ribbon("pavement_left", line, ss, kerb_left, paving, 1.0), "sidewalk")
+    facades = [
+        mats.principled("panels", albedo="panels", roughness=0.4),
+        mats.principled("plaster", albedo="plaster", roughness=0.9),
+        mats.principled("blocks", albedo="blocks", roughness=0.8),
+    ]
+    rng = np.random.default_rng(11)
+    for side, x in (("right", 6.0), ("left", -6.0)):
+        s0, k = -8.0, 0
+        while s0 < 108.0:
+            length = float(rng.uniform(10.0, 18.0))
+            height = float(rng.uniform(7.0, 14.0))
+            seg = np.linspace(s0, min(s0 + length, 110.0), 8)
+            prof = [(x, -1.0), (x, height)] if side == "right" else [(x, height), (x, -1.0)]
+            tile = 6.0 if k % 3 == 1 else 3.0
+            obj = ribbon(f"facade_{side}_{k}", line, seg, prof, facades[k % 3], tile, True)
+            tag(obj, "building")
+            s0, k = s0 + length, k + 1
+    for k, s in enumerate((6.0, 22.0, 38.0, 54.0, 70.0, 86.0)):
+        side = 1.0 if k % 2 == 0 else -1.0
+        foot = line.point(s) + 4.6 * side * line.right(s) + np.array([0.0, 0.0, 0.12])
+        street_lamp(mats, f"lamp{k}", tuple(foot), line.heading(s), side, LED_3000, 2400.0)
+    paint_blue = mats.principled(
+        "paint_blue", (0.05, 0.09, 0.3), roughness=0.3, metallic=0.4, coat=1.0
+    )
+    s = 30.0
+    centre = line.point(s) + 2.4 * line.right(s)
+    car(mats, "parked_car", tuple(centre), line.heading(s), paint_blue, 1)
+    eye = line.point(0.0) + 1.75 * line.right(0.0) + np.array([0.0, 0.0, 1.3])
+    camera("driver", tuple(eye), pitched(line.along(0.0), 1.5), 42.0, 640, 480)
+
+
+def build_crossing(mats: Materials) -> None:
+    """A straight street (8 m, crowned by 8 cm) crossed by another (9 m, crowned by 8 cm,
+    its crown fading out where it meets the first) 35-44 m ahead; corner pavements and
+    buildings, low-pressure sodium lamps along the street, LED 4000 K lamps along the cross
+    street, an oncoming car with its headlights on and a car ahead showing its tail lights."""
+    road = mats.principled("wet_asphalt", albedo="asphalt", roughness_map="puddles", road=True)
+    ys = np.arange(-10.0, 91.0, 1.0)
+    grid("road", np.linspace(-4.0, 4.0, 17), ys, lambda x, y: crown(x, 4.0, 0.08), road, 2.0)
+    tag(bpy.data.objects["road"], "road")
+    y0, y1, yc = 35.0, 44.0, 39.5
+
+    def cross_height(x: float, y: float) -> float:
+        return crown(y - yc, 4.5, 0.08) * min(1.0, max(0.0, (abs(x) - 4.0) / 3.0))
+
+    cys = np.linspace(y0, y1, 10)
+    for name, xs in (
+        ("cross_left", np.arange(-70.0, -3.99, 1.0)),
+        ("cross_right", np.arange(4.0, 70.01, 1.0)),
+    ):
+        tag(grid(name, xs, cys, cross_height, road, 2.0), "road")
+    paint = mats.principled("road_paint", (0.6, 0.6, 0.57), roughness=0.25, road=True)
+    for k, y in enumerate(np.arange(-6.0, 33.0, 5.0)):
+        tag(box(f"dash_{k}", (-0.06, y, 0.081), (0.06, y + 2.5, 0.085), paint), "marking")
+    for k, y in enumerate(np.arange(46.0, 88.0, 5.0)):
+        tag(box(f"dash_far_{k}", (-0.06, y, 0.081), (0.06, y + 2.5, 0.085), paint), "marking")
+    # the stop line of our lane
+    tag(box("stop_line", (0.0, 33.2, 0.0), (4.0, 33.6, 0.085), paint), "marking")
+    paving = mats.principled("paving", albedo="paving", roughness=0.35)
+    pav = 3.0
+    for sx in (-1.0, 1.0):
+        for near in (True, False):
+            ya, yb = (-10.0, y0 - pav) if near else (y1 + pav, 90.0)
+            yc0, yc1 = (y0 - pav, y0) if near else (y1, y1 + pav)
+            xa, xb = sorted((sx * 4.0, sx * (4.0 + pav)))
+            xc, xd = sorted((sx * 4.0, sx * 70.0))
+            q = f"{'l' if sx < 0 else 'r'}{'n' if near else 'f'}"
+            tag(box(f"pavement_{q}_a", (xa, ya, -0.2), (xb, yb, 0.12), paving), "sidewalk")
+            tag(box(f"pavement_{q}_b", (xc, yc0, -0.2), (xd, yc1, 0.12), paving), "sidewalk")
+    facades = [
+        mats.principled("plaster", albedo="plaster", roughness=0.9),
+        mats.principled("blocks", albedo="blocks", roughness=0.8),
+        mats.principled("panels", albedo="panels", roughness=0.4),
+    ]
+    rng = np.random.default_rng(12)
+    k = 0
+    for sx in (-1.0, 1.0):
+        for near in (True, False):
+            # along the street: lots of 12-20 m
+            ya, yb = (-10.0, y0 - pav) if near else (y1 + pav, 90.0)
+            y = ya
+            while y < yb - 1.0:
+                ln = min(float(rng.uniform(12.0, 20.0)), yb - y)
+                xa, xb = sorted((sx * (4.0 + pav), sx * (4.0 + pav + 12.0)))
+                h = float(rng.uniform(8.0, 16.0))
+                tag(
+                    box(f"building_{k}", (xa, y, -0.5), (xb, y + ln, h), facades[k % 3], 3.0),
+                    "building",
+                )
+                y, k = y + ln, k + 1
+            # along the cross street
+            yc0, yc1 = (y0 - pav - 12.0, y0 - pav) if near else (y1 + pav, y1 + pav + 12.0)
+            xa, xb = sorted((sx * (4.0 + pav + 12.0), sx * 60.0))
+            h = float(rng.uniform(8.0, 16.0))
+            tag(
+                box(f"building_{k}", (xa, yc0, -0.5), (xb, yc1, h), facades[k % 3], 3.0), "building"
+            )
+            k += 1
+    # Lamps: low-pressure sodium along the street (staggered), LED 4000 K on the cross street.
+    for k, y in enumerate((6.0, 24.0, 50.0, 68.0, 86.0)):
+        side = 1.0 if k % 2 == 0 else -1.0
+        street_lamp(mats, f"sodium{k}", (side * 5.0, y, 0.12), 0.0, side, LPS, 1800.0)
+    for k, x in enumerate((-24.0, -10.0, 12.0, 26.0)):
+        side = 1.0 if k % 2 == 0 else -1.0  # +1: the cross street's near (south) side
+        foot = (x, y0 - 1.0 if side > 0 else y1 + 1.0, 0.12)
+        # heading pi/2 turns local +X to +Y: the arm reaches north from the south side
+        street_lamp(
+            mats,
+            f"led{k}",
+            foot,
+            math.pi / 2.0 if side > 0 else -math.pi / 2.0,
+            -1.0,
+            LED_4000,
+            3000.0,
+        )
+    # The oncoming car (left lane, facing -Y) with dipped headlights.
+    white = mats.principled("paint_white", (0.7, 0.7, 0.68), roughness=0.3, coat=1.0)
+    to_world = car(mats, "oncoming_car", (-2.0, 58.0, 0.07), math.pi, white, 1)
+    for k, x in enumerate((-0.65, 0.65)):
+        car_light(
+            mats,
+            f"headlight{k}",
+            to_world,
+            math.pi,
+            (x, 2.2, 0.7),
+            1.0,
+            HALOGEN,
+            20000.0,
+            14000.0,
+            20.0,
+            1,
+            pitch_deg=1.5,
+        )
+    # The car ahead (our lane, facing +Y) shows its tail lights.
+    red = mats.principled("paint_red", (0.35, 0.02, 0.02), roughness=0.3, metallic=0.3, coat=1.0)
+    to_world = car(mats, "car_ahead", (2.0, 20.0, 0.06), 0.0, red, 2)
+    for k, x in enumerate((-0.7, 0.7)):
+        car_light(
+            mats, f"taillight{k}", to_world, 0.0, (x, -2.2, 0.8), -1.0, RED, 800.0, 10.0, 40.0, 2
+        )
+    eye = (2.0, 0.0, crown(2.0, 4.0, 0.08) + 1.3)
+    camera("driver", eye, pitched(np.array([0.0, 1.0, 0.0]), 1.0), 40.0, 800, 450)
+
+
+SCENES = {"hill_bend": build_hill_bend, "crossing": build_crossing}
+
+
+def export(out: Path, name: str) -> Path:
+    """Saves the .blend and exports the .glb with Blender's exporter (defaults, plus cameras,
+    punctual lights and custom properties as extras); checks the road's extras."""
+    bpy.ops.wm.save_as_mainfile(filepath=str(out / f"{name}.blend"))
+    glb = out / f"{name}.glb"
+    bpy.ops.export_scene.gltf(
+        filepath=str(glb),
+        export_format="GLB",
+        export_cameras=True,
+        export_lights=True,
+        export_extras=True,
+    )
+    doc, _ = read_glb(glb.read_bytes())
+    roads = [
+        m["name"]
+        for m in doc.get("materials", [])
+        if m.get("extras", {}).get("streaks", {}).get("road") is True
+    ]
+    if "wet_asphalt" not in roads:
+        raise SystemExit(f"{glb}: the road material has no extras.streaks.road = true")
+    lights = doc.get("extensions", {}).get("KHR_lights_punctual", {}).get("lights", [])
+    print(
+        json.dumps(
+            {
+                "scene": name,
+                "bytes": glb.stat().st_size,
+                "road_materials": roads,
+                "lights": len(lights),
+                "cameras": len(doc.get("cameras", [])),
+            }
+        )
+    )
+    return glb
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("out", type=Path)
+    parser.add_argument("--scenes", nargs="+", default=list(SCENES), choices=list(SCENES))
+    args = parser.parse_args()
+    args.out.mkdir(parents=True, exist_ok=True)
+    for name in args.scenes:
+        reset()
+        mats = Materials(args.out / "textures")
+        SCENES[name](mats)
+        black_world()
+        export(args.out, name)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,121 @@
+"""The outside streets' textures and light levels (no bpy)."""
+
+import math
+import struct
+import zlib
+
+import numpy as np
+import pytest
+from levels import (
+    crown,
+    hill_profile,
+    luminance,
+    radiance_for_luminance,
+    smoothstep,
+    watts_for_candela,
+)
+from textures import (
+    TEXTURES,
+    asphalt_albedo,
+    facade_blocks,
+    periodic_noise,
+    puddle_roughness,
+    write_all,
+    write_png,
+)
+
+
+def srgb8_to_linear(c: np.ndarray) -> np.ndarray:
+    s = c.astype(np.float64) / 255.0
+    return np.where(s <= 0.04045, s / 12.92, ((s + 0.055) / 1.055) ** 2.4)
+
+
+def read_png(data: bytes) -> tuple[int, int, int, bytes]:
+    """Width, height, colour type and the filtered scanlines of a PNG written by write_png."""
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    pos, idat, header = 8, b"", None
+    while pos < len(data):
+        (length,) = struct.unpack(">I", data[pos : pos + 4])
+        tag = data[pos + 4 : pos + 8]
+        body = data[pos + 8 : pos + 8 + length]
+        (crc,) = struct.unpack(">I", data[pos + 8 + length : pos + 12 + length])
+        assert crc == zlib.crc32(tag + body)
+        if tag == b"IHDR":
+            header = struct.unpack(">IIBBBBB", body)
+        elif tag == b"IDAT":
+            idat += body
+        pos += 12 + length
+    assert header is not None
+    return header[0], header[1], header[3], zlib.decompress(idat)
+
+
+def test_png_round_trip(tmp_path):
+    pixels = np.arange(5 * 7 * 3, dtype=np.uint8).reshape(5, 7, 3)
+    write_png(tmp_path / "a.png", pixels)
+    w, h, colour_type, raw = read_png((tmp_path / "a.png").read_bytes())
+    assert (w, h, colour_type) == (7, 5, 2)
+    rows = np.frombuffer(raw, dtype=np.uint8).reshape(5, 1 + 7 * 3)
+    assert (rows[:, 0] == 0).all()
+    assert (rows[:, 1:].reshape(5, 7, 3) == pixels).all()
+
+
+def test_png_refuses_floats(tmp_path):
+    with pytest.raises(ValueError):
+        write_png(tmp_path / "a.png", np.zeros((2, 2, 3)))
+
+
+def test_noise_is_normalised_and_periodic():
+    f = periodic_noise(64, 3.0, np.random.default_rng(0))
+    assert abs(f.mean()) < 1e-9 and abs(f.std() - 1.0) < 1e-9
+    # across the wrap-around edge the field changes no more than between interior rows
+    interior = np.abs(np.diff(f, axis=0)).mean()
+    seam = np.abs(f[0] - f[-1]).mean()
+    assert seam < 1.5 * interior
+
+
+def test_asphalt_is_dark_and_grainy():
+    lin = srgb8_to_linear(asphalt_albedo(128, seed=1)).mean(axis=-1)
+    assert 0.03 < lin.mean() < 0.08
+    # grain: neighbouring pixels differ by a good share of the mean (texture for matching)
+    assert np.abs(np.diff(lin, axis=1)).mean() > 0.2 * lin.mean()
+
+
+def test_puddle_roughness_range_and_share():
+    img = puddle_roughness(128, seed=2, wet=0.13, puddle=0.05, share=0.3)
+    rough = img[..., 1] / 255.0
+    assert (img[..., 2] == 0).all() and (img[..., 0] == 255).all()
+    assert rough.min() >= 0.04 and rough.max() <= 0.2
+    puddles = (rough < 0.07).mean()
+    assert 0.1 < puddles < 0.35
+
+
+def test_facades_have_windows():
+    img = facade_blocks(128, seed=6)
+    lin = srgb8_to_linear(img).mean(axis=-1)
+    assert (lin < 0.03).mean() > 0.05  # dark panes
+    assert lin.mean() > 0.15  # a lit wall between them
+
+
+def test_write_all(tmp_path):
+    paths = write_all(tmp_path)
+    assert set(paths) == set(TEXTURES)
+    for p in paths.values():
+        assert p.stat().st_size < 200_000
+
+
+def test_light_levels():
+    # 2400 cd of a warm LED: the exporter's P / (4 pi) * 683 * luminance gives it back
+    colour = (1.0, 0.71, 0.42)
+    p = watts_for_candela(2400.0, colour)
+    assert math.isclose(p / (4 * math.pi) * 683 * luminance(colour), 2400.0)
+    assert math.isclose(radiance_for_luminance(683.0, (1.0, 1.0, 1.0)), 1.0)
+
+
+def test_road_shapes():
+    assert smoothstep(-1) == 0 and smoothstep(2) == 1 and smoothstep(0.5) == 0.5
+    assert hill_profile(0.0) == 0.0
+    rise = hill_profile(60.0) - hill_profile(0.0)
+    assert 2.0 <= rise <= 3.0
+    grades = np.diff([hill_profile(s) for s in np.arange(0.0, 120.0, 1.0)])
+    assert grades.max() > 0.05 and grades.min() < -0.05  # climbs, then falls past the crest
+    assert crown(0.0, 4.0, 0.08) == 0.08 and crown(4.0, 4.0, 0.08) == 0.0

@@ -1,0 +1,190 @@
+"""Procedural textures of the outside streets (no bpy): asphalt, a puddle roughness map,
+pavement flags and three facades, as 8-bit arrays, and a small PNG writer.
+
+They are made here, not taken from the generator (crates/scenes), so that the evaluation
+streets do not share the generator's look. Every texture tiles seamlessly: the noise is white
+noise filtered in the Fourier domain (periodic by construction) and the patterns have whole
+periods per tile. Row 0 is the top of the image, as a PNG stores it.
+"""
+
+from __future__ import annotations
+
+import struct
+import zlib
+from pathlib import Path
+
+import numpy as np
+
+
+def periodic_noise(n: int, scale_px: float, rng: np.random.Generator) -> np.ndarray:
+    """An n x n field of zero mean and unit standard deviation, smooth over about `scale_px`
+    pixels, that tiles seamlessly (white noise low-passed by a Gaussian in frequency)."""
+    white = rng.standard_normal((n, n))
+    f = np.fft.fftfreq(n)
+    fx, fy = np.meshgrid(f, f)
+    sigma_f = 1.0 / (2.0 * np.pi * max(scale_px, 1e-6))
+    gain = np.exp(-(fx * fx + fy * fy) / (2.0 * sigma_f * sigma_f))
+    field = np.real(np.fft.ifft2(np.fft.fft2(white) * gain))
+    field -= field.mean()
+    std = field.std()
+    return field / std if std > 0 else field
+
+
+def linear_to_srgb8(linear: np.ndarray) -> np.ndarray:
+    """Linear values in [0, 1] as 8-bit sRGB (IEC 61966-2-1)."""
+    c = np.clip(linear, 0.0, 1.0)
+    s = np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
+    return np.round(s * 255.0).astype(np.uint8)
+
+
+def asphalt_albedo(n: int = 256, seed: int = 1) -> np.ndarray:
+    """Wet asphalt's base colour (n x n x 3, sRGB): dark binder (linear albedo about 0.04)
+    with grain (one-pixel speckle), lighter stones of a few pixels and a slow patchiness."""
+    rng = np.random.default_rng(seed)
+    base = 0.045 * np.exp(0.18 * periodic_noise(n, n / 10.0, rng))
+    grain = 1.0 + 0.35 * rng.standard_normal((n, n))
+    stones = periodic_noise(n, 1.5, rng)
+    stone_mask = np.clip((stones - 1.3) * 2.0, 0.0, 1.0)
+    value = base * grain * (1.0 + 1.6 * stone_mask)
+    rgb = np.stack([value * 0.97, value * 0.98, value * 1.03], axis=-1)
+    return linear_to_srgb8(rgb)
+
+
+def puddle_roughness(
+    n: int = 256, seed: int = 2, wet: float = 0.13, puddle: float = 0.05, share: float = 0.3
+) -> np.ndarray:
+    """glTF's metallicRoughness image (n x n x 3): roughness in G, metallic 0 in B, R unused
+    (255). Wet asphalt of roughness about `wet` with a little noise, and puddles (about
+    `share` of the area, smooth blobs with soft rims) of roughness `puddle`."""
+    rng = np.random.default_rng(seed)
+    blobs = periodic_noise(n, n / 12.0, rng)
+    threshold = np.quantile(blobs, 1.0 - share)
+    t = np.clip((blobs - threshold) / 0.25, 0.0, 1.0)  # 0 asphalt .. 1 puddle, soft rim
+    rough = wet * (1.0 + 0.15 * periodic_noise(n, 2.0, rng))
+    rough = rough * (1.0 - t) + puddle * t
+    out = np.empty((n, n, 3), dtype=np.uint8)
+    out[..., 0] = 255
+    out[..., 1] = np.round(np.clip(rough, 0.0, 1.0) * 255.0).astype(np.uint8)
+    out[..., 2] = 0
+    return out
+
+
+def paving(n: int = 128, seed: int = 3, flags: int = 4) -> np.ndarray:
+    """Pavement flags (n x n x 3, sRGB): `flags` x `flags` square slabs of concrete of slightly
+    different shades with dark joints."""
+    rng = np.random.default_rng(seed)
+    cell = n // flags
+    shade = 0.16 + 0.04 * rng.standard_normal((flags, flags))
+    value = np.kron(shade, np.ones((cell, cell)))
+    value = value * (1.0 + 0.12 * periodic_noise(n, 1.0, rng))
+    v, u = np.mgrid[0:n, 0:n]
+    joint = ((u % cell) < 2) | ((v % cell) < 2)
+    value = np.where(joint, 0.04, value)
+    return linear_to_srgb8(np.stack([value, value, value * 0.96], axis=-1))
+
+
+def _windows(n: int, per_row: int, rows: int, width: float, height: float) -> np.ndarray:
+    """A mask of dark window panes: `rows` x `per_row` windows per tile, each `width` x
+    `height` of its cell (fractions), its sill in the lower third."""
+    v, u = np.mgrid[0:n, 0:n].astype(np.float64)
+    cu = (u * per_row / n) % 1.0
+    cv = (v * rows / n) % 1.0
+    return (np.abs(cu - 0.5) < width / 2) & (np.abs(cv - 0.45) < height / 2)
+
+
+def facade_panels(n: int = 256, seed: int = 4) -> np.ndarray:
+    """A facade of large cladding panels (n x n x 3, sRGB): a 4 x 2 grid of panels of
+    different grey-green tints with light seams, and a ribbon window per storey."""
+    rng = np.random.default_rng(seed)
+    nx, ny = 4, 2
+    tint = 0.25 + 0.06 * rng.standard_normal((ny, nx))
+    value = np.kron(tint, np.ones((n // ny, n // nx)))
+    value = value * (1.0 + 0.05 * periodic_noise(n, 3.0, rng))
+    v, u = np.mgrid[0:n, 0:n]
+    seam = ((u % (n // nx)) < 2) | ((v % (n // ny)) < 2)
+    value = np.where(seam, 0.5, value)
+    ribbon = ((v % (n // ny)) > n // ny * 0.35) & ((v % (n // ny)) < n // ny * 0.7)
+    rgb = np.stack([value * 0.9, value, value * 0.95], axis=-1)
+    rgb[ribbon] = (0.015, 0.02, 0.025)
+    return linear_to_srgb8(rgb)
+
+
+def facade_plaster(n: int = 256, seed: int = 5) -> np.ndarray:
+    """A rendered (plastered) facade (n x n x 3, sRGB): ochre plaster with blotchy weathering
+    and fine roughcast noise, two rows of three windows per tile."""
+    rng = np.random.default_rng(seed)
+    value = 0.42 * np.exp(0.12 * periodic_noise(n, n / 8.0, rng))
+    value = value * (1.0 + 0.08 * rng.standard_normal((n, n)))
+    rgb = np.stack([value, value * 0.78, value * 0.52], axis=-1)
+    rgb[_windows(n, 3, 2, 0.42, 0.5)] = (0.02, 0.02, 0.022)
+    return linear_to_srgb8(rgb)
+
+
+def facade_blocks(n: int = 256, seed: int = 6) -> np.ndarray:
+    """Concrete blocks in running bond (n x n x 3, sRGB): 8 courses of 4 blocks per tile,
+    each block its own grey, mortar joints, one row of square windows."""
+    rng = np.random.default_rng(seed)
+    courses, per_course = 8, 4
+    ch, bw = n // courses, n // per_course
+    v, u = np.mgrid[0:n, 0:n]
+    course = v // ch
+    shifted = (u + (course % 2) * (bw // 2)) % n
+    block = shifted // bw
+    shade = 0.3 + 0.05 * rng.standard_normal((courses, per_course))
+    value = shade[course, block] * (1.0 + 0.1 * periodic_noise(n, 1.2, rng))
+    joint = ((v % ch) < 2) | ((shifted % bw) < 2)
+    value = np.where(joint, 0.5, value)
+    rgb = np.stack([value, value, value * 0.97], axis=-1)
+    rgb[_windows(n, 2, 1, 0.4, 0.35)] = (0.02, 0.02, 0.02)
+    return linear_to_srgb8(rgb)
+
+
+def write_png(path: Path, pixels: np.ndarray) -> None:
+    """Writes an 8-bit grey (h x w) or RGB (h x w x 3) array as a PNG (row 0 at the top)."""
+    pixels = np.asarray(pixels)
+    if pixels.dtype != np.uint8:
+        raise ValueError("write_png takes uint8 pixels")
+    if pixels.ndim == 2:
+        colour_type, channels = 0, 1
+    elif pixels.ndim == 3 and pixels.shape[2] == 3:
+        colour_type, channels = 2, 3
+    else:
+        raise ValueError(f"write_png takes h x w or h x w x 3, not {pixels.shape}")
+    h, w = pixels.shape[:2]
+    rows = pixels.reshape(h, w * channels)
+    raw = b"".join(b"\x00" + rows[i].tobytes() for i in range(h))
+
+    def chunk(tag: bytes, data: bytes) -> bytes:
+        body = tag + data
+        return struct.pack(">I", len(data)) + body + struct.pack(">I", zlib.crc32(body))
+
+    header = struct.pack(">IIBBBBB", w, h, 8, colour_type, 0, 0, 0)
+    png = (
+        b"\x89PNG\r\n\x1a\n"
+        + chunk(b"IHDR", header)
+        + chunk(b"IDAT", zlib.compress(raw, 9))
+        + chunk(b"IEND", b"")
+    )
+    Path(path).write_bytes(png)
+
+
+#: The textures of the outside streets: name -> (maker, whether it holds colour (sRGB) rather
+#: than data).
+TEXTURES = {
+    "asphalt": (asphalt_albedo, True),
+    "puddles": (puddle_roughness, False),
+    "paving": (paving, True),
+    "panels": (facade_panels, True),
+    "plaster": (facade_plaster, True),
+    "blocks": (facade_blocks, True),
+}
+
+
+def write_all(folder: Path) -> dict[str, Path]:
+    """Writes every texture of `TEXTURES` as `folder/<name>.png`; returns the paths."""
+    folder.mkdir(parents=True, exist_ok=True)
+    paths = {}
+    for name, (make, _) in TEXTURES.items():
+        paths[name] = folder / f"{name}.png"
+        write_png(paths[name], make())
+    return paths
