@@ -640,6 +640,11 @@ def export(out: Path, name: str) -> Path:
     ]
     if name in STREETS and "wet_asphalt" not in roads:
         raise SystemExit(f"{glb}: the road material has no extras.streaks.road = true")
+    if name in STREETS:
+        road = next(m for m in doc["materials"] if m["name"] == "wet_asphalt")
+        pbr = road.get("pbrMetallicRoughness", {})
+        if "baseColorTexture" not in pbr or "metallicRoughnessTexture" not in pbr:
+            raise SystemExit(f"{glb}: the road's textures were not exported")
     lights = doc.get("extensions", {}).get("KHR_lights_punctual", {}).get("lights", [])
     print(
         json.dumps(
@@ -660,13 +665,16 @@ def main() -> None:
     parser.add_argument("out", type=Path)
     parser.add_argument("--scenes", nargs="+", default=list(SCENES), choices=list(SCENES))
     args = parser.parse_args()
-    args.out.mkdir(parents=True, exist_ok=True)
+    # Absolute: saving the .blend makes the image paths relative to it, which breaks paths
+    # that were relative to the working folder (the export then finds no pixels).
+    out = args.out.resolve()
+    out.mkdir(parents=True, exist_ok=True)
     for name in args.scenes:
         reset()
-        mats = Materials(args.out / "textures")
+        mats = Materials(out / "textures")
         SCENES[name](mats)
         black_world()
-        export(args.out, name)
+        export(out, name)
 
 
 if __name__ == "__main__":

@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# Makes the outside evaluation inputs of streak-robust stereo (tools/streak_eval/README.md)
+# into one folder:
+#
+#   tools/streak_eval/inputs.sh [OUT]          (OUT defaults to target/streak-eval)
+#
+#   OUT/scenes/{hill_bend,crossing,tabletop}.glb  built in Blender, exported by its exporter
+#   OUT/pairs/{hill_bend,crossing,tabletop}/      `streaks stereo` pairs of them
+#   OUT/other_config/                             3 samples of other_config.toml (seed 77)
+#   OUT/dry_config/                               4 samples of dry_config.toml (seed 78)
+#
+# BLENDER_PYTHON: the Python with bpy 5.0 (default target/blender-venv/bin/python);
+# STREAKS: the streaks binary (default target/release/streaks). Run from the repository root.
+# Evaluation-only inputs: no parameter may be tuned on them.
+set -euo pipefail
+
+out="${1:-target/streak-eval}"
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+blender_python="${BLENDER_PYTHON:-target/blender-venv/bin/python}"
+streaks="${STREAKS:-target/release/streaks}"
+
+mkdir -p -- "$out/scenes" "$out/pairs"
+
+stamp() { date -u +%H:%M:%S; }
+
+echo "$(stamp) building the Blender scenes"
+"$blender_python" "$here/blender_streets.py" "$out/scenes"
+
+echo "$(stamp) hill_bend: 640x480, 64 spp, baseline 0.12 m, +5.5 EV"
+"$streaks" stereo "$out/scenes/hill_bend.glb" -o "$out/pairs/hill_bend" \
+    --width 640 --height 480 --spp 64 --baseline 0.12 --exposure 5.5 --seed 1
+
+echo "$(stamp) crossing: 800x450, 64 spp, baseline 0.30 m, automotive_hdr sensor"
+"$streaks" stereo "$out/scenes/crossing.glb" -o "$out/pairs/crossing" \
+    --width 800 --height 450 --spp 64 --baseline 0.30 --sensor automotive_hdr --seed 1
+
+echo "$(stamp) tabletop: 640x480, 64 spp, baseline 0.06 m, +2 EV"
+"$streaks" stereo "$out/scenes/tabletop.glb" -o "$out/pairs/tabletop" \
+    --width 640 --height 480 --spp 64 --baseline 0.06 --exposure 2 --seed 1
+
+echo "$(stamp) other_config: 3 samples, 720x400, 24 spp"
+"$streaks" dataset generate -o "$out/other_config" --config "$here/other_config.toml" \
+    --count 3 --seed 77 --width 720 --height 400 --spp 24 --denoise off \
+    --outputs images,gt,masks
+
+echo "$(stamp) dry_config: 4 samples, 640x360, 16 spp"
+"$streaks" dataset generate -o "$out/dry_config" --config "$here/dry_config.toml" \
+    --count 4 --seed 78 --width 640 --height 360 --spp 16 --denoise off \
+    --outputs images,gt,masks
+
+echo "$(stamp) done: $out"
