@@ -63,7 +63,7 @@ fn dataset_benchmark_scores_every_method_and_a_command_like_sgm() {
     ])
     .assert_success();
     let r = report(&t, "out");
-    assert_eq!(r["format"], "streaks-benchmark/2");
+    assert_eq!(r["format"], "streaks-benchmark/3");
     assert_eq!(r["input"]["kind"], "dataset");
     let names: Vec<&str> = r["methods"]
         .as_array()
@@ -800,7 +800,7 @@ fn a_kitti_folder_is_scored_with_predictions_and_a_batch_command() {
         "{err}"
     );
     let r = report(&t, "out");
-    assert_eq!(r["format"], "streaks-benchmark/2");
+    assert_eq!(r["format"], "streaks-benchmark/3");
     assert_eq!(r["input"]["kind"], "kitti");
     let ids: Vec<&str> = r["samples"]
         .as_array()
