@@ -24,7 +24,7 @@ use streaks_dataset::files::{
     PAIR_NAMES, RIG, SAMPLE_NAMES,
 };
 use streaks_dataset::layout::Layout;
-use streaks_dataset::meta::{Condition, SampleMeta};
+use streaks_dataset::meta::{Condition, PresetNoise, SampleMeta};
 use streaks_image::pfm::read_pfm;
 use streaks_image::GrayImage;
 use streaks_stereo::rig::Eye;
@@ -70,6 +70,16 @@ impl SampleMasks {
             non_occluded: self.non_occluded.as_ref(),
         }
     }
+}
+
+/// The sensor preset `name`'s shutter time and whether it has noise, for a sample's noise
+/// condition (`None` for a preset this version does not know).
+fn preset_noise(name: &str) -> Option<PresetNoise> {
+    let p = streaks_sensor::SensorProfile::preset(name).ok()?;
+    Some(PresetNoise {
+        exposure_s: p.exposure_s,
+        noisy: p.shot_noise || p.read_noise_e > 0.0,
+    })
 }
 
 /// The files of one sample to benchmark on.
@@ -129,7 +139,7 @@ impl Sample {
         let Some(path) = &self.meta else {
             return Ok(None);
         };
-        Ok(Some(SampleMeta::load(path)?.conditions()))
+        Ok(Some(SampleMeta::load(path)?.conditions(preset_noise)))
     }
 
     /// Its masks, each checked to have the ground truth's `size`.

@@ -179,7 +179,7 @@ pub enum Condition {
     /// The scene has fog: `weather.fog` is not `null`.
     Fog,
     /// The camera's auto-exposure gain is above its preset's: [`WeatherMeta::gain_ev`] >
-    /// [`NOISE_GAIN_EV`] with a preset that has noise.
+    /// [`NOISE_GAIN_EV`] with a preset that has noise ([`PresetNoise`]).
     Noise,
 }
 
@@ -210,24 +210,33 @@ impl Condition {
 /// stops, so any gain above the preset's, 0 stops, is the noisy end (about 7 % of samples).
 pub const NOISE_GAIN_EV: f64 = 0.0;
 
+/// What [`Condition::Noise`] needs to know of a sensor preset (the caller looks it up by the
+/// preset's name: `streaks_sensor::SensorProfile::preset`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PresetNoise {
+    /// The preset's own shutter time, seconds (the one its development is set for).
+    pub exposure_s: f64,
+    /// Whether the preset has any noise (shot or read noise; the `ideal` preset has none).
+    pub noisy: bool,
+}
+
 impl WeatherMeta {
-    /// The auto-exposure gain of the sample's camera above its sensor preset's, stops:
+    /// The auto-exposure gain of the sample's camera above its sensor `preset`'s, stops:
     /// `log2(preset exposure_s / exposure_s)`, as the generator develops the image
-    /// (`src/dataset/sample.rs`). `None` when the preset is unknown to this version or has no
-    /// noise at all (the `ideal` preset: no shot and no read noise).
-    pub fn gain_ev(&self) -> Option<f64> {
-        let preset = streaks_sensor::SensorProfile::preset(&self.sensor).ok()?;
-        let noisy = preset.shot_noise || preset.read_noise_e > 0.0;
-        (noisy && self.exposure_s > 0.0).then(|| (preset.exposure_s / self.exposure_s).log2())
+    /// (`src/dataset/sample.rs`). `None` without the preset (unknown to this version) or when
+    /// it has no noise at all.
+    pub fn gain_ev(&self, preset: Option<PresetNoise>) -> Option<f64> {
+        let p = preset.filter(|p| p.noisy)?;
+        (self.exposure_s > 0.0).then(|| (p.exposure_s / self.exposure_s).log2())
     }
 
-    /// The conditions of a sample with this weather, in [`Condition::ALL`]'s order: `rain` when
-    /// rain falls, `fog` when there is fog, `dry` when neither, and `noise` when the gain is
-    /// above [`NOISE_GAIN_EV`].
-    pub fn conditions(&self) -> Vec<Condition> {
+    /// The conditions of a sample with this weather and the sensor `preset` it names, in
+    /// [`Condition::ALL`]'s order: `rain` when rain falls, `fog` when there is fog, `dry` when
+    /// neither, and `noise` when the gain is above [`NOISE_GAIN_EV`].
+    pub fn conditions(&self, preset: Option<PresetNoise>) -> Vec<Condition> {
         let rain = self.rain_mm_h > 0.0;
         let fog = self.fog.is_some();
-        let noise = self.gain_ev().is_some_and(|g| g > NOISE_GAIN_EV);
+        let noise = self.gain_ev(preset).is_some_and(|g| g > NOISE_GAIN_EV);
         [
             (Condition::Dry, !rain && !fog),
             (Condition::Rain, rain),
@@ -389,10 +398,11 @@ impl SampleMeta {
     /// The conditions the sample was rendered in ([`WeatherMeta::conditions`]); a sample
     /// without a weather record (a config without `[weather]`: no rain, no fog, the render
     /// without a camera's noise) is `dry` only.
-    pub fn conditions(&self) -> Vec<Condition> {
+    /// `preset` gives a sensor preset's [`PresetNoise`] by its name (`None`: unknown).
+    pub fn conditions(&self, preset: impl Fn(&str) -> Option<PresetNoise>) -> Vec<Condition> {
         self.weather
             .as_ref()
-            .map_or_else(|| vec![Condition::Dry], WeatherMeta::conditions)
+            .map_or_else(|| vec![Condition::Dry], |w| w.conditions(preset(&w.sensor)))
     }
 
     /// The file's bytes (pretty JSON, a final newline).
@@ -439,41 +449,49 @@ mod tests {
             g: 0.8,
             height_falloff: 0.1,
         };
-        let weather =
-            |rain_mm_h: f64, fog: Option<FogMeta>, sensor: &str, exposure_s: f64| WeatherMeta {
-                rain_class: "x".into(),
-                rain_mm_h,
-                rain_seed: 1,
-                fog,
-                sensor: sensor.into(),
-                exposure_s,
-                rig_velocity: [0.0; 3],
-            };
+        let weather = |rain_mm_h: f64, fog: Option<FogMeta>, exposure_s: f64| WeatherMeta {
+            rain_class: "x".into(),
+            rain_mm_h,
+            rain_seed: 1,
+            fog,
+            sensor: "automotive_hdr".into(),
+            exposure_s,
+            rig_velocity: [0.0; 3],
+        };
+        // Both automotive presets expose 10 ms.
+        let automotive = Some(PresetNoise {
+            exposure_s: 0.01,
+            noisy: true,
+        });
         use Condition::*;
-        // Both automotive presets expose 10 ms: 20 ms is 1 stop below their gain, 5 ms 1 above.
-        let w = weather(0.0, None, "automotive_linear", 0.02);
-        assert_eq!(w.gain_ev(), Some(-1.0));
-        assert_eq!(w.conditions(), vec![Dry]);
-        let w = weather(0.0, None, "automotive_hdr", 0.005);
-        assert_eq!(w.gain_ev(), Some(1.0));
-        assert_eq!(w.conditions(), vec![Dry, Noise]);
+        // 20 ms is 1 stop below the preset's gain, 5 ms 1 stop above.
+        let w = weather(0.0, None, 0.02);
+        assert_eq!(w.gain_ev(automotive), Some(-1.0));
+        assert_eq!(w.conditions(automotive), vec![Dry]);
+        let w = weather(0.0, None, 0.005);
+        assert_eq!(w.gain_ev(automotive), Some(1.0));
+        assert_eq!(w.conditions(automotive), vec![Dry, Noise]);
         // Exactly the preset's shutter: no gain, no noise condition.
+        assert_eq!(weather(0.5, None, 0.01).conditions(automotive), vec![Rain]);
         assert_eq!(
-            weather(0.5, None, "automotive_hdr", 0.01).conditions(),
-            vec![Rain]
-        );
-        assert_eq!(
-            weather(0.0, Some(fog), "automotive_linear", 0.03).conditions(),
+            weather(0.0, Some(fog), 0.03).conditions(automotive),
             vec![Fog]
         );
         assert_eq!(
-            weather(30.0, Some(fog), "automotive_linear", 1.0 / 120.0).conditions(),
+            weather(30.0, Some(fog), 1.0 / 120.0).conditions(automotive),
             vec![Rain, Fog, Noise]
         );
         // A noise-free or unknown preset is never noisy.
-        let ideal = weather(0.0, None, "ideal", 0.001);
-        assert_eq!((ideal.gain_ev(), ideal.conditions()), (None, vec![Dry]));
-        assert_eq!(weather(0.0, None, "nope", 0.001).gain_ev(), None);
+        let ideal = Some(PresetNoise {
+            exposure_s: 0.01,
+            noisy: false,
+        });
+        let short = weather(0.0, None, 0.001);
+        assert_eq!(
+            (short.gain_ev(ideal), short.conditions(ideal)),
+            (None, vec![Dry])
+        );
+        assert_eq!(short.gain_ev(None), None);
         assert_eq!(
             Condition::ALL.map(Condition::name),
             ["dry", "rain", "fog", "noise"]
@@ -526,7 +544,7 @@ mod tests {
         });
         let old: SampleMeta = serde_json::from_value(meta.clone()).unwrap();
         assert_eq!(old.weather, None);
-        assert_eq!(old.conditions(), vec![Condition::Dry]);
+        assert_eq!(old.conditions(|_| None), vec![Condition::Dry]);
         assert!(!String::from_utf8(old.to_bytes())
             .unwrap()
             .contains("weather"));
@@ -534,7 +552,17 @@ mod tests {
         let new: SampleMeta = serde_json::from_value(meta).unwrap();
         assert_eq!(new.weather.as_ref(), Some(&weather));
         // 20 ms on a 10 ms preset: 1 stop below its gain, not noisy.
-        assert_eq!(new.conditions(), vec![Condition::Rain, Condition::Fog]);
+        let preset = |name: &str| {
+            assert_eq!(name, "automotive_hdr");
+            Some(PresetNoise {
+                exposure_s: 0.01,
+                noisy: true,
+            })
+        };
+        assert_eq!(
+            new.conditions(preset),
+            vec![Condition::Rain, Condition::Fog]
+        );
         let again: SampleMeta = serde_json::from_slice(&new.to_bytes()).unwrap();
         assert_eq!(again, new);
     }
