@@ -1,7 +1,8 @@
 //! `streaks benchmark DIR --method NAME... [--method-cmd NAME=TEMPLATE]... [--predictions
 //! NAME=DIR]... -o OUT`: stereo methods scored against the ground truth of a dataset, of
 //! `streaks stereo` pair folders, or of a KITTI 2015 or Middlebury 2014 folder, by region
-//! (streak, road, off-road, non-occluded), with `OUT/report.json` ([`report`]) and a
+//! (streak, road, off-road, non-occluded) and broken down by condition, streak length and
+//! distance ([`streaks_analysis::benchmark::breakdown`]), with `OUT/report.json` ([`report`]) and a
 //! self-contained `OUT/index.html` ([`html`]).
 //!
 //! - [`input`]: the samples of DIR;
