@@ -5,6 +5,9 @@ use super::report::{FailureKind, MethodScore, Report, REGIONS};
 use crate::html::{bar_chart, esc, Bar, CSS};
 use anyhow::Result;
 use std::fmt::Write;
+use streaks_analysis::benchmark::breakdown::{
+    BinErrors, Breakdown, DISTANCE_BINS, STREAK_LENGTH_BINS,
+};
 use streaks_analysis::benchmark::{
     error_colour, ERROR_MAP_RANGE_PX, NO_ESTIMATE_RGB, NO_TRUTH_RGB,
 };
@@ -265,6 +268,192 @@ fn failures(o: &mut String, report: &Report) {
     o.push_str("</section>\n");
 }
 
+/// A cell of a bin's figure: `n/a` when no pixel with ground truth falls in the bin (not
+/// available, not zero), else as [`cell`].
+fn bin_cell(e: Option<&DisparityErrors>, text: impl Fn(&DisparityErrors) -> String) -> String {
+    match e {
+        None => "<td class=\"none\" title=\"not available: no pixel with a ground truth in \
+                 this bin\">n/a</td>"
+            .to_string(),
+        Some(e) => cell(e, text(e)),
+    }
+}
+
+/// The errors of bin `k` of a breakdown's list.
+fn bin_of(bins: &Option<Vec<BinErrors>>, k: usize) -> Option<&DisparityErrors> {
+    bins.as_ref()?.get(k)?.errors.as_ref()
+}
+
+/// The pixels of bin `k` over the methods' breakdowns (the same for every method: the ground
+/// truth's), as a header note.
+fn bin_pixels(
+    report: &Report,
+    list: fn(&Breakdown) -> &Option<Vec<BinErrors>>,
+    k: usize,
+) -> String {
+    let n = report
+        .summary
+        .iter()
+        .find_map(|m| bin_of(list(&m.breakdown), k))
+        .map_or(0, |e| e.truth_pixels);
+    format!("{n} px")
+}
+
+/// The breakdown sections: by condition (a dataset's samples), by streak length, by
+/// distance; each left out when no sample has what it needs.
+fn breakdown(o: &mut String, report: &Report, colour: &dyn Fn(usize) -> &'static str) {
+    let swatch = |i: usize, name: &str| {
+        format!(
+            "<td class=\"l\"><span class=\"swatch\" style=\"background:{}\"></span>{}</td>",
+            colour(i),
+            esc(name)
+        )
+    };
+    if let Some(by) = &report.by_condition {
+        let _ = write!(
+            o,
+            "<section><h2>By condition</h2><p class=\"note\">{}.</p><table id=\"condition\">\
+             <tr><th class=\"l\">condition</th><th class=\"l\">method</th><th>EPE px</th><th>bad-2</th><th>D1</th>\
+             <th>valid</th><th>streak EPE px</th><th>phantom-hole rate</th>\
+             <th>failed samples</th></tr>",
+            esc_code(report.breakdown["condition"].as_str().unwrap_or_default())
+        );
+        for c in by {
+            let head = |rows: usize| {
+                format!(
+                    "<td rowspan=\"{rows}\" class=\"l\"><b>{}</b><br><span class=\"note\">{} \
+                     sample{}</span></td>",
+                    c.condition.name(),
+                    c.samples,
+                    if c.samples == 1 { "" } else { "s" }
+                )
+            };
+            if c.summary.is_empty() {
+                let _ = write!(
+                    o,
+                    "<tr>{}<td class=\"none\" colspan=\"8\" title=\"not available: no sample \
+                     in this condition\">n/a</td></tr>",
+                    head(1)
+                );
+                continue;
+            }
+            for (j, m) in c.summary.iter().enumerate() {
+                let i = report
+                    .summary
+                    .iter()
+                    .position(|s| s.method == m.method)
+                    .unwrap_or(j);
+                let e = &m.errors;
+                let _ = write!(
+                    o,
+                    "<tr>{}{}{}{}{}<td>{}</td>{}{}{}</tr>",
+                    if j == 0 {
+                        head(c.summary.len())
+                    } else {
+                        String::new()
+                    },
+                    swatch(i, &m.method),
+                    cell(&e.all, format!("{:.3}", e.all.mean_abs)),
+                    cell(&e.all, pct(e.all.bad_2)),
+                    cell(&e.all, pct(e.all.d1)),
+                    pct(e.all.density),
+                    region_cell(e.streak.as_ref(), |s| format!("{:.3}", s.mean_abs)),
+                    phantom_cell(m),
+                    failed_cell(m)
+                );
+            }
+        }
+        o.push_str("</table></section>\n");
+    }
+    let has = |list: fn(&Breakdown) -> &Option<Vec<BinErrors>>| {
+        report.summary.iter().any(|m| list(&m.breakdown).is_some())
+    };
+    if has(|b| &b.streak_length) {
+        let _ = write!(
+            o,
+            "<section><h2>By streak length</h2><p class=\"note\">{}.</p>\
+             <table id=\"streak-length\"><tr><th rowspan=\"2\">method</th>",
+            esc_code(
+                report.breakdown["streak_length"]
+                    .as_str()
+                    .unwrap_or_default()
+            )
+        );
+        for (k, b) in STREAK_LENGTH_BINS.iter().enumerate() {
+            let range = if b.high.is_finite() {
+                format!("{}-{} % of the height", 100.0 * b.low, 100.0 * b.high)
+            } else {
+                format!("&ge; {} % of the height", 100.0 * b.low)
+            };
+            let _ = write!(
+                o,
+                "<th colspan=\"3\">{}<br><span class=\"note\">{range}, {}</span></th>",
+                b.name,
+                bin_pixels(report, |b| &b.streak_length, k)
+            );
+        }
+        o.push_str("</tr><tr>");
+        for _ in STREAK_LENGTH_BINS {
+            o.push_str("<th>EPE px</th><th>bad-2</th><th>&gt; 1 px below</th>");
+        }
+        o.push_str("</tr>");
+        for (i, m) in report.summary.iter().enumerate() {
+            let _ = write!(o, "<tr>{}", swatch(i, &m.method));
+            for k in 0..STREAK_LENGTH_BINS.len() {
+                let e = bin_of(&m.breakdown.streak_length, k);
+                let _ = write!(
+                    o,
+                    "{}{}{}",
+                    bin_cell(e, |e| format!("{:.3}", e.mean_abs)),
+                    bin_cell(e, |e| pct(e.bad_2)),
+                    bin_cell(e, |e| pct(e.below_1px))
+                );
+            }
+            o.push_str("</tr>");
+        }
+        o.push_str("</table></section>\n");
+    }
+    if has(|b| &b.road_surface_by_distance) || has(|b| &b.off_road_by_distance) {
+        let _ = write!(
+            o,
+            "<section><h2>By distance</h2><p class=\"note\">{}.</p>\
+             <table id=\"distance\"><tr><th rowspan=\"2\">method</th>",
+            esc_code(report.breakdown["distance"].as_str().unwrap_or_default())
+        );
+        for (k, b) in DISTANCE_BINS.iter().enumerate() {
+            let _ = write!(
+                o,
+                "<th colspan=\"2\">{}<br><span class=\"note\">road {}, off-road {}</span></th>",
+                esc(b.name),
+                bin_pixels(report, |b| &b.road_surface_by_distance, k),
+                bin_pixels(report, |b| &b.off_road_by_distance, k)
+            );
+        }
+        o.push_str("</tr><tr>");
+        for _ in DISTANCE_BINS {
+            o.push_str("<th>road: phantom holes</th><th>off-road: bad-2</th>");
+        }
+        o.push_str("</tr>");
+        for (i, m) in report.summary.iter().enumerate() {
+            let _ = write!(o, "<tr>{}", swatch(i, &m.method));
+            for k in 0..DISTANCE_BINS.len() {
+                let _ = write!(
+                    o,
+                    "{}{}",
+                    bin_cell(bin_of(&m.breakdown.road_surface_by_distance, k), |e| pct(
+                        e.below_1px
+                    )),
+                    bin_cell(bin_of(&m.breakdown.off_road_by_distance, k), |e| pct(
+                        e.bad_2
+                    ))
+                );
+            }
+            o.push_str("</tr>");
+        }
+        o.push_str("</table></section>\n");
+    }
+}
+
 /// The page.
 pub fn page(report: &Report, thumbs: &[SampleThumbs]) -> String {
     let colour = |i: usize| PALETTE[i % PALETTE.len()];
@@ -445,6 +634,7 @@ pub fn page(report: &Report, thumbs: &[SampleThumbs]) -> String {
         o.push_str("</table>");
     }
     o.push_str("<p class=\"note\">D1 is KITTI 2015's: off by more than 3 px and by more than 5 % of the true disparity. A region is left out where no sample has its masks: the road regions without road masks (pair folders of scenes that flag no road, KITTI, Middlebury), the streak regions without streak masks (KITTI, Middlebury), the non-occluded pixels without an occlusion mask (KITTI's disp_noc_0, Middlebury's mask0nocc.png).</p></section>\n");
+    breakdown(&mut o, report, &colour);
     // Per-sample table.
     o.push_str("<section><h2>Per sample</h2><table id=\"samples\"><tr><th>sample</th><th class=\"l\">method</th><th>EPE px</th><th>bad-2</th><th>streak EPE px</th><th>valid</th><th>phantom-hole rate</th><th>seconds</th><th>s / megapixel</th><th class=\"l\">status</th></tr>");
     for s in &report.samples {
@@ -457,8 +647,17 @@ pub fn page(report: &Report, thumbs: &[SampleThumbs]) -> String {
                     ),
                     _ => String::new(),
                 };
+                let conditions = s
+                    .conditions
+                    .as_ref()
+                    .map(|cs| {
+                        let names: Vec<&str> = cs.iter().map(|c| c.name()).collect();
+                        format!("<br><span class=\"note\">{}</span>", names.join(", "))
+                    })
+                    .unwrap_or_default();
                 format!(
-                    "<td rowspan=\"{}\">{}<br><span class=\"note\">{}x{}</span>{plane}</td>",
+                    "<td rowspan=\"{}\">{}<br><span class=\"note\">{}x{}</span>{conditions}\
+                     {plane}</td>",
                     s.results.len(),
                     esc(&s.id),
                     s.width,

@@ -24,6 +24,8 @@ use streaks_dataset::files::{
     PAIR_NAMES, RIG, SAMPLE_NAMES,
 };
 use streaks_dataset::layout::Layout;
+use streaks_dataset::meta::{Condition, PresetNoise, SampleMeta};
+use streaks_image::pfm::read_pfm;
 use streaks_image::GrayImage;
 use streaks_stereo::rig::Eye;
 
@@ -70,6 +72,16 @@ impl SampleMasks {
     }
 }
 
+/// The sensor preset `name`'s shutter time and whether it has noise, for a sample's noise
+/// condition (`None` for a preset this version does not know).
+fn preset_noise(name: &str) -> Option<PresetNoise> {
+    let p = streaks_sensor::SensorProfile::preset(name).ok()?;
+    Some(PresetNoise {
+        exposure_s: p.exposure_s,
+        noisy: p.shot_noise || p.read_noise_e > 0.0,
+    })
+}
+
 /// The files of one sample to benchmark on.
 #[derive(Clone, Debug)]
 pub struct Sample {
@@ -91,6 +103,11 @@ pub struct Sample {
     pub road: Option<PathBuf>,
     /// The non-occluded pixels, when the data marks them.
     pub occlusion: Option<Occlusion>,
+    /// The left view's ground-truth depth (PFM, metres), when the sample has one (dataset
+    /// samples and pair folders; not KITTI or Middlebury data).
+    pub depth: Option<PathBuf>,
+    /// Its `meta.json`, when it has one (dataset samples): its conditions.
+    pub meta: Option<PathBuf>,
 }
 
 impl Sample {
@@ -101,6 +118,28 @@ impl Sample {
             .with_context(|| format!("reading the ground truth {}", self.truth.display()))?;
         streaks_analysis::benchmark::method::no_value_below_zero(&mut truth);
         Ok(truth)
+    }
+
+    /// Its ground-truth depth, metres, checked to have the ground truth's `size` (`None`
+    /// without one).
+    pub fn read_depth(&self, size: (usize, usize)) -> Result<Option<GrayImage>> {
+        let Some(path) = &self.depth else {
+            return Ok(None);
+        };
+        let depth =
+            read_pfm(path).with_context(|| format!("reading the depth {}", path.display()))?;
+        streaks_image::ensure_same_size("the depth", depth.size(), "the ground truth", size)
+            .with_context(|| format!("the depth {}", path.display()))?;
+        Ok(Some(depth))
+    }
+
+    /// The conditions it was rendered in, from its `meta.json`
+    /// ([`SampleMeta::conditions`]); `None` without one.
+    pub fn conditions(&self) -> Result<Option<Vec<Condition>>> {
+        let Some(path) = &self.meta else {
+            return Ok(None);
+        };
+        Ok(Some(SampleMeta::load(path)?.conditions(preset_noise)))
     }
 
     /// Its masks, each checked to have the ground truth's `size`.
@@ -178,6 +217,8 @@ fn sample(id: String, dir: &Path, rerun: &str) -> Result<Sample> {
         streaks: Some(files.streak_mask(Eye::Left)),
         road: Some(files.road_mask(Eye::Left)).filter(|p| p.is_file()),
         occlusion: None,
+        depth: Some(files.depth(Eye::Left)).filter(|p| p.is_file()),
+        meta: Some(files.meta()).filter(|p| p.is_file()),
         dir: dir.to_path_buf(),
     };
     files
@@ -227,6 +268,8 @@ fn middlebury_sample(dir: &Path, truth: PathBuf) -> Sample {
         streaks: None,
         road: None,
         occlusion: nocc.is_file().then_some(Occlusion::MiddleburyMask(nocc)),
+        depth: None,
+        meta: None,
         dir: dir.to_path_buf(),
     }
 }
@@ -275,6 +318,8 @@ fn kitti_samples(root: &Path) -> Result<Vec<Sample>> {
                 streaks: None,
                 road: None,
                 occlusion: noc.is_file().then_some(Occlusion::KittiNoc(noc)),
+                depth: None,
+                meta: None,
             })
         })
         .collect()

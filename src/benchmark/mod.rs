@@ -1,7 +1,8 @@
 //! `streaks benchmark DIR --method NAME... [--method-cmd NAME=TEMPLATE]... [--predictions
 //! NAME=DIR]... -o OUT`: stereo methods scored against the ground truth of a dataset, of
 //! `streaks stereo` pair folders, or of a KITTI 2015 or Middlebury 2014 folder, by region
-//! (streak, road, off-road, non-occluded), with `OUT/report.json` ([`report`]) and a
+//! (streak, road, off-road, non-occluded) and broken down by condition, streak length and
+//! distance ([`streaks_analysis::benchmark::breakdown`]), with `OUT/report.json` ([`report`]) and a
 //! self-contained `OUT/index.html` ([`html`]).
 //!
 //! - [`input`]: the samples of DIR;
@@ -35,6 +36,7 @@ use method::Method;
 use report::{Input, MethodInfo, MethodScore, Report, SampleReport};
 use std::path::PathBuf;
 use std::time::Duration;
+use streaks_analysis::benchmark::breakdown::{score_breakdown, SampleBins};
 use streaks_analysis::benchmark::{error_map, score_regions, BAD_THRESHOLD_PX};
 use streaks_analysis::road_plane::RoadPlaneCheck;
 use streaks_dataset::files::SampleDir;
@@ -191,6 +193,11 @@ pub fn run(args: Args) -> Result<()> {
         let size = (truth.width, truth.height);
         let masks = sample.masks(size)?;
         let road = masks.road.as_ref();
+        let bins = SampleBins::new(size, &masks.as_masks(), sample.read_depth(size)?.as_ref())
+            .with_context(|| format!("sample {}", sample.id))?;
+        let conditions = sample
+            .conditions()
+            .with_context(|| format!("the conditions of sample {}", sample.id))?;
         let megapixels = (size.0 * size.1) as f64 / 1e6;
         let mut results = Vec::new();
         let mut maps = Vec::new();
@@ -214,16 +221,15 @@ pub fn run(args: Args) -> Result<()> {
                 }
             };
             let errors = score_regions(&disp, &truth, &masks.as_masks()).with_context(what)?;
+            let breakdown =
+                score_breakdown(&disp, &truth, &masks.as_masks(), &bins).with_context(what)?;
             if k < args.thumbnails {
                 maps.push((m.name().to_string(), error_map(&disp, &truth)?));
             }
-            results.push(MethodScore::new(
-                m.name(),
-                errors,
-                outcome.seconds,
-                megapixels,
-                failure,
-            ));
+            results.push(
+                MethodScore::new(m.name(), errors, outcome.seconds, megapixels, failure)
+                    .with_breakdown(breakdown),
+            );
             bar.inc(1);
         }
         if k < args.thumbnails {
@@ -247,6 +253,7 @@ pub fn run(args: Args) -> Result<()> {
             streak_mask: masks.streaks.is_some(),
             road_mask: road.is_some(),
             occlusion_mask: masks.non_occluded.is_some(),
+            conditions,
             road_plane,
             results,
         });
@@ -254,6 +261,7 @@ pub fn run(args: Args) -> Result<()> {
     bar.finish_and_clear();
     let summary = report::summary(methods.iter().map(|m| m.name()), &sample_reports)
         .context("pooling the samples")?;
+    let by_condition = report::by_condition(methods.iter().map(|m| m.name()), &sample_reports);
     let report = Report {
         format: report::FORMAT,
         input: Input {
@@ -276,7 +284,9 @@ pub fn run(args: Args) -> Result<()> {
                 timing: m.timing(),
             })
             .collect(),
+        breakdown: report::breakdown_definitions(),
         summary,
+        by_condition,
         samples: sample_reports,
         failure_scoring: report::FAILURE_SCORING,
         unavailable: report::UNAVAILABLE,

@@ -3,8 +3,9 @@
 
 use serde::Serialize;
 pub use streaks_analysis::benchmark::report::{
-    summary, Failure, FailureKind, MethodInfo, MethodScore, SampleReport, AGGREGATION,
-    FAILURE_SCORING, FORMAT, REGIONS, UNAVAILABLE,
+    breakdown_definitions, by_condition, summary, ConditionSummary, Failure, FailureKind,
+    MethodInfo, MethodScore, SampleReport, AGGREGATION, FAILURE_SCORING, FORMAT, REGIONS,
+    UNAVAILABLE,
 };
 
 /// The whole report.
@@ -22,8 +23,13 @@ pub struct Report {
     pub regions: serde_json::Map<String, serde_json::Value>,
     /// The methods, in the order run.
     pub methods: Vec<MethodInfo>,
+    /// [`breakdown_definitions`]: what the breakdowns mean.
+    pub breakdown: serde_json::Map<String, serde_json::Value>,
     /// Per method, over all samples.
     pub summary: Vec<MethodScore>,
+    /// Per condition, per method, over the samples in it ([`by_condition`]; `None` when no
+    /// sample has a `meta.json`).
+    pub by_condition: Option<Vec<ConditionSummary>>,
     /// Per sample.
     pub samples: Vec<SampleReport>,
     /// [`FAILURE_SCORING`].

@@ -63,7 +63,7 @@ fn dataset_benchmark_scores_every_method_and_a_command_like_sgm() {
     ])
     .assert_success();
     let r = report(&t, "out");
-    assert_eq!(r["format"], "streaks-benchmark/2");
+    assert_eq!(r["format"], "streaks-benchmark/3");
     assert_eq!(r["input"]["kind"], "dataset");
     let names: Vec<&str> = r["methods"]
         .as_array()
@@ -208,6 +208,8 @@ fn pair_folders_are_benchmarked_with_their_road_masks() {
     assert_eq!(one["input"]["kind"], "pair");
     assert_eq!(one["samples"][0]["id"], "a");
     assert_eq!(one["samples"][0]["road_mask"], true);
+    // No meta.json: no conditions, no breakdown by condition.
+    assert!(one["samples"][0]["conditions"].is_null() && one["by_condition"].is_null());
     let road_pixels = one["samples"][0]["results"][0]["errors"]["road_surface"]["truth_pixels"]
         .as_u64()
         .unwrap();
@@ -409,6 +411,113 @@ fn tiny_dataset(t: &TestDir, dir: &str) {
         "--spp", "4",
     ])
     .assert_success();
+}
+
+/// The sum of `truth_pixels` over a breakdown's bins; every bin is null or has pixels.
+fn bin_pixels(bins: &Value) -> u64 {
+    bins.as_array()
+        .unwrap()
+        .iter()
+        .map(|b| match &b["errors"] {
+            Value::Null => 0,
+            e => {
+                let n = e["truth_pixels"].as_u64().unwrap();
+                assert!(n > 0, "a bin with no pixels must be null: {b}");
+                n
+            }
+        })
+        .sum()
+}
+
+#[test]
+fn a_dataset_report_breaks_the_errors_down_by_condition_streak_length_and_distance() {
+    let t = TestDir::new();
+    tiny_dataset(&t, "ds");
+    // Set the two samples' weather: 000000 dry at 5 ms (1 stop of gain over the presets'
+    // 10 ms: noise), 000001 in rain and fog at 20 ms (no gain).
+    let set = |id: &str, rain: f64, fog: Value, exposure: f64| {
+        let path = t.join(&format!("ds/samples/{id}/meta.json"));
+        let mut meta: Value =
+            serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        let w = &mut meta["weather"];
+        w["rain_mm_h"] = rain.into();
+        w["fog"] = fog;
+        w["exposure_s"] = exposure.into();
+        std::fs::write(&path, serde_json::to_string_pretty(&meta).unwrap()).unwrap();
+    };
+    set("000000", 0.0, Value::Null, 0.005);
+    let fog = serde_json::json!({"sigma_t": 0.02, "albedo": 0.95, "g": 0.8, "height_falloff": 0.1});
+    set("000001", 3.0, fog, 0.02);
+    t.streaks(&["benchmark", "ds", "--method", "sgm", "-o", "out"])
+        .assert_success();
+    let r = report(&t, "out");
+    for k in ["condition", "streak_length", "distance", "empty_bins"] {
+        assert!(r["breakdown"][k].is_string(), "{k}");
+    }
+    let samples = r["samples"].as_array().unwrap();
+    assert_eq!(
+        samples[0]["conditions"],
+        serde_json::json!(["dry", "noise"])
+    );
+    assert_eq!(samples[1]["conditions"], serde_json::json!(["rain", "fog"]));
+    // Each condition pools its own sample; a condition without samples has no figures.
+    let all_pixels = |k: usize| samples[k]["results"][0]["errors"]["all"]["truth_pixels"].clone();
+    let by = r["by_condition"].as_array().unwrap();
+    let names: Vec<&str> = by
+        .iter()
+        .map(|c| c["condition"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["dry", "rain", "fog", "noise"]);
+    for (c, k) in by.iter().zip([0, 1, 1, 0]) {
+        assert_eq!(c["samples"], 1, "{}", c["condition"]);
+        assert_eq!(c["summary"][0]["method"], "sgm");
+        assert_eq!(
+            c["summary"][0]["errors"]["all"]["truth_pixels"],
+            all_pixels(k)
+        );
+    }
+    // The breakdown by streak length covers exactly the streak pixels on the road with a
+    // ground truth; by distance, the road surface and the off-road region.
+    let sgm = summary(&r, "sgm");
+    let b = &sgm["breakdown"];
+    let bins: Vec<&str> = b["streak_length"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x["bin"].as_str().unwrap())
+        .collect();
+    assert_eq!(bins, ["short", "medium", "long"]);
+    let mut on_road_streaks = 0;
+    for id in ["000000", "000001"] {
+        let dir = t.join(&format!("ds/samples/{id}"));
+        let streaks = streaks_image::GrayImage::load(&dir.join("streaks0.png")).unwrap();
+        let road = streaks_image::GrayImage::load(&dir.join("road0.png")).unwrap();
+        let truth = streaks_image::pfm::read_pfm(&dir.join("disp0.pfm")).unwrap();
+        on_road_streaks += (0..truth.data.len())
+            .filter(|&i| {
+                streaks.data[i] > 0.0
+                    && road.data[i] > 0.0
+                    && truth.data[i].is_finite()
+                    && truth.data[i] > 0.0
+            })
+            .count() as u64;
+    }
+    assert!(on_road_streaks > 0);
+    assert_eq!(bin_pixels(&b["streak_length"]), on_road_streaks);
+    let region = |k: &str| sgm["errors"][k]["truth_pixels"].as_u64().unwrap();
+    assert_eq!(
+        bin_pixels(&b["road_surface_by_distance"]),
+        region("road_surface")
+    );
+    assert_eq!(bin_pixels(&b["off_road_by_distance"]), region("off_road"));
+    assert_eq!(b["road_surface_by_distance"][3]["bin"], "40+ m");
+    // Per sample too, and the page has the tables.
+    let own = &samples[0]["results"][0]["breakdown"];
+    assert!(own["streak_length"].is_array() && own["road_surface_by_distance"].is_array());
+    let page = std::fs::read_to_string(t.join("out/index.html")).unwrap();
+    for heading in ["By condition", "By streak length", "By distance"] {
+        assert!(page.contains(heading), "{heading}");
+    }
 }
 
 #[test]
@@ -800,8 +909,12 @@ fn a_kitti_folder_is_scored_with_predictions_and_a_batch_command() {
         "{err}"
     );
     let r = report(&t, "out");
-    assert_eq!(r["format"], "streaks-benchmark/2");
+    assert_eq!(r["format"], "streaks-benchmark/3");
     assert_eq!(r["input"]["kind"], "kitti");
+    // No masks, no depth, no meta.json: no breakdown, not zeros.
+    assert!(r["by_condition"].is_null());
+    let b = &r["samples"][0]["results"][0]["breakdown"];
+    assert!(b["streak_length"].is_null() && b["road_surface_by_distance"].is_null());
     let ids: Vec<&str> = r["samples"]
         .as_array()
         .unwrap()

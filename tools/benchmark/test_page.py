@@ -6,7 +6,9 @@
 starts chromedriver (/usr/bin/chromedriver, or $CHROMEDRIVER) and talks WebDriver to it over
 plain HTTP (the W3C protocol, no Selenium): it opens the page from file://, waits for it to
 load, and checks that every <img> resolved (complete, naturalWidth > 0), that the methods
-table and the summary table hold every method, and that the bar charts are there.
+table, the summary table and the breakdown tables (by condition, streak length and distance,
+where the page has them) hold every method, that an empty bin reads n/a, and that the bar
+charts are there.
 """
 
 from __future__ import annotations
@@ -158,5 +160,20 @@ def test_page_loads_with_every_image_and_method(browser: WebDriver) -> None:
         text = browser.run(f"return document.getElementById('{table}').innerText")
         for m in methods:
             assert m in text, f"table {table} lacks method {m}: {text}"
+    # The breakdown tables, where the report has them (a dataset's: all three; KITTI: none):
+    # every method, and n/a (never 0) in a bin or condition without pixels.
+    for table in ("condition", "streak-length", "distance"):
+        text = browser.run(
+            f"const t = document.getElementById('{table}'); return t ? t.innerText : null"
+        )
+        if text is None:
+            continue
+        for m in methods:
+            assert m in text, f"table {table} lacks method {m}: {text}"
+    empty = browser.run(
+        "return Array.from(document.querySelectorAll('td.none[title^=\"not available: no\"]'))"
+        ".map(td => td.innerText)"
+    )
+    assert all(t == "n/a" for t in empty), empty
     charts = browser.run("return document.querySelectorAll('svg rect').length")
     assert charts >= len(methods), charts

@@ -167,6 +167,88 @@ pub struct WeatherMeta {
     pub rig_velocity: [f64; 3],
 }
 
+/// A condition a sample was rendered in, from its `meta.json` ([`SampleMeta::conditions`]); a
+/// sample can be in several (rain, fog and noise), and `dry` is neither rain nor fog.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Condition {
+    /// No rain falls and there is no fog.
+    Dry,
+    /// Rain falls: `weather.rain_mm_h > 0`.
+    Rain,
+    /// The scene has fog: `weather.fog` is not `null`.
+    Fog,
+    /// The camera's auto-exposure gain is above its preset's: [`WeatherMeta::gain_ev`] >
+    /// [`NOISE_GAIN_EV`] with a preset that has noise ([`PresetNoise`]).
+    Noise,
+}
+
+impl Condition {
+    /// Every condition, in the order reports list them.
+    pub const ALL: [Condition; 4] = [
+        Condition::Dry,
+        Condition::Rain,
+        Condition::Fog,
+        Condition::Noise,
+    ];
+
+    /// Its name in reports (`dry`, `rain`, `fog`, `noise`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Condition::Dry => "dry",
+            Condition::Rain => "rain",
+            Condition::Fog => "fog",
+            Condition::Noise => "noise",
+        }
+    }
+}
+
+/// The gain above which a sample is in [`Condition::Noise`], stops: a shutter time shorter than
+/// the sensor preset's own (10 ms for both automotive presets) makes the auto exposure raise
+/// the gain by `log2(preset exposure / exposure)`, and the relative shot noise by half of that
+/// in stops. With the default shutter times (1/120 to 1/30 s) the gain spans -1.74 to +0.26
+/// stops, so any gain above the preset's, 0 stops, is the noisy end (about 7 % of samples).
+pub const NOISE_GAIN_EV: f64 = 0.0;
+
+/// What [`Condition::Noise`] needs to know of a sensor preset (the caller looks it up by the
+/// preset's name: `streaks_sensor::SensorProfile::preset`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PresetNoise {
+    /// The preset's own shutter time, seconds (the one its development is set for).
+    pub exposure_s: f64,
+    /// Whether the preset has any noise (shot or read noise; the `ideal` preset has none).
+    pub noisy: bool,
+}
+
+impl WeatherMeta {
+    /// The auto-exposure gain of the sample's camera above its sensor `preset`'s, stops:
+    /// `log2(preset exposure_s / exposure_s)`, as the generator develops the image
+    /// (`src/dataset/sample.rs`). `None` without the preset (unknown to this version) or when
+    /// it has no noise at all.
+    pub fn gain_ev(&self, preset: Option<PresetNoise>) -> Option<f64> {
+        let p = preset.filter(|p| p.noisy)?;
+        (self.exposure_s > 0.0).then(|| (p.exposure_s / self.exposure_s).log2())
+    }
+
+    /// The conditions of a sample with this weather and the sensor `preset` it names, in
+    /// [`Condition::ALL`]'s order: `rain` when rain falls, `fog` when there is fog, `dry` when
+    /// neither, and `noise` when the gain is above [`NOISE_GAIN_EV`].
+    pub fn conditions(&self, preset: Option<PresetNoise>) -> Vec<Condition> {
+        let rain = self.rain_mm_h > 0.0;
+        let fog = self.fog.is_some();
+        let noise = self.gain_ev(preset).is_some_and(|g| g > NOISE_GAIN_EV);
+        [
+            (Condition::Dry, !rain && !fog),
+            (Condition::Rain, rain),
+            (Condition::Fog, fog),
+            (Condition::Noise, noise),
+        ]
+        .into_iter()
+        .filter_map(|(c, on)| on.then_some(c))
+        .collect()
+    }
+}
+
 /// How a sample was rendered: the dataset's render settings, the eyes' seeds and the samples
 /// they took.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -313,6 +395,16 @@ impl SampleMeta {
         })
     }
 
+    /// The conditions the sample was rendered in ([`WeatherMeta::conditions`]); a sample
+    /// without a weather record (a config without `[weather]`: no rain, no fog, the render
+    /// without a camera's noise) is `dry` only.
+    /// `preset` gives a sensor preset's [`PresetNoise`] by its name (`None`: unknown).
+    pub fn conditions(&self, preset: impl Fn(&str) -> Option<PresetNoise>) -> Vec<Condition> {
+        self.weather
+            .as_ref()
+            .map_or_else(|| vec![Condition::Dry], |w| w.conditions(preset(&w.sensor)))
+    }
+
     /// The file's bytes (pretty JSON, a final newline).
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut text = serde_json::to_string_pretty(self).expect("meta.json serialises");
@@ -347,6 +439,64 @@ mod tests {
             [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]
         );
         assert_eq!(matrix_rows(&first)[0], [1.0, 0.0, 0.0, 5.0]);
+    }
+
+    #[test]
+    fn conditions_follow_rain_fog_and_the_gain() {
+        let fog = FogMeta {
+            sigma_t: 0.02,
+            albedo: 0.95,
+            g: 0.8,
+            height_falloff: 0.1,
+        };
+        let weather = |rain_mm_h: f64, fog: Option<FogMeta>, exposure_s: f64| WeatherMeta {
+            rain_class: "x".into(),
+            rain_mm_h,
+            rain_seed: 1,
+            fog,
+            sensor: "automotive_hdr".into(),
+            exposure_s,
+            rig_velocity: [0.0; 3],
+        };
+        // Both automotive presets expose 10 ms.
+        let automotive = Some(PresetNoise {
+            exposure_s: 0.01,
+            noisy: true,
+        });
+        use Condition::*;
+        // 20 ms is 1 stop below the preset's gain, 5 ms 1 stop above.
+        let w = weather(0.0, None, 0.02);
+        assert_eq!(w.gain_ev(automotive), Some(-1.0));
+        assert_eq!(w.conditions(automotive), vec![Dry]);
+        let w = weather(0.0, None, 0.005);
+        assert_eq!(w.gain_ev(automotive), Some(1.0));
+        assert_eq!(w.conditions(automotive), vec![Dry, Noise]);
+        // Exactly the preset's shutter: no gain, no noise condition.
+        assert_eq!(weather(0.5, None, 0.01).conditions(automotive), vec![Rain]);
+        assert_eq!(
+            weather(0.0, Some(fog), 0.03).conditions(automotive),
+            vec![Fog]
+        );
+        assert_eq!(
+            weather(30.0, Some(fog), 1.0 / 120.0).conditions(automotive),
+            vec![Rain, Fog, Noise]
+        );
+        // A noise-free or unknown preset is never noisy.
+        let ideal = Some(PresetNoise {
+            exposure_s: 0.01,
+            noisy: false,
+        });
+        let short = weather(0.0, None, 0.001);
+        assert_eq!(
+            (short.gain_ev(ideal), short.conditions(ideal)),
+            (None, vec![Dry])
+        );
+        assert_eq!(short.gain_ev(None), None);
+        assert_eq!(
+            Condition::ALL.map(Condition::name),
+            ["dry", "rain", "fog", "noise"]
+        );
+        assert_eq!(serde_json::to_string(&Noise).unwrap(), "\"noise\"");
     }
 
     #[test]
@@ -394,12 +544,25 @@ mod tests {
         });
         let old: SampleMeta = serde_json::from_value(meta.clone()).unwrap();
         assert_eq!(old.weather, None);
+        assert_eq!(old.conditions(|_| None), vec![Condition::Dry]);
         assert!(!String::from_utf8(old.to_bytes())
             .unwrap()
             .contains("weather"));
         meta["weather"] = serde_json::to_value(&weather).unwrap();
         let new: SampleMeta = serde_json::from_value(meta).unwrap();
         assert_eq!(new.weather.as_ref(), Some(&weather));
+        // 20 ms on a 10 ms preset: 1 stop below its gain, not noisy.
+        let preset = |name: &str| {
+            assert_eq!(name, "automotive_hdr");
+            Some(PresetNoise {
+                exposure_s: 0.01,
+                noisy: true,
+            })
+        };
+        assert_eq!(
+            new.conditions(preset),
+            vec![Condition::Rain, Condition::Fog]
+        );
         let again: SampleMeta = serde_json::from_slice(&new.to_bytes()).unwrap();
         assert_eq!(again, new);
     }

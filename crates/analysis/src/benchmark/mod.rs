@@ -1,6 +1,7 @@
 //! Scoring stereo methods against ground truth by region, for `streaks benchmark`.
 //!
 //! - this file: the regions, [`score_regions`], the LK method's map, error maps;
+//! - [`breakdown`]: the errors by streak length and by distance;
 //! - [`method`]: the built-in methods by name ([`method::BuiltIn`]);
 //! - [`report`]: a method's figures per sample and pooled, its failures.
 //!
@@ -26,6 +27,14 @@
 //! [`RegionErrors::pooled`] combines samples pixel-weighted (every pixel counts once, the
 //! KITTI convention).
 //!
+//! # Breakdown
+//!
+//! Where a method fails is shown by three breakdowns, each scored by the same scorer and
+//! pooled the same way: by the sample's **condition** (`dry`, `rain`, `fog`, `noise`, read
+//! from its `meta.json`: [`streaks_dataset::meta::Condition`]; [`report::by_condition`]
+//! pools the samples of each), by **streak length** and by **distance**
+//! ([`breakdown`]).
+//!
 //! # The Lucas-Kanade method where it applies
 //!
 //! The paper's per-row LK ([`crate::lk`]) measures one disparity per row of a streak, at its
@@ -35,6 +44,7 @@
 //! through the centre; every other pixel has no value. Its valid share is therefore small and
 //! its scores speak only for the detected streak rows.
 
+pub mod breakdown;
 pub mod method;
 pub mod report;
 

@@ -1,11 +1,11 @@
 //! The parts of a benchmark report (`report.json` of `streaks benchmark`, format
-//! `streaks-benchmark/2`) that do not depend on where the samples came from: a method's
+//! `streaks-benchmark/3`) that do not depend on where the samples came from: a method's
 //! figures on a sample and pooled over samples, its failures, and what the report states
 //! about them. The report's top level (`format`, `input`) is the command's, with the reading
 //! of its input. The whole schema:
 //!
 //! ```text
-//! format             "streaks-benchmark/2"
+//! format             "streaks-benchmark/3"
 //! input              the folder benchmarked, its kind (dataset, pair, pairs, kitti,
 //!                    middlebury) and split
 //! aggregation        how the summary pools samples (pixel-weighted)
@@ -13,11 +13,18 @@
 //! regions            what each region means
 //! methods[]          name, kind (built-in, command, batch-command, predictions),
 //!                    description, timing (what its seconds cover)
-//! summary[]          per method: pooled errors by region, phantom-hole rate, seconds,
-//!                    megapixels, seconds per megapixel (`null` for predictions: not
-//!                    timed), samples, failed (how many of them the method failed on)
+//! breakdown          what the breakdowns mean (condition, streak_length, distance,
+//!                    empty_bins)
+//! summary[]          per method: pooled errors by region, phantom-hole rate, breakdown
+//!                    (streak_length, road_surface_by_distance, off_road_by_distance: each
+//!                    a list of {bin, errors}, errors null for a bin without pixels),
+//!                    seconds, megapixels, seconds per megapixel (`null` for predictions:
+//!                    not timed), samples, failed (how many of them the method failed on)
+//! by_condition[]     per condition (dry, rain, fog, noise): condition, samples, and a
+//!                    summary[] over those samples (null when no sample has a meta.json)
 //! samples[]          per sample: id, folder, size, which masks it has (streak_mask,
-//!                    road_mask, occlusion_mask), the road-plane check, and per method the
+//!                    road_mask, occlusion_mask), its conditions (null without a
+//!                    meta.json), the road-plane check, and per method the
 //!                    same figures for that sample alone, with `failure` (kind, reason,
 //!                    stderr_tail, stdout_tail) when the method failed on it
 //! failure_scoring    how a failed sample counts in the scores
@@ -36,12 +43,17 @@
 //! ([`UNAVAILABLE`]). Each is a [`crate::sgm::DisparityErrors`] (`truth_pixels`,
 //! `valid_pixels`, `density` = the valid share, `mean_abs` = EPE, `rms`, `bad_1`, `bad_2`,
 //! `bad_3`, `d1` (KITTI), `bad` and `bad_all` at `threshold`, `below_1px`).
+//!
+//! Version 3 adds `breakdown`, `by_condition`, each figure's `breakdown` and each sample's
+//! `conditions` to version 2; every field of version 2 is still there and means the same.
 
+use super::breakdown::{Breakdown, DISTANCE_BINS, STREAK_LENGTH_BINS};
 use super::RegionErrors;
 use serde::Serialize;
+use streaks_dataset::meta::{Condition, NOISE_GAIN_EV};
 
 /// The report's format.
-pub const FORMAT: &str = "streaks-benchmark/2";
+pub const FORMAT: &str = "streaks-benchmark/3";
 
 /// How the summary pools samples.
 pub const AGGREGATION: &str = "pixel-weighted: every pixel of every sample counts once (the \
@@ -152,6 +164,8 @@ pub struct MethodScore {
     /// How many of them it failed on; the other figures leave them out (see
     /// [`FAILURE_SCORING`]).
     pub failed: usize,
+    /// Errors by streak length and by distance ([`Breakdown`]).
+    pub breakdown: Breakdown,
     /// Why the method failed on this sample (per-sample figures only; absent when it did
     /// not).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -175,6 +189,7 @@ impl MethodScore {
             phantom_hole_rate: errors.phantom_hole_rate().filter(|_| failure.is_none()),
             failure,
             errors,
+            breakdown: Breakdown::default(),
             seconds,
             megapixels,
             seconds_per_megapixel: seconds.map(|s| {
@@ -185,6 +200,11 @@ impl MethodScore {
                 }
             }),
         }
+    }
+
+    /// These figures with their breakdown by streak length and distance.
+    pub fn with_breakdown(self, breakdown: Breakdown) -> Self {
+        Self { breakdown, ..self }
     }
 
     /// The pooled figures of one method's per-sample figures: over the samples it succeeded
@@ -201,6 +221,7 @@ impl MethodScore {
             &succeeded
         };
         let errors: Vec<RegionErrors> = scored.iter().map(|p| p.errors).collect();
+        let breakdowns: Vec<&Breakdown> = scored.iter().map(|p| &p.breakdown).collect();
         let pooled = Self::new(
             method,
             RegionErrors::pooled(&errors)?,
@@ -212,6 +233,7 @@ impl MethodScore {
             samples: parts.iter().map(|p| p.samples).sum(),
             failed: parts.iter().map(|p| p.failed).sum(),
             phantom_hole_rate: pooled.phantom_hole_rate.filter(|_| !succeeded.is_empty()),
+            breakdown: Breakdown::pooled(&breakdowns),
             ..pooled
         })
     }
@@ -223,6 +245,14 @@ pub fn summary<'a>(
     methods: impl IntoIterator<Item = &'a str>,
     samples: &[SampleReport],
 ) -> Option<Vec<MethodScore>> {
+    summary_of(methods, &samples.iter().collect::<Vec<_>>())
+}
+
+/// [`summary`] of some of the samples.
+fn summary_of<'a>(
+    methods: impl IntoIterator<Item = &'a str>,
+    samples: &[&SampleReport],
+) -> Option<Vec<MethodScore>> {
     methods
         .into_iter()
         .map(|m| {
@@ -233,6 +263,101 @@ pub fn summary<'a>(
             MethodScore::pooled(m, &parts)
         })
         .collect()
+}
+
+/// The figures of the samples in one condition.
+#[derive(Clone, Debug, Serialize)]
+pub struct ConditionSummary {
+    /// The condition.
+    pub condition: Condition,
+    /// How many samples are in it.
+    pub samples: usize,
+    /// Per method, its figures pooled over those samples as in the summary (empty when no
+    /// sample is in the condition: not available, not zero).
+    pub summary: Vec<MethodScore>,
+}
+
+/// Per condition of [`Condition::ALL`], the figures of `methods` pooled over the samples in it
+/// ([`summary`]); `None` when no sample has conditions (no `meta.json`: pair folders, KITTI,
+/// Middlebury).
+pub fn by_condition<'a>(
+    methods: impl IntoIterator<Item = &'a str> + Clone,
+    samples: &[SampleReport],
+) -> Option<Vec<ConditionSummary>> {
+    if samples.iter().all(|s| s.conditions.is_none()) {
+        return None;
+    }
+    Some(
+        Condition::ALL
+            .into_iter()
+            .map(|c| {
+                let in_it: Vec<&SampleReport> = samples
+                    .iter()
+                    .filter(|s| s.conditions.as_ref().is_some_and(|cs| cs.contains(&c)))
+                    .collect();
+                ConditionSummary {
+                    condition: c,
+                    samples: in_it.len(),
+                    summary: summary_of(methods.clone(), &in_it).unwrap_or_default(),
+                }
+            })
+            .collect(),
+    )
+}
+
+/// The breakdowns' definitions, as the report states them (`breakdown`).
+pub fn breakdown_definitions() -> serde_json::Map<String, serde_json::Value> {
+    let names =
+        |bins: &[super::breakdown::Bin]| bins.iter().map(|b| b.name).collect::<Vec<_>>().join(", ");
+    [
+        (
+            "condition",
+            format!(
+                "per sample, from its meta.json weather record: rain = rain_mm_h > 0; fog = fog \
+                 not null; dry = neither rain nor fog (also a sample without a weather record); \
+                 noise = the auto-exposure gain log2(sensor preset exposure_s / exposure_s) > \
+                 {NOISE_GAIN_EV} stops (a shutter shorter than the preset's) with a preset that \
+                 has noise; a sample can be in several; samples without meta.json have none \
+                 (by_condition is null when no sample has one); each condition's summary pools \
+                 its samples as the summary does"
+            ),
+        ),
+        (
+            "streak_length",
+            format!(
+                "the streak pixels on the road (streak and road masks), by the vertical extent \
+                 (rows spanned) of their streak, an 8-connected component of those pixels, as a \
+                 share of the image height: {} below {}, {} {} to {}, {} from {}; null without \
+                 the masks",
+                STREAK_LENGTH_BINS[0].name,
+                STREAK_LENGTH_BINS[0].high,
+                STREAK_LENGTH_BINS[1].name,
+                STREAK_LENGTH_BINS[1].low,
+                STREAK_LENGTH_BINS[1].high,
+                STREAK_LENGTH_BINS[2].name,
+                STREAK_LENGTH_BINS[2].low,
+            ),
+        ),
+        (
+            "distance",
+            format!(
+                "the ground-truth depth (depth0.pfm, metres) in bins {}: \
+                 road_surface_by_distance is the whole road mask (its below_1px the \
+                 phantom-hole rate), off_road_by_distance the pixels neither streak nor road \
+                 (read its bad_2); null without a depth or the masks",
+                names(&DISTANCE_BINS)
+            ),
+        ),
+        (
+            "empty_bins",
+            "a bin without a pixel with ground truth has errors null (not available, never \
+             0); each bin is pooled pixel-weighted over the samples with pixels in it"
+                .to_string(),
+        ),
+    ]
+    .into_iter()
+    .map(|(k, v)| (k.to_string(), serde_json::Value::from(v)))
+    .collect()
 }
 
 /// One sample.
@@ -252,6 +377,9 @@ pub struct SampleReport {
     pub road_mask: bool,
     /// Whether it has an occlusion mask (else `non_occluded` is `null`).
     pub occlusion_mask: bool,
+    /// The conditions it was rendered in, from its `meta.json` (`None` without one: pair
+    /// folders, KITTI, Middlebury).
+    pub conditions: Option<Vec<Condition>>,
     /// How far its road departs from the plane `Y = 0` the analysis assumes, when it has a
     /// road mask and a ground-truth depth ([`crate::road_plane`]).
     pub road_plane: Option<crate::road_plane::RoadPlaneCheck>,
@@ -310,5 +438,49 @@ mod tests {
             (all.errors.all.valid_pixels, all.phantom_hole_rate),
             (0, None)
         );
+    }
+
+    #[test]
+    fn conditions_pool_their_own_samples() {
+        let truth = GrayImage::new(2, 1, 5.0).unwrap();
+        let sample = |id: &str, estimate: f32, conditions: Option<Vec<Condition>>| {
+            let est = GrayImage::new(2, 1, estimate).unwrap();
+            let errors = score_regions(&est, &truth, &Masks::default()).unwrap();
+            SampleReport {
+                id: id.into(),
+                dir: id.into(),
+                width: 2,
+                height: 1,
+                streak_mask: false,
+                road_mask: false,
+                occlusion_mask: false,
+                conditions,
+                road_plane: None,
+                results: vec![MethodScore::new("m", errors, None, 2e-6, None)],
+            }
+        };
+        use Condition::*;
+        // a: rain, 1 px off; b: rain and noise, exact; c: dry, exact.
+        let samples = [
+            sample("a", 6.0, Some(vec![Rain])),
+            sample("b", 5.0, Some(vec![Rain, Noise])),
+            sample("c", 5.0, Some(vec![Dry])),
+        ];
+        let by = by_condition(["m"], &samples).unwrap();
+        let names: Vec<_> = by.iter().map(|c| (c.condition, c.samples)).collect();
+        assert_eq!(names, [(Dry, 1), (Rain, 2), (Fog, 0), (Noise, 1)]);
+        assert_eq!(by[1].summary[0].errors.all.truth_pixels, 4);
+        assert_eq!(by[1].summary[0].errors.all.mean_abs, 0.5);
+        assert_eq!(by[0].summary[0].errors.all.mean_abs, 0.0);
+        // No sample in fog: no figures at all, not zeros.
+        assert!(by[2].summary.is_empty());
+        // Without any meta.json there is no breakdown by condition.
+        let pairs = [sample("p", 5.0, None)];
+        assert!(by_condition(["m"], &pairs).is_none());
+        let defs = breakdown_definitions();
+        assert!(defs["streak_length"]
+            .as_str()
+            .unwrap()
+            .contains("short below 0.05, medium 0.05 to 0.2, long from 0.2;"));
     }
 }
