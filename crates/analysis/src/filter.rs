@@ -52,7 +52,39 @@ fn along(img: &GrayImage, axis: Axis, mut row_filter: impl FnMut(&[f32], &mut [f
 /// The median of each pixel's window `[i - r, i + r]` along `axis` (the upper median of an
 /// even count at the sides). Values are compared with `total_cmp`.
 pub fn median(img: &GrayImage, axis: Axis, r: usize) -> GrayImage {
-    // A sorted sliding window: insertion and removal by binary search.
+    sorted_window(img, axis, r, |_| true, |w| w[w.len() / 2])
+}
+
+/// The `q`-quantile (0 to 1, the nearest rank below: `q = 0.5` is the lower median of an
+/// even count) of the **finite** values in each pixel's window `[i - r, i + r]` along
+/// `axis`; `inf` where the window holds none. Disparity maps mark "no value" with `inf`,
+/// which this skips.
+pub fn finite_quantile(img: &GrayImage, axis: Axis, r: usize, q: f32) -> GrayImage {
+    let q = q.clamp(0.0, 1.0);
+    sorted_window(
+        img,
+        axis,
+        r,
+        |v| v.is_finite(),
+        |w| {
+            if w.is_empty() {
+                f32::INFINITY
+            } else {
+                w[((w.len() - 1) as f32 * q) as usize]
+            }
+        },
+    )
+}
+
+/// Slides a window `[i - r, i + r]` along `axis`, keeping the values `keep` accepts sorted
+/// (insertion and removal by binary search), and writes `pick(sorted window)` per pixel.
+fn sorted_window(
+    img: &GrayImage,
+    axis: Axis,
+    r: usize,
+    keep: impl Fn(f32) -> bool,
+    pick: impl Fn(&[f32]) -> f32,
+) -> GrayImage {
     let mut window: Vec<f32> = Vec::with_capacity(2 * r + 1);
     let pos = |win: &[f32], v: f32| win.partition_point(|&u| u.total_cmp(&v).is_lt());
     along(img, axis, |row, out| {
@@ -63,15 +95,19 @@ pub fn median(img: &GrayImage, axis: Axis, r: usize) -> GrayImage {
             let (want_lo, want_hi) = (i.saturating_sub(r), (i + r + 1).min(n));
             while hi < want_hi {
                 let v = row[hi];
-                window.insert(pos(&window, v), v);
+                if keep(v) {
+                    window.insert(pos(&window, v), v);
+                }
                 hi += 1;
             }
             while lo < want_lo {
-                let k = pos(&window, row[lo]);
-                window.remove(k);
+                if keep(row[lo]) {
+                    let k = pos(&window, row[lo]);
+                    window.remove(k);
+                }
                 lo += 1;
             }
-            *o = window[window.len() / 2];
+            *o = pick(&window);
         }
     })
 }
@@ -162,6 +198,39 @@ mod tests {
                         let m = w.iter().sum::<f32>() / w.len() as f32;
                         assert!((mn.get(x, y) - m).abs() < 1e-5, "mean {axis:?} r {r}");
                         assert_eq!(mx.get(x, y), *w.last().unwrap(), "max {axis:?} r {r}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn finite_quantile_skips_no_values_and_matches_brute_force() {
+        // Every third value is `inf` (no value); a row of only `inf` gives `inf`.
+        let im = img(19, 7, |x, y| {
+            if (x + 2 * y) % 3 == 0 || y == 6 {
+                f32::INFINITY
+            } else {
+                ((x * 31 + y * 17) % 11) as f32
+            }
+        });
+        for axis in [Axis::Rows, Axis::Columns] {
+            for r in [0, 2, 9] {
+                for q in [0.0, 0.5, 0.75, 1.0] {
+                    let out = finite_quantile(&im, axis, r, q);
+                    for y in 0..im.height {
+                        for x in 0..im.width {
+                            let w: Vec<f32> = window(&im, axis, x, y, r)
+                                .into_iter()
+                                .filter(|v| v.is_finite())
+                                .collect();
+                            let want = if w.is_empty() {
+                                f32::INFINITY
+                            } else {
+                                w[((w.len() - 1) as f32 * q) as usize]
+                            };
+                            assert_eq!(out.get(x, y), want, "{axis:?} r {r} q {q} ({x}, {y})");
+                        }
                     }
                 }
             }

@@ -97,24 +97,34 @@ pub fn streak_extents(streaks: &GrayImage, road: &GrayImage) -> Result<Vec<usize
         road.size(),
     )?;
     let (w, h) = (streaks.width, streaks.height);
-    let on = |i: usize| streaks.data[i] > 0.0 && road.data[i] > 0.0;
     let mut extent = vec![0usize; w * h];
+    for members in components8(w, h, |i| streaks.data[i] > 0.0 && road.data[i] > 0.0) {
+        let (y0, y1) = members
+            .iter()
+            .fold((usize::MAX, 0), |(a, b), &i| (a.min(i / w), b.max(i / w)));
+        for &i in &members {
+            extent[i] = y1 - y0 + 1;
+        }
+    }
+    Ok(extent)
+}
+
+/// The 8-connected components of the pixels of a `w` x `h` image that `on` accepts (by index
+/// `y * w + x`), each as its pixels' indices, in the order of their first pixel.
+pub fn components8(w: usize, h: usize, on: impl Fn(usize) -> bool) -> Vec<Vec<usize>> {
     let mut seen = vec![false; w * h];
     let mut stack = Vec::new();
-    let mut members = Vec::new();
+    let mut out = Vec::new();
     for start in 0..w * h {
         if seen[start] || !on(start) {
             continue;
         }
         seen[start] = true;
         stack.push(start);
-        members.clear();
-        let (mut y0, mut y1) = (usize::MAX, 0);
+        let mut members = Vec::new();
         while let Some(i) = stack.pop() {
             members.push(i);
             let (x, y) = (i % w, i / w);
-            y0 = y0.min(y);
-            y1 = y1.max(y);
             for ny in y.saturating_sub(1)..=(y + 1).min(h - 1) {
                 for nx in x.saturating_sub(1)..=(x + 1).min(w - 1) {
                     let j = ny * w + nx;
@@ -125,11 +135,9 @@ pub fn streak_extents(streaks: &GrayImage, road: &GrayImage) -> Result<Vec<usize
                 }
             }
         }
-        for &i in &members {
-            extent[i] = y1 - y0 + 1;
-        }
+        out.push(members);
     }
-    Ok(extent)
+    out
 }
 
 /// What a sample's breakdown needs besides the estimate, computed once per sample: each
