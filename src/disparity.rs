@@ -1,13 +1,13 @@
 //! `streaks disparity`: dense disparity of the left image by semi-global matching, written as
 //! a PFM (inf where the left-right check fails), with an optional colour preview and an
 //! optional comparison against ground truth. `--streaks mask|repair` makes it streak-robust
-//! ([`streaks_analysis::repair`]): the pixels streaks and reflections put beneath the road
-//! plane (fitted from the pair itself) are made invalid or given the road's disparity, and a
-//! confidence map is written beside the output.
+//! ([`streaks_analysis::repair`]): the values a learned classifier finds fooled by streaks,
+//! reflections and noise are made invalid or given the median of the kept values around
+//! them, and a calibrated confidence map and the streak mask are written beside the output.
 
 use anyhow::{bail, Context};
 use std::path::PathBuf;
-use streaks_analysis::repair::{estimate, Estimate, StreakHandling};
+use streaks_analysis::repair::{estimate, Estimate, RepairModel, StreakHandling};
 use streaks_analysis::sgm::{
     compare_disparity, compare_disparity_where, write_disparity_png, Census, Paths, SgmParams,
 };
@@ -61,22 +61,30 @@ pub struct Args {
     /// (with their phantom-hole rate, `below_1px`) and the others separately.
     #[arg(long, requires = "truth")]
     pub road: Option<PathBuf>,
-    /// Streak-robust output: `mask` marks detected streak and below-the-road (reflection)
-    /// pixels invalid; `repair` gives them the road plane's disparity.
+    /// Streak-robust output: `mask` leaves the values that streaks, reflections and noise
+    /// fooled without a value; `repair` gives them the median of the kept values around them.
     #[arg(long, value_enum)]
     pub streaks: Option<Handling>,
-    /// Where the confidence map goes with --streaks (PFM: 1 measured, 0.5 repaired, 0 no
-    /// value); default: OUTPUT with `_confidence` added to its stem.
+    /// Where the confidence map goes with --streaks (PFM: the calibrated probability that a
+    /// value is within 2 px and not more than 1 px beneath the truth; 0 no value); default:
+    /// OUTPUT with `_confidence` added to its stem.
     #[arg(long, requires = "streaks")]
     pub confidence: Option<PathBuf>,
+    /// Where the streak mask goes with --streaks (PNG, 255 on road streaks); default: OUTPUT
+    /// with `_streaks` added to its stem, as a PNG.
+    #[arg(long, requires = "streaks")]
+    pub streak_mask: Option<PathBuf>,
+    /// With --streaks: a model of `streaks train-repair` instead of the shipped one.
+    #[arg(long, requires = "streaks")]
+    pub model: Option<PathBuf>,
 }
 
 /// `--streaks`.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Handling {
-    /// Mark streak and reflection pixels invalid.
+    /// Leave fooled values without a value.
     Mask,
-    /// Replace them with the road plane's disparity.
+    /// Replace them with the median of the kept values around them.
     Repair,
 }
 
@@ -108,9 +116,23 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         median: !args.no_median,
         ..defaults
     };
-    let handling = args.streaks.map(|h| match h {
-        Handling::Mask => StreakHandling::Mask,
-        Handling::Repair => StreakHandling::Repair,
+    let model = match &args.model {
+        Some(path) => {
+            let text = streaks_image::input::read_text(path, streaks_image::input::MAX_TEXT_BYTES)
+                .with_context(|| format!("reading the repair model {}", path.display()))?;
+            Some(
+                RepairModel::from_json(&text)
+                    .with_context(|| format!("the repair model {}", path.display()))?,
+            )
+        }
+        None => None,
+    };
+    let handling = args.streaks.map(|h| {
+        let h = match h {
+            Handling::Mask => StreakHandling::Mask,
+            Handling::Repair => StreakHandling::Repair,
+        };
+        (h, model.as_ref().unwrap_or_else(|| RepairModel::shipped()))
     });
     let Estimate {
         disparity: disp,
@@ -124,31 +146,31 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         params.disparities(),
     );
     if let Some(r) = &robust {
-        match r.plane {
-            Some(p) => eprintln!(
-                "road plane: d = {:.4} (y - {:.1}), {} inliers ({:.0} %), RMS {:.2} px",
-                p.slope,
-                p.horizon,
-                p.inliers,
-                100.0 * p.inlier_share,
-                p.rms_px
-            ),
-            None => eprintln!("no road plane found: streak pixels are masked, not repaired"),
-        }
         eprintln!(
-            "streaks: {} detected pixels, {} below the road; {} repaired, {} masked",
-            r.streak_pixels, r.below_road_pixels, r.repaired_pixels, r.masked_pixels
+            "streaks: {} streak pixels; {} values dropped as fooled, {} repaired, {} masked",
+            r.streak_pixels, r.dropped_pixels, r.repaired_pixels, r.masked_pixels
         );
-        let conf_path = args.confidence.clone().unwrap_or_else(|| {
+        let beside = |suffix: &str, ext: &str| {
             let stem = args
                 .output
                 .file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
                 .unwrap_or_else(|| "disparity".into());
-            args.output.with_file_name(format!("{stem}_confidence.pfm"))
-        });
+            args.output.with_file_name(format!("{stem}_{suffix}.{ext}"))
+        };
+        let conf_path = args
+            .confidence
+            .clone()
+            .unwrap_or_else(|| beside("confidence", "pfm"));
         write_pfm(&conf_path, &r.confidence)
             .with_context(|| format!("writing the confidence map {}", conf_path.display()))?;
+        let mask_path = args
+            .streak_mask
+            .clone()
+            .unwrap_or_else(|| beside("streaks", "png"));
+        r.streaks
+            .save_png(&mask_path)
+            .with_context(|| format!("writing the streak mask {}", mask_path.display()))?;
     }
     write_pfm(&args.output, &disp).context("writing the disparity map")?;
     if let Some(png) = &args.png {

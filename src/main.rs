@@ -22,6 +22,7 @@ mod render_opts;
 mod stereo;
 mod texture_map;
 mod train_detector;
+mod train_repair;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -64,6 +65,8 @@ enum Command {
     Detect(detect::Args),
     /// Train the learned streak detector on datasets (for `streaks detect --model`).
     TrainDetector(train_detector::Args),
+    /// Train the streak-robust stereo model on datasets (for `streaks disparity --streaks`).
+    TrainRepair(train_repair::Args),
     /// Generate stereo datasets of procedural rainy streets (generate), and index them (index).
     Dataset(dataset::Args),
     /// Score stereo methods (built-in, external, predictions) against the ground truth of a
@@ -90,6 +93,7 @@ fn main() -> ExitCode {
         Command::Benchmark(args) => benchmark::run(args),
         Command::Detect(args) => detect::run(args),
         Command::TrainDetector(args) => train_detector::run(args),
+        Command::TrainRepair(args) => train_repair::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

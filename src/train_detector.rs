@@ -95,7 +95,7 @@ fn load_sample(dir: &Path) -> Result<Option<Sample>> {
 }
 
 /// The sample folders of `split` in every dataset, in order.
-fn split_samples(datasets: &[PathBuf], split: &str) -> Result<Vec<PathBuf>> {
+pub(crate) fn split_samples(datasets: &[PathBuf], split: &str) -> Result<Vec<PathBuf>> {
     let mut out = vec![];
     for d in datasets {
         let layout = Layout::new(d);
@@ -241,28 +241,7 @@ pub fn run(args: Args) -> Result<()> {
         val_score.recall,
         maps.len()
     );
-    let datasets: Vec<serde_json::Value> = args
-        .datasets
-        .iter()
-        .map(|d| {
-            let info: serde_json::Value = streaks_image::input::read_text(
-                &Layout::new(d).dataset_json(),
-                streaks_image::input::MAX_TEXT_BYTES,
-            )
-            .ok()
-            .and_then(|t| serde_json::from_str(&t).ok())
-            .unwrap_or_default();
-            serde_json::json!({
-                "folder": d.file_name().map(|n| n.to_string_lossy().into_owned()),
-                "seed": info.get("seed"),
-                "count": info.get("count"),
-                "config_hash": info.get("config_hash"),
-                "width": info.get("width"),
-                "height": info.get("height"),
-                "spp": info.get("spp"),
-            })
-        })
-        .collect();
+    let datasets = dataset_provenance(&args.datasets);
     // The left view's files of a sample, by their names.
     let left = 0;
     classifier.provenance = serde_json::json!({
@@ -291,4 +270,30 @@ pub fn run(args: Args) -> Result<()> {
         json.len() / 1024
     );
     Ok(())
+}
+
+/// What a trained model's provenance records of each dataset it was trained on: the folder's
+/// name and the settings `dataset.json` holds.
+pub(crate) fn dataset_provenance(datasets: &[PathBuf]) -> Vec<serde_json::Value> {
+    datasets
+        .iter()
+        .map(|d| {
+            let info: serde_json::Value = streaks_image::input::read_text(
+                &Layout::new(d).dataset_json(),
+                streaks_image::input::MAX_TEXT_BYTES,
+            )
+            .ok()
+            .and_then(|t| serde_json::from_str(&t).ok())
+            .unwrap_or_default();
+            serde_json::json!({
+                "folder": d.file_name().map(|n| n.to_string_lossy().into_owned()),
+                "seed": info.get("seed"),
+                "count": info.get("count"),
+                "config_hash": info.get("config_hash"),
+                "width": info.get("width"),
+                "height": info.get("height"),
+                "spp": info.get("spp"),
+            })
+        })
+        .collect()
 }

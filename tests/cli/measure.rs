@@ -103,9 +103,10 @@ fn locus_centre_model_is_flat_where_eq4_is_not() {
     }
 }
 
-/// `streaks disparity --streaks repair` on a rendered pair writes the repaired map and its
-/// confidence map (values 0, 0.5 and 1 only), and `--truth --road` scores the road's
-/// phantom-hole rate; `--road` without `--truth` and a bad `--streaks` are errors.
+/// `streaks disparity --streaks repair` on a rendered pair writes the repaired map, its
+/// confidence map (probabilities, 0 exactly where there is no value) and the streak mask,
+/// and `--truth --road` scores the road's phantom-hole rate; `--road` without `--truth`, a
+/// bad `--streaks` and a bad `--model` are errors.
 #[test]
 fn disparity_streak_repair_writes_confidence_and_scores_phantom_holes() {
     let t = TestDir::new();
@@ -160,8 +161,31 @@ fn disparity_streak_repair_writes_confidence_and_scores_phantom_holes() {
     assert!(run.stderr().contains("streaks:"), "{}", run.stderr());
     let conf = streaks_image::pfm::read_pfm(&t.join("d_confidence.pfm")).unwrap();
     assert_eq!((conf.width, conf.height), (truth.width, truth.height));
-    assert!(conf.data.iter().all(|&c| c == 0.0 || c == 0.5 || c == 1.0));
-    assert!(conf.data.contains(&1.0));
+    let disp = streaks_image::pfm::read_pfm(&t.join("d.pfm")).unwrap();
+    for (&c, &d) in conf.data.iter().zip(&disp.data) {
+        assert!((0.0..=1.0).contains(&c), "confidence {c}");
+        assert_eq!(c == 0.0, !d.is_finite(), "confidence {c} for disparity {d}");
+    }
+    assert!(conf.data.iter().any(|&c| c > 0.5));
+    let mask = image::open(t.join("d_streaks.png")).unwrap().to_luma8();
+    assert_eq!(
+        (mask.width() as usize, mask.height() as usize),
+        (truth.width, truth.height)
+    );
+    assert!(mask.pixels().all(|p| p[0] == 0 || p[0] == 255));
+    std::fs::write(t.join("bad.json"), "{\"format\": \"streaks-repair/0\"}").unwrap();
+    t.streaks(&[
+        "disparity",
+        "pair/im0.png",
+        "pair/im1.png",
+        "-o",
+        "f.pfm",
+        "--streaks",
+        "mask",
+        "--model",
+        "bad.json",
+    ])
+    .assert_failure_mentioning("bad.json");
     t.streaks(&[
         "disparity",
         "pair/im0.png",

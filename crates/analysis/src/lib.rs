@@ -26,9 +26,10 @@
 //!   with known streaks (per sample, pooled, a point of the precision-recall curve).
 //! - [`benchmark`]: an estimate scored by region (streak, road, off-road; the phantom-hole
 //!   rate), pooled over samples; the LK streak disparity as a map; signed error maps.
-//! - [`repair`]: streak-robust stereo: the road plane from the pair's own v-disparity, and
-//!   the masking or repair of the pixels streaks and reflections put beneath the road;
-//!   [`repair::estimate`], the dense estimate with or without it.
+//! - [`repair`]: streak-robust stereo without a road model: local stereo and appearance
+//!   features, learned classifiers of fooled values and of road streaks (the shipped model
+//!   in `models/`), the masking or repair of fooled values from the surface around them, a
+//!   calibrated confidence map; [`repair::estimate`], the dense estimate with or without it.
 //! - [`road_plane`]: whether the road is the plane `Y = 0` the analysis assumes, measured on
 //!   a sample's ground-truth depth and road mask.
 //! - [`sgm`]: dense semi-global matching, and its errors against a ground truth (bad-2.0).

@@ -1,222 +1,727 @@
-//! Streak-robust stereo: the road plane from a pair's own disparities, and the masking or
-//! repair of the pixels a streak or a mirror reflection fools.
+//! Streak-robust stereo: which of semi-global matching's disparities a streak or a mirror
+//! reflection fooled, their masking or repair from the surface around them, a calibrated
+//! confidence map and the streak mask, all from the pair alone.
 //!
 //! # Why
 //!
 //! A wet road's reflections (streaks of lamps and headlights, mirror images of cars and
-//! facades) are seen at the disparity of the reflected object's virtual image, which lies
-//! *beneath* the road: stereo then reports holes in the road (phantom holes). Nothing opaque
-//! can be seen beneath the road surface, so an estimate below the road plane is a reflection
-//! or a mismatch, never a measurement of a real surface.
+//! facades) are matched at the disparity of the reflected object's virtual image, which lies
+//! *beneath* the road: stereo then reports holes in the road (phantom holes). Rain drops,
+//! sensor noise and the dark, nearly textureless road between the streaks add mismatches of
+//! their own, and semi-global matching's smoothness spreads a streak's disparity over them.
 //!
-//! # The road plane ([`fit_road_plane`])
+//! # No road model
 //!
-//! For a roll-free rectified rig over a planar road every image row `y` below the horizon
-//! sees the road at one disparity, linear in the row: `d = a (y - y_h)`, with
-//! `a = b / h` (baseline over camera height) and `y_h` the horizon (the v-disparity line of
-//! Labayrade et al. 2002). Walls and cars are not on that line (a facade along the street has
-//! a disparity that changes along the row, an object standing on the road is nearer than
-//! the road behind it and has a larger disparity). The fit is a Hough vote over the
-//! valid, unmasked disparities of the lower part of the image: for each slope `a` on a
-//! log-spaced grid (`b / h` from 0.005 to 2) the offsets `d - a y` are histogrammed at
-//! 0.25 px, and the slope and offset with the most votes win; a least-squares fit on the
-//! winners' inliers (within 0.75 px) refines them. It needs no camera calibration, so it
-//! works on photographs.
+//! Nothing here assumes a planar road, a horizon or a calibrated camera: streets bend, climb
+//! and are crowned, and one wrong global estimate (a road plane fitted to the wrong rows)
+//! must not be able to spoil a whole image. Every decision is local, from what the physics
+//! gives at and around the pixel ([`StereoFeatures`]):
 //!
-//! [`estimate`] is the whole dense estimate: semi-global matching, then, if asked, the masking
-//! or repair below.
+//! - a reflection's disparity is that of its virtual image, far below the surface: it is
+//!   *lower* than the disparities beside it on its row (upper quantiles of a row window, at
+//!   three widths) and, being the image of a vertical column of light, nearly *constant down
+//!   its column*, where a road's disparity grows toward the camera;
+//! - a specular streak breaks photo-consistency between the eyes in a way a Lambertian
+//!   surface does not: warped by the surface's disparity (the row's upper quartile) the right
+//!   image does not match the left where a streak is, while at the streak's own disparity it
+//!   does;
+//! - a streak is bright against the road beside it, over a long vertical run (contrast over
+//!   row medians, persisting down the column), and the surface around it is seen in both
+//!   eyes (textured, with consistent disparities).
 //!
-//! # Mask and repair ([`robust_disparity`])
+//! # The learned part
 //!
-//! The pixels to distrust are those the streak detector marks (streaks and the wide glows of
-//! mirror reflections at the bottom, [`crate::detect::detect_streaks`]), dilated by the census
-//! window's reach, plus every pixel whose disparity is more than `below_tolerance` below
-//! the road plane at its row. `mask` makes them invalid (infinite, the PFM convention);
-//! `repair` gives each the road plane's disparity at its row, the surface it lies on, where
-//! the row is below the horizon. The confidence map is 1 for kept measurements, 0.5 for
-//! repaired pixels (a model value, not a measurement) and 0 where there is no value.
+//! Two gradient-boosted classifiers ([`crate::gbdt`]) on those features, trained on generated
+//! streets by `streaks train-repair` and shipped as `models/streak_repair.json`
+//! ([`RepairModel::shipped`]; its `provenance` records the datasets, seeds and settings):
+//!
+//! - `wrong`: the probability that semi-global matching's value at a pixel is wrong (more than
+//!   1 px beneath the truth, or more than 2 px off);
+//! - `streak`: the probability that a pixel is a road streak (the renderer's streak mask on its
+//!   road mask), smoothed and thresholded at an operating point chosen for precision on
+//!   streets the trees never saw: the streak mask.
+//!
+//! # Mask, repair, confidence ([`robust_disparity`])
+//!
+//! A value whose `wrong` probability reaches [`RepairModel::wrong_threshold`] is dropped.
+//! `mask` leaves it without a value (`inf`); `repair` gives it the median of the kept values
+//! around it, from the smallest of the windows [`FILL_RADII`] in which at least a quarter of
+//! the pixels were kept: the surface around the streak, on its rows and columns, with no
+//! model of its shape. A pixel with no kept value within the largest window stays without
+//! one. The confidence map is calibrated: for a kept value, the share of kept values of its
+//! `wrong`-probability decile that were right on the validation streets; for a repaired one,
+//! the share of repaired values right at its window's size; 0 where there is no value.
 
-use crate::detect::{detect_streaks, DetectError, DetectParams};
+use crate::detect::MaskScore;
+use crate::filter::{finite_quantile, max, max_above, mean, median, Axis};
+use crate::gbdt::{GbdtError, Model};
 use crate::sgm::{sgm, SgmError, SgmParams};
+use crate::streak_classifier::smooth_probability;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use streaks_image::stats::quantile;
 use streaks_image::{ensure_same_size, GrayImage, ImageError, SizeMismatch};
+
+/// The format tag of a saved repair model.
+pub const FORMAT: &str = "streaks-repair/1";
+
+/// The value of a feature that is not defined at a pixel (no disparity there, or none in its
+/// window): far outside every real value, so a tree splits it off.
+pub const MISSING: f32 = 1.0e4;
+
+/// The half-widths of the row windows of the disparity features, pixels.
+const ROW_RADII: [usize; 3] = [8, 32, 96];
+
+/// The half-widths of the windows a repair takes its value from, smallest first, pixels.
+pub const FILL_RADII: [usize; 5] = [2, 4, 8, 16, 32];
+
+/// The quantile of the kept values a repair takes (rows, then columns).
+const FILL_QUANTILE: f32 = 0.75;
+
+/// The share of a repair window's pixels that must be kept values.
+const FILL_SUPPORT: f32 = 0.25;
+
+/// The number of `wrong`-probability bins of the kept values' calibration.
+pub const CALIBRATION_BINS: usize = 10;
+
+/// The names of the features, in order (see the module documentation and
+/// [`StereoFeatures::new`]).
+pub const FEATURES: [&str; 25] = [
+    "valid",
+    "d_minus_q75_r8",
+    "d_minus_q75_r32",
+    "d_minus_q75_r96",
+    "d_minus_q90_r8",
+    "d_minus_q90_r32",
+    "d_minus_q90_r96",
+    "d_relative_to_q75_r32",
+    "d_change_4_rows_down",
+    "d_change_12_rows_down",
+    "d_std_5x5",
+    "valid_share_5x5",
+    "l_minus_p999",
+    "contrast_9",
+    "contrast_31",
+    "contrast_91",
+    "contrast_31_over_15_rows",
+    "contrast_31_over_45_rows",
+    "texture_5x5",
+    "photo_at_d",
+    "photo_at_surface",
+    "photo_surface_minus_d",
+    "right_contrast_31_at_d",
+    "brightest_above_minus_l",
+    "contrast_31_run_45_rows",
+];
 
 /// What went wrong.
 #[derive(Debug, thiserror::Error)]
 pub enum RepairError {
-    /// The streak detector failed (the cause is the source, so a chain prints it once).
-    #[error("streak detection")]
-    Detect(#[from] DetectError),
+    /// The images or the disparity map differ in size.
+    #[error(transparent)]
+    Size(#[from] SizeMismatch),
     /// An image could not be made.
     #[error(transparent)]
     Image(#[from] ImageError),
-    /// The left image and the disparity map differ in size.
+    /// A saved model is not one this version reads.
+    #[error("repair model: {0}")]
+    Format(String),
+    /// A model's trees are malformed.
     #[error(transparent)]
-    Size(#[from] SizeMismatch),
+    Gbdt(#[from] GbdtError),
 }
 
-/// The road's v-disparity line `d = slope (y - horizon)`.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
-pub struct RoadPlane {
-    /// Disparity per image row, pixels per pixel (`b / h` for a level rig).
-    pub slope: f64,
-    /// The image row where the road's disparity reaches 0.
-    pub horizon: f64,
-    /// Pixels that voted for the line (inliers within 0.75 px).
-    pub inliers: usize,
-    /// Share of the voting pixels that are inliers.
-    pub inlier_share: f64,
-    /// RMS of the inliers' residuals, pixels.
-    pub rms_px: f64,
+/// The per-pixel features of a pair and its disparity (see the module documentation), one
+/// plane per feature of [`FEATURES`].
+#[derive(Clone, Debug)]
+pub struct StereoFeatures {
+    /// Image width.
+    pub width: usize,
+    /// Image height.
+    pub height: usize,
+    planes: Vec<Vec<f32>>,
 }
 
-impl RoadPlane {
-    /// The road's disparity at the centre of row `row`, if the row is below the horizon.
-    pub fn disparity_at(&self, row: usize) -> Option<f32> {
-        let d = self.slope * (row as f64 + 0.5 - self.horizon);
-        (d > 0.0).then_some(d as f32)
+/// `ln(v + 1/255)` of an image's values in [0, 1]: a log luminance whose floor is an 8-bit
+/// camera's step.
+fn log_luminance(img: &GrayImage) -> GrayImage {
+    let mut out = img.clone();
+    for v in &mut out.data {
+        *v = (v.max(0.0) + 1.0 / 255.0).ln();
     }
+    out
 }
 
-/// Fits the road's v-disparity line to the valid (finite, positive) disparities of `disp`
-/// outside `exclude` (non-zero = excluded) in the lower `lower_share` of the rows (see the
-/// module documentation). `None` if fewer than 50 pixels vote for any line.
-pub fn fit_road_plane(
-    disp: &GrayImage,
-    exclude: Option<&GrayImage>,
-    lower_share: f64,
-) -> Option<RoadPlane> {
-    let (w, h) = (disp.width, disp.height);
-    let first = ((1.0 - lower_share.clamp(0.05, 1.0)) * h as f64) as usize;
-    let step = if w * (h - first) > 200_000 { 2 } else { 1 };
-    let mut pts: Vec<(f64, f64)> = Vec::new();
-    for y in (first..h).step_by(step) {
-        for x in (0..w).step_by(step) {
-            let i = y * w + x;
-            let d = disp.data[i];
-            if d.is_finite() && d > 0.0 && exclude.is_none_or(|m| m.data[i] == 0.0) {
-                pts.push((y as f64 + 0.5, d as f64));
+/// The mean over the `(2 r + 1)`-square around each pixel (clipped at the borders).
+fn box_mean(img: &GrayImage, r: usize) -> GrayImage {
+    mean(&mean(img, Axis::Rows, r), Axis::Columns, r)
+}
+
+/// The mean of `values` over the `(2 r + 1)`-square where `values` is finite, with the share
+/// of finite pixels: `(mean, share)`, the mean `MISSING` where the share is 0.
+fn finite_box_mean(values: &[f32], w: usize, h: usize, r: usize) -> (Vec<f32>, Vec<f32>) {
+    let plane = |f: &dyn Fn(f32) -> f32| GrayImage {
+        width: w,
+        height: h,
+        data: values.iter().map(|&v| f(v)).collect(),
+    };
+    let sum = box_mean(&plane(&|v| if v.is_finite() { v } else { 0.0 }), r);
+    let share = box_mean(&plane(&|v| f32::from(u8::from(v.is_finite()))), r);
+    let m = sum
+        .data
+        .iter()
+        .zip(&share.data)
+        .map(|(&s, &c)| if c > 1e-6 { s / c } else { MISSING })
+        .collect();
+    (m, share.data)
+}
+
+impl StereoFeatures {
+    /// The features of the left view's pixels, from the left and right luminance (values in
+    /// [0, 1], as [`GrayImage::load`] reads a camera's PNG) and the left view's disparity
+    /// (`inf` or a value <= 0: none).
+    pub fn new(left: &GrayImage, right: &GrayImage, disp: &GrayImage) -> Result<Self, RepairError> {
+        ensure_same_size(
+            "the left image",
+            left.size(),
+            "the right image",
+            right.size(),
+        )?;
+        ensure_same_size(
+            "the left image",
+            left.size(),
+            "the disparity map",
+            disp.size(),
+        )?;
+        let (w, h) = (left.width, left.height);
+        let n = w * h;
+        let mut d = disp.clone();
+        for v in &mut d.data {
+            if !(v.is_finite() && *v > 0.0) {
+                *v = f32::INFINITY;
             }
         }
-    }
-    if pts.len() < 50 {
-        return None;
-    }
-    const BIN: f64 = 0.25;
-    let (mut best, mut best_votes) = ((0.0, 0.0), 0usize);
-    let mut hist: Vec<u32> = Vec::new();
-    for k in 0..=240 {
-        let a = 0.005 * (400f64).powf(k as f64 / 240.0);
-        // Offsets c = d - a y; the road's is -a y_h.
-        let (lo, hi) = pts
+        let valid = |i: usize| d.data[i].is_finite();
+        let or_missing = |v: f32| if v.is_finite() { v } else { MISSING };
+        let l = log_luminance(left);
+        let rl = log_luminance(right);
+        let mut planes: Vec<Vec<f32>> = Vec::with_capacity(FEATURES.len());
+        planes.push((0..n).map(|i| f32::from(u8::from(valid(i)))).collect());
+        let q75: Vec<GrayImage> = ROW_RADII
             .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, u), p| {
-                let c = p.1 - a * p.0;
-                (l.min(c), u.max(c))
-            });
-        let bins = (((hi - lo) / BIN) as usize + 2).min(1 << 20);
-        hist.clear();
-        hist.resize(bins, 0);
-        for p in &pts {
-            let b = (((p.1 - a * p.0) - lo) / BIN) as usize;
-            hist[b.min(bins - 1)] += 1;
-        }
-        // Votes of a bin and its two neighbours (a line straddling bins).
-        for b in 1..bins.saturating_sub(1) {
-            let v = (hist[b - 1] + hist[b] + hist[b + 1]) as usize;
-            if v > best_votes {
-                best_votes = v;
-                best = (a, lo + (b as f64 + 0.5) * BIN);
-            }
-        }
-    }
-    // Refine by least squares on the inliers, twice.
-    let (mut a, mut c) = best;
-    let mut inl: Vec<(f64, f64)> = Vec::new();
-    for _ in 0..2 {
-        inl = pts
-            .iter()
-            .copied()
-            .filter(|p| (p.1 - a * p.0 - c).abs() < 0.75)
+            .map(|&r| finite_quantile(&d, Axis::Rows, r, 0.75))
             .collect();
-        if inl.len() < 50 {
-            return None;
+        let q90: Vec<GrayImage> = ROW_RADII
+            .iter()
+            .map(|&r| finite_quantile(&d, Axis::Rows, r, 0.9))
+            .collect();
+        for q in q75.iter().chain(&q90) {
+            planes.push((0..n).map(|i| or_missing(d.data[i] - q.data[i])).collect());
         }
-        let n = inl.len() as f64;
-        let (sx, sy) = inl.iter().fold((0.0, 0.0), |s, p| (s.0 + p.0, s.1 + p.1));
-        let (mx, my) = (sx / n, sy / n);
-        let (sxx, sxy) = inl.iter().fold((0.0, 0.0), |s, p| {
-            (s.0 + (p.0 - mx).powi(2), s.1 + (p.0 - mx) * (p.1 - my))
-        });
-        if sxx <= 0.0 {
-            break;
+        let surface = &q75[1];
+        planes.push(
+            (0..n)
+                .map(|i| or_missing((d.data[i] - surface.data[i]) / surface.data[i].max(0.5)))
+                .collect(),
+        );
+        for k in [4usize, 12] {
+            planes.push(
+                (0..n)
+                    .map(|i| {
+                        if i + k * w < n {
+                            or_missing(d.data[i + k * w] - d.data[i])
+                        } else {
+                            MISSING
+                        }
+                    })
+                    .collect(),
+            );
         }
-        a = sxy / sxx;
-        c = my - a * mx;
+        let (m1, share) = finite_box_mean(&d.data, w, h, 2);
+        let sq: Vec<f32> = d.data.iter().map(|v| v * v).collect();
+        let (m2, _) = finite_box_mean(&sq, w, h, 2);
+        planes.push(
+            (0..n)
+                .map(|i| {
+                    if share[i] > 1e-6 {
+                        (m2[i] - m1[i] * m1[i]).max(0.0).sqrt()
+                    } else {
+                        MISSING
+                    }
+                })
+                .collect(),
+        );
+        planes.push(share);
+        let p999 = quantile(l.data.iter().copied(), 0.999).unwrap_or(0.0);
+        planes.push(l.data.iter().map(|v| v - p999).collect());
+        let contrast = |r: usize| {
+            let m = median(&l, Axis::Rows, r);
+            GrayImage {
+                width: w,
+                height: h,
+                data: l.data.iter().zip(&m.data).map(|(a, b)| a - b).collect(),
+            }
+        };
+        let c31 = contrast(15);
+        planes.push(contrast(4).data);
+        planes.push(c31.data.clone());
+        planes.push(contrast(45).data);
+        planes.push(mean(&c31, Axis::Columns, 7).data);
+        planes.push(mean(&c31, Axis::Columns, 22).data);
+        let lm = box_mean(&l, 2);
+        let l2 = box_mean(
+            &GrayImage {
+                width: w,
+                height: h,
+                data: l.data.iter().map(|v| v * v).collect(),
+            },
+            2,
+        );
+        planes.push(
+            lm.data
+                .iter()
+                .zip(&l2.data)
+                .map(|(m, s)| (s - m * m).max(0.0).sqrt())
+                .collect(),
+        );
+        // Photo-consistency: |left - right warped by a disparity|, averaged over 5x5 where the
+        // disparity is defined.
+        let photo = |disparity: &dyn Fn(usize) -> f32| {
+            let diff: Vec<f32> = (0..n)
+                .map(|i| {
+                    let dv = disparity(i);
+                    if !dv.is_finite() {
+                        return f32::INFINITY;
+                    }
+                    let (x, y) = (i % w, i / w);
+                    let xr = (x as f32 - dv).round();
+                    if xr < 0.0 {
+                        return f32::INFINITY;
+                    }
+                    (l.data[i] - rl.data[y * w + (xr as usize).min(w - 1)]).abs()
+                })
+                .collect();
+            finite_box_mean(&diff, w, h, 2).0
+        };
+        let at_d = photo(&|i| d.data[i]);
+        let at_s = photo(&|i| surface.data[i]);
+        let own = |p: &[f32], i: usize| if valid(i) { p[i] } else { MISSING };
+        planes.push((0..n).map(|i| own(&at_d, i)).collect());
+        planes.push((0..n).map(|i| at_s[i]).collect());
+        planes.push(
+            (0..n)
+                .map(|i| {
+                    if valid(i) && at_s[i] < MISSING && at_d[i] < MISSING {
+                        at_s[i] - at_d[i]
+                    } else {
+                        MISSING
+                    }
+                })
+                .collect(),
+        );
+        // The right eye sees a streak at its own disparity: its contrast there.
+        let rc31 = {
+            let m = median(&rl, Axis::Rows, 15);
+            let c: Vec<f32> = rl.data.iter().zip(&m.data).map(|(a, b)| a - b).collect();
+            c
+        };
+        planes.push(
+            (0..n)
+                .map(|i| {
+                    let (x, y) = (i % w, i / w);
+                    let xr = (x as f32 - d.data[i]).round();
+                    if valid(i) && xr >= 0.0 {
+                        rc31[y * w + (xr as usize).min(w - 1)]
+                    } else {
+                        MISSING
+                    }
+                })
+                .collect(),
+        );
+        // The light a streak hangs from lies above it, within a few columns.
+        let above = max(&max_above(&l), Axis::Rows, 2);
+        planes.push(above.data.iter().zip(&l.data).map(|(a, b)| a - b).collect());
+        let run = GrayImage {
+            width: w,
+            height: h,
+            data: c31
+                .data
+                .iter()
+                .map(|&c| f32::from(u8::from(c > 0.5)))
+                .collect(),
+        };
+        planes.push(mean(&run, Axis::Columns, 22).data);
+        debug_assert_eq!(planes.len(), FEATURES.len());
+        Ok(Self {
+            width: w,
+            height: h,
+            planes,
+        })
     }
-    if a <= 0.0 {
-        return None;
+
+    /// The features of pixel `i` (`y * width + x`).
+    pub fn row(&self, i: usize, out: &mut [f32; FEATURES.len()]) {
+        for (o, p) in out.iter_mut().zip(&self.planes) {
+            *o = p[i];
+        }
     }
-    let n = inl.len() as f64;
-    let rms = (inl.iter().map(|p| (p.1 - a * p.0 - c).powi(2)).sum::<f64>() / n).sqrt();
-    Some(RoadPlane {
-        slope: a,
-        horizon: -c / a,
-        inliers: inl.len(),
-        inlier_share: n / pts.len() as f64,
-        rms_px: rms,
-    })
+
+    /// The probability of `model` at every pixel.
+    pub fn probability(&self, model: &Model) -> GrayImage {
+        let data = (0..self.width * self.height)
+            .into_par_iter()
+            .map_init(
+                || [0f32; FEATURES.len()],
+                |row, i| {
+                    self.row(i, row);
+                    model.probability(row)
+                },
+            )
+            .collect();
+        GrayImage {
+            width: self.width,
+            height: self.height,
+            data,
+        }
+    }
 }
 
-/// What to do with the pixels a streak or reflection fools.
+/// The calibration of the confidence map: measured shares of right values on the
+/// validation streets.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Calibration {
+    /// For kept values, by decile of the `wrong` probability (below the threshold, in
+    /// [`CALIBRATION_BINS`] equal bins of [0, threshold)): the share that was right.
+    pub kept: Vec<f32>,
+    /// For repaired values, by the window they took their value from ([`FILL_RADII`]): the
+    /// share that was right.
+    pub repaired: Vec<f32>,
+}
+
+/// A trained streak-robust stereo model: the two classifiers, their thresholds and the
+/// confidence calibration (see the module documentation).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RepairModel {
+    /// [`FORMAT`].
+    pub format: String,
+    /// The feature names ([`FEATURES`] when saved by this version).
+    pub features: Vec<String>,
+    /// The probability that semi-global matching's value is wrong.
+    pub wrong: Model,
+    /// A value is dropped where `wrong` reaches this.
+    pub wrong_threshold: f32,
+    /// The probability that a pixel is a road streak.
+    pub streak: Model,
+    /// A pixel is a streak where the smoothed `streak` probability reaches this.
+    pub streak_threshold: f32,
+    /// Radius of the box filter on the `streak` probability before its threshold.
+    pub streak_smooth: usize,
+    /// The confidence map's calibration.
+    pub calibration: Calibration,
+    /// What the model was trained on and how (free-form, for people).
+    pub provenance: serde_json::Value,
+}
+
+impl RepairModel {
+    /// A model of two classifiers with this version's format and features, thresholds 0.5,
+    /// no smoothing, a neutral calibration and no provenance: what training has before it
+    /// measures them.
+    pub fn new(wrong: Model, streak: Model) -> Self {
+        Self {
+            format: FORMAT.into(),
+            features: FEATURES.iter().map(|s| s.to_string()).collect(),
+            wrong,
+            wrong_threshold: 0.5,
+            streak,
+            streak_threshold: 0.5,
+            streak_smooth: 0,
+            calibration: Calibration {
+                kept: vec![0.5; CALIBRATION_BINS],
+                repaired: vec![0.5; FILL_RADII.len()],
+            },
+            provenance: serde_json::Value::Null,
+        }
+    }
+
+    /// Checks a loaded model: format, features, thresholds, calibration, the trees.
+    pub fn validate(&self) -> Result<(), RepairError> {
+        let bad = |m: String| Err(RepairError::Format(m));
+        if self.format != FORMAT {
+            return bad(format!("format {:?}, expected {FORMAT:?}", self.format));
+        }
+        if self.features != FEATURES
+            || self.wrong.features != FEATURES.len()
+            || self.streak.features != FEATURES.len()
+        {
+            return bad(format!(
+                "features {:?}, this version computes {FEATURES:?}",
+                self.features
+            ));
+        }
+        for (name, t) in [
+            ("wrong_threshold", self.wrong_threshold),
+            ("streak_threshold", self.streak_threshold),
+        ] {
+            if !(0.0..=1.0).contains(&t) {
+                return bad(format!("{name} {t} is not a probability"));
+            }
+        }
+        let c = &self.calibration;
+        if c.kept.len() != CALIBRATION_BINS
+            || c.repaired.len() != FILL_RADII.len()
+            || c.kept
+                .iter()
+                .chain(&c.repaired)
+                .any(|v| !(0.0..=1.0).contains(v))
+        {
+            return bad(format!(
+                "calibration needs {CALIBRATION_BINS} kept and {} repaired shares in [0, 1]",
+                FILL_RADII.len()
+            ));
+        }
+        self.wrong.validate()?;
+        self.streak.validate()?;
+        Ok(())
+    }
+
+    /// Parses and checks a model saved as JSON.
+    pub fn from_json(text: &str) -> Result<Self, RepairError> {
+        let m: Self = serde_json::from_str(text).map_err(|e| RepairError::Format(e.to_string()))?;
+        m.validate()?;
+        Ok(m)
+    }
+
+    /// The model that ships with the crate (`models/streak_repair.json`), trained by
+    /// `streaks train-repair` on generated streets (its `provenance` says which).
+    pub fn shipped() -> &'static Self {
+        static SHIPPED: std::sync::OnceLock<RepairModel> = std::sync::OnceLock::new();
+        SHIPPED.get_or_init(|| {
+            Self::from_json(include_str!("../models/streak_repair.json"))
+                .expect("the shipped repair model is valid (tested)")
+        })
+    }
+
+    /// The calibration bin of a kept value's `wrong` probability `p`.
+    fn kept_bin(&self, p: f32) -> usize {
+        let t = self.wrong_threshold.max(1e-6);
+        ((p / t * CALIBRATION_BINS as f32) as usize).min(CALIBRATION_BINS - 1)
+    }
+}
+
+/// What to do with the values a streak or reflection fooled.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum StreakHandling {
-    /// Mark them invalid.
+    /// Leave them without a value.
     Mask,
-    /// Give them the road plane's disparity.
+    /// Give them the median of the kept values around them.
     Repair,
 }
 
-/// The parameters of [`robust_disparity`].
-#[derive(Clone, Debug, PartialEq)]
-pub struct RepairParams {
-    /// The streak detector's parameters (its horizon defaults to the road plane's).
-    pub detect: DetectParams,
-    /// Radius by which the detected streak mask grows (the census window's reach), pixels.
-    pub dilate: usize,
-    /// A disparity more than this below the road plane is a reflection, pixels.
-    pub below_tolerance: f32,
-    /// The share of the rows, from the bottom, used to fit the road plane.
-    pub lower_share: f64,
+/// A masked or repaired disparity map and what was done.
+#[derive(Clone, Debug)]
+pub struct RobustDisparity {
+    /// The disparities (`inf`: no value).
+    pub disparity: GrayImage,
+    /// The calibrated probability that each value is right (within 2 px and not more than
+    /// 1 px beneath the truth); 0 where there is no value.
+    pub confidence: GrayImage,
+    /// The `wrong` probability of every pixel (1 where semi-global matching gave no value).
+    pub wrong: GrayImage,
+    /// The smoothed road-streak probability.
+    pub streak_probability: GrayImage,
+    /// The streak mask: 1 where the smoothed streak probability reaches the threshold.
+    pub streaks: GrayImage,
+    /// How the value of each pixel came about.
+    pub origin: Vec<Origin>,
+    /// Pixels the streak mask holds.
+    pub streak_pixels: usize,
+    /// Values dropped as fooled.
+    pub dropped_pixels: usize,
+    /// Dropped values repaired.
+    pub repaired_pixels: usize,
+    /// Dropped values left without a value.
+    pub masked_pixels: usize,
 }
 
-impl Default for RepairParams {
-    fn default() -> Self {
-        Self {
-            detect: DetectParams::default(),
-            dilate: 3,
-            below_tolerance: 1.0,
-            lower_share: 0.45,
+/// How a pixel's value in a [`RobustDisparity`] came about.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Origin {
+    /// Semi-global matching gave none.
+    None,
+    /// Semi-global matching's value, kept.
+    Kept,
+    /// Dropped and left without a value.
+    Masked,
+    /// Dropped and repaired from the window of [`FILL_RADII`] with this index.
+    Repaired(u8),
+}
+
+/// The median of the kept values around each dropped pixel (see the module documentation):
+/// the repaired value and the index of its window in [`FILL_RADII`], per pixel; `None` where
+/// no window has the support.
+fn fill(kept: &GrayImage) -> Vec<Option<(f32, u8)>> {
+    let (w, h) = (kept.width, kept.height);
+    let mut out: Vec<Option<(f32, u8)>> = vec![None; w * h];
+    for (k, &r) in FILL_RADII.iter().enumerate() {
+        // A separable median (rows, then columns) of the finite values: robust to the
+        // outliers that survive, cheap at every radius.
+        let rows = finite_quantile(kept, Axis::Rows, r, FILL_QUANTILE);
+        let med = finite_quantile(&rows, Axis::Columns, r, FILL_QUANTILE);
+        let (_, share) = finite_box_mean(&kept.data, w, h, r);
+        for i in 0..w * h {
+            if out[i].is_none() && med.data[i].is_finite() && share[i] >= FILL_SUPPORT {
+                out[i] = Some((med.data[i], k as u8));
+            }
         }
+    }
+    out
+}
+
+/// Masks or repairs the values of `disp` (the left view's disparity) that streaks and
+/// reflections fool, from the pair's luminance `left` and `right` and `model`; see the module
+/// documentation.
+pub fn robust_disparity(
+    left: &GrayImage,
+    right: &GrayImage,
+    disp: &GrayImage,
+    handling: StreakHandling,
+    model: &RepairModel,
+) -> Result<RobustDisparity, RepairError> {
+    let features = StereoFeatures::new(left, right, disp)?;
+    Ok(robust_from_features(&features, disp, handling, model))
+}
+
+/// [`robust_disparity`] on features already computed (training measures the calibration so).
+pub fn robust_from_features(
+    features: &StereoFeatures,
+    disp: &GrayImage,
+    handling: StreakHandling,
+    model: &RepairModel,
+) -> RobustDisparity {
+    let (w, h) = (features.width, features.height);
+    let n = w * h;
+    let valid = |i: usize| disp.data[i].is_finite() && disp.data[i] > 0.0;
+    let mut wrong = features.probability(&model.wrong);
+    for (i, p) in wrong.data.iter_mut().enumerate() {
+        if !valid(i) {
+            *p = 1.0;
+        }
+    }
+    let streak_probability =
+        smooth_probability(&features.probability(&model.streak), model.streak_smooth);
+    let mut streaks = streak_probability.clone();
+    for v in &mut streaks.data {
+        *v = f32::from(u8::from(*v >= model.streak_threshold));
+    }
+    let mut kept = GrayImage {
+        width: w,
+        height: h,
+        data: vec![f32::INFINITY; n],
+    };
+    let mut origin = vec![Origin::None; n];
+    for i in 0..n {
+        if valid(i) {
+            if wrong.data[i] < model.wrong_threshold {
+                kept.data[i] = disp.data[i];
+                origin[i] = Origin::Kept;
+            } else {
+                origin[i] = Origin::Masked;
+            }
+        }
+    }
+    let filled = match handling {
+        StreakHandling::Repair => fill(&kept),
+        StreakHandling::Mask => vec![None; n],
+    };
+    let mut out = kept.clone();
+    let mut confidence = GrayImage {
+        width: w,
+        height: h,
+        data: vec![0.0; n],
+    };
+    let (mut dropped, mut repaired) = (0, 0);
+    for i in 0..n {
+        match origin[i] {
+            Origin::Kept => {
+                confidence.data[i] = model.calibration.kept[model.kept_bin(wrong.data[i])];
+            }
+            Origin::Masked => {
+                dropped += 1;
+                if let Some((v, k)) = filled[i] {
+                    out.data[i] = v;
+                    origin[i] = Origin::Repaired(k);
+                    confidence.data[i] = model.calibration.repaired[k as usize];
+                    repaired += 1;
+                }
+            }
+            Origin::None | Origin::Repaired(_) => {}
+        }
+    }
+    let streak_pixels = streaks.data.iter().filter(|&&v| v > 0.0).count();
+    RobustDisparity {
+        disparity: out,
+        confidence,
+        wrong,
+        streak_probability,
+        streaks,
+        origin,
+        streak_pixels,
+        dropped_pixels: dropped,
+        repaired_pixels: repaired,
+        masked_pixels: dropped - repaired,
     }
 }
 
-/// A repaired or masked disparity map and what was done.
-#[derive(Clone, Debug)]
-pub struct RobustDisparity {
-    /// The disparities (infinite: no value).
-    pub disparity: GrayImage,
-    /// Confidence per pixel: 1 measured, 0.5 repaired (the road plane's), 0 no value.
-    pub confidence: GrayImage,
-    /// The road plane, if one was found.
-    pub plane: Option<RoadPlane>,
-    /// Pixels the streak detector marked (after dilation).
-    pub streak_pixels: usize,
-    /// Pixels whose disparity lay below the road plane.
-    pub below_road_pixels: usize,
-    /// Pixels repaired (given the road plane's disparity).
-    pub repaired_pixels: usize,
-    /// Pixels masked (made invalid) that had a value.
-    pub masked_pixels: usize,
+/// The shortest streak (rows spanned, as a share of the image height) that the streak-level
+/// score counts, in the truth and in the mask: shorter specks are not streaks.
+pub const MIN_STREAK_EXTENT: f32 = 0.03;
+
+/// A truth streak is found when the mask covers at least this share of its pixels.
+pub const FOUND_COVER: f32 = 0.25;
+
+/// A detected streak is correct when at least this share of its pixels lies within 2 px of
+/// the truth's streak pixels.
+pub const CORRECT_SHARE: f32 = 0.5;
+
+/// The streak-level counts of a streak mask against the road-streak truth (both non-zero on
+/// streak pixels): `(truth streaks found, truth streaks, detected streaks correct, detected
+/// streaks)`. Streaks are 8-connected components spanning at least [`MIN_STREAK_EXTENT`] of
+/// the image's rows; see [`FOUND_COVER`] and [`CORRECT_SHARE`].
+pub fn streak_objects(mask: &GrayImage, truth: &GrayImage) -> (usize, usize, usize, usize) {
+    use crate::benchmark::breakdown::components8;
+    let (w, h) = (truth.width, truth.height);
+    let min_rows = (MIN_STREAK_EXTENT * h as f32).ceil() as usize;
+    let tall = |c: &Vec<usize>| {
+        let (y0, y1) = c
+            .iter()
+            .fold((usize::MAX, 0), |(a, b), &i| (a.min(i / w), b.max(i / w)));
+        y1 + 1 - y0 >= min_rows
+    };
+    let near_truth = max(&max(truth, Axis::Rows, 2), Axis::Columns, 2);
+    let (mut found, mut truths, mut correct, mut detected) = (0, 0, 0, 0);
+    for c in components8(w, h, |i| truth.data[i] > 0.0)
+        .iter()
+        .filter(|c| tall(c))
+    {
+        truths += 1;
+        let covered = c.iter().filter(|&&i| mask.data[i] > 0.0).count();
+        found += usize::from(covered as f32 >= FOUND_COVER * c.len() as f32);
+    }
+    for c in components8(w, h, |i| mask.data[i] > 0.0)
+        .iter()
+        .filter(|c| tall(c))
+    {
+        detected += 1;
+        let on = c.iter().filter(|&&i| near_truth.data[i] > 0.0).count();
+        correct += usize::from(on as f32 >= CORRECT_SHARE * c.len() as f32);
+    }
+    (found, truths, correct, detected)
+}
+
+/// Whether an estimate `e` of the true disparity `t` is right: within 2 px and not more than
+/// 1 px beneath it (the `wrong` classifier's label and the confidence map's meaning).
+pub fn is_right(e: f32, t: f32) -> bool {
+    (e - t).abs() <= 2.0 && e >= t - 1.0
 }
 
 /// What went wrong in [`estimate`].
@@ -242,15 +747,15 @@ pub struct Estimate {
     pub robust: Option<RobustDisparity>,
 }
 
-/// Semi-global matching of `left` and `right` with `params`, then, given a `handling`, the
-/// streak-robust pass with its default parameters ([`robust_disparity`]). One function, so
-/// that `streaks disparity [--streaks mask|repair]` and the benchmark's `sgm` and
-/// `sgm-streaks` methods compute exactly the same map.
+/// Semi-global matching of `left` and `right` with `params`, then, given a handling and a
+/// model (usually [`RepairModel::shipped`]), the streak-robust pass ([`robust_disparity`]).
+/// One function, so that `streaks disparity [--streaks mask|repair]` and the benchmark's
+/// `sgm` and `sgm-streaks` methods compute exactly the same map.
 pub fn estimate(
     left: &GrayImage,
     right: &GrayImage,
     params: &SgmParams,
-    handling: Option<StreakHandling>,
+    handling: Option<(StreakHandling, &RepairModel)>,
 ) -> Result<Estimate, EstimateError> {
     let start = std::time::Instant::now();
     let disp = sgm(left, right, params)?;
@@ -261,8 +766,8 @@ pub fn estimate(
             sgm_seconds,
             robust: None,
         },
-        Some(handling) => {
-            let r = robust_disparity(left, &disp, handling, &RepairParams::default())?;
+        Some((handling, model)) => {
+            let r = robust_disparity(left, right, &disp, handling, model)?;
             Estimate {
                 disparity: r.disparity.clone(),
                 sgm_seconds,
@@ -272,175 +777,361 @@ pub fn estimate(
     })
 }
 
-/// `mask` grown by `r` pixels (a square structuring element).
-fn dilate(mask: &GrayImage, r: usize) -> GrayImage {
-    let (w, h) = (mask.width, mask.height);
-    let mut rows = mask.clone();
-    for y in 0..h {
-        for x in 0..w {
-            let (x0, x1) = (x.saturating_sub(r), (x + r + 1).min(w));
-            rows.data[y * w + x] = f32::from(u8::from(
-                mask.data[y * w + x0..y * w + x1].iter().any(|&v| v > 0.0),
-            ));
-        }
-    }
-    let mut out = rows.clone();
-    for y in 0..h {
-        let (y0, y1) = (y.saturating_sub(r), (y + r + 1).min(h));
-        for x in 0..w {
-            out.data[y * w + x] =
-                f32::from(u8::from((y0..y1).any(|yy| rows.data[yy * w + x] > 0.0)));
-        }
-    }
-    out
+/// Counts for the figures of a repair on samples with ground truth: the phantom holes, the
+/// off-road bad-2, the densities, the streak mask's score and the calibration's counts.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct RepairCounts {
+    /// Road pixels with a finite truth.
+    pub road: usize,
+    /// Of those, semi-global matching's values more than 1 px beneath the truth.
+    pub road_below_sgm: usize,
+    /// Of those, the repaired map's values more than 1 px beneath the truth.
+    pub road_below: usize,
+    /// Road pixels with a value, semi-global matching and repaired.
+    pub road_valid_sgm: usize,
+    /// See `road_valid_sgm`.
+    pub road_valid: usize,
+    /// Off-road pixels with a finite truth and a value, semi-global matching and repaired.
+    pub off_valid_sgm: usize,
+    /// See `off_valid_sgm`.
+    pub off_valid: usize,
+    /// Of those, more than 2 px off: semi-global matching and repaired.
+    pub off_bad_sgm: usize,
+    /// See `off_bad_sgm`.
+    pub off_bad: usize,
+    /// Off-road pixels with a finite truth.
+    pub off: usize,
+    /// Streak mask against the road-streak truth: pixels in both.
+    pub streak_true_positives: usize,
+    /// Pixels of the streak mask.
+    pub streak_detected: usize,
+    /// Pixels of the road-streak truth.
+    pub streak_truth: usize,
+    /// Truth streaks found by the streak mask ([`streak_objects`]).
+    pub streaks_found: usize,
+    /// Truth streaks.
+    pub streaks_true: usize,
+    /// Detected streaks that are correct.
+    pub detections_correct: usize,
+    /// Detected streaks.
+    pub detections: usize,
+    /// Kept values by calibration bin: (right, all).
+    pub kept: Vec<(usize, usize)>,
+    /// Repaired values by window: (right, all).
+    pub repaired: Vec<(usize, usize)>,
 }
 
-/// Masks or repairs the pixels of `disp` (the left view's disparity) that streaks and
-/// reflections fool, using `left` (the left image's luminance) to detect streaks; see the
-/// module documentation.
-pub fn robust_disparity(
-    left: &GrayImage,
-    disp: &GrayImage,
-    handling: StreakHandling,
-    params: &RepairParams,
-) -> Result<RobustDisparity, RepairError> {
-    ensure_same_size(
-        "the left image",
-        left.size(),
-        "the disparity map",
-        disp.size(),
-    )?;
-    let (w, h) = (disp.width, disp.height);
-    // The plane from all valid pixels first (streaks are few), for the detector's horizon.
-    let first = fit_road_plane(disp, None, params.lower_share);
-    let mut detect = params.detect;
-    if detect.horizon.is_none() {
-        if let Some(p) = first {
-            if p.horizon.is_finite() && p.horizon > 0.0 && p.horizon < h as f64 {
-                detect.horizon = Some(p.horizon as f32);
+impl RepairCounts {
+    /// Adds the counts of one sample: semi-global matching's map `sgm`, the repair `r` of it
+    /// with `model`, the truth, and the road and road-streak masks (non-zero: in the mask).
+    pub fn add(
+        &mut self,
+        sgm: &GrayImage,
+        r: &RobustDisparity,
+        model: &RepairModel,
+        truth: &GrayImage,
+        road: &GrayImage,
+        road_streaks: &GrayImage,
+    ) {
+        if self.kept.is_empty() {
+            self.kept = vec![(0, 0); CALIBRATION_BINS];
+            self.repaired = vec![(0, 0); FILL_RADII.len()];
+        }
+        let (found, truths, correct, detected) = streak_objects(&r.streaks, road_streaks);
+        self.streaks_found += found;
+        self.streaks_true += truths;
+        self.detections_correct += correct;
+        self.detections += detected;
+        for i in 0..truth.data.len() {
+            let t = truth.data[i];
+            let (s, e) = (sgm.data[i], r.disparity.data[i]);
+            let streak = road_streaks.data[i] > 0.0;
+            let detected = r.streaks.data[i] > 0.0;
+            self.streak_truth += usize::from(streak);
+            self.streak_detected += usize::from(detected);
+            self.streak_true_positives += usize::from(streak && detected);
+            if !t.is_finite() {
+                continue;
+            }
+            let (sv, ev) = (s.is_finite() && s > 0.0, e.is_finite());
+            if road.data[i] > 0.0 {
+                self.road += 1;
+                self.road_below_sgm += usize::from(sv && s < t - 1.0);
+                self.road_below += usize::from(ev && e < t - 1.0);
+                self.road_valid_sgm += usize::from(sv);
+                self.road_valid += usize::from(ev);
+            } else {
+                self.off += 1;
+                self.off_valid_sgm += usize::from(sv);
+                self.off_valid += usize::from(ev);
+                self.off_bad_sgm += usize::from(sv && (s - t).abs() > 2.0);
+                self.off_bad += usize::from(ev && (e - t).abs() > 2.0);
+            }
+            let slot = match r.origin[i] {
+                Origin::Kept => Some(&mut self.kept[model.kept_bin(r.wrong.data[i])]),
+                Origin::Repaired(k) => Some(&mut self.repaired[k as usize]),
+                Origin::None | Origin::Masked => None,
+            };
+            if let Some(c) = slot {
+                c.0 += usize::from(is_right(e, t));
+                c.1 += 1;
             }
         }
     }
-    let detection = detect_streaks(left, &detect)?;
-    let streaks = dilate(&detection.mask, params.dilate);
-    let plane = fit_road_plane(disp, Some(&streaks), params.lower_share).or(first);
-    let mut out = disp.clone();
-    let mut confidence = GrayImage::new(w, h, 0.0)?;
-    let (mut streak_pixels, mut below, mut repaired, mut masked) = (0, 0, 0, 0);
-    for y in 0..h {
-        let road = plane.and_then(|p| p.disparity_at(y));
-        for x in 0..w {
-            let i = y * w + x;
-            let d = disp.data[i];
-            let in_streak = streaks.data[i] > 0.0;
-            let beneath = road.is_some_and(|r| d.is_finite() && d < r - params.below_tolerance);
-            streak_pixels += usize::from(in_streak);
-            below += usize::from(beneath);
-            if in_streak || beneath {
-                match (handling, road) {
-                    (StreakHandling::Repair, Some(r)) => {
-                        out.data[i] = r;
-                        confidence.data[i] = 0.5;
-                        repaired += 1;
-                    }
-                    _ => {
-                        masked += usize::from(d.is_finite());
-                        out.data[i] = f32::INFINITY;
-                    }
-                }
-            } else if d.is_finite() {
-                confidence.data[i] = 1.0;
-            }
+
+    /// The phantom-hole rates (semi-global matching, repaired): road pixels more than 1 px
+    /// beneath the truth, over all road pixels with a truth.
+    pub fn phantom(&self) -> (f64, f64) {
+        let f = |a: usize| a as f64 / self.road.max(1) as f64;
+        (f(self.road_below_sgm), f(self.road_below))
+    }
+
+    /// Off-road bad-2 over the off-road values (semi-global matching, repaired).
+    pub fn off_road_bad2(&self) -> (f64, f64) {
+        (
+            self.off_bad_sgm as f64 / self.off_valid_sgm.max(1) as f64,
+            self.off_bad as f64 / self.off_valid.max(1) as f64,
+        )
+    }
+
+    /// The streak-level score: (precision, recall) over the detected and the truth streaks
+    /// ([`streak_objects`]); 1 where there is nothing to count.
+    pub fn streak_level(&self) -> (f64, f64) {
+        let f = |a: usize, b: usize| if b > 0 { a as f64 / b as f64 } else { 1.0 };
+        (
+            f(self.detections_correct, self.detections),
+            f(self.streaks_found, self.streaks_true),
+        )
+    }
+
+    /// The streak mask's pixel score.
+    pub fn streak_score(&self) -> MaskScore {
+        MaskScore::from_counts(
+            self.streak_true_positives,
+            self.streak_detected,
+            self.streak_truth,
+        )
+    }
+
+    /// The calibration these counts measure (a bin without values gets its neighbours'
+    /// share, or 0.5 with none).
+    pub fn calibration(&self) -> Calibration {
+        let shares = |c: &[(usize, usize)]| -> Vec<f32> {
+            let raw: Vec<Option<f32>> = c
+                .iter()
+                .map(|&(r, a)| (a > 0).then(|| r as f32 / a as f32))
+                .collect();
+            (0..raw.len())
+                .map(|k| {
+                    raw[k]
+                        .or_else(|| (0..k).rev().find_map(|j| raw[j]))
+                        .or_else(|| raw[k..].iter().find_map(|v| *v))
+                        .unwrap_or(0.5)
+                })
+                .collect()
+        };
+        Calibration {
+            kept: shares(&self.kept),
+            repaired: shares(&self.repaired),
         }
     }
-    Ok(RobustDisparity {
-        disparity: out,
-        confidence,
-        plane,
-        streak_pixels,
-        below_road_pixels: below,
-        repaired_pixels: repaired,
-        masked_pixels: masked,
-    })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::gbdt::Node;
 
-    /// A synthetic scene: road rows `d = 0.2 (y - 40)`, a wall on the left third (constant
-    /// 30 px), and a streak column at x in 60..64 reading 5 px below the road.
-    fn scene(w: usize, h: usize) -> (GrayImage, GrayImage) {
+    /// A textured road whose disparity grows down the rows (`floor(0.2 (y - 20))`), with a bright
+    /// streak column at x in 60..64 that semi-global matching read at 1 px all the way down
+    /// (the virtual light far beneath the road), and no value
+    /// in the top 20 rows (the sky): `(left, right, disparity, truth)`.
+    fn scene(w: usize, h: usize) -> (GrayImage, GrayImage, GrayImage, GrayImage) {
+        let texture = |x: f32, y: usize| 0.2 + 0.1 * ((x * 0.9).sin() * (y as f32 * 0.7).cos());
+        let mut left = GrayImage::new(w, h, 0.0).unwrap();
+        let mut right = GrayImage::new(w, h, 0.0).unwrap();
         let mut disp = GrayImage::new(w, h, f32::INFINITY).unwrap();
-        let mut left = GrayImage::new(w, h, 0.05).unwrap();
+        let mut truth = GrayImage::new(w, h, f32::INFINITY).unwrap();
         for y in 0..h {
+            // Whole pixels, so that the right image is the left one shifted exactly.
+            let road = (0.2 * (y as f32 + 0.5 - 20.0)).floor();
             for x in 0..w {
-                let road = 0.2 * (y as f32 + 0.5 - 40.0);
-                let d = if x < w / 3 {
-                    30.0
-                } else if road > 0.0 {
-                    road + 0.05 * ((x * 7 + y * 3) % 5) as f32 - 0.1
-                } else {
-                    f32::INFINITY
-                };
-                disp.set(x, y, d);
+                left.set(x, y, texture(x as f32, y));
+                right.set(x, y, texture(x as f32 + road.max(0.0), y));
+                if road > 0.0 {
+                    truth.set(x, y, road);
+                    let streak = (60..64).contains(&x);
+                    disp.set(x, y, if streak { 1.0 } else { road });
+                    if streak {
+                        left.set(x, y, 0.95);
+                    }
+                }
             }
         }
-        for y in 50..h {
-            for x in 60..64 {
-                let road = 0.2 * (y as f32 + 0.5 - 40.0);
-                disp.set(x, y, (road - 5.0).max(0.1));
-                left.set(x, y, 0.9);
-            }
+        (left, right, disp, truth)
+    }
+
+    /// One stump: log-odds `hi` where `feature > value`, `lo` elsewhere.
+    fn stump(feature: &str, value: f32, lo: f32, hi: f32) -> Model {
+        let f = FEATURES.iter().position(|n| *n == feature).unwrap() as u16;
+        Model {
+            features: FEATURES.len(),
+            base: 0.0,
+            trees: vec![vec![
+                Node {
+                    feature: f,
+                    value,
+                    left: 1,
+                    right: 2,
+                },
+                Node {
+                    feature: 0,
+                    value: lo,
+                    left: 0,
+                    right: 0,
+                },
+                Node {
+                    feature: 0,
+                    value: hi,
+                    left: 0,
+                    right: 0,
+                },
+            ]],
         }
-        (left, disp)
+    }
+
+    /// `wrong` where the value is more than 2 px below its row's upper quartile (32 px), a
+    /// streak where the 31-px contrast exceeds 0.5.
+    fn model() -> RepairModel {
+        let mut m = RepairModel::new(
+            stump("d_minus_q75_r32", -2.0, 4.0, -4.0),
+            stump("contrast_31", 0.5, -4.0, 4.0),
+        );
+        m.calibration.kept = (0..CALIBRATION_BINS)
+            .map(|k| 0.9 - 0.01 * k as f32)
+            .collect();
+        m.calibration.repaired = vec![0.7, 0.6, 0.5, 0.4, 0.3];
+        m
     }
 
     #[test]
-    fn plane_is_found_among_walls() {
-        let (_, disp) = scene(160, 120);
-        let p = fit_road_plane(&disp, None, 0.6).unwrap();
-        assert!((p.slope - 0.2).abs() < 0.005, "{p:?}");
-        assert!((p.horizon - 40.0).abs() < 1.0, "{p:?}");
-        assert!(p.inlier_share > 0.4, "{p:?}");
-    }
-
-    #[test]
-    fn repair_puts_streaks_on_the_road_and_mask_removes_them() {
-        let (left, disp) = scene(160, 120);
-        let params = RepairParams {
-            detect: DetectParams {
-                horizon: Some(40.0),
-                ..DetectParams::default()
-            },
-            ..RepairParams::default()
+    fn features_see_the_streak_below_its_row_and_nothing_where_there_is_no_value() {
+        let (left, right, disp, _) = scene(160, 100);
+        let f = StereoFeatures::new(&left, &right, &disp).unwrap();
+        let at = |name: &str, x: usize, y: usize| {
+            let mut row = [0f32; FEATURES.len()];
+            f.row(y * 160 + x, &mut row);
+            row[FEATURES.iter().position(|n| *n == name).unwrap()]
         };
-        let r = robust_disparity(&left, &disp, StreakHandling::Repair, &params).unwrap();
-        for y in 50..120 {
-            let road = 0.2 * (y as f32 + 0.5 - 40.0);
-            for x in 60..64 {
-                assert!((r.disparity.get(x, y) - road).abs() < 0.3, "({x}, {y})");
-                assert_eq!(r.confidence.get(x, y), 0.5);
-            }
-        }
-        // The wall, nearer than the road, is untouched.
-        assert_eq!(r.disparity.get(10, 100), 30.0);
-        assert_eq!(r.confidence.get(10, 100), 1.0);
-        assert!(r.below_road_pixels >= 4 * 60, "{}", r.below_road_pixels);
-        let m = robust_disparity(&left, &disp, StreakHandling::Mask, &params).unwrap();
-        assert!(m.disparity.get(61, 100).is_infinite());
-        assert_eq!(m.confidence.get(61, 100), 0.0);
-        assert!(m.masked_pixels >= 4 * 60);
-        assert_eq!(m.disparity.get(100, 100), disp.get(100, 100));
+        let road = (0.2f32 * (80.5 - 20.0)).floor();
+        assert!((at("d_minus_q75_r32", 61, 80) - (1.0 - road)).abs() < 0.01);
+        assert!(at("d_minus_q75_r32", 100, 80).abs() < 0.01);
+        assert!(at("contrast_31", 61, 80) > 1.0);
+        // The road beside the streak matches at its disparity; the streak does not match at
+        // the surface's, where it does at its own.
+        assert!(
+            at("photo_at_d", 100, 80) < 0.01,
+            "{}",
+            at("photo_at_d", 100, 80)
+        );
+        assert!(at("photo_surface_minus_d", 61, 80) > 0.05);
+        assert_eq!(at("valid", 30, 5), 0.0);
+        assert_eq!(at("d_minus_q75_r8", 30, 5), MISSING);
+        assert_eq!(at("photo_at_d", 30, 5), MISSING);
+        // A streak's disparity does not grow down its column, the road's does.
+        assert!(at("d_change_12_rows_down", 100, 60) >= 2.0);
+        assert!(at("d_change_12_rows_down", 61, 60).abs() < at("d_change_12_rows_down", 100, 60));
     }
 
     #[test]
-    fn sizes_must_agree_and_empty_maps_have_no_plane() {
-        let (left, _) = scene(40, 30);
-        let disp = GrayImage::new(41, 30, 1.0).unwrap();
-        let e = robust_disparity(&left, &disp, StreakHandling::Mask, &RepairParams::default());
-        assert!(matches!(e, Err(RepairError::Size(..))));
-        let empty = GrayImage::new(40, 30, f32::INFINITY).unwrap();
-        assert!(fit_road_plane(&empty, None, 0.5).is_none());
+    fn repair_gives_fooled_values_the_surface_around_them_and_mask_removes_them() {
+        let (left, right, disp, truth) = scene(160, 100);
+        let m = model();
+        let r = robust_disparity(&left, &right, &disp, StreakHandling::Repair, &m).unwrap();
+        for y in 40..100 {
+            for x in 60..64 {
+                let want = truth.get(x, y);
+                let got = r.disparity.get(x, y);
+                // The upper quartile of a window on a road whose disparity grows down the rows
+                // leans a little toward the near side.
+                assert!((got - want).abs() <= 1.0, "({x}, {y}): {got} for {want}");
+                let Origin::Repaired(k) = r.origin[y * 160 + x] else {
+                    panic!("({x}, {y}) is not repaired");
+                };
+                assert_eq!(r.confidence.get(x, y), m.calibration.repaired[k as usize]);
+                assert_eq!(r.streaks.get(x, y), 1.0);
+            }
+        }
+        assert_eq!(r.disparity.get(100, 80), disp.get(100, 80));
+        assert_eq!(r.confidence.get(100, 80), m.calibration.kept[0]);
+        assert_eq!(r.confidence.get(100, 5), 0.0);
+        assert_eq!(r.streaks.get(100, 80), 0.0);
+        assert_eq!(r.dropped_pixels, r.repaired_pixels + r.masked_pixels);
+        let k = robust_disparity(&left, &right, &disp, StreakHandling::Mask, &m).unwrap();
+        assert!(k.disparity.get(61, 80).is_infinite());
+        assert_eq!(k.confidence.get(61, 80), 0.0);
+        assert_eq!(k.masked_pixels, k.dropped_pixels);
+        assert!(k.dropped_pixels >= 4 * 60);
+        // The counts: phantom holes gone, the streak found.
+        let road = GrayImage::new(160, 100, 1.0).unwrap();
+        let mut c = RepairCounts::default();
+        c.add(&disp, &r, &m, &truth, &road, &r.streaks.clone());
+        let (before, after) = c.phantom();
+        assert!(before > 0.02 && after == 0.0, "{before} {after}");
+        assert_eq!(c.streak_level(), (1.0, 1.0));
+        assert!(c.repaired.iter().all(|&(right, all)| right == all));
+    }
+
+    #[test]
+    fn streak_objects_count_tall_components_found_and_correct() {
+        let mut truth = GrayImage::new(50, 100, 0.0).unwrap();
+        let mut mask = truth.clone();
+        for y in 10..60 {
+            truth.set(5, y, 1.0); // a 50-row streak, found (mask covers 30 rows)
+            truth.set(30, y, 1.0); // a 50-row streak, missed (mask covers 5 rows)
+            if y < 40 {
+                mask.set(5, y, 1.0);
+            }
+            if y < 15 {
+                mask.set(30, y, 1.0);
+            }
+            mask.set(45, y, 1.0); // a detection far from any streak
+        }
+        truth.set(20, 90, 1.0); // one row: too short to count
+        assert_eq!(streak_objects(&mask, &truth), (1, 2, 2, 3));
+    }
+
+    #[test]
+    fn models_are_checked_when_read_and_the_shipped_one_is_valid() {
+        let shipped = RepairModel::shipped();
+        assert!(shipped.provenance["datasets"]
+            .as_array()
+            .is_some_and(|d| !d.is_empty()));
+        let text = serde_json::to_string(&model()).unwrap();
+        assert!(RepairModel::from_json(&text).is_ok());
+        let mut bad = model();
+        bad.wrong_threshold = 1.5;
+        let e = RepairModel::from_json(&serde_json::to_string(&bad).unwrap()).unwrap_err();
+        assert!(e.to_string().contains("wrong_threshold"), "{e}");
+        let mut bad = model();
+        bad.calibration.repaired.pop();
+        assert!(RepairModel::from_json(&serde_json::to_string(&bad).unwrap()).is_err());
+        let e = RepairModel::from_json(&text.replace(FORMAT, "streaks-repair/0")).unwrap_err();
+        assert!(e.to_string().contains("format"), "{e}");
+        assert!(RepairModel::from_json("{").is_err());
+    }
+
+    #[test]
+    fn sizes_must_agree() {
+        let (left, right, disp, _) = scene(40, 30);
+        let small = GrayImage::new(39, 30, 1.0).unwrap();
+        assert!(matches!(
+            StereoFeatures::new(&left, &small, &disp),
+            Err(RepairError::Size(..))
+        ));
+        assert!(matches!(
+            robust_disparity(&left, &right, &small, StreakHandling::Mask, &model()),
+            Err(RepairError::Size(..))
+        ));
     }
 }

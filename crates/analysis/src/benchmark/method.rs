@@ -7,7 +7,7 @@
 
 use super::{lk_streak_disparity, streak_lk_params, StreakLkError};
 use crate::detect::DetectParams;
-use crate::repair::{estimate, EstimateError, StreakHandling};
+use crate::repair::{estimate, EstimateError, RepairModel, StreakHandling};
 use crate::sgm::SgmParams;
 use streaks_image::GrayImage;
 
@@ -20,9 +20,9 @@ pub const BUILT_INS: [(&str, &str); 3] = [
     ),
     (
         "sgm-streaks",
-        "sgm, then the streak repair: `streaks disparity --streaks repair` (road plane from \
-         the pair's v-disparity; detected streaks and below-the-road pixels given the plane's \
-         disparity)",
+        "sgm, then the streak repair: `streaks disparity --streaks repair` (values a learned \
+         classifier of local stereo and appearance features finds fooled are replaced by the \
+         median of the kept values around them; no road model)",
     ),
     (
         "lk",
@@ -82,7 +82,7 @@ impl BuiltIn {
                     left,
                     right,
                     &SgmParams::default(),
-                    Some(StreakHandling::Repair),
+                    Some((StreakHandling::Repair, RepairModel::shipped())),
                 )?
                 .disparity
             }

@@ -308,9 +308,9 @@ mod tests {
                 "Lucas-Kanade: invalid Lucas-Kanade parameter window",
             ),
             (
-                Box::new(EstimateError::from(RepairError::from(detect()))),
-                detect().to_string(),
-                "streak-robust disparity: streak detection: invalid",
+                Box::new(EstimateError::from(RepairError::Format("no trees".into()))),
+                "no trees".to_string(),
+                "streak-robust disparity: repair model: no trees",
             ),
         ];
         for (err, cause, start) in cases {
