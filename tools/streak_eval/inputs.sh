@@ -8,6 +8,8 @@
 #   OUT/pairs/{hill_bend,crossing,tabletop}/      `streaks stereo` pairs of them
 #   OUT/other_config/                             3 samples of other_config.toml (seed 77)
 #   OUT/dry_config/                               4 samples of dry_config.toml (seed 78)
+#   OUT/heldback/                                 24 default-config samples (seed 44900), the
+#                                                 held-back split no parameter choice sees
 #
 # BLENDER_PYTHON: the Python with bpy 5.0 (default target/blender-venv/bin/python);
 # STREAKS: the streaks binary (default target/release/streaks). Run from the repository root.
@@ -47,5 +49,9 @@ echo "$(stamp) dry_config: 4 samples, 640x360, 16 spp"
 "$streaks" dataset generate -o "$out/dry_config" --config "$here/dry_config.toml" \
     --count 4 --seed 78 --width 640 --height 360 --spp 16 --denoise off \
     --outputs images,gt,masks
+
+echo "$(stamp) heldback: 24 samples of the default config, seed 44900, 480x288, 16 spp"
+"$streaks" dataset generate -o "$out/heldback" --seed 44900 --count 24 \
+    --width 480 --height 288 --spp 16 --denoise off --outputs images,gt,masks
 
 echo "$(stamp) done: $out"

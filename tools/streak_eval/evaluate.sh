@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Scores streak-robust stereo on the evaluation inputs that inputs.sh made:
+#
+#   tools/streak_eval/evaluate.sh [IN [OUT]]    (IN defaults to target/streak-eval, OUT to IN/results)
+#
+# For each of heldback/, other_config/, dry_config/ and pairs/ (hill_bend, crossing, tabletop):
+#   OUT/bench-NAME/             `streaks benchmark` of sgm, sgm-streaks (and opencv-sgbm with
+#                               OPENCV_PYTHON), with the breakdown by condition, streak length
+#                               and distance (report.json, index.html)
+#   OUT/repair-NAME.json        `streaks train-repair --evaluate`: phantom holes, off-road bad-2
+#                               and densities before and after, the streak mask's scores
+# then prints one table (summary.py).
+#
+# STREAKS: the binary (default target/release/streaks); OPENCV_PYTHON: a Python with
+# opencv-python-headless (tools/opencv/requirements.txt) to add OpenCV's StereoSGBM.
+# Evaluation only: no parameter may be tuned on these figures.
+set -euo pipefail
+
+in="${1:-target/streak-eval}"
+out="${2:-$in/results}"
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+streaks="${STREAKS:-target/release/streaks}"
+
+methods=(--method sgm sgm-streaks)
+if [[ -n "${OPENCV_PYTHON:-}" ]]; then
+    methods+=(--method-cmd "opencv-sgbm=$OPENCV_PYTHON $here/../opencv/sgbm.py {left} {right} {out}")
+fi
+
+mkdir -p -- "$out"
+stamp() { date -u +%H:%M:%S; }
+
+for name in heldback other_config dry_config pairs; do
+    echo "$(stamp) benchmark: $name"
+    "$streaks" benchmark "$in/$name" "${methods[@]}" -o "$out/bench-$name"
+done
+
+for name in heldback other_config dry_config pairs/hill_bend pairs/crossing; do
+    echo "$(stamp) repair figures: $name"
+    "$streaks" train-repair --evaluate "$in/$name" --val-split all \
+        -o "$out/repair-$(basename "$name").json"
+done
+
+python3 "$here/summary.py" "$out"
