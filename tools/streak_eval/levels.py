@@ -40,3 +40,13 @@ def hill_profile(s: float) -> float:
 def crown(x: float, half: float, rise: float) -> float:
     """A crowned carriageway's height: `rise` on the centre line, 0 at +-`half`."""
     return rise * max(0.0, 1.0 - (x / half) ** 2)
+
+
+def eased_grade(y: float, grade: float, ease_from: float, ease_len: float) -> float:
+    """A road's height along y: a constant `grade` (rise / run, e.g. -0.04) from y = 0 up to
+    `ease_from`, easing to level over the next `ease_len` metres (the grade times 1 -
+    smoothstep), level after; 0 at y = 0 and continuous in height and grade."""
+    if y <= ease_from:
+        return grade * y
+    t = min(1.0, (y - ease_from) / ease_len)
+    return grade * (ease_from + ease_len * (t - t**3 + 0.5 * t**4))

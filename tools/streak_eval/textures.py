@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import struct
 import zlib
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -37,27 +38,41 @@ def linear_to_srgb8(linear: np.ndarray) -> np.ndarray:
     return np.round(s * 255.0).astype(np.uint8)
 
 
-def asphalt_albedo(n: int = 256, seed: int = 1) -> np.ndarray:
-    """Wet asphalt's base colour (n x n x 3, sRGB): dark binder (linear albedo about 0.04)
-    with grain (one-pixel speckle), lighter stones of a few pixels and a slow patchiness."""
+def asphalt_albedo(
+    n: int = 256,
+    seed: int = 1,
+    level: float = 0.045,
+    stone_px: float = 1.5,
+    stone_cut: float = 1.3,
+    tint: tuple[float, float, float] = (0.97, 0.98, 1.03),
+) -> np.ndarray:
+    """Wet asphalt's base colour (n x n x 3, sRGB): dark binder (linear albedo about `level`)
+    with grain (one-pixel speckle), lighter stones of about `stone_px` pixels (where the stone
+    noise exceeds `stone_cut` standard deviations) and a slow patchiness, times `tint`."""
     rng = np.random.default_rng(seed)
-    base = 0.045 * np.exp(0.18 * periodic_noise(n, n / 10.0, rng))
+    base = level * np.exp(0.18 * periodic_noise(n, n / 10.0, rng))
     grain = 1.0 + 0.35 * rng.standard_normal((n, n))
-    stones = periodic_noise(n, 1.5, rng)
-    stone_mask = np.clip((stones - 1.3) * 2.0, 0.0, 1.0)
+    stones = periodic_noise(n, stone_px, rng)
+    stone_mask = np.clip((stones - stone_cut) * 2.0, 0.0, 1.0)
     value = base * grain * (1.0 + 1.6 * stone_mask)
-    rgb = np.stack([value * 0.97, value * 0.98, value * 1.03], axis=-1)
+    rgb = np.stack([value * tint[0], value * tint[1], value * tint[2]], axis=-1)
     return linear_to_srgb8(rgb)
 
 
 def puddle_roughness(
-    n: int = 256, seed: int = 2, wet: float = 0.13, puddle: float = 0.05, share: float = 0.3
+    n: int = 256,
+    seed: int = 2,
+    wet: float = 0.13,
+    puddle: float = 0.05,
+    share: float = 0.3,
+    blobs_per_tile: float = 12.0,
 ) -> np.ndarray:
     """glTF's metallicRoughness image (n x n x 3): roughness in G, metallic 0 in B, R unused
     (255). Wet asphalt of roughness about `wet` with a little noise, and puddles (about
-    `share` of the area, smooth blobs with soft rims) of roughness `puddle`."""
+    `share` of the area, smooth blobs of about n / `blobs_per_tile` pixels with soft rims) of
+    roughness `puddle`."""
     rng = np.random.default_rng(seed)
-    blobs = periodic_noise(n, n / 12.0, rng)
+    blobs = periodic_noise(n, n / blobs_per_tile, rng)
     threshold = np.quantile(blobs, 1.0 - share)
     t = np.clip((blobs - threshold) / 0.25, 0.0, 1.0)  # 0 asphalt .. 1 puddle, soft rim
     rough = wet * (1.0 + 0.15 * periodic_noise(n, 2.0, rng))
@@ -109,33 +124,113 @@ def facade_panels(n: int = 256, seed: int = 4) -> np.ndarray:
     return linear_to_srgb8(rgb)
 
 
-def facade_plaster(n: int = 256, seed: int = 5) -> np.ndarray:
-    """A rendered (plastered) facade (n x n x 3, sRGB): ochre plaster with blotchy weathering
-    and fine roughcast noise, two rows of three windows per tile."""
+def facade_plaster(
+    n: int = 256,
+    seed: int = 5,
+    colour: tuple[float, float, float] = (1.0, 0.78, 0.52),
+    per_row: int = 3,
+    rows: int = 2,
+) -> np.ndarray:
+    """A rendered (plastered) facade (n x n x 3, sRGB): plaster (ochre by default, times
+    `colour`) with blotchy weathering and fine roughcast noise, `rows` rows of `per_row`
+    windows per tile."""
     rng = np.random.default_rng(seed)
     value = 0.42 * np.exp(0.12 * periodic_noise(n, n / 8.0, rng))
     value = value * (1.0 + 0.08 * rng.standard_normal((n, n)))
-    rgb = np.stack([value, value * 0.78, value * 0.52], axis=-1)
-    rgb[_windows(n, 3, 2, 0.42, 0.5)] = (0.02, 0.02, 0.022)
+    rgb = np.stack([value * colour[0], value * colour[1], value * colour[2]], axis=-1)
+    rgb[_windows(n, per_row, rows, 0.42, 0.5)] = (0.02, 0.02, 0.022)
     return linear_to_srgb8(rgb)
 
 
-def facade_blocks(n: int = 256, seed: int = 6) -> np.ndarray:
-    """Concrete blocks in running bond (n x n x 3, sRGB): 8 courses of 4 blocks per tile,
-    each block its own grey, mortar joints, one row of square windows."""
+def facade_blocks(
+    n: int = 256,
+    seed: int = 6,
+    courses: int = 8,
+    per_course: int = 4,
+    colour: tuple[float, float, float] = (1.0, 1.0, 0.97),
+    shade: float = 0.3,
+    mortar: tuple[float, float, float] | None = None,
+    windows: bool = True,
+) -> np.ndarray:
+    """Blocks or bricks in running bond (n x n x 3, sRGB): `courses` courses of `per_course`
+    blocks per tile, each block its own shade about `shade` (times `colour`), mortar joints
+    (0.5 times `colour`, or the linear colour `mortar`), one row of square windows (unless
+    `windows` is false). The defaults: grey concrete blocks, 8 courses of 4."""
     rng = np.random.default_rng(seed)
-    courses, per_course = 8, 4
     ch, bw = n // courses, n // per_course
     v, u = np.mgrid[0:n, 0:n]
     course = v // ch
     shifted = (u + (course % 2) * (bw // 2)) % n
     block = shifted // bw
-    shade = 0.3 + 0.05 * rng.standard_normal((courses, per_course))
-    value = shade[course, block] * (1.0 + 0.1 * periodic_noise(n, 1.2, rng))
+    shades = shade + 0.05 * rng.standard_normal((courses, per_course))
+    value = shades[course, block] * (1.0 + 0.1 * periodic_noise(n, 1.2, rng))
     joint = ((v % ch) < 2) | ((shifted % bw) < 2)
     value = np.where(joint, 0.5, value)
-    rgb = np.stack([value, value, value * 0.97], axis=-1)
-    rgb[_windows(n, 2, 1, 0.4, 0.35)] = (0.02, 0.02, 0.02)
+    rgb = np.stack([value * colour[0], value * colour[1], value * colour[2]], axis=-1)
+    if mortar is not None:
+        rgb[joint] = mortar
+    if windows:
+        rgb[_windows(n, 2, 1, 0.4, 0.35)] = (0.02, 0.02, 0.02)
+    return linear_to_srgb8(rgb)
+
+
+def lawn(n: int = 128, seed: int = 7) -> np.ndarray:
+    """Mown grass seen at night (n x n x 3, sRGB): dark green with blade-scale speckle and
+    slow patches of lighter and browner turf."""
+    rng = np.random.default_rng(seed)
+    patches = periodic_noise(n, n / 6.0, rng)
+    value = 0.07 * np.exp(0.25 * patches) * (1.0 + 0.4 * rng.standard_normal((n, n)))
+    brown = np.clip(0.5 + 0.3 * periodic_noise(n, n / 10.0, rng), 0.0, 1.0)
+    rgb = np.stack([value * (0.45 + 0.5 * brown), value, value * 0.3], axis=-1)
+    return linear_to_srgb8(rgb)
+
+
+def wood(n: int = 256, seed: int = 8, colour: tuple[float, float, float] = (0.5, 0.3, 0.15)):
+    """Wood grain along the image's x axis (n x n x 3, sRGB): rings as wavy stripes (a whole
+    number of them per tile), knots of slow noise, fine fibre noise; linear albedo about
+    `colour`."""
+    rng = np.random.default_rng(seed)
+    v, u = np.mgrid[0:n, 0:n].astype(np.float64)
+    warp = 3.0 * periodic_noise(n, n / 8.0, rng)
+    rings = 0.5 + 0.5 * np.sin(2.0 * np.pi * (v * 14.0 / n) + warp)
+    fibre = 1.0 + 0.12 * periodic_noise(n, 0.7, rng)
+    value = (0.75 + 0.35 * rings) * fibre
+    rgb = np.stack([value * colour[0], value * colour[1], value * colour[2]], axis=-1)
+    return linear_to_srgb8(rgb)
+
+
+def book_spines(n: int = 256, seed: int = 9, books: int = 14) -> np.ndarray:
+    """A row of book spines (n x n x 3, sRGB): `books` vertical strips of random widths and
+    cloth colours across the tile, each with a light title band and noise of the cloth."""
+    rng = np.random.default_rng(seed)
+    widths = rng.uniform(0.5, 1.5, books)
+    edges = np.round(np.concatenate([[0.0], np.cumsum(widths)]) / widths.sum() * n).astype(int)
+    colours = rng.uniform(0.04, 0.5, (books, 3))
+    v, u = np.mgrid[0:n, 0:n]
+    book = np.searchsorted(edges, u, side="right") - 1
+    rgb = colours[book] * (1.0 + 0.1 * periodic_noise(n, 1.0, rng))[..., None]
+    band_lo = rng.uniform(0.15, 0.6, books)
+    band = (v / n > band_lo[book]) & (v / n < band_lo[book] + 0.12)
+    letters = periodic_noise(n, 1.2, rng) > 0.3
+    rgb[band & ~letters] = 0.7
+    rgb[band & letters] = 0.08
+    gap = np.isin(u, edges[1:-1])
+    rgb[gap] = 0.01
+    return linear_to_srgb8(rgb)
+
+
+def wallpaper(n: int = 256, seed: int = 10) -> np.ndarray:
+    """A patterned wallpaper (n x n x 3, sRGB): a diamond lattice of 8 x 8 motifs per tile,
+    dots at the lattice points, faded by slow blotches, on a pale blue-grey ground."""
+    rng = np.random.default_rng(seed)
+    v, u = np.mgrid[0:n, 0:n].astype(np.float64)
+    a = 2.0 * np.pi * 8.0 / n
+    lattice = np.abs(np.sin(a * (u + v) / 2.0)) * np.abs(np.sin(a * (u - v) / 2.0))
+    dots = (np.cos(a * u) * np.cos(a * v)) > 0.85
+    fade = 1.0 + 0.1 * periodic_noise(n, n / 6.0, rng)
+    value = (0.35 + 0.2 * lattice) * fade
+    rgb = np.stack([value * 0.85, value * 0.9, value], axis=-1)
+    rgb[dots] = (0.5, 0.2, 0.12)
     return linear_to_srgb8(rgb)
 
 
@@ -169,7 +264,8 @@ def write_png(path: Path, pixels: np.ndarray) -> None:
 
 
 #: The textures of the outside streets: name -> (maker, whether it holds colour (sRGB) rather
-#: than data).
+#: than data). The first set (hill_bend, crossing, tabletop) uses the first six; the second
+#: set (roundabout, avenue, shelf) the rest, made with other seeds and patterns.
 TEXTURES = {
     "asphalt": (asphalt_albedo, True),
     "puddles": (puddle_roughness, False),
@@ -177,6 +273,48 @@ TEXTURES = {
     "panels": (facade_panels, True),
     "plaster": (facade_plaster, True),
     "blocks": (facade_blocks, True),
+    # second set
+    "asphalt_b": (
+        partial(
+            asphalt_albedo,
+            seed=21,
+            level=0.055,
+            stone_px=2.5,
+            stone_cut=1.0,
+            tint=(1.02, 1.0, 0.96),
+        ),
+        True,
+    ),
+    "puddles_b": (
+        partial(puddle_roughness, seed=22, wet=0.15, puddle=0.04, share=0.25, blobs_per_tile=8.0),
+        False,
+    ),
+    "puddles_strong": (
+        partial(puddle_roughness, seed=23, wet=0.12, puddle=0.02, share=0.55, blobs_per_tile=5.0),
+        False,
+    ),
+    "paving_b": (partial(paving, seed=24, flags=8), True),
+    "bricks": (
+        partial(
+            facade_blocks,
+            seed=25,
+            courses=32,
+            per_course=8,
+            colour=(1.0, 0.42, 0.28),
+            shade=0.22,
+            mortar=(0.3, 0.29, 0.27),
+            windows=False,
+        ),
+        True,
+    ),
+    "render_b": (
+        partial(facade_plaster, seed=26, colour=(0.78, 0.84, 0.9), per_row=4, rows=3),
+        True,
+    ),
+    "lawn": (lawn, True),
+    "wood": (wood, True),
+    "spines": (book_spines, True),
+    "wallpaper": (wallpaper, True),
 }
 
 

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from levels import (
     crown,
+    eased_grade,
     hill_profile,
     luminance,
     radiance_for_luminance,
@@ -17,9 +18,14 @@ from levels import (
 from textures import (
     TEXTURES,
     asphalt_albedo,
+    book_spines,
     facade_blocks,
+    facade_plaster,
+    lawn,
     periodic_noise,
     puddle_roughness,
+    wallpaper,
+    wood,
     write_all,
     write_png,
 )
@@ -119,3 +125,77 @@ def test_road_shapes():
     grades = np.diff([hill_profile(s) for s in np.arange(0.0, 120.0, 1.0)])
     assert grades.max() > 0.05 and grades.min() < -0.05  # climbs, then falls past the crest
     assert crown(0.0, 4.0, 0.08) == 0.08 and crown(4.0, 4.0, 0.08) == 0.0
+
+
+FIRST_SET = ("asphalt", "puddles", "paving", "panels", "plaster", "blocks")
+
+
+def test_second_set_differs_from_the_first():
+    made = {name: make() for name, (make, _) in TEXTURES.items()}
+    second = [name for name in TEXTURES if name not in FIRST_SET]
+    assert len(second) >= 8
+    for name in second:
+        img = made[name]
+        assert img.dtype == np.uint8 and img.ndim == 3 and img.shape[2] == 3
+        for old in FIRST_SET:
+            if made[old].shape == img.shape:
+                assert not np.array_equal(made[old], img), (name, old)
+
+
+def test_first_set_defaults_unchanged():
+    # the options added for the second set leave the first set's textures as they were
+    assert np.array_equal(asphalt_albedo(64, seed=1), asphalt_albedo(64, 1, 0.045, 1.5, 1.3))
+    assert np.array_equal(facade_blocks(64, seed=6), facade_blocks(64, 6, 8, 4))
+    assert np.array_equal(facade_plaster(64, seed=5), facade_plaster(64, 5, per_row=3, rows=2))
+
+
+def test_second_set_asphalt_and_puddles():
+    make, colour = TEXTURES["asphalt_b"]
+    lin = srgb8_to_linear(make(128)).mean(axis=-1)
+    assert colour and 0.03 < lin.mean() < 0.1
+    strong = TEXTURES["puddles_strong"][0](128)[..., 1] / 255.0
+    assert 0.4 < (strong < 0.04).mean() < 0.7  # more than half the road a mirror-like puddle
+    assert strong.min() >= 0.015
+    # fewer, larger puddles than the first set's: its blobs cover more pixels each
+    assert not TEXTURES["puddles_b"][1] and not TEXTURES["puddles_strong"][1]
+
+
+def test_bricks_have_no_windows_and_are_red():
+    lin = srgb8_to_linear(TEXTURES["bricks"][0]())
+    assert (lin.mean(axis=-1) < 0.03).mean() < 0.02
+    assert lin[..., 0].mean() > 1.5 * lin[..., 2].mean()
+
+
+def test_new_patterns():
+    g = srgb8_to_linear(lawn(64))
+    assert g[..., 1].mean() > g[..., 2].mean() and g[..., 1].mean() > g[..., 0].mean()
+    w = srgb8_to_linear(wood(64)).mean(axis=-1)
+    # grain along x: rows vary less than columns
+    assert np.abs(np.diff(w, axis=1)).mean() < np.abs(np.diff(w, axis=0)).mean()
+    b = srgb8_to_linear(book_spines(128, books=10))
+    assert (b.mean(axis=-1) < 0.02).any()  # the gaps between books
+    assert len(np.unique(b[5, :, 0])) >= 6  # several books across a row
+    p = srgb8_to_linear(wallpaper(64))
+    assert p.std() > 0.03 and p.mean() > 0.2
+
+
+@pytest.mark.parametrize("name", ["lawn", "wood", "spines", "wallpaper"])
+def test_new_textures_tile(name):
+    lin = srgb8_to_linear(TEXTURES[name][0]()).mean(axis=-1)
+    # across the wrap-around edge no larger jumps than between interior neighbours
+    for axis in (0, 1):
+        inner = np.abs(np.diff(lin, axis=axis)).mean()
+        seam = np.abs(np.take(lin, 0, axis) - np.take(lin, -1, axis)).mean()
+        assert seam < 3.0 * inner + 0.01
+
+
+def test_eased_grade():
+    assert eased_grade(0.0, -0.04, 14.0, 12.0) == 0.0
+    assert math.isclose(eased_grade(10.0, -0.04, 14.0, 12.0), -0.4)
+    end = eased_grade(26.0, -0.04, 14.0, 12.0)
+    assert math.isclose(end, -0.04 * (14.0 + 6.0))
+    assert eased_grade(40.0, -0.04, 14.0, 12.0) == end  # level after the easing
+    ys = np.arange(0.0, 40.0, 0.25)
+    grades = np.diff([eased_grade(y, -0.04, 14.0, 12.0) for y in ys]) / 0.25
+    assert grades.min() >= -0.0401 and grades.max() <= 1e-12
+    assert np.abs(np.diff(grades)).max() < 0.002  # the grade changes smoothly
