@@ -49,7 +49,7 @@ def main() -> None:
         sys.exit("usage: error_maps.py OUTDIR PAGE SAMPLE [PAGE SAMPLE ...]")
     out = Path(args[0])
     out.mkdir(parents=True, exist_ok=True)
-    for page, sample in zip(args[1::2], args[2::2]):
+    for page, sample in zip(args[1::2], args[2::2], strict=False):
         for p in extract(out, Path(page), sample):
             print(p)
 
