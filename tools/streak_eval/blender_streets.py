@@ -37,7 +37,13 @@ import numpy as np  # noqa: E402
 import textures  # noqa: E402
 from build import black_world, box_geometry, point_along, reset  # noqa: E402
 from glb import read_glb  # noqa: E402
-from levels import crown, hill_profile, radiance_for_luminance, watts_for_candela  # noqa: E402
+from levels import (  # noqa: E402
+    crown,
+    eased_grade,
+    hill_profile,
+    radiance_for_luminance,
+    watts_for_candela,
+)
 
 Vec3 = tuple[float, float, float]
 
@@ -49,6 +55,12 @@ LED_3000 = (1.0, 0.71, 0.42)
 LED_4000 = (1.0, 0.84, 0.66)
 HALOGEN = (1.0, 0.78, 0.52)
 RED = (1.0, 0.02, 0.01)
+#: Second set: LED 5000 K (roundabout), metal halide 4200 K (avenue's median), xenon-like
+#: cool headlights and a cool white shop / advert light box.
+LED_5000 = (1.0, 0.93, 0.84)
+METAL_HALIDE = (1.0, 0.88, 0.74)
+XENON = (0.9, 0.95, 1.0)
+COOL_WHITE = (0.92, 0.96, 1.0)
 
 
 # --- materials --------------------------------------------------------------------------------
@@ -571,6 +583,503 @@ def build_crossing(mats: Materials) -> None:
     camera("driver", eye, pitched(np.array([0.0, 1.0, 0.0]), 1.0), 40.0, 800, 450)
 
 
+class Circle:
+    """A ring road's centre line: a circle of `radius` about `centre` (x, y), travelled
+    anticlockwise from the angle `start` (radians from +X); height by `profile(s)`. Its
+    right is outwards, so a `ribbon` profile runs from the inside (x < 0) out."""
+
+    def __init__(self, centre, radius: float, start: float, profile: Callable[[float], float]):
+        self.centre, self.radius, self.start, self.profile = centre, radius, start, profile
+
+    def angle(self, s: float) -> float:
+        return self.start + s / self.radius
+
+    def heading(self, s: float) -> float:
+        return self.angle(s) - math.pi / 2.0
+
+    def point(self, s: float) -> np.ndarray:
+        a = self.angle(s)
+        x, y = (
+            self.centre[0] + self.radius * math.cos(a),
+            self.centre[1] + self.radius * math.sin(a),
+        )
+        return np.array([x, y, self.profile(s)])
+
+    def right(self, s: float) -> np.ndarray:
+        a = self.angle(s)
+        return np.array([math.cos(a), math.sin(a), 0.0])
+
+    def along(self, s: float) -> np.ndarray:
+        a = self.angle(s)
+        return np.array([-math.sin(a), math.cos(a), 0.0])
+
+
+def drape(height: Callable[[float, float], float]) -> None:
+    """Lays the scene, built level, on the terrain `height(x, y)`: every mesh vertex and every
+    lamp and camera is raised by the height under it (walls stay vertical, roads follow)."""
+    bpy.context.view_layer.update()
+    for obj in bpy.context.scene.collection.objects:
+        if obj.type == "MESH":
+            m = obj.matrix_world
+            inv = m.inverted()
+            for v in obj.data.vertices:
+                w = m @ v.co
+                w.z += height(w.x, w.y)
+                v.co = inv @ w
+            obj.data.update()
+        else:
+            obj.location.z += height(obj.location.x, obj.location.y)
+
+
+def tree(mats: Materials, name: str, foot: Vec3, height: float, conifer: bool, inst: int):
+    """A tree: a trunk (an 8-sided prism) and a crown, a cone (`conifer`) or a sphere."""
+    bark = mats.principled("bark", (0.06, 0.045, 0.035), roughness=0.9)
+    leaves = mats.principled("leaves", albedo="lawn", roughness=0.85)
+    trunk_h = 0.45 * height if conifer else 0.55 * height
+    bpy.ops.mesh.primitive_cylinder_add(
+        vertices=8, radius=0.12, depth=trunk_h, location=(foot[0], foot[1], foot[2] + trunk_h / 2)
+    )
+    trunk = bpy.context.active_object
+    trunk.name = f"{name}_trunk"
+    trunk.data.materials.append(bark)
+    tag(trunk, "vegetation", inst)
+    crown_h = height - trunk_h
+    if conifer:
+        bpy.ops.mesh.primitive_cone_add(
+            vertices=12,
+            radius1=0.35 * height,
+            depth=crown_h + 0.3,
+            location=(foot[0], foot[1], foot[2] + trunk_h - 0.3 + (crown_h + 0.3) / 2),
+        )
+    else:
+        bpy.ops.mesh.primitive_uv_sphere_add(
+            segments=16,
+            ring_count=8,
+            radius=crown_h / 2 + 0.4,
+            location=(foot[0], foot[1], foot[2] + trunk_h + crown_h / 2),
+        )
+    top = bpy.context.active_object
+    top.name = f"{name}_crown"
+    top.data.materials.append(leaves)
+    tag(top, "vegetation", inst)
+
+
+def headlights(mats, name, to_world, heading, inst, colour=XENON, cd=16000.0, pitch=1.2):
+    """A car's two dipped headlights (`cd` on axis, 20 degree cones, pitched down)."""
+    for k, x in enumerate((-0.65, 0.65)):
+        car_light(
+            mats,
+            f"{name}{k}",
+            to_world,
+            heading,
+            (x, 2.2, 0.7),
+            1.0,
+            colour,
+            25000.0,
+            cd,
+            20.0,
+            inst,
+            pitch_deg=pitch,
+        )
+
+
+def tail_lights(mats, name, to_world, heading, inst, cd=10.0):
+    """A car's two tail lights (`cd` candela, lens 800 cd/m2)."""
+    for k, x in enumerate((-0.7, 0.7)):
+        car_light(
+            mats, f"{name}{k}", to_world, heading, (x, -2.2, 0.8), -1.0, RED, 800.0, cd, 40.0, inst
+        )
+
+
+def light_box(mats, name, lo: Vec3, hi: Vec3, heading: float, foot: Vec3, cd_m2: float, cls):
+    """An emissive box (a shop window or an advert panel) of luminance `cd_m2`, cool white."""
+    mat = mats.principled(
+        f"glow_{name}", emission=COOL_WHITE, strength=radiance_for_luminance(cd_m2, COOL_WHITE)
+    )
+    return place(box(name, lo, hi, mat, cls=cls), foot, heading)
+
+
+def point_lamp(name: str, location: Vec3, cd: float, colour) -> None:
+    """A punctual point lamp of `cd` candela."""
+    lamp = bpy.data.lights.new(name, "POINT")
+    lamp.color = colour
+    lamp.energy = watts_for_candela(cd, colour)
+    lamp.shadow_soft_size = 0.0
+    lamp.use_soft_falloff = False
+    obj = bpy.data.objects.new(name, lamp)
+    obj.location = location
+    bpy.context.scene.collection.objects.link(obj)
+
+
+def build_roundabout(mats: Materials) -> None:
+    """A two-lane approach road (7 m) descending at -4 % into a roundabout 25-55 m ahead
+    (a ring carriageway 8 m wide about a 7 m raised central island with a lawn, a plinth and
+    two conifers), side roads leaving east and west, 15 cm kerbs, 3 m pavements, brick and
+    rendered buildings set back 8-10 m, five LED 5000 K lamps of 2.8 kcd, a lit bus shelter
+    with an advert light box, a shop window, a car ahead on the ring with its tail lights and
+    a car on the ring with xenon headlights; the camera 1.5 m up (a van driver)."""
+    yc, r_ring = 40.0, 11.0  # the island: 7 m
+    r_out = r_ring + 4.0  # 15 m
+    road = mats.principled("wet_asphalt", albedo="asphalt_b", roughness_map="puddles_b", road=True)
+    paving = mats.principled("paving_b", albedo="paving_b", roughness=0.4)
+    # the approach (x -3.5..3.5) and the side roads (y yc-3.5..yc+3.5), level meshes that
+    # stop 0.6 m inside the ring's outer edge (they lie 5 mm under the ring there)
+    approach_end = yc - r_out + 0.6
+    grid(
+        "road",
+        np.linspace(-3.5, 3.5, 8),
+        np.arange(-12.0, approach_end + 0.01, 1.0),
+        lambda x, y: -0.005 if y > yc - r_out - 0.6 else 0.0,
+        road,
+        2.0,
+    )
+    tag(bpy.data.objects["road"], "road")
+    for name, xs in (
+        ("road_east", np.arange(r_out - 0.6, 80.01, 1.0)),
+        ("road_west", np.arange(-80.0, -(r_out - 0.6) + 0.01, 1.0)),
+    ):
+        g = grid(
+            name,
+            xs,
+            np.linspace(yc - 3.5, yc + 3.5, 8),
+            lambda x, y: -0.005 if abs(x) < r_out + 0.6 else 0.0,
+            road,
+            2.0,
+        )
+        tag(g, "road")
+    ring = Circle((0.0, yc), r_ring, 0.0, lambda s: 0.0)
+    circ = 2.0 * math.pi * r_ring
+    ss = np.linspace(0.0, circ, 97)
+    tag(ribbon("ring", ring, ss, [(x, 0.0) for x in np.linspace(-4.0, 4.0, 5)], road, 2.0), "road")
+    # the central island: a 15 cm kerb and a lawn, a plinth and two conifers on it
+    kerb = mats.principled("kerb_stone", (0.3, 0.3, 0.29), roughness=0.6)
+    tag(ribbon("island_kerb", ring, ss, [(-4.0, 0.15), (-4.0, 0.0)], kerb, 1.0), "sidewalk")
+    grass = mats.principled("lawn", albedo="lawn", roughness=0.9)
+    tag(ribbon("island", ring, ss, [(-10.9, 0.15), (-4.0, 0.15)], grass, 2.0), "terrain")
+    plinth = mats.principled("plinth", albedo="render_b", roughness=0.8)
+    tag(box("plinth", (-1.2, yc - 1.2, 0.0), (1.2, yc + 1.2, 2.2), plinth, 2.0), "building")
+    tree(mats, "island_tree0", (-3.5, yc + 2.0, 0.15), 7.0, True, 1)
+    tree(mats, "island_tree1", (3.8, yc + 1.0, 0.15), 5.5, True, 2)
+    # the ring's outer kerb and pavement, open where the three roads meet it
+    gaps = []
+    for a in (-math.pi / 2.0, 0.0, math.pi):
+        half = math.asin(3.5 / r_out) + 0.02
+        gaps.append(((a - half) % (2 * math.pi), (a + half) % (2 * math.pi)))
+
+    def open_at(s: float) -> bool:
+        a = ring.angle(s) % (2 * math.pi)
+        return any((lo <= a <= hi) if lo < hi else (a >= lo or a <= hi) for lo, hi in gaps)
+
+    runs, cur = [], []
+    for s in np.linspace(0.0, circ, 193):
+        if open_at(s):
+            if len(cur) > 1:
+                runs.append(cur)
+            cur = []
+        else:
+            cur.append(s)
+    if len(cur) > 1:
+        runs.append(cur)
+    for k, run in enumerate(runs):
+        prof = [(4.0, 0.0), (4.0, 0.15), (7.0, 0.15)]
+        tag(ribbon(f"ring_pavement_{k}", ring, run, prof, paving, 1.0), "sidewalk")
+    # pavements along the approach and the side roads, up to the ring's pavement
+    y_ring = yc - math.sqrt(r_out**2 - 3.5**2)
+    for sx in (-1.0, 1.0):
+        xa, xb = sorted((sx * 3.5, sx * 6.5))
+        tag(
+            box(
+                f"pavement_approach_{sx:+.0f}", (xa, -12.0, -0.2), (xb, y_ring - 0.2, 0.15), paving
+            ),
+            "sidewalk",
+        )
+        x_ring = math.sqrt(r_out**2 - 3.5**2)
+        for sy in (-1.0, 1.0):
+            ya, yb = sorted((yc + sy * 3.5, yc + sy * 6.5))
+            xa, xb = sorted((sx * (x_ring + 0.2), sx * 80.0))
+            tag(
+                box(f"pavement_side_{sx:+.0f}{sy:+.0f}", (xa, ya, -0.2), (xb, yb, 0.15), paving),
+                "sidewalk",
+            )
+    # the terrain between: dark ground, a little above the road, under the buildings
+    ground = mats.principled("verge", albedo="lawn", roughness=0.9)
+    for sx in (-1.0, 1.0):
+        xa, xb = sorted((sx * 6.5, sx * 80.0))
+        tag(
+            box(f"verge_near_{sx:+.0f}", (xa, -12.0, -0.2), (xb, yc - 6.5, 0.1), ground, 2.0),
+            "terrain",
+        )
+    tag(box("verge_far", (-80.0, yc + 6.5, -0.2), (80.0, 120.0, 0.1), ground, 2.0), "terrain")
+    # buildings set back from the roads
+    facades = [
+        mats.principled("bricks", albedo="bricks", roughness=0.85),
+        mats.principled("render_b", albedo="render_b", roughness=0.9),
+    ]
+    rng = np.random.default_rng(21)
+    k = 0
+    for sx in (-1.0, 1.0):
+        y = -10.0
+        while y < yc - 16.0:
+            ln = float(rng.uniform(9.0, 14.0))
+            x0 = sx * float(rng.uniform(14.0, 16.0))
+            xa, xb = sorted((x0, x0 + sx * 10.0))
+            h = float(rng.uniform(6.0, 11.0))
+            tag(
+                box(f"building_{k}", (xa, y, -0.5), (xb, y + ln, h), facades[k % 2], 3.0),
+                "building",
+            )
+            y, k = y + ln + float(rng.uniform(2.0, 5.0)), k + 1
+    for x0 in (-60.0, -38.0, 22.0, 44.0):
+        h = float(rng.uniform(8.0, 14.0))
+        tag(
+            box(
+                f"building_{k}",
+                (x0, yc + 14.0, -0.5),
+                (x0 + 18.0, yc + 26.0, h),
+                facades[k % 2],
+                3.0,
+            ),
+            "building",
+        )
+        k += 1
+    # a shop window on the nearest right-hand building's front (facing the road, -X)
+    light_box(
+        mats,
+        "shop_window",
+        (-0.05, -4.0, 0.3),
+        (0.0, 4.0, 2.6),
+        0.0,
+        (14.0 - 0.01, 6.0, 0.0),
+        120.0,
+        "building",
+    )
+    # the bus shelter on the left pavement, its advert light box facing the road
+    glassy = mats.principled("shelter_frame", (0.1, 0.1, 0.11), roughness=0.4, metallic=0.7)
+    foot = (-5.6, 18.0, 0.15)
+    tag(
+        place(box("shelter_roof", (-0.8, -2.0, 2.3), (0.8, 2.0, 2.4), glassy), foot, 0.0),
+        "street_furniture",
+    )
+    tag(
+        place(box("shelter_back", (-0.8, -2.0, 0.0), (-0.75, 2.0, 2.3), glassy), foot, 0.0),
+        "street_furniture",
+    )
+    light_box(
+        mats,
+        "shelter_advert",
+        (-0.6, 1.9, 0.3),
+        (0.6, 2.0, 2.1),
+        0.0,
+        foot,
+        350.0,
+        "street_furniture",
+    )
+    point_lamp("shelter_light", (foot[0], foot[1], 2.2), 150.0, COOL_WHITE)
+    # five LED 5000 K lamps: two along the approach, three round the ring, arms over the road
+    for k, y in enumerate((4.0, 16.0)):
+        side = 1.0 if k % 2 == 0 else -1.0
+        street_lamp(mats, f"led{k}", (side * 4.6, y, 0.15), 0.0, side, LED_5000, 2800.0)
+    for k, a in enumerate((-0.25 * math.pi, 0.5 * math.pi, 1.25 * math.pi)):
+        foot = (1.2 + r_out) * np.array([math.cos(a), math.sin(a), 0.0]) + np.array([0, yc, 0.15])
+        street_lamp(mats, f"ring_led{k}", tuple(foot), a, 1.0, LED_5000, 2800.0)
+    # a car ahead on the ring (tail lights) and one coming round it (headlights)
+    red = mats.principled("paint_maroon", (0.2, 0.03, 0.05), roughness=0.3, metallic=0.3, coat=1.0)
+    s = (-0.5 * math.pi + 0.55) * r_ring  # just past the entry, going right
+    c = ring.point(s) + 1.8 * ring.right(s)
+    tw = car(mats, "car_ahead", tuple(c), ring.heading(s), red, 1)
+    tail_lights(mats, "taillight", tw, ring.heading(s), 1)
+    silver = mats.principled("paint_silver", (0.45, 0.46, 0.48), roughness=0.25, metallic=0.8)
+    s = (0.75 * math.pi) * r_ring
+    c = ring.point(s) - 1.6 * ring.right(s)
+    tw = car(mats, "car_ring", tuple(c), ring.heading(s), silver, 2)
+    headlights(mats, "headlight", tw, ring.heading(s), 2)
+    drape(lambda x, y: eased_grade(y, -0.04, 14.0, 12.0))
+    dz = -0.04
+    eye = (1.75, 0.0, 1.5)
+    d = np.array([0.0, 1.0, dz])
+    camera("driver", eye, pitched(d, 2.0), 44.0, 640, 400)
+
+
+def build_avenue(mats: Materials) -> None:
+    """A straight four-lane avenue: two 7 m carriageways either side of a 3 m raised median
+    with a lawn, broadleaf trees and twin-arm metal-halide lamps (4200 K, 3.2 kcd a head);
+    4 m pavements with high-pressure sodium lamps (2 kcd) on both sides, bricks and rendered
+    facades; a wet road with strong puddles (a third of it at roughness 0.02); oncoming cars
+    with xenon headlights in the far lanes; the camera 1.15 m up in the inner lane."""
+    road = mats.principled(
+        "wet_asphalt", albedo="asphalt_b", roughness_map="puddles_strong", road=True
+    )
+    ys = np.arange(-10.0, 151.0, 2.0)
+    for name, xa, xb in (("road_near", 1.5, 8.5), ("road_far", -8.5, -1.5)):
+        tag(grid(name, np.linspace(xa, xb, 8), ys, lambda x, y: 0.0, road, 2.0), "road")
+    paint = mats.principled("road_paint", (0.6, 0.6, 0.57), roughness=0.25, road=True)
+    k = 0
+    for x in (5.0, -5.0):
+        for y in np.arange(-8.0, 148.0, 9.0):
+            tag(
+                box(f"lane_dash_{k}", (x - 0.06, y, 0.0), (x + 0.06, y + 3.0, 0.004), paint),
+                "marking",
+            )
+            k += 1
+    kerb = mats.principled("kerb_stone", (0.3, 0.3, 0.29), roughness=0.6)
+    grass = mats.principled("lawn", albedo="lawn", roughness=0.9)
+    tag(box("median_kerb", (-1.5, -10.0, -0.1), (1.5, 150.0, 0.12), kerb, 1.0), "sidewalk")
+    tag(box("median_lawn", (-1.35, -10.0, 0.0), (1.35, 150.0, 0.14), grass, 2.0), "terrain")
+    paving = mats.principled("paving_b", albedo="paving_b", roughness=0.4)
+    facades = [
+        mats.principled("render_b", albedo="render_b", roughness=0.9),
+        mats.principled("bricks", albedo="bricks", roughness=0.85),
+    ]
+    rng = np.random.default_rng(22)
+    k = 0
+    for sx in (-1.0, 1.0):
+        xa, xb = sorted((sx * 8.5, sx * 12.5))
+        tag(box(f"pavement_{sx:+.0f}", (xa, -10.0, -0.2), (xb, 150.0, 0.13), paving), "sidewalk")
+        y = -10.0
+        while y < 148.0:
+            ln = float(rng.uniform(14.0, 24.0))
+            xa, xb = sorted((sx * 12.5, sx * 24.0))
+            h = float(rng.uniform(12.0, 22.0))
+            tag(
+                box(f"building_{k}", (xa, y, -0.5), (xb, y + ln, h), facades[k % 2], 3.0),
+                "building",
+            )
+            y, k = y + ln, k + 1
+    # trees on the median, lamps between them
+    for k, y in enumerate(np.arange(6.0, 140.0, 12.0)):
+        tree(
+            mats,
+            f"median_tree{k}",
+            (0.0, float(y), 0.14),
+            float(rng.uniform(5.0, 7.0)),
+            False,
+            k + 1,
+        )
+    for k, y in enumerate(np.arange(12.0, 140.0, 24.0)):
+        for j, side in enumerate((-1.0, 1.0)):
+            # the arm of side -1 reaches +X (over our carriageway), of +1 over the far one
+            street_lamp(
+                mats, f"median{k}_{j}", (0.0, float(y), 0.14), 0.0, side, METAL_HALIDE, 3200.0
+            )
+    for k, y in enumerate(np.arange(0.0, 140.0, 20.0)):
+        for sx in (-1.0, 1.0):
+            yy = float(y) + (10.0 if sx < 0 else 0.0)
+            street_lamp(mats, f"sodium{k}_{sx:+.0f}", (sx * 9.1, yy, 0.13), 0.0, sx, HPS, 2000.0)
+    # oncoming cars in the far lanes, a car ahead in ours
+    paints = [
+        mats.principled("paint_black", (0.02, 0.02, 0.02), roughness=0.2, coat=1.0),
+        mats.principled("paint_white", (0.7, 0.7, 0.68), roughness=0.3, coat=1.0),
+        mats.principled("paint_green", (0.04, 0.15, 0.08), roughness=0.3, metallic=0.4, coat=1.0),
+    ]
+    for k, (x, y) in enumerate(((-3.25, 38.0), (-6.75, 62.0), (-3.25, 95.0))):
+        tw = car(mats, f"oncoming{k}", (x, y, 0.0), math.pi, paints[k], k + 1)
+        headlights(
+            mats,
+            f"headlight{k}_",
+            tw,
+            math.pi,
+            k + 1,
+            colour=XENON if k != 1 else HALOGEN,
+            cd=15000.0,
+        )
+    tw = car(mats, "car_ahead", (6.75, 30.0, 0.0), 0.0, paints[1], 4)
+    tail_lights(mats, "taillight", tw, 0.0, 4)
+    camera("driver", (3.25, 0.0, 1.15), pitched(np.array([0.0, 1.0, 0.0]), 0.8), 38.0, 720, 405)
+
+
+def build_shelf(mats: Materials) -> None:
+    """A Middlebury-like close-range scene without streaks, other than the tabletop: a wooden
+    bookcase before a wallpapered wall, books (spines) of several heights, standing and lying,
+    a box file and two boxes, a pot; matte only (roughness 0.85-0.95), lit by three point
+    lamps (500-900 cd); the camera 1.1-1.9 m from the objects. No road, no gloss."""
+    wall = mats.principled("wallpaper", albedo="wallpaper", roughness=0.95)
+    tag(box("wall", (-2.5, 0.4, -0.1), (2.5, 0.5, 2.6), wall, 0.8), "wall")
+    floor = mats.principled("floorboards", albedo="wood", roughness=0.9)
+    tag(box("floor", (-2.5, -2.5, -0.1), (2.5, 0.4, 0.0), floor, 1.2), "terrain")
+    oak = mats.principled("shelf_wood", albedo="wood", roughness=0.85)
+    # the bookcase: 1.2 m wide, 0.3 m deep, boards at 0.05, 0.45, 0.85, 1.25 m, 1.6 m tall
+    x0, x1, yb, yf = -0.6, 0.6, 0.1, 0.4
+    parts = [
+        ("side_l", (x0 - 0.02, yb, 0.0), (x0, yf, 1.62)),
+        ("side_r", (x1, yb, 0.0), (x1 + 0.02, yf, 1.62)),
+        ("back", (x0, yf - 0.01, 0.0), (x1, yf, 1.62)),
+    ]
+    parts += [
+        (f"board{k}", (x0, yb, z), (x1, yf, z + 0.02))
+        for k, z in enumerate((0.03, 0.45, 0.85, 1.25, 1.6))
+    ]
+    for name, lo, hi in parts:
+        tag(box(name, lo, hi, oak, 0.6), "street_furniture")
+    spines = mats.principled("spines", albedo="spines", roughness=0.9)
+    boxes = mats.principled("box_card", albedo="bricks", roughness=0.9)
+    render = mats.principled("box_paper", albedo="render_b", roughness=0.9)
+    rng = np.random.default_rng(23)
+    inst = 1
+    for k, z in enumerate((0.05, 0.47, 0.87, 1.27)):
+        x = x0 + 0.02
+        end = x1 - (0.35 if k % 2 == 0 else 0.05)
+        while x < end - 0.03:
+            w = float(rng.uniform(0.02, 0.05))
+            h = float(rng.uniform(0.22, 0.34))
+            d = float(rng.uniform(0.17, 0.25))
+            # the spine faces the camera (-Y): tile 0.3 m maps the spines' strips across
+            tag(
+                box(f"book{inst}", (x, yb + 0.01, z), (x + w, yb + d, z + h), spines, 0.3),
+                "street_furniture",
+                inst,
+            )
+            x, inst = x + w + 0.002, inst + 1
+        if k % 2 == 0:
+            # a lying stack and a box in the remaining space
+            for j in range(3):
+                t = 0.04
+                tag(
+                    box(
+                        f"stack{k}_{j}",
+                        (end + 0.02 + 0.01 * j, yb + 0.03, z + j * t),
+                        (x1 - 0.03 - 0.01 * j, yb + 0.26, z + (j + 1) * t),
+                        spines,
+                        0.25,
+                    ),
+                    "street_furniture",
+                    inst,
+                )
+                inst += 1
+            tag(
+                box(
+                    f"box{k}",
+                    (end + 0.05, yb + 0.05, z + 0.12),
+                    (x1 - 0.06, yb + 0.24, z + 0.3),
+                    boxes,
+                    0.4,
+                ),
+                "street_furniture",
+                inst,
+            )
+            inst += 1
+    # on the floor before the bookcase: a box and a pot (a cylinder)
+    tag(
+        box("floor_box", (-0.95, -0.5, 0.0), (-0.55, -0.15, 0.35), render, 0.5),
+        "street_furniture",
+        inst,
+    )
+    bpy.ops.mesh.primitive_cylinder_add(
+        vertices=32, radius=0.15, depth=0.4, location=(0.8, -0.3, 0.2)
+    )
+    pot = bpy.context.active_object
+    pot.name = "pot"
+    pot.data.materials.append(mats.principled("pot_clay", albedo="bricks", roughness=0.9))
+    tag(pot, "street_furniture", inst + 1)
+    warm = (1.0, 0.9, 0.78)
+    for k, (loc, cd) in enumerate(
+        (((-1.3, -1.2, 2.1), 900.0), ((1.5, -1.4, 1.6), 600.0), ((0.2, -2.0, 0.4), 500.0))
+    ):
+        point_lamp(f"room_lamp{k}", loc, cd, warm)
+    eye = np.array([0.1, -1.6, 1.05])
+    target = np.array([0.0, 0.25, 0.8])
+    camera("camera", tuple(eye), tuple(target - eye), 48.0, 640, 480)
+
+
 def build_tabletop(mats: Materials) -> None:
     """A Middlebury-like close-range scene without streaks: matte, textured objects on a
     table before a textured backdrop, lit by two point lamps (800 cd each), an indoor
@@ -615,9 +1124,19 @@ def build_tabletop(mats: Materials) -> None:
     camera("camera", tuple(eye), tuple(target - eye), 40.0, 640, 480)
 
 
-SCENES = {"hill_bend": build_hill_bend, "crossing": build_crossing, "tabletop": build_tabletop}
+SCENES = {
+    "hill_bend": build_hill_bend,
+    "crossing": build_crossing,
+    "tabletop": build_tabletop,
+    # the second set (made after the first had been looked at)
+    "roundabout": build_roundabout,
+    "avenue": build_avenue,
+    "shelf": build_shelf,
+}
+#: The scene sets: `--set a` (the default) builds the first, `--set b` the second.
+SETS = {"a": ("hill_bend", "crossing", "tabletop"), "b": ("roundabout", "avenue", "shelf")}
 #: The scenes with a wet road (the others have none).
-STREETS = ("hill_bend", "crossing")
+STREETS = ("hill_bend", "crossing", "roundabout", "avenue")
 
 
 def export(out: Path, name: str) -> Path:
@@ -663,8 +1182,11 @@ def export(out: Path, name: str) -> Path:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("out", type=Path)
-    parser.add_argument("--scenes", nargs="+", default=list(SCENES), choices=list(SCENES))
+    parser.add_argument("--scenes", nargs="+", choices=list(SCENES))
+    parser.add_argument("--set", choices=list(SETS), default="a", help="the scene set (a: first)")
     args = parser.parse_args()
+    if args.scenes is None:
+        args.scenes = list(SETS[args.set])
     # Absolute: saving the .blend makes the image paths relative to it, which breaks paths
     # that were relative to the working folder (the export then finds no pixels).
     out = args.out.resolve()
