@@ -11,6 +11,13 @@
 #   OUT/heldback/                                 24 default-config samples (seed 44900), the
 #                                                 held-back split no parameter choice sees
 #
+# SET=b makes the second set instead (made after the first had been looked at):
+#
+#   OUT/scenes_b/{roundabout,avenue,shelf}.glb    built in Blender, exported by its exporter
+#   OUT/pairs_b/{roundabout,avenue,shelf}/        `streaks stereo` pairs of them
+#   OUT/heldback_b/                               24 default-config samples (seed 45900), a
+#                                                 new held-back split
+#
 # BLENDER_PYTHON: the Python with bpy 5.0 (default target/blender-venv/bin/python);
 # STREAKS: the streaks binary (default target/release/streaks). Run from the repository root.
 # Evaluation-only inputs: no parameter may be tuned on them.
@@ -20,10 +27,39 @@ out="${1:-target/streak-eval}"
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 blender_python="${BLENDER_PYTHON:-target/blender-venv/bin/python}"
 streaks="${STREAKS:-target/release/streaks}"
-
-mkdir -p -- "$out/scenes" "$out/pairs"
+set_name="${SET:-a}"
 
 stamp() { date -u +%H:%M:%S; }
+
+if [[ "$set_name" == "b" ]]; then
+    mkdir -p -- "$out/scenes_b" "$out/pairs_b"
+    echo "$(stamp) building the second set's Blender scenes"
+    "$blender_python" "$here/blender_streets.py" "$out/scenes_b" --set b
+
+    echo "$(stamp) roundabout: 640x400, 64 spp, baseline 0.20 m, automotive_linear sensor"
+    "$streaks" stereo "$out/scenes_b/roundabout.glb" -o "$out/pairs_b/roundabout" \
+        --width 640 --height 400 --spp 64 --baseline 0.20 --sensor automotive_linear --seed 2
+
+    echo "$(stamp) avenue: 720x405, 64 spp, baseline 0.15 m, +2.5 EV"
+    "$streaks" stereo "$out/scenes_b/avenue.glb" -o "$out/pairs_b/avenue" \
+        --width 720 --height 405 --spp 64 --baseline 0.15 --exposure 2.5 --seed 2
+
+    echo "$(stamp) shelf: 640x480, 64 spp, baseline 0.05 m, +2 EV"
+    "$streaks" stereo "$out/scenes_b/shelf.glb" -o "$out/pairs_b/shelf" \
+        --width 640 --height 480 --spp 64 --baseline 0.05 --exposure 2 --seed 2
+
+    echo "$(stamp) heldback_b: 24 samples of the default config, seed 45900, 400x256, 16 spp"
+    "$streaks" dataset generate -o "$out/heldback_b" --seed 45900 --count 24 \
+        --width 400 --height 256 --spp 16 --denoise off --outputs images,gt,masks
+
+    echo "$(stamp) done: $out (second set)"
+    exit 0
+elif [[ "$set_name" != "a" ]]; then
+    echo "SET must be a or b, not $set_name" >&2
+    exit 2
+fi
+
+mkdir -p -- "$out/scenes" "$out/pairs"
 
 echo "$(stamp) building the Blender scenes"
 "$blender_python" "$here/blender_streets.py" "$out/scenes"
