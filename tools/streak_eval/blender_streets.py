@@ -1,11 +1,13 @@
 """Builds the outside night streets in Blender (bpy) and exports them with Blender's own glTF
 exporter: evaluation-only inputs for streak-robust stereo (tools/streak_eval/README.md).
 
-    BLENDER_PYTHON tools/streak_eval/blender_streets.py OUT [--scenes hill_bend crossing]
+    BLENDER_PYTHON tools/streak_eval/blender_streets.py OUT [--set b] [--scenes hill_bend ...]
 
 writes OUT/<scene>.glb (textures embedded) and OUT/<scene>.blend. The streets are not the
 generator's (crates/scenes): a road that bends and climbs over a crest, a crossroads with a
-crowned carriageway, their own textures (textures.py), lamps and cars.
+crowned carriageway, their own textures (textures.py), lamps and cars. `--set b` builds the
+second set instead (made after the first had been looked at): a roundabout at the foot of a
+-4 % approach, a four-lane avenue with a tree-lined median, a bookcase (no road).
 
 The export is the exporter's defaults plus three Include choices a user ticks: cameras,
 punctual lights and "Custom Properties" (`export_extras`): without the last one, the road
