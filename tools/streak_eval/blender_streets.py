@@ -653,17 +653,43 @@ def tree(mats: Materials, name: str, foot: Vec3, height: float, conifer: bool, i
             depth=crown_h + 0.3,
             location=(foot[0], foot[1], foot[2] + trunk_h - 0.3 + (crown_h + 0.3) / 2),
         )
+        top = bpy.context.active_object
+        top.name = f"{name}_crown"
+        top.data.materials.append(leaves)
     else:
-        bpy.ops.mesh.primitive_uv_sphere_add(
-            segments=16,
-            ring_count=8,
-            radius=crown_h / 2 + 0.4,
-            location=(foot[0], foot[1], foot[2] + trunk_h + crown_h / 2),
-        )
-    top = bpy.context.active_object
-    top.name = f"{name}_crown"
-    top.data.materials.append(leaves)
+        centre = (foot[0], foot[1], foot[2] + trunk_h + crown_h / 2)
+        top = sphere(f"{name}_crown", centre, crown_h / 2 + 0.4, leaves)
     tag(top, "vegetation", inst)
+
+
+def sphere(name, centre: Vec3, radius: float, mat, segments: int = 16, rings: int = 8):
+    """A UV sphere (quads, triangles at the poles) with UVs (longitude, latitude) / tile 1,
+    built vertex by vertex (`bpy.ops`' UV sphere exports in a varying order)."""
+    verts, faces, uvs = [], [], []
+    for j in range(rings + 1):
+        lat = math.pi * (j / rings - 0.5)
+        for i in range(segments + 1):
+            lon = 2.0 * math.pi * i / segments
+            verts.append(
+                (
+                    centre[0] + radius * math.cos(lat) * math.cos(lon),
+                    centre[1] + radius * math.cos(lat) * math.sin(lon),
+                    centre[2] + radius * math.sin(lat),
+                )
+            )
+    row = segments + 1
+    for j in range(rings):
+        for i in range(segments):
+            a, b = j * row + i, j * row + i + 1
+            c, d = (j + 1) * row + i + 1, (j + 1) * row + i
+            quad = [(a, i, j), (b, i + 1, j), (c, i + 1, j + 1), (d, i, j + 1)]
+            if j == 0:
+                quad.pop(0)  # the south pole: one vertex
+            elif j == rings - 1:
+                quad.pop(2)  # the north pole
+            faces.append(tuple(k for k, _, _ in quad))
+            uvs.extend((u / segments, v / rings) for _, u, v in quad)
+    return mesh_object(name, verts, faces, uvs, mat)
 
 
 def headlights(mats, name, to_world, heading, inst, colour=XENON, cd=16000.0, pitch=1.2):
