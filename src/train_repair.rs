@@ -27,29 +27,39 @@ use streaks_analysis::repair::{
 use streaks_analysis::sgm::{sgm, SgmParams};
 use streaks_analysis::streak_classifier::{smooth_probability, SMOOTHING_RADII};
 use streaks_dataset::files::{load_mask, SampleDir, SAMPLE_NAMES};
+use streaks_dataset::layout::Layout;
 use streaks_image::pfm::read_pfm;
 use streaks_image::{write_bytes_atomically, GrayImage};
 use streaks_stereo::rig::Eye;
 
 use crate::cli::sample_truths;
 use crate::train_detector::{dataset_provenance, split_samples};
+use streaks_analysis::detector::road_streaks;
 
 /// Train the streak-robust stereo model on datasets.
 #[derive(clap::Args, Debug)]
 pub struct Args {
     /// Dataset folders (with dataset.json) to train on; their samples need the `images`,
-    /// `gt` and `masks` groups.
+    /// `gt` and `masks` groups. With --evaluate, pair folders too.
     #[arg(required = true)]
     pub datasets: Vec<PathBuf>,
-    /// The model to write (JSON).
-    #[arg(short, long)]
-    pub output: PathBuf,
+    /// The model to write (JSON); with --evaluate, where the figures go (JSON), if anywhere.
+    #[arg(short, long, required_unless_present = "evaluate")]
+    pub output: Option<PathBuf>,
+    /// Train nothing: score a model (--model, else the shipped one) on DIRS, which may be
+    /// datasets (their --val-split samples; `all` for every sample) and `streaks stereo` pair
+    /// folders, and print the figures the training prints for its validation split.
+    #[arg(long)]
+    pub evaluate: bool,
+    /// With --evaluate: the model to score.
+    #[arg(long, requires = "evaluate")]
+    pub model: Option<PathBuf>,
     /// The split whose samples train the trees.
     #[arg(long, default_value = "train")]
     pub train_split: String,
-    /// The splits whose samples choose the streak mask's threshold and calibrate the
-    /// confidence, comma-separated (other streets than the training split's).
-    #[arg(long, default_value = "val", value_delimiter = ',')]
+    /// The splits whose samples choose the streak mask's threshold, the drop threshold and
+    /// calibrate the confidence, comma-separated (other streets than the training split's).
+    #[arg(long, default_value = "val,test", value_delimiter = ',')]
     pub val_split: Vec<String>,
     /// The precision the streak mask's threshold is chosen for, on the validation split.
     #[arg(long, default_value_t = 0.9)]
@@ -57,18 +67,19 @@ pub struct Args {
     /// Training pixels per sample (every k-th pixel, k = pixels in the image / this).
     #[arg(long, default_value_t = 20_000)]
     pub pixels: usize,
-    /// Boosting rounds of each classifier.
-    #[arg(long, default_value_t = 150)]
+    /// Boosting rounds of each classifier. The defaults of these four are the shipped
+    /// model's.
+    #[arg(long, default_value_t = 300)]
     pub rounds: usize,
     /// Learning rate.
     #[arg(long, default_value_t = TrainParams::default().learning_rate)]
     pub learning_rate: f32,
     /// Most leaves per tree.
-    #[arg(long, default_value_t = 15)]
+    #[arg(long, default_value_t = 31)]
     pub max_leaves: usize,
     /// Fewest training rows in a leaf: large, because a street's pixels are far from
     /// independent and small leaves learn the training streets.
-    #[arg(long, default_value_t = 1000)]
+    #[arg(long, default_value_t = 500)]
     pub min_leaf: usize,
 }
 
@@ -84,23 +95,35 @@ struct Sample {
 
 fn load_sample(dir: &Path) -> Result<Option<Sample>> {
     let sample = SampleDir::new(dir);
-    let meta = sample.load_meta()?;
-    let (_, on_road) = sample_truths(&sample, &meta)?;
-    let Some(road_streaks) = on_road else {
-        return Ok(None);
-    };
-    let size = (meta.rig.width as usize, meta.rig.height as usize);
-    let road = load_mask(&sample.road_mask(Eye::Left), size, "the image")?;
     let read =
         |p: PathBuf| GrayImage::load(&p).with_context(|| format!("cannot read {}", p.display()));
     let left = read(sample.png(Eye::Left))?;
     let right = read(sample.png(Eye::Right))?;
+    let size = (left.width, left.height);
+    let (road, road_streaks) = if sample.meta().is_file() {
+        let meta = sample.load_meta()?;
+        let (_, on_road) = sample_truths(&sample, &meta)?;
+        let Some(road_streaks) = on_road else {
+            return Ok(None);
+        };
+        let road = load_mask(&sample.road_mask(Eye::Left), size, "the image")?;
+        (road, road_streaks)
+    } else {
+        // A `streaks stereo` pair folder: its masks, if the scene flags a road.
+        if !sample.road_mask(Eye::Left).is_file() {
+            return Ok(None);
+        }
+        let road = load_mask(&sample.road_mask(Eye::Left), size, "the image")?;
+        let streaks = load_mask(&sample.streak_mask(Eye::Left), size, "the image")?;
+        let on_road = road_streaks(&streaks, &road);
+        (road, on_road)
+    };
     let truth_path = sample.disparity(Eye::Left);
     let truth =
         read_pfm(&truth_path).with_context(|| format!("cannot read {}", truth_path.display()))?;
-    if left.size() != truth.size() || right.size() != truth.size() || road.size() != truth.size() {
+    if right.size() != left.size() || truth.size() != left.size() {
         bail!(
-            "{}: the images, masks and ground truth differ in size",
+            "{}: the images and the ground truth differ in size",
             dir.display()
         );
     }
@@ -175,6 +198,12 @@ pub fn run(args: Args) -> Result<()> {
         ..TrainParams::default()
     };
     params.validate().context("training settings")?;
+    if args.evaluate {
+        return evaluate(&args);
+    }
+    let Some(output) = args.output.clone() else {
+        bail!("--output is needed to train");
+    };
     let train = split_samples(&args.datasets, &args.train_split)?;
     let mut val = vec![];
     for split in &args.val_split {
@@ -223,19 +252,7 @@ pub fn run(args: Args) -> Result<()> {
 
     let mut model = RepairModel::new(wrong, streak);
     eprintln!("matching {} validation samples", val.len());
-    let bar = crate::cli::progress_bar(val.len() as u64);
-    let val_samples: Vec<Sample> = val
-        .par_iter()
-        .map(|dir| {
-            let s = load_sample(dir).with_context(|| format!("sample {}", dir.display()));
-            bar.inc(1);
-            s
-        })
-        .collect::<Result<Vec<_>>>()?
-        .into_iter()
-        .flatten()
-        .collect();
-    bar.finish_and_clear();
+    let val_samples = load_samples(&val)?;
     // The streak mask's operating point: per smoothing radius and threshold, the streak-level
     // precision and recall over the validation samples; the most recall at `--precision`.
     let probabilities: Vec<GrayImage> = val_samples
@@ -282,54 +299,29 @@ pub fn run(args: Args) -> Result<()> {
             args.precision
         ),
     }
-    // The drop threshold: a value is dropped where it is more likely wrong than a repair is,
-    // so it is measured from the repairs at the default threshold first.
-    let pass = |model: &RepairModel| {
-        let mut counts = RepairCounts::default();
-        for s in &val_samples {
-            let r = robust_from_features(&s.features, &s.sgm, StreakHandling::Repair, model);
-            counts.add(&s.sgm, &r, model, &s.truth, &s.road, &s.road_streaks);
-        }
-        counts
-    };
+    // The drop threshold: a value is dropped where it is more likely wrong than a repair is
+    // right, so that every value given out is at least as reliable as a repair. A missing
+    // value is shown as missing (confidence 0); a wrong one is read as a surface, a phantom
+    // hole among them. The repairs' precision is measured at the default threshold first.
+    let pass = |model: &RepairModel| score(&val_samples, model);
     let first = pass(&model);
     let (right, all) = first
         .repaired
         .iter()
         .fold((0, 0), |(r, a), &(x, y)| (r + x, a + y));
     if all > 0 {
-        model.wrong_threshold = 1.0 - right as f32 / all as f32;
+        let q = right as f32 / all as f32;
+        model.wrong_threshold = 1.0 - q;
         eprintln!(
-            "repairs at threshold 0.5 are right at {:.3}: values are dropped at a wrong probability of {:.3}",
-            right as f32 / all as f32,
+            "repairs at threshold 0.5 are right at {q:.3}: values are dropped at a wrong probability of {:.3}",
             model.wrong_threshold
         );
     }
     let counts = pass(&model);
     model.calibration = counts.calibration();
-    let (ph_sgm, ph) = counts.phantom();
-    let (off_sgm, off) = counts.off_road_bad2();
-    let score = counts.streak_score();
-    let (level_p, level_r) = counts.streak_level();
-    let pct = |v: f64| 100.0 * v;
+    let figures = print_figures(&format!("{val_name} split"), val_samples.len(), &counts);
     eprintln!(
-        "{val_name} split, {} samples: phantom holes {:.2} % -> {:.2} %; off-road bad-2 {:.2} % -> {:.2} %; road density {:.1} % -> {:.1} %, off-road {:.1} % -> {:.1} %; streak mask P {:.3} R {:.3} (pixels), P {:.3} R {:.3} (streaks)",
-        val_samples.len(),
-        pct(ph_sgm),
-        pct(ph),
-        pct(off_sgm),
-        pct(off),
-        pct(counts.road_valid_sgm as f64 / counts.road.max(1) as f64),
-        pct(counts.road_valid as f64 / counts.road.max(1) as f64),
-        pct(counts.off_valid_sgm as f64 / counts.off.max(1) as f64),
-        pct(counts.off_valid as f64 / counts.off.max(1) as f64),
-        score.precision,
-        score.recall,
-        level_p,
-        level_r,
-    );
-    eprintln!(
-        "calibration: kept {:?}, repaired {:?}",
+        "confidence calibration: kept values {:?}, repaired values {:?}",
         model.calibration.kept, model.calibration.repaired
     );
     let left = 0;
@@ -348,26 +340,150 @@ pub fn run(args: Args) -> Result<()> {
         "val_split": args.val_split,
         "val_samples": val_samples.len(),
         "target_precision": args.precision,
-        "val_figures": {
-            "phantom_holes_sgm": ph_sgm,
-            "phantom_holes": ph,
-            "off_road_bad2_sgm": off_sgm,
-            "off_road_bad2": off,
-            "streak_mask": score,
-            "streak_level_precision": level_p,
-            "streak_level_recall": level_r,
-        },
+        "val_figures": figures,
         "train_seconds": train_s,
     });
     let json = serde_json::to_vec(&model)?;
-    write_bytes_atomically(&args.output, &json)
-        .with_context(|| format!("writing {}", args.output.display()))?;
+    write_bytes_atomically(&output, &json)
+        .with_context(|| format!("writing {}", output.display()))?;
     eprintln!(
         "wrote {} ({} + {} trees, {} kB)",
-        args.output.display(),
+        output.display(),
         model.wrong.trees.len(),
         model.streak.trees.len(),
         json.len() / 1024
     );
+    Ok(())
+}
+
+/// Matches and describes the samples of `dirs` (in parallel, with a progress bar); samples
+/// without a road mask are left out.
+fn load_samples(dirs: &[PathBuf]) -> Result<Vec<Sample>> {
+    let bar = crate::cli::progress_bar(dirs.len() as u64);
+    let samples = dirs
+        .par_iter()
+        .map(|dir| {
+            let s = load_sample(dir).with_context(|| format!("sample {}", dir.display()));
+            bar.inc(1);
+            s
+        })
+        .collect::<Result<Vec<_>>>()?
+        .into_iter()
+        .flatten()
+        .collect();
+    bar.finish_and_clear();
+    Ok(samples)
+}
+
+/// The counts of `model`'s repair over `samples`.
+fn score(samples: &[Sample], model: &RepairModel) -> RepairCounts {
+    let mut counts = RepairCounts::default();
+    for s in samples {
+        let r = robust_from_features(&s.features, &s.sgm, StreakHandling::Repair, model);
+        counts.add(&s.sgm, &r, model, &s.truth, &s.road, &s.road_streaks);
+    }
+    counts
+}
+
+/// Prints the figures of `counts` over `n` samples of `what`, and returns them as JSON.
+fn print_figures(what: &str, n: usize, counts: &RepairCounts) -> serde_json::Value {
+    let (ph_sgm, ph) = counts.phantom();
+    let (off_sgm, off) = counts.off_road_bad2();
+    let score = counts.streak_score();
+    let (level_p, level_r) = counts.streak_level();
+    let (mw_sgm, mw) = counts.missing_or_wrong();
+    let pct = |v: f64| 100.0 * v;
+    let share = |a: usize, b: usize| a as f64 / b.max(1) as f64;
+    eprintln!(
+        "{what}, {n} samples: phantom holes {:.2} % -> {:.2} %; off-road bad-2 {:.2} % -> {:.2} %; missing or wrong {:.2} % -> {:.2} %; road density {:.1} % -> {:.1} %, off-road {:.1} % -> {:.1} %; streak mask P {:.3} R {:.3} (pixels), P {:.3} R {:.3} (streaks: {} true, {} detected)",
+        pct(ph_sgm),
+        pct(ph),
+        pct(off_sgm),
+        pct(off),
+        pct(mw_sgm),
+        pct(mw),
+        pct(share(counts.road_valid_sgm, counts.road)),
+        pct(share(counts.road_valid, counts.road)),
+        pct(share(counts.off_valid_sgm, counts.off)),
+        pct(share(counts.off_valid, counts.off)),
+        score.precision,
+        score.recall,
+        level_p,
+        level_r,
+        counts.streaks_true,
+        counts.detections,
+    );
+    serde_json::json!({
+        "samples": n,
+        "phantom_holes_sgm": ph_sgm,
+        "phantom_holes": ph,
+        "off_road_bad2_sgm": off_sgm,
+        "off_road_bad2": off,
+        "missing_or_wrong_sgm": mw_sgm,
+        "missing_or_wrong": mw,
+        "road_density_sgm": share(counts.road_valid_sgm, counts.road),
+        "road_density": share(counts.road_valid, counts.road),
+        "off_road_density_sgm": share(counts.off_valid_sgm, counts.off),
+        "off_road_density": share(counts.off_valid, counts.off),
+        "streak_mask": score,
+        "streak_level_precision": level_p,
+        "streak_level_recall": level_r,
+        "counts": counts,
+    })
+}
+
+/// `--evaluate`: scores a model on datasets and pair folders.
+fn evaluate(args: &Args) -> Result<()> {
+    let model = match &args.model {
+        Some(path) => {
+            let text = streaks_image::input::read_text(path, streaks_image::input::MAX_TEXT_BYTES)
+                .with_context(|| format!("reading the repair model {}", path.display()))?;
+            RepairModel::from_json(&text)
+                .with_context(|| format!("the repair model {}", path.display()))?
+        }
+        None => RepairModel::shipped().clone(),
+    };
+    let mut dirs = vec![];
+    for d in &args.datasets {
+        if Layout::new(d).dataset_json().is_file() {
+            for split in &args.val_split {
+                if split == "all" {
+                    let layout = Layout::new(d);
+                    let ids = layout
+                        .sample_ids(None)
+                        .with_context(|| format!("the samples of {}", d.display()))?;
+                    dirs.extend(
+                        ids.iter()
+                            .map(|id| layout.sample_by_id(id).path().to_path_buf()),
+                    );
+                } else {
+                    dirs.extend(split_samples(std::slice::from_ref(d), split)?);
+                }
+            }
+        } else if SampleDir::is_pair(d) {
+            dirs.push(d.clone());
+        } else {
+            bail!(
+                "{} is neither a dataset (dataset.json) nor a pair folder (im0.png, im1.png, disp0.pfm)",
+                d.display()
+            );
+        }
+    }
+    if dirs.is_empty() {
+        bail!("no samples to score");
+    }
+    let samples = load_samples(&dirs)?;
+    if samples.is_empty() {
+        bail!(
+            "none of the {} samples has a road mask to score against",
+            dirs.len()
+        );
+    }
+    let counts = score(&samples, &model);
+    let figures = print_figures("scored", samples.len(), &counts);
+    if let Some(out) = &args.output {
+        write_bytes_atomically(out, &serde_json::to_vec_pretty(&figures)?)
+            .with_context(|| format!("writing {}", out.display()))?;
+    }
     Ok(())
 }

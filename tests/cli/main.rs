@@ -11,6 +11,7 @@ mod detect;
 mod khronos;
 mod measure;
 mod render;
+mod repair;
 mod sensor;
 mod special_files;
 mod stereo;

@@ -9,7 +9,8 @@
 #                               and distance (report.json, index.html)
 #   OUT/repair-NAME.json        `streaks train-repair --evaluate`: phantom holes, off-road bad-2
 #                               and densities before and after, the streak mask's scores
-# then prints one table (summary.py).
+# then prints one table (summary.py). With SET=b it scores the second set instead (heldback_b/
+# and pairs_b/: roundabout, avenue, shelf), made after the first set had been looked at.
 #
 # STREAKS: the binary (default target/release/streaks); OPENCV_PYTHON: a Python with
 # opencv-python-headless (tools/opencv/requirements.txt) to add OpenCV's StereoSGBM.
@@ -29,12 +30,20 @@ fi
 mkdir -p -- "$out"
 stamp() { date -u +%H:%M:%S; }
 
-for name in heldback other_config dry_config pairs; do
+if [[ "${SET:-a}" == b ]]; then
+    benches=(heldback_b pairs_b)
+    repairs=(heldback_b pairs_b/roundabout pairs_b/avenue)
+else
+    benches=(heldback other_config dry_config pairs)
+    repairs=(heldback other_config dry_config pairs/hill_bend pairs/crossing)
+fi
+
+for name in "${benches[@]}"; do
     echo "$(stamp) benchmark: $name"
     "$streaks" benchmark "$in/$name" "${methods[@]}" -o "$out/bench-$name"
 done
 
-for name in heldback other_config dry_config pairs/hill_bend pairs/crossing; do
+for name in "${repairs[@]}"; do
     echo "$(stamp) repair figures: $name"
     "$streaks" train-repair --evaluate "$in/$name" --val-split all \
         -o "$out/repair-$(basename "$name").json"

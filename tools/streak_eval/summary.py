@@ -13,8 +13,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
-INPUTS = ["heldback", "other_config", "dry_config"]
-PAIRS = ["hill_bend", "crossing", "tabletop"]
+INPUTS = ["heldback", "other_config", "dry_config", "heldback_b"]
+PAIRS = ["hill_bend", "crossing", "tabletop", "roundabout", "avenue", "shelf"]
 
 
 def pct(region: dict[str, Any] | None, key: str) -> str:
@@ -90,8 +90,9 @@ def tables(out: Path) -> str:
             for s in c["summary"]:
                 label = f"{name}: {c['condition']} ({c['samples']})"
                 conditions.append(row(label, s["method"], s["errors"]))
-    path = out / "bench-pairs" / "report.json"
-    if path.is_file():
+    for path in (out / "bench-pairs" / "report.json", out / "bench-pairs_b" / "report.json"):
+        if not path.is_file():
+            continue
         report = json.loads(path.read_text(encoding="utf-8"))
         for sample in report["samples"]:
             for r in sample["results"]:
@@ -103,9 +104,9 @@ def tables(out: Path) -> str:
     if conditions:
         text += "\n\nBy condition:\n\n" + "\n".join([HEADER, *conditions])
     repair = [
-        "| input | phantom holes % (sgm -> repaired) | off-road bad-2 % | road density % "
-        "| streak mask P / R (pixels) | P / R (streaks) | streaks |",
-        "| --- | --- | --- | --- | --- | --- | --- |",
+        "| input | phantom holes % (sgm -> repaired) | off-road bad-2 % | missing or wrong % "
+        "| road density % | streak mask P / R (pixels) | P / R (streaks) | streaks |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
     for name in [*INPUTS, *PAIRS]:
         path = out / f"repair-{name}.json"
@@ -116,6 +117,7 @@ def tables(out: Path) -> str:
         repair.append(
             f"| {name} | {100 * f['phantom_holes_sgm']:.1f} -> {100 * f['phantom_holes']:.1f} "
             f"| {100 * f['off_road_bad2_sgm']:.1f} -> {100 * f['off_road_bad2']:.1f} "
+            f"| {100 * f['missing_or_wrong_sgm']:.1f} -> {100 * f['missing_or_wrong']:.1f} "
             f"| {100 * f['road_density_sgm']:.1f} -> {100 * f['road_density']:.1f} "
             f"| {mask['precision']:.3f} / {mask['recall']:.3f} "
             f"| {f['streak_level_precision']:.3f} / {f['streak_level_recall']:.3f} "

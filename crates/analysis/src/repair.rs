@@ -43,12 +43,20 @@
 //!
 //! # Mask, repair, confidence ([`robust_disparity`])
 //!
-//! A value whose `wrong` probability reaches [`RepairModel::wrong_threshold`] is dropped.
-//! `mask` leaves it without a value (`inf`); `repair` gives it the median of the kept values
-//! around it, from the smallest of the windows [`FILL_RADII`] in which at least a quarter of
-//! the pixels were kept: the surface around the streak, on its rows and columns, with no
-//! model of its shape. A pixel with no kept value within the largest window stays without
-//! one. The confidence map is calibrated: for a kept value, the share of kept values of its
+//! A value whose `wrong` probability reaches [`RepairModel::wrong_threshold`] is dropped: the
+//! probability above which a value is more likely wrong than a repair is right, measured by
+//! training on the validation streets, so that every value given out is at least as
+//! reliable as a repair (a missing value is shown as missing; a wrong one is read as a
+//! surface). `mask` leaves a dropped value without a value (`inf`); `repair` gives it the
+//! surface around it, from the smallest of the windows [`FILL_RADII`] that has support (at
+//! least a quarter of its pixels kept) and holds one surface (the kept values' quartiles
+//! within 1 px or 10 % of each other): first the pixel's row (twice the radius to each
+//! side: a road's disparity changes little along a row, and the surface on both sides of a
+//! streak is seen by both eyes), then the square (rows, then columns). The value is the
+//! upper quartile, since a fooled value lies beneath the surface. Nothing models the
+//! surface's shape, and where the kept values around disagree (a depth edge: an occlusion's
+//! repair would take the far side, a reflection's the near one) the value stays missing. The
+//! confidence map is calibrated: for a kept value, the share of kept values of its
 //! `wrong`-probability decile that were right on the validation streets; for a repaired one,
 //! the share of repaired values right at its window's size; 0 where there is no value.
 
@@ -78,6 +86,13 @@ pub const FILL_RADII: [usize; 5] = [2, 4, 8, 16, 32];
 /// The quantile of the kept values a repair takes (rows, then columns).
 const FILL_QUANTILE: f32 = 0.75;
 
+/// A window's kept values describe one surface when their quartiles differ by at most this,
+/// pixels, ...
+const FILL_AGREEMENT_PX: f32 = 1.0;
+
+/// ... or by at most this share of the upper quartile.
+const FILL_AGREEMENT_SHARE: f32 = 0.1;
+
 /// The share of a repair window's pixels that must be kept values.
 const FILL_SUPPORT: f32 = 0.25;
 
@@ -86,7 +101,7 @@ pub const CALIBRATION_BINS: usize = 10;
 
 /// The names of the features, in order (see the module documentation and
 /// [`StereoFeatures::new`]).
-pub const FEATURES: [&str; 25] = [
+pub const FEATURES: [&str; 27] = [
     "valid",
     "d_minus_q75_r8",
     "d_minus_q75_r32",
@@ -112,6 +127,8 @@ pub const FEATURES: [&str; 25] = [
     "right_contrast_31_at_d",
     "brightest_above_minus_l",
     "contrast_31_run_45_rows",
+    "vertical_minus_horizontal_mean_45",
+    "vertical_contrast_91",
 ];
 
 /// What went wrong.
@@ -351,6 +368,26 @@ impl StereoFeatures {
                 .collect(),
         };
         planes.push(mean(&run, Axis::Columns, 22).data);
+        // A streak is long down its column and narrow across its row; a lamp or a window is
+        // compact both ways.
+        let vertical = mean(&l, Axis::Columns, 22);
+        let horizontal = mean(&l, Axis::Rows, 22);
+        planes.push(
+            vertical
+                .data
+                .iter()
+                .zip(&horizontal.data)
+                .map(|(a, b)| a - b)
+                .collect(),
+        );
+        let column_median = median(&l, Axis::Columns, 45);
+        planes.push(
+            l.data
+                .iter()
+                .zip(&column_median.data)
+                .map(|(a, b)| a - b)
+                .collect(),
+        );
         debug_assert_eq!(planes.len(), FEATURES.len());
         Ok(Self {
             width: w,
@@ -368,11 +405,25 @@ impl StereoFeatures {
 
     /// The probability of `model` at every pixel.
     pub fn probability(&self, model: &Model) -> GrayImage {
+        self.probability_where(model, |_| true, 0.0)
+    }
+
+    /// The probability of `model` at the pixels `at` accepts, `otherwise` elsewhere (the
+    /// trees are the cost of a pixel: a pixel that needs no answer is not asked).
+    pub fn probability_where(
+        &self,
+        model: &Model,
+        at: impl Fn(usize) -> bool + Sync,
+        otherwise: f32,
+    ) -> GrayImage {
         let data = (0..self.width * self.height)
             .into_par_iter()
             .map_init(
                 || [0f32; FEATURES.len()],
                 |row, i| {
+                    if !at(i) {
+                        return otherwise;
+                    }
                     self.row(i, row);
                     model.probability(row)
                 },
@@ -556,21 +607,51 @@ pub enum Origin {
     Repaired(u8),
 }
 
-/// The median of the kept values around each dropped pixel (see the module documentation):
-/// the repaired value and the index of its window in [`FILL_RADII`], per pixel; `None` where
-/// no window has the support.
+/// The repair of each dropped pixel from the kept values around it (see the module
+/// documentation): the repaired value and the index of its window in [`FILL_RADII`], per
+/// pixel; `None` where no window has the support and one surface.
 fn fill(kept: &GrayImage) -> Vec<Option<(f32, u8)>> {
     let (w, h) = (kept.width, kept.height);
     let mut out: Vec<Option<(f32, u8)>> = vec![None; w * h];
+    let agree = |lo: f32, hi: f32| hi - lo <= FILL_AGREEMENT_PX.max(FILL_AGREEMENT_SHARE * hi);
     for (k, &r) in FILL_RADII.iter().enumerate() {
-        // A separable median (rows, then columns) of the finite values: robust to the
-        // outliers that survive, cheap at every radius.
+        // The row first: a road's disparity changes little along a row, and the surface on
+        // both sides of a streak is seen by both eyes.
+        let hi = finite_quantile(kept, Axis::Rows, 2 * r, FILL_QUANTILE);
+        let lo = finite_quantile(kept, Axis::Rows, 2 * r, 1.0 - FILL_QUANTILE);
+        let share = mean(
+            &GrayImage {
+                width: w,
+                height: h,
+                data: kept
+                    .data
+                    .iter()
+                    .map(|v| f32::from(u8::from(v.is_finite())))
+                    .collect(),
+            },
+            Axis::Rows,
+            2 * r,
+        );
+        // Then a square (rows, then columns): robust to the outliers that survive.
         let rows = finite_quantile(kept, Axis::Rows, r, FILL_QUANTILE);
-        let med = finite_quantile(&rows, Axis::Columns, r, FILL_QUANTILE);
-        let (_, share) = finite_box_mean(&kept.data, w, h, r);
+        let sq = finite_quantile(&rows, Axis::Columns, r, FILL_QUANTILE);
+        let rows_lo = finite_quantile(kept, Axis::Rows, r, 1.0 - FILL_QUANTILE);
+        let sq_lo = finite_quantile(&rows_lo, Axis::Columns, r, 1.0 - FILL_QUANTILE);
+        let (_, sq_share) = finite_box_mean(&kept.data, w, h, r);
         for i in 0..w * h {
-            if out[i].is_none() && med.data[i].is_finite() && share[i] >= FILL_SUPPORT {
-                out[i] = Some((med.data[i], k as u8));
+            if out[i].is_some() {
+                continue;
+            }
+            if hi.data[i].is_finite()
+                && share.data[i] >= FILL_SUPPORT
+                && agree(lo.data[i], hi.data[i])
+            {
+                out[i] = Some((hi.data[i], k as u8));
+            } else if sq.data[i].is_finite()
+                && sq_share[i] >= FILL_SUPPORT
+                && agree(sq_lo.data[i], sq.data[i])
+            {
+                out[i] = Some((sq.data[i], k as u8));
             }
         }
     }
@@ -601,12 +682,7 @@ pub fn robust_from_features(
     let (w, h) = (features.width, features.height);
     let n = w * h;
     let valid = |i: usize| disp.data[i].is_finite() && disp.data[i] > 0.0;
-    let mut wrong = features.probability(&model.wrong);
-    for (i, p) in wrong.data.iter_mut().enumerate() {
-        if !valid(i) {
-            *p = 1.0;
-        }
-    }
+    let wrong = features.probability_where(&model.wrong, valid, 1.0);
     let streak_probability =
         smooth_probability(&features.probability(&model.streak), model.streak_smooth);
     let mut streaks = streak_probability.clone();
@@ -801,6 +877,15 @@ pub struct RepairCounts {
     pub off_bad: usize,
     /// Off-road pixels with a finite truth.
     pub off: usize,
+    /// Pixels with a finite truth whose value is missing or wrong ([`is_right`]): semi-global
+    /// matching and repaired.
+    pub missing_or_wrong_sgm: usize,
+    /// See `missing_or_wrong_sgm`.
+    pub missing_or_wrong: usize,
+    /// Pixels with a finite truth.
+    pub truth: usize,
+    /// Pixels with a finite truth whose value was dropped (repaired or masked).
+    pub dropped: usize,
     /// Streak mask against the road-streak truth: pixels in both.
     pub streak_true_positives: usize,
     /// Pixels of the streak mask.
@@ -854,6 +939,9 @@ impl RepairCounts {
                 continue;
             }
             let (sv, ev) = (s.is_finite() && s > 0.0, e.is_finite());
+            self.truth += 1;
+            self.missing_or_wrong_sgm += usize::from(!(sv && is_right(s, t)));
+            self.missing_or_wrong += usize::from(!(ev && is_right(e, t)));
             if road.data[i] > 0.0 {
                 self.road += 1;
                 self.road_below_sgm += usize::from(sv && s < t - 1.0);
@@ -867,6 +955,8 @@ impl RepairCounts {
                 self.off_bad_sgm += usize::from(sv && (s - t).abs() > 2.0);
                 self.off_bad += usize::from(ev && (e - t).abs() > 2.0);
             }
+            self.dropped +=
+                usize::from(matches!(r.origin[i], Origin::Masked | Origin::Repaired(_)));
             let slot = match r.origin[i] {
                 Origin::Kept => Some(&mut self.kept[model.kept_bin(r.wrong.data[i])]),
                 Origin::Repaired(k) => Some(&mut self.repaired[k as usize]),
@@ -884,6 +974,13 @@ impl RepairCounts {
     pub fn phantom(&self) -> (f64, f64) {
         let f = |a: usize| a as f64 / self.road.max(1) as f64;
         (f(self.road_below_sgm), f(self.road_below))
+    }
+
+    /// The share of pixels with a truth whose value is missing or wrong (semi-global
+    /// matching, repaired).
+    pub fn missing_or_wrong(&self) -> (f64, f64) {
+        let f = |a: usize| a as f64 / self.truth.max(1) as f64;
+        (f(self.missing_or_wrong_sgm), f(self.missing_or_wrong))
     }
 
     /// Off-road bad-2 over the off-road values (semi-global matching, repaired).

@@ -1,0 +1,153 @@
+//! End-to-end tests of `streaks train-repair`: training the streak-robust stereo model on a
+//! dataset, using it with `streaks disparity --model`, scoring it with `--evaluate`, and the
+//! refusals.
+
+use crate::common::TestDir;
+use serde_json::Value;
+
+/// A tiny dataset (not denoised, on any machine) and its splits, most samples first.
+fn dataset(t: &TestDir) -> Vec<&'static str> {
+    t.streaks(&[
+        "dataset",
+        "generate",
+        "-o",
+        "ds",
+        "--count",
+        "6",
+        "--width",
+        "96",
+        "--height",
+        "64",
+        "--spp",
+        "4",
+        "--denoise",
+        "off",
+        "--outputs",
+        "images,gt,masks",
+    ])
+    .assert_success();
+    let mut splits: Vec<(usize, &str)> = ["train", "val", "test"]
+        .into_iter()
+        .map(|s| {
+            let text = std::fs::read_to_string(t.join("ds/splits").join(format!("{s}.txt")))
+                .unwrap_or_default();
+            (text.split_whitespace().count(), s)
+        })
+        .filter(|(n, _)| *n > 0)
+        .collect();
+    splits.sort();
+    splits.reverse();
+    splits.into_iter().map(|(_, s)| s).collect()
+}
+
+/// `train-repair` writes a model (two classifiers, thresholds, a calibration, provenance) that
+/// `disparity --model` applies and `--evaluate` scores; the figures are shares and count the
+/// dataset's samples.
+#[test]
+fn a_model_trained_on_a_dataset_is_used_and_scored() {
+    let t = TestDir::new();
+    let splits = dataset(&t);
+    assert!(splits.len() >= 2, "{splits:?}");
+    let (train, val) = (splits[0], splits[1]);
+    let run = t.streaks(&[
+        "train-repair",
+        "ds",
+        "-o",
+        "model.json",
+        "--train-split",
+        train,
+        "--val-split",
+        val,
+        "--rounds",
+        "10",
+        "--min-leaf",
+        "20",
+    ]);
+    run.assert_success();
+    assert!(run.stderr().contains("phantom holes"), "{}", run.stderr());
+    let model: Value =
+        serde_json::from_str(&std::fs::read_to_string(t.join("model.json")).unwrap()).unwrap();
+    assert_eq!(model["format"], "streaks-repair/1");
+    assert_eq!(model["wrong"]["trees"].as_array().unwrap().len(), 10);
+    assert_eq!(model["streak"]["trees"].as_array().unwrap().len(), 10);
+    assert_eq!(model["provenance"]["train_split"], train);
+    let threshold = model["wrong_threshold"].as_f64().unwrap();
+    assert!((0.0..=1.0).contains(&threshold), "{threshold}");
+    for c in model["calibration"]["kept"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .chain(model["calibration"]["repaired"].as_array().unwrap())
+    {
+        assert!((0.0..=1.0).contains(&c.as_f64().unwrap()), "{c}");
+    }
+    t.streaks(&[
+        "disparity",
+        "ds/samples/000000/im0.png",
+        "ds/samples/000000/im1.png",
+        "-o",
+        "d.pfm",
+        "--streaks",
+        "repair",
+        "--model",
+        "model.json",
+    ])
+    .assert_success();
+    assert!(t.join("d_confidence.pfm").is_file() && t.join("d_streaks.png").is_file());
+    let run = t.streaks(&[
+        "train-repair",
+        "--evaluate",
+        "ds",
+        "--model",
+        "model.json",
+        "--val-split",
+        "all",
+        "-o",
+        "figures.json",
+    ]);
+    run.assert_success();
+    let f: Value =
+        serde_json::from_str(&std::fs::read_to_string(t.join("figures.json")).unwrap()).unwrap();
+    assert_eq!(f["samples"], 6);
+    for key in [
+        "phantom_holes_sgm",
+        "phantom_holes",
+        "off_road_bad2",
+        "missing_or_wrong",
+        "road_density",
+    ] {
+        let v = f[key].as_f64().unwrap();
+        assert!((0.0..=1.0).contains(&v), "{key} {v}");
+    }
+    // Every pixel with a truth is counted once: 6 samples of 96x64, less the sky.
+    let truth = f["counts"]["truth"].as_u64().unwrap();
+    assert!(truth > 0 && truth <= 6 * 96 * 64, "{truth}");
+    assert_eq!(
+        f["counts"]["road"].as_u64().unwrap() + f["counts"]["off"].as_u64().unwrap(),
+        truth
+    );
+}
+
+/// The refusals: one split for both, a folder that is neither a dataset nor a pair, training
+/// without `-o`.
+#[test]
+fn bad_arguments_are_refused_with_their_reason() {
+    let t = TestDir::new();
+    std::fs::create_dir(t.join("empty")).unwrap();
+    t.streaks(&[
+        "train-repair",
+        "empty",
+        "-o",
+        "m.json",
+        "--val-split",
+        "train",
+    ])
+    .assert_failure_mentioning("must differ");
+    t.streaks(&["train-repair", "--evaluate", "empty"])
+        .assert_failure_mentioning("neither a dataset");
+    t.streaks(&["train-repair", "empty"])
+        .assert_failure_mentioning("--output");
+    t.streaks(&["train-repair", "empty", "-o", "m.json"])
+        .assert_failure_mentioning("not a dataset folder");
+    assert!(!t.join("m.json").exists());
+}
