@@ -695,13 +695,13 @@ pub fn robust_from_features(
         data: vec![f32::INFINITY; n],
     };
     let mut origin = vec![Origin::None; n];
-    for i in 0..n {
+    for (i, o) in origin.iter_mut().enumerate() {
         if valid(i) {
             if wrong.data[i] < model.wrong_threshold {
                 kept.data[i] = disp.data[i];
-                origin[i] = Origin::Kept;
+                *o = Origin::Kept;
             } else {
-                origin[i] = Origin::Masked;
+                *o = Origin::Masked;
             }
         }
     }
