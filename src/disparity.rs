@@ -2,8 +2,8 @@
 //! a PFM (inf where the left-right check fails), with an optional colour preview and an
 //! optional comparison against ground truth. `--streaks mask|repair` makes it streak-robust
 //! ([`streaks_analysis::repair`]): the values a learned classifier finds fooled by streaks,
-//! reflections and noise are made invalid or given the median of the kept values around
-//! them, and a calibrated confidence map and the streak mask are written beside the output.
+//! reflections and noise are made invalid or given the surface around them, and a calibrated
+//! confidence map and the streak mask are written beside the output.
 
 use anyhow::{bail, Context};
 use std::path::PathBuf;
@@ -62,7 +62,7 @@ pub struct Args {
     #[arg(long, requires = "truth")]
     pub road: Option<PathBuf>,
     /// Streak-robust output: `mask` leaves the values that streaks, reflections and noise
-    /// fooled without a value; `repair` gives them the median of the kept values around them.
+    /// fooled without a value; `repair` gives them the surface around them where one is seen.
     #[arg(long, value_enum)]
     pub streaks: Option<Handling>,
     /// Where the confidence map goes with --streaks (PFM: the calibrated probability that a
@@ -84,7 +84,7 @@ pub struct Args {
 pub enum Handling {
     /// Leave fooled values without a value.
     Mask,
-    /// Replace them with the median of the kept values around them.
+    /// Replace them with the surface around them where one is seen.
     Repair,
 }
 

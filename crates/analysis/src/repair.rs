@@ -564,7 +564,8 @@ impl RepairModel {
 pub enum StreakHandling {
     /// Leave them without a value.
     Mask,
-    /// Give them the median of the kept values around them.
+    /// Give them the surface around them: the upper quartile of the kept values of the
+    /// smallest window that holds one surface.
     Repair,
 }
 

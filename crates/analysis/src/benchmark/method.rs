@@ -22,7 +22,8 @@ pub const BUILT_INS: [(&str, &str); 3] = [
         "sgm-streaks",
         "sgm, then the streak repair: `streaks disparity --streaks repair` (values a learned \
          classifier of local stereo and appearance features finds fooled are replaced by the \
-         median of the kept values around them; no road model)",
+         surface around them where the kept values agree, else left without a value; no road \
+         model)",
     ),
     (
         "lk",
