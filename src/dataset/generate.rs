@@ -9,7 +9,7 @@
 //! the folder renamed to `samples/NNNNNN/`. Rendering is deterministic, so a repaired sample has
 //! the bytes the manifest lists (the message says whether it does).
 //!
-//! Locks ([`super::lock`]): a run of the whole dataset holds the dataset lock exclusively (a
+//! Locks ([`streaks_dataset::lock`]): a run of the whole dataset holds the dataset lock exclusively (a
 //! second one is refused, naming the holder), a shard holds it shared; a sample is cleaned and
 //! rendered under its own lock, so two shards never render one sample at once and temporary
 //! folders are removed only when no live run renders that sample. Without `--shard` the
