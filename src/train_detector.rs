@@ -119,38 +119,19 @@ pub(crate) fn split_samples(datasets: &[PathBuf], split: &str) -> Result<Vec<Pat
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<()> {
-    if !(args.precision > 0.0 && args.precision < 1.0) {
-        bail!("--precision must be in (0, 1), not {}", args.precision);
-    }
-    if args.pixels == 0 {
-        bail!("--pixels must be at least 1");
-    }
-    if args.val_split.contains(&args.train_split) {
-        bail!("the training and validation splits must differ: the threshold needs samples the trees did not see");
-    }
-    let params = TrainParams {
-        rounds: args.rounds,
-        learning_rate: args.learning_rate,
-        max_leaves: args.max_leaves,
-        min_leaf: args.min_leaf,
-        ..TrainParams::default()
-    };
-    params.validate().context("training settings")?;
-    let train = split_samples(&args.datasets, &args.train_split)?;
-    let mut val = vec![];
-    for split in &args.val_split {
-        val.extend(split_samples(&args.datasets, split)?);
-    }
-    let val_name = args.val_split.join("+");
-    if train.is_empty() || val.is_empty() {
-        bail!(
-            "need samples in both splits: {} in {:?}, {} in {:?}",
-            train.len(),
-            args.train_split,
-            val.len(),
-            val_name
-        );
-    }
+    let params = training_params(
+        args.precision,
+        args.pixels,
+        TrainParams {
+            rounds: args.rounds,
+            learning_rate: args.learning_rate,
+            max_leaves: args.max_leaves,
+            min_leaf: args.min_leaf,
+            ..TrainParams::default()
+        },
+    )?;
+    let (train, val, val_name) =
+        training_splits(&args.datasets, &args.train_split, &args.val_split)?;
     let t0 = std::time::Instant::now();
     eprintln!("reading {} training samples", train.len());
     let bar = crate::cli::progress_bar(train.len() as u64);
@@ -296,4 +277,49 @@ pub(crate) fn dataset_provenance(datasets: &[PathBuf]) -> Vec<serde_json::Value>
             })
         })
         .collect()
+}
+
+/// Checks the settings a trained model's command shares (a target precision in (0, 1), at
+/// least one pixel per sample, the trees' parameters) and returns the trees' parameters.
+pub(crate) fn training_params(
+    precision: f64,
+    pixels: usize,
+    params: TrainParams,
+) -> Result<TrainParams> {
+    if !(precision > 0.0 && precision < 1.0) {
+        bail!("--precision must be in (0, 1), not {precision}");
+    }
+    if pixels == 0 {
+        bail!("--pixels must be at least 1");
+    }
+    params.validate().context("training settings")?;
+    Ok(params)
+}
+
+/// The training split's and the validation splits' sample folders in `datasets`, and the
+/// validation splits' name (`val+test`); an error if the splits overlap or one is empty.
+pub(crate) fn training_splits(
+    datasets: &[PathBuf],
+    train_split: &str,
+    val_split: &[String],
+) -> Result<(Vec<PathBuf>, Vec<PathBuf>, String)> {
+    if val_split.iter().any(|s| s == train_split) {
+        bail!("the training and validation splits must differ: the validation needs samples the trees did not see");
+    }
+    let train = split_samples(datasets, train_split)?;
+    let mut val = vec![];
+    for split in val_split {
+        val.extend(split_samples(datasets, split)?);
+    }
+    let val_name = val_split.join("+");
+    if train.is_empty() || val.is_empty() {
+        bail!(
+            "need samples in both splits: {} in {:?}, {} in {:?}",
+            train.len(),
+            train_split,
+            val.len(),
+            val_name
+        );
+    }
+    Ok((train, val, val_name))
 }

@@ -33,7 +33,7 @@ use streaks_image::{write_bytes_atomically, GrayImage};
 use streaks_stereo::rig::Eye;
 
 use crate::cli::sample_truths;
-use crate::train_detector::{dataset_provenance, split_samples};
+use crate::train_detector::{dataset_provenance, split_samples, training_params, training_splits};
 use streaks_analysis::detector::road_streaks;
 
 /// Train the streak-robust stereo model on datasets.
@@ -181,44 +181,25 @@ fn train_one(name: &str, data: &Dataset, params: &TrainParams) -> Result<gbdt::M
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<()> {
-    if !(args.precision > 0.0 && args.precision < 1.0) {
-        bail!("--precision must be in (0, 1), not {}", args.precision);
-    }
-    if args.pixels == 0 {
-        bail!("--pixels must be at least 1");
-    }
-    if args.val_split.contains(&args.train_split) {
-        bail!("the training and validation splits must differ: the calibration needs samples the trees did not see");
-    }
-    let params = TrainParams {
-        rounds: args.rounds,
-        learning_rate: args.learning_rate,
-        max_leaves: args.max_leaves,
-        min_leaf: args.min_leaf,
-        ..TrainParams::default()
-    };
-    params.validate().context("training settings")?;
+    let params = training_params(
+        args.precision,
+        args.pixels,
+        TrainParams {
+            rounds: args.rounds,
+            learning_rate: args.learning_rate,
+            max_leaves: args.max_leaves,
+            min_leaf: args.min_leaf,
+            ..TrainParams::default()
+        },
+    )?;
     if args.evaluate {
         return evaluate(&args);
     }
     let Some(output) = args.output.clone() else {
         bail!("--output is needed to train");
     };
-    let train = split_samples(&args.datasets, &args.train_split)?;
-    let mut val = vec![];
-    for split in &args.val_split {
-        val.extend(split_samples(&args.datasets, split)?);
-    }
-    let val_name = args.val_split.join("+");
-    if train.is_empty() || val.is_empty() {
-        bail!(
-            "need samples in both splits: {} in {:?}, {} in {:?}",
-            train.len(),
-            args.train_split,
-            val.len(),
-            val_name
-        );
-    }
+    let (train, val, val_name) =
+        training_splits(&args.datasets, &args.train_split, &args.val_split)?;
     let t0 = std::time::Instant::now();
     eprintln!("matching and reading {} training samples", train.len());
     let bar = crate::cli::progress_bar(train.len() as u64);

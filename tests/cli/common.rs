@@ -26,6 +26,45 @@ impl TestDir {
         self.dir.path().join(name)
     }
 
+    /// Generates the 6-sample 96x64 dataset `ds` at 4 spp, not denoised on any machine (the
+    /// tests are about pipelines, and at 4 spp the denoiser smooths the tiny streaks), keeping
+    /// `outputs` (the default groups without), and returns its non-empty splits, the one with
+    /// the most samples first (splits are drawn per street).
+    pub fn tiny_dataset(&self, outputs: Option<&str>) -> Vec<&'static str> {
+        let mut args = vec![
+            "dataset",
+            "generate",
+            "-o",
+            "ds",
+            "--count",
+            "6",
+            "--width",
+            "96",
+            "--height",
+            "64",
+            "--spp",
+            "4",
+            "--denoise",
+            "off",
+        ];
+        if let Some(o) = outputs {
+            args.extend(["--outputs", o]);
+        }
+        self.streaks(&args).assert_success();
+        let mut splits: Vec<(usize, &str)> = ["train", "val", "test"]
+            .into_iter()
+            .map(|s| {
+                let text = std::fs::read_to_string(self.join("ds/splits").join(format!("{s}.txt")))
+                    .unwrap_or_default();
+                (text.split_whitespace().count(), s)
+            })
+            .filter(|(n, _)| *n > 0)
+            .collect();
+        splits.sort();
+        splits.reverse();
+        splits.into_iter().map(|(_, s)| s).collect()
+    }
+
     /// Runs `streaks ARGS` in this folder (CI=true: no progress bar).
     pub fn streaks(&self, args: &[&str]) -> Run {
         let output = Command::new(env!("CARGO_BIN_EXE_streaks"))

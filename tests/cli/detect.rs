@@ -207,38 +207,9 @@ fn bad_detect_input_fails_without_writing() {
 #[test]
 fn a_classifier_trained_on_a_dataset_is_used_by_detect() {
     let t = TestDir::new();
-    // Not denoised, on any machine: at 4 spp the denoiser smooths the tiny streaks this small
-    // training set has, and the test is about the training pipeline.
-    t.streaks(&[
-        "dataset",
-        "generate",
-        "-o",
-        "ds",
-        "--count",
-        "6",
-        "--width",
-        "96",
-        "--height",
-        "64",
-        "--spp",
-        "4",
-        "--denoise",
-        "off",
-    ])
-    .assert_success();
-    // Splits are drawn per street; train on the split with most samples, choose the threshold
-    // on another non-empty one.
-    let mut splits: Vec<(usize, &str)> = ["train", "val", "test"]
-        .into_iter()
-        .map(|s| {
-            let text = std::fs::read_to_string(t.join("ds/splits").join(format!("{s}.txt")))
-                .unwrap_or_default();
-            (text.split_whitespace().count(), s)
-        })
-        .filter(|(n, _)| *n > 0)
-        .collect();
-    splits.sort();
-    let (train, val) = (splits.last().unwrap().1, splits[0].1);
+    // Train on the split with most samples, choose the threshold on the one with fewest.
+    let splits = t.tiny_dataset(None);
+    let (train, val) = (splits[0], splits[splits.len() - 1]);
     assert_ne!(train, val, "{splits:?}");
     let run = t.streaks(&[
         "train-detector",

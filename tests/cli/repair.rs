@@ -5,48 +5,13 @@
 use crate::common::TestDir;
 use serde_json::Value;
 
-/// A tiny dataset (not denoised, on any machine) and its splits, most samples first.
-fn dataset(t: &TestDir) -> Vec<&'static str> {
-    t.streaks(&[
-        "dataset",
-        "generate",
-        "-o",
-        "ds",
-        "--count",
-        "6",
-        "--width",
-        "96",
-        "--height",
-        "64",
-        "--spp",
-        "4",
-        "--denoise",
-        "off",
-        "--outputs",
-        "images,gt,masks",
-    ])
-    .assert_success();
-    let mut splits: Vec<(usize, &str)> = ["train", "val", "test"]
-        .into_iter()
-        .map(|s| {
-            let text = std::fs::read_to_string(t.join("ds/splits").join(format!("{s}.txt")))
-                .unwrap_or_default();
-            (text.split_whitespace().count(), s)
-        })
-        .filter(|(n, _)| *n > 0)
-        .collect();
-    splits.sort();
-    splits.reverse();
-    splits.into_iter().map(|(_, s)| s).collect()
-}
-
 /// `train-repair` writes a model (two classifiers, thresholds, a calibration, provenance) that
 /// `disparity --model` applies and `--evaluate` scores; the figures are shares and count the
 /// dataset's samples.
 #[test]
 fn a_model_trained_on_a_dataset_is_used_and_scored() {
     let t = TestDir::new();
-    let splits = dataset(&t);
+    let splits = t.tiny_dataset(Some("images,gt,masks"));
     assert!(splits.len() >= 2, "{splits:?}");
     let (train, val) = (splits[0], splits[1]);
     let run = t.streaks(&[
