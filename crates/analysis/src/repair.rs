@@ -416,19 +416,37 @@ impl StereoFeatures {
         at: impl Fn(usize) -> bool + Sync,
         otherwise: f32,
     ) -> GrayImage {
-        let data = (0..self.width * self.height)
-            .into_par_iter()
-            .map_init(
-                || [0f32; FEATURES.len()],
-                |row, i| {
-                    if !at(i) {
-                        return otherwise;
+        // Blocks of pixels, each scored tree by tree ([`Model::probabilities`]), with one
+        // buffer of rows per worker.
+        const BLOCK: usize = 256;
+        let mut data = vec![otherwise; self.width * self.height];
+        data.par_chunks_mut(BLOCK).enumerate().for_each_init(
+            || {
+                (
+                    Vec::with_capacity(BLOCK * FEATURES.len()),
+                    Vec::with_capacity(BLOCK),
+                    Vec::with_capacity(BLOCK),
+                )
+            },
+            |(rows, asked, scores): &mut (Vec<f32>, Vec<usize>, Vec<f32>), (b, out)| {
+                rows.clear();
+                asked.clear();
+                let mut row = [0f32; FEATURES.len()];
+                for k in 0..out.len() {
+                    let i = b * BLOCK + k;
+                    if at(i) {
+                        self.row(i, &mut row);
+                        rows.extend_from_slice(&row);
+                        asked.push(k);
                     }
-                    self.row(i, row);
-                    model.probability(row)
-                },
-            )
-            .collect();
+                }
+                scores.resize(asked.len(), 0.0);
+                model.probabilities(rows, FEATURES.len(), scores);
+                for (&k, &p) in asked.iter().zip(scores.iter()) {
+                    out[k] = p;
+                }
+            },
+        );
         GrayImage {
             width: self.width,
             height: self.height,
