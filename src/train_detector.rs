@@ -161,22 +161,9 @@ pub fn run(args: Args) -> Result<()> {
         data.extend(p);
     }
     let positives = data.labels.iter().filter(|&&y| y).count();
-    eprintln!(
-        "{} rows, {:.2} % streak; training {} rounds",
-        data.rows(),
-        100.0 * positives as f64 / data.rows().max(1) as f64,
-        params.rounds
-    );
-    let bar = crate::cli::progress_bar(params.rounds as u64);
-    let mut last_loss = 0.0;
-    let model = gbdt::train(&data, &params, |_, loss| {
-        last_loss = loss;
-        bar.inc(1);
-    })
-    .context("training the trees")?;
-    bar.finish_and_clear();
+    let model = train_trees("streak", &data, &params)?;
     let train_s = t0.elapsed().as_secs_f64();
-    eprintln!("trained in {train_s:.1} s, training log-loss {last_loss:.4}");
+    eprintln!("trained in {train_s:.1} s");
 
     let mut classifier = StreakClassifier::new(model);
     // Threshold and smoothing on every pixel of the validation samples.
@@ -322,4 +309,26 @@ pub(crate) fn training_splits(
         );
     }
     Ok((train, val, val_name))
+}
+
+/// Trains the trees of `data` with a progress bar, printing the rows, the share of positive
+/// labels and the final training log-loss under `name`.
+pub(crate) fn train_trees(name: &str, data: &Dataset, params: &TrainParams) -> Result<gbdt::Model> {
+    let positives = data.labels.iter().filter(|&&y| y).count();
+    eprintln!(
+        "{name}: {} rows, {:.2} % positive; training {} rounds",
+        data.rows(),
+        100.0 * positives as f64 / data.rows().max(1) as f64,
+        params.rounds
+    );
+    let bar = crate::cli::progress_bar(params.rounds as u64);
+    let mut last = 0.0;
+    let model = gbdt::train(data, params, |_, loss| {
+        last = loss;
+        bar.inc(1);
+    })
+    .with_context(|| format!("training the {name} trees"))?;
+    bar.finish_and_clear();
+    eprintln!("{name}: training log-loss {last:.4}");
+    Ok(model)
 }

@@ -19,7 +19,7 @@
 use anyhow::{bail, Context, Result};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
-use streaks_analysis::gbdt::{self, Dataset, TrainParams};
+use streaks_analysis::gbdt::{Dataset, TrainParams};
 use streaks_analysis::repair::{
     is_right, robust_from_features, streak_objects, RepairCounts, RepairModel, StereoFeatures,
     StreakHandling, FEATURES,
@@ -33,7 +33,9 @@ use streaks_image::{write_bytes_atomically, GrayImage};
 use streaks_stereo::rig::Eye;
 
 use crate::cli::sample_truths;
-use crate::train_detector::{dataset_provenance, split_samples, training_params, training_splits};
+use crate::train_detector::{
+    dataset_provenance, split_samples, train_trees, training_params, training_splits,
+};
 use streaks_analysis::detector::road_streaks;
 
 /// Train the streak-robust stereo model on datasets.
@@ -159,26 +161,6 @@ fn rows(s: &Sample, stride: usize, offset: usize) -> (Dataset, Dataset) {
     (wrong, streak)
 }
 
-fn train_one(name: &str, data: &Dataset, params: &TrainParams) -> Result<gbdt::Model> {
-    let positives = data.labels.iter().filter(|&&y| y).count();
-    eprintln!(
-        "{name}: {} rows, {:.2} % positive; training {} rounds",
-        data.rows(),
-        100.0 * positives as f64 / data.rows().max(1) as f64,
-        params.rounds
-    );
-    let bar = crate::cli::progress_bar(params.rounds as u64);
-    let mut last = 0.0;
-    let model = gbdt::train(data, params, |_, loss| {
-        last = loss;
-        bar.inc(1);
-    })
-    .with_context(|| format!("training the {name} trees"))?;
-    bar.finish_and_clear();
-    eprintln!("{name}: training log-loss {last:.4}");
-    Ok(model)
-}
-
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<()> {
     let params = training_params(
@@ -226,8 +208,8 @@ pub fn run(args: Args) -> Result<()> {
         wrong_rows.extend(w);
         streak_rows.extend(s);
     }
-    let wrong = train_one("wrong", &wrong_rows, &params)?;
-    let streak = train_one("streak", &streak_rows, &params)?;
+    let wrong = train_trees("wrong", &wrong_rows, &params)?;
+    let streak = train_trees("streak", &streak_rows, &params)?;
     let train_s = t0.elapsed().as_secs_f64();
     eprintln!("trained in {train_s:.1} s");
 

@@ -137,16 +137,7 @@ impl Model {
     pub fn score(&self, row: &[f32]) -> f32 {
         let mut s = self.base;
         for tree in &self.trees {
-            let mut n = &tree[0];
-            while !n.is_leaf() {
-                let i = if row[n.feature as usize] <= n.value {
-                    n.left
-                } else {
-                    n.right
-                };
-                n = &tree[i as usize];
-            }
-            s += n.value;
+            s += leaf(tree, row);
         }
         s
     }
@@ -164,16 +155,7 @@ impl Model {
         out.fill(self.base);
         for tree in &self.trees {
             for (s, row) in out.iter_mut().zip(rows.chunks_exact(stride)) {
-                let mut n = &tree[0];
-                while !n.is_leaf() {
-                    let i = if row[n.feature as usize] <= n.value {
-                        n.left
-                    } else {
-                        n.right
-                    };
-                    n = &tree[i as usize];
-                }
-                *s += n.value;
+                *s += leaf(tree, row);
             }
         }
         for s in out.iter_mut() {
@@ -215,6 +197,21 @@ impl Model {
         }
         Ok(())
     }
+}
+
+/// The value of the leaf `row` reaches in `tree` (its root first).
+#[inline]
+fn leaf(tree: &[Node], row: &[f32]) -> f32 {
+    let mut n = &tree[0];
+    while !n.is_leaf() {
+        let i = if row[n.feature as usize] <= n.value {
+            n.left
+        } else {
+            n.right
+        };
+        n = &tree[i as usize];
+    }
+    n.value
 }
 
 /// The logistic function.
