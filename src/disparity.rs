@@ -74,6 +74,11 @@ pub struct Args {
     /// with `_streaks` added to its stem, as a PNG.
     #[arg(long, requires = "streaks")]
     pub streak_mask: Option<PathBuf>,
+    /// Where the streak probability goes with --streaks (PFM: the streak classifier's
+    /// smoothed probability that a pixel is a road streak, which the streak mask thresholds);
+    /// default: not written.
+    #[arg(long, requires = "streaks")]
+    pub streak_probability: Option<PathBuf>,
     /// With --streaks: a model of `streaks train-repair` instead of the shipped one.
     #[arg(long, requires = "streaks")]
     pub model: Option<PathBuf>,
@@ -171,6 +176,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         r.streaks
             .save_png(&mask_path)
             .with_context(|| format!("writing the streak mask {}", mask_path.display()))?;
+        if let Some(path) = &args.streak_probability {
+            write_pfm(path, &r.streak_probability)
+                .with_context(|| format!("writing the streak probability {}", path.display()))?;
+        }
     }
     write_pfm(&args.output, &disp).context("writing the disparity map")?;
     if let Some(png) = &args.png {

@@ -56,9 +56,24 @@ fn a_model_trained_on_a_dataset_is_used_and_scored() {
         "repair",
         "--model",
         "model.json",
+        "--streak-probability",
+        "p.pfm",
     ])
     .assert_success();
     assert!(t.join("d_confidence.pfm").is_file() && t.join("d_streaks.png").is_file());
+    // The streak mask is the probability map thresholded at the model's streak threshold.
+    let streak_threshold = model["streak_threshold"].as_f64().unwrap() as f32;
+    let p = streaks_image::pfm::read_pfm(&t.join("p.pfm")).unwrap();
+    let mask = streaks_image::GrayImage::load(&t.join("d_streaks.png")).unwrap();
+    assert_eq!(p.size(), mask.size());
+    for (&pv, &m) in p.data.iter().zip(&mask.data) {
+        assert!((0.0..=1.0).contains(&pv), "{pv}");
+        assert_eq!(
+            m > 0.0,
+            pv >= streak_threshold,
+            "{pv} against {streak_threshold}"
+        );
+    }
     let run = t.streaks(&[
         "train-repair",
         "--evaluate",

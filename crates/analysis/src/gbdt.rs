@@ -163,6 +163,52 @@ impl Model {
         }
     }
 
+    /// [`Model::probability`] of `n` items (pixels, say) whose rows of `width` features
+    /// `row_of(i, row)` writes, for the items `at` accepts, `otherwise` for the others (an
+    /// item that needs no answer is not asked: the trees are its cost). In parallel over
+    /// blocks of items, each scored tree by tree ([`Model::probabilities`]) from one buffer
+    /// per worker; bit for bit [`Model::probability`] of each row.
+    pub fn probabilities_of(
+        &self,
+        n: usize,
+        width: usize,
+        row_of: impl Fn(usize, &mut [f32]) + Sync,
+        at: impl Fn(usize) -> bool + Sync,
+        otherwise: f32,
+    ) -> Vec<f32> {
+        const BLOCK: usize = 256;
+        let mut data = vec![otherwise; n];
+        data.par_chunks_mut(BLOCK).enumerate().for_each_init(
+            || {
+                (
+                    Vec::with_capacity(BLOCK * width),
+                    Vec::with_capacity(BLOCK),
+                    Vec::with_capacity(BLOCK),
+                    vec![0f32; width],
+                )
+            },
+            |(rows, asked, scores, row): &mut (Vec<f32>, Vec<usize>, Vec<f32>, Vec<f32>),
+             (b, out)| {
+                rows.clear();
+                asked.clear();
+                for k in 0..out.len() {
+                    let i = b * BLOCK + k;
+                    if at(i) {
+                        row_of(i, row);
+                        rows.extend_from_slice(row);
+                        asked.push(k);
+                    }
+                }
+                scores.resize(asked.len(), 0.0);
+                self.probabilities(rows, width, scores);
+                for (&k, &p) in asked.iter().zip(scores.iter()) {
+                    out[k] = p;
+                }
+            },
+        );
+        data
+    }
+
     /// Checks that every tree is well formed: children in range and after their parent (so
     /// [`Model::score`] terminates), features below [`Model::features`], finite values.
     pub fn validate(&self) -> Result<(), GbdtError> {
@@ -620,6 +666,20 @@ mod tests {
             assert_eq!(out[k].to_bits(), m.probability(row).to_bits(), "row {k}");
         }
         m.probabilities(&[], test.features, &mut []);
+        // Over blocks in parallel, with items left out: the same bits where asked, the
+        // stand-in elsewhere (529 items: two full blocks and a part).
+        let f = test.features;
+        let all = m.probabilities_of(
+            test.rows(),
+            f,
+            |i, row| row.copy_from_slice(&test.values[i * f..(i + 1) * f]),
+            |i| i % 3 != 0,
+            -1.0,
+        );
+        for (k, p) in all.iter().enumerate() {
+            let want = if k % 3 != 0 { out[k] } else { -1.0 };
+            assert_eq!(p.to_bits(), want.to_bits(), "item {k}");
+        }
     }
 
     #[test]

@@ -65,7 +65,6 @@ use crate::filter::{finite_quantile, max, max_above, mean, median, Axis};
 use crate::gbdt::{GbdtError, Model};
 use crate::sgm::{sgm, SgmError, SgmParams};
 use crate::streak_classifier::smooth_probability;
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use streaks_image::stats::quantile;
 use streaks_image::{ensure_same_size, GrayImage, ImageError, SizeMismatch};
@@ -416,36 +415,12 @@ impl StereoFeatures {
         at: impl Fn(usize) -> bool + Sync,
         otherwise: f32,
     ) -> GrayImage {
-        // Blocks of pixels, each scored tree by tree ([`Model::probabilities`]), with one
-        // buffer of rows per worker.
-        const BLOCK: usize = 256;
-        let mut data = vec![otherwise; self.width * self.height];
-        data.par_chunks_mut(BLOCK).enumerate().for_each_init(
-            || {
-                (
-                    Vec::with_capacity(BLOCK * FEATURES.len()),
-                    Vec::with_capacity(BLOCK),
-                    Vec::with_capacity(BLOCK),
-                )
-            },
-            |(rows, asked, scores): &mut (Vec<f32>, Vec<usize>, Vec<f32>), (b, out)| {
-                rows.clear();
-                asked.clear();
-                let mut row = [0f32; FEATURES.len()];
-                for k in 0..out.len() {
-                    let i = b * BLOCK + k;
-                    if at(i) {
-                        self.row(i, &mut row);
-                        rows.extend_from_slice(&row);
-                        asked.push(k);
-                    }
-                }
-                scores.resize(asked.len(), 0.0);
-                model.probabilities(rows, FEATURES.len(), scores);
-                for (&k, &p) in asked.iter().zip(scores.iter()) {
-                    out[k] = p;
-                }
-            },
+        let data = model.probabilities_of(
+            self.width * self.height,
+            FEATURES.len(),
+            |i, row| self.row(i, row.try_into().expect("one row of FEATURES")),
+            at,
+            otherwise,
         );
         GrayImage {
             width: self.width,

@@ -262,16 +262,13 @@ impl StreakClassifier {
     /// The streak probability of every pixel of the linear luminance `lum`.
     pub fn probability(&self, lum: &GrayImage, horizon: f32) -> Result<GrayImage, ClassifierError> {
         let f = Features::new(lum, horizon)?;
-        let data = (0..f.width * f.height)
-            .into_par_iter()
-            .map_init(
-                || [0f32; FEATURES.len()],
-                |row, i| {
-                    f.row(i, row);
-                    self.model.probability(row)
-                },
-            )
-            .collect();
+        let data = self.model.probabilities_of(
+            f.width * f.height,
+            FEATURES.len(),
+            |i, row| f.row(i, row.try_into().expect("one row of FEATURES")),
+            |_| true,
+            0.0,
+        );
         Ok(GrayImage {
             width: f.width,
             height: f.height,
