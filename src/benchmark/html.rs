@@ -533,26 +533,27 @@ pub fn page(report: &Report, thumbs: &[SampleThumbs]) -> String {
             each.join("; ")
         );
     }
-    o.push_str("<table id=\"summary\"><tr><th>method</th><th>EPE px</th><th>bad-2</th><th>D1</th><th>valid</th><th>streak EPE px</th><th>phantom-hole rate</th><th>s / megapixel</th><th>failed samples</th></tr>");
+    o.push_str("<table id=\"summary\"><tr><th>method</th><th>EPE px</th><th>bad-2</th><th>D1</th><th>valid</th><th>bad-2 filled</th><th>streak EPE px</th><th>phantom-hole rate</th><th>s / megapixel</th><th>failed samples</th></tr>");
     for (i, m) in report.summary.iter().enumerate() {
         let e = &m.errors;
         let _ = write!(
             o,
             "<tr><td><span class=\"swatch\" style=\"background:{}\"></span>{}</td>{}{}{}\
-             <td>{}</td>{}{}{}{}</tr>",
+             <td>{}</td>{}{}{}{}{}</tr>",
             colour(i),
             esc(&m.method),
             cell(&e.all, format!("{:.3}", e.all.mean_abs)),
             cell(&e.all, pct(e.all.bad_2)),
             cell(&e.all, pct(e.all.d1)),
             pct(e.all.density),
+            cell(&e.all, pct(e.all.bad_2_filled)),
             region_cell(e.streak.as_ref(), |s| format!("{:.3}", s.mean_abs)),
             phantom_cell(m),
             seconds_cell(m.seconds_per_megapixel),
             failed_cell(m)
         );
     }
-    o.push_str("</table><p class=\"note\">The phantom-hole rate is the share of road pixels (streaks included) whose estimate is more than 1 px below the true disparity: stereo puts them beneath the road.</p><div class=\"grid\">");
+    o.push_str("</table><p class=\"note\">The phantom-hole rate is the share of road pixels (streaks included) whose estimate is more than 1 px below the true disparity: stereo puts them beneath the road. Bad-2 filled is the share of all pixels with a truth that are more than 2 px off once the missing values are filled as KITTI's development kit fills a sparse map (each gap in a row takes the smaller of its two sides), so that sparse and dense methods are on one scale.</p><div class=\"grid\">");
     let bars = |f: &dyn Fn(&MethodScore) -> Option<f64>| -> Vec<Bar> {
         report
             .summary

@@ -384,8 +384,12 @@ fn failing_commands_are_recorded_and_the_run_goes_on() {
         // A failed sample is scored as no value: nothing valid, everything bad.
         let e = &summary(&r, m)["errors"]["all"];
         assert_eq!(
-            (e["valid_pixels"].as_u64(), e["bad_all"].as_f64()),
-            (Some(0), Some(1.0))
+            (
+                e["valid_pixels"].as_u64(),
+                e["bad_all"].as_f64(),
+                e["bad_2_filled"].as_f64()
+            ),
+            (Some(0), Some(1.0), Some(1.0))
         );
         assert_eq!(summary(&r, m)["failed"], 1);
         assert!(summary(&r, m)["phantom_hole_rate"].is_null());

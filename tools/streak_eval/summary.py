@@ -1,6 +1,6 @@
 """Prints the figures of `evaluate.sh` as Markdown tables: per input and method the phantom
-holes, off-road and overall bad-2, density and bad-or-missing share (from `streaks benchmark`'s
-report.json), the held-back split by condition, and the repair's own figures with its streak
+holes, off-road and overall bad-2, density, bad-or-missing share and bad-2 after KITTI's fill
+of the missing values (from `streaks benchmark`'s report.json), the held-back split by condition, and the repair's own figures with its streak
 mask's scores (from `streaks train-repair --evaluate`).
 
     python3 tools/streak_eval/summary.py OUT
@@ -19,7 +19,9 @@ PAIRS = ["hill_bend", "crossing", "tabletop", "roundabout", "avenue", "shelf"]
 
 def pct(region: dict[str, Any] | None, key: str) -> str:
     """A share of a region's errors as a percentage, or n/a without the region."""
-    return "n/a" if region is None else f"{100 * region[key]:.1f}"
+    if region is None or key not in region:
+        return "n/a"
+    return f"{100 * region[key]:.1f}"
 
 
 def row(name: str, method: str, errors: dict[str, Any]) -> str:
@@ -33,6 +35,7 @@ def row(name: str, method: str, errors: dict[str, Any]) -> str:
         pct(full, "bad_2"),
         pct(full, "density"),
         pct(full, "bad_all"),
+        pct(full, "bad_2_filled"),
         pct(errors.get("streak"), "bad_2"),
     ]
     return "| " + " | ".join(cells) + " |"
@@ -40,7 +43,8 @@ def row(name: str, method: str, errors: dict[str, Any]) -> str:
 
 HEADER = (
     "| input | method | phantom holes % | off-road bad-2 % | bad-2 % | density % "
-    "| bad or missing % | streak bad-2 % |\n| --- | --- | --- | --- | --- | --- | --- | --- |"
+    "| bad or missing % | bad-2 filled % | streak bad-2 % |\n"
+    "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"
 )
 
 

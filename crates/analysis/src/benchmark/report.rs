@@ -42,7 +42,8 @@
 //! available: KITTI and Middlebury data have no streak or road masks), never zeros
 //! ([`UNAVAILABLE`]). Each is a [`crate::sgm::DisparityErrors`] (`truth_pixels`,
 //! `valid_pixels`, `density` = the valid share, `mean_abs` = EPE, `rms`, `bad_1`, `bad_2`,
-//! `bad_3`, `d1` (KITTI), `bad` and `bad_all` at `threshold`, `below_1px`).
+//! `bad_3`, `d1` (KITTI), `bad` and `bad_all` at `threshold`, `below_1px`, `bad_2_filled`:
+//! bad-2 over every truth pixel after KITTI's background fill of the missing values).
 //!
 //! Version 3 adds `breakdown`, `by_condition`, each figure's `breakdown` and each sample's
 //! `conditions` to version 2; every field of version 2 is still there and means the same.
