@@ -21,8 +21,8 @@ use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use streaks_analysis::gbdt::{Dataset, TrainParams};
 use streaks_analysis::repair::{
-    is_right, robust_from_features, streak_objects, RepairCounts, RepairModel, StereoFeatures,
-    StreakHandling, FEATURES,
+    is_right, robust_from_features, streak_mask, streak_objects, RepairCounts, RepairModel,
+    StereoFeatures, StreakHandling, FEATURES,
 };
 use streaks_analysis::sgm::{sgm, SgmParams};
 use streaks_analysis::streak_classifier::{smooth_probability, SMOOTHING_RADII};
@@ -216,13 +216,14 @@ pub fn run(args: Args) -> Result<()> {
     let mut model = RepairModel::new(wrong, streak);
     eprintln!("matching {} validation samples", val.len());
     let val_samples = load_samples(&val)?;
-    // The streak mask's operating point: per smoothing radius and threshold, the streak-level
-    // precision and recall over the validation samples; the most recall at `--precision`.
+    // The streak mask's operating point: per smoothing radius, threshold and hysteresis
+    // (lower) threshold, the streak-level precision and recall over the validation samples;
+    // the most recall at `--precision`.
     let probabilities: Vec<GrayImage> = val_samples
         .iter()
         .map(|s| s.features.probability(&model.streak))
         .collect();
-    let mut best: Option<(usize, f32, f64, f64)> = None;
+    let mut best: Option<(usize, f32, Option<f32>, f64, f64)> = None;
     for smooth in SMOOTHING_RADII {
         let smoothed: Vec<GrayImage> = probabilities
             .iter()
@@ -230,31 +231,33 @@ pub fn run(args: Args) -> Result<()> {
             .collect();
         for k in 1..20 {
             let t = k as f32 * 0.05;
-            let (mut found, mut truths, mut correct, mut detected) = (0, 0, 0, 0);
-            for (p, s) in smoothed.iter().zip(&val_samples) {
-                let mut mask = p.clone();
-                for v in &mut mask.data {
-                    *v = f32::from(u8::from(*v >= t));
+            let grows = std::iter::once(None).chain((1..k).map(|j| Some(j as f32 * 0.05)));
+            for grow in grows {
+                let (found, truths, correct, detected) = smoothed
+                    .par_iter()
+                    .zip(&val_samples)
+                    .map(|(p, s)| streak_objects(&streak_mask(p, t, grow), &s.road_streaks))
+                    .reduce(
+                        || (0, 0, 0, 0),
+                        |a, b| (a.0 + b.0, a.1 + b.1, a.2 + b.2, a.3 + b.3),
+                    );
+                let precision = correct as f64 / detected.max(1) as f64;
+                let recall = found as f64 / truths.max(1) as f64;
+                if detected > 0 && precision >= args.precision && best.is_none_or(|b| recall > b.4)
+                {
+                    best = Some((smooth, t, grow, precision, recall));
                 }
-                let c = streak_objects(&mask, &s.road_streaks);
-                found += c.0;
-                truths += c.1;
-                correct += c.2;
-                detected += c.3;
-            }
-            let precision = correct as f64 / detected.max(1) as f64;
-            let recall = found as f64 / truths.max(1) as f64;
-            if detected > 0 && precision >= args.precision && best.is_none_or(|b| recall > b.3) {
-                best = Some((smooth, t, precision, recall));
             }
         }
     }
     match best {
-        Some((smooth, t, p, r)) => {
+        Some((smooth, t, grow, p, r)) => {
             model.streak_smooth = smooth;
             model.streak_threshold = t;
+            model.streak_grow_threshold = grow;
+            let grown = grow.map_or(String::new(), |g| format!(", grown down to {g:.2}"));
             eprintln!(
-                "streak mask: smoothing radius {smooth}, threshold {t:.2}: {val_name} streak-level P {p:.3} R {r:.3}"
+                "streak mask: smoothing radius {smooth}, threshold {t:.2}{grown}: {val_name} streak-level P {p:.3} R {r:.3}"
             );
         }
         None => eprintln!(

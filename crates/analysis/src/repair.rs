@@ -460,6 +460,12 @@ pub struct RepairModel {
     pub streak_threshold: f32,
     /// Radius of the box filter on the `streak` probability before its threshold.
     pub streak_smooth: usize,
+    /// The streak mask's hysteresis: a streak is a connected region where the smoothed
+    /// probability reaches this lower threshold and somewhere reaches `streak_threshold`
+    /// (a streak's faint tail is kept with its bright core; a faint speck alone is not).
+    /// `None`: the plain threshold (models written before it was added).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub streak_grow_threshold: Option<f32>,
     /// The confidence map's calibration.
     pub calibration: Calibration,
     /// What the model was trained on and how (free-form, for people).
@@ -479,6 +485,7 @@ impl RepairModel {
             streak,
             streak_threshold: 0.5,
             streak_smooth: 0,
+            streak_grow_threshold: None,
             calibration: Calibration {
                 kept: vec![0.5; CALIBRATION_BINS],
                 repaired: vec![0.5; FILL_RADII.len()],
@@ -508,6 +515,14 @@ impl RepairModel {
         ] {
             if !(0.0..=1.0).contains(&t) {
                 return bad(format!("{name} {t} is not a probability"));
+            }
+        }
+        if let Some(g) = self.streak_grow_threshold {
+            if !(0.0..=self.streak_threshold).contains(&g) {
+                return bad(format!(
+                    "streak_grow_threshold {g} is not a probability at most streak_threshold {}",
+                    self.streak_threshold
+                ));
             }
         }
         let c = &self.calibration;
@@ -574,7 +589,8 @@ pub struct RobustDisparity {
     pub wrong: GrayImage,
     /// The smoothed road-streak probability.
     pub streak_probability: GrayImage,
-    /// The streak mask: 1 where the smoothed streak probability reaches the threshold.
+    /// The streak mask ([`streak_mask`] of the smoothed probability at the model's
+    /// thresholds).
     pub streaks: GrayImage,
     /// How the value of each pixel came about.
     pub origin: Vec<Origin>,
@@ -679,10 +695,11 @@ pub fn robust_from_features(
     let wrong = features.probability_where(&model.wrong, valid, 1.0);
     let streak_probability =
         smooth_probability(&features.probability(&model.streak), model.streak_smooth);
-    let mut streaks = streak_probability.clone();
-    for v in &mut streaks.data {
-        *v = f32::from(u8::from(*v >= model.streak_threshold));
-    }
+    let streaks = streak_mask(
+        &streak_probability,
+        model.streak_threshold,
+        model.streak_grow_threshold,
+    );
     let mut kept = GrayImage {
         width: w,
         height: h,
@@ -740,6 +757,32 @@ pub fn robust_from_features(
         repaired_pixels: repaired,
         masked_pixels: dropped - repaired,
     }
+}
+
+/// The streak mask (1 on streaks, 0 elsewhere) of a smoothed streak probability `p`: the
+/// pixels where it reaches `threshold`, and with a `grow` threshold (hysteresis) the whole
+/// 8-connected regions where it reaches `grow` that hold such a pixel.
+pub fn streak_mask(p: &GrayImage, threshold: f32, grow: Option<f32>) -> GrayImage {
+    use crate::benchmark::breakdown::components8;
+    let mut mask = p.clone();
+    match grow {
+        None => {
+            for v in &mut mask.data {
+                *v = f32::from(u8::from(*v >= threshold));
+            }
+        }
+        Some(g) => {
+            mask.data.fill(0.0);
+            for c in components8(p.width, p.height, |i| p.data[i] >= g.min(threshold)) {
+                if c.iter().any(|&i| p.data[i] >= threshold) {
+                    for i in c {
+                        mask.data[i] = 1.0;
+                    }
+                }
+            }
+        }
+    }
+    mask
 }
 
 /// The shortest streak (rows spanned, as a share of the image height) that the streak-level
@@ -1174,6 +1217,32 @@ mod tests {
     }
 
     #[test]
+    fn the_streak_mask_grows_from_cores_into_their_faint_tails_only() {
+        // Column 1: a core (0.8) with a faint tail (0.3) below it; column 4: a faint speck
+        // (0.3) alone.
+        let mut p = GrayImage::new(6, 6, 0.0).unwrap();
+        for y in 0..2 {
+            p.set(1, y, 0.8);
+        }
+        for y in 2..6 {
+            p.set(1, y, 0.3);
+        }
+        p.set(4, 3, 0.3);
+        p.set(4, 4, 0.3);
+        let on = |m: &GrayImage| -> Vec<(usize, usize)> {
+            (0..36)
+                .filter(|&i| m.data[i] > 0.0)
+                .map(|i| (i % 6, i / 6))
+                .collect()
+        };
+        assert_eq!(on(&streak_mask(&p, 0.5, None)), vec![(1, 0), (1, 1)]);
+        let grown = on(&streak_mask(&p, 0.5, Some(0.2)));
+        assert_eq!(grown, (0..6).map(|y| (1, y)).collect::<Vec<_>>());
+        // A lower threshold above the tail grows nothing.
+        assert_eq!(on(&streak_mask(&p, 0.5, Some(0.4))), vec![(1, 0), (1, 1)]);
+    }
+
+    #[test]
     fn streak_objects_count_tall_components_found_and_correct() {
         let mut truth = GrayImage::new(50, 100, 0.0).unwrap();
         let mut mask = truth.clone();
@@ -1204,6 +1273,10 @@ mod tests {
         bad.wrong_threshold = 1.5;
         let e = RepairModel::from_json(&serde_json::to_string(&bad).unwrap()).unwrap_err();
         assert!(e.to_string().contains("wrong_threshold"), "{e}");
+        let mut bad = model();
+        bad.streak_grow_threshold = Some(bad.streak_threshold + 0.1);
+        let e = RepairModel::from_json(&serde_json::to_string(&bad).unwrap()).unwrap_err();
+        assert!(e.to_string().contains("streak_grow_threshold"), "{e}");
         let mut bad = model();
         bad.calibration.repaired.pop();
         assert!(RepairModel::from_json(&serde_json::to_string(&bad).unwrap()).is_err());
