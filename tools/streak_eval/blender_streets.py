@@ -1552,6 +1552,7 @@ def build_hillside(mats: Materials) -> None:
     c = line.point(s) + x * line.right(s) + np.array([0.0, 0.0, -fall * x])
     pitch = math.atan(grade(s + 0.5) - grade(s - 0.5))
     tw = sloped_car(mats, "oncoming", tuple(c), line.heading(s) + math.pi, -pitch, paints[3], inst)
+    # it faces downhill: its dipped beams 1.5 degrees below the road, which falls by `pitch`
     headlights(
         mats,
         "headlight",
@@ -1560,7 +1561,7 @@ def build_hillside(mats: Materials) -> None:
         inst,
         colour=HALOGEN,
         cd=12000.0,
-        pitch=1.5 - math.degrees(pitch),
+        pitch=1.5 + math.degrees(pitch),
     )
     x = 1.4
     eye = line.point(0.0) + x * line.right(0.0) + np.array([0.0, 0.0, -fall * x + 2.4])
