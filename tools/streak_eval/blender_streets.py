@@ -1,13 +1,17 @@
 """Builds the outside night streets in Blender (bpy) and exports them with Blender's own glTF
 exporter: evaluation-only inputs for streak-robust stereo (tools/streak_eval/README.md).
 
-    BLENDER_PYTHON tools/streak_eval/blender_streets.py OUT [--set b] [--scenes hill_bend ...]
+    BLENDER_PYTHON tools/streak_eval/blender_streets.py OUT [--set b|c] [--scenes hill_bend ...]
 
 writes OUT/<scene>.glb (textures embedded) and OUT/<scene>.blend. The streets are not the
 generator's (crates/scenes): a road that bends and climbs over a crest, a crossroads with a
 crowned carriageway, their own textures (textures.py), lamps and cars. `--set b` builds the
 second set instead (made after the first had been looked at): a roundabout at the foot of a
--4 % approach, a four-lane avenue with a tree-lined median, a bookcase (no road).
+-4 % approach, a four-lane avenue with a tree-lined median, a bookcase (no road). `--set c`
+builds the third (made after the first two had been looked at): a road descending through a
+cutting under a railway bridge onto wet setts, lamps hung over the road and on walls; a narrow
+banked street climbing a hill, seen from a truck; a dry street in sunshine (a sun, a sky as the
+scene's `extras.streaks.environment`), whose road is flagged but shows no streaks.
 
 The export is the exporter's defaults plus three Include choices a user ticks: cameras,
 punctual lights and "Custom Properties" (`export_extras`): without the last one, the road
@@ -43,8 +47,11 @@ from levels import (  # noqa: E402
     crown,
     eased_grade,
     hill_profile,
+    luminance,
     radiance_for_luminance,
+    ramp_grade,
     watts_for_candela,
+    watts_for_lux,
 )
 
 Vec3 = tuple[float, float, float]
@@ -633,10 +640,21 @@ def drape(height: Callable[[float, float], float]) -> None:
             obj.location.z += height(obj.location.x, obj.location.y)
 
 
-def tree(mats: Materials, name: str, foot: Vec3, height: float, conifer: bool, inst: int):
-    """A tree: a trunk (an 8-sided prism) and a crown, a cone (`conifer`) or a sphere."""
+def tree(
+    mats: Materials,
+    name: str,
+    foot: Vec3,
+    height: float,
+    conifer: bool,
+    inst: int,
+    leaves: str = "lawn",
+):
+    """A tree: a trunk (an 8-sided prism) and a crown, a cone (`conifer`) or a sphere, its
+    leaves the texture `leaves`."""
     bark = mats.principled("bark", (0.06, 0.045, 0.035), roughness=0.9)
-    leaves = mats.principled("leaves", albedo="lawn", roughness=0.85)
+    leaves = mats.principled(
+        f"leaves_{leaves}" if leaves != "lawn" else "leaves", albedo=leaves, roughness=0.85
+    )
     trunk_h = 0.45 * height if conifer else 0.55 * height
     bpy.ops.mesh.primitive_cylinder_add(
         vertices=8, radius=0.12, depth=trunk_h, location=(foot[0], foot[1], foot[2] + trunk_h / 2)
@@ -1152,6 +1170,525 @@ def build_tabletop(mats: Materials) -> None:
     camera("camera", tuple(eye), tuple(target - eye), 40.0, 640, 480)
 
 
+# --- the third set ----------------------------------------------------------------------------
+
+#: Third set's lamp colours, blackbodies in linear sRGB (integrated against the CIE 1931
+#: observer, peak 1): LED 2200 K and 2700 K (warm), LED 5700 K (cool), a noon sun (5700 K)
+#: and a blue sky.
+LED_2200 = (1.0, 0.31, 0.03)
+LED_2700 = (1.0, 0.42, 0.10)
+LED_5700 = (1.0, 0.87, 0.80)
+SUN = (1.0, 0.87, 0.80)
+SKY = (0.45, 0.62, 1.0)
+SHOP_WARM = (1.0, 0.57, 0.26)
+
+
+def lamp_head(mats, name, centre: Vec3, size: tuple[float, float], colour, cd) -> None:
+    """A luminaire head centred at `centre`: a dark housing `size` (x, y) metres and 0.15 m
+    tall, an emissive lens facing down under it (luminance I / A) and a spot light straight
+    down, full to 60 degrees from the nadir and none past 85 (decision 0030's luminaire)."""
+    metal = mats.principled("lamp_metal_c", (0.12, 0.12, 0.12), roughness=0.45, metallic=0.6)
+    sx, sy = size
+    x, y, z = centre
+    head = box(
+        f"{name}_head", (x - sx / 2, y - sy / 2, z), (x + sx / 2, y + sy / 2, z + 0.15), metal
+    )
+    tag(head, "light_source")
+    lx, ly = 0.4 * sx, 0.4 * sy
+    lens = mats.principled(
+        f"lens_{name}",
+        emission=colour,
+        strength=radiance_for_luminance(cd / (4.0 * lx * ly), colour),
+    )
+    zl = z - 0.005
+    verts = [(x - lx, y - ly, zl), (x - lx, y + ly, zl), (x + lx, y + ly, zl), (x + lx, y - ly, zl)]
+    q = mesh_object(f"{name}_lens", verts, [(0, 1, 2, 3)], [(0, 0), (0, 1), (1, 1), (1, 0)], lens)
+    tag(q, "light_source")
+    spot(
+        f"{name}_light",
+        (x, y, z - 0.05),
+        (0.0, 0.0, -1.0),
+        watts_for_candela(cd, colour),
+        colour,
+        170.0,
+        1.0 - 60.0 / 85.0,
+    )
+
+
+def wall_lamp(mats, name, wall: Vec3, out: float, colour, cd) -> None:
+    """A wall-mounted luminaire: a bracket from the wall point `wall` (x, y, z) reaching 0.7 m
+    along X (`out` = +1 or -1, towards the road) and a 0.45 x 0.3 m head at its end."""
+    metal = mats.principled("lamp_metal_c", (0.12, 0.12, 0.12), roughness=0.45, metallic=0.6)
+    x, y, z = wall
+    xa, xb = sorted((x, x + out * 0.7))
+    tag(box(f"{name}_bracket", (xa, y - 0.04, z + 0.1), (xb, y + 0.04, z + 0.16), metal), "pole")
+    lamp_head(mats, name, (x + out * 0.75, y, z), (0.45, 0.3), colour, cd)
+
+
+def catenary_lamp(mats, name, x_span: tuple[float, float], centre: Vec3, colour, cd) -> None:
+    """A lamp hung over the road's centre from a span wire between x_span (the wire 0.4 m
+    above the head, a drop rod to it): a round-ish 0.5 x 0.5 m head."""
+    metal = mats.principled("lamp_metal_c", (0.12, 0.12, 0.12), roughness=0.45, metallic=0.6)
+    x, y, z = centre
+    zw = z + 0.55
+    tag(
+        box(f"{name}_wire", (x_span[0], y - 0.01, zw), (x_span[1], y + 0.01, zw + 0.02), metal),
+        "pole",
+    )
+    tag(
+        box(f"{name}_drop", (x - 0.02, y - 0.02, z + 0.15), (x + 0.02, y + 0.02, zw), metal), "pole"
+    )
+    lamp_head(mats, name, centre, (0.5, 0.5), colour, cd)
+
+
+def wall(name, ys, x: float, z_lo, z_hi, mat, tile: float, facing: float):
+    """A vertical wall along Y at `x` between heights z_lo(y) and z_hi(y), facing -X (`facing`
+    = -1) or +X (+1); UVs (along, up) in metres / `tile`."""
+    verts, faces, uvs = [], [], []
+    for y in ys:
+        verts += [(x, y, z_lo(y)), (x, y, z_hi(y))]
+    for j in range(len(ys) - 1):
+        a, b, c, d = 2 * j, 2 * j + 2, 2 * j + 3, 2 * j + 1
+        f = (a, b, c, d) if facing > 0 else (a, d, c, b)
+        faces.append(f)
+        uvs.extend((verts[k][1] / tile, verts[k][2] / tile) for k in f)
+    return mesh_object(name, verts, faces, uvs, mat)
+
+
+def sloped_car(mats, name, centre: Vec3, heading: float, pitch: float, paint, instance: int):
+    """`car` pitched nose-up by `pitch` radians (on a grade); returns its local-to-world map."""
+    car(mats, name, centre, heading, paint, instance)
+    for part in ("body", "cabin", "wheels"):
+        bpy.data.objects[f"{name}_{part}"].rotation_euler = (pitch, 0.0, heading)
+    cp, sp = math.cos(pitch), math.sin(pitch)
+    c, s = math.cos(heading), math.sin(heading)
+
+    def to_world(p: Vec3) -> Vec3:
+        x, y, z = p[0], cp * p[1] - sp * p[2], sp * p[1] + cp * p[2]
+        return (centre[0] + c * x - s * y, centre[1] + s * x + c * y, centre[2] + z)
+
+    return to_world
+
+
+def straight(profile: Callable[[float], float]) -> CentreLine:
+    """A straight centre line along +Y with heights `profile(y)`."""
+    return CentreLine(radius=1e9, bend_start=1e9, profile=profile)
+
+
+def build_underpass(mats: Materials) -> None:
+    """A two-lane road (7 m) descending at -6 % in a cutting between board-marked concrete
+    retaining walls (easing to level 22-38 m ahead, 1.8 m down) and passing under a railway
+    bridge 44-56 m ahead (sandstone abutments and embankment, a concrete deck 4.6 m over the
+    road); beyond it a level street of wet granite setts between shop fronts and rendered
+    terraces. Lamps hung over the road's centre from span wires (LED 2700 K, 2.2 kcd), cool
+    wall-mounted lamps in the underpass and on the facades (LED 5700 K, 1.2-1.5 kcd); a car
+    ahead on the descent with its tail lights, an oncoming car in the underpass with LED
+    headlights; wet asphalt (roughness 0.11, puddles 0.03 on a third) and wet setts (stones
+    about 0.2, water in the joints 0.05); the camera 1.3 m up (a car)."""
+
+    def h(y: float) -> float:
+        return eased_grade(y, -0.06, 22.0, 16.0)
+
+    line = straight(h)
+    low = h(40.0)  # -1.8 m
+    asphalt = mats.principled(
+        "wet_asphalt", albedo="asphalt_c", roughness_map="puddles_c", road=True
+    )
+    setts_mat = mats.principled("wet_setts", albedo="setts", roughness_map="setts_wet", road=True)
+    xs = [(x, 0.0) for x in np.linspace(-3.5, 3.5, 8)]
+    tag(ribbon("road", line, np.arange(-10.0, 58.01, 1.0), xs, asphalt, 2.0), "road")
+    tag(ribbon("road_setts", line, np.arange(58.0, 140.01, 2.0), xs, setts_mat, 1.5), "road")
+    paint = mats.principled("road_paint_c", (0.62, 0.6, 0.5), roughness=0.22, road=True)
+    for k, y0 in enumerate(np.arange(-6.0, 56.0, 4.5)):
+        dash = ribbon(
+            f"centre_dash_{k}",
+            line,
+            np.linspace(y0, y0 + 2.0, 3),
+            [(-0.07, 0.004), (0.07, 0.004)],
+            paint,
+            1.0,
+        )
+        tag(dash, "marking")
+    paving = mats.principled("paving_c", albedo="paving_c", roughness=0.45)
+    ys = np.arange(-10.0, 140.01, 1.0)
+    tag(
+        ribbon("pavement_right", line, ys, [(3.5, 0.0), (3.5, 0.13), (5.5, 0.13)], paving, 4.0),
+        "sidewalk",
+    )
+    tag(
+        ribbon("pavement_left", line, ys, [(-5.5, 0.13), (-3.5, 0.13), (-3.5, 0.0)], paving, 4.0),
+        "sidewalk",
+    )
+    concrete = mats.principled("board_concrete", albedo="concrete_c", roughness=0.85)
+    stone = mats.principled("sandstone", albedo="sandstone", roughness=0.8)
+    # the cutting's retaining walls, their tops level at +1.2 m, to the bridge
+    wys = np.arange(-10.0, 44.01, 2.0)
+    tag(wall("wall_right", wys, 5.5, lambda y: h(y), lambda y: 1.2, concrete, 4.0, -1.0), "wall")
+    tag(wall("wall_left", wys, -5.5, lambda y: h(y), lambda y: 1.2, concrete, 4.0, 1.0), "wall")
+    # ground above the cutting and buildings set back on it
+    ground = mats.principled("ground_c", albedo="paving_c", roughness=0.9)
+    for sx in (-1.0, 1.0):
+        xa, xb = sorted((sx * 5.5, sx * 40.0))
+        tag(box(f"ground_{sx:+.0f}", (xa, -10.0, 0.0), (xb, 44.0, 1.2), ground, 4.0), "terrain")
+    # the railway: a sandstone embankment either side, a concrete deck over the road
+    deck_lo = low + 4.6
+    for sx in (-1.0, 1.0):
+        xa, xb = sorted((sx * 5.5, sx * 60.0))
+        tag(
+            box(
+                f"embankment_{sx:+.0f}",
+                (xa, 44.0, low - 0.5),
+                (xb, 56.0, deck_lo + 1.3),
+                stone,
+                3.0,
+            ),
+            "building",
+        )
+    tag(box("deck", (-5.6, 44.0, deck_lo), (5.6, 56.0, deck_lo + 1.3), concrete, 4.0), "building")
+    rail = mats.principled("parapet_steel", (0.1, 0.11, 0.12), roughness=0.5, metallic=0.7)
+    for k, (ya, yb) in enumerate(((44.0, 44.3), (55.7, 56.0))):
+        tag(
+            box(f"parapet{k}", (-60.0, ya, deck_lo + 1.3), (60.0, yb, deck_lo + 2.4), rail),
+            "street_furniture",
+        )
+    # beyond: shop fronts and rendered terraces on both sides, a terrace closing the view
+    facades = [
+        mats.principled("shopfronts", albedo="shopfronts", roughness=0.7),
+        mats.principled("render_c", albedo="render_c", roughness=0.9),
+        stone,
+    ]
+    rng = np.random.default_rng(31)
+    k = 0
+    for sx in (-1.0, 1.0):
+        y = 56.0
+        while y < 138.0:
+            ln = float(rng.uniform(9.0, 15.0))
+            xa, xb = sorted((sx * 5.5, sx * 15.0))
+            ht = float(rng.uniform(7.0, 13.0))
+            tag(
+                box(
+                    f"building_{k}",
+                    (xa, y, low - 0.5),
+                    (xb, y + ln, low + ht),
+                    facades[k % 3],
+                    8.0 if k % 3 == 0 else 3.0,
+                ),
+                "building",
+            )
+            y, k = y + ln, k + 1
+    tag(
+        box("terrace_end", (-20.0, 140.0, low - 0.5), (20.0, 152.0, low + 12.0), facades[1], 3.0),
+        "building",
+    )
+    for sx in (-1.0, 1.0):
+        xa, xb = sorted((sx * 12.0, sx * 25.0))
+        for y0 in (-6.0, 14.0):
+            tag(
+                box(
+                    f"house_{sx:+.0f}_{y0:.0f}",
+                    (xa, y0, 1.2),
+                    (xb, y0 + 15.0, 9.0),
+                    facades[1],
+                    3.0,
+                ),
+                "building",
+            )
+    # lamps: hung over the centre from span wires (cutting and setts street), wall-mounted in
+    # the underpass and on the facades beyond
+    for j, y in enumerate((6.0, 26.0, 70.0, 94.0, 118.0)):
+        top = (h(y) + 7.0) if y < 44.0 else (low + 7.0)
+        catenary_lamp(mats, f"span{j}", (-5.5, 5.5), (0.0, y, top), LED_2700, 2200.0)
+        for sx in (-1.0, 1.0):
+            tag(
+                box(
+                    f"span{j}_mast{sx:+.0f}",
+                    (sx * 5.6 - 0.08, y - 0.08, h(y)),
+                    (sx * 5.6 + 0.08, y + 0.08, top + 0.7),
+                    mats.principled(
+                        "lamp_metal_c", (0.12, 0.12, 0.12), roughness=0.45, metallic=0.6
+                    ),
+                ),
+                "pole",
+            )
+    for j, (sx, y) in enumerate(((1.0, 47.0), (-1.0, 53.0))):
+        wall_lamp(mats, f"underpass{j}", (sx * 5.5, y, low + 3.4), -sx, LED_5700, 1200.0)
+    for j, (sx, y) in enumerate(((-1.0, 62.0), (1.0, 82.0), (-1.0, 106.0))):
+        wall_lamp(mats, f"facade_lamp{j}", (sx * 5.5, y, low + 5.0), -sx, LED_5700, 1500.0)
+    # a car ahead on the descent, an oncoming car in the underpass
+    grey = mats.principled(
+        "paint_graphite", (0.08, 0.08, 0.09), roughness=0.3, metallic=0.6, coat=1.0
+    )
+    y = 24.0
+    pitch = math.atan(h(y + 0.5) - h(y - 0.5))
+    tw = sloped_car(mats, "car_ahead", (1.75, y, h(y)), 0.0, pitch, grey, 1)
+    tail_lights(mats, "taillight", tw, 0.0, 1, cd=12.0)
+    yellow = mats.principled("paint_yellow", (0.5, 0.35, 0.03), roughness=0.3, coat=1.0)
+    tw = car(mats, "oncoming_car", (-1.75, 52.0, low), math.pi, yellow, 2)
+    headlights(mats, "headlight", tw, math.pi, 2, colour=LED_5700, cd=13000.0, pitch=1.0)
+    eye = (1.75, 0.0, 1.3)
+    camera("driver", eye, pitched(np.array([0.0, 1.0, 0.0]), 2.5), 40.0, 704, 396)
+
+
+def build_hillside(mats: Materials) -> None:
+    """A narrow street climbing a hill on a right-hand bend (radius 45 m from 10 m ahead), its
+    grade rising from 3 % to 9 % over the first 35 m, the carriageway banked (cross-fall
+    3.5 %, falling to the right, the inside of the bend): 5.6 m of running lanes between 2 m
+    parking strips, cars parked on both sides, 12 cm kerbs, 1.8 m pavements, shop fronts
+    (some lit, warm and cool), rendered and sandstone terraces; warm LED 2200 K lamps on
+    wall brackets on the left, cool LED 5700 K lamps on posts on the right; a car coming down
+    with its headlights; wet asphalt with few puddles (roughness 0.16, puddles 0.05 on 15 %);
+    a truck's camera 2.4 m up."""
+
+    def grade(s: float) -> float:
+        return ramp_grade(s, 0.03, 0.09, 35.0)
+
+    line = CentreLine(radius=-45.0, bend_start=10.0, profile=grade)
+    fall = 0.035
+    ss = np.arange(-8.0, 100.01, 1.0)
+    road = mats.principled(
+        "wet_asphalt", albedo="asphalt_hill", roughness_map="puddles_hill", road=True
+    )
+    xs = [(x, -fall * x) for x in np.linspace(-4.8, 4.8, 9)]
+    tag(ribbon("road", line, ss, xs, road, 2.0), "road")
+    paint = mats.principled("road_paint_c", (0.62, 0.6, 0.5), roughness=0.22, road=True)
+    for sx in (-1.0, 1.0):
+        x = sx * 2.8
+        prof = [(x - 0.06, -fall * x + 0.004), (x + 0.06, -fall * x + 0.004)]
+        tag(ribbon(f"edge_line_{sx:+.0f}", line, ss, prof, paint, 1.0), "marking")
+    paving = mats.principled("paving_c", albedo="paving_c", roughness=0.45)
+    hl, hr = fall * 4.8, -fall * 4.8
+    tag(
+        ribbon(
+            "pavement_left",
+            line,
+            ss,
+            [(-6.6, hl + 0.12), (-4.8, hl + 0.12), (-4.8, hl)],
+            paving,
+            4.0,
+        ),
+        "sidewalk",
+    )
+    tag(
+        ribbon(
+            "pavement_right", line, ss, [(4.8, hr), (4.8, hr + 0.12), (6.6, hr + 0.12)], paving, 4.0
+        ),
+        "sidewalk",
+    )
+    facades = [
+        mats.principled("shopfronts", albedo="shopfronts", roughness=0.7),
+        mats.principled("render_c", albedo="render_c", roughness=0.9),
+        mats.principled("sandstone", albedo="sandstone", roughness=0.8),
+    ]
+    rng = np.random.default_rng(32)
+    shops = []
+    for side, x, hb in (("right", 6.6, hr), ("left", -6.6, hl)):
+        s0, k = -8.0, 0
+        while s0 < 98.0:
+            length = float(rng.uniform(7.0, 12.0))
+            height = float(rng.uniform(8.0, 13.0))
+            seg = np.linspace(s0, min(s0 + length, 100.0), 6)
+            prof = (
+                [(x, hb - 1.0), (x, hb + height)]
+                if side == "right"
+                else [(x, hb + height), (x, hb - 1.0)]
+            )
+            tile = 8.0 if k % 3 == 0 else 3.0
+            tag(
+                ribbon(f"facade_{side}_{k}", line, seg, prof, facades[k % 3], tile, True),
+                "building",
+            )
+            if k % 3 == 0 and s0 > 0.0:
+                shops.append((side, s0 + 0.5 * length, length))
+            s0, k = s0 + length, k + 1
+    # lit shop windows in the shop-front terraces (every other one warm, the rest cool)
+    for j, (side, s, length) in enumerate(shops):
+        sx = 1.0 if side == "right" else -1.0
+        hb = hr if side == "right" else hl
+        foot = line.point(s) + sx * 6.58 * line.right(s) + np.array([0.0, 0.0, hb + 0.12])
+        colour, cd_m2 = (SHOP_WARM, 180.0) if j % 2 == 0 else (COOL_WHITE, 120.0)
+        mat = mats.principled(
+            f"glow_shop{j}", emission=colour, strength=radiance_for_luminance(cd_m2, colour)
+        )
+        lo, hi = (-0.04, -0.3 * length, 0.4), (0.0, 0.2 * length, 2.4)
+        if sx < 0:
+            lo, hi = (0.0, -0.3 * length, 0.4), (0.04, 0.2 * length, 2.4)
+        place(box(f"shop_window{j}", lo, hi, mat, cls="building"), tuple(foot), line.heading(s))
+    # lamps: warm wall lamps on the left facades, cool post lamps on the right pavement
+    for j, s in enumerate((8.0, 30.0, 52.0, 74.0)):
+        w = line.point(s) - 6.6 * line.right(s) + np.array([0.0, 0.0, hl + 5.5])
+        a = line.heading(s)
+        metal = mats.principled("lamp_metal_c", (0.12, 0.12, 0.12), roughness=0.45, metallic=0.6)
+        bracket = box(
+            f"wall_lamp{j}_bracket", (0.0, -0.04, 0.1), (0.8, 0.04, 0.16), metal, cls="pole"
+        )
+        place(bracket, tuple(w), a)
+        head = line.point(s) - 5.75 * line.right(s) + np.array([0.0, 0.0, hl + 5.5])
+        lamp_head(mats, f"wall_lamp{j}", tuple(head), (0.4, 0.4), LED_2200, 1600.0)
+    for j, s in enumerate((18.0, 42.0, 66.0, 90.0)):
+        foot = line.point(s) + 5.9 * line.right(s) + np.array([0.0, 0.0, hr + 0.12])
+        street_lamp(mats, f"post_lamp{j}", tuple(foot), line.heading(s), 1.0, LED_5700, 2600.0)
+    # parked cars on both strips, a car coming down the hill with its headlights
+    paints = [
+        mats.principled("paint_cream", (0.55, 0.5, 0.38), roughness=0.3, coat=1.0),
+        mats.principled("paint_navy", (0.02, 0.04, 0.12), roughness=0.25, metallic=0.5, coat=1.0),
+        mats.principled("paint_red_c", (0.4, 0.04, 0.03), roughness=0.3, coat=1.0),
+        mats.principled("paint_grey", (0.25, 0.26, 0.27), roughness=0.35, metallic=0.7),
+    ]
+    inst = 1
+    for sx, spots in (
+        (1.0, (7.0, 12.5, 24.0, 36.0, 41.5, 58.0)),
+        (-1.0, (10.0, 21.0, 26.5, 44.0, 55.0)),
+    ):
+        for s in spots:
+            x = sx * 3.8
+            c = line.point(s) + x * line.right(s) + np.array([0.0, 0.0, -fall * x])
+            pitch = math.atan(grade(s + 0.5) - grade(s - 0.5))
+            sloped_car(
+                mats, f"parked{inst}", tuple(c), line.heading(s), pitch, paints[inst % 4], inst
+            )
+            inst += 1
+    s = 48.0
+    x = -1.4
+    c = line.point(s) + x * line.right(s) + np.array([0.0, 0.0, -fall * x])
+    pitch = math.atan(grade(s + 0.5) - grade(s - 0.5))
+    tw = sloped_car(mats, "oncoming", tuple(c), line.heading(s) + math.pi, -pitch, paints[3], inst)
+    # it faces downhill: its dipped beams 1.5 degrees below the road, which falls by `pitch`
+    headlights(
+        mats,
+        "headlight",
+        tw,
+        line.heading(s) + math.pi,
+        inst,
+        colour=HALOGEN,
+        cd=12000.0,
+        pitch=1.5 + math.degrees(pitch),
+    )
+    x = 1.4
+    eye = line.point(0.0) + x * line.right(0.0) + np.array([0.0, 0.0, -fall * x + 2.4])
+    camera("truck", tuple(eye), pitched(line.along(0.0), 1.0), 40.0, 560, 420)
+
+
+def build_daylight_street(mats: Materials) -> None:
+    """A streak-free street a KITTI user would recognise: a straight residential street in
+    sunshine, a dry, rough road (roughness 0.72 +- 0.08, no puddles; flagged as the road),
+    crowned by 6 cm, 2 m parking strips with cars on both sides, 12 cm kerbs, 3 m
+    pavements with trees, shop fronts, rendered and sandstone facades 9-16 m high, unlit lamp
+    posts; a sun of 60 klx (5700 K) 40 degrees up from behind the camera on the left and a
+    constant blue sky (3 kcd/m^2); a car ahead, an oncoming car; the camera 1.65 m up."""
+    road = mats.principled(
+        "dry_asphalt", albedo="asphalt_dry", roughness_map="dry_rough", road=True
+    )
+    ys = np.arange(-10.0, 161.0, 4.0)
+    tag(
+        grid("road", np.linspace(-5.0, 5.0, 11), ys, lambda x, y: crown(x, 5.0, 0.06), road, 2.5),
+        "road",
+    )
+    paint = mats.principled("road_paint_dry", (0.7, 0.7, 0.66), roughness=0.7, road=True)
+    for k, y in enumerate(np.arange(-6.0, 156.0, 6.0)):
+        tag(box(f"centre_dash_{k}", (-0.06, y, 0.055), (0.06, y + 3.0, 0.064), paint), "marking")
+    paving = mats.principled("paving_c", albedo="paving_c", roughness=0.8)
+    kerb = mats.principled("kerb_c", (0.35, 0.35, 0.33), roughness=0.8)
+    facades = [
+        mats.principled("shopfronts", albedo="shopfronts", roughness=0.8),
+        mats.principled("render_c", albedo="render_c", roughness=0.9),
+        mats.principled("sandstone", albedo="sandstone", roughness=0.85),
+    ]
+    rng = np.random.default_rng(33)
+    k = 0
+    for sx in (-1.0, 1.0):
+        xa, xb = sorted((sx * 5.0, sx * 5.15))
+        tag(box(f"kerb_{sx:+.0f}", (xa, -10.0, -0.2), (xb, 160.0, 0.12), kerb), "sidewalk")
+        xa, xb = sorted((sx * 5.15, sx * 8.0))
+        tag(
+            box(f"pavement_{sx:+.0f}", (xa, -10.0, -0.2), (xb, 160.0, 0.12), paving, 4.0),
+            "sidewalk",
+        )
+        y = -10.0
+        while y < 158.0:
+            ln = float(rng.uniform(10.0, 18.0))
+            xa, xb = sorted((sx * 8.0, sx * 20.0))
+            ht = float(rng.uniform(9.0, 16.0))
+            tag(
+                box(
+                    f"building_{k}",
+                    (xa, y, -0.5),
+                    (xb, y + ln, ht),
+                    facades[k % 3],
+                    8.0 if k % 3 == 0 else 3.0,
+                ),
+                "building",
+            )
+            y, k = y + ln, k + 1
+        for j, y0 in enumerate(np.arange(4.0, 150.0, 20.0)):
+            tree(
+                mats,
+                f"tree{sx:+.0f}_{j}",
+                (sx * 6.6, float(y0) + (10.0 if sx < 0 else 0.0), 0.12),
+                float(rng.uniform(5.5, 7.5)),
+                False,
+                100 + j + (50 if sx > 0 else 0),
+                leaves="leaves_c",
+            )
+    metal = mats.principled("lamp_metal_c", (0.12, 0.12, 0.12), roughness=0.45, metallic=0.6)
+    for j, y0 in enumerate(np.arange(10.0, 150.0, 28.0)):
+        for sx in (-1.0, 1.0):
+            yy = float(y0) + (14.0 if sx < 0 else 0.0)
+            tag(
+                box(
+                    f"post{j}{sx:+.0f}",
+                    (sx * 5.5 - 0.07, yy - 0.07, 0.12),
+                    (sx * 5.5 + 0.07, yy + 0.07, 7.0),
+                    metal,
+                ),
+                "pole",
+            )
+            xa, xb = sorted((sx * 5.5, sx * 4.3))
+            tag(
+                box(f"post{j}{sx:+.0f}_head", (xa, yy - 0.15, 6.85), (xb, yy + 0.15, 7.0), metal),
+                "pole",
+            )
+    paints = [
+        mats.principled("paint_silver_c", (0.5, 0.5, 0.52), roughness=0.45, metallic=0.6),
+        mats.principled("paint_blue_c", (0.05, 0.12, 0.35), roughness=0.45),
+        mats.principled("paint_white_c", (0.7, 0.7, 0.68), roughness=0.5),
+        mats.principled("paint_black_c", (0.03, 0.03, 0.03), roughness=0.45),
+        mats.principled("paint_red_d", (0.45, 0.05, 0.04), roughness=0.5),
+    ]
+    inst = 1
+    for sx, spots in (
+        (1.0, (9.0, 14.5, 27.0, 33.0, 46.0, 60.0, 72.0)),
+        (-1.0, (6.0, 18.0, 23.5, 38.0, 52.0, 65.0)),
+    ):
+        for y in spots:
+            car(
+                mats,
+                f"parked{inst}",
+                (sx * 4.0, y, 0.02),
+                0.0 if sx > 0 else math.pi,
+                paints[inst % 5],
+                inst,
+            )
+            inst += 1
+    car(mats, "car_ahead", (1.5, 22.0, 0.05), 0.0, paints[2], inst)
+    car(mats, "oncoming", (-1.5, 40.0, 0.05), math.pi, paints[4], inst + 1)
+    sun = bpy.data.lights.new("sun", "SUN")
+    sun.color = SUN
+    sun.energy = watts_for_lux(60000.0, SUN)
+    sun.angle = 0.0
+    obj = bpy.data.objects.new("sun", sun)
+    bpy.context.scene.collection.objects.link(obj)
+    # light travelling forwards (+Y), to the right and down: the sun behind-left of the camera
+    elev, azim = math.radians(40.0), math.radians(30.0)
+    point_along(
+        obj, (math.sin(azim) * math.cos(elev), math.cos(azim) * math.cos(elev), -math.sin(elev))
+    )
+    sky = 3000.0 / 683.0 / luminance(SKY)  # a 3 kcd/m^2 sky, as a radiance factor on SKY
+    bpy.context.scene["streaks"] = {"environment": {"color": list(SKY), "strength": sky}}
+    camera(
+        "camera", (1.5, 0.0, 0.05 + 1.65), pitched(np.array([0.0, 1.0, 0.0]), 1.0), 36.0, 640, 384
+    )
+
+
 SCENES = {
     "hill_bend": build_hill_bend,
     "crossing": build_crossing,
@@ -1160,11 +1697,22 @@ SCENES = {
     "roundabout": build_roundabout,
     "avenue": build_avenue,
     "shelf": build_shelf,
+    # the third set (made after the first two had been looked at)
+    "underpass": build_underpass,
+    "hillside": build_hillside,
+    "daylight_street": build_daylight_street,
 }
-#: The scene sets: `--set a` (the default) builds the first, `--set b` the second.
-SETS = {"a": ("hill_bend", "crossing", "tabletop"), "b": ("roundabout", "avenue", "shelf")}
+#: The scene sets: `--set a` (the default) builds the first, `--set b` the second, `--set c`
+#: the third.
+SETS = {
+    "a": ("hill_bend", "crossing", "tabletop"),
+    "b": ("roundabout", "avenue", "shelf"),
+    "c": ("underpass", "hillside", "daylight_street"),
+}
 #: The scenes with a wet road (the others have none).
-STREETS = ("hill_bend", "crossing", "roundabout", "avenue")
+STREETS = ("hill_bend", "crossing", "roundabout", "avenue", "underpass", "hillside")
+#: The streets with a dry road (no streaks; their road material is `dry_asphalt`).
+DRY_STREETS = ("daylight_street",)
 
 
 def export(out: Path, name: str) -> Path:
@@ -1185,10 +1733,12 @@ def export(out: Path, name: str) -> Path:
         for m in doc.get("materials", [])
         if m.get("extras", {}).get("streaks", {}).get("road") is True
     ]
-    if name in STREETS and "wet_asphalt" not in roads:
+    road_name = "dry_asphalt" if name in DRY_STREETS else "wet_asphalt"
+    has_road = name in STREETS or name in DRY_STREETS
+    if has_road and road_name not in roads:
         raise SystemExit(f"{glb}: the road material has no extras.streaks.road = true")
-    if name in STREETS:
-        road = next(m for m in doc["materials"] if m["name"] == "wet_asphalt")
+    if has_road:
+        road = next(m for m in doc["materials"] if m["name"] == road_name)
         pbr = road.get("pbrMetallicRoughness", {})
         if "baseColorTexture" not in pbr or "metallicRoughnessTexture" not in pbr:
             raise SystemExit(f"{glb}: the road's textures were not exported")

@@ -10,7 +10,9 @@
 #   OUT/repair-NAME.json        `streaks train-repair --evaluate`: phantom holes, off-road bad-2
 #                               and densities before and after, the streak mask's scores
 # then prints one table (summary.py). With SET=b it scores the second set instead (heldback_b/
-# and pairs_b/: roundabout, avenue, shelf), made after the first set had been looked at.
+# and pairs_b/: roundabout, avenue, shelf), made after the first set had been looked at; with
+# SET=c the third set (heldback_c/, other_config_c/ and pairs_c/: underpass, hillside,
+# daylight_street), made after the first two had been looked at.
 #
 # STREAKS: the binary (default target/release/streaks); OPENCV_PYTHON: a Python with
 # opencv-python-headless (tools/opencv/requirements.txt) to add OpenCV's StereoSGBM.
@@ -33,6 +35,9 @@ stamp() { date -u +%H:%M:%S; }
 if [[ "${SET:-a}" == b ]]; then
     benches=(heldback_b pairs_b)
     repairs=(heldback_b pairs_b/roundabout pairs_b/avenue)
+elif [[ "${SET:-a}" == c ]]; then
+    benches=(heldback_c other_config_c pairs_c)
+    repairs=(heldback_c other_config_c pairs_c/underpass pairs_c/hillside pairs_c/daylight_street)
 else
     benches=(heldback other_config dry_config pairs)
     repairs=(heldback other_config dry_config pairs/hill_bend pairs/crossing)

@@ -18,6 +18,14 @@
 #   OUT/heldback_b/                               24 default-config samples (seed 45900), a
 #                                                 new held-back split
 #
+# SET=c makes the third set (made after the first two had been looked at):
+#
+#   OUT/scenes_c/{underpass,hillside,daylight_street}.glb  built in Blender, exported by it
+#   OUT/pairs_c/{underpass,hillside,daylight_street}/      `streaks stereo` pairs of them
+#   OUT/other_config_c/                           4 samples of other_config_c.toml (seed 79)
+#   OUT/heldback_c/                               24 default-config samples (seed 46900), a
+#                                                 third held-back split
+#
 # BLENDER_PYTHON: the Python with bpy 5.0 (default target/blender-venv/bin/python);
 # STREAKS: the streaks binary (default target/release/streaks). Run from the repository root.
 # Evaluation-only inputs: no parameter may be tuned on them.
@@ -54,8 +62,36 @@ if [[ "$set_name" == "b" ]]; then
 
     echo "$(stamp) done: $out (second set)"
     exit 0
+elif [[ "$set_name" == "c" ]]; then
+    mkdir -p -- "$out/scenes_c" "$out/pairs_c"
+    echo "$(stamp) building the third set's Blender scenes"
+    "$blender_python" "$here/blender_streets.py" "$out/scenes_c" --set c
+
+    echo "$(stamp) underpass: 704x396, 64 spp, baseline 0.25 m, +4.5 EV"
+    "$streaks" stereo "$out/scenes_c/underpass.glb" -o "$out/pairs_c/underpass" \
+        --width 704 --height 396 --spp 64 --baseline 0.25 --exposure 4.5 --seed 3
+
+    echo "$(stamp) hillside: 560x420, 64 spp, baseline 0.54 m, sensor_c.toml (a 10-bit camera)"
+    "$streaks" stereo "$out/scenes_c/hillside.glb" -o "$out/pairs_c/hillside" \
+        --width 560 --height 420 --spp 64 --baseline 0.54 --sensor "$here/sensor_c.toml" --seed 3
+
+    echo "$(stamp) daylight_street: 640x384, 64 spp, baseline 0.40 m, -3.5 EV (sunlit, dry)"
+    "$streaks" stereo "$out/scenes_c/daylight_street.glb" -o "$out/pairs_c/daylight_street" \
+        --width 640 --height 384 --spp 64 --baseline 0.40 --exposure -3.5 --seed 3
+
+    echo "$(stamp) other_config_c: 4 samples, 576x320, 24 spp"
+    "$streaks" dataset generate -o "$out/other_config_c" --config "$here/other_config_c.toml" \
+        --count 4 --seed 79 --width 576 --height 320 --spp 24 --denoise off \
+        --outputs images,gt,masks
+
+    echo "$(stamp) heldback_c: 24 samples of the default config, seed 46900, 448x256, 16 spp"
+    "$streaks" dataset generate -o "$out/heldback_c" --seed 46900 --count 24 \
+        --width 448 --height 256 --spp 16 --denoise off --outputs images,gt,masks
+
+    echo "$(stamp) done: $out (third set)"
+    exit 0
 elif [[ "$set_name" != "a" ]]; then
-    echo "SET must be a or b, not $set_name" >&2
+    echo "SET must be a, b or c, not $set_name" >&2
     exit 2
 fi
 

@@ -50,3 +50,19 @@ def eased_grade(y: float, grade: float, ease_from: float, ease_len: float) -> fl
         return grade * y
     t = min(1.0, (y - ease_from) / ease_len)
     return grade * (ease_from + ease_len * (t - t**3 + 0.5 * t**4))
+
+
+def watts_for_lux(lux: float, colour: tuple[float, float, float]) -> float:
+    """Blender's Strength (W/m^2) of a sun lamp of `colour` whose illuminance is `lux` (the
+    exporter writes the strength times 683 as lux, times the colour)."""
+    return lux / (683.0 * luminance(colour))
+
+
+def ramp_grade(s: float, g0: float, g1: float, length: float) -> float:
+    """A road's height along s whose grade rises smoothly (smoothstep) from `g0` at s = 0 to
+    `g1` at s = `length` and stays there; `g0` before s = 0. 0 at s = 0, continuous in height
+    and grade (the smoothstep's integral is length (t^3 - t^4 / 2))."""
+    if s <= 0.0:
+        return g0 * s
+    t = min(1.0, s / length)
+    return g0 * s + (g1 - g0) * (length * (t**3 - 0.5 * t**4) + max(0.0, s - length))

@@ -13,8 +13,18 @@ import sys
 from pathlib import Path
 from typing import Any
 
-INPUTS = ["heldback", "other_config", "dry_config", "heldback_b"]
-PAIRS = ["hill_bend", "crossing", "tabletop", "roundabout", "avenue", "shelf"]
+INPUTS = ["heldback", "other_config", "dry_config", "heldback_b", "heldback_c", "other_config_c"]
+PAIRS = [
+    "hill_bend",
+    "crossing",
+    "tabletop",
+    "roundabout",
+    "avenue",
+    "shelf",
+    "underpass",
+    "hillside",
+    "daylight_street",
+]
 
 
 def pct(region: dict[str, Any] | None, key: str) -> str:
@@ -94,7 +104,8 @@ def tables(out: Path) -> str:
             for s in c["summary"]:
                 label = f"{name}: {c['condition']} ({c['samples']})"
                 conditions.append(row(label, s["method"], s["errors"]))
-    for path in (out / "bench-pairs" / "report.json", out / "bench-pairs_b" / "report.json"):
+    for pairs in ("pairs", "pairs_b", "pairs_c"):
+        path = out / f"bench-{pairs}" / "report.json"
         if not path.is_file():
             continue
         report = json.loads(path.read_text(encoding="utf-8"))

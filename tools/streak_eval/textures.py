@@ -234,6 +234,124 @@ def wallpaper(n: int = 256, seed: int = 10) -> np.ndarray:
     return linear_to_srgb8(rgb)
 
 
+def setts(
+    n: int = 256,
+    seed: int = 31,
+    rows: int = 10,
+    per_row: int = 5,
+    colour: tuple[float, float, float] = (1.0, 0.97, 0.93),
+    shade: float = 0.11,
+) -> np.ndarray:
+    """Granite setts in stretcher bond (n x n x 3, sRGB): `rows` courses of `per_row` stones
+    per tile, each its own shade about `shade` (times `colour`), with a mica speckle, darker
+    worn edges and dark joints (4 % of the stone's size)."""
+    rng = np.random.default_rng(seed)
+    ch, bw = n / rows, n / per_row
+    v, u = np.mgrid[0:n, 0:n].astype(np.float64)
+    course = np.floor(v / ch).astype(int)
+    shifted = (u + (course % 2) * bw / 2.0) % n
+    stone = np.floor(shifted / bw).astype(int)
+    shades = shade * np.exp(0.25 * rng.standard_normal((rows, per_row)))
+    value = shades[course, stone] * (1.0 + 0.3 * rng.standard_normal((n, n)))
+    # distance to the stone's edge, in fractions of its height: darker (worn, dirty) edges
+    fv, fu = (v % ch) / ch, (shifted % bw) / bw
+    edge = np.minimum(np.minimum(fv, 1.0 - fv), np.minimum(fu, 1.0 - fu) * bw / ch)
+    value = value * (0.6 + 0.4 * np.clip(edge / 0.15, 0.0, 1.0))
+    joint = edge < 0.04
+    value = np.where(joint, 0.025, value)
+    rgb = np.stack([value * colour[0], value * colour[1], value * colour[2]], axis=-1)
+    return linear_to_srgb8(rgb)
+
+
+def setts_roughness(
+    n: int = 256,
+    seed: int = 32,
+    rows: int = 10,
+    per_row: int = 5,
+    stone: float = 0.2,
+    joint: float = 0.05,
+) -> np.ndarray:
+    """The metallicRoughness image of wet setts laid as `setts` (same `rows`, `per_row`): the
+    stones' tops at roughness about `stone` (each stone its own), the water-filled joints and
+    the stones' worn edges smoother, towards `joint`; G roughness, B metallic 0, R 255."""
+    rng = np.random.default_rng(seed)
+    ch, bw = n / rows, n / per_row
+    v, u = np.mgrid[0:n, 0:n].astype(np.float64)
+    course = np.floor(v / ch).astype(int)
+    shifted = (u + (course % 2) * bw / 2.0) % n
+    block = np.floor(shifted / bw).astype(int)
+    per_stone = stone * np.exp(0.2 * rng.standard_normal((rows, per_row)))
+    fv, fu = (v % ch) / ch, (shifted % bw) / bw
+    edge = np.minimum(np.minimum(fv, 1.0 - fv), np.minimum(fu, 1.0 - fu) * bw / ch)
+    t = np.clip(edge / 0.12, 0.0, 1.0)
+    rough = per_stone[course, block] * (1.0 + 0.1 * periodic_noise(n, 1.5, rng))
+    rough = joint + (rough - joint) * t
+    out = np.empty((n, n, 3), dtype=np.uint8)
+    out[..., 0] = 255
+    out[..., 1] = np.round(np.clip(rough, 0.0, 1.0) * 255.0).astype(np.uint8)
+    out[..., 2] = 0
+    return out
+
+
+def dry_roughness(n: int = 256, seed: int = 33, mean: float = 0.72, spread: float = 0.08):
+    """The metallicRoughness image of a dry road: roughness about `mean` everywhere, slow
+    patches and grain of `spread` (no puddles, nothing below mean - 3 spread); G roughness,
+    B metallic 0, R 255."""
+    rng = np.random.default_rng(seed)
+    field = 0.6 * periodic_noise(n, n / 12.0, rng) + 0.8 * periodic_noise(n, 1.0, rng)
+    rough = mean + spread * np.clip(field, -3.0, 3.0)
+    out = np.empty((n, n, 3), dtype=np.uint8)
+    out[..., 0] = 255
+    out[..., 1] = np.round(np.clip(rough, 0.0, 1.0) * 255.0).astype(np.uint8)
+    out[..., 2] = 0
+    return out
+
+
+def board_concrete(n: int = 256, seed: int = 34, boards: int = 8, level: float = 0.3):
+    """Board-marked concrete (n x n x 3, sRGB): `boards` horizontal formwork boards per tile,
+    each a slightly different shade about `level` with its grain along x, thin joints
+    between boards and a grid of tie holes, and slow water staining."""
+    rng = np.random.default_rng(seed)
+    v, u = np.mgrid[0:n, 0:n].astype(np.float64)
+    bh = n / boards
+    board = np.floor(v / bh).astype(int)
+    shades = level * (1.0 + 0.06 * rng.standard_normal(boards))
+    grain = np.sin(2.0 * np.pi * (v * 3.0 * boards / n) + 2.0 * periodic_noise(n, n / 16.0, rng))
+    stain = np.exp(0.15 * periodic_noise(n, n / 5.0, rng))
+    value = shades[board] * (1.0 + 0.04 * grain) * stain
+    value = value * (1.0 + 0.06 * periodic_noise(n, 0.8, rng))
+    value = np.where((v % bh) < 1.5, 0.6 * value, value)
+    holes = ((u - n / 8.0) % (n / 4.0)) ** 2 + ((v - bh / 2.0) % (2.0 * bh) - 0.0) ** 2 < 9.0
+    value = np.where(holes, 0.05, value)
+    return linear_to_srgb8(np.stack([value, value * 0.99, value * 0.95], axis=-1))
+
+
+def shopfronts(n: int = 256, seed: int = 35, shops: int = 2) -> np.ndarray:
+    """A terrace's ground floor and upper storey (n x n x 3, sRGB): `shops` shop fronts per
+    tile, each a painted fascia (its own colour) over a dark glazed window and a door, on
+    painted brick above with two sash windows per shop."""
+    rng = np.random.default_rng(seed)
+    v, u = np.mgrid[0:n, 0:n].astype(np.float64)
+    cell = n / shops
+    shop = np.floor(u / cell).astype(int)
+    fu = (u % cell) / cell
+    fv = v / n  # 0 at the top of the tile
+    paints = rng.uniform(0.05, 0.45, (shops, 3))
+    wall = 0.35 * (1.0 + 0.08 * periodic_noise(n, 1.0, rng))
+    courses = (v % (n / 32.0)) < 1.0
+    rgb = np.stack([wall * 0.95, wall * 0.9, wall * 0.85], axis=-1)
+    rgb[courses] *= 0.7
+    upper = (fv > 0.1) & (fv < 0.38) & (np.abs((fu * 2.0) % 1.0 - 0.5) < 0.22)
+    rgb[upper] = (0.02, 0.022, 0.025)
+    fascia = (fv > 0.5) & (fv < 0.58) & (fu > 0.03) & (fu < 0.97)
+    rgb[fascia] = paints[shop][fascia]
+    glass = (fv > 0.6) & (fv < 0.92) & (fu > 0.06) & (fu < 0.66)
+    rgb[glass] = (0.015, 0.018, 0.02)
+    door = (fv > 0.6) & (fu > 0.72) & (fu < 0.9)
+    rgb[door] = paints[shop][door] * 0.5
+    return linear_to_srgb8(rgb)
+
+
 def write_png(path: Path, pixels: np.ndarray) -> None:
     """Writes an 8-bit grey (h x w) or RGB (h x w x 3) array as a PNG (row 0 at the top)."""
     pixels = np.asarray(pixels)
@@ -265,7 +383,8 @@ def write_png(path: Path, pixels: np.ndarray) -> None:
 
 #: The textures of the outside streets: name -> (maker, whether it holds colour (sRGB) rather
 #: than data). The first set (hill_bend, crossing, tabletop) uses the first six; the second
-#: set (roundabout, avenue, shelf) the rest, made with other seeds and patterns.
+#: set (roundabout, avenue, shelf) the next ten, made with other seeds and patterns; the third set
+#: (underpass, hillside, daylight_street) the last fourteen, again new seeds and patterns.
 TEXTURES = {
     "asphalt": (asphalt_albedo, True),
     "puddles": (puddle_roughness, False),
@@ -315,6 +434,61 @@ TEXTURES = {
     "wood": (wood, True),
     "spines": (book_spines, True),
     "wallpaper": (wallpaper, True),
+    # third set (underpass, hillside, daylight_street)
+    "asphalt_c": (
+        partial(
+            asphalt_albedo,
+            seed=41,
+            level=0.05,
+            stone_px=2.0,
+            stone_cut=1.15,
+            tint=(0.98, 1.0, 1.02),
+        ),
+        True,
+    ),
+    "puddles_c": (
+        partial(puddle_roughness, seed=42, wet=0.11, puddle=0.03, share=0.35, blobs_per_tile=10.0),
+        False,
+    ),
+    "setts": (setts, True),
+    "setts_wet": (setts_roughness, False),
+    "concrete_c": (board_concrete, True),
+    "asphalt_hill": (
+        partial(
+            asphalt_albedo, seed=47, level=0.04, stone_px=1.2, stone_cut=1.5, tint=(1.0, 0.99, 0.97)
+        ),
+        True,
+    ),
+    "puddles_hill": (
+        partial(puddle_roughness, seed=46, wet=0.16, puddle=0.05, share=0.15, blobs_per_tile=16.0),
+        False,
+    ),
+    "shopfronts": (shopfronts, True),
+    "sandstone": (
+        partial(
+            facade_blocks,
+            seed=49,
+            courses=16,
+            per_course=4,
+            colour=(1.0, 0.86, 0.66),
+            shade=0.4,
+            mortar=(0.3, 0.28, 0.25),
+        ),
+        True,
+    ),
+    "render_c": (
+        partial(facade_plaster, seed=50, colour=(1.0, 0.86, 0.82), per_row=2, rows=3),
+        True,
+    ),
+    "asphalt_dry": (
+        partial(
+            asphalt_albedo, seed=51, level=0.11, stone_px=1.5, stone_cut=1.1, tint=(1.0, 1.0, 1.0)
+        ),
+        True,
+    ),
+    "dry_rough": (dry_roughness, False),
+    "paving_c": (partial(paving, seed=53, flags=16), True),
+    "leaves_c": (partial(lawn, seed=54), True),
 }
 
 

@@ -12,18 +12,25 @@ from levels import (
     hill_profile,
     luminance,
     radiance_for_luminance,
+    ramp_grade,
     smoothstep,
     watts_for_candela,
+    watts_for_lux,
 )
 from textures import (
     TEXTURES,
     asphalt_albedo,
+    board_concrete,
     book_spines,
+    dry_roughness,
     facade_blocks,
     facade_plaster,
     lawn,
     periodic_noise,
     puddle_roughness,
+    setts,
+    setts_roughness,
+    shopfronts,
     wallpaper,
     wood,
     write_all,
@@ -199,3 +206,76 @@ def test_eased_grade():
     grades = np.diff([eased_grade(y, -0.04, 14.0, 12.0) for y in ys]) / 0.25
     assert grades.min() >= -0.0401 and grades.max() <= 1e-12
     assert np.abs(np.diff(grades)).max() < 0.002  # the grade changes smoothly
+
+
+THIRD_SET = (
+    "asphalt_c",
+    "puddles_c",
+    "setts",
+    "setts_wet",
+    "concrete_c",
+    "asphalt_hill",
+    "puddles_hill",
+    "shopfronts",
+    "sandstone",
+    "render_c",
+    "asphalt_dry",
+    "dry_rough",
+    "paving_c",
+    "leaves_c",
+)
+
+
+def test_third_set_differs_from_the_first_two():
+    assert set(THIRD_SET) <= set(TEXTURES)
+    made = {name: make() for name, (make, _) in TEXTURES.items()}
+    earlier = [name for name in TEXTURES if name not in THIRD_SET]
+    for name in THIRD_SET:
+        img = made[name]
+        assert img.dtype == np.uint8 and img.ndim == 3 and img.shape[2] == 3
+        for old in earlier:
+            if made[old].shape == img.shape:
+                assert not np.array_equal(made[old], img), (name, old)
+
+
+def test_setts_and_their_wet_joints():
+    lin = srgb8_to_linear(setts(128)).mean(axis=-1)
+    assert (lin < 0.03).mean() > 0.03  # the dark joints
+    assert 0.04 < lin.mean() < 0.2
+    rough = setts_roughness(128)[..., 1] / 255.0
+    # the same laying: the joints of the albedo are where the roughness is lowest
+    joints = lin < 0.03
+    assert rough[joints].mean() < rough[~joints].mean()
+    assert rough.min() >= 0.04 and rough.max() <= 0.5  # each stone its own, about 0.2
+
+
+def test_dry_road_is_rough_everywhere():
+    img = dry_roughness(128)
+    rough = img[..., 1] / 255.0
+    assert (img[..., 2] == 0).all() and (img[..., 0] == 255).all()
+    assert rough.min() >= 0.45 and abs(rough.mean() - 0.72) < 0.03
+    make, colour = TEXTURES["asphalt_dry"]
+    lin = srgb8_to_linear(make(128)).mean(axis=-1)
+    assert colour and 0.08 < lin.mean() < 0.2  # lighter than the wet streets' asphalt
+    assert not TEXTURES["dry_rough"][1] and not TEXTURES["setts_wet"][1]
+
+
+def test_third_set_patterns():
+    c = srgb8_to_linear(board_concrete(128)).mean(axis=-1)
+    # horizontal boards: the shade changes more down the image than along it
+    assert np.abs(np.diff(c.mean(axis=1))).mean() > np.abs(np.diff(c.mean(axis=0))).mean()
+    shop = srgb8_to_linear(shopfronts(128))
+    assert (shop.mean(axis=-1) < 0.03).mean() > 0.15  # glazing and upper windows
+    assert shop.std(axis=-1).max() > 0.05  # the painted fascias have a colour
+
+
+def test_sun_and_ramp():
+    sun = (1.0, 0.87, 0.8)
+    assert math.isclose(watts_for_lux(60000.0, sun) * 683.0 * luminance(sun), 60000.0)
+    assert ramp_grade(0.0, 0.03, 0.09, 35.0) == 0.0
+    assert math.isclose(ramp_grade(-2.0, 0.03, 0.09, 35.0), -0.06)
+    ss = np.arange(0.0, 80.0, 0.25)
+    grades = np.diff([ramp_grade(s, 0.03, 0.09, 35.0) for s in ss]) / 0.25
+    assert abs(grades[0] - 0.03) < 1e-3 and abs(grades[-1] - 0.09) < 1e-9
+    assert np.all(np.diff(grades) >= -1e-12)  # the grade only rises
+    assert math.isclose(ramp_grade(35.0, 0.03, 0.09, 35.0), 0.03 * 35.0 + 0.06 * 17.5)
