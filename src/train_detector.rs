@@ -106,9 +106,12 @@ pub(crate) fn split_samples(datasets: &[PathBuf], split: &str) -> Result<Vec<Pat
                 streaks_dataset::files::DATASET_JSON
             );
         }
-        let ids = layout
-            .sample_ids(Some(split))
-            .with_context(|| format!("the {split} split of {}", d.display()))?;
+        // A split that one dataset leaves empty (a small dataset's val split, say) adds
+        // nothing; the callers refuse a selection that is empty over all datasets.
+        let ids = match layout.sample_ids(Some(split)) {
+            Err(streaks_dataset::error::DatasetError::NoSamples { .. }) => continue,
+            ids => ids.with_context(|| format!("the {split} split of {}", d.display()))?,
+        };
         out.extend(
             ids.iter()
                 .map(|id| layout.sample_by_id(id).path().to_path_buf()),
