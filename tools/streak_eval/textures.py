@@ -352,6 +352,74 @@ def shopfronts(n: int = 256, seed: int = 35, shops: int = 2) -> np.ndarray:
     return linear_to_srgb8(rgb)
 
 
+def large_slabs(n: int = 256, seed: int = 61, across: int = 2, along: int = 3) -> np.ndarray:
+    """Large granite-like paving slabs (n x n x 3, sRGB): `across` x `along` slabs per tile,
+    each its own grey with a fine speckle (dark crystals, light quartz) and narrow dark
+    joints; a running bond (every other row shifted by half a slab)."""
+    rng = np.random.default_rng(seed)
+    v, u = np.mgrid[0:n, 0:n].astype(np.float64)
+    ch, cw = n / along, n / across
+    row = np.floor(v / ch).astype(int)
+    shifted = (u + (row % 2) * cw / 2.0) % n
+    col = np.floor(shifted / cw).astype(int)
+    shade = 0.13 + 0.035 * rng.standard_normal((along, across))
+    value = shade[row, col]
+    speckle = rng.standard_normal((n, n))
+    value = value * (1.0 + 0.25 * np.clip(speckle, -2.0, 2.0))
+    value = value * np.exp(0.1 * periodic_noise(n, n / 6.0, rng))
+    joint = ((v % ch) < 1.5) | ((shifted % cw) < 1.5)
+    value = np.where(joint, 0.03, value)
+    return linear_to_srgb8(np.stack([value * 0.98, value, value * 1.03], axis=-1))
+
+
+def slabs_roughness(
+    n: int = 256, seed: int = 62, across: int = 2, along: int = 3, wet: float = 0.09
+) -> np.ndarray:
+    """The metallicRoughness image of `large_slabs`' laying (G roughness, B metallic 0): each
+    slab wet at about `wet` (its own, +-25 %), water standing in the joints (0.03)."""
+    rng = np.random.default_rng(seed)
+    v, u = np.mgrid[0:n, 0:n].astype(np.float64)
+    ch, cw = n / along, n / across
+    row = np.floor(v / ch).astype(int)
+    shifted = (u + (row % 2) * cw / 2.0) % n
+    col = np.floor(shifted / cw).astype(int)
+    each = wet * (1.0 + 0.25 * rng.uniform(-1.0, 1.0, (along, across)))
+    rough = each[row, col] * (1.0 + 0.1 * periodic_noise(n, 1.5, rng))
+    joint = ((v % ch) < 2.0) | ((shifted % cw) < 2.0)
+    rough = np.where(joint, 0.03, rough)
+    out = np.empty((n, n, 3), dtype=np.uint8)
+    out[..., 0] = 255
+    out[..., 1] = np.round(np.clip(rough, 0.0, 1.0) * 255.0).astype(np.uint8)
+    out[..., 2] = 0
+    return out
+
+
+def lit_windows(
+    n: int = 256,
+    seed: int = 63,
+    per_row: int = 6,
+    rows: int = 4,
+    lit: float = 0.35,
+    colour: tuple[float, float, float] = (0.55, 0.5, 0.45),
+) -> np.ndarray:
+    """An apartment block's facade for the far bank (n x n x 3, sRGB): a plain wall of
+    `colour` with `rows` x `per_row` windows per tile, about `lit` of them a pale yellow
+    albedo (curtains; the windows that glow are emissive boxes in the scene) and the rest
+    dark."""
+    rng = np.random.default_rng(seed)
+    v, u = np.mgrid[0:n, 0:n].astype(np.float64)
+    wall = 0.3 * np.exp(0.12 * periodic_noise(n, n / 8.0, rng))
+    rgb = np.stack([wall * colour[0], wall * colour[1], wall * colour[2]], axis=-1) / 0.5
+    panes = _windows(n, per_row, rows, 0.45, 0.5)
+    iu = np.floor(u * per_row / n).astype(int)
+    iv = np.floor(v * rows / n).astype(int)
+    on = rng.uniform(size=(rows, per_row)) < lit
+    lit_px = panes & on[iv, iu]
+    rgb[panes] = (0.02, 0.02, 0.025)
+    rgb[lit_px] = (0.8, 0.62, 0.3)
+    return linear_to_srgb8(rgb)
+
+
 def write_png(path: Path, pixels: np.ndarray) -> None:
     """Writes an 8-bit grey (h x w) or RGB (h x w x 3) array as a PNG (row 0 at the top)."""
     pixels = np.asarray(pixels)
@@ -384,7 +452,9 @@ def write_png(path: Path, pixels: np.ndarray) -> None:
 #: The textures of the outside streets: name -> (maker, whether it holds colour (sRGB) rather
 #: than data). The first set (hill_bend, crossing, tabletop) uses the first six; the second
 #: set (roundabout, avenue, shelf) the next ten, made with other seeds and patterns; the third set
-#: (underpass, hillside, daylight_street) the last fourteen, again new seeds and patterns.
+#: (underpass, hillside, daylight_street) the next fourteen, again new seeds and patterns; the
+#: fourth (bridge, square) the last eleven, new seeds and three new patterns (large slabs,
+#: their wet roughness, blocks of flats with lit windows).
 TEXTURES = {
     "asphalt": (asphalt_albedo, True),
     "puddles": (puddle_roughness, False),
@@ -489,6 +559,45 @@ TEXTURES = {
     "dry_rough": (dry_roughness, False),
     "paving_c": (partial(paving, seed=53, flags=16), True),
     "leaves_c": (partial(lawn, seed=54), True),
+    # fourth set (bridge, square)
+    "asphalt_d": (
+        partial(
+            asphalt_albedo,
+            seed=71,
+            level=0.042,
+            stone_px=1.8,
+            stone_cut=1.25,
+            tint=(0.99, 0.99, 1.0),
+        ),
+        True,
+    ),
+    "puddles_d": (
+        partial(puddle_roughness, seed=72, wet=0.12, puddle=0.035, share=0.3, blobs_per_tile=7.0),
+        False,
+    ),
+    "asphalt_sq": (
+        partial(
+            asphalt_albedo, seed=73, level=0.06, stone_px=1.0, stone_cut=1.4, tint=(1.0, 0.98, 0.95)
+        ),
+        True,
+    ),
+    "puddles_sq": (
+        partial(puddle_roughness, seed=74, wet=0.14, puddle=0.03, share=0.2, blobs_per_tile=20.0),
+        False,
+    ),
+    "slabs": (large_slabs, True),
+    "slabs_wet": (slabs_roughness, False),
+    "parapet_d": (partial(board_concrete, seed=75, boards=4, level=0.22), True),
+    "far_flats": (lit_windows, True),
+    "far_flats_b": (
+        partial(lit_windows, seed=76, per_row=4, rows=5, lit=0.5, colour=(0.5, 0.42, 0.36)),
+        True,
+    ),
+    "shopfronts_d": (partial(shopfronts, seed=77, shops=3), True),
+    "render_d": (
+        partial(facade_plaster, seed=78, colour=(0.86, 0.9, 0.8), per_row=3, rows=4),
+        True,
+    ),
 }
 
 

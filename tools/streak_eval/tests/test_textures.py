@@ -25,12 +25,15 @@ from textures import (
     dry_roughness,
     facade_blocks,
     facade_plaster,
+    large_slabs,
     lawn,
+    lit_windows,
     periodic_noise,
     puddle_roughness,
     setts,
     setts_roughness,
     shopfronts,
+    slabs_roughness,
     wallpaper,
     wood,
     write_all,
@@ -279,3 +282,50 @@ def test_sun_and_ramp():
     assert abs(grades[0] - 0.03) < 1e-3 and abs(grades[-1] - 0.09) < 1e-9
     assert np.all(np.diff(grades) >= -1e-12)  # the grade only rises
     assert math.isclose(ramp_grade(35.0, 0.03, 0.09, 35.0), 0.03 * 35.0 + 0.06 * 17.5)
+
+
+FOURTH_SET = (
+    "asphalt_d",
+    "puddles_d",
+    "asphalt_sq",
+    "puddles_sq",
+    "slabs",
+    "slabs_wet",
+    "parapet_d",
+    "far_flats",
+    "far_flats_b",
+    "shopfronts_d",
+    "render_d",
+)
+
+
+def test_fourth_set_differs_from_the_first_three():
+    assert set(FOURTH_SET) <= set(TEXTURES)
+    assert list(TEXTURES)[-len(FOURTH_SET) :] == list(FOURTH_SET)
+    made = {name: make() for name, (make, _) in TEXTURES.items()}
+    earlier = [name for name in TEXTURES if name not in FOURTH_SET]
+    for name in FOURTH_SET:
+        img = made[name]
+        assert img.dtype == np.uint8 and img.ndim == 3 and img.shape[2] == 3
+        for old in earlier:
+            if made[old].shape == img.shape:
+                assert not np.array_equal(made[old], img), (name, old)
+
+
+def test_large_slabs_and_their_wet_joints():
+    lin = srgb8_to_linear(large_slabs(128)).mean(axis=-1)
+    joints = lin < 0.035
+    assert 0.02 < joints.mean() < 0.2  # narrow joints between large slabs
+    assert 0.05 < lin[~joints].mean() < 0.25
+    rough = slabs_roughness(128)[..., 1] / 255.0
+    # the same laying: water stands in the albedo's joints
+    assert rough[joints].mean() < rough[~joints].mean()
+    assert rough.min() >= 0.02 and rough.max() <= 0.16
+    assert not TEXTURES["slabs_wet"][1] and TEXTURES["slabs"][1]
+
+
+def test_lit_windows():
+    img = srgb8_to_linear(lit_windows(128))
+    lit = (img[..., 0] > 0.6) & (img[..., 2] < 0.4)
+    dark = img.mean(axis=-1) < 0.03
+    assert lit.mean() > 0.01 and dark.mean() > 0.02
