@@ -1,7 +1,7 @@
 """Builds the outside night streets in Blender (bpy) and exports them with Blender's own glTF
 exporter: evaluation-only inputs for streak-robust stereo (tools/streak_eval/README.md).
 
-    BLENDER_PYTHON tools/streak_eval/blender_streets.py OUT [--set b|c] [--scenes hill_bend ...]
+    BLENDER_PYTHON tools/streak_eval/blender_streets.py OUT [--set b|c|d] [--scenes hill_bend ...]
 
 writes OUT/<scene>.glb (textures embedded) and OUT/<scene>.blend. The streets are not the
 generator's (crates/scenes): a road that bends and climbs over a crest, a crossroads with a
@@ -11,7 +11,10 @@ second set instead (made after the first had been looked at): a roundabout at th
 builds the third (made after the first two had been looked at): a road descending through a
 cutting under a railway bridge onto wet setts, lamps hung over the road and on walls; a narrow
 banked street climbing a hill, seen from a truck; a dry street in sunshine (a sun, a sky as the
-scene's `extras.streaks.environment`), whose road is flagged but shows no streaks.
+scene's `extras.streaks.environment`), whose road is flagged but shows no streaks. `--set d`
+builds the fourth (made after the first three had been looked at): a road over a river bridge
+with lamps on both parapets and the far bank's lit flats; a wide town square crossed by a tram
+street, paved with large wet slabs, lamps on tall masts, seen from a low car.
 
 The export is the exporter's defaults plus three Include choices a user ticks: cameras,
 punctual lights and "Custom Properties" (`export_extras`): without the last one, the road
@@ -1689,6 +1692,460 @@ def build_daylight_street(mats: Materials) -> None:
     )
 
 
+# --- the fourth set (made after the first three had been looked at) ---------------------------
+
+#: Fourth set: a mercury-vapour-like bluish white (about 4000 K, its green-blue lines) on the
+#: bridge's parapets and LED 3500 K on the square's masts, both linear sRGB, peak 1.
+MERCURY = (0.80, 0.94, 1.0)
+LED_3500 = (1.0, 0.55, 0.25)
+WINDOW_WARM = (1.0, 0.66, 0.32)
+
+
+def glow_box(mats, name, lo: Vec3, hi: Vec3, colour, cd_m2: float, cls: str):
+    """An emissive box (a lit window, a shop window, a tram's windows) of luminance `cd_m2`;
+    one material per colour and luminance."""
+    mat = mats.principled(
+        f"glow_{cd_m2:.0f}_{colour[1]:.2f}",
+        emission=colour,
+        strength=radiance_for_luminance(cd_m2, colour),
+    )
+    return box(name, lo, hi, mat, cls=cls)
+
+
+def post_lamp(mats, name, foot: Vec3, height: float, arms, colour, cd, metal) -> None:
+    """A mast standing at `foot` to `height` with a luminaire at the end of each arm: `arms`
+    is a list of (dx, dy) reaches from the mast (a head 0.6 x 0.35 m on each)."""
+    x, y, z = foot
+    tag(
+        box(f"{name}_mast", (x - 0.08, y - 0.08, z), (x + 0.08, y + 0.08, z + height), metal),
+        "pole",
+    )
+    for k, (dx, dy) in enumerate(arms):
+        xa, xb = sorted((x, x + dx))
+        ya, yb = sorted((y, y + dy))
+        tag(
+            box(
+                f"{name}_arm{k}",
+                (xa - 0.04, ya - 0.04, z + height - 0.08),
+                (xb + 0.04, yb + 0.04, z + height),
+                metal,
+            ),
+            "pole",
+        )
+        size = (0.6, 0.35) if abs(dx) >= abs(dy) else (0.35, 0.6)
+        lamp_head(mats, f"{name}_{k}", (x + dx, y + dy, z + height - 0.2), size, colour, cd)
+
+
+def bus(mats, name, centre: Vec3, pitch: float, paint, instance: int):
+    """A bus (11 x 2.5 x 3.1 m) heading +Y, pitched nose-up by `pitch` radians, a dark rear
+    window; returns its local-to-world map (local +Y its front)."""
+    body = box(
+        f"{name}_body", (-1.25, -5.5, 0.35), (1.25, 5.5, 3.1), paint, cls="bus", inst=instance
+    )
+    glass = mats.principled("bus_glass", (0.015, 0.015, 0.02), roughness=0.05, coat=1.0)
+    rear = box(
+        f"{name}_rear_window",
+        (-1.1, -5.53, 1.5),
+        (1.1, -5.49, 2.8),
+        glass,
+        cls="bus",
+        inst=instance,
+    )
+    tyre = mats.principled("tyre", (0.02, 0.02, 0.02), roughness=0.9)
+    skirt = box(
+        f"{name}_wheels", (-1.2, -5.0, 0.0), (1.2, 5.0, 0.35), tyre, cls="bus", inst=instance
+    )
+    for part in (body, rear, skirt):
+        part.location = centre
+        part.rotation_euler = (pitch, 0.0, 0.0)
+    cp, sp = math.cos(pitch), math.sin(pitch)
+
+    def to_world(p: Vec3) -> Vec3:
+        return (
+            centre[0] + p[0],
+            centre[1] + cp * p[1] - sp * p[2],
+            centre[2] + sp * p[1] + cp * p[2],
+        )
+
+    return to_world
+
+
+def build_bridge(mats: Materials) -> None:
+    """A two-lane road (7 m) over a river bridge: the deck climbs at 2 % to a crest about 12 m
+    ahead, then falls at up to -3.5 % to the far bank (3 m lower, 110 m ahead), where the road
+    runs on level between shop fronts and rendered houses. 15 cm kerbs, 1.8 m footways, open
+    parapets (a 0.45 m concrete plinth, steel posts every 4 m and a rail at 1.15 m) with lamps
+    on both sides every 24 m (mercury-vapour-like bluish white, about 4000 K, 1.9 kcd); the
+    river 9 m below; along the far bank's quay a row of blocks of flats with lit windows, facing the
+    bridge; a bus ahead on the descent with its tail lights, two oncoming cars (halogen and
+    xenon headlights); wet asphalt (roughness 0.12, puddles 0.035 on 30 %); the camera 1.35 m
+    up (a car) just short of the crest."""
+    far = 110.0
+
+    def h(y: float) -> float:
+        return ramp_grade(min(y, far), 0.02, -0.035, 30.0)
+
+    low = h(far)  # about -3 m
+    line = straight(h)
+    asphalt = mats.principled(
+        "wet_asphalt", albedo="asphalt_d", roughness_map="puddles_d", road=True
+    )
+    xs = [(x, 0.0) for x in np.linspace(-3.5, 3.5, 8)]
+    tag(ribbon("road", line, np.arange(-10.0, far + 60.01, 1.0), xs, asphalt, 2.0), "road")
+    paint = mats.principled("road_paint_d", (0.6, 0.6, 0.55), roughness=0.25, road=True)
+    for k, y0 in enumerate(np.arange(-8.0, far + 50.0, 6.0)):
+        dash = ribbon(
+            f"centre_dash_{k}",
+            line,
+            np.linspace(y0, y0 + 3.0, 3),
+            [(-0.07, 0.004), (0.07, 0.004)],
+            paint,
+            1.0,
+        )
+        tag(dash, "marking")
+    footway = mats.principled("footway_d", albedo="slabs", roughness=0.5)
+    ys = np.arange(-10.0, far + 60.01, 1.0)
+    tag(
+        ribbon("footway_right", line, ys, [(3.5, 0.0), (3.5, 0.15), (5.3, 0.15)], footway, 3.0),
+        "sidewalk",
+    )
+    tag(
+        ribbon("footway_left", line, ys, [(-5.3, 0.15), (-3.5, 0.15), (-3.5, 0.0)], footway, 3.0),
+        "sidewalk",
+    )
+    # the parapets: a concrete plinth, steel posts every 4 m and a rail, over the river only
+    parapet = mats.principled("parapet_d", albedo="parapet_d", roughness=0.85)
+    steel = mats.principled("rail_steel_d", (0.16, 0.17, 0.18), roughness=0.35, metallic=0.8)
+    bys = np.arange(-10.0, far + 0.01, 2.0)
+    tag(
+        ribbon("plinth_right", line, bys, [(5.3, 0.15), (5.3, 0.6), (5.6, 0.6)], parapet, 2.0),
+        "wall",
+    )
+    tag(
+        ribbon("plinth_left", line, bys, [(-5.6, 0.6), (-5.3, 0.6), (-5.3, 0.15)], parapet, 2.0),
+        "wall",
+    )
+    tag(
+        ribbon("rail_right", line, bys, [(5.4, 1.15), (5.5, 1.15), (5.5, 1.05)], steel, 1.0),
+        "fence",
+    )
+    tag(
+        ribbon("rail_left", line, bys, [(-5.5, 1.05), (-5.5, 1.15), (-5.4, 1.15)], steel, 1.0),
+        "fence",
+    )
+    for sx in (-1.0, 1.0):
+        for k, y in enumerate(np.arange(-9.0, far, 4.0)):
+            tag(
+                box(
+                    f"post_{sx:+.0f}_{k}",
+                    (sx * 5.45 - 0.03, y - 0.03, h(y) + 0.6),
+                    (sx * 5.45 + 0.03, y + 0.03, h(y) + 1.1),
+                    steel,
+                ),
+                "fence",
+            )
+    # the deck's edge beams (seen from the far bank's reflections only) and the river
+    tag(
+        box("deck_beam", (-5.7, -40.0, low - 1.6), (5.7, far, low - 0.4), parapet, 4.0),
+        "building",
+    )
+    water = mats.principled("river", (0.01, 0.012, 0.014), roughness=0.04)
+    q = mesh_object(
+        "river",
+        [(-300.0, -60.0, -9.0), (300.0, -60.0, -9.0), (300.0, far, -9.0), (-300.0, far, -9.0)],
+        [(0, 1, 2, 3)],
+        [(0, 0), (60, 0), (60, 34), (0, 34)],
+        water,
+    )
+    tag(q, "terrain")
+    # the far bank: a quay wall, the bank, a row of flats along the quay facing the bridge
+    tag(box("quay", (-300.0, far, -9.5), (300.0, far + 2.0, low - 0.02), parapet, 4.0), "wall")
+    ground = mats.principled("bank_d", albedo="parapet_d", roughness=0.8)
+    for sx in (-1.0, 1.0):
+        xa, xb = sorted((sx * 5.3, sx * 300.0))
+        tag(
+            box(
+                f"bank_{sx:+.0f}", (xa, far + 2.0, -9.5), (xb, far + 90.0, low + 0.15), ground, 4.0
+            ),
+            "terrain",
+        )
+    flats = [
+        mats.principled("far_flats", albedo="far_flats", roughness=0.85),
+        mats.principled("far_flats_b", albedo="far_flats_b", roughness=0.85),
+    ]
+    rng = np.random.default_rng(83)
+    k = 0
+    for sx in (-1.0, 1.0):
+        x = 9.0
+        while x < 160.0:
+            wd = float(rng.uniform(14.0, 26.0))
+            ht = float(rng.uniform(12.0, 28.0))
+            xa, xb = sorted((sx * x, sx * (x + wd)))
+            y0 = far + float(rng.uniform(8.0, 14.0))
+            tag(
+                box(f"flats_{k}", (xa, y0, low), (xb, y0 + 12.0, low + ht), flats[k % 2], 14.0),
+                "building",
+            )
+            # a few lit windows on the face towards the river
+            for j in range(int(rng.integers(4, 9))):
+                wx = float(rng.uniform(xa + 1.0, xb - 2.2))
+                wz = low + 3.5 * int(rng.integers(0, int(ht / 3.5))) + 1.2
+                glow_box(
+                    mats,
+                    f"window_{k}_{j}",
+                    (wx, y0 - 0.06, wz),
+                    (wx + 1.2, y0 - 0.01, wz + 1.4),
+                    WINDOW_WARM,
+                    40.0,
+                    "building",
+                )
+            x, k = x + wd + float(rng.uniform(2.0, 6.0)), k + 1
+    # the street on the far bank: shop fronts and rendered houses, a terrace closing the view
+    shops = mats.principled("shopfronts_d", albedo="shopfronts_d", roughness=0.7)
+    render = mats.principled("render_d", albedo="render_d", roughness=0.9)
+    for sx in (-1.0, 1.0):
+        y = far + 28.0
+        while y < far + 86.0:
+            ln = float(rng.uniform(8.0, 13.0))
+            xa, xb = sorted((sx * 5.3, sx * 16.0))
+            ht = float(rng.uniform(7.0, 12.0))
+            mat = shops if k % 2 == 0 else render
+            tag(
+                box(
+                    f"house_{k}",
+                    (xa, y, low),
+                    (xb, y + ln, low + ht),
+                    mat,
+                    8.0 if k % 2 == 0 else 3.0,
+                ),
+                "building",
+            )
+            if k % 2 == 0:
+                glow_box(
+                    mats,
+                    f"shop_{k}",
+                    (sx * 5.33 - 0.02, y + 1.0, low + 0.5),
+                    (sx * 5.33 + 0.02, y + ln - 2.0, low + 2.6),
+                    WINDOW_WARM,
+                    120.0,
+                    "building",
+                )
+            y, k = y + ln, k + 1
+    tag(
+        box("terrace_end", (-25.0, far + 88.0, low), (25.0, far + 100.0, low + 11.0), render, 3.0),
+        "building",
+    )
+    # lamps on the parapets, both sides every 24 m; two on the far bank's street
+    metal = mats.principled("lamp_metal_d", (0.2, 0.21, 0.22), roughness=0.4, metallic=0.7)
+    for j, y in enumerate(np.arange(6.0, far, 24.0)):
+        for sx in (-1.0, 1.0):
+            post_lamp(
+                mats,
+                f"parapet_lamp{j}{'r' if sx > 0 else 'l'}",
+                (sx * 5.45, float(y), h(float(y)) + 0.6),
+                6.9,
+                [(-sx * 1.3, 0.0)],
+                MERCURY,
+                1900.0,
+                metal,
+            )
+    for j, (sx, y) in enumerate(((1.0, far + 40.0), (-1.0, far + 64.0))):
+        post_lamp(
+            mats,
+            f"bank_lamp{j}",
+            (sx * 4.8, y, low + 0.15),
+            7.0,
+            [(-sx * 1.4, 0.0)],
+            MERCURY,
+            1900.0,
+            metal,
+        )
+    # a bus ahead on the descent, two oncoming cars
+    red = mats.principled("paint_bus_d", (0.35, 0.03, 0.02), roughness=0.35, coat=1.0)
+    y = 34.0
+    pitch = math.atan(h(y + 0.5) - h(y - 0.5))
+    tw = bus(mats, "bus_ahead", (1.75, y, h(y)), pitch, red, 1)
+    for k, x in enumerate((-1.0, 1.0)):
+        car_light(mats, f"bus_tail{k}", tw, 0.0, (x, -5.5, 0.9), -1.0, RED, 800.0, 11.0, 40.0, 1)
+    silver = mats.principled(
+        "paint_silver_d", (0.45, 0.46, 0.48), roughness=0.25, metallic=0.8, coat=1.0
+    )
+    for k, (y, colour, cd) in enumerate(((66.0, HALOGEN, 14000.0), (98.0, XENON, 15000.0))):
+        up = -math.atan(h(y + 0.5) - h(y - 0.5))  # nose-up climbing towards the crest
+        tw = sloped_car(mats, f"oncoming{k}", (-1.75, y, h(y)), math.pi, up, silver, 2 + k)
+        headlights(
+            mats,
+            f"headlight{k}_",
+            tw,
+            math.pi,
+            2 + k,
+            colour=colour,
+            cd=cd,
+            pitch=1.2 - math.degrees(up),
+        )
+    eye = (1.75, 0.0, h(0.0) + 1.35)
+    camera("driver", eye, pitched(np.array([0.0, 1.0, 0.0]), 1.5), 36.0, 768, 384)
+
+
+def build_square(mats: Materials) -> None:
+    """A street opening into a wide level town square (60 x 42 m) and crossed in it by
+    another street carrying a double tram track; no roundabout, a plain junction. The
+    approach and the far street are wet asphalt (roughness 0.14, small puddles 0.03 on 20 %);
+    in the square the carriageways are paved with large granite-like slabs, wet (about 0.09,
+    water in the joints 0.03), flagged as road; the pedestrian plaza the same slabs, rougher,
+    8 cm up. Shop fronts all round (lit windows, warm), rendered upper storeys; LED 3500 K
+    luminaires (2.6-3 kcd) on 8-10 m masts, one to four heads each; a car ahead entering the
+    square with its tail lights, a car on the cross street with xenon headlights, a tram past
+    the junction with lit windows, an oncoming car in the far street; the camera 1.0 m up (a
+    low car) 6 m before the approach's buildings end."""
+    asphalt = mats.principled(
+        "wet_asphalt", albedo="asphalt_sq", roughness_map="puddles_sq", road=True
+    )
+    slabs = mats.principled("wet_slabs", albedo="slabs", roughness_map="slabs_wet", road=True)
+    plaza = mats.principled("plaza_slabs", albedo="slabs", roughness=0.32)
+    level = lambda s: 0.0  # noqa: E731
+    xs = [(x, 0.0) for x in np.linspace(-3.5, 3.5, 8)]
+    line = straight(level)
+    tag(ribbon("road", line, np.arange(-10.0, 24.01, 1.0), xs, asphalt, 2.0), "road")
+    tag(ribbon("road_far", line, np.arange(66.0, 150.01, 2.0), xs, asphalt, 2.0), "road")
+    tag(ribbon("road_square", line, np.arange(24.0, 66.01, 1.0), xs, slabs, 3.0), "road")
+    flat = lambda x, y: 0.0  # noqa: E731
+    for k, (xa, xb) in enumerate(((-30.0, -3.5), (3.5, 30.0))):
+        tag(
+            grid(
+                f"cross_square{k}",
+                np.arange(xa, xb + 0.01, (xb - xa) / 12),
+                [41.0, 48.0],
+                flat,
+                slabs,
+                3.0,
+            ),
+            "road",
+        )
+    for k, (xa, xb) in enumerate(((-90.0, -30.0), (30.0, 90.0))):
+        tag(
+            grid(f"cross_street{k}", np.linspace(xa, xb, 13), [41.0, 48.0], flat, asphalt, 2.0),
+            "road",
+        )
+    # the tram's double track along the cross street
+    steel = mats.principled("tram_rail", (0.3, 0.3, 0.32), roughness=0.2, metallic=0.9)
+    for k, y in enumerate((42.3, 43.7, 45.3, 46.7)):
+        tag(box(f"rail{k}", (-90.0, y - 0.035, 0.0), (90.0, y + 0.035, 0.006), steel), "rail_track")
+    # the plaza (8 cm up), pavements along the approach and the far street
+    for k, (xa, xb, ya, yb) in enumerate(
+        (
+            (-30.0, -3.5, 24.0, 41.0),
+            (3.5, 30.0, 24.0, 41.0),
+            (-30.0, -3.5, 48.0, 66.0),
+            (3.5, 30.0, 48.0, 66.0),
+        )
+    ):
+        tag(box(f"plaza{k}", (xa, ya, -0.2), (xb, yb, 0.08), plaza, 3.0), "sidewalk")
+    for sx in (-1.0, 1.0):
+        for k, (ya, yb) in enumerate(((-10.0, 24.0), (66.0, 150.0))):
+            xa, xb = sorted((sx * 3.5, sx * 6.0))
+            tag(
+                box(f"pavement_{sx:+.0f}_{k}", (xa, ya, -0.2), (xb, yb, 0.12), plaza, 3.0),
+                "sidewalk",
+            )
+        for k, (ya, yb) in enumerate(((34.0, 41.0), (48.0, 55.0))):
+            xa, xb = sorted((sx * 30.0, sx * 90.0))
+            tag(
+                box(f"cross_pavement_{sx:+.0f}_{k}", (xa, ya, -0.2), (xb, yb, 0.12), plaza, 3.0),
+                "sidewalk",
+            )
+    # buildings all round: shop fronts on the ground floor, rendered above
+    shops = mats.principled("shopfronts_d", albedo="shopfronts_d", roughness=0.7)
+    render = mats.principled("render_d", albedo="render_d", roughness=0.9)
+    blocks = [
+        (-16.0, -6.0, -10.0, 12.0, -1.0),  # approach, left (faces +X)
+        (6.0, 16.0, -10.0, 12.0, 1.0),
+        (-30.0, -6.0, 12.0, 24.0, 0.0),  # the square's near side (faces +Y)
+        (6.0, 30.0, 12.0, 24.0, 0.0),
+        (-42.0, -30.0, 24.0, 34.0, -1.0),  # west and east sides (face the square)
+        (-42.0, -30.0, 55.0, 66.0, -1.0),
+        (30.0, 42.0, 24.0, 34.0, 1.0),
+        (30.0, 42.0, 55.0, 66.0, 1.0),
+        (-30.0, -6.0, 66.0, 78.0, 2.0),  # the far side (faces -Y)
+        (6.0, 30.0, 66.0, 78.0, 2.0),
+        (-16.0, -6.0, 78.0, 150.0, -1.0),  # the far street
+        (6.0, 16.0, 78.0, 150.0, 1.0),
+        (-20.0, 20.0, 150.0, 160.0, 2.0),
+    ]
+    rng = np.random.default_rng(91)
+    for k, (xa, xb, ya, yb, face) in enumerate(blocks):
+        ground_h = 4.2
+        top = float(rng.uniform(10.0, 17.0))
+        tag(box(f"shops_{k}", (xa, ya, -0.3), (xb, yb, ground_h), shops, 8.5), "building")
+        tag(box(f"upper_{k}", (xa, ya, ground_h), (xb, yb, top), render, 3.0), "building")
+        # lit shop windows on the face towards the street or the square
+        if face == 0.0:
+            continue
+        if abs(face) == 1.0:  # facing +-X: the face at the inner x
+            x = xb if face < 0 else xa
+            step = 9.0
+            for j, y in enumerate(np.arange(ya + 1.5, yb - 4.0, step)):
+                if rng.uniform() < 0.35:
+                    continue
+                glow_box(
+                    mats,
+                    f"shopwin_{k}_{j}",
+                    (x - 0.03, float(y), 0.6),
+                    (x + 0.03, float(y) + 4.0, 2.9),
+                    WINDOW_WARM if j % 3 else COOL_WHITE,
+                    150.0,
+                    "building",
+                )
+        else:  # facing -Y: the face at ya
+            for j, x in enumerate(np.arange(xa + 1.5, xb - 4.0, 7.0)):
+                if rng.uniform() < 0.3:
+                    continue
+                glow_box(
+                    mats,
+                    f"shopwin_{k}_{j}",
+                    (float(x), ya - 0.03, 0.6),
+                    (float(x) + 4.0, ya + 0.03, 2.9),
+                    WINDOW_WARM if j % 2 else COOL_WHITE,
+                    150.0,
+                    "building",
+                )
+    # lamps on tall masts
+    metal = mats.principled("lamp_metal_sq", (0.1, 0.1, 0.11), roughness=0.5, metallic=0.6)
+    masts = [
+        ("approach_l", (-4.6, 6.0), 8.0, [(1.2, 0.0)], 2600.0),
+        ("approach_r", (4.6, 18.0), 8.0, [(-1.2, 0.0)], 2600.0),
+        ("corner_sw", (-5.2, 37.0), 9.0, [(1.2, 0.0), (0.0, 1.2)], 2800.0),
+        ("corner_ne", (5.2, 52.0), 9.0, [(-1.2, 0.0), (0.0, -1.2)], 2800.0),
+        (
+            "plaza_w",
+            (-17.0, 58.0),
+            10.0,
+            [(1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)],
+            3000.0,
+        ),
+        ("plaza_e", (17.0, 30.0), 10.0, [(1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)], 3000.0),
+        ("far_l", (-4.6, 92.0), 8.0, [(1.2, 0.0)], 2600.0),
+        ("far_r", (4.6, 116.0), 8.0, [(-1.2, 0.0)], 2600.0),
+    ]
+    for name, (x, y), ht, arms, cd in masts:
+        post_lamp(mats, f"mast_{name}", (x, y, 0.08), ht, arms, LED_3500, cd, metal)
+    # a car ahead entering the square, a car on the cross street, a tram, an oncoming car
+    blue = mats.principled("paint_blue_d", (0.03, 0.06, 0.2), roughness=0.3, coat=1.0)
+    tw = car(mats, "car_ahead", (1.75, 27.0, 0.0), 0.0, blue, 1)
+    tail_lights(mats, "taillight", tw, 0.0, 1, cd=10.0)
+    white = mats.principled("paint_white_d", (0.6, 0.6, 0.58), roughness=0.3, coat=1.0)
+    tw = car(mats, "cross_car", (-13.0, 42.75, 0.0), -math.pi / 2, white, 2)
+    headlights(mats, "cross_headlight", tw, -math.pi / 2, 2, colour=XENON, cd=14000.0)
+    green = mats.principled("paint_tram_d", (0.05, 0.18, 0.08), roughness=0.35, coat=1.0)
+    box("tram_body", (8.0, 45.2, 0.35), (38.0, 47.8, 3.4), green, cls="train", inst=3)
+    glow_box(mats, "tram_windows", (9.0, 45.15, 1.3), (37.0, 45.19, 2.6), COOL_WHITE, 90.0, "train")
+    grey = mats.principled("paint_grey_d", (0.2, 0.2, 0.21), roughness=0.3, metallic=0.5, coat=1.0)
+    tw = car(mats, "oncoming_car", (-1.75, 96.0, 0.0), math.pi, grey, 4)
+    headlights(mats, "headlight", tw, math.pi, 4, colour=HALOGEN, cd=14000.0)
+    eye = (1.75, 6.0, 1.0)
+    camera("driver", eye, pitched(np.array([0.0, 1.0, 0.0]), 1.0), 40.0, 600, 400)
+
+
 SCENES = {
     "hill_bend": build_hill_bend,
     "crossing": build_crossing,
@@ -1701,16 +2158,29 @@ SCENES = {
     "underpass": build_underpass,
     "hillside": build_hillside,
     "daylight_street": build_daylight_street,
+    # the fourth set (made after the first three had been looked at)
+    "bridge": build_bridge,
+    "square": build_square,
 }
 #: The scene sets: `--set a` (the default) builds the first, `--set b` the second, `--set c`
-#: the third.
+#: the third, `--set d` the fourth.
 SETS = {
     "a": ("hill_bend", "crossing", "tabletop"),
     "b": ("roundabout", "avenue", "shelf"),
     "c": ("underpass", "hillside", "daylight_street"),
+    "d": ("bridge", "square"),
 }
 #: The scenes with a wet road (the others have none).
-STREETS = ("hill_bend", "crossing", "roundabout", "avenue", "underpass", "hillside")
+STREETS = (
+    "hill_bend",
+    "crossing",
+    "roundabout",
+    "avenue",
+    "underpass",
+    "hillside",
+    "bridge",
+    "square",
+)
 #: The streets with a dry road (no streaks; their road material is `dry_asphalt`).
 DRY_STREETS = ("daylight_street",)
 
