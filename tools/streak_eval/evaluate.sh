@@ -12,7 +12,8 @@
 # then prints one table (summary.py). With SET=b it scores the second set instead (heldback_b/
 # and pairs_b/: roundabout, avenue, shelf), made after the first set had been looked at; with
 # SET=c the third set (heldback_c/, other_config_c/ and pairs_c/: underpass, hillside,
-# daylight_street), made after the first two had been looked at.
+# daylight_street), made after the first two had been looked at; with SET=d the fourth
+# (heldback_d/, other_config_d/ and pairs_d/: bridge, square), made after the first three.
 #
 # STREAKS: the binary (default target/release/streaks); OPENCV_PYTHON: a Python with
 # opencv-python-headless (tools/opencv/requirements.txt) to add OpenCV's StereoSGBM.
@@ -38,6 +39,9 @@ if [[ "${SET:-a}" == b ]]; then
 elif [[ "${SET:-a}" == c ]]; then
     benches=(heldback_c other_config_c pairs_c)
     repairs=(heldback_c other_config_c pairs_c/underpass pairs_c/hillside pairs_c/daylight_street)
+elif [[ "${SET:-a}" == d ]]; then
+    benches=(heldback_d other_config_d pairs_d)
+    repairs=(heldback_d other_config_d pairs_d/bridge pairs_d/square)
 else
     benches=(heldback other_config dry_config pairs)
     repairs=(heldback other_config dry_config pairs/hill_bend pairs/crossing)

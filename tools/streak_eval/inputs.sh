@@ -26,6 +26,14 @@
 #   OUT/heldback_c/                               24 default-config samples (seed 46900), a
 #                                                 third held-back split
 #
+# SET=d makes the fourth set (made after the first three had been looked at):
+#
+#   OUT/scenes_d/{bridge,square}.glb              built in Blender, exported by its exporter
+#   OUT/pairs_d/{bridge,square}/                  `streaks stereo` pairs of them
+#   OUT/other_config_d/                           3 samples of other_config_d.toml (seed 80)
+#   OUT/heldback_d/                               24 default-config samples (seed 47900), a
+#                                                 fourth held-back split
+#
 # BLENDER_PYTHON: the Python with bpy 5.0 (default target/blender-venv/bin/python);
 # STREAKS: the streaks binary (default target/release/streaks). Run from the repository root.
 # Evaluation-only inputs: no parameter may be tuned on them.
@@ -90,8 +98,32 @@ elif [[ "$set_name" == "c" ]]; then
 
     echo "$(stamp) done: $out (third set)"
     exit 0
+elif [[ "$set_name" == "d" ]]; then
+    mkdir -p -- "$out/scenes_d" "$out/pairs_d"
+    echo "$(stamp) building the fourth set's Blender scenes"
+    "$blender_python" "$here/blender_streets.py" "$out/scenes_d" --set d
+
+    echo "$(stamp) bridge: 768x384, 64 spp, baseline 0.35 m, +4 EV"
+    "$streaks" stereo "$out/scenes_d/bridge.glb" -o "$out/pairs_d/bridge" \
+        --width 768 --height 384 --spp 64 --baseline 0.35 --exposure 4 --seed 4
+
+    echo "$(stamp) square: 600x400, 64 spp, baseline 0.18 m, +3.5 EV"
+    "$streaks" stereo "$out/scenes_d/square.glb" -o "$out/pairs_d/square" \
+        --width 600 --height 400 --spp 64 --baseline 0.18 --exposure 3.5 --seed 4
+
+    echo "$(stamp) other_config_d: 3 samples, 640x352, 24 spp"
+    "$streaks" dataset generate -o "$out/other_config_d" --config "$here/other_config_d.toml" \
+        --count 3 --seed 80 --width 640 --height 352 --spp 24 --denoise off \
+        --outputs images,gt,masks
+
+    echo "$(stamp) heldback_d: 24 samples of the default config, seed 47900, 512x288, 16 spp"
+    "$streaks" dataset generate -o "$out/heldback_d" --seed 47900 --count 24 \
+        --width 512 --height 288 --spp 16 --denoise off --outputs images,gt,masks
+
+    echo "$(stamp) done: $out (fourth set)"
+    exit 0
 elif [[ "$set_name" != "a" ]]; then
-    echo "SET must be a, b or c, not $set_name" >&2
+    echo "SET must be a, b, c or d, not $set_name" >&2
     exit 2
 fi
 

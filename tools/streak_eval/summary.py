@@ -1,7 +1,8 @@
 """Prints the figures of `evaluate.sh` as Markdown tables: per input and method the phantom
 holes, off-road and overall bad-2, density, bad-or-missing share and bad-2 after KITTI's fill
-of the missing values (from `streaks benchmark`'s report.json), the held-back split by condition, and the repair's own figures with its streak
-mask's scores (from `streaks train-repair --evaluate`).
+of the missing values (from `streaks benchmark`'s report.json), the held-back split by
+condition, and the repair's own figures with its streak mask's scores (from `streaks
+train-repair --evaluate`).
 
     python3 tools/streak_eval/summary.py OUT
 """
@@ -13,7 +14,16 @@ import sys
 from pathlib import Path
 from typing import Any
 
-INPUTS = ["heldback", "other_config", "dry_config", "heldback_b", "heldback_c", "other_config_c"]
+INPUTS = [
+    "heldback",
+    "other_config",
+    "dry_config",
+    "heldback_b",
+    "heldback_c",
+    "other_config_c",
+    "heldback_d",
+    "other_config_d",
+]
 PAIRS = [
     "hill_bend",
     "crossing",
@@ -24,6 +34,8 @@ PAIRS = [
     "underpass",
     "hillside",
     "daylight_street",
+    "bridge",
+    "square",
 ]
 
 
@@ -104,7 +116,7 @@ def tables(out: Path) -> str:
             for s in c["summary"]:
                 label = f"{name}: {c['condition']} ({c['samples']})"
                 conditions.append(row(label, s["method"], s["errors"]))
-    for pairs in ("pairs", "pairs_b", "pairs_c"):
+    for pairs in ("pairs", "pairs_b", "pairs_c", "pairs_d"):
         path = out / f"bench-{pairs}" / "report.json"
         if not path.is_file():
             continue
