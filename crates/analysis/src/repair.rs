@@ -19,7 +19,8 @@
 //!
 //! - a reflection's disparity is that of its virtual image, far below the surface: it is
 //!   *lower* than the disparities beside it on its row (upper quantiles of a row window, at
-//!   three widths) and, being the image of a vertical column of light, nearly *constant down
+//!   three widths; of its column and of a square, where a wide reflection fills the row's
+//!   window) and, being the image of a vertical column of light, nearly *constant down
 //!   its column*, where a road's disparity grows toward the camera;
 //! - a specular streak breaks photo-consistency between the eyes in a way a Lambertian
 //!   surface does not: warped by the surface's disparity (the row's upper quartile) the right
@@ -100,7 +101,7 @@ pub const CALIBRATION_BINS: usize = 10;
 
 /// The names of the features, in order (see the module documentation and
 /// [`StereoFeatures::new`]).
-pub const FEATURES: [&str; 27] = [
+pub const FEATURES: [&str; 30] = [
     "valid",
     "d_minus_q75_r8",
     "d_minus_q75_r32",
@@ -128,6 +129,9 @@ pub const FEATURES: [&str; 27] = [
     "contrast_31_run_45_rows",
     "vertical_minus_horizontal_mean_45",
     "vertical_contrast_91",
+    "d_minus_q75_column_r48",
+    "d_minus_q90_square_r32",
+    "d_change_32_rows_down",
 ];
 
 /// What went wrong.
@@ -385,6 +389,33 @@ impl StereoFeatures {
                 .iter()
                 .zip(&column_median.data)
                 .map(|(a, b)| a - b)
+                .collect(),
+        );
+        // Wider context for a reflection that fills its row window (a lit facade or an
+        // underpass mouth mirrored over a wide stretch of far road): the disparities down the
+        // pixel's column, where the road below comes nearer; the upper quantile of a square
+        // (rows, then columns); the change over a third of a window down the column.
+        let column = finite_quantile(&d, Axis::Columns, 48, 0.75);
+        planes.push(
+            (0..n)
+                .map(|i| or_missing(d.data[i] - column.data[i]))
+                .collect(),
+        );
+        let square = finite_quantile(&q90[1], Axis::Columns, 32, 0.9);
+        planes.push(
+            (0..n)
+                .map(|i| or_missing(d.data[i] - square.data[i]))
+                .collect(),
+        );
+        planes.push(
+            (0..n)
+                .map(|i| {
+                    if i + 32 * w < n {
+                        or_missing(d.data[i + 32 * w] - d.data[i])
+                    } else {
+                        MISSING
+                    }
+                })
                 .collect(),
         );
         debug_assert_eq!(planes.len(), FEATURES.len());
