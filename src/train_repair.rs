@@ -9,9 +9,10 @@
 //! 2. **Trees**: gradient boosting of each label ([`streaks_analysis::gbdt`]).
 //! 3. **Operating point and calibration**, over every pixel of the validation split (samples
 //!    the trees never saw, of other streets): the streak mask's smoothing, threshold and
-//!    lower (hysteresis) threshold for `--precision`, then the whole repair, whose right shares per `wrong` decile and per
-//!    repair window are the confidence map's calibration. The validation figures (phantom
-//!    holes, off-road bad-2, densities, the streak mask's score) are printed and recorded.
+//!    lower (hysteresis) threshold for `--precision`, then the whole repair, whose right
+//!    shares per `wrong` decile and per repair window are the confidence map's calibration.
+//!    The validation figures (phantom holes, off-road bad-2, densities, the streak mask's
+//!    score) are printed and recorded.
 //!
 //! Everything is deterministic: the same datasets and settings give the same file, whatever
 //! the number of threads.

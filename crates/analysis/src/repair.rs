@@ -235,8 +235,23 @@ impl StereoFeatures {
             .iter()
             .map(|&r| finite_quantile(&d, Axis::Rows, r, 0.9))
             .collect();
+        // The disparity against a window's quantile, and its change k rows down the column.
+        let minus = |q: &GrayImage| -> Vec<f32> {
+            (0..n).map(|i| or_missing(d.data[i] - q.data[i])).collect()
+        };
+        let change_down = |k: usize| -> Vec<f32> {
+            (0..n)
+                .map(|i| {
+                    if i + k * w < n {
+                        or_missing(d.data[i + k * w] - d.data[i])
+                    } else {
+                        MISSING
+                    }
+                })
+                .collect()
+        };
         for q in q75.iter().chain(&q90) {
-            planes.push((0..n).map(|i| or_missing(d.data[i] - q.data[i])).collect());
+            planes.push(minus(q));
         }
         let surface = &q75[1];
         planes.push(
@@ -244,18 +259,8 @@ impl StereoFeatures {
                 .map(|i| or_missing((d.data[i] - surface.data[i]) / surface.data[i].max(0.5)))
                 .collect(),
         );
-        for k in [4usize, 12] {
-            planes.push(
-                (0..n)
-                    .map(|i| {
-                        if i + k * w < n {
-                            or_missing(d.data[i + k * w] - d.data[i])
-                        } else {
-                            MISSING
-                        }
-                    })
-                    .collect(),
-            );
+        for k in [4, 12] {
+            planes.push(change_down(k));
         }
         let (m1, share) = finite_box_mean(&d.data, w, h, 2);
         let sq: Vec<f32> = d.data.iter().map(|v| v * v).collect();
@@ -395,29 +400,9 @@ impl StereoFeatures {
         // underpass mouth mirrored over a wide stretch of far road): the disparities down the
         // pixel's column, where the road below comes nearer; the upper quantile of a square
         // (rows, then columns); the change over a third of a window down the column.
-        let column = finite_quantile(&d, Axis::Columns, 48, 0.75);
-        planes.push(
-            (0..n)
-                .map(|i| or_missing(d.data[i] - column.data[i]))
-                .collect(),
-        );
-        let square = finite_quantile(&q90[1], Axis::Columns, 32, 0.9);
-        planes.push(
-            (0..n)
-                .map(|i| or_missing(d.data[i] - square.data[i]))
-                .collect(),
-        );
-        planes.push(
-            (0..n)
-                .map(|i| {
-                    if i + 32 * w < n {
-                        or_missing(d.data[i + 32 * w] - d.data[i])
-                    } else {
-                        MISSING
-                    }
-                })
-                .collect(),
-        );
+        planes.push(minus(&finite_quantile(&d, Axis::Columns, 48, 0.75)));
+        planes.push(minus(&finite_quantile(&q90[1], Axis::Columns, 32, 0.9)));
+        planes.push(change_down(32));
         debug_assert_eq!(planes.len(), FEATURES.len());
         Ok(Self {
             width: w,
