@@ -22,11 +22,11 @@ use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use streaks_analysis::gbdt::{Dataset, TrainParams};
 use streaks_analysis::repair::{
-    is_right, robust_from_features, streak_mask, streak_objects, RepairCounts, RepairModel,
-    StereoFeatures, StreakHandling, FEATURES,
+    is_right, robust_from_features, streak_objects, RepairCounts, RepairModel, StereoFeatures,
+    StreakHandling, FEATURES,
 };
 use streaks_analysis::sgm::{sgm, SgmParams};
-use streaks_analysis::streak_classifier::{smooth_probability, SMOOTHING_RADII};
+use streaks_analysis::streak_classifier::{smooth_probability, streak_mask, SMOOTHING_RADII};
 use streaks_dataset::files::{load_mask, SampleDir, SAMPLE_NAMES};
 use streaks_dataset::layout::Layout;
 use streaks_image::pfm::read_pfm;

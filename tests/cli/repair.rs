@@ -67,7 +67,7 @@ fn a_model_trained_on_a_dataset_is_used_and_scored() {
     let p = streaks_image::pfm::read_pfm(&t.join("p.pfm")).unwrap();
     let mask = streaks_image::GrayImage::load(&t.join("d_streaks.png")).unwrap();
     assert!(p.data.iter().all(|v| (0.0..=1.0).contains(v)));
-    let want = streaks_analysis::repair::streak_mask(&p, streak_threshold, grow);
+    let want = streaks_analysis::streak_classifier::streak_mask(&p, streak_threshold, grow);
     assert_eq!(
         mask.data.iter().map(|&m| m > 0.0).collect::<Vec<_>>(),
         want.data.iter().map(|&m| m > 0.0).collect::<Vec<_>>()

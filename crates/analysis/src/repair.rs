@@ -65,7 +65,7 @@ use crate::detect::MaskScore;
 use crate::filter::{finite_quantile, max, max_above, mean, median, Axis};
 use crate::gbdt::{GbdtError, Model};
 use crate::sgm::{sgm, SgmError, SgmParams};
-use crate::streak_classifier::smooth_probability;
+use crate::streak_classifier::{smooth_probability, streak_mask};
 use serde::{Deserialize, Serialize};
 use streaks_image::stats::quantile;
 use streaks_image::{ensure_same_size, GrayImage, ImageError, SizeMismatch};
@@ -775,32 +775,6 @@ pub fn robust_from_features(
     }
 }
 
-/// The streak mask (1 on streaks, 0 elsewhere) of a smoothed streak probability `p`: the
-/// pixels where it reaches `threshold`, and with a `grow` threshold (hysteresis) the whole
-/// 8-connected regions where it reaches `grow` that hold such a pixel.
-pub fn streak_mask(p: &GrayImage, threshold: f32, grow: Option<f32>) -> GrayImage {
-    use crate::benchmark::breakdown::components8;
-    let mut mask = p.clone();
-    match grow {
-        None => {
-            for v in &mut mask.data {
-                *v = f32::from(u8::from(*v >= threshold));
-            }
-        }
-        Some(g) => {
-            mask.data.fill(0.0);
-            for c in components8(p.width, p.height, |i| p.data[i] >= g.min(threshold)) {
-                if c.iter().any(|&i| p.data[i] >= threshold) {
-                    for i in c {
-                        mask.data[i] = 1.0;
-                    }
-                }
-            }
-        }
-    }
-    mask
-}
-
 /// The shortest streak (rows spanned, as a share of the image height) that the streak-level
 /// score counts, in the truth and in the mask: shorter specks are not streaks.
 pub const MIN_STREAK_EXTENT: f32 = 0.03;
@@ -1230,32 +1204,6 @@ mod tests {
         assert!(before > 0.02 && after == 0.0, "{before} {after}");
         assert_eq!(c.streak_level(), (1.0, 1.0));
         assert!(c.repaired.iter().all(|&(right, all)| right == all));
-    }
-
-    #[test]
-    fn the_streak_mask_grows_from_cores_into_their_faint_tails_only() {
-        // Column 1: a core (0.8) with a faint tail (0.3) below it; column 4: a faint speck
-        // (0.3) alone.
-        let mut p = GrayImage::new(6, 6, 0.0).unwrap();
-        for y in 0..2 {
-            p.set(1, y, 0.8);
-        }
-        for y in 2..6 {
-            p.set(1, y, 0.3);
-        }
-        p.set(4, 3, 0.3);
-        p.set(4, 4, 0.3);
-        let on = |m: &GrayImage| -> Vec<(usize, usize)> {
-            (0..36)
-                .filter(|&i| m.data[i] > 0.0)
-                .map(|i| (i % 6, i / 6))
-                .collect()
-        };
-        assert_eq!(on(&streak_mask(&p, 0.5, None)), vec![(1, 0), (1, 1)]);
-        let grown = on(&streak_mask(&p, 0.5, Some(0.2)));
-        assert_eq!(grown, (0..6).map(|y| (1, y)).collect::<Vec<_>>());
-        // A lower threshold above the tail grows nothing.
-        assert_eq!(on(&streak_mask(&p, 0.5, Some(0.4))), vec![(1, 0), (1, 1)]);
     }
 
     #[test]

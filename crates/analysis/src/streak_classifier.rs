@@ -291,11 +291,7 @@ impl StreakClassifier {
 
     /// The streak mask (1 where `p >= threshold`, 0 elsewhere) of a smoothed probability.
     pub fn mask_of(&self, p: &GrayImage) -> GrayImage {
-        let mut mask = p.clone();
-        for v in &mut mask.data {
-            *v = (*v >= self.threshold) as u8 as f32;
-        }
-        mask
+        streak_mask(p, self.threshold, None)
     }
 
     /// The streak mask (1 on streak pixels, 0 elsewhere) of the linear luminance `lum`.
@@ -311,6 +307,32 @@ pub fn smooth_probability(p: &GrayImage, r: usize) -> GrayImage {
         return p.clone();
     }
     mean(&mean(p, Axis::Rows, r), Axis::Columns, r)
+}
+
+/// The streak mask (1 on streaks, 0 elsewhere) of a smoothed streak probability `p`: the
+/// pixels where it reaches `threshold`, and with a `grow` threshold (hysteresis) the whole
+/// 8-connected regions where it reaches `grow` that hold such a pixel.
+pub fn streak_mask(p: &GrayImage, threshold: f32, grow: Option<f32>) -> GrayImage {
+    use crate::benchmark::breakdown::components8;
+    let mut mask = p.clone();
+    match grow {
+        None => {
+            for v in &mut mask.data {
+                *v = f32::from(u8::from(*v >= threshold));
+            }
+        }
+        Some(g) => {
+            mask.data.fill(0.0);
+            for c in components8(p.width, p.height, |i| p.data[i] >= g.min(threshold)) {
+                if c.iter().any(|&i| p.data[i] >= threshold) {
+                    for i in c {
+                        mask.data[i] = 1.0;
+                    }
+                }
+            }
+        }
+    }
+    mask
 }
 
 /// Training rows from one image: the features of every `stride`-th pixel (row-major order,
@@ -569,5 +591,30 @@ mod tests {
             StreakClassifier::from_json("{"),
             Err(ClassifierError::Format(_))
         ));
+    }
+    #[test]
+    fn the_streak_mask_grows_from_cores_into_their_faint_tails_only() {
+        // Column 1: a core (0.8) with a faint tail (0.3) below it; column 4: a faint speck
+        // (0.3) alone.
+        let mut p = GrayImage::new(6, 6, 0.0).unwrap();
+        for y in 0..2 {
+            p.set(1, y, 0.8);
+        }
+        for y in 2..6 {
+            p.set(1, y, 0.3);
+        }
+        p.set(4, 3, 0.3);
+        p.set(4, 4, 0.3);
+        let on = |m: &GrayImage| -> Vec<(usize, usize)> {
+            (0..36)
+                .filter(|&i| m.data[i] > 0.0)
+                .map(|i| (i % 6, i / 6))
+                .collect()
+        };
+        assert_eq!(on(&streak_mask(&p, 0.5, None)), vec![(1, 0), (1, 1)]);
+        let grown = on(&streak_mask(&p, 0.5, Some(0.2)));
+        assert_eq!(grown, (0..6).map(|y| (1, y)).collect::<Vec<_>>());
+        // A lower threshold above the tail grows nothing.
+        assert_eq!(on(&streak_mask(&p, 0.5, Some(0.4))), vec![(1, 0), (1, 1)]);
     }
 }
