@@ -53,6 +53,7 @@ from levels import (  # noqa: E402
     luminance,
     radiance_for_luminance,
     ramp_grade,
+    smoothstep,
     watts_for_candela,
     watts_for_lux,
 )
@@ -2146,6 +2147,379 @@ def build_square(mats: Materials) -> None:
     camera("driver", eye, pitched(np.array([0.0, 1.0, 0.0]), 1.0), 40.0, 600, 400)
 
 
+# --- the fifth set (made after the first four had been looked at) ----------------------------
+
+#: Fifth set's lamp colours, linear sRGB of their blackbodies (peak 1): high-pressure sodium
+#: at about 2000 K (warmer than the first sets' near-sRGB-encoded HPS), a cold LED at 6000 K
+#: (quay walls, headlights) and a neutral LED at 4500 K (the arterial's median columns).
+SODIUM_2000 = (1.0, 0.27, 0.02)
+LED_6000 = (1.0, 0.90, 0.86)
+LED_4500 = (1.0, 0.71, 0.49)
+SIGN_GREEN = (0.05, 0.45, 0.2)
+
+
+def van(mats, name, centre: Vec3, heading: float, paint, instance: int):
+    """A box van (5.6 x 2.0 x 2.5 m) heading along its local +Y: a tall load box, a cab with a
+    dark windscreen, a skirt of wheels; returns the local-to-world map."""
+    body = box(f"{name}_body", (-1.0, -2.8, 0.35), (1.0, 1.6, 2.5), paint, cls="car", inst=instance)
+    cab = box(f"{name}_cab", (-1.0, 1.6, 0.35), (1.0, 2.8, 1.3), paint, cls="car", inst=instance)
+    glass = mats.principled("van_glass_e", (0.02, 0.02, 0.025), roughness=0.05, coat=1.0)
+    screen = box(
+        f"{name}_screen", (-0.95, 1.6, 1.3), (0.95, 2.3, 2.0), glass, cls="car", inst=instance
+    )
+    tyre = mats.principled("tyre", (0.02, 0.02, 0.02), roughness=0.9)
+    skirt = box(
+        f"{name}_wheels", (-0.95, -2.5, 0.0), (0.95, 2.5, 0.35), tyre, cls="car", inst=instance
+    )
+    for part in (body, cab, screen, skirt):
+        place(part, centre, heading)
+
+    def to_world(p: Vec3) -> Vec3:
+        c, s = math.cos(heading), math.sin(heading)
+        return (centre[0] + c * p[0] - s * p[1], centre[1] + s * p[0] + c * p[1], centre[2] + p[2])
+
+    return to_world
+
+
+def build_quay(mats: Materials) -> None:
+    """A harbour-side street: a straight two-way street (6.5 m) of wet basalt cobbles (stones
+    about 0.3, water in the joints 0.07, puddles of 0.03 on a fifth where the paving has sunk;
+    flagged as road, material `wet_cobbles`) falling 2.5 % across towards the harbour on its
+    left; on the left a 4.7 m quay promenade of flags ending at a low granite quay wall (0.75
+    m) over the dark water of the basin 2.6 m below, which ends 130 m ahead at a far quay with
+    a row of warehouses whose lit windows face the street; on the right a 2.2 m pavement and
+    brick warehouses 9-15 m high with a few lit windows and a lit pub window. Lamps at varying
+    heights: high-pressure sodium (2000 K, 2 kcd) on 9 m posts on the promenade reaching over
+    the road, cold LED lanterns (6000 K, 600 cd) on 3.6 m posts on the quay wall, cold LED
+    wall lamps (6000 K, 1.1-1.4 kcd) on the warehouses at 4.2-5.5 m. A white van parked at
+    the right kerb, a car ahead with its tail lights, an oncoming car with cold LED
+    headlights (13 kcd); the camera 1.25 m above the road in the right lane."""
+    cobbles = mats.principled(
+        "wet_cobbles", albedo="cobbles_e", roughness_map="cobbles_wet_e", road=True
+    )
+    fall = 0.025  # across, falling to the left (the harbour side)
+    line = straight(lambda s: 0.0)
+    xs = [(float(x), fall * float(x)) for x in np.linspace(-3.25, 3.25, 8)]
+    tag(ribbon("road", line, np.arange(-10.0, 210.01, 1.0), xs, cobbles, 2.0), "road")
+    left_edge, right_edge = -3.25 * fall, 3.25 * fall
+    # the promenade and the quay wall over the basin, as far as the basin's head (130 m)
+    head = 130.0
+    flags = mats.principled("quay_flags_e", albedo="flags_e", roughness=0.35)
+    stone = mats.principled("quay_stone_e", albedo="quay_stone_e", roughness=0.7)
+    top = left_edge + 0.13
+    tag(box("kerb_left", (-3.4, -10.0, -0.5), (-3.25, 210.0, top), stone, 1.0), "sidewalk")
+    tag(box("promenade", (-7.95, -10.0, -0.5), (-3.4, head, top), flags, 2.0), "sidewalk")
+    tag(box("quay_face", (-8.25, -10.0, -3.5), (-7.95, head, top), stone, 2.0), "wall")
+    tag(box("quay_wall", (-8.25, -10.0, top), (-7.95, head, top + 0.75), stone, 2.0), "wall")
+    water = mats.principled("harbour_water_e", (0.008, 0.01, 0.012), roughness=0.03)
+    q = mesh_object(
+        "basin",
+        [(-300.0, -60.0, -2.6), (-8.25, -60.0, -2.6), (-8.25, head, -2.6), (-300.0, head, -2.6)],
+        [(0, 1, 2, 3)],
+        [(0, 0), (73, 0), (73, 47), (0, 47)],
+        water,
+    )
+    tag(q, "terrain")
+    # the basin's head: a quay across, and the left side of the street beyond it
+    tag(box("head_quay", (-300.0, head, -3.5), (-3.4, head + 40.0, top), flags, 2.0), "sidewalk")
+    tag(box("head_face", (-300.0, head - 0.3, -3.5), (-8.25, head, top), stone, 2.0), "wall")
+    tag(box("head_wall", (-300.0, head - 0.3, top), (-8.25, head, top + 0.75), stone, 2.0), "wall")
+    ware = mats.principled("warehouse_e", albedo="warehouse_e", roughness=0.85)
+    far = mats.principled("far_quay_e", albedo="far_quay_e", roughness=0.85)
+    rng = np.random.default_rng(113)
+    x, k = -9.0, 0
+    while x > -220.0:
+        wd = float(rng.uniform(16.0, 30.0))
+        ht = float(rng.uniform(8.0, 16.0))
+        y0 = head + float(rng.uniform(6.0, 10.0))
+        tag(
+            box(f"far_shed_{k}", (x - wd, y0, top), (x, y0 + 20.0, top + ht), far, 12.0), "building"
+        )
+        for j in range(int(rng.integers(3, 8))):
+            wx = float(rng.uniform(x - wd + 1.0, x - 2.5))
+            wz = top + 3.2 * int(rng.integers(0, max(1, int(ht / 3.2)))) + 1.0
+            glow_box(
+                mats,
+                f"far_window_{k}_{j}",
+                (wx, y0 - 0.06, wz),
+                (wx + 1.4, y0 - 0.01, wz + 1.5),
+                WINDOW_WARM if j % 3 else COOL_WHITE,
+                35.0,
+                "building",
+            )
+        x, k = x - wd - float(rng.uniform(3.0, 12.0)), k + 1
+    # the right side: a pavement and brick warehouses with gaps between them
+    ptop = right_edge + 0.14
+    tag(box("kerb_right", (3.25, -10.0, -0.5), (3.4, 210.0, ptop), stone, 1.0), "sidewalk")
+    tag(box("pavement_right", (3.4, -10.0, -0.5), (5.45, 210.0, ptop), flags, 2.0), "sidewalk")
+    y = -10.0
+    while y < 200.0:
+        ln = float(rng.uniform(14.0, 28.0))
+        ht = float(rng.uniform(9.0, 15.0))
+        tag(box(f"warehouse_{k}", (5.45, y, -0.3), (20.0, y + ln, ht), ware, 6.0), "building")
+        for j in range(int(rng.integers(1, 4))):
+            wy = float(rng.uniform(y + 1.0, y + ln - 2.0))
+            wz = 3.4 * int(rng.integers(1, max(2, int(ht / 3.4)))) + 0.9
+            glow_box(
+                mats,
+                f"window_{k}_{j}",
+                (5.41, wy, wz),
+                (5.44, wy + 1.1, wz + 1.4),
+                WINDOW_WARM,
+                25.0,
+                "building",
+            )
+        y, k = y + ln + float(rng.uniform(0.0, 6.0)), k + 1
+    # the left side beyond the basin's head: sheds set back 3 m behind the pavement
+    tag(
+        box("shed_left", (-40.0, head + 3.0, top), (-6.4, 200.0, top + 10.0), ware, 6.0), "building"
+    )
+    tag(box("street_end", (-40.0, 205.0, -0.3), (40.0, 215.0, 14.0), ware, 6.0), "building")
+    glow_box(
+        mats, "pub_window", (5.41, 62.0, 0.6), (5.44, 66.5, 2.6), WINDOW_WARM, 140.0, "building"
+    )
+    # lamps at varying heights
+    metal = mats.principled("lamp_metal_e", (0.07, 0.08, 0.08), roughness=0.45, metallic=0.7)
+    for j, y in enumerate((8.0, 40.0, 72.0, 104.0, 136.0, 168.0)):
+        post_lamp(
+            mats, f"quay_post{j}", (-3.9, y, top), 9.0, [(1.6, 0.0)], SODIUM_2000, 2000.0, metal
+        )
+    for j, y in enumerate((24.0, 56.0, 88.0, 120.0)):
+        post_lamp(
+            mats, f"lantern{j}", (-7.75, y, top + 0.75), 2.85, [(0.45, 0.0)], LED_6000, 600.0, metal
+        )
+    for j, (y, z, cd) in enumerate(((18.0, 5.5, 1400.0), (60.0, 4.2, 1100.0), (92.0, 5.5, 1400.0))):
+        wall_lamp(mats, f"wall_lamp{j}", (5.45, y, z), -1.0, LED_6000, cd)
+    # a van parked at the right kerb, a car ahead, an oncoming car
+    white = mats.principled("paint_van_e", (0.55, 0.56, 0.55), roughness=0.35, coat=0.5)
+    van(mats, "parked_van", (2.25, 28.0, right_edge - 0.02), 0.0, white, 1)
+    dark_red = mats.principled("paint_red_e", (0.2, 0.02, 0.02), roughness=0.3, coat=1.0)
+    tw = car(mats, "car_ahead", (1.45, 48.0, 0.03), 0.0, dark_red, 2)
+    tail_lights(mats, "taillight", tw, 0.0, 2, cd=12.0)
+    black = mats.principled("paint_black_e", (0.02, 0.02, 0.022), roughness=0.25, coat=1.0)
+    tw = car(mats, "oncoming_car", (-1.6, 82.0, -0.04), math.pi, black, 3)
+    headlights(mats, "headlight", tw, math.pi, 3, colour=LED_6000, cd=13000.0, pitch=1.0)
+    eye = (1.3, 0.0, fall * 1.3 + 1.25)
+    camera("driver", eye, pitched(np.array([0.0, 1.0, 0.0]), 1.2), 38.0, 656, 368)
+
+
+def banked(name, line: CentreLine, bank, ss, profile, mat, tile: float):
+    """`ribbon` on a banked road: at each s the cross-section `profile` (x to the right,
+    height) is lifted by `bank(s) * x` (superelevation: a rise of bank(s) per metre to the
+    right); UVs (across, along) in metres / `tile`."""
+    across = [0.0]
+    for (x0, h0), (x1, h1) in zip(profile, profile[1:], strict=False):
+        across.append(across[-1] + math.hypot(x1 - x0, h1 - h0))
+    verts, uv_of = [], []
+    for s in ss:
+        c, r, e = line.point(s), line.right(s), bank(s)
+        for (x, h), a in zip(profile, across, strict=True):
+            verts.append(c + x * r + np.array([0.0, 0.0, h + e * x]))
+            uv_of.append((a / tile, s / tile))
+    m = len(profile)
+    faces, uvs = [], []
+    for j in range(len(ss) - 1):
+        for i in range(m - 1):
+            f = (j * m + i, j * m + i + 1, (j + 1) * m + i + 1, (j + 1) * m + i)
+            faces.append(f)
+            uvs.extend(uv_of[k] for k in f)
+    return mesh_object(name, verts, faces, uvs, mat)
+
+
+def build_arterial(mats: Materials) -> None:
+    """A wide divided arterial road: two 7.3 m carriageways (two 3.65 m lanes each, a 1 m
+    hard shoulder) either side of a 2.4 m median with a 0.9 m concrete barrier; it falls
+    downhill (grade from -1.5 % at the camera to -4 % from 50 m on) and bends left on a 350 m
+    radius from 45 m ahead, superelevated to 5 % (rising to the right) over 45-85 m. Twin-arm
+    lamp columns on the median barrier every 36 m (12 m, neutral LED 4500 K, 3.2 kcd a head);
+    an overhead sign gantry 40 m ahead with two lit green direction signs over our
+    carriageway; steel guardrails, grass verges rising into a shallow cutting, a few
+    industrial units with lit windows beyond; two cars ahead with tail lights, four oncoming
+    cars on the far carriageway with halogen and cold LED headlights (13-15 kcd); wet asphalt
+    (roughness 0.1, puddles 0.025 on 22 %); an SUV's camera 1.5 m above the road in the
+    nearside lane."""
+
+    def h(s: float) -> float:
+        return ramp_grade(s, -0.015, -0.04, 50.0)
+
+    def bank(s: float) -> float:
+        return 0.05 * smoothstep((s - 45.0) / 40.0)
+
+    line = CentreLine(radius=350.0, bend_start=45.0, profile=h)
+    ss = np.arange(-10.0, 260.01, 2.0)
+
+    def at(s: float, x: float, up: float = 0.0) -> Vec3:
+        p = line.point(s) + x * line.right(s)
+        return (float(p[0]), float(p[1]), float(p[2] + bank(s) * x + up))
+
+    asphalt = mats.principled(
+        "wet_asphalt", albedo="asphalt_e", roughness_map="puddles_e", road=True
+    )
+    xs = [(float(x), 0.0) for x in np.linspace(-9.5, 9.5, 20)]
+    tag(banked("road", line, bank, ss, xs, asphalt, 2.0), "road")
+    # markings: lane dashes (3 m every 12 m), edge lines by the shoulders and the median
+    paint = mats.principled("road_paint_e", (0.62, 0.62, 0.6), roughness=0.3, road=True)
+    for sx in (-1.0, 1.0):
+        for k, s0 in enumerate(np.arange(-9.0, 255.0, 12.0)):
+            x = sx * 4.85
+            dash = banked(
+                f"dash_{sx:+.0f}_{k}",
+                line,
+                bank,
+                np.linspace(s0, s0 + 3.0, 3),
+                [(x - 0.08, 0.004), (x + 0.08, 0.004)],
+                paint,
+                1.0,
+            )
+            tag(dash, "marking")
+        for k, x in enumerate((sx * 1.35, sx * 8.5)):
+            lo, hi = sorted((x - 0.1, x + 0.1))
+            tag(
+                banked(
+                    f"edge_{sx:+.0f}_{k}", line, bank, ss, [(lo, 0.004), (hi, 0.004)], paint, 1.0
+                ),
+                "marking",
+            )
+    # the median barrier (a concrete safety-shape wall)
+    barrier = mats.principled("barrier_e", albedo="barrier_e", roughness=0.8)
+    shape = [(-0.3, 0.0), (-0.2, 0.25), (-0.12, 0.9), (0.12, 0.9), (0.2, 0.25), (0.3, 0.0)]
+    tag(banked("median_barrier", line, bank, ss, shape, barrier, 1.0), "wall")
+    # guardrails and verges rising into a shallow cutting
+    steel = mats.principled("guardrail_e", (0.3, 0.31, 0.32), roughness=0.3, metallic=0.8)
+    grass = mats.principled("verge_e", albedo="verge_e", roughness=0.9)
+    for sx in (-1.0, 1.0):
+        x = sx * 9.9
+        lo, hi = sorted((x - 0.02 * sx, x))
+        rail = [(lo, 0.45), (lo, 0.78)] if sx > 0 else [(hi, 0.78), (hi, 0.45)]
+        tag(banked(f"guardrail_{sx:+.0f}", line, bank, ss, rail, steel, 1.0), "fence")
+        for k, s in enumerate(np.arange(-8.0, 250.0, 4.0)):
+            c = at(float(s), sx * 9.95)
+            post = box(f"rail_post_{sx:+.0f}_{k}", (-0.04, -0.04, -0.1), (0.04, 0.04, 0.75), steel)
+            tag(place(post, c, line.heading(float(s))), "fence")
+        verge = [(9.5, 0.0), (12.0, 0.1), (18.0, 2.0), (40.0, 3.0)]
+        if sx < 0:
+            verge = [(-x_, h_) for x_, h_ in reversed(verge)]
+        tag(banked(f"verge_{sx:+.0f}", line, bank, ss, verge, grass, 2.0), "terrain")
+    # industrial units beyond the verges, a few lit windows
+    units = mats.principled("units_e", albedo="far_quay_e", roughness=0.85)
+    rng = np.random.default_rng(131)
+    for k, (s, sx, d) in enumerate(
+        (
+            (70.0, 1.0, 45.0),
+            (120.0, 1.0, 55.0),
+            (170.0, 1.0, 40.0),
+            (150.0, -1.0, 60.0),
+            (215.0, -1.0, 45.0),
+            (240.0, 1.0, 50.0),
+        )
+    ):
+        c = at(s, sx * d, 3.0)
+        heading = line.heading(s)
+        wd, dp, ht = (float(v) for v in rng.uniform((20.0, 12.0, 7.0), (40.0, 20.0, 12.0)))
+        tag(
+            place(
+                box(f"unit_{k}", (-dp / 2, -wd / 2, -1.0), (dp / 2, wd / 2, ht), units, 12.0),
+                c,
+                heading,
+            ),
+            "building",
+        )
+        for j in range(int(rng.integers(2, 6))):
+            wy = float(rng.uniform(-wd / 2 + 1.0, wd / 2 - 2.5))
+            wz = float(rng.uniform(1.0, ht - 2.5))
+            fx = -sx * (dp / 2 + 0.03)
+            win = glow_box(
+                mats,
+                f"unit_window_{k}_{j}",
+                (fx - 0.02, wy, wz),
+                (fx + 0.02, wy + 2.0, wz + 1.2),
+                WINDOW_WARM if j % 2 else COOL_WHITE,
+                60.0,
+                "building",
+            )
+            place(win, c, heading)
+    # twin-arm lamp columns on the median barrier
+    metal = mats.principled("lamp_metal_e", (0.07, 0.08, 0.08), roughness=0.45, metallic=0.7)
+    for j, s in enumerate(np.arange(12.0, 250.0, 36.0)):
+        s = float(s)
+        r = line.right(s)
+        arms = [(float(2.3 * r[0]), float(2.3 * r[1])), (float(-2.3 * r[0]), float(-2.3 * r[1]))]
+        post_lamp(mats, f"column{j}", at(s, 0.0, 0.9), 11.1, arms, LED_4500, 3200.0, metal)
+    # the sign gantry 40 m ahead (the road is straight and unbanked there)
+    sg = 40.0
+    zg = h(sg)
+    for k, x in enumerate((-10.6, 10.6)):
+        tag(
+            box(
+                f"gantry_leg{k}",
+                (x - 0.2, sg - 0.2, zg - 0.2),
+                (x + 0.2, sg + 0.2, zg + 7.4),
+                steel,
+            ),
+            "pole",
+        )
+    tag(box("gantry_truss", (-10.8, sg - 0.5, zg + 6.4), (10.8, sg + 0.5, zg + 7.4), steel), "pole")
+    for k, (xa, xb) in enumerate(((1.6, 4.9), (5.1, 8.4))):
+        glow_box(
+            mats,
+            f"sign{k}",
+            (xa, sg - 0.62, zg + 4.6),
+            (xb, sg - 0.52, zg + 6.9),
+            SIGN_GREEN,
+            30.0,
+            "traffic_sign",
+        )
+        glow_box(
+            mats,
+            f"sign_text{k}",
+            (xa + 0.4, sg - 0.66, zg + 5.6),
+            (xb - 0.4, sg - 0.62, zg + 6.0),
+            COOL_WHITE,
+            90.0,
+            "traffic_sign",
+        )
+
+    # traffic: two cars ahead, four oncoming on the far carriageway
+    def slope(s: float) -> float:
+        return math.atan(h(s + 0.5) - h(s - 0.5))
+
+    blue = mats.principled("paint_blue_e", (0.02, 0.05, 0.15), roughness=0.3, coat=1.0)
+    silver = mats.principled(
+        "paint_silver_e", (0.4, 0.41, 0.43), roughness=0.25, metallic=0.8, coat=1.0
+    )
+    for k, (s, x) in enumerate(((52.0, 3.0), (118.0, 6.7))):
+        tw = sloped_car(
+            mats, f"ahead{k}", at(s, x), line.heading(s), slope(s), blue if k else silver, 1 + k
+        )
+        tail_lights(mats, f"tail{k}_", tw, line.heading(s), 1 + k, cd=11.0)
+    white = mats.principled("paint_white_e", (0.62, 0.62, 0.6), roughness=0.3, coat=1.0)
+    for k, (s, x, colour) in enumerate(
+        (
+            (64.0, -3.0, HALOGEN),
+            (100.0, -6.7, LED_6000),
+            (148.0, -3.0, LED_6000),
+            (196.0, -6.7, HALOGEN),
+        )
+    ):
+        up = -slope(s)  # climbing towards the camera
+        heading = line.heading(s) + math.pi
+        tw = sloped_car(
+            mats, f"oncoming{k}", at(s, x), heading, up, white if k % 2 else silver, 3 + k
+        )
+        headlights(
+            mats,
+            f"headlight{k}_",
+            tw,
+            heading,
+            3 + k,
+            colour=colour,
+            cd=13000.0 + 700.0 * k,
+            pitch=1.2 - math.degrees(up),
+        )
+    eye = at(0.0, 6.7, 1.5)
+    camera("driver", eye, pitched(np.array([0.0, 1.0, 0.0]), 1.9), 32.0, 720, 360)
+
+
 SCENES = {
     "hill_bend": build_hill_bend,
     "crossing": build_crossing,
@@ -2161,6 +2535,9 @@ SCENES = {
     # the fourth set (made after the first three had been looked at)
     "bridge": build_bridge,
     "square": build_square,
+    # the fifth set (made after the first four had been looked at)
+    "quay": build_quay,
+    "arterial": build_arterial,
 }
 #: The scene sets: `--set a` (the default) builds the first, `--set b` the second, `--set c`
 #: the third, `--set d` the fourth.
@@ -2169,6 +2546,7 @@ SETS = {
     "b": ("roundabout", "avenue", "shelf"),
     "c": ("underpass", "hillside", "daylight_street"),
     "d": ("bridge", "square"),
+    "e": ("quay", "arterial"),
 }
 #: The scenes with a wet road (the others have none).
 STREETS = (
@@ -2180,9 +2558,14 @@ STREETS = (
     "hillside",
     "bridge",
     "square",
+    "quay",
+    "arterial",
 )
 #: The streets with a dry road (no streaks; their road material is `dry_asphalt`).
 DRY_STREETS = ("daylight_street",)
+#: The streets whose road material the export checks is not `wet_asphalt` (the quay has no
+#: asphalt: its cobbles are its road).
+ROAD_MATERIAL = {"daylight_street": "dry_asphalt", "quay": "wet_cobbles"}
 
 
 def export(out: Path, name: str) -> Path:
@@ -2203,7 +2586,7 @@ def export(out: Path, name: str) -> Path:
         for m in doc.get("materials", [])
         if m.get("extras", {}).get("streaks", {}).get("road") is True
     ]
-    road_name = "dry_asphalt" if name in DRY_STREETS else "wet_asphalt"
+    road_name = ROAD_MATERIAL.get(name, "wet_asphalt")
     has_road = name in STREETS or name in DRY_STREETS
     if has_road and road_name not in roads:
         raise SystemExit(f"{glb}: the road material has no extras.streaks.road = true")

@@ -13,7 +13,9 @@
 # and pairs_b/: roundabout, avenue, shelf), made after the first set had been looked at; with
 # SET=c the third set (heldback_c/, other_config_c/ and pairs_c/: underpass, hillside,
 # daylight_street), made after the first two had been looked at; with SET=d the fourth
-# (heldback_d/, other_config_d/ and pairs_d/: bridge, square), made after the first three.
+# (heldback_d/, other_config_d/ and pairs_d/: bridge, square), made after the first three;
+# with SET=e the fifth (heldback_e/, other_config_e/ and pairs_e/: quay, arterial), made after
+# the first four.
 #
 # STREAKS: the binary (default target/release/streaks); OPENCV_PYTHON: a Python with
 # opencv-python-headless (tools/opencv/requirements.txt) to add OpenCV's StereoSGBM.
@@ -42,6 +44,9 @@ elif [[ "${SET:-a}" == c ]]; then
 elif [[ "${SET:-a}" == d ]]; then
     benches=(heldback_d other_config_d pairs_d)
     repairs=(heldback_d other_config_d pairs_d/bridge pairs_d/square)
+elif [[ "${SET:-a}" == e ]]; then
+    benches=(heldback_e other_config_e pairs_e)
+    repairs=(heldback_e other_config_e pairs_e/quay pairs_e/arterial)
 else
     benches=(heldback other_config dry_config pairs)
     repairs=(heldback other_config dry_config pairs/hill_bend pairs/crossing)

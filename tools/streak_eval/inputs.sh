@@ -34,6 +34,14 @@
 #   OUT/heldback_d/                               24 default-config samples (seed 47900), a
 #                                                 fourth held-back split
 #
+# SET=e makes the fifth set (made after the first four had been looked at):
+#
+#   OUT/scenes_e/{quay,arterial}.glb              built in Blender, exported by its exporter
+#   OUT/pairs_e/{quay,arterial}/                  `streaks stereo` pairs of them
+#   OUT/other_config_e/                           3 samples of other_config_e.toml (seed 81)
+#   OUT/heldback_e/                               24 default-config samples (seed 48900), a
+#                                                 fifth held-back split
+#
 # BLENDER_PYTHON: the Python with bpy 5.0 (default target/blender-venv/bin/python);
 # STREAKS: the streaks binary (default target/release/streaks). Run from the repository root.
 # Evaluation-only inputs: no parameter may be tuned on them.
@@ -51,9 +59,9 @@ stamp() { date -u +%H:%M:%S; }
 suffix=""
 [[ "$set_name" == "a" ]] || suffix="_$set_name"
 case "$set_name" in
-    a | b | c | d) ;;
+    a | b | c | d | e) ;;
     *)
-        echo "SET must be a, b, c or d, not $set_name" >&2
+        echo "SET must be a, b, c, d or e, not $set_name" >&2
         exit 2
         ;;
 esac
@@ -116,6 +124,15 @@ case "$set_name" in
         samples other_config_d --config "$here/other_config_d.toml" --count 3 --seed 80 \
             --width 640 --height 352 --spp 24
         samples heldback_d --seed 47900 --count 24 --width 512 --height 288 --spp 16
+        ;;
+    e)
+        pair quay --width 656 --height 368 --baseline 0.22 --exposure 4.75 --seed 5
+        # sensor_e.toml: a 14-bit large-pixel camera on an SUV.
+        pair arterial --width 720 --height 360 --baseline 0.32 --sensor "$here/sensor_e.toml" \
+            --seed 5
+        samples other_config_e --config "$here/other_config_e.toml" --count 3 --seed 81 \
+            --width 608 --height 336 --spp 24
+        samples heldback_e --seed 48900 --count 24 --width 464 --height 272 --spp 16
         ;;
 esac
 echo "$(stamp) done: $out (set $set_name)"

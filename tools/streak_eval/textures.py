@@ -420,6 +420,35 @@ def lit_windows(
     return linear_to_srgb8(rgb)
 
 
+def cobbles_roughness(
+    n: int = 256,
+    seed: int = 101,
+    rows: int = 16,
+    per_row: int = 8,
+    stone: float = 0.3,
+    joint: float = 0.07,
+    puddle: float = 0.03,
+    share: float = 0.2,
+    blobs_per_tile: float = 8.0,
+) -> np.ndarray:
+    """The metallicRoughness image of wet cobbles laid as `setts` with the same `rows` and
+    `per_row`, rough-ish stones (about `stone`, each its own) with wetter joints (towards
+    `joint`), and standing water over about `share` of the area (smooth blobs about n /
+    `blobs_per_tile` pixels across, roughness `puddle`) where the paving has sunk; G roughness,
+    B metallic 0, R 255."""
+    rng = np.random.default_rng(seed)
+    base = setts_roughness(n, seed + 1, rows, per_row, stone, joint)[..., 1] / 255.0
+    blobs = periodic_noise(n, n / blobs_per_tile, rng)
+    threshold = np.quantile(blobs, 1.0 - share)
+    t = np.clip((blobs - threshold) / 0.3, 0.0, 1.0)
+    rough = base * (1.0 - t) + puddle * t
+    out = np.empty((n, n, 3), dtype=np.uint8)
+    out[..., 0] = 255
+    out[..., 1] = np.round(np.clip(rough, 0.0, 1.0) * 255.0).astype(np.uint8)
+    out[..., 2] = 0
+    return out
+
+
 def write_png(path: Path, pixels: np.ndarray) -> None:
     """Writes an 8-bit grey (h x w) or RGB (h x w x 3) array as a PNG (row 0 at the top)."""
     pixels = np.asarray(pixels)
@@ -598,6 +627,59 @@ TEXTURES = {
         partial(facade_plaster, seed=78, colour=(0.86, 0.9, 0.8), per_row=3, rows=4),
         True,
     ),
+    # fifth set (quay, arterial)
+    "cobbles_e": (
+        partial(setts, seed=102, rows=16, per_row=8, colour=(0.9, 0.95, 1.0), shade=0.08),
+        True,
+    ),
+    "cobbles_wet_e": (cobbles_roughness, False),
+    "flags_e": (partial(paving, seed=103, flags=8, n=256), True),
+    "quay_stone_e": (
+        partial(
+            facade_blocks,
+            seed=104,
+            courses=4,
+            per_course=2,
+            colour=(0.85, 0.88, 0.9),
+            shade=0.2,
+            mortar=(0.06, 0.06, 0.06),
+            windows=False,
+        ),
+        True,
+    ),
+    "warehouse_e": (
+        partial(
+            facade_blocks,
+            seed=105,
+            courses=32,
+            per_course=8,
+            colour=(0.9, 0.62, 0.36),
+            shade=0.2,
+            mortar=(0.22, 0.2, 0.18),
+        ),
+        True,
+    ),
+    "far_quay_e": (
+        partial(lit_windows, seed=106, per_row=8, rows=6, lit=0.3, colour=(0.42, 0.44, 0.5)),
+        True,
+    ),
+    "asphalt_e": (
+        partial(
+            asphalt_albedo,
+            seed=107,
+            level=0.038,
+            stone_px=1.3,
+            stone_cut=1.2,
+            tint=(1.0, 1.0, 1.02),
+        ),
+        True,
+    ),
+    "puddles_e": (
+        partial(puddle_roughness, seed=108, wet=0.1, puddle=0.025, share=0.22, blobs_per_tile=4.0),
+        False,
+    ),
+    "barrier_e": (partial(board_concrete, seed=109, boards=2, level=0.35), True),
+    "verge_e": (partial(lawn, seed=110), True),
 }
 
 

@@ -22,6 +22,7 @@ from textures import (
     asphalt_albedo,
     board_concrete,
     book_spines,
+    cobbles_roughness,
     dry_roughness,
     facade_blocks,
     facade_plaster,
@@ -301,7 +302,9 @@ FOURTH_SET = (
 
 def test_fourth_set_differs_from_the_first_three():
     assert set(FOURTH_SET) <= set(TEXTURES)
-    assert list(TEXTURES)[-len(FOURTH_SET) :] == list(FOURTH_SET)
+    names = list(TEXTURES)
+    start = names.index(FOURTH_SET[0])
+    assert names[start : start + len(FOURTH_SET)] == list(FOURTH_SET)
     made = {name: make() for name, (make, _) in TEXTURES.items()}
     earlier = [name for name in TEXTURES if name not in FOURTH_SET]
     for name in FOURTH_SET:
@@ -329,3 +332,38 @@ def test_lit_windows():
     lit = (img[..., 0] > 0.6) & (img[..., 2] < 0.4)
     dark = img.mean(axis=-1) < 0.03
     assert lit.mean() > 0.01 and dark.mean() > 0.02
+
+
+FIFTH_SET = (
+    "cobbles_e",
+    "cobbles_wet_e",
+    "flags_e",
+    "quay_stone_e",
+    "warehouse_e",
+    "far_quay_e",
+    "asphalt_e",
+    "puddles_e",
+    "barrier_e",
+    "verge_e",
+)
+
+
+def test_fifth_set_differs_from_the_first_four():
+    assert list(TEXTURES)[-len(FIFTH_SET) :] == list(FIFTH_SET)
+    made = {name: make() for name, (make, _) in TEXTURES.items()}
+    earlier = [name for name in TEXTURES if name not in FIFTH_SET]
+    for name in FIFTH_SET:
+        img = made[name]
+        assert img.dtype == np.uint8 and img.ndim == 3 and img.shape[2] == 3
+        for old in earlier:
+            if made[old].shape == img.shape:
+                assert not np.array_equal(made[old], img), (name, old)
+
+
+def test_cobbles_rough_with_puddles():
+    img = cobbles_roughness(128)
+    rough = img[..., 1] / 255.0
+    assert (img[..., 2] == 0).all() and (img[..., 0] == 255).all()
+    assert 0.05 < (rough < 0.05).mean() < 0.4  # standing water and wet joints
+    assert np.median(rough) > 0.2  # the stones rough-ish
+    assert not TEXTURES["cobbles_wet_e"][1] and TEXTURES["cobbles_e"][1]
