@@ -1,7 +1,7 @@
 """Builds the outside night streets in Blender (bpy) and exports them with Blender's own glTF
 exporter: evaluation-only inputs for streak-robust stereo (tools/streak_eval/README.md).
 
-    BLENDER_PYTHON tools/streak_eval/blender_streets.py OUT [--set b|c|d] [--scenes hill_bend ...]
+    BLENDER_PYTHON tools/streak_eval/blender_streets.py OUT [--set b|c|d|e] [--scenes hill_bend ...]
 
 writes OUT/<scene>.glb (textures embedded) and OUT/<scene>.blend. The streets are not the
 generator's (crates/scenes): a road that bends and climbs over a crest, a crossroads with a
@@ -14,7 +14,12 @@ banked street climbing a hill, seen from a truck; a dry street in sunshine (a su
 scene's `extras.streaks.environment`), whose road is flagged but shows no streaks. `--set d`
 builds the fourth (made after the first three had been looked at): a road over a river bridge
 with lamps on both parapets and the far bank's lit flats; a wide town square crossed by a tram
-street, paved with large wet slabs, lamps on tall masts, seen from a low car.
+street, paved with large wet slabs, lamps on tall masts, seen from a low car. `--set e`
+builds the fifth (made after the first four had been looked at): a harbour-side street of wet
+cobbles beside a quay wall and the basin's dark water, lamps at varying heights (sodium posts,
+LED lanterns and wall lamps), a parked van; a wide divided arterial road falling downhill into
+a superelevated left bend, twin-arm lamp columns on its median barrier, a sign gantry and
+oncoming headlights on the far carriageway, seen from an SUV.
 
 The export is the exporter's defaults plus three Include choices a user ticks: cameras,
 punctual lights and "Custom Properties" (`export_extras`): without the last one, the road
@@ -2540,7 +2545,7 @@ SCENES = {
     "arterial": build_arterial,
 }
 #: The scene sets: `--set a` (the default) builds the first, `--set b` the second, `--set c`
-#: the third, `--set d` the fourth.
+#: the third, `--set d` the fourth, `--set e` the fifth.
 SETS = {
     "a": ("hill_bend", "crossing", "tabletop"),
     "b": ("roundabout", "avenue", "shelf"),
