@@ -23,6 +23,8 @@ INPUTS = [
     "other_config_c",
     "heldback_d",
     "other_config_d",
+    "heldback_e",
+    "other_config_e",
 ]
 PAIRS = [
     "hill_bend",
@@ -36,6 +38,8 @@ PAIRS = [
     "daylight_street",
     "bridge",
     "square",
+    "quay",
+    "arterial",
 ]
 
 
@@ -116,10 +120,7 @@ def tables(out: Path) -> str:
             for s in c["summary"]:
                 label = f"{name}: {c['condition']} ({c['samples']})"
                 conditions.append(row(label, s["method"], s["errors"]))
-    for pairs in ("pairs", "pairs_b", "pairs_c", "pairs_d"):
-        path = out / f"bench-{pairs}" / "report.json"
-        if not path.is_file():
-            continue
+    for path in sorted(out.glob("bench-pairs*/report.json")):
         report = json.loads(path.read_text(encoding="utf-8"))
         for sample in report["samples"]:
             for r in sample["results"]:
