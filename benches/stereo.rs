@@ -1,13 +1,16 @@
 //! Stereo estimator benchmarks, per megapixel: 1D Lucas-Kanade along rows (one estimate per
 //! pixel: every pixel of the image is a `(row, x)` centre) and semi-global matching (dense
 //! disparity, default parameters: 64 disparities, census 7x7, 8 paths, sub-pixel, left-right
-//! check and median), both from `streaks-analysis`, on a synthetic textured 640x480 pair.
+//! check and median), both from `streaks-analysis`, on a synthetic textured 640x480 pair, and the
+//! streak-robust pass on SGM's map (`robust_disparity` with the shipped model: its features,
+//! both classifiers' trees at every pixel and the fill).
 //!
 //! Run: `cargo bench --bench stereo`. Throughput is in pixels per second.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use std::hint::black_box;
 use streaks_analysis::lk::{lk_rows, LkParams};
+use streaks_analysis::repair::{robust_disparity, RepairModel, StreakHandling};
 use streaks_analysis::sgm::{sgm, SgmParams};
 use streaks_analysis::synth::SynthScene;
 
@@ -35,6 +38,21 @@ fn bench_estimators(c: &mut Criterion) {
     let params = SgmParams::default();
     group.bench_function("sgm_dense", |b| {
         b.iter(|| sgm(black_box(&pair.left), black_box(&pair.right), &params).map(|d| d.width))
+    });
+
+    let disp = sgm(&pair.left, &pair.right, &params).expect("SGM of the synthetic pair");
+    let model = RepairModel::shipped();
+    group.bench_function("streak_repair_after_sgm", |b| {
+        b.iter(|| {
+            robust_disparity(
+                black_box(&pair.left),
+                black_box(&pair.right),
+                black_box(&disp),
+                StreakHandling::Repair,
+                model,
+            )
+            .map(|r| r.repaired_pixels)
+        })
     });
     group.finish();
 }
