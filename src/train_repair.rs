@@ -20,10 +20,11 @@
 use anyhow::{bail, Context, Result};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
+use streaks_analysis::benchmark::breakdown::{Bin, STREAK_LENGTH_BINS};
 use streaks_analysis::gbdt::{Dataset, TrainParams};
 use streaks_analysis::repair::{
     is_right, robust_from_features, streak_objects, RepairCounts, RepairModel, StereoFeatures,
-    StreakHandling, FEATURES,
+    StreakHandling, FEATURES, STREAK_CONTRAST_BINS,
 };
 use streaks_analysis::sgm::{sgm, SgmParams};
 use streaks_analysis::streak_classifier::{smooth_probability, streak_mask, SMOOTHING_RADII};
@@ -89,6 +90,8 @@ pub struct Args {
 /// A sample matched and described: its features, semi-global matching's map, the truth and
 /// the masks.
 struct Sample {
+    /// The left image's luminance (the streak-level score's contrast).
+    left: GrayImage,
     features: StereoFeatures,
     sgm: GrayImage,
     truth: GrayImage,
@@ -133,6 +136,7 @@ fn load_sample(dir: &Path) -> Result<Option<Sample>> {
     let sgm = sgm(&left, &right, &SgmParams::default())?;
     let features = StereoFeatures::new(&left, &right, &sgm)?;
     Ok(Some(Sample {
+        left,
         features,
         sgm,
         truth,
@@ -347,7 +351,15 @@ fn score(samples: &[Sample], model: &RepairModel) -> RepairCounts {
     let mut counts = RepairCounts::default();
     for s in samples {
         let r = robust_from_features(&s.features, &s.sgm, StreakHandling::Repair, model);
-        counts.add(&s.sgm, &r, model, &s.truth, &s.road, &s.road_streaks);
+        counts.add(
+            &s.left,
+            &s.sgm,
+            &r,
+            model,
+            &s.truth,
+            &s.road,
+            &s.road_streaks,
+        );
     }
     counts
 }
@@ -395,8 +407,24 @@ fn print_figures(what: &str, n: usize, counts: &RepairCounts) -> serde_json::Val
         "streak_mask": score,
         "streak_level_precision": level_p,
         "streak_level_recall": level_r,
+        "streak_recall_by_length": by_bins(&STREAK_LENGTH_BINS, &counts.streaks_by_length),
+        "streak_recall_by_contrast": by_bins(&STREAK_CONTRAST_BINS, &counts.streaks_by_contrast),
         "counts": counts,
     })
+}
+
+/// Per bin: its name, the truth streaks in it and the share of them found.
+fn by_bins(bins: &[Bin], counts: &[(usize, usize)]) -> serde_json::Value {
+    bins.iter()
+        .zip(counts)
+        .map(|(b, &(found, all))| {
+            serde_json::json!({
+                "bin": b.name,
+                "streaks": all,
+                "recall": (all > 0).then(|| found as f64 / all as f64),
+            })
+        })
+        .collect()
 }
 
 /// `--evaluate`: scores a model on datasets and pair folders.

@@ -1,8 +1,8 @@
 """Prints the figures of `evaluate.sh` as Markdown tables: per input and method the phantom
 holes, off-road and overall bad-2, density, bad-or-missing share and bad-2 after KITTI's fill
 of the missing values (from `streaks benchmark`'s report.json), the held-back split by
-condition, and the repair's own figures with its streak mask's scores (from `streaks
-train-repair --evaluate`).
+condition, and the repair's own figures with its streak mask's scores and its
+streak-level recall by length and contrast (from `streaks train-repair --evaluate`).
 
     python3 tools/streak_eval/summary.py OUT
 """
@@ -151,7 +151,36 @@ def tables(out: Path) -> str:
             f"| {f['streak_level_precision']:.3f} / {f['streak_level_recall']:.3f} "
             f"| {f['counts']['streaks_true']} |"
         )
-    return text + "\n\nThe repair's own figures:\n\n" + "\n".join(repair) + "\n"
+    text += "\n\nThe repair's own figures:\n\n" + "\n".join(repair) + "\n"
+    recall = [
+        "| input | streak-level recall of short / medium / long streaks "
+        "| of faint / moderate / bright streaks |",
+        "| --- | --- | --- |",
+    ]
+    for name in [*INPUTS, *PAIRS]:
+        path = out / f"repair-{name}.json"
+        if not path.is_file():
+            continue
+        f = json.loads(path.read_text(encoding="utf-8"))
+        if "streak_recall_by_length" not in f:
+            continue
+        cells = [
+            " / ".join(
+                "n/a" if b["recall"] is None else f"{b['recall']:.2f} ({b['streaks']})"
+                for b in f[key]
+            )
+            for key in ("streak_recall_by_length", "streak_recall_by_contrast")
+        ]
+        recall.append(f"| {name} | " + " | ".join(cells) + " |")
+    if len(recall) > 2:
+        text += (
+            "\nStreak-level recall by length (short below 5 % of the height, long from 20 %) "
+            "and by contrast (the streak's mean luminance less that beside it, in 8-bit code "
+            "values: faint below 10, bright from 40), with the number of truth streaks:\n\n"
+            + "\n".join(recall)
+            + "\n"
+        )
+    return text
 
 
 def main() -> None:

@@ -61,6 +61,7 @@
 //! `wrong`-probability decile that were right on the validation streets; for a repaired one,
 //! the share of repaired values right at its window's size; 0 where there is no value.
 
+use crate::benchmark::breakdown::{bin_index, Bin, STREAK_LENGTH_BINS};
 use crate::detect::MaskScore;
 use crate::filter::{finite_quantile, max, max_above, mean, median, Axis};
 use crate::gbdt::{GbdtError, Model};
@@ -786,10 +787,98 @@ pub const FOUND_COVER: f32 = 0.25;
 /// the truth's streak pixels.
 pub const CORRECT_SHARE: f32 = 0.5;
 
+/// The contrast bins of a truth streak, in 8-bit code values of the image's luminance: the
+/// streak's mean less the mean of the pixels beside it ([`TruthStreak::contrast`]). A faint
+/// streak is within a few noise steps of the road around it.
+pub const STREAK_CONTRAST_BINS: [Bin; 3] = [
+    Bin {
+        name: "faint",
+        low: f64::NEG_INFINITY,
+        high: 10.0,
+    },
+    Bin {
+        name: "moderate",
+        low: 10.0,
+        high: 40.0,
+    },
+    Bin {
+        name: "bright",
+        low: 40.0,
+        high: f64::INFINITY,
+    },
+];
+
+/// How many columns on each side of a truth streak's pixels [`TruthStreak::contrast`] takes
+/// as the pixels beside it.
+const CONTRAST_SIDE_PX: usize = 4;
+
+/// One streak of the road-streak truth, as the streak-level score counts it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TruthStreak {
+    /// Rows it spans, as a share of the image height.
+    pub extent: f32,
+    /// Its mean luminance less that of the pixels beside it (within [`CONTRAST_SIDE_PX`]
+    /// columns on its rows, not on any truth streak), in 8-bit code values (luminance in
+    /// [0, 1] times 255); `None` without an image or without such pixels.
+    pub contrast: Option<f32>,
+    /// Whether the mask covers at least [`FOUND_COVER`] of its pixels.
+    pub found: bool,
+}
+
+/// The streaks of the road-streak `truth` (non-zero on streak pixels): its 8-connected
+/// components spanning at least [`MIN_STREAK_EXTENT`] of the image's rows, each with whether
+/// `mask` finds it and, given the image's luminance `lum` (in [0, 1]), its contrast.
+pub fn truth_streaks(
+    mask: &GrayImage,
+    truth: &GrayImage,
+    lum: Option<&GrayImage>,
+) -> Vec<TruthStreak> {
+    use crate::benchmark::breakdown::components8;
+    let (w, h) = (truth.width, truth.height);
+    let min_rows = (MIN_STREAK_EXTENT * h as f32).ceil() as usize;
+    let mut beside = vec![usize::MAX; if lum.is_some() { w * h } else { 0 }];
+    let mut out = vec![];
+    for (k, c) in components8(w, h, |i| truth.data[i] > 0.0)
+        .iter()
+        .enumerate()
+    {
+        let (y0, y1) = c
+            .iter()
+            .fold((usize::MAX, 0), |(a, b), &i| (a.min(i / w), b.max(i / w)));
+        if y1 + 1 - y0 < min_rows {
+            continue;
+        }
+        let covered = c.iter().filter(|&&i| mask.data[i] > 0.0).count();
+        let contrast = lum.and_then(|l| {
+            let (mut side, mut n) = (0.0f64, 0usize);
+            for &i in c {
+                let (x, y) = (i % w, i / w);
+                let row = y * w;
+                for nx in x.saturating_sub(CONTRAST_SIDE_PX)..=(x + CONTRAST_SIDE_PX).min(w - 1) {
+                    let j = row + nx;
+                    if truth.data[j] <= 0.0 && beside[j] != k {
+                        beside[j] = k;
+                        side += f64::from(l.data[j]);
+                        n += 1;
+                    }
+                }
+            }
+            let on = c.iter().map(|&i| f64::from(l.data[i])).sum::<f64>() / c.len() as f64;
+            (n > 0).then(|| (255.0 * (on - side / n as f64)) as f32)
+        });
+        out.push(TruthStreak {
+            extent: (y1 + 1 - y0) as f32 / h as f32,
+            contrast,
+            found: covered as f32 >= FOUND_COVER * c.len() as f32,
+        });
+    }
+    out
+}
+
 /// The streak-level counts of a streak mask against the road-streak truth (both non-zero on
 /// streak pixels): `(truth streaks found, truth streaks, detected streaks correct, detected
 /// streaks)`. Streaks are 8-connected components spanning at least [`MIN_STREAK_EXTENT`] of
-/// the image's rows; see [`FOUND_COVER`] and [`CORRECT_SHARE`].
+/// the image's rows; see [`truth_streaks`], [`FOUND_COVER`] and [`CORRECT_SHARE`].
 pub fn streak_objects(mask: &GrayImage, truth: &GrayImage) -> (usize, usize, usize, usize) {
     use crate::benchmark::breakdown::components8;
     let (w, h) = (truth.width, truth.height);
@@ -800,16 +889,10 @@ pub fn streak_objects(mask: &GrayImage, truth: &GrayImage) -> (usize, usize, usi
             .fold((usize::MAX, 0), |(a, b), &i| (a.min(i / w), b.max(i / w)));
         y1 + 1 - y0 >= min_rows
     };
+    let truths = truth_streaks(mask, truth, None);
+    let found = truths.iter().filter(|t| t.found).count();
     let near_truth = max(&max(truth, Axis::Rows, 2), Axis::Columns, 2);
-    let (mut found, mut truths, mut correct, mut detected) = (0, 0, 0, 0);
-    for c in components8(w, h, |i| truth.data[i] > 0.0)
-        .iter()
-        .filter(|c| tall(c))
-    {
-        truths += 1;
-        let covered = c.iter().filter(|&&i| mask.data[i] > 0.0).count();
-        found += usize::from(covered as f32 >= FOUND_COVER * c.len() as f32);
-    }
+    let (mut correct, mut detected) = (0, 0);
     for c in components8(w, h, |i| mask.data[i] > 0.0)
         .iter()
         .filter(|c| tall(c))
@@ -818,7 +901,7 @@ pub fn streak_objects(mask: &GrayImage, truth: &GrayImage) -> (usize, usize, usi
         let on = c.iter().filter(|&&i| near_truth.data[i] > 0.0).count();
         correct += usize::from(on as f32 >= CORRECT_SHARE * c.len() as f32);
     }
-    (found, truths, correct, detected)
+    (found, truths.len(), correct, detected)
 }
 
 /// Whether an estimate `e` of the true disparity `t` is right: within 2 px and not more than
@@ -927,6 +1010,13 @@ pub struct RepairCounts {
     pub detections_correct: usize,
     /// Detected streaks.
     pub detections: usize,
+    /// Truth streaks by their length ([`STREAK_LENGTH_BINS`]): (found, all).
+    #[serde(default)]
+    pub streaks_by_length: Vec<(usize, usize)>,
+    /// Truth streaks by their contrast ([`STREAK_CONTRAST_BINS`]): (found, all); a streak
+    /// without a contrast is in none.
+    #[serde(default)]
+    pub streaks_by_contrast: Vec<(usize, usize)>,
     /// Kept values by calibration bin: (right, all).
     pub kept: Vec<(usize, usize)>,
     /// Repaired values by window: (right, all).
@@ -934,10 +1024,13 @@ pub struct RepairCounts {
 }
 
 impl RepairCounts {
-    /// Adds the counts of one sample: semi-global matching's map `sgm`, the repair `r` of it
-    /// with `model`, the truth, and the road and road-streak masks (non-zero: in the mask).
+    /// Adds the counts of one sample: the left image's luminance `left` (in [0, 1]),
+    /// semi-global matching's map `sgm`, the repair `r` of it with `model`, the truth, and the
+    /// road and road-streak masks (non-zero: in the mask).
+    #[allow(clippy::too_many_arguments)]
     pub fn add(
         &mut self,
+        left: &GrayImage,
         sgm: &GrayImage,
         r: &RobustDisparity,
         model: &RepairModel,
@@ -948,6 +1041,26 @@ impl RepairCounts {
         if self.kept.is_empty() {
             self.kept = vec![(0, 0); CALIBRATION_BINS];
             self.repaired = vec![(0, 0); FILL_RADII.len()];
+        }
+        if self.streaks_by_length.is_empty() {
+            self.streaks_by_length = vec![(0, 0); STREAK_LENGTH_BINS.len()];
+            self.streaks_by_contrast = vec![(0, 0); STREAK_CONTRAST_BINS.len()];
+        }
+        for t in truth_streaks(&r.streaks, road_streaks, Some(left)) {
+            let length = bin_index(&STREAK_LENGTH_BINS, f64::from(t.extent));
+            let contrast = t
+                .contrast
+                .and_then(|c| bin_index(&STREAK_CONTRAST_BINS, f64::from(c)));
+            for slot in [
+                length.map(|k| &mut self.streaks_by_length[k]),
+                contrast.map(|k| &mut self.streaks_by_contrast[k]),
+            ]
+            .into_iter()
+            .flatten()
+            {
+                slot.0 += usize::from(t.found);
+                slot.1 += 1;
+            }
         }
         let (found, truths, correct, detected) = streak_objects(&r.streaks, road_streaks);
         self.streaks_found += found;
@@ -1199,7 +1312,7 @@ mod tests {
         // The counts: phantom holes gone, the streak found.
         let road = GrayImage::new(160, 100, 1.0).unwrap();
         let mut c = RepairCounts::default();
-        c.add(&disp, &r, &m, &truth, &road, &r.streaks.clone());
+        c.add(&left, &disp, &r, &m, &truth, &road, &r.streaks.clone());
         let (before, after) = c.phantom();
         assert!(before > 0.02 && after == 0.0, "{before} {after}");
         assert_eq!(c.streak_level(), (1.0, 1.0));
@@ -1223,6 +1336,61 @@ mod tests {
         }
         truth.set(20, 90, 1.0); // one row: too short to count
         assert_eq!(streak_objects(&mask, &truth), (1, 2, 2, 3));
+    }
+
+    #[test]
+    fn truth_streaks_have_their_extent_contrast_and_found_flag() {
+        let (w, h) = (40, 100);
+        let mut truth = GrayImage::new(w, h, 0.0).unwrap();
+        let mut lum = GrayImage::new(w, h, 0.2).unwrap();
+        let mut mask = truth.clone();
+        for y in 10..60 {
+            // A bright streak (0.2 + 60/255 on a 0.2 road), found, beside a faint one.
+            truth.set(5, y, 1.0);
+            lum.set(5, y, 0.2 + 60.0 / 255.0);
+            mask.set(5, y, 1.0);
+            truth.set(30, y, 1.0);
+            lum.set(30, y, 0.2 + 4.0 / 255.0);
+        }
+        // A second truth streak beside the bright one is not its background.
+        for y in 10..20 {
+            truth.set(8, y, 1.0);
+            lum.set(8, y, 1.0);
+        }
+        let t = truth_streaks(&mask, &truth, Some(&lum));
+        assert_eq!(t.len(), 3, "{t:?}");
+        let bright = t.iter().find(|s| s.found).unwrap();
+        assert_eq!(bright.extent, 0.5);
+        assert!((bright.contrast.unwrap() - 60.0).abs() < 1e-3, "{bright:?}");
+        let faint = t.iter().find(|s| s.extent == 0.5 && !s.found).unwrap();
+        assert!((faint.contrast.unwrap() - 4.0).abs() < 1e-3, "{faint:?}");
+        assert_eq!(
+            bin_index(&STREAK_CONTRAST_BINS, f64::from(faint.contrast.unwrap())),
+            Some(0)
+        );
+        // Without an image there is no contrast; the same streaks are found.
+        let plain = truth_streaks(&mask, &truth, None);
+        assert!(plain.iter().all(|s| s.contrast.is_none()));
+        assert_eq!(plain.iter().filter(|s| s.found).count(), 1);
+        // The counts bin them: the 50-row streaks are long (50 % of the height), the 10-row
+        // one medium; by contrast one faint, two bright.
+        let r = RobustDisparity {
+            disparity: truth.clone(),
+            confidence: truth.clone(),
+            wrong: truth.clone(),
+            streak_probability: truth.clone(),
+            streaks: mask.clone(),
+            origin: vec![Origin::None; w * h],
+            streak_pixels: 0,
+            dropped_pixels: 0,
+            repaired_pixels: 0,
+            masked_pixels: 0,
+        };
+        let mut c = RepairCounts::default();
+        let none = GrayImage::new(w, h, f32::INFINITY).unwrap();
+        c.add(&lum, &none, &r, &model(), &none, &truth, &truth);
+        assert_eq!(c.streaks_by_length, vec![(0, 0), (0, 1), (1, 2)]);
+        assert_eq!(c.streaks_by_contrast, vec![(0, 1), (0, 0), (1, 2)]);
     }
 
     #[test]
