@@ -842,10 +842,8 @@ pub fn truth_streaks(
         .iter()
         .enumerate()
     {
-        let (y0, y1) = c
-            .iter()
-            .fold((usize::MAX, 0), |(a, b), &i| (a.min(i / w), b.max(i / w)));
-        if y1 + 1 - y0 < min_rows {
+        let rows = rows_spanned(c, w);
+        if rows < min_rows {
             continue;
         }
         let covered = c.iter().filter(|&&i| mask.data[i] > 0.0).count();
@@ -867,7 +865,7 @@ pub fn truth_streaks(
             (n > 0).then(|| (255.0 * (on - side / n as f64)) as f32)
         });
         out.push(TruthStreak {
-            extent: (y1 + 1 - y0) as f32 / h as f32,
+            extent: rows as f32 / h as f32,
             contrast,
             found: covered as f32 >= FOUND_COVER * c.len() as f32,
         });
@@ -878,30 +876,40 @@ pub fn truth_streaks(
 /// The streak-level counts of a streak mask against the road-streak truth (both non-zero on
 /// streak pixels): `(truth streaks found, truth streaks, detected streaks correct, detected
 /// streaks)`. Streaks are 8-connected components spanning at least [`MIN_STREAK_EXTENT`] of
-/// the image's rows; see [`truth_streaks`], [`FOUND_COVER`] and [`CORRECT_SHARE`].
+/// the image's rows; see [`truth_streaks`] and [`detected_streaks`].
 pub fn streak_objects(mask: &GrayImage, truth: &GrayImage) -> (usize, usize, usize, usize) {
+    let truths = truth_streaks(mask, truth, None);
+    let (correct, detected) = detected_streaks(mask, truth);
+    let found = truths.iter().filter(|t| t.found).count();
+    (found, truths.len(), correct, detected)
+}
+
+/// The streaks of `mask` (its 8-connected components spanning at least [`MIN_STREAK_EXTENT`]
+/// of the rows) against the road-streak `truth`: `(correct, detected)`, a detected streak
+/// being correct when at least [`CORRECT_SHARE`] of its pixels lie within 2 px of the truth.
+pub fn detected_streaks(mask: &GrayImage, truth: &GrayImage) -> (usize, usize) {
     use crate::benchmark::breakdown::components8;
     let (w, h) = (truth.width, truth.height);
     let min_rows = (MIN_STREAK_EXTENT * h as f32).ceil() as usize;
-    let tall = |c: &Vec<usize>| {
-        let (y0, y1) = c
-            .iter()
-            .fold((usize::MAX, 0), |(a, b), &i| (a.min(i / w), b.max(i / w)));
-        y1 + 1 - y0 >= min_rows
-    };
-    let truths = truth_streaks(mask, truth, None);
-    let found = truths.iter().filter(|t| t.found).count();
     let near_truth = max(&max(truth, Axis::Rows, 2), Axis::Columns, 2);
     let (mut correct, mut detected) = (0, 0);
     for c in components8(w, h, |i| mask.data[i] > 0.0)
         .iter()
-        .filter(|c| tall(c))
+        .filter(|c| rows_spanned(c, w) >= min_rows)
     {
         detected += 1;
         let on = c.iter().filter(|&&i| near_truth.data[i] > 0.0).count();
         correct += usize::from(on as f32 >= CORRECT_SHARE * c.len() as f32);
     }
-    (found, truths.len(), correct, detected)
+    (correct, detected)
+}
+
+/// The rows a component (pixel indices of an image `w` wide) spans.
+fn rows_spanned(c: &[usize], w: usize) -> usize {
+    let (y0, y1) = c
+        .iter()
+        .fold((usize::MAX, 0), |(a, b), &i| (a.min(i / w), b.max(i / w)));
+    y1 + 1 - y0
 }
 
 /// Whether an estimate `e` of the true disparity `t` is right: within 2 px and not more than
@@ -1002,11 +1010,11 @@ pub struct RepairCounts {
     pub streak_detected: usize,
     /// Pixels of the road-streak truth.
     pub streak_truth: usize,
-    /// Truth streaks found by the streak mask ([`streak_objects`]).
+    /// Truth streaks found by the streak mask ([`truth_streaks`]).
     pub streaks_found: usize,
     /// Truth streaks.
     pub streaks_true: usize,
-    /// Detected streaks that are correct.
+    /// Detected streaks that are correct ([`detected_streaks`]).
     pub detections_correct: usize,
     /// Detected streaks.
     pub detections: usize,
@@ -1046,7 +1054,13 @@ impl RepairCounts {
             self.streaks_by_length = vec![(0, 0); STREAK_LENGTH_BINS.len()];
             self.streaks_by_contrast = vec![(0, 0); STREAK_CONTRAST_BINS.len()];
         }
-        for t in truth_streaks(&r.streaks, road_streaks, Some(left)) {
+        let truths = truth_streaks(&r.streaks, road_streaks, Some(left));
+        let (correct, detected) = detected_streaks(&r.streaks, road_streaks);
+        self.streaks_found += truths.iter().filter(|t| t.found).count();
+        self.streaks_true += truths.len();
+        self.detections_correct += correct;
+        self.detections += detected;
+        for t in &truths {
             let length = bin_index(&STREAK_LENGTH_BINS, f64::from(t.extent));
             let contrast = t
                 .contrast
@@ -1062,11 +1076,6 @@ impl RepairCounts {
                 slot.1 += 1;
             }
         }
-        let (found, truths, correct, detected) = streak_objects(&r.streaks, road_streaks);
-        self.streaks_found += found;
-        self.streaks_true += truths;
-        self.detections_correct += correct;
-        self.detections += detected;
         for i in 0..truth.data.len() {
             let t = truth.data[i];
             let (s, e) = (sgm.data[i], r.disparity.data[i]);
