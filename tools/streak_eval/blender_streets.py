@@ -247,11 +247,22 @@ class CentreLine:
         return np.array([-math.sin(a), math.cos(a), 0.0])
 
 
-def ribbon(name, line: CentreLine, ss, profile, mat, tile: float, along_first: bool = False):
+def ribbon(
+    name,
+    line: CentreLine,
+    ss,
+    profile,
+    mat,
+    tile: float,
+    along_first: bool = False,
+    bank: Callable[[float], float] | None = None,
+):
     """A surface swept along `line`: at each s of `ss` the cross-section `profile`, a list of
     (x to the right, height above the centre line) from left to right, so that the faces
     face up (or towards the road, for a kerb or a facade). UVs in metres / `tile`: (across,
-    along), or (along, across) when `along_first` (facades: along, then up)."""
+    along), or (along, across) when `along_first` (facades: along, then up). With `bank` the
+    road is banked: at each s the cross-section is lifted by `bank(s) * x` (superelevation,
+    a rise of bank(s) per metre to the right)."""
     across = [0.0]
     for (x0, h0), (x1, h1) in zip(profile, profile[1:], strict=False):
         across.append(across[-1] + math.hypot(x1 - x0, h1 - h0))
@@ -259,7 +270,8 @@ def ribbon(name, line: CentreLine, ss, profile, mat, tile: float, along_first: b
     for s in ss:
         c, r = line.point(s), line.right(s)
         for (x, h), a in zip(profile, across, strict=True):
-            verts.append(c + x * r + np.array([0.0, 0.0, h]))
+            lift = h if bank is None else h + bank(s) * x
+            verts.append(c + x * r + np.array([0.0, 0.0, lift]))
             uv_of.append((s / tile, a / tile) if along_first else (a / tile, s / tile))
     m = len(profile)
     faces, uvs = [], []
@@ -2308,29 +2320,6 @@ def build_quay(mats: Materials) -> None:
     camera("driver", eye, pitched(np.array([0.0, 1.0, 0.0]), 1.2), 38.0, 656, 368)
 
 
-def banked(name, line: CentreLine, bank, ss, profile, mat, tile: float):
-    """`ribbon` on a banked road: at each s the cross-section `profile` (x to the right,
-    height) is lifted by `bank(s) * x` (superelevation: a rise of bank(s) per metre to the
-    right); UVs (across, along) in metres / `tile`."""
-    across = [0.0]
-    for (x0, h0), (x1, h1) in zip(profile, profile[1:], strict=False):
-        across.append(across[-1] + math.hypot(x1 - x0, h1 - h0))
-    verts, uv_of = [], []
-    for s in ss:
-        c, r, e = line.point(s), line.right(s), bank(s)
-        for (x, h), a in zip(profile, across, strict=True):
-            verts.append(c + x * r + np.array([0.0, 0.0, h + e * x]))
-            uv_of.append((a / tile, s / tile))
-    m = len(profile)
-    faces, uvs = [], []
-    for j in range(len(ss) - 1):
-        for i in range(m - 1):
-            f = (j * m + i, j * m + i + 1, (j + 1) * m + i + 1, (j + 1) * m + i)
-            faces.append(f)
-            uvs.extend(uv_of[k] for k in f)
-    return mesh_object(name, verts, faces, uvs, mat)
-
-
 def build_arterial(mats: Materials) -> None:
     """A wide divided arterial road: two 7.3 m carriageways (two 3.65 m lanes each, a 1 m
     hard shoulder) either side of a 2.4 m median with a 0.9 m concrete barrier; it falls
@@ -2361,34 +2350,40 @@ def build_arterial(mats: Materials) -> None:
         "wet_asphalt", albedo="asphalt_e", roughness_map="puddles_e", road=True
     )
     xs = [(float(x), 0.0) for x in np.linspace(-9.5, 9.5, 20)]
-    tag(banked("road", line, bank, ss, xs, asphalt, 2.0), "road")
+    tag(ribbon("road", line, ss, xs, asphalt, 2.0, bank=bank), "road")
     # markings: lane dashes (3 m every 12 m), edge lines by the shoulders and the median
     paint = mats.principled("road_paint_e", (0.62, 0.62, 0.6), roughness=0.3, road=True)
     for sx in (-1.0, 1.0):
         for k, s0 in enumerate(np.arange(-9.0, 255.0, 12.0)):
             x = sx * 4.85
-            dash = banked(
+            dash = ribbon(
                 f"dash_{sx:+.0f}_{k}",
                 line,
-                bank,
                 np.linspace(s0, s0 + 3.0, 3),
                 [(x - 0.08, 0.004), (x + 0.08, 0.004)],
                 paint,
                 1.0,
+                bank=bank,
             )
             tag(dash, "marking")
         for k, x in enumerate((sx * 1.35, sx * 8.5)):
             lo, hi = sorted((x - 0.1, x + 0.1))
             tag(
-                banked(
-                    f"edge_{sx:+.0f}_{k}", line, bank, ss, [(lo, 0.004), (hi, 0.004)], paint, 1.0
+                ribbon(
+                    f"edge_{sx:+.0f}_{k}",
+                    line,
+                    ss,
+                    [(lo, 0.004), (hi, 0.004)],
+                    paint,
+                    1.0,
+                    bank=bank,
                 ),
                 "marking",
             )
     # the median barrier (a concrete safety-shape wall)
     barrier = mats.principled("barrier_e", albedo="barrier_e", roughness=0.8)
     shape = [(-0.3, 0.0), (-0.2, 0.25), (-0.12, 0.9), (0.12, 0.9), (0.2, 0.25), (0.3, 0.0)]
-    tag(banked("median_barrier", line, bank, ss, shape, barrier, 1.0), "wall")
+    tag(ribbon("median_barrier", line, ss, shape, barrier, 1.0, bank=bank), "wall")
     # guardrails and verges rising into a shallow cutting
     steel = mats.principled("guardrail_e", (0.3, 0.31, 0.32), roughness=0.3, metallic=0.8)
     grass = mats.principled("verge_e", albedo="verge_e", roughness=0.9)
@@ -2396,7 +2391,7 @@ def build_arterial(mats: Materials) -> None:
         x = sx * 9.9
         lo, hi = sorted((x - 0.02 * sx, x))
         rail = [(lo, 0.45), (lo, 0.78)] if sx > 0 else [(hi, 0.78), (hi, 0.45)]
-        tag(banked(f"guardrail_{sx:+.0f}", line, bank, ss, rail, steel, 1.0), "fence")
+        tag(ribbon(f"guardrail_{sx:+.0f}", line, ss, rail, steel, 1.0, bank=bank), "fence")
         for k, s in enumerate(np.arange(-8.0, 250.0, 4.0)):
             c = at(float(s), sx * 9.95)
             post = box(f"rail_post_{sx:+.0f}_{k}", (-0.04, -0.04, -0.1), (0.04, 0.04, 0.75), steel)
@@ -2404,7 +2399,7 @@ def build_arterial(mats: Materials) -> None:
         verge = [(9.5, 0.0), (12.0, 0.1), (18.0, 2.0), (40.0, 3.0)]
         if sx < 0:
             verge = [(-x_, h_) for x_, h_ in reversed(verge)]
-        tag(banked(f"verge_{sx:+.0f}", line, bank, ss, verge, grass, 2.0), "terrain")
+        tag(ribbon(f"verge_{sx:+.0f}", line, ss, verge, grass, 2.0, bank=bank), "terrain")
     # industrial units beyond the verges, a few lit windows
     units = mats.principled("units_e", albedo="far_quay_e", roughness=0.85)
     rng = np.random.default_rng(131)
