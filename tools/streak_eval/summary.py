@@ -136,6 +136,11 @@ def tables(out: Path) -> str:
         "| road density % | streak mask P / R (pixels) | P / R (streaks) | streaks |",
         "| --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
+    recall = [
+        "| input | streak-level recall of short / medium / long streaks "
+        "| of faint / moderate / bright streaks |",
+        "| --- | --- | --- |",
+    ]
     for name in [*INPUTS, *PAIRS]:
         path = out / f"repair-{name}.json"
         if not path.is_file():
@@ -151,27 +156,16 @@ def tables(out: Path) -> str:
             f"| {f['streak_level_precision']:.3f} / {f['streak_level_recall']:.3f} "
             f"| {f['counts']['streaks_true']} |"
         )
+        if "streak_recall_by_length" in f:
+            cells = [
+                " / ".join(
+                    "n/a" if b["recall"] is None else f"{b['recall']:.2f} ({b['streaks']})"
+                    for b in f[key]
+                )
+                for key in ("streak_recall_by_length", "streak_recall_by_contrast")
+            ]
+            recall.append(f"| {name} | " + " | ".join(cells) + " |")
     text += "\n\nThe repair's own figures:\n\n" + "\n".join(repair) + "\n"
-    recall = [
-        "| input | streak-level recall of short / medium / long streaks "
-        "| of faint / moderate / bright streaks |",
-        "| --- | --- | --- |",
-    ]
-    for name in [*INPUTS, *PAIRS]:
-        path = out / f"repair-{name}.json"
-        if not path.is_file():
-            continue
-        f = json.loads(path.read_text(encoding="utf-8"))
-        if "streak_recall_by_length" not in f:
-            continue
-        cells = [
-            " / ".join(
-                "n/a" if b["recall"] is None else f"{b['recall']:.2f} ({b['streaks']})"
-                for b in f[key]
-            )
-            for key in ("streak_recall_by_length", "streak_recall_by_contrast")
-        ]
-        recall.append(f"| {name} | " + " | ".join(cells) + " |")
     if len(recall) > 2:
         text += (
             "\nStreak-level recall by length (short below 5 % of the height, long from 20 %) "

@@ -1,5 +1,6 @@
 """The outside streets' textures and light levels (no bpy)."""
 
+import functools
 import math
 import struct
 import zlib
@@ -141,16 +142,26 @@ def test_road_shapes():
 FIRST_SET = ("asphalt", "puddles", "paving", "panels", "plaster", "blocks")
 
 
+@functools.cache
+def made() -> dict[str, np.ndarray]:
+    """Every texture, made once for the tests that compare them."""
+    return {name: make() for name, (make, _) in TEXTURES.items()}
+
+
+def assert_new(names, earlier) -> None:
+    """The textures `names` are 8-bit RGB and none equals one of `earlier` of its size."""
+    for name in names:
+        img = made()[name]
+        assert img.dtype == np.uint8 and img.ndim == 3 and img.shape[2] == 3
+        for old in earlier:
+            if made()[old].shape == img.shape:
+                assert not np.array_equal(made()[old], img), (name, old)
+
+
 def test_second_set_differs_from_the_first():
-    made = {name: make() for name, (make, _) in TEXTURES.items()}
     second = [name for name in TEXTURES if name not in FIRST_SET]
     assert len(second) >= 8
-    for name in second:
-        img = made[name]
-        assert img.dtype == np.uint8 and img.ndim == 3 and img.shape[2] == 3
-        for old in FIRST_SET:
-            if made[old].shape == img.shape:
-                assert not np.array_equal(made[old], img), (name, old)
+    assert_new(second, FIRST_SET)
 
 
 def test_first_set_defaults_unchanged():
@@ -230,18 +241,6 @@ THIRD_SET = (
 )
 
 
-def test_third_set_differs_from_the_first_two():
-    assert set(THIRD_SET) <= set(TEXTURES)
-    made = {name: make() for name, (make, _) in TEXTURES.items()}
-    earlier = [name for name in TEXTURES if name not in THIRD_SET]
-    for name in THIRD_SET:
-        img = made[name]
-        assert img.dtype == np.uint8 and img.ndim == 3 and img.shape[2] == 3
-        for old in earlier:
-            if made[old].shape == img.shape:
-                assert not np.array_equal(made[old], img), (name, old)
-
-
 def test_setts_and_their_wet_joints():
     lin = srgb8_to_linear(setts(128)).mean(axis=-1)
     assert (lin < 0.03).mean() > 0.03  # the dark joints
@@ -300,21 +299,6 @@ FOURTH_SET = (
 )
 
 
-def test_fourth_set_differs_from_the_first_three():
-    assert set(FOURTH_SET) <= set(TEXTURES)
-    names = list(TEXTURES)
-    start = names.index(FOURTH_SET[0])
-    assert names[start : start + len(FOURTH_SET)] == list(FOURTH_SET)
-    made = {name: make() for name, (make, _) in TEXTURES.items()}
-    earlier = [name for name in TEXTURES if name not in FOURTH_SET]
-    for name in FOURTH_SET:
-        img = made[name]
-        assert img.dtype == np.uint8 and img.ndim == 3 and img.shape[2] == 3
-        for old in earlier:
-            if made[old].shape == img.shape:
-                assert not np.array_equal(made[old], img), (name, old)
-
-
 def test_large_slabs_and_their_wet_joints():
     lin = srgb8_to_linear(large_slabs(128)).mean(axis=-1)
     joints = lin < 0.035
@@ -348,18 +332,6 @@ FIFTH_SET = (
 )
 
 
-def test_fifth_set_differs_from_the_first_four():
-    assert list(TEXTURES)[-len(FIFTH_SET) :] == list(FIFTH_SET)
-    made = {name: make() for name, (make, _) in TEXTURES.items()}
-    earlier = [name for name in TEXTURES if name not in FIFTH_SET]
-    for name in FIFTH_SET:
-        img = made[name]
-        assert img.dtype == np.uint8 and img.ndim == 3 and img.shape[2] == 3
-        for old in earlier:
-            if made[old].shape == img.shape:
-                assert not np.array_equal(made[old], img), (name, old)
-
-
 def test_cobbles_rough_with_puddles():
     img = cobbles_roughness(128)
     rough = img[..., 1] / 255.0
@@ -367,3 +339,13 @@ def test_cobbles_rough_with_puddles():
     assert 0.05 < (rough < 0.05).mean() < 0.4  # standing water and wet joints
     assert np.median(rough) > 0.2  # the stones rough-ish
     assert not TEXTURES["cobbles_wet_e"][1] and TEXTURES["cobbles_e"][1]
+
+
+@pytest.mark.parametrize(
+    "new_set", [THIRD_SET, FOURTH_SET, FIFTH_SET], ids=["third", "fourth", "fifth"]
+)
+def test_a_later_set_differs_from_every_other_texture(new_set):
+    names = list(TEXTURES)
+    start = names.index(new_set[0])
+    assert names[start : start + len(new_set)] == list(new_set)
+    assert_new(new_set, [name for name in TEXTURES if name not in new_set])
