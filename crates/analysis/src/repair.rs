@@ -827,7 +827,8 @@ pub struct TruthStreak {
 
 /// The streaks of the road-streak `truth` (non-zero on streak pixels): its 8-connected
 /// components spanning at least [`MIN_STREAK_EXTENT`] of the image's rows, each with whether
-/// `mask` finds it and, given the image's luminance `lum` (in [0, 1]), its contrast.
+/// `mask` finds it and, given the image's luminance `lum` (in [0, 1]), its contrast. The
+/// three images have one size.
 pub fn truth_streaks(
     mask: &GrayImage,
     truth: &GrayImage,
@@ -1034,7 +1035,7 @@ pub struct RepairCounts {
 impl RepairCounts {
     /// Adds the counts of one sample: the left image's luminance `left` (in [0, 1]),
     /// semi-global matching's map `sgm`, the repair `r` of it with `model`, the truth, and the
-    /// road and road-streak masks (non-zero: in the mask).
+    /// road and road-streak masks (non-zero: in the mask), all of one size.
     #[allow(clippy::too_many_arguments)]
     pub fn add(
         &mut self,
