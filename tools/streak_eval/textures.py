@@ -59,6 +59,26 @@ def asphalt_albedo(
     return linear_to_srgb8(rgb)
 
 
+def metallic_roughness(rough: np.ndarray) -> np.ndarray:
+    """glTF's metallicRoughness image (n x n x 3) of a roughness field: roughness in G (clipped
+    to [0, 1]), metallic 0 in B, R unused (255)."""
+    out = np.empty((*rough.shape, 3), dtype=np.uint8)
+    out[..., 0] = 255
+    out[..., 1] = np.round(np.clip(rough, 0.0, 1.0) * 255.0).astype(np.uint8)
+    out[..., 2] = 0
+    return out
+
+
+def puddles(
+    n: int, rng: np.random.Generator, blobs_per_tile: float, share: float, rim: float
+) -> np.ndarray:
+    """Where water stands (n x n, 0 dry .. 1 puddle): smooth blobs about n / `blobs_per_tile`
+    pixels across over about `share` of the area, with soft rims `rim` wide in the noise."""
+    blobs = periodic_noise(n, n / blobs_per_tile, rng)
+    threshold = np.quantile(blobs, 1.0 - share)
+    return np.clip((blobs - threshold) / rim, 0.0, 1.0)
+
+
 def puddle_roughness(
     n: int = 256,
     seed: int = 2,
@@ -72,16 +92,10 @@ def puddle_roughness(
     `share` of the area, smooth blobs of about n / `blobs_per_tile` pixels with soft rims) of
     roughness `puddle`."""
     rng = np.random.default_rng(seed)
-    blobs = periodic_noise(n, n / blobs_per_tile, rng)
-    threshold = np.quantile(blobs, 1.0 - share)
-    t = np.clip((blobs - threshold) / 0.25, 0.0, 1.0)  # 0 asphalt .. 1 puddle, soft rim
+    t = puddles(n, rng, blobs_per_tile, share, rim=0.25)  # 0 asphalt .. 1 puddle
     rough = wet * (1.0 + 0.15 * periodic_noise(n, 2.0, rng))
     rough = rough * (1.0 - t) + puddle * t
-    out = np.empty((n, n, 3), dtype=np.uint8)
-    out[..., 0] = 255
-    out[..., 1] = np.round(np.clip(rough, 0.0, 1.0) * 255.0).astype(np.uint8)
-    out[..., 2] = 0
-    return out
+    return metallic_roughness(rough)
 
 
 def paving(n: int = 128, seed: int = 3, flags: int = 4) -> np.ndarray:
@@ -286,11 +300,7 @@ def setts_roughness(
     t = np.clip(edge / 0.12, 0.0, 1.0)
     rough = per_stone[course, block] * (1.0 + 0.1 * periodic_noise(n, 1.5, rng))
     rough = joint + (rough - joint) * t
-    out = np.empty((n, n, 3), dtype=np.uint8)
-    out[..., 0] = 255
-    out[..., 1] = np.round(np.clip(rough, 0.0, 1.0) * 255.0).astype(np.uint8)
-    out[..., 2] = 0
-    return out
+    return metallic_roughness(rough)
 
 
 def dry_roughness(n: int = 256, seed: int = 33, mean: float = 0.72, spread: float = 0.08):
@@ -300,11 +310,7 @@ def dry_roughness(n: int = 256, seed: int = 33, mean: float = 0.72, spread: floa
     rng = np.random.default_rng(seed)
     field = 0.6 * periodic_noise(n, n / 12.0, rng) + 0.8 * periodic_noise(n, 1.0, rng)
     rough = mean + spread * np.clip(field, -3.0, 3.0)
-    out = np.empty((n, n, 3), dtype=np.uint8)
-    out[..., 0] = 255
-    out[..., 1] = np.round(np.clip(rough, 0.0, 1.0) * 255.0).astype(np.uint8)
-    out[..., 2] = 0
-    return out
+    return metallic_roughness(rough)
 
 
 def board_concrete(n: int = 256, seed: int = 34, boards: int = 8, level: float = 0.3):
@@ -387,11 +393,7 @@ def slabs_roughness(
     rough = each[row, col] * (1.0 + 0.1 * periodic_noise(n, 1.5, rng))
     joint = ((v % ch) < 2.0) | ((shifted % cw) < 2.0)
     rough = np.where(joint, 0.03, rough)
-    out = np.empty((n, n, 3), dtype=np.uint8)
-    out[..., 0] = 255
-    out[..., 1] = np.round(np.clip(rough, 0.0, 1.0) * 255.0).astype(np.uint8)
-    out[..., 2] = 0
-    return out
+    return metallic_roughness(rough)
 
 
 def lit_windows(
@@ -438,15 +440,9 @@ def cobbles_roughness(
     B metallic 0, R 255."""
     rng = np.random.default_rng(seed)
     base = setts_roughness(n, seed + 1, rows, per_row, stone, joint)[..., 1] / 255.0
-    blobs = periodic_noise(n, n / blobs_per_tile, rng)
-    threshold = np.quantile(blobs, 1.0 - share)
-    t = np.clip((blobs - threshold) / 0.3, 0.0, 1.0)
+    t = puddles(n, rng, blobs_per_tile, share, rim=0.3)
     rough = base * (1.0 - t) + puddle * t
-    out = np.empty((n, n, 3), dtype=np.uint8)
-    out[..., 0] = 255
-    out[..., 1] = np.round(np.clip(rough, 0.0, 1.0) * 255.0).astype(np.uint8)
-    out[..., 2] = 0
-    return out
+    return metallic_roughness(rough)
 
 
 def write_png(path: Path, pixels: np.ndarray) -> None:
