@@ -98,17 +98,28 @@ def puddle_roughness(
     return metallic_roughness(rough)
 
 
-def paving(n: int = 128, seed: int = 3, flags: int = 4) -> np.ndarray:
-    """Pavement flags (n x n x 3, sRGB): `flags` x `flags` square slabs of concrete of slightly
-    different shades with dark joints."""
+def paving(
+    n: int = 128,
+    seed: int = 3,
+    flags: int = 4,
+    level: float = 0.16,
+    spread: float = 0.04,
+    stains: float = 0.0,
+) -> np.ndarray:
+    """Pavement flags or concrete panels (n x n x 3, sRGB): `flags` x `flags` square slabs of
+    concrete of shades about `level` (standard deviation `spread`) with dark joints; with
+    `stains` > 0, dark oil and tyre stains (soft blobs about n / 6 pixels across, up to 45 %
+    darker) over about that share of the area."""
     rng = np.random.default_rng(seed)
     cell = n // flags
-    shade = 0.16 + 0.04 * rng.standard_normal((flags, flags))
+    shade = level + spread * rng.standard_normal((flags, flags))
     value = np.kron(shade, np.ones((cell, cell)))
     value = value * (1.0 + 0.12 * periodic_noise(n, 1.0, rng))
     v, u = np.mgrid[0:n, 0:n]
     joint = ((u % cell) < 2) | ((v % cell) < 2)
     value = np.where(joint, 0.04, value)
+    if stains > 0.0:
+        value = value * (1.0 - 0.45 * puddles(n, rng, 6.0, stains, rim=0.6))
     return linear_to_srgb8(np.stack([value, value, value * 0.96], axis=-1))
 
 
@@ -478,8 +489,10 @@ def write_png(path: Path, pixels: np.ndarray) -> None:
 #: than data). The first set (hill_bend, crossing, tabletop) uses the first six; the second
 #: set (roundabout, avenue, shelf) the next ten, made with other seeds and patterns; the third set
 #: (underpass, hillside, daylight_street) the next fourteen, again new seeds and patterns; the
-#: fourth (bridge, square) the last eleven, new seeds and three new patterns (large slabs,
-#: their wet roughness, blocks of flats with lit windows).
+#: fourth (bridge, square) the next eleven, new seeds and three new patterns (large slabs,
+#: their wet roughness, blocks of flats with lit windows); the fifth (quay, arterial) the next
+#: ten; the sixth (tramway, forecourt) the last thirteen, new seeds and stained concrete
+#: panels (`paving` with `stains`).
 TEXTURES = {
     "asphalt": (asphalt_albedo, True),
     "puddles": (puddle_roughness, False),
@@ -676,6 +689,69 @@ TEXTURES = {
     ),
     "barrier_e": (partial(board_concrete, seed=109, boards=2, level=0.35), True),
     "verge_e": (partial(lawn, seed=110), True),
+    # sixth set (tramway, forecourt)
+    "asphalt_f": (
+        partial(
+            asphalt_albedo,
+            seed=121,
+            level=0.048,
+            stone_px=1.6,
+            stone_cut=1.2,
+            tint=(1.0, 0.99, 0.98),
+        ),
+        True,
+    ),
+    "puddles_f": (
+        partial(puddle_roughness, seed=122, wet=0.14, puddle=0.03, share=0.28, blobs_per_tile=9.0),
+        False,
+    ),
+    "flags_f": (partial(paving, seed=123, n=192, flags=6, level=0.2, spread=0.05), True),
+    "shopfronts_f": (partial(shopfronts, seed=124, shops=4), True),
+    "render_f": (
+        partial(facade_plaster, seed=125, colour=(0.95, 0.9, 0.75), per_row=4, rows=2),
+        True,
+    ),
+    "bricks_f": (
+        partial(
+            facade_blocks,
+            seed=126,
+            courses=32,
+            per_course=4,
+            colour=(0.75, 0.45, 0.35),
+            shade=0.25,
+            mortar=(0.35, 0.33, 0.3),
+        ),
+        True,
+    ),
+    "concrete_f": (
+        partial(paving, seed=127, n=256, flags=2, level=0.3, spread=0.03, stains=0.2),
+        True,
+    ),
+    "concrete_wet_f": (
+        partial(puddle_roughness, seed=128, wet=0.2, puddle=0.035, share=0.35, blobs_per_tile=5.0),
+        False,
+    ),
+    "asphalt_road_f": (
+        partial(
+            asphalt_albedo,
+            seed=129,
+            level=0.04,
+            stone_px=2.2,
+            stone_cut=1.3,
+            tint=(0.98, 0.99, 1.02),
+        ),
+        True,
+    ),
+    "puddles_road_f": (
+        partial(puddle_roughness, seed=130, wet=0.12, puddle=0.025, share=0.3, blobs_per_tile=6.0),
+        False,
+    ),
+    "cladding_f": (partial(facade_panels, seed=131), True),
+    "field_f": (partial(lawn, seed=132), True),
+    "houses_f": (
+        partial(lit_windows, seed=133, per_row=3, rows=2, lit=0.4, colour=(0.6, 0.55, 0.5)),
+        True,
+    ),
 }
 
 

@@ -30,6 +30,7 @@ from textures import (
     large_slabs,
     lawn,
     lit_windows,
+    paving,
     periodic_noise,
     puddle_roughness,
     setts,
@@ -341,8 +342,40 @@ def test_cobbles_rough_with_puddles():
     assert not TEXTURES["cobbles_wet_e"][1] and TEXTURES["cobbles_e"][1]
 
 
+SIXTH_SET = (
+    "asphalt_f",
+    "puddles_f",
+    "flags_f",
+    "shopfronts_f",
+    "render_f",
+    "bricks_f",
+    "concrete_f",
+    "concrete_wet_f",
+    "asphalt_road_f",
+    "puddles_road_f",
+    "cladding_f",
+    "field_f",
+    "houses_f",
+)
+
+
+def test_stained_concrete_panels():
+    plain = paving(128, seed=127, flags=2, level=0.3, spread=0.03)
+    stained = paving(128, seed=127, flags=2, level=0.3, spread=0.03, stains=0.2)
+    lin_plain = srgb8_to_linear(plain).mean(axis=-1)
+    lin = srgb8_to_linear(stained).mean(axis=-1)
+    assert np.all(lin <= lin_plain + 1e-12)  # stains only darken
+    darker = lin < 0.8 * lin_plain
+    assert 0.05 < darker.mean() < 0.35  # about a fifth of the area
+    assert 0.15 < np.median(lin) < 0.45  # light concrete, not asphalt
+    # the options leave the earlier flags as they were
+    assert np.array_equal(paving(64, seed=3), paving(64, 3, 4, 0.16, 0.04, 0.0))
+
+
 @pytest.mark.parametrize(
-    "new_set", [THIRD_SET, FOURTH_SET, FIFTH_SET], ids=["third", "fourth", "fifth"]
+    "new_set",
+    [THIRD_SET, FOURTH_SET, FIFTH_SET, SIXTH_SET],
+    ids=["third", "fourth", "fifth", "sixth"],
 )
 def test_a_later_set_differs_from_every_other_texture(new_set):
     names = list(TEXTURES)
