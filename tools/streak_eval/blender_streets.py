@@ -1276,11 +1276,10 @@ def wall(name, ys, x: float, z_lo, z_hi, mat, tile: float, facing: float):
     return mesh_object(name, verts, faces, uvs, mat)
 
 
-def sloped_car(mats, name, centre: Vec3, heading: float, pitch: float, paint, instance: int):
-    """`car` pitched nose-up by `pitch` radians (on a grade); returns its local-to-world map."""
-    car(mats, name, centre, heading, paint, instance)
-    for part in ("body", "cabin", "wheels"):
-        bpy.data.objects[f"{name}_{part}"].rotation_euler = (pitch, 0.0, heading)
+def sloped_to_world(centre: Vec3, heading: float, pitch: float) -> Callable[[Vec3], Vec3]:
+    """The local-to-world map of an object at `centre` turned by `heading` about Z and pitched
+    nose-up (its local +Y rising) by `pitch` radians: Blender's rotation_euler (pitch, 0,
+    heading)."""
     cp, sp = math.cos(pitch), math.sin(pitch)
     c, s = math.cos(heading), math.sin(heading)
 
@@ -1289,6 +1288,14 @@ def sloped_car(mats, name, centre: Vec3, heading: float, pitch: float, paint, in
         return (centre[0] + c * x - s * y, centre[1] + s * x + c * y, centre[2] + z)
 
     return to_world
+
+
+def sloped_car(mats, name, centre: Vec3, heading: float, pitch: float, paint, instance: int):
+    """`car` pitched nose-up by `pitch` radians (on a grade); returns its local-to-world map."""
+    car(mats, name, centre, heading, paint, instance)
+    for part in ("body", "cabin", "wheels"):
+        bpy.data.objects[f"{name}_{part}"].rotation_euler = (pitch, 0.0, heading)
+    return sloped_to_world(centre, heading, pitch)
 
 
 def straight(profile: Callable[[float], float]) -> CentreLine:
