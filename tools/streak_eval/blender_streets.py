@@ -1,7 +1,7 @@
 """Builds the outside night streets in Blender (bpy) and exports them with Blender's own glTF
 exporter: evaluation-only inputs for streak-robust stereo (tools/streak_eval/README.md).
 
-    BLENDER_PYTHON tools/streak_eval/blender_streets.py OUT [--set b|c|d|e] [--scenes hill_bend ...]
+    BLENDER_PYTHON tools/streak_eval/blender_streets.py OUT [--set b|c|d|e|f] [--scenes quay ...]
 
 writes OUT/<scene>.glb (textures embedded) and OUT/<scene>.blend. The streets are not the
 generator's (crates/scenes): a road that bends and climbs over a crest, a crossroads with a
@@ -19,7 +19,12 @@ builds the fifth (made after the first four had been looked at): a harbour-side 
 cobbles beside a quay wall and the basin's dark water, lamps at varying heights (sodium posts,
 LED lanterns and wall lamps), a parked van; a wide divided arterial road falling downhill into
 a superelevated left bend, twin-arm lamp columns on its median barrier, a sign gantry and
-oncoming headlights on the far carriageway, seen from an SUV.
+oncoming headlights on the far carriageway, seen from an SUV. `--set f` builds the sixth (made
+after the first five had been looked at): an old town's tram street, its double track set into
+the wet asphalt under the overhead line, lit shop windows, a tram stop's shelter lit from
+inside and an oncoming tram; a petrol station's forecourt of wet concrete with painted bays
+under a canopy of bright LED panels, pumps, a shop, and a dark road beyond, seen from a van
+through the 16-bit camera of sensor_f.toml.
 
 The export is the exporter's defaults plus three Include choices a user ticks: cameras,
 punctual lights and "Custom Properties" (`export_extras`): without the last one, the road
@@ -2527,6 +2532,513 @@ def build_arterial(mats: Materials) -> None:
     camera("driver", eye, pitched(np.array([0.0, 1.0, 0.0]), 1.9), 32.0, 720, 360)
 
 
+# --- the sixth set (made after the first five had been looked at) ----------------------------
+
+#: Sixth set's light colours, linear sRGB of their blackbodies (peak 1, about; Tanner
+#: Helland's fit of the sRGB values, linearised): a neutral LED at 4200 K on the tramway's
+#: catenary poles, a warm LED at 2400 K along the road past the forecourt, a cold LED at
+#: 5000 K in the forecourt's canopy panels; the forecourt's blue brand colour.
+LED_4200 = (1.0, 0.644, 0.429)
+LED_2400 = (1.0, 0.328, 0.045)
+PANEL_5000 = (1.0, 0.77, 0.62)
+BRAND_BLUE = (0.02, 0.12, 0.9)
+AMBER = (1.0, 0.45, 0.03)
+
+
+def tram(mats, name, centre: Vec3, heading: float, pitch: float, paint, instance: int):
+    """A tram (30 x 2.65 x 3.5 m, one rigid body) whose front is along its local +Y, pitched
+    nose-up by `pitch`: a dark skirt, a body with lit windows down both sides (60 cd/m2), a
+    dark windscreen, an amber destination display (150 cd/m2), a pantograph reaching 5.88 m
+    up; returns the local-to-world map."""
+    glass = mats.principled("tram_glass_f", (0.015, 0.015, 0.02), roughness=0.05, coat=1.0)
+    skirt = mats.principled("tram_skirt_f", (0.03, 0.03, 0.035), roughness=0.6)
+    metal = mats.principled("pantograph_f", (0.1, 0.1, 0.1), roughness=0.4, metallic=0.8)
+    parts = [
+        box(
+            f"{name}_body",
+            (-1.32, -15.0, 0.45),
+            (1.32, 15.0, 3.5),
+            paint,
+            cls="train",
+            inst=instance,
+        ),
+        box(
+            f"{name}_skirt",
+            (-1.25, -14.5, 0.1),
+            (1.25, 14.5, 0.45),
+            skirt,
+            cls="train",
+            inst=instance,
+        ),
+        box(
+            f"{name}_screen",
+            (-1.2, 14.99, 1.2),
+            (1.2, 15.03, 2.9),
+            glass,
+            cls="train",
+            inst=instance,
+        ),
+        box(
+            f"{name}_pantograph",
+            (-0.5, -0.05, 3.5),
+            (0.5, 0.05, 5.88),
+            metal,
+            cls="train",
+            inst=instance,
+        ),
+    ]
+    for sx in (-1.0, 1.0):
+        lo, hi = sorted((sx * 1.32, sx * 1.35))
+        parts.append(
+            glow_box(
+                mats,
+                f"{name}_windows{sx:+.0f}",
+                (lo, -13.5, 1.3),
+                (hi, 13.0, 2.5),
+                COOL_WHITE,
+                60.0,
+                "train",
+            )
+        )
+    parts.append(
+        glow_box(
+            mats, f"{name}_display", (-0.8, 15.0, 3.0), (0.8, 15.05, 3.35), AMBER, 150.0, "train"
+        )
+    )
+    for part in parts:
+        part.location = centre
+        part.rotation_euler = (pitch, 0.0, heading)
+        tag(part, "train", instance)
+    return sloped_to_world(centre, heading, pitch)
+
+
+def build_tramway(mats: Materials) -> None:
+    """An old town's tram street: a 10 m carriageway of wet asphalt (roughness 0.14, puddles
+    0.03 on 28 %) with a double tram track set into it (grooved rails flush with the surface,
+    track centres 3.2 m apart, the cars sharing the tracks), level for 10 m, then climbing
+    gently (to 2.5 % at 50 m) and bending left (R 140 m) from 60 m ahead; 3.4 m pavements of
+    flags, a terrace of shops on both sides (half the shop windows lit, warm and cool, 40-70
+    cd/m2) under rendered and brick upper storeys with some lit windows. The overhead line:
+    poles at both kerbs every 30 m carrying span wires and two contact wires over the track
+    centres (5.9 m), and on every other pole, staggered, a neutral LED 4200 K luminaire (2.4
+    kcd, 8 m) on a 1.8 m bracket. A tram stop's shelter on the right pavement 36-44 m ahead,
+    lit from inside (a diffuser under its roof, 350 cd/m2, and an advert panel, 300 cd/m2);
+    a zebra crossing; a car ahead with tail lights, an oncoming tram on the left track
+    (front 30 m ahead, lit windows, LED headlights 9 kcd), a van parked at the left kerb;
+    the camera 1.4 m above the road in the right lane (a saloon)."""
+
+    def h(s: float) -> float:
+        return ramp_grade(s - 10.0, 0.0, 0.025, 40.0) if s > 10.0 else 0.0
+
+    line = CentreLine(radius=140.0, bend_start=60.0, profile=h)
+    ss = np.arange(-10.0, 230.01, 1.0)
+    half, walk = 5.0, 3.4
+
+    def at(s: float, x: float, up: float = 0.0) -> Vec3:
+        p = line.point(s) + x * line.right(s)
+        return (float(p[0]), float(p[1]), float(p[2] + up))
+
+    asphalt = mats.principled(
+        "wet_asphalt", albedo="asphalt_f", roughness_map="puddles_f", road=True
+    )
+    xs = [(float(x), 0.0) for x in np.linspace(-half, half, 11)]
+    tag(ribbon("road", line, ss, xs, asphalt, 2.0), "road")
+    # the double track: rail heads of wet steel and the water-filled grooves inside them
+    steel = mats.principled("rail_steel_f", (0.42, 0.42, 0.44), roughness=0.12, metallic=1.0)
+    groove = mats.principled("rail_groove_f", (0.01, 0.01, 0.012), roughness=0.05)
+    gauge, head_w, groove_w = 1.435, 0.06, 0.04
+    for t, tc in enumerate((-1.6, 1.6)):
+        for side in (-1.0, 1.0):
+            inner = tc + side * gauge / 2.0
+            for part, (a, b), mat in (
+                ("head", (inner, inner + side * head_w), steel),
+                ("groove", (inner - side * groove_w, inner), groove),
+            ):
+                lo, hi = sorted((a, b))
+                rail = ribbon(
+                    f"rail_{part}_{t}_{side:+.0f}", line, ss, [(lo, 0.002), (hi, 0.002)], mat, 1.0
+                )
+                tag(rail, "rail_track")
+    # a zebra crossing 14-17 m ahead
+    paint = mats.principled("road_paint_f", (0.6, 0.6, 0.58), roughness=0.35, road=True)
+    for k, x in enumerate(np.arange(-4.5, 4.0, 1.0)):
+        stripe = ribbon(
+            f"zebra_{k}",
+            line,
+            np.linspace(14.0, 17.0, 3),
+            [(x, 0.004), (x + 0.5, 0.004)],
+            paint,
+            1.0,
+        )
+        tag(stripe, "marking")
+    # kerbs and pavements
+    flags = mats.principled("flags_f", albedo="flags_f", roughness=0.4)
+    kerb = 0.13
+    left = [(-half - walk, kerb), (-half, kerb), (-half, 0.0)]
+    right = [(half, 0.0), (half, kerb), (half + walk, kerb)]
+    for k, prof in enumerate((left, right)):
+        tag(ribbon(f"pavement{k}", line, ss, prof, flags, 2.0), "sidewalk")
+    # terraces: shop fronts on the ground floor, rendered or brick upper storeys
+    shops = mats.principled("shopfronts_f", albedo="shopfronts_f", roughness=0.7)
+    uppers = (
+        (mats.principled("render_f", albedo="render_f", roughness=0.9), 6.0, (0.9, 2.4)),
+        (mats.principled("bricks_f", albedo="bricks_f", roughness=0.85), 3.0, (1.125, 2.175)),
+    )
+    rng = np.random.default_rng(141)
+    ground = 6.0
+    for sx in (-1.0, 1.0):
+        s0, k = -10.0, 0
+        while s0 < 222.0:
+            ln = float(rng.uniform(7.0, 13.0))
+            sm = s0 + ln / 2.0
+            c, heading = at(sm, sx * (half + walk), kerb), line.heading(sm)
+            xa, xb = sorted((0.0, sx * 12.0))
+            top = float(rng.uniform(10.0, 17.0))
+            mat, tile, (z0, z1) = uppers[int(rng.integers(0, 2))]
+            parts = [
+                box(f"shops_{sx:+.0f}_{k}", (xa, -ln / 2, -0.5), (xb, ln / 2, ground), shops, 12.0),
+                box(f"upper_{sx:+.0f}_{k}", (xa, -ln / 2, ground), (xb, ln / 2, top), mat, tile),
+            ]
+            # lit shop windows where the texture has its glazing (3 m shops, glass 0.18-1.98 m
+            # along, 0.96-4.8 m up), lit upper windows where it has its panes (1.5 m bays)
+            fa, fb = sorted((0.0, -sx * 0.04))
+            for j in range(math.floor(-ln / 6.0), math.ceil(ln / 6.0)):
+                y0 = 3.0 * j + 0.18
+                if y0 < -ln / 2 or y0 + 1.8 > ln / 2 or rng.uniform() < 0.5:
+                    continue
+                colour = (WINDOW_WARM, COOL_WHITE, SHOP_WARM)[int(rng.integers(0, 3))]
+                cd = (40.0, 70.0)[int(rng.integers(0, 2))]
+                parts.append(
+                    glow_box(
+                        mats,
+                        f"shopwin_{sx:+.0f}_{k}_{j}",
+                        (fa, y0, 0.96),
+                        (fb, y0 + 1.8, 4.8),
+                        colour,
+                        cd,
+                        "building",
+                    )
+                )
+            for j in range(math.floor(-ln / 3.0), math.ceil(ln / 3.0)):
+                y0 = 1.5 * j + 0.45
+                if y0 < -ln / 2 or y0 + 0.6 > ln / 2:
+                    continue
+                for st in range(int((top - ground) // 3.0)):
+                    if rng.uniform() > 0.18:
+                        continue
+                    z = ground + 3.0 * st
+                    parts.append(
+                        glow_box(
+                            mats,
+                            f"win_{sx:+.0f}_{k}_{j}_{st}",
+                            (fa, y0, z + z0),
+                            (fb, y0 + 0.6, z + z1),
+                            WINDOW_WARM,
+                            25.0,
+                            "building",
+                        )
+                    )
+            for part in parts:
+                place(part, c, heading)
+                tag(part, "building")
+            s0, k = s0 + ln, k + 1
+    # the overhead line: poles at both kerbs every 30 m, span wires, contact wires
+    metal = mats.principled("pole_metal_f", (0.09, 0.1, 0.1), roughness=0.45, metallic=0.7)
+    wire = mats.principled("wire_f", (0.05, 0.05, 0.05), roughness=0.4, metallic=0.8)
+    for j, s in enumerate(np.arange(4.0, 200.0, 30.0)):
+        s = float(s)
+        r = line.right(s)
+        for sx in (-1.0, 1.0):
+            foot = at(s, sx * (half + 0.5), kerb)
+            lit = (j % 2 == 0) == (sx < 0)  # staggered: left on even poles, right on odd
+            if lit:
+                arm = (float(-sx * 1.8 * r[0]), float(-sx * 1.8 * r[1]))
+                post_lamp(mats, f"pole{j}_{sx:+.0f}", foot, 8.0, [arm], LED_4200, 2400.0, metal)
+            else:
+                mast = box(f"pole{j}_{sx:+.0f}_mast", (-0.08, -0.08, 0.0), (0.08, 0.08, 7.2), metal)
+                tag(place(mast, foot, line.heading(s)), "pole")
+        span = box(f"span{j}", (-half - 0.5, -0.01, 6.6), (half + 0.5, 0.01, 6.62), wire)
+        tag(place(span, at(s, 0.0), line.heading(s)), "pole")
+    for t, tc in enumerate((-1.6, 1.6)):
+        contact = ribbon(
+            f"contact_wire{t}", line, ss, [(tc + 0.008, 5.9), (tc - 0.008, 5.9)], wire, 1.0
+        )
+        tag(contact, "pole")
+    # the tram stop's shelter on the right pavement, lit from inside
+    shelter_metal = mats.principled("shelter_f", (0.25, 0.26, 0.27), roughness=0.4, metallic=0.6)
+    shelter_glass = mats.principled(
+        "shelter_glass_f", (0.02, 0.022, 0.025), roughness=0.05, coat=1.0
+    )
+    c, heading = at(40.0, 0.0, kerb), line.heading(40.0)
+    xo = half + 1.5
+    parts = [
+        box("shelter_roof", (xo - 0.2, -3.7, 2.5), (xo + 1.8, 3.7, 2.62), shelter_metal),
+        box("shelter_back", (xo + 1.5, -3.5, 0.15), (xo + 1.55, 3.5, 2.5), shelter_glass),
+        box("shelter_bench", (xo + 1.0, -2.0, 0.45), (xo + 1.45, 2.0, 0.5), shelter_metal),
+    ]
+    for k, (x, y) in enumerate(((xo, -3.5), (xo, 3.5), (xo + 1.5, -3.5), (xo + 1.5, 3.5))):
+        parts.append(
+            box(
+                f"shelter_post{k}",
+                (x - 0.04, y - 0.04, 0.0),
+                (x + 0.04, y + 0.04, 2.5),
+                shelter_metal,
+            )
+        )
+    for part in parts:
+        tag(place(part, c, heading), "street_furniture")
+    for part in (
+        glow_box(
+            mats,
+            "shelter_light",
+            (xo + 0.3, -3.0, 2.47),
+            (xo + 1.2, 3.0, 2.5),
+            COOL_WHITE,
+            350.0,
+            "street_furniture",
+        ),
+        glow_box(
+            mats,
+            "shelter_advert",
+            (xo + 0.05, 3.44, 0.25),
+            (xo + 1.45, 3.5, 2.05),
+            COOL_WHITE,
+            300.0,
+            "street_furniture",
+        ),
+    ):
+        place(part, c, heading)
+
+    # traffic: a car ahead, an oncoming tram on the left track, a van parked at the left kerb
+    def slope(s: float) -> float:
+        return math.atan(h(s + 0.5) - h(s - 0.5))
+
+    blue = mats.principled("paint_blue_f", (0.03, 0.07, 0.18), roughness=0.3, coat=1.0)
+    tw = sloped_car(mats, "car_ahead", at(22.0, 2.4), 0.0, slope(22.0), blue, 1)
+    tail_lights(mats, "taillight", tw, 0.0, 1, cd=12.0)
+    cream = mats.principled("paint_tram_f", (0.55, 0.5, 0.38), roughness=0.35, coat=1.0)
+    tw = tram(mats, "tram", at(45.0, -1.6), math.pi, -slope(45.0), cream, 2)
+    for k, x in enumerate((-0.9, 0.9)):
+        car_light(
+            mats,
+            f"tram_headlight{k}",
+            tw,
+            math.pi,
+            (x, 15.0, 0.95),
+            1.0,
+            LED_6000,
+            25000.0,
+            9000.0,
+            20.0,
+            2,
+            pitch_deg=1.5,
+        )
+    white = mats.principled("paint_van_f", (0.5, 0.5, 0.48), roughness=0.35, coat=0.5)
+    van(mats, "parked_van", at(92.0, -half + 1.05), line.heading(92.0) + math.pi, white, 3)
+    eye = at(0.0, 2.3, 1.4)
+    camera("driver", eye, pitched(np.array([0.0, 1.0, 0.0]), 1.5), 36.0, 688, 400)
+
+
+def build_forecourt(mats: Materials) -> None:
+    """A petrol station's forecourt at night by a dark country road: 44 x 56 m of flat wet
+    concrete in 5 m panels with oil stains (roughness 0.2, puddles 0.035 on 35 %; flagged as
+    road, material `wet_concrete`), painted parking bays on the apron's right, along the left
+    edge and before the shop; a canopy (26 x 12 m, its underside 5.2 m up) with a blue lit
+    fascia and fifteen square LED panels (5000 K, 4 kcd each) over three pump islands (six
+    pumps with lit displays); a shop with a lit glass front and a car wash behind; a price
+    sign lit on both faces by the exit. Beyond, a two-lane road of wet asphalt (roughness
+    0.12, puddles 0.025 on 30 %; flagged as road too) with warm LED 2400 K lamps (1.8 kcd,
+    8 m) along its far verge, a hedge, a dark field and a few houses with lit windows; a car
+    at a pump, a car in a bay, a car leaving with its tail lights, two cars on the road
+    (xenon and halogen headlights, 13-14 kcd); a van's camera 1.85 m up on the apron 20 m
+    before the canopy."""
+    concrete = mats.principled(
+        "wet_concrete", albedo="concrete_f", roughness_map="concrete_wet_f", road=True
+    )
+    asphalt = mats.principled(
+        "wet_asphalt", albedo="asphalt_road_f", roughness_map="puddles_road_f", road=True
+    )
+    flat = lambda x, y: 0.0  # noqa: E731
+    tag(
+        grid(
+            "forecourt",
+            np.linspace(-22.0, 22.0, 23),
+            np.linspace(-12.0, 44.0, 29),
+            flat,
+            concrete,
+            10.0,
+        ),
+        "road",
+    )
+    tag(
+        grid("road", np.linspace(-160.0, 160.0, 81), [44.0, 48.5, 53.0], flat, asphalt, 2.0), "road"
+    )
+    # painted bays, the give-way line at the exit, the road's centre line
+    paint = mats.principled("bay_paint_f", (0.62, 0.62, 0.6), roughness=0.35, road=True)
+    marks = []
+    for y in np.arange(-2.0, 20.01, 2.5):
+        marks.append(((-21.5, y - 0.06), (-16.5, y + 0.06)))
+    marks.append(((-16.56, -2.0), (-16.44, 20.0)))
+    for y in np.arange(-6.0, 6.51, 2.5):  # bays on the apron's right, by the entrance
+        marks.append(((7.5, y - 0.06), (12.5, y + 0.06)))
+    for x in np.arange(-21.0, -3.99, 2.5):
+        marks.append(((x - 0.06, 22.5), (x + 0.06, 27.0)))
+    for x in np.arange(-21.5, 21.5, 1.0):
+        marks.append(((x, 43.4), (x + 0.6, 43.7)))
+    for x in np.arange(-150.0, 150.0, 9.0):
+        marks.append(((x, 48.42), (x + 3.0, 48.58)))
+    for k, ((xa, ya), (xb, yb)) in enumerate(marks):
+        tag(box(f"mark{k}", (xa, ya, 0.0), (xb, yb, 0.004), paint), "marking")
+    # verges, the hedge, the field and houses beyond the road
+    grass = mats.principled("field_f", albedo="field_f", roughness=0.9)
+    for k, (xa, xb, ya, yb) in enumerate(
+        ((-160.0, -22.0, -40.0, 44.0), (22.0, 160.0, -40.0, 44.0), (-160.0, 160.0, 53.0, 56.0))
+    ):
+        tag(box(f"verge{k}", (xa, ya, -0.5), (xb, yb, 0.12), grass, 3.0), "terrain")
+    tag(
+        grid(
+            "field",
+            np.linspace(-300.0, 300.0, 13),
+            np.linspace(56.0, 400.0, 9),
+            lambda x, y: 0.1 + 0.004 * (y - 56.0),
+            grass,
+            3.0,
+        ),
+        "terrain",
+    )
+    hedge = mats.principled("hedge_f", albedo="field_f", roughness=0.95)
+    tag(box("hedge", (-160.0, 55.0, 0.1), (160.0, 56.0, 1.4), hedge, 2.0), "vegetation")
+    houses = mats.principled("houses_f", albedo="houses_f", roughness=0.85)
+    rng = np.random.default_rng(151)
+    for k, x in enumerate((-95.0, -52.0, -30.0, 18.0, 47.0, 110.0)):
+        y = float(rng.uniform(85.0, 130.0))
+        wd, dp, ht = (float(v) for v in rng.uniform((8.0, 7.0, 5.5), (14.0, 10.0, 8.0)))
+        z = 0.1 + 0.004 * (y - 56.0)
+        tag(
+            box(f"house{k}", (x - wd / 2, y, z - 0.5), (x + wd / 2, y + dp, z + ht), houses, 8.0),
+            "building",
+        )
+        for j in range(int(rng.integers(1, 4))):
+            wx = float(rng.uniform(x - wd / 2 + 0.8, x + wd / 2 - 2.0))
+            wz = z + (1.0 if rng.uniform() < 0.5 else 3.8)
+            glow_box(
+                mats,
+                f"house_window{k}_{j}",
+                (wx, y - 0.05, wz),
+                (wx + 1.2, y - 0.01, wz + 1.3),
+                WINDOW_WARM,
+                30.0,
+                "building",
+            )
+    for k, x in enumerate((-70.0, -58.0, 36.0, 64.0, 75.0)):
+        tree(
+            mats,
+            f"tree{k}",
+            (x, 58.0 + 2.0 * k, 0.1),
+            float(rng.uniform(7.0, 11.0)),
+            k % 2 == 0,
+            20 + k,
+            leaves="field_f",
+        )
+    # the road's lamps along its far verge
+    metal = mats.principled("lamp_metal_f", (0.08, 0.08, 0.09), roughness=0.45, metallic=0.7)
+    for j, x in enumerate(np.arange(-104.0, 100.0, 32.0)):
+        post_lamp(
+            mats,
+            f"road_lamp{j}",
+            (float(x), 53.6, 0.12),
+            8.0,
+            [(0.0, -1.6)],
+            LED_2400,
+            1800.0,
+            metal,
+        )
+    # the canopy: a deck with a lit blue fascia, fifteen LED panels, columns on the islands
+    deck = mats.principled("canopy_f", (0.55, 0.56, 0.57), roughness=0.5, metallic=0.3)
+    tag(box("canopy", (-13.0, 10.0, 5.2), (13.0, 22.0, 6.1), deck), "building")
+    glow_box(
+        mats, "fascia", (-13.02, 9.97, 5.45), (13.02, 9.99, 5.85), BRAND_BLUE, 45.0, "building"
+    )
+    for i, x in enumerate((-10.0, -5.0, 0.0, 5.0, 10.0)):
+        for j, y in enumerate((12.5, 16.0, 19.5)):
+            lamp_head(mats, f"canopy_panel{i}{j}", (x, y, 5.05), (1.3, 1.3), PANEL_5000, 4000.0)
+    island = mats.principled("island_f", (0.35, 0.35, 0.34), roughness=0.6)
+    column = mats.principled("column_f", (0.6, 0.6, 0.6), roughness=0.4, metallic=0.2)
+    pump = mats.principled("pump_f", (0.55, 0.55, 0.56), roughness=0.35, coat=0.5)
+    for i, x in enumerate((-8.0, 0.0, 8.0)):
+        tag(box(f"island{i}", (x - 0.7, 12.0, 0.0), (x + 0.7, 20.0, 0.16), island), "sidewalk")
+        for j, y in enumerate((12.5, 19.5)):
+            tag(
+                box(f"column{i}{j}", (x - 0.2, y - 0.2, 0.16), (x + 0.2, y + 0.2, 5.2), column),
+                "pole",
+            )
+        for j, y in enumerate((14.6, 17.4)):
+            tag(
+                box(f"pump{i}{j}", (x - 0.35, y - 0.5, 0.16), (x + 0.35, y + 0.5, 2.0), pump),
+                "street_furniture",
+            )
+            tag(
+                box(f"pump_top{i}{j}", (x - 0.38, y - 0.55, 2.0), (x + 0.38, y + 0.55, 2.3), deck),
+                "street_furniture",
+            )
+            for sx in (-1.0, 1.0):
+                lo, hi = sorted((x + sx * 0.35, x + sx * 0.37))
+                glow_box(
+                    mats,
+                    f"pump_display{i}{j}{sx:+.0f}",
+                    (lo, y - 0.25, 1.3),
+                    (hi, y + 0.25, 1.6),
+                    COOL_WHITE,
+                    80.0,
+                    "street_furniture",
+                )
+    # the shop and the car wash behind the canopy
+    cladding = mats.principled("cladding_f", albedo="cladding_f", roughness=0.6)
+    tag(box("shop", (-21.0, 27.0, 0.0), (-3.0, 37.0, 4.6), cladding, 8.0), "building")
+    glow_box(
+        mats, "shop_front", (-19.5, 26.96, 0.3), (-6.0, 27.0, 3.0), COOL_WHITE, 160.0, "building"
+    )
+    glow_box(
+        mats, "shop_sign", (-18.0, 26.95, 3.5), (-8.0, 26.99, 4.2), BRAND_BLUE, 60.0, "building"
+    )
+    tag(box("car_wash", (9.0, 29.0, 0.0), (20.0, 40.0, 4.2), cladding, 8.0), "building")
+    glow_box(mats, "car_wash_sign", (11.0, 28.95, 3.2), (15.0, 28.99, 3.8), AMBER, 90.0, "building")
+    # the price sign by the exit, lit on both faces
+    tag(box("price_sign", (15.0, 41.0, 0.0), (17.0, 41.5, 6.4), deck), "traffic_sign")
+    glow_box(
+        mats, "price_logo", (15.2, 40.95, 5.0), (16.8, 41.55, 6.0), BRAND_BLUE, 80.0, "traffic_sign"
+    )
+    glow_box(
+        mats,
+        "price_panel",
+        (15.3, 40.95, 2.8),
+        (16.7, 41.55, 4.8),
+        COOL_WHITE,
+        120.0,
+        "traffic_sign",
+    )
+    # a car at a pump, a car leaving, two cars on the road
+    silver = mats.principled(
+        "paint_silver_f", (0.4, 0.41, 0.43), roughness=0.25, metallic=0.8, coat=1.0
+    )
+    car(mats, "car_at_pump", (-4.0, 16.0, 0.0), 0.0, silver, 1)
+    green = mats.principled("paint_green_f", (0.03, 0.12, 0.06), roughness=0.3, coat=1.0)
+    car(mats, "car_in_bay", (10.2, 0.25, 0.0), -math.pi / 2, green, 5)
+    red = mats.principled("paint_red_f", (0.25, 0.02, 0.02), roughness=0.3, coat=1.0)
+    tw = car(mats, "car_leaving", (4.0, 30.0, 0.0), 0.0, red, 2)
+    tail_lights(mats, "taillight", tw, 0.0, 2, cd=12.0)
+    white = mats.principled("paint_white_f", (0.62, 0.62, 0.6), roughness=0.3, coat=1.0)
+    tw = car(mats, "road_car_west", (18.0, 50.7, 0.0), math.pi / 2, white, 3)
+    headlights(mats, "headlight_w", tw, math.pi / 2, 3, colour=XENON, cd=14000.0)
+    tail_lights(mats, "taillight_w", tw, math.pi / 2, 3, cd=10.0)
+    black = mats.principled("paint_black_f", (0.02, 0.02, 0.022), roughness=0.25, coat=1.0)
+    tw = car(mats, "road_car_east", (-26.0, 46.3, 0.0), -math.pi / 2, black, 4)
+    headlights(mats, "headlight_e", tw, -math.pi / 2, 4, colour=HALOGEN, cd=13000.0)
+    tail_lights(mats, "taillight_e", tw, -math.pi / 2, 4, cd=10.0)
+    eye = (2.0, -12.0 + 2.0, 1.85)
+    camera("driver", eye, pitched(np.array([0.0, 1.0, 0.0]), 2.5), 40.0, 600, 336)
+
+
 SCENES = {
     "hill_bend": build_hill_bend,
     "crossing": build_crossing,
@@ -2545,15 +3057,19 @@ SCENES = {
     # the fifth set (made after the first four had been looked at)
     "quay": build_quay,
     "arterial": build_arterial,
+    # the sixth set (made after the first five had been looked at)
+    "tramway": build_tramway,
+    "forecourt": build_forecourt,
 }
 #: The scene sets: `--set a` (the default) builds the first, `--set b` the second, `--set c`
-#: the third, `--set d` the fourth, `--set e` the fifth.
+#: the third, `--set d` the fourth, `--set e` the fifth, `--set f` the sixth.
 SETS = {
     "a": ("hill_bend", "crossing", "tabletop"),
     "b": ("roundabout", "avenue", "shelf"),
     "c": ("underpass", "hillside", "daylight_street"),
     "d": ("bridge", "square"),
     "e": ("quay", "arterial"),
+    "f": ("tramway", "forecourt"),
 }
 #: The scenes with a wet road (the others have none).
 STREETS = (
@@ -2567,12 +3083,19 @@ STREETS = (
     "square",
     "quay",
     "arterial",
+    "tramway",
+    "forecourt",
 )
 #: The streets with a dry road (no streaks; their road material is `dry_asphalt`).
 DRY_STREETS = ("daylight_street",)
 #: The streets whose road material the export checks is not `wet_asphalt` (the quay has no
-#: asphalt: its cobbles are its road).
-ROAD_MATERIAL = {"daylight_street": "dry_asphalt", "quay": "wet_cobbles"}
+#: asphalt: its cobbles are its road; the forecourt's concrete is flagged as well as the
+#: asphalt of the road beyond it).
+ROAD_MATERIAL = {
+    "daylight_street": "dry_asphalt",
+    "quay": "wet_cobbles",
+    "forecourt": "wet_concrete",
+}
 
 
 def export(out: Path, name: str) -> Path:
