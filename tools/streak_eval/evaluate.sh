@@ -15,7 +15,8 @@
 # daylight_street), made after the first two had been looked at; with SET=d the fourth
 # (heldback_d/, other_config_d/ and pairs_d/: bridge, square), made after the first three;
 # with SET=e the fifth (heldback_e/, other_config_e/ and pairs_e/: quay, arterial), made after
-# the first four.
+# the first four; with SET=f the sixth (heldback_f/, other_config_f/ and pairs_f/: tramway,
+# forecourt), made after the first five.
 #
 # STREAKS: the binary (default target/release/streaks); OPENCV_PYTHON: a Python with
 # opencv-python-headless (tools/opencv/requirements.txt) to add OpenCV's StereoSGBM.
@@ -47,6 +48,9 @@ elif [[ "${SET:-a}" == d ]]; then
 elif [[ "${SET:-a}" == e ]]; then
     benches=(heldback_e other_config_e pairs_e)
     repairs=(heldback_e other_config_e pairs_e/quay pairs_e/arterial)
+elif [[ "${SET:-a}" == f ]]; then
+    benches=(heldback_f other_config_f pairs_f)
+    repairs=(heldback_f other_config_f pairs_f/tramway pairs_f/forecourt)
 else
     benches=(heldback other_config dry_config pairs)
     repairs=(heldback other_config dry_config pairs/hill_bend pairs/crossing)

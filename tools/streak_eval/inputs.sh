@@ -42,6 +42,14 @@
 #   OUT/heldback_e/                               24 default-config samples (seed 48900), a
 #                                                 fifth held-back split
 #
+# SET=f makes the sixth set (made after the first five had been looked at):
+#
+#   OUT/scenes_f/{tramway,forecourt}.glb          built in Blender, exported by its exporter
+#   OUT/pairs_f/{tramway,forecourt}/              `streaks stereo` pairs of them
+#   OUT/other_config_f/                           3 samples of other_config_f.toml (seed 91)
+#   OUT/heldback_f/                               24 default-config samples (seed 49900), a
+#                                                 sixth held-back split
+#
 # BLENDER_PYTHON: the Python with bpy 5.0 (default target/blender-venv/bin/python);
 # STREAKS: the streaks binary (default target/release/streaks). Run from the repository root.
 # Evaluation-only inputs: no parameter may be tuned on them.
@@ -59,9 +67,9 @@ stamp() { date -u +%H:%M:%S; }
 suffix=""
 [[ "$set_name" == "a" ]] || suffix="_$set_name"
 case "$set_name" in
-    a | b | c | d | e) ;;
+    a | b | c | d | e | f) ;;
     *)
-        echo "SET must be a, b, c, d or e, not $set_name" >&2
+        echo "SET must be a, b, c, d, e or f, not $set_name" >&2
         exit 2
         ;;
 esac
@@ -133,6 +141,15 @@ case "$set_name" in
         samples other_config_e --config "$here/other_config_e.toml" --count 3 --seed 81 \
             --width 608 --height 336 --spp 24
         samples heldback_e --seed 48900 --count 24 --width 464 --height 272 --spp 16
+        ;;
+    f)
+        pair tramway --width 688 --height 400 --baseline 0.24 --exposure 3.75 --seed 6
+        # sensor_f.toml: a 16-bit dual-gain camera behind a dirty windscreen on a van.
+        pair forecourt --width 600 --height 336 --baseline 0.28 --sensor "$here/sensor_f.toml" \
+            --seed 6
+        samples other_config_f --config "$here/other_config_f.toml" --count 3 --seed 91 \
+            --width 544 --height 304 --spp 24
+        samples heldback_f --seed 49900 --count 24 --width 464 --height 272 --spp 16
         ;;
 esac
 echo "$(stamp) done: $out (set $set_name)"

@@ -25,6 +25,8 @@ INPUTS = [
     "other_config_d",
     "heldback_e",
     "other_config_e",
+    "heldback_f",
+    "other_config_f",
 ]
 PAIRS = [
     "hill_bend",
@@ -40,6 +42,8 @@ PAIRS = [
     "square",
     "quay",
     "arterial",
+    "tramway",
+    "forecourt",
 ]
 
 

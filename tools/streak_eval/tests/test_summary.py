@@ -1,9 +1,10 @@
 """summary.py's tables from a small made-up evaluate.sh folder."""
 
 import json
+import re
 from pathlib import Path
 
-from summary import tables
+from summary import INPUTS, PAIRS, tables
 
 
 def errors(phantom: float, off: float) -> dict:
@@ -77,3 +78,13 @@ def test_every_pairs_folder_and_the_recall_bins_are_tabled(tmp_path: Path) -> No
     assert "| heldback_e | 0.50 (4) / n/a / 1.00 (6) | 0.00 (2) / 0.60 (5) / 1.00 (3) |" in text
     recall_table = text.split("Streak-level recall by length")[1]
     assert "| quay |" not in recall_table
+
+
+def test_every_scored_input_has_a_row() -> None:
+    # Each folder that evaluate.sh scores (any SET) is one of summary.py's inputs or pairs.
+    script = (Path(__file__).resolve().parents[1] / "evaluate.sh").read_text(encoding="utf-8")
+    lists = re.findall(r"repairs=\(([^)]*)\)", script)
+    assert len(lists) >= 6  # the first set and SET=b .. f
+    names = {Path(entry).name for entry in " ".join(lists).split()}
+    assert {"heldback_f", "other_config_f", "tramway", "forecourt"} <= names
+    assert names <= set(INPUTS) | set(PAIRS)
