@@ -6,9 +6,13 @@
 //!    `--pixels` of its pixels give rows of [`FEATURES`]: labelled *wrong* (semi-global
 //!    matching's value more than 1 px beneath the truth or more than 2 px off), for the pixels
 //!    with a value, and *road streak* (`streaks0.png` ∩ `road0.png`), for all.
-//! 2. **Trees**: gradient boosting of each label ([`streaks_analysis::gbdt`]).
+//! 2. **Trees**: gradient boosting of each label ([`streaks_analysis::gbdt`]); then, unless
+//!    `--first-stage-only`, the second stage: the first stage's trees are trained again on
+//!    each half of the training samples and give the other half its probabilities (out of
+//!    fold, as the trees will meet streets they never saw), whose context planes
+//!    ([`StereoFeatures::context`]) join the features of a second pair of classifiers.
 //! 3. **Operating point and calibration**, over every pixel of the validation split (samples
-//!    the trees never saw, of other streets): the streak mask's smoothing, threshold and
+//!    the trees never saw, of other streets) and of every sample of the `--val-dataset`s: the streak mask's smoothing, threshold and
 //!    lower (hysteresis) threshold for `--precision`, then the whole repair, whose right
 //!    shares per `wrong` decile and per repair window are the confidence map's calibration.
 //!    The validation figures (phantom holes, off-road bad-2, densities, the streak mask's
@@ -23,8 +27,8 @@ use std::path::{Path, PathBuf};
 use streaks_analysis::benchmark::breakdown::{Bin, STREAK_LENGTH_BINS};
 use streaks_analysis::gbdt::{Dataset, TrainParams};
 use streaks_analysis::repair::{
-    is_right, robust_from_features, streak_objects, RepairCounts, RepairModel, StereoFeatures,
-    StreakHandling, FEATURES, STREAK_CONTRAST_BINS,
+    is_right, probabilities, robust_from_features, streak_objects, ContextStage, RepairCounts,
+    RepairModel, StereoFeatures, StreakHandling, FEATURES, STREAK_CONTRAST_BINS,
 };
 use streaks_analysis::sgm::{sgm, SgmParams};
 use streaks_analysis::streak_classifier::{smooth_probability, streak_mask, SMOOTHING_RADII};
@@ -65,6 +69,11 @@ pub struct Args {
     /// calibrate the confidence, comma-separated (other streets than the training split's).
     #[arg(long, default_value = "val,test", value_delimiter = ',')]
     pub val_split: Vec<String>,
+    /// Datasets whose every sample joins the validation: more streets to choose the operating
+    /// point and calibrate on than the --val-split samples of DATASETS (none of them trains
+    /// a tree).
+    #[arg(long = "val-dataset", value_name = "DIR", conflicts_with = "evaluate")]
+    pub val_datasets: Vec<PathBuf>,
     /// The precision the streak mask's threshold is chosen for, on the validation split.
     #[arg(long, default_value_t = 0.9)]
     pub precision: f64,
@@ -85,6 +94,12 @@ pub struct Args {
     /// independent and small leaves learn the training streets.
     #[arg(long, default_value_t = 500)]
     pub min_leaf: usize,
+    /// Train the first stage only. By default a second stage decides again from the
+    /// features and the first stage's probabilities pooled over columns, rows and squares,
+    /// trained on first-stage probabilities of streets those trees did not see (two folds of
+    /// the training samples): four times the trees.
+    #[arg(long)]
+    pub first_stage_only: bool,
 }
 
 /// A sample matched and described: its features, semi-global matching's map, the truth and
@@ -145,18 +160,20 @@ fn load_sample(dir: &Path) -> Result<Option<Sample>> {
     }))
 }
 
-/// Rows of every `stride`-th pixel from `offset`: (wrong rows, streak rows).
-fn rows(s: &Sample, stride: usize, offset: usize) -> (Dataset, Dataset) {
-    let mut wrong = Dataset::new(FEATURES.len());
-    let mut streak = Dataset::new(FEATURES.len());
-    let mut row = [0f32; FEATURES.len()];
+/// Rows of every `stride`-th pixel from `offset`, of the features followed by the `extra`
+/// planes: (wrong rows, streak rows).
+fn rows(s: &Sample, extra: &[Vec<f32>], stride: usize, offset: usize) -> (Dataset, Dataset) {
+    let width = FEATURES.len() + extra.len();
+    let mut wrong = Dataset::new(width);
+    let mut streak = Dataset::new(width);
+    let mut row = vec![0f32; width];
     let n = s.truth.data.len();
     for i in (offset % stride..n).step_by(stride) {
         let t = s.truth.data[i];
         if !t.is_finite() {
             continue;
         }
-        s.features.row(i, &mut row);
+        s.features.row_with(extra, i, &mut row);
         streak.push(&row, s.road_streaks.data[i] > 0.0);
         let e = s.sgm.data[i];
         if e.is_finite() && e > 0.0 {
@@ -185,40 +202,90 @@ pub fn run(args: Args) -> Result<()> {
     let Some(output) = args.output.clone() else {
         bail!("--output is needed to train");
     };
-    let (train, val, val_name) =
+    if let Some(d) = args
+        .val_datasets
+        .iter()
+        .find(|d| args.datasets.iter().any(|t| same_folder(t, d)))
+    {
+        bail!(
+            "{} is both a training dataset and a validation dataset: the validation needs streets the trees did not see",
+            d.display()
+        );
+    }
+    let (train, mut val, mut val_name) =
         training_splits(&args.datasets, &args.train_split, &args.val_split)?;
+    for d in &args.val_datasets {
+        val.extend(all_samples(d)?);
+        val_name.push_str(&format!(" and all of {}", d.display()));
+    }
     let t0 = std::time::Instant::now();
     eprintln!("matching and reading {} training samples", train.len());
-    let bar = crate::cli::progress_bar(train.len() as u64);
-    let parts = train
-        .par_iter()
-        .enumerate()
-        .map(|(k, dir)| {
-            let s = load_sample(dir).with_context(|| format!("sample {}", dir.display()))?;
-            bar.inc(1);
-            Ok(s.map(|s| {
-                let stride = s.truth.data.len().div_ceil(args.pixels);
-                rows(&s, stride, k)
-            }))
-        })
-        .collect::<Result<Vec<_>>>()?;
-    bar.finish_and_clear();
-    let skipped = parts.iter().filter(|p| p.is_none()).count();
+    let train_samples = load_samples(&train)?;
+    let skipped = train.len() - train_samples.len();
     if skipped > 0 {
         eprintln!("{skipped} training samples have no road mask and were skipped");
     }
-    let mut wrong_rows = Dataset::new(FEATURES.len());
-    let mut streak_rows = Dataset::new(FEATURES.len());
-    for (w, s) in parts.iter().flatten() {
-        wrong_rows.extend(w);
-        streak_rows.extend(s);
-    }
+    let stride = |s: &Sample| s.truth.data.len().div_ceil(args.pixels);
+    let parts: Vec<(Dataset, Dataset)> = train_samples
+        .par_iter()
+        .enumerate()
+        .map(|(k, s)| rows(s, &[], stride(s), k))
+        .collect();
+    let gather = |parts: &[(Dataset, Dataset)], take: &dyn Fn(usize) -> bool| {
+        let width = parts.first().map_or(FEATURES.len(), |p| p.0.features);
+        let (mut wrong, mut streak) = (Dataset::new(width), Dataset::new(width));
+        for (k, (w, s)) in parts.iter().enumerate() {
+            if take(k) {
+                wrong.extend(w);
+                streak.extend(s);
+            }
+        }
+        (wrong, streak)
+    };
+    let (wrong_rows, streak_rows) = gather(&parts, &|_| true);
     let wrong = train_trees("wrong", &wrong_rows, &params)?;
     let streak = train_trees("streak", &streak_rows, &params)?;
+    let mut model = RepairModel::new(wrong, streak);
+    let mut context_rows = None;
+    if !args.first_stage_only {
+        // The second stage learns from first-stage probabilities of streets those trees did
+        // not see, as it will meet them: out of fold, two folds of the training samples.
+        let mut first: Vec<Option<(GrayImage, GrayImage)>> = vec![None; train_samples.len()];
+        for fold in 0..2 {
+            eprintln!("context fold {}/2", fold + 1);
+            let (w, s) = gather(&parts, &|k| k % 2 != fold);
+            let fold_model = RepairModel::new(
+                train_trees("wrong (fold)", &w, &params)?,
+                train_trees("streak (fold)", &s, &params)?,
+            );
+            for (k, sample) in train_samples.iter().enumerate() {
+                if k % 2 == fold {
+                    first[k] = Some(probabilities(&sample.features, &sample.sgm, &fold_model));
+                }
+            }
+        }
+        let parts2: Vec<(Dataset, Dataset)> = train_samples
+            .par_iter()
+            .zip(&first)
+            .enumerate()
+            .map(|(k, (s, p))| {
+                let (wrong, streak) = p.as_ref().expect("every sample is in a fold");
+                let extra = s.features.context(&s.sgm, wrong, streak);
+                rows(s, &extra, stride(s), k)
+            })
+            .collect();
+        drop(first);
+        let (w2, s2) = gather(&parts2, &|_| true);
+        model.context = Some(ContextStage::new(
+            train_trees("wrong (second stage)", &w2, &params)?,
+            train_trees("streak (second stage)", &s2, &params)?,
+        ));
+        context_rows = Some((w2.rows(), s2.rows()));
+    }
+    drop(train_samples);
     let train_s = t0.elapsed().as_secs_f64();
     eprintln!("trained in {train_s:.1} s");
 
-    let mut model = RepairModel::new(wrong, streak);
     eprintln!("matching {} validation samples", val.len());
     let val_samples = load_samples(&val)?;
     // The streak mask's operating point: per smoothing radius, threshold and hysteresis
@@ -226,7 +293,7 @@ pub fn run(args: Args) -> Result<()> {
     // the most recall at `--precision`.
     let probabilities: Vec<GrayImage> = val_samples
         .iter()
-        .map(|s| s.features.probability(&model.streak))
+        .map(|s| probabilities(&s.features, &s.sgm, &model).1)
         .collect();
     let mut best: Option<(usize, f32, Option<f32>, f64, f64)> = None;
     for smooth in SMOOTHING_RADII {
@@ -303,12 +370,18 @@ pub fn run(args: Args) -> Result<()> {
         "train_samples": train.len() - skipped,
         "wrong_rows": wrong_rows.rows(),
         "streak_rows": streak_rows.rows(),
+        "context": context_rows.map(|(wrong, streak)| serde_json::json!({
+            "folds": 2,
+            "wrong_rows": wrong,
+            "streak_rows": streak,
+        })),
         "pixels_per_sample": args.pixels,
         "params": params,
         "images": format!("{} and {} (8-bit, luminance)", SAMPLE_NAMES.png[0], SAMPLE_NAMES.png[1]),
         "streak_truth": format!("{} ∩ {}", SAMPLE_NAMES.streak_mask[left], SAMPLE_NAMES.road_mask[left]),
         "sgm": "SgmParams::default()",
         "val_split": args.val_split,
+        "val_datasets": (!args.val_datasets.is_empty()).then(|| dataset_provenance(&args.val_datasets)),
         "val_samples": val_samples.len(),
         "target_precision": args.precision,
         "val_figures": figures,
@@ -427,6 +500,26 @@ fn by_bins(bins: &[Bin], counts: &[(usize, usize)]) -> serde_json::Value {
         .collect()
 }
 
+/// The folders of every sample of the dataset `d`.
+fn all_samples(d: &Path) -> Result<Vec<PathBuf>> {
+    let layout = Layout::new(d);
+    let ids = layout
+        .sample_ids(None)
+        .with_context(|| format!("the samples of {}", d.display()))?;
+    Ok(ids
+        .iter()
+        .map(|id| layout.sample_by_id(id).path().to_path_buf())
+        .collect())
+}
+
+/// Whether two paths name one folder (compared canonically where they exist).
+fn same_folder(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => a == b,
+    }
+}
+
 /// `--evaluate`: scores a model on datasets and pair folders.
 fn evaluate(args: &Args) -> Result<()> {
     let model = match &args.model {
@@ -443,14 +536,7 @@ fn evaluate(args: &Args) -> Result<()> {
         if Layout::new(d).dataset_json().is_file() {
             for split in &args.val_split {
                 if split == "all" {
-                    let layout = Layout::new(d);
-                    let ids = layout
-                        .sample_ids(None)
-                        .with_context(|| format!("the samples of {}", d.display()))?;
-                    dirs.extend(
-                        ids.iter()
-                            .map(|id| layout.sample_by_id(id).path().to_path_buf()),
-                    );
+                    dirs.extend(all_samples(d)?);
                 } else {
                     dirs.extend(split_samples(std::slice::from_ref(d), split)?);
                 }

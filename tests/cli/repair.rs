@@ -14,6 +14,28 @@ fn a_model_trained_on_a_dataset_is_used_and_scored() {
     let splits = t.tiny_dataset(Some("images,gt,masks"));
     assert!(splits.len() >= 2, "{splits:?}");
     let (train, val) = (splits[0], splits[1]);
+    // A second dataset whose every sample validates.
+    t.streaks(&[
+        "dataset",
+        "generate",
+        "-o",
+        "more",
+        "--count",
+        "2",
+        "--seed",
+        "9",
+        "--width",
+        "96",
+        "--height",
+        "64",
+        "--spp",
+        "4",
+        "--denoise",
+        "off",
+        "--outputs",
+        "images,gt,masks",
+    ])
+    .assert_success();
     let run = t.streaks(&[
         "train-repair",
         "ds",
@@ -23,6 +45,8 @@ fn a_model_trained_on_a_dataset_is_used_and_scored() {
         train,
         "--val-split",
         val,
+        "--val-dataset",
+        "more",
         "--rounds",
         "10",
         "--min-leaf",
@@ -33,9 +57,21 @@ fn a_model_trained_on_a_dataset_is_used_and_scored() {
     let model: Value =
         serde_json::from_str(&std::fs::read_to_string(t.join("model.json")).unwrap()).unwrap();
     assert_eq!(model["format"], "streaks-repair/1");
-    assert_eq!(model["wrong"]["trees"].as_array().unwrap().len(), 10);
-    assert_eq!(model["streak"]["trees"].as_array().unwrap().len(), 10);
+    for stage in [&model, &model["context"]] {
+        assert_eq!(stage["wrong"]["trees"].as_array().unwrap().len(), 10);
+        assert_eq!(stage["streak"]["trees"].as_array().unwrap().len(), 10);
+    }
+    assert_eq!(
+        model["context"]["features"].as_array().unwrap().len(),
+        streaks_analysis::repair::CONTEXT_FEATURES.len()
+    );
     assert_eq!(model["provenance"]["train_split"], train);
+    let val_samples = std::fs::read_to_string(t.join("ds/splits").join(format!("{val}.txt")))
+        .unwrap()
+        .split_whitespace()
+        .count();
+    assert_eq!(model["provenance"]["val_samples"], val_samples + 2);
+    assert_eq!(model["provenance"]["val_datasets"][0]["seed"], 9);
     let threshold = model["wrong_threshold"].as_f64().unwrap();
     assert!((0.0..=1.0).contains(&threshold), "{threshold}");
     for c in model["calibration"]["kept"]
@@ -119,8 +155,8 @@ fn a_model_trained_on_a_dataset_is_used_and_scored() {
     );
 }
 
-/// The refusals: one split for both, a folder that is neither a dataset nor a pair, training
-/// without `-o`.
+/// The refusals: one split for both, a folder that is neither a dataset nor a pair, one
+/// dataset that would both train and validate, training without `-o`.
 #[test]
 fn bad_arguments_are_refused_with_their_reason() {
     let t = TestDir::new();
@@ -136,6 +172,15 @@ fn bad_arguments_are_refused_with_their_reason() {
     .assert_failure_mentioning("must differ");
     t.streaks(&["train-repair", "--evaluate", "empty"])
         .assert_failure_mentioning("neither a dataset");
+    t.streaks(&[
+        "train-repair",
+        "empty",
+        "-o",
+        "m.json",
+        "--val-dataset",
+        "./empty",
+    ])
+    .assert_failure_mentioning("both a training dataset and a validation dataset");
     t.streaks(&["train-repair", "empty"])
         .assert_failure_mentioning("--output");
     t.streaks(&["train-repair", "empty", "-o", "m.json"])

@@ -42,6 +42,15 @@
 //!   road mask), smoothed and thresholded at an operating point chosen for precision on
 //!   streets the trees never saw: the streak mask.
 //!
+//! Each decides from windows a few dozen pixels wide, and a wide reflection or a long faint
+//! streak is then decided pixel by pixel, each from too little. A **second stage**
+//! ([`RepairModel::context`], [`probabilities`]) decides both again from the features and
+//! the first stage's probabilities pooled down the column, along the row and over squares,
+//! with the disparity against the surface of the values the first stage trusts
+//! ([`StereoFeatures::context`], [`CONTEXT_FEATURES`]): a region's verdict seen as a whole
+//! (auto-context). Its trees learn from first-stage probabilities of streets those trees
+//! did not see, as they will meet them.
+//!
 //! # Mask, repair, confidence ([`robust_disparity`])
 //!
 //! A value whose `wrong` probability reaches [`RepairModel::wrong_threshold`] is dropped: the
@@ -134,6 +143,32 @@ pub const FEATURES: [&str; 30] = [
     "d_minus_q90_square_r32",
     "d_change_32_rows_down",
 ];
+
+/// The names of the second stage's context features, in order ([`StereoFeatures::context`]):
+/// the first stage's probabilities at the pixel and pooled over its column, its row and
+/// squares, and the disparity against the surface of the values the first stage trusts.
+pub const CONTEXT_FEATURES: [&str; 16] = [
+    "wrong1",
+    "streak1",
+    "wrong1_column_r22",
+    "wrong1_column_r66",
+    "wrong1_row_r32",
+    "wrong1_square_r16",
+    "wrong1_square_r48",
+    "streak1_column_r22",
+    "streak1_column_r66",
+    "streak1_row_max_r8",
+    "streak1_square_r16",
+    "streak1_above_max_r4",
+    "d_minus_trusted_q75_row_r32",
+    "d_minus_trusted_q75_column_r48",
+    "d_minus_trusted_q75_square_r32",
+    "trusted_share_row_r32",
+];
+
+/// A value the first stage's `wrong` probability puts below this is trusted by the second
+/// stage's surface features.
+const TRUSTED_BELOW: f32 = 0.5;
 
 /// What went wrong.
 #[derive(Debug, thiserror::Error)]
@@ -414,7 +449,14 @@ impl StereoFeatures {
 
     /// The features of pixel `i` (`y * width + x`).
     pub fn row(&self, i: usize, out: &mut [f32; FEATURES.len()]) {
-        for (o, p) in out.iter_mut().zip(&self.planes) {
+        self.row_with(&[], i, out);
+    }
+
+    /// The features of pixel `i` followed by its values of `extra` planes (the second
+    /// stage's [`StereoFeatures::context`]); `out` holds one value per plane.
+    pub fn row_with(&self, extra: &[Vec<f32>], i: usize, out: &mut [f32]) {
+        debug_assert_eq!(out.len(), self.planes.len() + extra.len());
+        for (o, p) in out.iter_mut().zip(self.planes.iter().chain(extra)) {
             *o = p[i];
         }
     }
@@ -432,10 +474,22 @@ impl StereoFeatures {
         at: impl Fn(usize) -> bool + Sync,
         otherwise: f32,
     ) -> GrayImage {
+        self.probability_with(&[], model, at, otherwise)
+    }
+
+    /// [`StereoFeatures::probability_where`] of a model of these features followed by
+    /// `extra` planes.
+    pub fn probability_with(
+        &self,
+        extra: &[Vec<f32>],
+        model: &Model,
+        at: impl Fn(usize) -> bool + Sync,
+        otherwise: f32,
+    ) -> GrayImage {
         let data = model.probabilities_of(
             self.width * self.height,
-            FEATURES.len(),
-            |i, row| self.row(i, row.try_into().expect("one row of FEATURES")),
+            self.planes.len() + extra.len(),
+            |i, row| self.row_with(extra, i, row),
             at,
             otherwise,
         );
@@ -444,6 +498,101 @@ impl StereoFeatures {
             height: self.height,
             data,
         }
+    }
+
+    /// The second stage's context planes ([`CONTEXT_FEATURES`]) of the left view's disparity
+    /// `disp` (`inf` or <= 0: none) and the first stage's probabilities `wrong` (1 where
+    /// there is no value) and `streak` (unsmoothed).
+    ///
+    /// The first stage decides from windows of a few dozen pixels; a wide reflection or a
+    /// long faint streak is decided pixel by pixel, each from too little. Its probabilities
+    /// pooled down the column, along the row and over squares let the second stage see a
+    /// region's verdict as a whole (auto-context), and the disparities it trusts give the
+    /// surface a fooled value lies beneath.
+    pub fn context(
+        &self,
+        disp: &GrayImage,
+        wrong: &GrayImage,
+        streak: &GrayImage,
+    ) -> Vec<Vec<f32>> {
+        let (w, h) = (self.width, self.height);
+        let n = w * h;
+        let d = |i: usize| {
+            let v = disp.data[i];
+            if v.is_finite() && v > 0.0 {
+                v
+            } else {
+                f32::INFINITY
+            }
+        };
+        let trusted = GrayImage {
+            width: w,
+            height: h,
+            data: (0..n)
+                .map(|i| {
+                    if wrong.data[i] < TRUSTED_BELOW {
+                        d(i)
+                    } else {
+                        f32::INFINITY
+                    }
+                })
+                .collect(),
+        };
+        let minus = |q: &GrayImage| -> Vec<f32> {
+            (0..n)
+                .map(|i| {
+                    let v = d(i) - q.data[i];
+                    if v.is_finite() {
+                        v
+                    } else {
+                        MISSING
+                    }
+                })
+                .collect()
+        };
+        let row_q = finite_quantile(&trusted, Axis::Rows, 32, 0.75);
+        let column_q = finite_quantile(&trusted, Axis::Columns, 48, 0.75);
+        let square_q = finite_quantile(
+            &finite_quantile(&trusted, Axis::Rows, 32, 0.75),
+            Axis::Columns,
+            32,
+            0.75,
+        );
+        let trusted_share = mean(
+            &GrayImage {
+                width: w,
+                height: h,
+                data: trusted
+                    .data
+                    .iter()
+                    .map(|v| f32::from(u8::from(v.is_finite())))
+                    .collect(),
+            },
+            Axis::Rows,
+            32,
+        );
+        // A streak hangs below its light: the most streak-like pixel a few columns wide above.
+        let above = max(&max_above(streak), Axis::Rows, 4);
+        let planes = vec![
+            wrong.data.clone(),
+            streak.data.clone(),
+            mean(wrong, Axis::Columns, 22).data,
+            mean(wrong, Axis::Columns, 66).data,
+            mean(wrong, Axis::Rows, 32).data,
+            box_mean(wrong, 16).data,
+            box_mean(wrong, 48).data,
+            mean(streak, Axis::Columns, 22).data,
+            mean(streak, Axis::Columns, 66).data,
+            max(streak, Axis::Rows, 8).data,
+            box_mean(streak, 16).data,
+            above.data,
+            minus(&row_q),
+            minus(&column_q),
+            minus(&square_q),
+            trusted_share.data,
+        ];
+        debug_assert_eq!(planes.len(), CONTEXT_FEATURES.len());
+        planes
     }
 }
 
@@ -483,10 +632,61 @@ pub struct RepairModel {
     /// `None`: the plain threshold (models written before it was added).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub streak_grow_threshold: Option<f32>,
+    /// The second stage, if the model has one: `wrong` and `streak` decided again from the
+    /// features and the first stage's context ([`StereoFeatures::context`]); the thresholds
+    /// and the calibration are then the second stage's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub context: Option<ContextStage>,
     /// The confidence map's calibration.
     pub calibration: Calibration,
     /// What the model was trained on and how (free-form, for people).
     pub provenance: serde_json::Value,
+}
+
+/// A repair model's second stage: its classifiers read [`FEATURES`] followed by
+/// [`CONTEXT_FEATURES`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ContextStage {
+    /// The context feature names ([`CONTEXT_FEATURES`] when saved by this version).
+    pub features: Vec<String>,
+    /// The probability that semi-global matching's value is wrong.
+    pub wrong: Model,
+    /// The probability that a pixel is a road streak.
+    pub streak: Model,
+}
+
+impl ContextStage {
+    /// A second stage of these classifiers with this version's context features.
+    pub fn new(wrong: Model, streak: Model) -> Self {
+        Self {
+            features: CONTEXT_FEATURES.iter().map(|s| s.to_string()).collect(),
+            wrong,
+            streak,
+        }
+    }
+}
+
+/// The first stage's probabilities and, with a second stage, its context planes and the
+/// second stage's probabilities: `(wrong, unsmoothed streak)`, `wrong` at the pixels with a
+/// value of `disp` (1 elsewhere).
+pub fn probabilities(
+    features: &StereoFeatures,
+    disp: &GrayImage,
+    model: &RepairModel,
+) -> (GrayImage, GrayImage) {
+    let valid = |i: usize| disp.data[i].is_finite() && disp.data[i] > 0.0;
+    let wrong = features.probability_where(&model.wrong, valid, 1.0);
+    let streak = features.probability(&model.streak);
+    match &model.context {
+        None => (wrong, streak),
+        Some(stage) => {
+            let extra = features.context(disp, &wrong, &streak);
+            (
+                features.probability_with(&extra, &stage.wrong, valid, 1.0),
+                features.probability_with(&extra, &stage.streak, |_| true, 0.0),
+            )
+        }
+    }
 }
 
 impl RepairModel {
@@ -503,6 +703,7 @@ impl RepairModel {
             streak_threshold: 0.5,
             streak_smooth: 0,
             streak_grow_threshold: None,
+            context: None,
             calibration: Calibration {
                 kept: vec![0.5; CALIBRATION_BINS],
                 repaired: vec![0.5; FILL_RADII.len()],
@@ -557,6 +758,20 @@ impl RepairModel {
         }
         self.wrong.validate()?;
         self.streak.validate()?;
+        if let Some(stage) = &self.context {
+            let all = FEATURES.len() + CONTEXT_FEATURES.len();
+            if stage.features != CONTEXT_FEATURES
+                || stage.wrong.features != all
+                || stage.streak.features != all
+            {
+                return bad(format!(
+                    "context features {:?}, this version computes {CONTEXT_FEATURES:?}",
+                    stage.features
+                ));
+            }
+            stage.wrong.validate()?;
+            stage.streak.validate()?;
+        }
         Ok(())
     }
 
@@ -709,9 +924,8 @@ pub fn robust_from_features(
     let (w, h) = (features.width, features.height);
     let n = w * h;
     let valid = |i: usize| disp.data[i].is_finite() && disp.data[i] > 0.0;
-    let wrong = features.probability_where(&model.wrong, valid, 1.0);
-    let streak_probability =
-        smooth_probability(&features.probability(&model.streak), model.streak_smooth);
+    let (wrong, streak) = probabilities(features, disp, model);
+    let streak_probability = smooth_probability(&streak, model.streak_smooth);
     let streaks = streak_mask(
         &streak_probability,
         model.streak_threshold,
@@ -1220,9 +1434,22 @@ mod tests {
 
     /// One stump: log-odds `hi` where `feature > value`, `lo` elsewhere.
     fn stump(feature: &str, value: f32, lo: f32, hi: f32) -> Model {
-        let f = FEATURES.iter().position(|n| *n == feature).unwrap() as u16;
+        let f = FEATURES.iter().position(|n| *n == feature).unwrap();
+        stump_at(f, FEATURES.len(), value, lo, hi)
+    }
+
+    /// A second-stage stump on the context feature `feature` (see [`stump`]).
+    fn context_stump(feature: &str, value: f32, lo: f32, hi: f32) -> Model {
+        let f = CONTEXT_FEATURES.iter().position(|n| *n == feature).unwrap();
+        let all = FEATURES.len() + CONTEXT_FEATURES.len();
+        stump_at(FEATURES.len() + f, all, value, lo, hi)
+    }
+
+    /// One stump on feature index `f` of `features`.
+    fn stump_at(f: usize, features: usize, value: f32, lo: f32, hi: f32) -> Model {
+        let f = f as u16;
         Model {
-            features: FEATURES.len(),
+            features,
             base: 0.0,
             trees: vec![vec![
                 Node {
@@ -1327,6 +1554,67 @@ mod tests {
         assert!(before > 0.02 && after == 0.0, "{before} {after}");
         assert_eq!(c.streak_level(), (1.0, 1.0));
         assert!(c.repaired.iter().all(|&(right, all)| right == all));
+    }
+
+    #[test]
+    fn the_second_stage_sees_the_first_stages_verdict_pooled_and_the_trusted_surface() {
+        let (left, right, disp, truth) = scene(160, 100);
+        let f = StereoFeatures::new(&left, &right, &disp).unwrap();
+        let m = model();
+        let (wrong, streak) = probabilities(&f, &disp, &m);
+        let extra = f.context(&disp, &wrong, &streak);
+        assert_eq!(extra.len(), CONTEXT_FEATURES.len());
+        let at = |name: &str, x: usize, y: usize| {
+            extra[CONTEXT_FEATURES.iter().position(|n| *n == name).unwrap()][y * 160 + x]
+        };
+        // The first stage calls the streak wrong and a streak; pooled down its column, so
+        // does its context, and nothing does beside it.
+        assert!(at("wrong1", 61, 80) > 0.9 && at("wrong1", 100, 80) < 0.1);
+        assert!(at("wrong1_column_r22", 61, 80) > 0.9);
+        // (The streak starts at row 25, within the 133-row window.)
+        assert!(at("streak1_column_r66", 61, 80) > 0.8);
+        assert!(at("streak1_row_max_r8", 68, 80) > 0.9 && at("streak1_row_max_r8", 100, 80) < 0.1);
+        assert!(
+            at("wrong1_row_r32", 61, 80) < 0.2,
+            "{}",
+            at("wrong1_row_r32", 61, 80)
+        );
+        // The trusted values around the streak are the road: the streak's value lies beneath
+        // them by about the road's disparity; a road value is on them; no value, no feature.
+        let below = at("d_minus_trusted_q75_row_r32", 61, 80);
+        assert!((below + truth.get(61, 80) - 1.0).abs() <= 1.0, "{below}");
+        assert!(at("d_minus_trusted_q75_row_r32", 100, 80).abs() <= 1.0);
+        assert_eq!(at("d_minus_trusted_q75_column_r48", 100, 5), MISSING);
+        assert!(at("trusted_share_row_r32", 61, 80) > 0.8);
+
+        // A second stage that trusts nothing the first stage's column calls wrong, and calls a
+        // streak only what the first stage's row maximum does.
+        let mut two = m.clone();
+        two.context = Some(ContextStage::new(
+            context_stump("wrong1_column_r22", 0.5, -4.0, 4.0),
+            context_stump("streak1_row_max_r8", 0.5, -4.0, 4.0),
+        ));
+        assert!(RepairModel::from_json(&serde_json::to_string(&two).unwrap()).is_ok());
+        let (wrong2, streak2) = probabilities(&f, &disp, &two);
+        assert!(wrong2.get(61, 80) > 0.9 && wrong2.get(100, 80) < 0.1);
+        assert!(streak2.get(68, 80) > 0.9 && streak1_differs(&streak, &streak2));
+        assert_eq!(wrong2.get(100, 5), 1.0);
+        let r = robust_disparity(&left, &right, &disp, StreakHandling::Repair, &two).unwrap();
+        assert!((r.disparity.get(61, 80) - truth.get(61, 80)).abs() <= 1.0);
+
+        // A second stage of other features is refused.
+        let mut bad = two.clone();
+        bad.context.as_mut().unwrap().features.pop();
+        let e = RepairModel::from_json(&serde_json::to_string(&bad).unwrap()).unwrap_err();
+        assert!(e.to_string().contains("context features"), "{e}");
+        let mut bad = two;
+        bad.context.as_mut().unwrap().wrong = stump("contrast_31", 0.5, -4.0, 4.0);
+        assert!(RepairModel::from_json(&serde_json::to_string(&bad).unwrap()).is_err());
+    }
+
+    /// Whether the second stage's streak probability differs from the first's somewhere.
+    fn streak1_differs(first: &GrayImage, second: &GrayImage) -> bool {
+        first.data.iter().zip(&second.data).any(|(a, b)| a != b)
     }
 
     #[test]
