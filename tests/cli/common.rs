@@ -31,26 +31,7 @@ impl TestDir {
     /// `outputs` (the default groups without), and returns its non-empty splits, the one with
     /// the most samples first (splits are drawn per street).
     pub fn tiny_dataset(&self, outputs: Option<&str>) -> Vec<&'static str> {
-        let mut args = vec![
-            "dataset",
-            "generate",
-            "-o",
-            "ds",
-            "--count",
-            "6",
-            "--width",
-            "96",
-            "--height",
-            "64",
-            "--spp",
-            "4",
-            "--denoise",
-            "off",
-        ];
-        if let Some(o) = outputs {
-            args.extend(["--outputs", o]);
-        }
-        self.streaks(&args).assert_success();
+        self.generate_tiny("ds", "6", None, outputs);
         let mut splits: Vec<(usize, &str)> = ["train", "val", "test"]
             .into_iter()
             .map(|s| {
@@ -63,6 +44,40 @@ impl TestDir {
         splits.sort();
         splits.reverse();
         splits.into_iter().map(|(_, s)| s).collect()
+    }
+
+    /// Generates a dataset of `count` 96x64 samples at 4 spp without denoising into
+    /// `folder`, of `seed` if given, keeping `outputs` (the default groups without).
+    pub fn generate_tiny(
+        &self,
+        folder: &str,
+        count: &str,
+        seed: Option<&str>,
+        outputs: Option<&str>,
+    ) {
+        let mut args = vec![
+            "dataset",
+            "generate",
+            "-o",
+            folder,
+            "--count",
+            count,
+            "--width",
+            "96",
+            "--height",
+            "64",
+            "--spp",
+            "4",
+            "--denoise",
+            "off",
+        ];
+        if let Some(s) = seed {
+            args.extend(["--seed", s]);
+        }
+        if let Some(o) = outputs {
+            args.extend(["--outputs", o]);
+        }
+        self.streaks(&args).assert_success();
     }
 
     /// Runs `streaks ARGS` in this folder (CI=true: no progress bar).

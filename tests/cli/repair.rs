@@ -15,27 +15,7 @@ fn a_model_trained_on_a_dataset_is_used_and_scored() {
     assert!(splits.len() >= 2, "{splits:?}");
     let (train, val) = (splits[0], splits[1]);
     // A second dataset whose every sample validates.
-    t.streaks(&[
-        "dataset",
-        "generate",
-        "-o",
-        "more",
-        "--count",
-        "2",
-        "--seed",
-        "9",
-        "--width",
-        "96",
-        "--height",
-        "64",
-        "--spp",
-        "4",
-        "--denoise",
-        "off",
-        "--outputs",
-        "images,gt,masks",
-    ])
-    .assert_success();
+    t.generate_tiny("more", "2", Some("9"), Some("images,gt,masks"));
     let run = t.streaks(&[
         "train-repair",
         "ds",
