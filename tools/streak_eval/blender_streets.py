@@ -3088,7 +3088,7 @@ def gantry(mats, name, y: float, x_span: tuple[float, float], z: float, metal) -
 
 
 def build_toll_plaza(mats: Materials) -> None:
-    """A motorway toll plaza at night: one level, 64 m wide expanse of wet asphalt (roughness
+    """A motorway toll plaza at night: a level expanse, 68 m wide, of wet asphalt (roughness
     0.11, puddles 0.03 on a quarter; flagged as road) carrying both directions, a 0.8 m
     concrete barrier between them up to the booths; on our side eight toll lanes between nine
     booth islands 80-96 m ahead (eight more for the other direction), each island a kiosk
