@@ -1,7 +1,7 @@
 """Builds the outside night streets in Blender (bpy) and exports them with Blender's own glTF
 exporter: evaluation-only inputs for streak-robust stereo (tools/streak_eval/README.md).
 
-    BLENDER_PYTHON tools/streak_eval/blender_streets.py OUT [--set b|c|d|e|f] [--scenes quay ...]
+    BLENDER_PYTHON tools/streak_eval/blender_streets.py OUT [--set b|...|g] [--scenes quay ...]
 
 writes OUT/<scene>.glb (textures embedded) and OUT/<scene>.blend. The streets are not the
 generator's (crates/scenes): a road that bends and climbs over a crest, a crossroads with a
@@ -24,7 +24,12 @@ after the first five had been looked at): an old town's tram street, its double 
 the wet asphalt under the overhead line, lit shop windows, a tram stop's shelter lit from
 inside and an oncoming tram; a petrol station's forecourt of wet concrete with painted bays
 under a canopy of bright LED panels, pumps, a shop, and a dark road beyond, seen from a van
-through the 16-bit camera of sensor_f.toml.
+through the 16-bit camera of sensor_f.toml. `--set g` builds the seventh (made after the first
+six had been looked at): a motorway toll plaza, a wide wet expanse with booth islands, lane
+signals and a sign gantry under high masts, cars queueing ahead and many headlights coming
+through from the other side, seen through the 12-bit camera of sensor_g.toml; a narrow
+residential close with cars parked along both kerbs, brick garden walls, porch lanterns and a
+single street lamp, its wet asphalt full of large puddles.
 
 The export is the exporter's defaults plus three Include choices a user ticks: cameras,
 punctual lights and "Custom Properties" (`export_extras`): without the last one, the road
@@ -3039,6 +3044,397 @@ def build_forecourt(mats: Materials) -> None:
     camera("driver", eye, pitched(np.array([0.0, 1.0, 0.0]), 2.5), 40.0, 600, 336)
 
 
+# --- the seventh set (made after the first six had been looked at) ----------------------------
+
+#: Seventh set, linear sRGB near their blackbody, peak 1: warm-white high-mast floodlights
+#: (3300 K), the close's single LED lamp (3800 K); lane signals' green and a motorway sign's
+#: blue.
+MAST_3300 = (1.0, 0.52, 0.23)
+LED_3800 = (1.0, 0.58, 0.34)
+SIGNAL_GREEN = (0.05, 1.0, 0.3)
+SIGN_BLUE = (0.03, 0.12, 0.55)
+
+
+def high_mast(mats, name, foot: Vec3, height: float, heads: int, colour, cd, metal) -> None:
+    """A high mast at `foot`: a tapering-looking square column to `height` and a ring of
+    `heads` luminaires (`lamp_head`s of 0.7 x 0.7 m, `cd` each, pointing down) 1.2 m out."""
+    x, y, z = foot
+    tag(box(f"{name}_mast", (x - 0.3, y - 0.3, z), (x + 0.3, y + 0.3, z + height), metal), "pole")
+    tag(
+        box(
+            f"{name}_ring",
+            (x - 1.5, y - 1.5, z + height),
+            (x + 1.5, y + 1.5, z + height + 0.25),
+            metal,
+        ),
+        "pole",
+    )
+    for k in range(heads):
+        a = 2.0 * math.pi * (k + 0.5) / heads
+        centre = (x + 1.2 * math.cos(a), y + 1.2 * math.sin(a), z + height - 0.2)
+        lamp_head(mats, f"{name}_{k}", centre, (0.7, 0.7), colour, cd)
+
+
+def gantry(mats, name, y: float, x_span: tuple[float, float], z: float, metal) -> None:
+    """A sign gantry across the road at `y`: two legs at the ends of `x_span` and a truss
+    (a 0.8 x 0.8 m box) whose underside is `z` metres up."""
+    xa, xb = x_span
+    for k, x in enumerate((xa, xb)):
+        tag(
+            box(f"{name}_leg{k}", (x - 0.25, y - 0.25, 0.0), (x + 0.25, y + 0.25, z + 0.8), metal),
+            "pole",
+        )
+    tag(box(f"{name}_truss", (xa, y - 0.4, z), (xb, y + 0.4, z + 0.8), metal), "pole")
+
+
+def build_toll_plaza(mats: Materials) -> None:
+    """A motorway toll plaza at night: a level expanse, 68 m wide, of wet asphalt (roughness
+    0.11, puddles 0.03 on a quarter; flagged as road) carrying both directions, a 0.8 m
+    concrete barrier between them up to the booths; on our side eight toll lanes between nine
+    booth islands 80-96 m ahead (eight more for the other direction), each island a kiosk
+    with lit windows (60 cd/m2) under a small roof with an LED 5700 K downlight (1.2 kcd),
+    and over our lanes' entries a gantry of lane signals (green for open lanes, red for the
+    two closed ones, 250 cd/m2); a sign gantry 50 m ahead with three lit blue direction signs
+    (15 cd/m2, white lettering 40 cd/m2); five high masts (26 m, a ring of four warm-white
+    3300 K floodlights of 6 kcd each) at the plaza's edges and on the barrier's end; an admin
+    building with lit windows, grass verges and trees beyond. Many lights: six cars queueing
+    ahead with their tail lights (two braking, 60 cd), seven cars on the left that have paid
+    and drive towards us, 38-150 m ahead, with halogen, xenon and LED headlights (12-15
+    kcd); a saloon's camera 1.45 m up in a lane of the approach, looking at the booths."""
+    asphalt = mats.principled(
+        "wet_asphalt", albedo="asphalt_g", roughness_map="puddles_g", road=True
+    )
+    tag(
+        grid(
+            "plaza",
+            np.linspace(-34.0, 34.0, 35),
+            np.linspace(-10.0, 210.0, 45),
+            lambda x, y: -0.01 * abs(x + 2.5) / 34.0,
+            asphalt,
+            2.0,
+        ),
+        "road",
+    )
+    paint = mats.principled("road_paint_g", (0.62, 0.62, 0.6), roughness=0.35, road=True)
+    islands = [-1.0 + 3.8 * k for k in range(9)]
+    marks = []
+    for x in (2.8, 6.6):  # the approach's lane lines, dashed, until the lanes fan out
+        for y in np.arange(2.0, 60.0, 9.0):
+            marks.append(((x - 0.07, y), (x + 0.07, y + 3.0)))
+    for y in np.arange(0.0, 200.0, 6.0):  # the edge of the carriageway on our right
+        marks.append(((31.5, y), (31.65, y + 6.0)))
+    for k, ((xa, ya), (xb, yb)) in enumerate(marks):
+        tag(box(f"mark{k}", (xa, ya, -0.02), (xb, yb, 0.004), paint), "marking")
+    # the barrier between the directions, up to the booths
+    barrier = mats.principled("barrier_g", (0.25, 0.25, 0.24), roughness=0.7)
+    tag(box("barrier", (-2.85, -10.0, 0.0), (-2.15, 76.0, 0.8), barrier, 2.0), "wall")
+    # the booth islands: ours at islands, the other direction's mirrored to the left
+    island = mats.principled("island_g", (0.45, 0.44, 0.4), roughness=0.6)
+    kiosk = mats.principled("kiosk_g", albedo="booth_g", roughness=0.55)
+    roof = mats.principled("kiosk_roof_g", (0.5, 0.52, 0.55), roughness=0.4, metallic=0.5)
+    xs = islands + [-4.0 - 3.8 * k for k in range(8)]
+    for k, x in enumerate(xs):
+        tag(box(f"island{k}", (x - 0.9, 80.0, 0.0), (x + 0.9, 96.0, 0.2), island), "sidewalk")
+        tag(box(f"kiosk{k}", (x - 0.7, 86.0, 0.2), (x + 0.7, 89.0, 2.8), kiosk, 3.0), "building")
+        for sx in (-1.0, 1.0):
+            lo, hi = sorted((x + sx * 0.7, x + sx * 0.72))
+            glow_box(
+                mats,
+                f"kiosk_window{k}{sx:+.0f}",
+                (lo, 86.4, 1.1),
+                (hi, 88.6, 2.2),
+                COOL_WHITE,
+                60.0,
+                "building",
+            )
+        tag(box(f"kiosk_roof{k}", (x - 1.2, 84.5, 3.4), (x + 1.2, 90.5, 3.7), roof), "building")
+        lamp_head(mats, f"booth_light{k}", (x, 87.5, 3.35), (0.5, 0.5), LED_5700, 1200.0)
+    # the lane signals over our lanes' entries, and the plaza's sign gantry
+    metal = mats.principled("gantry_g", (0.35, 0.36, 0.37), roughness=0.45, metallic=0.7)
+    gantry(mats, "signal_gantry", 78.0, (-2.0, 31.0), 6.0, metal)
+    for k in range(8):
+        x = (islands[k] + islands[k + 1]) / 2.0
+        colour = RED if k in (0, 6) else SIGNAL_GREEN
+        glow_box(
+            mats,
+            f"lane_signal{k}",
+            (x - 0.35, 77.55, 5.2),
+            (x + 0.35, 77.6, 5.9),
+            colour,
+            250.0,
+            "traffic_light",
+        )
+    gantry(mats, "sign_gantry", 50.0, (-1.5, 31.5), 6.5, metal)
+    for k, (xa, xb) in enumerate(((0.5, 8.5), (11.0, 19.0), (21.5, 29.5))):
+        glow_box(
+            mats, f"sign{k}", (xa, 49.5, 7.3), (xb, 49.55, 9.8), SIGN_BLUE, 15.0, "traffic_sign"
+        )
+        glow_box(
+            mats,
+            f"sign_text{k}",
+            (xa + 1.0, 49.45, 8.2),
+            (xb - 1.0, 49.5, 8.9),
+            COOL_WHITE,
+            40.0,
+            "traffic_sign",
+        )
+    # the high masts at the edges and on the barrier's end
+    mast = mats.principled("mast_g", (0.3, 0.3, 0.31), roughness=0.5, metallic=0.6)
+    for k, (x, y) in enumerate(
+        ((33.0, 22.0), (-36.0, 40.0), (-2.5, 70.0), (33.0, 110.0), (-36.0, 130.0))
+    ):
+        high_mast(mats, f"high_mast{k}", (x, y, 0.0), 26.0, 4, MAST_3300, 6000.0, mast)
+    # verges, trees and the admin building beyond
+    grass = mats.principled("verge_g", albedo="verge_g", roughness=0.9)
+    for k, (xa, xb) in enumerate(((-300.0, -34.0), (34.0, 300.0))):
+        tag(box(f"verge{k}", (xa, -40.0, -0.6), (xb, 400.0, 0.05), grass, 3.0), "terrain")
+    tag(box("verge_end", (-34.0, 210.0, -0.6), (34.0, 400.0, 0.05), grass, 3.0), "terrain")
+    ware = mats.principled("admin_g", albedo="booth_g", roughness=0.7)
+    tag(box("admin", (42.0, 84.0, 0.0), (62.0, 98.0, 7.0), ware, 4.0), "building")
+    for j in range(5):
+        glow_box(
+            mats,
+            f"admin_window{j}",
+            (41.96, 85.5 + 2.4 * j, 1.2 + 3.0 * (j % 2)),
+            (41.99, 87.0 + 2.4 * j, 2.6 + 3.0 * (j % 2)),
+            WINDOW_WARM,
+            30.0,
+            "building",
+        )
+    rng = np.random.default_rng(171)
+    for k in range(14):
+        side = -1.0 if k % 2 else 1.0
+        x = side * float(rng.uniform(40.0, 80.0))
+        y = float(rng.uniform(110.0, 300.0)) if k > 3 else float(rng.uniform(0.0, 70.0))
+        tree(
+            mats,
+            f"tree{k}",
+            (x, y, 0.05),
+            float(rng.uniform(8.0, 14.0)),
+            k % 3 == 0,
+            40 + k,
+            leaves="verge_g",
+        )
+    # cars queueing ahead (tail lights, two braking), cars leaving on the left, oncoming
+    paints = [
+        mats.principled("paint_white_g", (0.6, 0.6, 0.58), roughness=0.3, coat=1.0),
+        mats.principled("paint_grey_g", (0.15, 0.16, 0.17), roughness=0.25, metallic=0.6, coat=1.0),
+        mats.principled("paint_red_g", (0.22, 0.02, 0.02), roughness=0.3, coat=1.0),
+        mats.principled("paint_blue_g", (0.02, 0.05, 0.16), roughness=0.3, coat=1.0),
+    ]
+    queue = (
+        (4.7, 24.0, 12.0),
+        (0.9, 42.0, 60.0),
+        (8.5, 58.0, 11.0),
+        (12.3, 71.0, 12.0),
+        (4.7, 74.0, 60.0),
+        (16.1, 69.0, 10.0),
+    )
+    for k, (x, y, cd) in enumerate(queue):
+        tw = car(mats, f"queue_car{k}", (x, y, 0.0), 0.0, paints[k % 4], 1 + k)
+        tail_lights(mats, f"queue_tail{k}", tw, 0.0, 1 + k, cd=cd)
+    oncoming = (
+        (-5.5, 38.0, HALOGEN, 13000.0),
+        (-9.5, 58.0, XENON, 15000.0),
+        (-13.5, 72.0, LED_6000, 14000.0),
+        (-7.0, 104.0, HALOGEN, 12000.0),
+        (-17.3, 100.0, XENON, 14000.0),
+        (-9.0, 150.0, LED_6000, 13000.0),
+        (-21.1, 118.0, HALOGEN, 13000.0),
+    )
+    for k, (x, y, colour, cd) in enumerate(oncoming):
+        inst = 10 + k
+        tw = car(mats, f"oncoming_car{k}", (x, y, 0.0), math.pi, paints[(k + 1) % 4], inst)
+        headlights(mats, f"oncoming_head{k}", tw, math.pi, inst, colour=colour, cd=cd, pitch=1.0)
+    eye = (4.7, 0.0, 1.45)
+    camera("driver", eye, pitched(np.array([0.0, 1.0, 0.0]), 1.2), 30.0, 784, 352)
+
+
+def porch(mats, name, door: Vec3, facing: float, lit: bool, cd: float) -> None:
+    """A house's porch at `door` (the foot of the door in the front wall, which faces +X when
+    `facing` = +1): a dark door, a small canopy, and when `lit` a porch lantern beside the door
+    (a warm glowing box and a point light of `cd` candela 0.25 m out from the wall)."""
+    x, y, z = door
+    wood_ = mats.principled("door_g", (0.12, 0.05, 0.03), roughness=0.5, coat=0.5)
+    lo, hi = sorted((x, x + facing * 0.05))
+    tag(box(f"{name}_door", (lo, y - 0.5, z), (hi, y + 0.5, z + 2.1), wood_), "building")
+    lo, hi = sorted((x, x + facing * 0.9))
+    canopy_ = mats.principled("porch_roof_g", (0.15, 0.15, 0.16), roughness=0.6)
+    tag(box(f"{name}_canopy", (lo, y - 0.9, z + 2.4), (hi, y + 0.9, z + 2.55), canopy_), "building")
+    if lit:
+        lx = x + facing * 0.2
+        glow_box(
+            mats,
+            f"{name}_lantern",
+            (lx - 0.08, y + 0.7, z + 1.9),
+            (lx + 0.08, y + 0.86, z + 2.15),
+            WINDOW_WARM,
+            3000.0,
+            "light_source",
+        )
+        point_lamp(f"{name}_light", (x + facing * 0.3, y + 0.78, z + 2.0), cd, WINDOW_WARM)
+
+
+def build_close(mats: Materials) -> None:
+    """A narrow residential street (a close) at night: a 5.6 m carriageway of wet asphalt
+    (roughness 0.16, large puddles of 0.02 over two fifths; crowned 6 cm; flagged as road),
+    cars parked along both kerbs leaving one lane between them, 1.6 m pavements, low brick
+    garden walls with gate gaps, front gardens of lawn and hedges, pairs of two-storey
+    rendered houses set 5.5 m back with a few lit windows and porches, most with a warm
+    porch lantern (60-150 cd); a single LED 3800 K street lamp (1.6 kcd, 6 m) on the right
+    pavement 34 m ahead; the street ends 96 m ahead at a T junction before a terrace; a car
+    ahead pulling away with its tail lights (12 cd). A people carrier's camera 1.55 m up on
+    the centre line (the only lane free)."""
+    half = 2.8
+    asphalt = mats.principled(
+        "wet_asphalt", albedo="asphalt_close_g", roughness_map="puddles_close_g", road=True
+    )
+    line = straight(lambda s: 0.0)
+    xs = [(float(x), crown(float(x), half, 0.06)) for x in np.linspace(-half, half, 9)]
+    tag(ribbon("road", line, np.arange(-10.0, 104.01, 1.0), xs, asphalt, 2.0), "road")
+    # the cross street at the end, a terrace facing the close
+    tag(box("cross_street", (-40.0, 96.0, -0.3), (40.0, 103.0, 0.0), asphalt, 2.0), "road")
+    flags = mats.principled("flags_g", albedo="flags_g", roughness=0.45)
+    kerb, walk = 0.12, 1.6
+    for k, sx in enumerate((-1.0, 1.0)):
+        xa, xb = sorted((sx * half, sx * (half + walk)))
+        tag(box(f"pavement{k}", (xa, -10.0, -0.3), (xb, 96.0, kerb), flags, 2.0), "sidewalk")
+    tag(box("far_pavement", (-40.0, 103.0, -0.3), (40.0, 105.0, kerb), flags, 2.0), "sidewalk")
+    brick = mats.principled("garden_wall_g", albedo="garden_wall_g", roughness=0.8)
+    lawn_ = mats.principled("garden_g", albedo="hedge_g", roughness=0.9)
+    hedge = mats.principled("hedge_g", albedo="hedge_g", roughness=0.95)
+    render = mats.principled("houses_g", albedo="houses_g", roughness=0.85)
+    roofs = mats.principled("roof_tiles_g", (0.08, 0.05, 0.045), roughness=0.6)
+    rng = np.random.default_rng(181)
+    back = half + walk + 5.5  # the houses' front walls
+    for sx in (-1.0, 1.0):
+        s, k = -10.0, 0
+        while s < 88.0:
+            width = float(rng.uniform(13.0, 16.0))  # a pair of semi-detached houses
+            tag_ = f"{'l' if sx < 0 else 'r'}{k}"
+            x_wall = sx * (half + walk)
+            xa, xb = sorted((x_wall, x_wall + sx * 0.25))
+            gates = (s + 2.0, s + width / 2.0 + 2.0)
+            edges = [s, gates[0], gates[0] + 1.2, gates[1], gates[1] + 1.2, s + width]
+            for j in range(0, len(edges), 2):
+                tag(
+                    box(
+                        f"garden_wall_{tag_}_{j}",
+                        (xa, edges[j], 0.0),
+                        (xb, edges[j + 1], 0.9),
+                        brick,
+                        1.0,
+                    ),
+                    "wall",
+                )
+            ga, gb = sorted((x_wall + sx * 0.25, sx * back))
+            tag(box(f"garden_{tag_}", (ga, s, -0.3), (gb, s + width, 0.1), lawn_, 2.0), "terrain")
+            if rng.uniform() < 0.6:
+                ha, hb = sorted((x_wall + sx * 0.3, x_wall + sx * 1.1))
+                tag(
+                    box(
+                        f"hedge_{tag_}",
+                        (ha, gates[0] + 1.4, 0.1),
+                        (hb, gates[1] - 0.2, float(rng.uniform(1.2, 1.8))),
+                        hedge,
+                        1.0,
+                    ),
+                    "vegetation",
+                )
+            fa, fb = sorted((sx * back, sx * (back + 9.0)))
+            top = float(rng.uniform(5.6, 6.4))
+            tag(
+                box(f"house_{tag_}", (fa, s + 0.5, 0.0), (fb, s + width - 0.5, top), render, 5.4),
+                "building",
+            )
+            tag(
+                box(
+                    f"roof_{tag_}",
+                    (fa - 0.3, s + 0.3, top),
+                    (fb + 0.3, s + width - 0.3, top + 0.4),
+                    roofs,
+                ),
+                "building",
+            )
+            for j, door_y in enumerate((s + 2.6, s + width - 2.6)):
+                porch(
+                    mats,
+                    f"porch_{tag_}_{j}",
+                    (sx * back, door_y, 0.1),
+                    -sx,
+                    rng.uniform() < 0.7,
+                    float(rng.uniform(60.0, 150.0)),
+                )
+            for j in range(int(rng.integers(0, 3))):
+                wy = float(rng.uniform(s + 4.0, s + width - 5.0))
+                wz = 0.9 if rng.uniform() < 0.5 else 3.7
+                lo, hi = sorted((sx * back - sx * 0.04, sx * back - sx * 0.01))
+                glow_box(
+                    mats,
+                    f"window_{tag_}_{j}",
+                    (lo, wy, wz),
+                    (hi, wy + 1.2, wz + 1.2),
+                    WINDOW_WARM,
+                    float(rng.uniform(10.0, 25.0)),
+                    "building",
+                )
+            s, k = s + width, k + 1
+    tag(box("terrace", (-40.0, 110.0, 0.0), (40.0, 119.0, 8.0), render, 4.0), "building")
+    for j, x in enumerate((-9.0, -3.5, 4.0, 11.0)):
+        glow_box(
+            mats,
+            f"terrace_window{j}",
+            (x, 109.96, 4.0),
+            (x + 1.2, 109.99, 5.3),
+            WINDOW_WARM,
+            18.0,
+            "building",
+        )
+    for k, (x, y) in enumerate(((-9.5, 20.0), (10.0, 58.0), (-10.5, 71.0))):
+        tree(
+            mats,
+            f"tree{k}",
+            (x, y, 0.1),
+            float(rng.uniform(6.0, 9.0)),
+            False,
+            60 + k,
+            leaves="hedge_g",
+        )
+    # the single street lamp
+    metal = mats.principled("lamp_metal_g", (0.1, 0.1, 0.1), roughness=0.45, metallic=0.6)
+    post_lamp(mats, "lamp", (half + 0.5, 34.0, kerb), 6.0, [(-1.1, 0.0)], LED_3800, 1600.0, metal)
+    # parked cars along both kerbs, a car pulling away
+    paints = [
+        mats.principled(
+            "paint_silver_g", (0.4, 0.41, 0.43), roughness=0.25, metallic=0.8, coat=1.0
+        ),
+        mats.principled("paint_black_g", (0.02, 0.02, 0.022), roughness=0.25, coat=1.0),
+        mats.principled("paint_white_close_g", (0.6, 0.6, 0.58), roughness=0.3, coat=1.0),
+        mats.principled("paint_green_g", (0.03, 0.1, 0.05), roughness=0.3, coat=1.0),
+        mats.principled("paint_maroon_g", (0.15, 0.02, 0.03), roughness=0.3, coat=1.0),
+    ]
+    inst = 1
+    for sx, ys in (
+        (-1.0, (9.0, 15.5, 27.0, 40.0, 47.0, 62.0, 80.0)),
+        (1.0, (12.0, 21.0, 44.0, 52.0, 67.0, 74.0)),
+    ):
+        for y in ys:
+            y_ = y + float(rng.uniform(-0.6, 0.6))
+            car(
+                mats,
+                f"parked{inst}",
+                (sx * 1.85, y_, 0.0),
+                0.0 if sx > 0 else math.pi,
+                paints[inst % 5],
+                inst,
+            )
+            inst += 1
+    tw = car(mats, "car_ahead", (0.0, 36.0, 0.05), 0.0, paints[4], inst)
+    tail_lights(mats, "taillight", tw, 0.0, inst, cd=12.0)
+    eye = (0.0, 0.0, 0.06 + 1.55)
+    camera("driver", eye, pitched(np.array([0.0, 1.0, 0.0]), 2.0), 42.0, 512, 384)
+
+
 SCENES = {
     "hill_bend": build_hill_bend,
     "crossing": build_crossing,
@@ -3060,9 +3456,13 @@ SCENES = {
     # the sixth set (made after the first five had been looked at)
     "tramway": build_tramway,
     "forecourt": build_forecourt,
+    # the seventh set (made after the first six had been looked at)
+    "toll_plaza": build_toll_plaza,
+    "close": build_close,
 }
 #: The scene sets: `--set a` (the default) builds the first, `--set b` the second, `--set c`
-#: the third, `--set d` the fourth, `--set e` the fifth, `--set f` the sixth.
+#: the third, `--set d` the fourth, `--set e` the fifth, `--set f` the sixth, `--set g` the
+#: seventh.
 SETS = {
     "a": ("hill_bend", "crossing", "tabletop"),
     "b": ("roundabout", "avenue", "shelf"),
@@ -3070,6 +3470,7 @@ SETS = {
     "d": ("bridge", "square"),
     "e": ("quay", "arterial"),
     "f": ("tramway", "forecourt"),
+    "g": ("toll_plaza", "close"),
 }
 #: The scenes with a wet road (the others have none).
 STREETS = (
@@ -3085,6 +3486,8 @@ STREETS = (
     "arterial",
     "tramway",
     "forecourt",
+    "toll_plaza",
+    "close",
 )
 #: The streets with a dry road (no streaks; their road material is `dry_asphalt`).
 DRY_STREETS = ("daylight_street",)

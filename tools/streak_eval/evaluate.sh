@@ -16,7 +16,8 @@
 # (heldback_d/, other_config_d/ and pairs_d/: bridge, square), made after the first three;
 # with SET=e the fifth (heldback_e/, other_config_e/ and pairs_e/: quay, arterial), made after
 # the first four; with SET=f the sixth (heldback_f/, other_config_f/ and pairs_f/: tramway,
-# forecourt), made after the first five.
+# forecourt), made after the first five; with SET=g the seventh (heldback_g/, other_config_g/
+# and pairs_g/: toll_plaza, close), made after the first six.
 #
 # STREAKS: the binary (default target/release/streaks); OPENCV_PYTHON: a Python with
 # opencv-python-headless (tools/opencv/requirements.txt) to add OpenCV's StereoSGBM.
@@ -51,6 +52,9 @@ elif [[ "${SET:-a}" == e ]]; then
 elif [[ "${SET:-a}" == f ]]; then
     benches=(heldback_f other_config_f pairs_f)
     repairs=(heldback_f other_config_f pairs_f/tramway pairs_f/forecourt)
+elif [[ "${SET:-a}" == g ]]; then
+    benches=(heldback_g other_config_g pairs_g)
+    repairs=(heldback_g other_config_g pairs_g/toll_plaza pairs_g/close)
 else
     benches=(heldback other_config dry_config pairs)
     repairs=(heldback other_config dry_config pairs/hill_bend pairs/crossing)

@@ -50,6 +50,14 @@
 #   OUT/heldback_f/                               24 default-config samples (seed 49900), a
 #                                                 sixth held-back split
 #
+# SET=g makes the seventh set (made after the first six had been looked at):
+#
+#   OUT/scenes_g/{toll_plaza,close}.glb           built in Blender, exported by its exporter
+#   OUT/pairs_g/{toll_plaza,close}/               `streaks stereo` pairs of them
+#   OUT/other_config_g/                           3 samples of other_config_g.toml (seed 101)
+#   OUT/heldback_g/                               24 default-config samples (seed 50900), a
+#                                                 seventh held-back split
+#
 # BLENDER_PYTHON: the Python with bpy 5.0 (default target/blender-venv/bin/python);
 # STREAKS: the streaks binary (default target/release/streaks). Run from the repository root.
 # Evaluation-only inputs: no parameter may be tuned on them.
@@ -67,9 +75,9 @@ stamp() { date -u +%H:%M:%S; }
 suffix=""
 [[ "$set_name" == "a" ]] || suffix="_$set_name"
 case "$set_name" in
-    a | b | c | d | e | f) ;;
+    a | b | c | d | e | f | g) ;;
     *)
-        echo "SET must be a, b, c, d, e or f, not $set_name" >&2
+        echo "SET must be a, b, c, d, e, f or g, not $set_name" >&2
         exit 2
         ;;
 esac
@@ -150,6 +158,15 @@ case "$set_name" in
         samples other_config_f --config "$here/other_config_f.toml" --count 3 --seed 91 \
             --width 544 --height 304 --spp 24
         samples heldback_f --seed 49900 --count 24 --width 464 --height 272 --spp 16
+        ;;
+    g)
+        # sensor_g.toml: a 12-bit large-pixel camera with a fast lens on a saloon.
+        pair toll_plaza --width 784 --height 352 --baseline 0.38 \
+            --sensor "$here/sensor_g.toml" --seed 7
+        pair close --width 512 --height 384 --baseline 0.10 --exposure 6.5 --seed 7
+        samples other_config_g --config "$here/other_config_g.toml" --count 3 --seed 101 \
+            --width 592 --height 320 --spp 24
+        samples heldback_g --seed 50900 --count 24 --width 480 --height 272 --spp 16
         ;;
 esac
 echo "$(stamp) done: $out (set $set_name)"

@@ -27,6 +27,8 @@ INPUTS = [
     "other_config_e",
     "heldback_f",
     "other_config_f",
+    "heldback_g",
+    "other_config_g",
 ]
 PAIRS = [
     "hill_bend",
@@ -44,6 +46,8 @@ PAIRS = [
     "arterial",
     "tramway",
     "forecourt",
+    "toll_plaza",
+    "close",
 ]
 
 

@@ -752,6 +752,58 @@ TEXTURES = {
         partial(lit_windows, seed=133, per_row=3, rows=2, lit=0.4, colour=(0.6, 0.55, 0.5)),
         True,
     ),
+    # seventh set (toll plaza, close)
+    "asphalt_g": (
+        partial(
+            asphalt_albedo,
+            seed=161,
+            level=0.05,
+            stone_px=1.8,
+            stone_cut=1.25,
+            tint=(0.99, 1.0, 1.02),
+        ),
+        True,
+    ),
+    "puddles_g": (
+        partial(puddle_roughness, seed=162, wet=0.11, puddle=0.03, share=0.25, blobs_per_tile=7.0),
+        False,
+    ),
+    "booth_g": (partial(facade_panels, seed=163), True),
+    "verge_g": (partial(lawn, seed=164), True),
+    "asphalt_close_g": (
+        partial(
+            asphalt_albedo,
+            seed=165,
+            level=0.042,
+            stone_px=1.3,
+            stone_cut=1.4,
+            tint=(1.02, 1.0, 0.97),
+        ),
+        True,
+    ),
+    "puddles_close_g": (
+        partial(puddle_roughness, seed=166, wet=0.16, puddle=0.02, share=0.4, blobs_per_tile=4.0),
+        False,
+    ),
+    "garden_wall_g": (
+        partial(
+            facade_blocks,
+            seed=167,
+            courses=32,
+            per_course=8,
+            colour=(0.8, 0.5, 0.38),
+            shade=0.28,
+            mortar=(0.4, 0.38, 0.35),
+            windows=False,
+        ),
+        True,
+    ),
+    "houses_g": (
+        partial(facade_plaster, seed=168, colour=(0.9, 0.92, 0.95), per_row=2, rows=2),
+        True,
+    ),
+    "flags_g": (partial(paving, seed=169, n=160, flags=5, level=0.18), True),
+    "hedge_g": (partial(lawn, seed=170), True),
 }
 
 

@@ -372,10 +372,32 @@ def test_stained_concrete_panels():
     assert np.array_equal(paving(64, seed=3), paving(64, 3, 4, 0.16, 0.04, 0.0))
 
 
+SEVENTH_SET = (
+    "asphalt_g",
+    "puddles_g",
+    "booth_g",
+    "verge_g",
+    "asphalt_close_g",
+    "puddles_close_g",
+    "garden_wall_g",
+    "houses_g",
+    "flags_g",
+    "hedge_g",
+)
+
+
+def test_garden_wall_has_no_windows_and_large_puddles():
+    lin = srgb8_to_linear(TEXTURES["garden_wall_g"][0]())
+    assert (lin.mean(axis=-1) < 0.03).mean() < 0.02
+    rough = TEXTURES["puddles_close_g"][0]()[..., 1] / 255.0
+    assert 0.3 < (rough < 0.04).mean() < 0.5  # large puddles over about two fifths
+    assert not TEXTURES["puddles_close_g"][1] and not TEXTURES["puddles_g"][1]
+
+
 @pytest.mark.parametrize(
     "new_set",
-    [THIRD_SET, FOURTH_SET, FIFTH_SET, SIXTH_SET],
-    ids=["third", "fourth", "fifth", "sixth"],
+    [THIRD_SET, FOURTH_SET, FIFTH_SET, SIXTH_SET, SEVENTH_SET],
+    ids=["third", "fourth", "fifth", "sixth", "seventh"],
 )
 def test_a_later_set_differs_from_every_other_texture(new_set):
     names = list(TEXTURES)
