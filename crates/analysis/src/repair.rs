@@ -147,7 +147,7 @@ pub const FEATURES: [&str; 30] = [
 /// The names of the second stage's context features, in order ([`StereoFeatures::context`]):
 /// the first stage's probabilities at the pixel and pooled over its column, its row and
 /// squares, and the disparity against the surface of the values the first stage trusts.
-pub const CONTEXT_FEATURES: [&str; 16] = [
+pub const CONTEXT_FEATURES: [&str; 18] = [
     "wrong1",
     "streak1",
     "wrong1_column_r22",
@@ -164,7 +164,19 @@ pub const CONTEXT_FEATURES: [&str; 16] = [
     "d_minus_trusted_q75_column_r48",
     "d_minus_trusted_q75_square_r32",
     "trusted_share_row_r32",
+    "d_minus_trusted_line_below",
+    "trusted_line_below_slope",
 ];
+
+/// The rows below a pixel whose trusted values the column's line is fitted to: from this many
+/// rows below it ...
+const LINE_GAP: usize = 6;
+
+/// ... over this many rows.
+const LINE_ROWS: usize = 64;
+
+/// The fewest trusted values a column's line is fitted to.
+const LINE_MIN: f64 = 12.0;
 
 /// A value the first stage's `wrong` probability puts below this is trusted by the second
 /// stage's surface features.
@@ -571,6 +583,7 @@ impl StereoFeatures {
             Axis::Rows,
             32,
         );
+        let (line_minus, line_slope) = trusted_line_below(&trusted, d);
         // A streak hangs below its light: the most streak-like pixel a few columns wide above.
         let above = max(&max_above(streak), Axis::Rows, 4);
         let planes = vec![
@@ -590,10 +603,60 @@ impl StereoFeatures {
             minus(&column_q),
             minus(&square_q),
             trusted_share.data,
+            line_minus,
+            line_slope,
         ];
         debug_assert_eq!(planes.len(), CONTEXT_FEATURES.len());
         planes
     }
+}
+
+/// The disparity `d(i)` of each pixel against the straight line fitted, down its column, to
+/// the `trusted` values (finite: trusted) of the [`LINE_ROWS`] rows from [`LINE_GAP`] below
+/// it, extrapolated to its row, and the line's slope (disparity per row): `(d minus line,
+/// slope)`, [`MISSING`] where the pixel has no value or fewer than [`LINE_MIN`] values fit.
+///
+/// A road's disparity grows steadily toward the camera down a column, whatever its bends and
+/// slopes over a few dozen rows, and the nearer road below a reflection is seen by both eyes;
+/// a wide reflection that fools every value of its row is a plateau beneath that line.
+fn trusted_line_below(trusted: &GrayImage, d: impl Fn(usize) -> f32) -> (Vec<f32>, Vec<f32>) {
+    let (w, h) = (trusted.width, trusted.height);
+    let mut minus = vec![MISSING; w * h];
+    let mut slope = vec![MISSING; w * h];
+    // Per column, prefix sums over rows of the trusted values' count, row, value, row
+    // squared and row times value.
+    let mut prefix = vec![[0f64; 5]; h + 1];
+    for x in 0..w {
+        for y in 0..h {
+            let v = trusted.data[y * w + x];
+            let mut p = prefix[y];
+            if v.is_finite() {
+                let (r, v) = (y as f64, f64::from(v));
+                p[0] += 1.0;
+                p[1] += r;
+                p[2] += v;
+                p[3] += r * r;
+                p[4] += r * v;
+            }
+            prefix[y + 1] = p;
+        }
+        for y in 0..h {
+            let i = y * w + x;
+            let dv = d(i);
+            let (a, b) = ((y + LINE_GAP).min(h), (y + LINE_GAP + LINE_ROWS).min(h));
+            let s: [f64; 5] = std::array::from_fn(|k| prefix[b][k] - prefix[a][k]);
+            let n = s[0];
+            let det = n * s[3] - s[1] * s[1];
+            if !dv.is_finite() || n < LINE_MIN || det <= 1e-9 {
+                continue;
+            }
+            let k = (n * s[4] - s[1] * s[2]) / det;
+            let c = (s[2] - k * s[1]) / n;
+            minus[i] = (f64::from(dv) - (c + k * y as f64)) as f32;
+            slope[i] = k as f32;
+        }
+    }
+    (minus, slope)
 }
 
 /// The calibration of the confidence map: measured shares of right values on the
@@ -1610,6 +1673,46 @@ mod tests {
         let mut bad = two;
         bad.context.as_mut().unwrap().wrong = stump("contrast_31", 0.5, -4.0, 4.0);
         assert!(RepairModel::from_json(&serde_json::to_string(&bad).unwrap()).is_err());
+    }
+
+    #[test]
+    fn the_line_below_a_plateau_shows_it_beneath_the_road() {
+        // One column: a road whose disparity grows by 0.25 px a row from row 0, with a
+        // plateau of 5 px (a reflection) over rows 40..60 that nothing trusts.
+        let (w, h) = (3, 140);
+        let road = |y: usize| 0.25 * y as f32;
+        let d = |i: usize| {
+            if (40..60).contains(&(i / w)) {
+                5.0
+            } else {
+                road(i / w)
+            }
+        };
+        let trusted = GrayImage {
+            width: w,
+            height: h,
+            data: (0..w * h)
+                .map(|i| {
+                    if (40..60).contains(&(i / w)) {
+                        f32::INFINITY
+                    } else {
+                        d(i)
+                    }
+                })
+                .collect(),
+        };
+        let (minus, slope) = trusted_line_below(&trusted, d);
+        let at = |v: &[f32], y: usize| v[y * w + 1];
+        assert!(at(&minus, 20).abs() < 1e-3 && (at(&slope, 20) - 0.25).abs() < 1e-3);
+        // On the plateau the road below predicts 0.25 px a row: the reflection is beneath it.
+        assert!(
+            (at(&minus, 50) - (5.0 - road(50))).abs() < 1e-3,
+            "{}",
+            at(&minus, 50)
+        );
+        // Too few rows below: no line.
+        assert_eq!(at(&minus, h - 10), MISSING);
+        assert_eq!(at(&slope, h - 10), MISSING);
     }
 
     /// Whether the second stage's streak probability differs from the first's somewhere.
