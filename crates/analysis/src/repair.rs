@@ -564,12 +564,8 @@ impl StereoFeatures {
         };
         let row_q = finite_quantile(&trusted, Axis::Rows, 32, 0.75);
         let column_q = finite_quantile(&trusted, Axis::Columns, 48, 0.75);
-        let square_q = finite_quantile(
-            &finite_quantile(&trusted, Axis::Rows, 32, 0.75),
-            Axis::Columns,
-            32,
-            0.75,
-        );
+        // The square's: the rows' upper quartiles, then the columns'.
+        let square_q = finite_quantile(&row_q, Axis::Columns, 32, 0.75);
         let trusted_share = mean(
             &GrayImage {
                 width: w,
