@@ -12,8 +12,9 @@
 //!    fold, as the trees will meet streets they never saw), whose context planes
 //!    ([`StereoFeatures::context`]) join the features of a second pair of classifiers.
 //! 3. **Operating point and calibration**, over every pixel of the validation split (samples
-//!    the trees never saw, of other streets) and of every sample of the `--val-dataset`s: the streak mask's smoothing, threshold and
-//!    lower (hysteresis) threshold for `--precision`, then the whole repair, whose right
+//!    the trees never saw, of other streets) and of every sample of the `--val-dataset`s:
+//!    the streak mask's smoothing, threshold and lower (hysteresis) threshold for
+//!    `--precision`, then the whole repair, whose right
 //!    shares per `wrong` decile and per repair window are the confidence map's calibration.
 //!    The validation figures (phantom holes, off-road bad-2, densities, the streak mask's
 //!    score) are printed and recorded.
