@@ -1,7 +1,7 @@
 """Builds the outside night streets in Blender (bpy) and exports them with Blender's own glTF
 exporter: evaluation-only inputs for streak-robust stereo (tools/streak_eval/README.md).
 
-    BLENDER_PYTHON tools/streak_eval/blender_streets.py OUT [--set b|...|g] [--scenes quay ...]
+    BLENDER_PYTHON tools/streak_eval/blender_streets.py OUT [--set b|...|h] [--scenes quay ...]
 
 writes OUT/<scene>.glb (textures embedded) and OUT/<scene>.blend. The streets are not the
 generator's (crates/scenes): a road that bends and climbs over a crest, a crossroads with a
@@ -29,7 +29,14 @@ six had been looked at): a motorway toll plaza, a wide wet expanse with booth is
 signals and a sign gantry under high masts, cars queueing ahead and many headlights coming
 through from the other side, seen through the 12-bit camera of sensor_g.toml; a narrow
 residential close with cars parked along both kerbs, brick garden walls, porch lanterns and a
-single street lamp, its wet asphalt full of large puddles.
+single street lamp, its wet asphalt full of large puddles. `--set h` builds the eighth (made
+after the first seven had been looked at): a town-centre street past a bus station, its
+bus bay under a long canopy of bright luminaires with lit adverts and buses standing in it,
+and on the other kerb a shopping arcade's tall lit shop windows, a cinema's lit marquee and a
+billboard, large lit surfaces near the camera whose mirror images lie wide on the wet road;
+the open top deck of a multi-storey car park, wet stained concrete with painted bays, lamp
+columns, parked cars, a stair tower and the town's blocks beyond the parapets, seen from a
+van through the 12-bit camera of sensor_h.toml.
 
 The export is the exporter's defaults plus three Include choices a user ticks: cameras,
 punctual lights and "Custom Properties" (`export_extras`): without the last one, the road
@@ -3435,6 +3442,387 @@ def build_close(mats: Materials) -> None:
     camera("driver", eye, pitched(np.array([0.0, 1.0, 0.0]), 2.0), 42.0, 512, 384)
 
 
+#: Eighth set: the bus station street's LED 2900 K lamps, its canopy's LED 4800 K luminaires
+#: and the cool 6500 K of its adverts and billboard; the car park deck's LED 5200 K columns and
+#: its stair tower's 3600 K light. Linear sRGB of the blackbody, peak 1.
+LED_2900 = (1.0, 0.464, 0.135)
+CANOPY_4800 = (1.0, 0.771, 0.579)
+ADVERT_6500 = (1.0, 0.944, 0.992)
+LED_5200 = (1.0, 0.819, 0.68)
+STAIR_3600 = (1.0, 0.594, 0.283)
+
+
+def car_paints(mats, suffix: str) -> list:
+    """Car body paints with colour and gloss (a clear coat; the grey and silver metallic)."""
+    return [
+        mats.principled(f"paint_red_{suffix}", (0.35, 0.03, 0.03), roughness=0.3, coat=1.0),
+        mats.principled(
+            f"paint_silver_{suffix}", (0.55, 0.56, 0.58), roughness=0.3, metallic=0.8, coat=1.0
+        ),
+        mats.principled(f"paint_white_{suffix}", (0.7, 0.7, 0.68), roughness=0.3, coat=1.0),
+        mats.principled(f"paint_blue_{suffix}", (0.04, 0.12, 0.35), roughness=0.3, coat=1.0),
+        mats.principled(f"paint_yellow_{suffix}", (0.6, 0.42, 0.04), roughness=0.3, coat=1.0),
+        mats.principled(
+            f"paint_grey_{suffix}", (0.2, 0.21, 0.22), roughness=0.3, metallic=0.6, coat=1.0
+        ),
+        mats.principled(f"paint_green_{suffix}", (0.05, 0.2, 0.1), roughness=0.3, coat=1.0),
+    ]
+
+
+def build_bus_station(mats: Materials) -> None:
+    """A town-centre street past a bus station at night: a level carriageway of wet asphalt
+    (roughness 0.12, puddles 0.025 on 22 %; crowned 7 cm; flagged as road) with a 2.3 m
+    parking lane on the left, and on the right a bus bay (3.3 m, 58 m long, the same asphalt)
+    along the bus station's platform; over the platform a long canopy (62 x 6.4 m, underside
+    4.2 m up) with two rows of LED 4800 K luminaires (1.5 kcd each, every 6 m), lit advert
+    panels at the platform's edge (300 cd/m2, 6500 K) and a glazed concourse lit from inside
+    (70 cd/m2) behind it; two buses standing in the bay with lit windows and tail lights. On
+    the left, near the kerb, a shopping arcade's ground floor of tall lit shop windows (4.2 x
+    3.2 m, 80-160 cd/m2, warm and cool) under offices, a cinema's marquee projecting over the
+    pavement (its lit front 350 cd/m2, a row of bulbs under it) and a lit billboard (6 x 4 m,
+    250 cd/m2) on the wall above; LED 2900 K lamps (2.6 kcd, 8 m) on both sides; cars parked
+    in the parking lane, a car ahead with tail lights (12 cd), an oncoming car (LED headlights,
+    13 kcd); a junction 104 m ahead before a terrace. A hatchback's camera 1.2 m up."""
+    asphalt = mats.principled(
+        "wet_asphalt", albedo="asphalt_h", roughness_map="puddles_h", road=True
+    )
+    left, right = -5.8, 3.5  # the kerbs (the parking lane x < -3.5)
+    centre, half = (left + right) / 2.0, (right - left) / 2.0
+    line = straight(lambda s: 0.0)
+    xs = [(float(x), crown(float(x) - centre, half, 0.07)) for x in np.linspace(left, right, 11)]
+    tag(ribbon("road", line, np.arange(-10.0, 104.01, 1.0), xs, asphalt, 2.0), "road")
+    flat = lambda x, y: 0.0  # noqa: E731
+    bay = grid(
+        "bus_bay", np.linspace(right, 6.8, 4), np.linspace(6.0, 64.0, 30), flat, asphalt, 2.0
+    )
+    tag(bay, "road")
+    tag(box("cross_street", (-60.0, 104.0, -0.3), (60.0, 114.0, 0.0), asphalt, 2.0), "road")
+    paint = mats.principled("road_paint_h", (0.6, 0.6, 0.58), roughness=0.35, road=True)
+    marks = []
+    for y in np.arange(-8.0, 100.0, 6.0):  # the centre line, dashed
+        marks.append(((centre - 0.06, y), (centre + 0.06, y + 3.0)))
+    for y in np.arange(6.5, 63.0, 1.0):  # the bus bay's edge, short dashes
+        marks.append(((right - 0.05, y), (right + 0.1, y + 0.5)))
+    for k, ((xa, ya), (xb, yb)) in enumerate(marks):
+        z = crown(min((xa + xb) / 2.0, right) - centre, half, 0.07)
+        tag(box(f"mark{k}", (xa, ya, z - 0.02), (xb, yb, z + 0.004), paint), "marking")
+    # pavements and the platform
+    flags = mats.principled("platform_h", albedo="platform_h", roughness=0.4)
+    kerb = 0.15
+    for k, (lo, hi) in enumerate(
+        (
+            ((-9.5, -10.0), (left, 104.0)),
+            ((right, -10.0), (12.5, 6.0)),
+            ((6.8, 6.0), (12.5, 64.0)),
+            ((right, 64.0), (12.5, 104.0)),
+        )
+    ):
+        tag(box(f"pavement{k}", (*lo, -0.3), (*hi, kerb), flags, 2.0), "sidewalk")
+    tag(box("far_pavement", (-60.0, 114.0, -0.3), (60.0, 117.0, kerb), flags, 2.0), "sidewalk")
+    # the bus station: canopy, luminaires, adverts, concourse
+    steel = mats.principled("canopy_h", (0.3, 0.31, 0.33), roughness=0.4, metallic=0.7)
+    tag(box("canopy", (6.4, 4.0, 4.2), (12.8, 66.0, 4.6), steel), "building")
+    for k, y in enumerate(np.arange(7.0, 64.0, 12.0)):
+        tag(box(f"canopy_column{k}", (11.6, y - 0.15, kerb), (11.9, y + 0.15, 4.2), steel), "pole")
+    for k, y in enumerate(np.arange(7.0, 64.0, 6.0)):
+        for j, x in enumerate((8.0, 10.8)):
+            lamp_head(mats, f"canopy_light{k}_{j}", (x, y, 4.05), (0.6, 1.2), CANOPY_4800, 1500.0)
+    for k, y in enumerate(np.arange(10.0, 62.0, 10.0)):
+        glow_box(
+            mats,
+            f"advert{k}",
+            (7.0, y, kerb + 0.3),
+            (7.25, y + 1.2, kerb + 2.1),
+            ADVERT_6500,
+            300.0,
+            "traffic_sign",
+        )
+    glass = mats.principled("concourse_glass_h", (0.02, 0.022, 0.025), roughness=0.05, coat=1.0)
+    tag(box("concourse_frame", (12.5, 4.0, 0.0), (24.0, 66.0, 4.2), glass, 4.0), "building")
+    glow_box(mats, "concourse", (12.45, 5.0, 0.3), (12.5, 65.0, 3.9), CANOPY_4800, 45.0, "building")
+    board = mats.principled("board_h", (0.01, 0.01, 0.012), roughness=0.3)
+    tag(box("departures", (9.0, 30.0, 2.6), (9.1, 32.4, 3.5), board), "traffic_sign")
+    glow_box(
+        mats, "departures_text", (8.97, 30.2, 2.75), (9.0, 32.2, 3.35), AMBER, 120.0, "traffic_sign"
+    )
+    offices = mats.principled("offices_h", albedo="offices_h", roughness=0.7)
+    tag(box("station_offices", (12.5, 66.0, 0.0), (24.0, 100.0, 12.0), offices, 9.0), "building")
+    # two buses in the bay with lit windows and tail lights
+    liveries = [
+        mats.principled("bus_livery_h", (0.5, 0.05, 0.04), roughness=0.3, coat=1.0),
+        mats.principled("bus_livery2_h", (0.05, 0.2, 0.45), roughness=0.3, coat=1.0),
+    ]
+    for k, y in enumerate((32.0, 52.0)):
+        inst = 20 + k
+        tw = bus(mats, f"bus{k}", (5.15, y, 0.0), 0.0, liveries[k], inst)
+        glow_box(
+            mats,
+            f"bus_windows{k}",
+            (3.88, y - 4.6, 1.35),
+            (3.9, y + 4.8, 2.6),
+            COOL_WHITE,
+            35.0,
+            "bus",
+        )
+        for j, x in enumerate((-0.9, 0.9)):
+            car_light(
+                mats, f"bus_tail{k}{j}", tw, 0.0, (x, -5.5, 0.9), -1.0, RED, 800.0, 12.0, 40.0, inst
+            )
+    # the shopping arcade on the left: shop windows, marquee, billboard, offices above
+    front = -9.5
+    tag(box("arcade", (front - 14.0, -10.0, 0.0), (front, 100.0, 16.0), offices, 9.0), "building")
+    stone = mats.principled("arcade_stone_h", (0.18, 0.17, 0.16), roughness=0.6)
+    tag(
+        box("arcade_plinth", (front, -10.0, 0.0), (front + 0.3, 100.0, 4.2), stone, 2.0), "building"
+    )
+    rng = np.random.default_rng(201)
+    k, y = 0, -8.0
+    while y < 96.0:
+        warm = rng.uniform() < 0.5
+        glow_box(
+            mats,
+            f"shop_window{k}",
+            (front + 0.3, y, 0.35),
+            (front + 0.33, y + 4.2, 3.55),
+            SHOP_WARM if warm else COOL_WHITE,
+            float(rng.choice((50.0, 80.0, 110.0))),
+            "building",
+        )
+        k, y = k + 1, y + 5.2
+    tag(box("marquee", (front, 40.0, 4.0), (-6.3, 52.0, 5.4), stone), "building")
+    glow_box(
+        mats,
+        "marquee_front",
+        (-6.32, 40.2, 4.15),
+        (-6.28, 51.8, 5.25),
+        ADVERT_6500,
+        350.0,
+        "traffic_sign",
+    )
+    for j, (ya, yb) in enumerate(((39.96, 40.0), (52.0, 52.04))):
+        glow_box(
+            mats,
+            f"marquee_end{j}",
+            (front + 0.4, ya, 4.15),
+            (-6.4, yb, 5.25),
+            ADVERT_6500,
+            350.0,
+            "traffic_sign",
+        )
+    for j, y in enumerate(np.arange(41.0, 52.0, 2.0)):
+        glow_box(
+            mats,
+            f"marquee_bulb{j}",
+            (-6.6, y - 0.06, 3.9),
+            (-6.48, y + 0.06, 4.0),
+            WINDOW_WARM,
+            3000.0,
+            "light_source",
+        )
+        point_lamp(f"marquee_bulb{j}_light", (-6.54, y, 3.85), 150.0, WINDOW_WARM)
+    glow_box(
+        mats,
+        "billboard",
+        (front + 0.02, 58.0, 6.5),
+        (front + 0.06, 64.0, 10.5),
+        ADVERT_6500,
+        250.0,
+        "traffic_sign",
+    )
+    # the terrace beyond the junction
+    tag(box("terrace", (-60.0, 118.0, 0.0), (60.0, 128.0, 11.0), offices, 9.0), "building")
+    for j, x in enumerate((-14.0, -6.0, 3.0, 9.5, 17.0)):
+        glow_box(
+            mats,
+            f"terrace_window{j}",
+            (x, 117.96, 4.5),
+            (x + 1.4, 117.99, 6.0),
+            WINDOW_WARM,
+            25.0,
+            "building",
+        )
+    # street lamps
+    metal = mats.principled("lamp_metal_h", (0.12, 0.12, 0.13), roughness=0.45, metallic=0.6)
+    for k, (x, y, dx) in enumerate(
+        (
+            (-6.3, 14.0, 1.4),
+            (-6.3, 34.0, 1.4),
+            (-6.3, 78.0, 1.4),
+            (4.0, 72.0, -1.2),
+            (4.0, 98.0, -1.2),
+        )
+    ):
+        post_lamp(mats, f"lamp{k}", (x, y, kerb), 8.0, [(dx, 0.0)], LED_2900, 2600.0, metal)
+    # cars: parked in the parking lane, one ahead, one oncoming
+    paints = car_paints(mats, "h")
+    inst = 1
+    for y in (4.0, 10.5, 24.0, 58.0, 66.0, 84.0):
+        car(
+            mats,
+            f"parked{inst}",
+            (-4.65, y + float(rng.uniform(-0.5, 0.5)), 0.0),
+            0.0,
+            paints[inst % 7],
+            inst,
+        )
+        inst += 1
+    tw = car(mats, "car_ahead", (1.75, 27.0, 0.02), 0.0, paints[2], inst)
+    tail_lights(mats, "taillight", tw, 0.0, inst, cd=12.0)
+    inst += 1
+    tw = car(mats, "oncoming", (-1.75, 74.0, 0.02), math.pi, paints[5], inst)
+    headlights(mats, "oncoming_head", tw, math.pi, inst, colour=LED_6000, cd=13000.0, pitch=1.0)
+    eye = (1.75, 0.0, crown(1.75 - centre, half, 0.07) + 1.2)
+    camera("driver", eye, pitched(np.array([0.0, 1.0, 0.0]), 1.5), 34.0, 736, 384)
+
+
+def build_car_park_deck(mats: Materials) -> None:
+    """The open top deck of a multi-storey car park at night, 15 m above the town: 42 x 84 m
+    of wet concrete in 2.5 m panels with oil stains (roughness 0.18, puddles 0.03 on 30 %,
+    falling gently to the edges; flagged as road, material `wet_deck`), three aisles between
+    rows of painted bays (2.5 x 5 m), lamp columns (6 m, two LED 5200 K heads of 2 kcd each)
+    every 16 m along the back-to-back bays, 1.1 m concrete parapets, a stair and lift tower
+    with lit glazing (3600 K, 60 cd/m2), a green exit sign and a lit car park sign; beyond the
+    parapets the town's taller blocks with lit windows; nine cars parked in the bays (painted,
+    glossy), a car driving away to the exit with its tail lights (12 cd) and one coming down
+    our aisle towards us (LED headlights, 12 kcd). A van's camera 1.7 m up in the middle
+    aisle."""
+    deck = mats.principled("wet_deck", albedo="deck_h", roughness_map="deck_wet_h", road=True)
+    fall = lambda x, y: -0.12 * abs(x) / 21.0 - 0.002 * y  # noqa: E731
+    tag(
+        grid("deck", np.linspace(-21.0, 21.0, 22), np.linspace(-10.0, 78.0, 45), fall, deck, 10.0),
+        "road",
+    )
+    paint = mats.principled("bay_paint_h", (0.65, 0.65, 0.6), roughness=0.35, road=True)
+    marks = []
+    for xa, xb in (
+        (-19.0, -14.0),
+        (-8.0, -3.0),
+        (-13.0, -8.0),
+        (3.0, 8.0),
+        (8.0, 13.0),
+        (14.0, 19.0),
+    ):
+        for y in np.arange(0.0, 62.6, 2.5):
+            marks.append(((xa, y - 0.05), (xb, y + 0.05)))
+    for x in (-8.0, 8.0):  # the line between back-to-back bays
+        marks.append(((x - 0.05, 0.0), (x + 0.05, 62.5)))
+    for k, ((xa, ya), (xb, yb)) in enumerate(marks):
+        z = fall((xa + xb) / 2.0, (ya + yb) / 2.0)
+        tag(box(f"mark{k}", (xa, ya, z - 0.02), (xb, yb, z + 0.004), paint), "marking")
+    # parapets and the stair tower
+    parapet = mats.principled("parapet_h", albedo="parapet_h", roughness=0.75)
+    for k, (lo, hi) in enumerate(
+        (
+            ((-21.5, -10.0), (-21.0, 78.0)),
+            ((21.0, -10.0), (21.5, 78.0)),
+            ((-21.5, 78.0), (21.5, 78.5)),
+        )
+    ):
+        tag(box(f"parapet{k}", (*lo, -0.3), (*hi, 1.1), parapet, 3.0), "wall")
+    tag(box("stair_tower", (14.0, 68.0, -0.3), (21.0, 78.0, 7.5), parapet, 3.0), "building")
+    glow_box(
+        mats, "stair_glazing", (13.96, 70.0, 0.4), (14.0, 76.5, 6.8), STAIR_3600, 60.0, "building"
+    )
+    glow_box(
+        mats,
+        "exit_sign",
+        (13.9, 68.5, 2.4),
+        (13.95, 69.7, 2.8),
+        SIGNAL_GREEN,
+        150.0,
+        "traffic_sign",
+    )
+    glow_box(
+        mats,
+        "car_park_sign",
+        (13.9, 70.5, 6.9),
+        (13.95, 72.5, 7.4),
+        (0.05, 0.25, 1.0),
+        120.0,
+        "traffic_sign",
+    )
+    tag(box("ramp_wall", (-21.0, 64.0, -0.3), (-13.0, 64.3, 1.1), parapet, 3.0), "wall")
+    # lamp columns
+    metal = mats.principled("lamp_metal_h2", (0.35, 0.36, 0.37), roughness=0.45, metallic=0.7)
+    k = 0
+    for x in (-8.0, 8.0):
+        for y in (5.0, 21.0, 37.0, 53.0):
+            post_lamp(
+                mats,
+                f"column{k}",
+                (x, y, fall(x, y)),
+                6.0,
+                [(-0.7, 0.0), (0.7, 0.0)],
+                LED_5200,
+                2000.0,
+                metal,
+            )
+            k += 1
+    # the town beyond: blocks with lit windows
+    town = mats.principled("town_h", albedo="skyline_h", roughness=0.8)
+    rng = np.random.default_rng(211)
+    blocks = (
+        (-90.0, 120.0, 30.0, 30.0),
+        (-20.0, 170.0, 40.0, 40.0),
+        (40.0, 140.0, 25.0, 24.0),
+        (110.0, 90.0, 30.0, 36.0),
+        (-120.0, 40.0, 25.0, 22.0),
+        (90.0, 10.0, 20.0, 28.0),
+        (10.0, 260.0, 60.0, 52.0),
+        (-60.0, 230.0, 30.0, 45.0),
+    )
+    for k, (x, y, w, top) in enumerate(blocks):
+        tag(
+            box(
+                f"block{k}",
+                (x - w / 2, y - w / 2, -15.0),
+                (x + w / 2, y + w / 2, top - 15.0),
+                town,
+                12.0,
+            ),
+            "building",
+        )
+        face = y - w / 2 - 0.03  # the face towards the deck
+        for j in range(int(rng.integers(6, 12))):
+            wx = float(rng.uniform(x - w / 2 + 1.0, x + w / 2 - 3.0))
+            wz = float(rng.uniform(-12.0, top - 17.0))
+            glow_box(
+                mats,
+                f"block_window{k}_{j}",
+                (wx, face, wz),
+                (wx + 1.6, face + 0.02, wz + 1.3),
+                WINDOW_WARM if rng.uniform() < 0.6 else COOL_WHITE,
+                float(rng.uniform(15.0, 40.0)),
+                "building",
+            )
+    # parked cars (nose in, across the bays), a car leaving, a car coming down our aisle
+    paints = car_paints(mats, "deck")
+    inst = 1
+    for x, y in (
+        (-5.5, 3.75),
+        (-5.5, 13.75),
+        (-5.5, 16.25),
+        (-5.5, 36.25),
+        (5.5, 8.75),
+        (5.5, 26.25),
+        (5.5, 28.75),
+        (10.5, 21.25),
+        (-10.5, 43.75),
+    ):
+        heading = math.pi / 2.0 if x < 0 else -math.pi / 2.0
+        if abs(x) > 8.0:
+            heading = -heading
+        car(mats, f"parked{inst}", (x, y, fall(x, y)), heading, paints[inst % 7], inst)
+        inst += 1
+    tw = car(mats, "leaving", (1.4, 33.0, fall(1.4, 33.0)), 0.0, paints[3], inst)
+    tail_lights(mats, "taillight", tw, 0.0, inst, cd=12.0)
+    inst += 1
+    tw = car(mats, "coming", (-1.5, 50.0, fall(1.5, 50.0)), math.pi, paints[1], inst)
+    headlights(mats, "coming_head", tw, math.pi, inst, colour=LED_6000, cd=12000.0, pitch=1.5)
+    eye = (0.9, 0.0, fall(0.9, 0.0) + 1.7)
+    camera("driver", eye, pitched(np.array([0.0, 1.0, 0.0]), 2.0), 42.0, 624, 416)
+
+
 SCENES = {
     "hill_bend": build_hill_bend,
     "crossing": build_crossing,
@@ -3459,10 +3847,13 @@ SCENES = {
     # the seventh set (made after the first six had been looked at)
     "toll_plaza": build_toll_plaza,
     "close": build_close,
+    # the eighth set (made after the first seven had been looked at)
+    "bus_station": build_bus_station,
+    "car_park_deck": build_car_park_deck,
 }
 #: The scene sets: `--set a` (the default) builds the first, `--set b` the second, `--set c`
 #: the third, `--set d` the fourth, `--set e` the fifth, `--set f` the sixth, `--set g` the
-#: seventh.
+#: seventh, `--set h` the eighth.
 SETS = {
     "a": ("hill_bend", "crossing", "tabletop"),
     "b": ("roundabout", "avenue", "shelf"),
@@ -3471,6 +3862,7 @@ SETS = {
     "e": ("quay", "arterial"),
     "f": ("tramway", "forecourt"),
     "g": ("toll_plaza", "close"),
+    "h": ("bus_station", "car_park_deck"),
 }
 #: The scenes with a wet road (the others have none).
 STREETS = (
@@ -3488,6 +3880,8 @@ STREETS = (
     "forecourt",
     "toll_plaza",
     "close",
+    "bus_station",
+    "car_park_deck",
 )
 #: The streets with a dry road (no streaks; their road material is `dry_asphalt`).
 DRY_STREETS = ("daylight_street",)
@@ -3498,6 +3892,7 @@ ROAD_MATERIAL = {
     "daylight_street": "dry_asphalt",
     "quay": "wet_cobbles",
     "forecourt": "wet_concrete",
+    "car_park_deck": "wet_deck",
 }
 
 

@@ -17,7 +17,9 @@
 # with SET=e the fifth (heldback_e/, other_config_e/ and pairs_e/: quay, arterial), made after
 # the first four; with SET=f the sixth (heldback_f/, other_config_f/ and pairs_f/: tramway,
 # forecourt), made after the first five; with SET=g the seventh (heldback_g/, other_config_g/
-# and pairs_g/: toll_plaza, close), made after the first six.
+# and pairs_g/: toll_plaza, close), made after the first six; with SET=h the eighth
+# (heldback_h/, other_config_h/ and pairs_h/: bus_station, car_park_deck), made after the
+# first seven.
 #
 # STREAKS: the binary (default target/release/streaks); OPENCV_PYTHON: a Python with
 # opencv-python-headless (tools/opencv/requirements.txt) to add OpenCV's StereoSGBM.
@@ -55,6 +57,9 @@ elif [[ "${SET:-a}" == f ]]; then
 elif [[ "${SET:-a}" == g ]]; then
     benches=(heldback_g other_config_g pairs_g)
     repairs=(heldback_g other_config_g pairs_g/toll_plaza pairs_g/close)
+elif [[ "${SET:-a}" == h ]]; then
+    benches=(heldback_h other_config_h pairs_h)
+    repairs=(heldback_h other_config_h pairs_h/bus_station pairs_h/car_park_deck)
 else
     benches=(heldback other_config dry_config pairs)
     repairs=(heldback other_config dry_config pairs/hill_bend pairs/crossing)

@@ -58,6 +58,14 @@
 #   OUT/heldback_g/                               24 default-config samples (seed 50900), a
 #                                                 seventh held-back split
 #
+# SET=h makes the eighth set (made after the first seven had been looked at):
+#
+#   OUT/scenes_h/{bus_station,car_park_deck}.glb  built in Blender, exported by its exporter
+#   OUT/pairs_h/{bus_station,car_park_deck}/      `streaks stereo` pairs of them
+#   OUT/other_config_h/                           3 samples of other_config_h.toml (seed 111)
+#   OUT/heldback_h/                               24 default-config samples (seed 51900), an
+#                                                 eighth held-back split
+#
 # BLENDER_PYTHON: the Python with bpy 5.0 (default target/blender-venv/bin/python);
 # STREAKS: the streaks binary (default target/release/streaks). Run from the repository root.
 # Evaluation-only inputs: no parameter may be tuned on them.
@@ -75,9 +83,9 @@ stamp() { date -u +%H:%M:%S; }
 suffix=""
 [[ "$set_name" == "a" ]] || suffix="_$set_name"
 case "$set_name" in
-    a | b | c | d | e | f | g) ;;
+    a | b | c | d | e | f | g | h) ;;
     *)
-        echo "SET must be a, b, c, d, e, f or g, not $set_name" >&2
+        echo "SET must be a, b, c, d, e, f, g or h, not $set_name" >&2
         exit 2
         ;;
 esac
@@ -167,6 +175,15 @@ case "$set_name" in
         samples other_config_g --config "$here/other_config_g.toml" --count 3 --seed 101 \
             --width 592 --height 320 --spp 24
         samples heldback_g --seed 50900 --count 24 --width 480 --height 272 --spp 16
+        ;;
+    h)
+        pair bus_station --width 736 --height 384 --baseline 0.16 --exposure 3 --seed 8
+        # sensor_h.toml: a 12-bit camera with a slow lens behind a tinted windscreen on a van.
+        pair car_park_deck --width 624 --height 416 --baseline 0.27 \
+            --sensor "$here/sensor_h.toml" --seed 8
+        samples other_config_h --config "$here/other_config_h.toml" --count 3 --seed 111 \
+            --width 560 --height 304 --spp 24
+        samples heldback_h --seed 51900 --count 24 --width 496 --height 288 --spp 16
         ;;
 esac
 echo "$(stamp) done: $out (set $set_name)"

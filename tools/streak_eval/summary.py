@@ -29,6 +29,8 @@ INPUTS = [
     "other_config_f",
     "heldback_g",
     "other_config_g",
+    "heldback_h",
+    "other_config_h",
 ]
 PAIRS = [
     "hill_bend",
@@ -48,6 +50,8 @@ PAIRS = [
     "forecourt",
     "toll_plaza",
     "close",
+    "bus_station",
+    "car_park_deck",
 ]
 
 

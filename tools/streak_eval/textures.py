@@ -804,6 +804,41 @@ TEXTURES = {
     ),
     "flags_g": (partial(paving, seed=169, n=160, flags=5, level=0.18), True),
     "hedge_g": (partial(lawn, seed=170), True),
+    # eighth set (bus station, car park deck)
+    "asphalt_h": (
+        partial(
+            asphalt_albedo,
+            seed=191,
+            level=0.046,
+            stone_px=2.0,
+            stone_cut=1.15,
+            tint=(1.0, 1.0, 1.0),
+        ),
+        True,
+    ),
+    "puddles_h": (
+        partial(puddle_roughness, seed=192, wet=0.12, puddle=0.025, share=0.22, blobs_per_tile=6.0),
+        False,
+    ),
+    "platform_h": (partial(paving, seed=193, n=192, flags=4, level=0.22, spread=0.03), True),
+    "arcade_h": (partial(shopfronts, seed=194, shops=3), True),
+    "offices_h": (
+        partial(lit_windows, seed=195, per_row=5, rows=3, lit=0.25, colour=(0.5, 0.52, 0.55)),
+        True,
+    ),
+    "deck_h": (
+        partial(paving, seed=196, n=256, flags=4, level=0.24, spread=0.025, stains=0.3),
+        True,
+    ),
+    "deck_wet_h": (
+        partial(puddle_roughness, seed=197, wet=0.18, puddle=0.03, share=0.3, blobs_per_tile=7.0),
+        False,
+    ),
+    "parapet_h": (partial(board_concrete, seed=198, boards=3, level=0.28), True),
+    "skyline_h": (
+        partial(lit_windows, seed=199, per_row=8, rows=6, lit=0.3, colour=(0.45, 0.45, 0.5)),
+        True,
+    ),
 }
 
 

@@ -394,10 +394,31 @@ def test_garden_wall_has_no_windows_and_large_puddles():
     assert not TEXTURES["puddles_close_g"][1] and not TEXTURES["puddles_g"][1]
 
 
+EIGHTH_SET = (
+    "asphalt_h",
+    "puddles_h",
+    "platform_h",
+    "arcade_h",
+    "offices_h",
+    "deck_h",
+    "deck_wet_h",
+    "parapet_h",
+    "skyline_h",
+)
+
+
+def test_car_park_deck_is_stained_wet_concrete():
+    lin = srgb8_to_linear(TEXTURES["deck_h"][0]()).mean(axis=-1)
+    assert 0.12 < np.median(lin) < 0.4  # light concrete, not asphalt
+    rough = TEXTURES["deck_wet_h"][0]()[..., 1] / 255.0
+    assert 0.15 < (rough < 0.06).mean() < 0.45  # standing water over about a third
+    assert not TEXTURES["deck_wet_h"][1] and not TEXTURES["puddles_h"][1]
+
+
 @pytest.mark.parametrize(
     "new_set",
-    [THIRD_SET, FOURTH_SET, FIFTH_SET, SIXTH_SET, SEVENTH_SET],
-    ids=["third", "fourth", "fifth", "sixth", "seventh"],
+    [THIRD_SET, FOURTH_SET, FIFTH_SET, SIXTH_SET, SEVENTH_SET, EIGHTH_SET],
+    ids=["third", "fourth", "fifth", "sixth", "seventh", "eighth"],
 )
 def test_a_later_set_differs_from_every_other_texture(new_set):
     names = list(TEXTURES)
