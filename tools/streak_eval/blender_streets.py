@@ -1,7 +1,7 @@
 """Builds the outside night streets in Blender (bpy) and exports them with Blender's own glTF
 exporter: evaluation-only inputs for streak-robust stereo (tools/streak_eval/README.md).
 
-    BLENDER_PYTHON tools/streak_eval/blender_streets.py OUT [--set b|...|h] [--scenes quay ...]
+    BLENDER_PYTHON tools/streak_eval/blender_streets.py OUT [--set b|...|i] [--scenes quay ...]
 
 writes OUT/<scene>.glb (textures embedded) and OUT/<scene>.blend. The streets are not the
 generator's (crates/scenes): a road that bends and climbs over a crest, a crossroads with a
@@ -36,7 +36,13 @@ and on the other kerb a shopping arcade's tall lit shop windows, a cinema's lit 
 billboard, large lit surfaces near the camera whose mirror images lie wide on the wet road;
 the open top deck of a multi-storey car park, wet stained concrete with painted bays, lamp
 columns, parked cars, a stair tower and the town's blocks beyond the parapets, seen from a
-van through the 12-bit camera of sensor_h.toml.
+van through the 12-bit camera of sensor_h.toml. `--set i` builds the ninth (made after the
+first eight had been looked at): a boulevard past a grand hotel whose porte-cochere over its
+drive has a glowing soffit, gold downlights and a lit fascia, opposite a car showroom's open
+glass front into a brightly lit hall, large lit surfaces near the camera whose mirror images
+lie wide on the wet road, seen from a low saloon; a mountain road climbing through a cutting
+into a tunnel portal, the tunnel's lit interior (light lined walls, rows of luminaires)
+bending away ahead, seen from a lorry through the 12-bit camera of sensor_i.toml.
 
 The export is the exporter's defaults plus three Include choices a user ticks: cameras,
 punctual lights and "Custom Properties" (`export_extras`): without the last one, the road
@@ -3823,6 +3829,557 @@ def build_car_park_deck(mats: Materials) -> None:
     camera("driver", eye, pitched(np.array([0.0, 1.0, 0.0]), 2.0), 42.0, 624, 416)
 
 
+LED_3200 = (1.0, 0.52, 0.19)
+GOLD_2500 = (1.0, 0.36, 0.065)
+SHOWROOM_5500 = (1.0, 0.84, 0.72)
+LED_4400 = (1.0, 0.75, 0.52)
+SIGN_GOLD = (1.0, 0.6, 0.12)
+SOS_BLUE = (0.05, 0.3, 1.0)
+
+
+def build_hotel_front(mats: Materials) -> None:
+    """A boulevard past a grand hotel at night: a level carriageway of wet asphalt (8.4 m,
+    two lanes and cycle strips; roughness 0.13, puddles 0.022 on a quarter; crowned 6 cm;
+    flagged as road). On the right the hotel's drive (6.5 x 32 m of wet granite setts,
+    flagged as road, material `hotel_drive`) under a porte-cochere (9 x 16 m, underside 4.6 m
+    up) whose soffit glows (70 cd/m2, 2500 K) with twelve gold downlights (1.2 kcd each) and
+    whose fascia along the road and ends are lit (400 cd/m2); the lobby's tall glazing lit
+    from inside (60 cd/m2) behind it, a restaurant's lit windows, a lit blade sign and a name
+    sign on the tower, a few lit rooms; two taxis in the drive. On the left, 4.5 m from the
+    kerb, a car showroom's open glass front (42 x 6 m, mullions every 3 m) into a hall 9 m
+    deep lit by ceiling strips (500 cd/m2, 5500 K) and a glowing back wall (45 cd/m2) over a
+    glossy floor with five display cars, under a lit blue brand band (200 cd/m2). LED 3200 K
+    lamps (2.4 kcd, 9 m) on both sides; a car ahead with tail lights (12 cd), an oncoming car
+    (halogen headlights, 14 kcd), a car parked by the showroom; a junction 110 m ahead before
+    a terrace. A low saloon's camera 1.1 m up."""
+    asphalt = mats.principled(
+        "wet_asphalt", albedo="asphalt_i", roughness_map="puddles_i", road=True
+    )
+    left, right = -4.2, 4.2
+    half = right
+    line = straight(lambda s: 0.0)
+    xs = [(float(x), crown(float(x), half, 0.06)) for x in np.linspace(left, right, 11)]
+    tag(ribbon("road", line, np.arange(-10.0, 110.01, 1.0), xs, asphalt, 2.0), "road")
+    tag(box("cross_street", (-70.0, 110.0, -0.3), (70.0, 120.0, 0.0), asphalt, 2.0), "road")
+    paint = mats.principled("road_paint_i", (0.62, 0.62, 0.6), roughness=0.35, road=True)
+    marks = []
+    for y in np.arange(-8.0, 106.0, 9.0):  # the centre line, long dashes
+        marks.append(((-0.07, y), (0.07, y + 4.5)))
+    for x in (-3.0, 3.0):  # the cycle strips' lines, solid
+        marks.append(((x - 0.06, -10.0), (x + 0.06, 108.0)))
+    for k, ((xa, ya), (xb, yb)) in enumerate(marks):
+        z = crown((xa + xb) / 2.0, half, 0.06)
+        tag(box(f"mark{k}", (xa, ya, z - 0.02), (xb, yb, z + 0.004), paint), "marking")
+    # the hotel's drive under the porte-cochere, flush with the road
+    drive = mats.principled("hotel_drive", albedo="drive_i", roughness_map="drive_wet_i", road=True)
+    flat = lambda x, y: 0.0  # noqa: E731
+    tag(
+        grid("drive", np.linspace(right, 10.7, 5), np.linspace(10.0, 42.0, 17), flat, drive, 1.5),
+        "road",
+    )
+    flags = mats.principled("flags_i", albedo="flags_i", roughness=0.35)
+    kerb = 0.14
+    for k, (lo, hi) in enumerate(
+        (
+            ((-8.7, -10.0), (left, 110.0)),
+            ((right, -10.0), (14.0, 10.0)),
+            ((10.7, 10.0), (14.0, 42.0)),
+            ((right, 42.0), (14.0, 110.0)),
+        )
+    ):
+        tag(box(f"pavement{k}", (*lo, -0.3), (*hi, kerb), flags, 2.0), "sidewalk")
+    tag(box("far_pavement", (-70.0, 120.0, -0.3), (70.0, 123.0, kerb), flags, 2.0), "sidewalk")
+    # the porte-cochere: slab, columns, glowing soffit, downlights, lit fascia
+    stone = mats.principled("hotel_stone_i", (0.42, 0.38, 0.32), roughness=0.5)
+    tag(box("porte_cochere", (4.6, 18.0, 4.6), (13.6, 34.0, 5.5), stone), "building")
+    for k, (x, y) in enumerate(((5.0, 18.6), (5.0, 33.4), (13.2, 18.6), (13.2, 33.4))):
+        tag(
+            box(f"pc_column{k}", (x - 0.25, y - 0.25, 0.0), (x + 0.25, y + 0.25, 4.6), stone),
+            "pole",
+        )
+    glow_box(mats, "pc_soffit", (5.2, 18.6, 4.56), (13.0, 33.4, 4.6), GOLD_2500, 70.0, "building")
+    k = 0
+    for x in (6.6, 9.1, 11.6):
+        for y in (20.5, 24.2, 27.8, 31.5):
+            lamp_head(mats, f"pc_light{k}", (x, y, 4.4), (0.5, 0.5), GOLD_2500, 1200.0)
+            k += 1
+    glow_box(
+        mats, "pc_fascia", (4.55, 18.0, 4.75), (4.6, 34.0, 5.35), SIGN_GOLD, 400.0, "traffic_sign"
+    )
+    for j, (ya, yb) in enumerate(((17.95, 18.0), (34.0, 34.05))):
+        glow_box(
+            mats,
+            f"pc_fascia_end{j}",
+            (4.6, ya, 4.75),
+            (13.6, yb, 5.35),
+            SIGN_GOLD,
+            400.0,
+            "traffic_sign",
+        )
+    # the hotel: tower, lobby glazing, restaurant, signs, lit rooms
+    hotel = mats.principled("hotel_i", albedo="hotel_i", roughness=0.6)
+    tag(box("hotel", (14.0, 2.0, 0.0), (36.0, 64.0, 42.0), hotel, 8.0), "building")
+    glow_box(mats, "lobby", (13.95, 17.0, 0.2), (14.0, 35.0, 6.5), WINDOW_WARM, 60.0, "building")
+    for j, y in enumerate(np.arange(43.0, 61.0, 4.5)):
+        glow_box(
+            mats,
+            f"restaurant{j}",
+            (13.95, y, 0.6),
+            (14.0, y + 3.6, 3.6),
+            SHOP_WARM,
+            60.0,
+            "building",
+        )
+    glow_box(
+        mats, "blade_sign", (13.2, 14.6, 6.5), (13.95, 15.0, 15.5), SIGN_GOLD, 250.0, "traffic_sign"
+    )
+    glow_box(
+        mats, "name_sign", (13.9, 20.0, 36.0), (13.95, 32.0, 39.0), SIGN_GOLD, 300.0, "traffic_sign"
+    )
+    rng = np.random.default_rng(241)
+    for j in range(28):
+        y = float(rng.uniform(3.0, 61.0))
+        z = float(2.67 * int(rng.integers(3, 14)) + 0.3)
+        glow_box(
+            mats,
+            f"room{j}",
+            (13.96, y, z),
+            (13.99, y + 1.4, z + 1.5),
+            WINDOW_WARM if rng.uniform() < 0.7 else COOL_WHITE,
+            float(rng.uniform(12.0, 35.0)),
+            "building",
+        )
+    # the car showroom on the left: glass front, mullions, brand band, panels above
+    front = -8.7
+    panels = mats.principled("showroom_i", albedo="showroom_i", roughness=0.45)
+    deep = front - 9.0  # the showroom's back wall
+    for j, (lo, hi) in enumerate(
+        (
+            ((front - 30.0, 4.0, 6.4), (front, 48.0, 9.0)),
+            ((front - 30.0, 4.0, 0.0), (deep, 48.0, 6.4)),
+            ((deep, 4.0, 0.0), (front, 5.0, 6.4)),
+            ((deep, 47.0, 0.0), (front, 48.0, 6.4)),
+        )
+    ):
+        tag(box(f"showroom{j}", lo, hi, panels, 6.0), "building")
+    tiles = mats.principled("showroom_floor_i", (0.55, 0.55, 0.56), roughness=0.12, coat=0.5)
+    tag(box("showroom_floor", (deep, 5.0, -0.3), (front, 47.0, 0.1), tiles, 1.0), "building")
+    glow_box(
+        mats,
+        "showroom_back",
+        (deep, 5.0, 0.1),
+        (deep + 0.04, 47.0, 6.4),
+        SHOWROOM_5500,
+        45.0,
+        "building",
+    )
+    for j, x in enumerate(np.arange(deep + 1.0, front, 2.0)):
+        glow_box(
+            mats,
+            f"showroom_ceiling{j}",
+            (x - 0.2, 5.5, 6.34),
+            (x + 0.2, 46.5, 6.4),
+            SHOWROOM_5500,
+            500.0,
+            "building",
+        )
+    display = car_paints(mats, "show")
+    for j, (x, y) in enumerate(
+        (
+            (front - 3.0, 9.0),
+            (front - 6.2, 17.0),
+            (front - 3.0, 25.0),
+            (front - 6.2, 33.0),
+            (front - 3.0, 41.0),
+        )
+    ):
+        car(mats, f"display{j}", (x, y, 0.1), 0.6 if j % 2 else -0.6, display[j + 1], 30 + j)
+    frame = mats.principled("mullion_i", (0.05, 0.05, 0.055), roughness=0.3, metallic=0.8)
+    for j, y in enumerate(np.arange(5.0, 47.1, 3.0)):
+        tag(
+            box(f"mullion{j}", (front + 0.04, y - 0.06, 0.2), (front + 0.14, y + 0.06, 6.2), frame),
+            "building",
+        )
+    glow_box(
+        mats,
+        "brand_band",
+        (front + 0.02, 8.0, 6.6),
+        (front + 0.08, 44.0, 7.6),
+        SOS_BLUE,
+        200.0,
+        "traffic_sign",
+    )
+    offices = mats.principled("offices_i", albedo="hotel_i", roughness=0.7)
+    tag(
+        box("left_block", (front - 20.0, 48.0, 0.0), (front, 108.0, 18.0), offices, 8.0), "building"
+    )
+    tag(
+        box("left_block0", (front - 20.0, -12.0, 0.0), (front, 4.0, 14.0), offices, 8.0), "building"
+    )
+    tag(box("right_block", (14.0, 64.0, 0.0), (30.0, 108.0, 20.0), offices, 8.0), "building")
+    for j in range(10):
+        side = -1 if j % 2 else 1
+        y = float(rng.uniform(52.0, 104.0))
+        z = float(3.0 * int(rng.integers(1, 5)) + 0.5)
+        x = front + 0.02 if side < 0 else 13.97
+        glow_box(
+            mats,
+            f"block_window{j}",
+            (x - 0.01, y, z),
+            (x + 0.02, y + 1.3, z + 1.4),
+            WINDOW_WARM,
+            float(rng.uniform(15.0, 30.0)),
+            "building",
+        )
+    tag(box("terrace", (-70.0, 123.0, 0.0), (70.0, 133.0, 12.0), offices, 8.0), "building")
+    for j, x in enumerate((-20.0, -9.0, 2.0, 11.0, 23.0)):
+        glow_box(
+            mats,
+            f"terrace_window{j}",
+            (x, 122.96, 4.0),
+            (x + 1.5, 122.99, 5.5),
+            WINDOW_WARM,
+            25.0,
+            "building",
+        )
+    # street lamps (none in the drive's mouth)
+    metal = mats.principled("lamp_metal_i", (0.1, 0.1, 0.11), roughness=0.45, metallic=0.6)
+    for k, (x, y, dx) in enumerate(
+        (
+            (-5.0, 12.0, 1.5),
+            (-5.0, 40.0, 1.5),
+            (-5.0, 68.0, 1.5),
+            (-5.0, 96.0, 1.5),
+            (5.0, 4.0, -1.5),
+            (5.0, 52.0, -1.5),
+            (5.0, 80.0, -1.5),
+        )
+    ):
+        post_lamp(mats, f"lamp{k}", (x, y, kerb), 9.0, [(dx, 0.0)], LED_3200, 2400.0, metal)
+    # cars: two taxis in the drive, a car ahead, an oncoming car, one parked on the left
+    paints = car_paints(mats, "i")
+    taxi = mats.principled("paint_taxi_i", (0.02, 0.02, 0.022), roughness=0.25, coat=1.0)
+    tw = car(mats, "taxi0", (7.3, 24.0, 0.0), 0.0, taxi, 1)
+    tail_lights(mats, "taxi0_tail", tw, 0.0, 1, cd=10.0)
+    car(mats, "taxi1", (7.3, 31.0, 0.0), 0.0, paints[4], 2)
+    tw = car(mats, "car_ahead", (1.9, 30.0, 0.02), 0.0, paints[1], 3)
+    tail_lights(mats, "taillight", tw, 0.0, 3, cd=12.0)
+    tw = car(mats, "oncoming", (-1.9, 70.0, 0.02), math.pi, paints[3], 4)
+    headlights(mats, "oncoming_head", tw, math.pi, 4, colour=HALOGEN, cd=14000.0, pitch=1.0)
+    car(mats, "parked5", (-3.3, 56.0, 0.0), 0.0, paints[6], 5)
+    eye = (1.9, 0.0, crown(1.9, half, 0.06) + 1.1)
+    camera("driver", eye, pitched(np.array([0.0, 1.0, 0.0]), 1.5), 36.0, 752, 400)
+
+
+def build_tunnel_portal(mats: Materials) -> None:
+    """A mountain road at night running into a tunnel: a two-lane road (7.5 m) of wet asphalt
+    (roughness 0.12, puddles 0.03 on a sixth; flagged as road) climbing at 1.2 % through a
+    cutting between retaining walls that rise from 1 m to 9 m, with guardrails, edge lines and
+    delineator posts, into a rectangular portal 70 m ahead in a concrete headwall under a
+    wooded hillside; inside, the tunnel (10 m wide, 6.3 m high, walkways on both sides) bends
+    left (R 320 m) from 110 m, its lower walls lined with light panels and its vault dark, two
+    rows of LED 4400 K luminaires (2.2 kcd every 4 m in the entrance zone, 1.0 kcd every 10 m
+    beyond), the road wet for 25 m inside and damp beyond (roughness 0.32, flagged as road,
+    material `tunnel_asphalt`); lane signals and a lit name sign over the portal, blue SOS
+    niches inside; LED 4400 K lamps (2 kcd, 10 m) on the approach; a car entering the tunnel
+    with its tail lights (12 cd), an oncoming car coming out (xenon headlights, 14 kcd). A
+    lorry's camera 2.1 m up."""
+    grade = lambda s: 0.012 * s  # noqa: E731
+    line = CentreLine(radius=320.0, bend_start=110.0, profile=grade)
+    asphalt = mats.principled(
+        "wet_asphalt", albedo="asphalt_pass_i", roughness_map="puddles_pass_i", road=True
+    )
+    inner = mats.principled(
+        "tunnel_asphalt", albedo="asphalt_pass_i", roughness_map="tunnel_damp_i", road=True
+    )
+    half = 3.75
+    xs = [(float(x), crown(float(x), half + 0.25, 0.05)) for x in np.linspace(-4.0, 4.0, 9)]
+    tag(ribbon("road", line, np.arange(-10.0, 95.01, 1.0), xs, asphalt, 2.0), "road")
+    tag(ribbon("tunnel_road", line, np.arange(95.0, 340.01, 2.0), xs, inner, 2.0), "road")
+    paint = mats.principled("road_paint_i2", (0.62, 0.62, 0.6), roughness=0.35, road=True)
+    k = 0
+    for s in np.arange(-8.0, 330.0, 12.0):  # the centre line, dashed
+        for x, length in ((0.0, 5.0), (-3.55, 12.0), (3.55, 12.0)):
+            c, r = line.point(s), line.right(s)
+            p = c + x * r
+            obj = box(f"mark{k}", (-0.07, 0.0, -0.02), (0.07, length, 0.054), paint)
+            obj.location = tuple(p)
+            obj.rotation_euler = (math.atan(0.012), 0.0, line.heading(s))
+            tag(obj, "marking")
+            k += 1
+    # the approach: verges, guardrails, retaining walls, hillsides
+    portal = 70.0
+    concrete = mats.principled("portal_i", albedo="portal_i", roughness=0.8)
+    grass = mats.principled("slope_i", albedo="slope_i", roughness=0.85)
+    for side in (-1.0, 1.0):
+        tag(
+            ribbon(
+                f"verge{int(side)}",
+                line,
+                np.arange(-10.0, portal + 0.01, 2.0),
+                [(4.0, 0.0), (7.0, 0.05)] if side > 0 else [(-7.0, 0.05), (-4.0, 0.0)],
+                grass,
+                2.0,
+            ),
+            "terrain",
+        )
+
+    def wall_top(y: float) -> float:
+        """The cutting's depth: nothing at 10 m, 9 m at the portal."""
+        return 9.0 * smoothstep((y - 10.0) / 60.0)
+
+    tag(
+        wall(
+            "cut_wall_l",
+            np.arange(10.0, portal + 0.01, 2.0),
+            -7.0,
+            grade,
+            lambda y: grade(y) + wall_top(y),
+            concrete,
+            3.0,
+            1.0,
+        ),
+        "wall",
+    )
+    tag(
+        wall(
+            "cut_wall_r",
+            np.arange(10.0, portal + 0.01, 2.0),
+            7.0,
+            grade,
+            lambda y: grade(y) + wall_top(y),
+            concrete,
+            3.0,
+            -1.0,
+        ),
+        "wall",
+    )
+
+    def hill(x: float, y: float) -> float:
+        """The hillsides beside the cutting, from the walls' tops up and away."""
+        away = max(0.0, abs(x) - 7.0)
+        bumps = 0.6 * math.sin(0.21 * x + 0.13 * y) * smoothstep(away / 5.0)
+        return grade(max(min(y, portal), -10.0)) + wall_top(y) + 0.55 * away + bumps
+
+    for side in (-1.0, 1.0):
+        xs_h = np.linspace(7.0, 60.0, 16) * side
+        tag(
+            grid(
+                f"hillside{int(side)}",
+                sorted(xs_h),
+                np.linspace(-10.0, portal + 2.0, 20),
+                hill,
+                grass,
+                4.0,
+            ),
+            "terrain",
+        )
+
+    def above(x: float, y: float) -> float:
+        """The hill over the tunnel, rising from the headwall's top."""
+        return grade(portal) + 12.0 + 0.35 * (y - portal) + 0.2 * abs(x) + 0.8 * math.sin(0.17 * x)
+
+    tag(
+        grid(
+            "hill_above",
+            np.linspace(-80.0, 80.0, 24),
+            np.linspace(portal + 1.0, 260.0, 24),
+            above,
+            grass,
+            4.0,
+        ),
+        "terrain",
+    )
+    rail = mats.principled("guardrail_i", (0.5, 0.52, 0.55), roughness=0.35, metallic=0.8)
+    for side in (-1.0, 1.0):
+        x = 4.6 * side
+        tag(
+            box(f"guardrail{int(side)}", (x - 0.03, -10.0, 0.5), (x + 0.03, 12.0, 0.8), rail),
+            "fence",
+        )
+        for j, y in enumerate(np.arange(-8.0, 12.0, 4.0)):
+            tag(
+                box(
+                    f"rail_post{int(side)}_{j}",
+                    (x - 0.06 + 0.1 * side, y - 0.06, 0.0),
+                    (x + 0.06 + 0.1 * side, y + 0.06, 0.75),
+                    rail,
+                ),
+                "pole",
+            )
+    white = mats.principled("delineator_i", (0.75, 0.75, 0.72), roughness=0.4)
+    amber = mats.principled("reflector_i", (0.9, 0.45, 0.05), roughness=0.1, coat=1.0)
+    for j, y in enumerate(np.arange(-5.0, 60.0, 16.0)):
+        for side in (-1.0, 1.0):
+            x = 5.2 * side
+            z = grade(y)
+            tag(
+                box(
+                    f"delineator{j}_{int(side)}",
+                    (x - 0.06, y - 0.06, z),
+                    (x + 0.06, y + 0.06, z + 1.0),
+                    white,
+                ),
+                "pole",
+            )
+            tag(
+                box(
+                    f"reflector{j}_{int(side)}",
+                    (x - 0.065, y - 0.065, z + 0.75),
+                    (x + 0.065, y - 0.05, z + 0.93),
+                    amber,
+                ),
+                "pole",
+            )
+    rng = np.random.default_rng(251)
+    t = 0
+    for side in (-1.0, 1.0):
+        for y in np.arange(-6.0, 66.0, 9.0):
+            x = side * float(rng.uniform(9.5, 30.0))
+            tree(
+                mats,
+                f"tree{t}",
+                (x, y, hill(x, y) - 0.2),
+                float(rng.uniform(7.0, 12.0)),
+                True,
+                40 + t,
+                leaves="slope_i",
+            )
+            t += 1
+    for _ in range(10):
+        x = float(rng.uniform(-40.0, 40.0))
+        y = float(rng.uniform(portal + 8.0, 110.0))
+        tree(
+            mats,
+            f"tree{t}",
+            (x, y, above(x, y) - 0.2),
+            float(rng.uniform(8.0, 13.0)),
+            True,
+            40 + t,
+            leaves="slope_i",
+        )
+        t += 1
+    # the portal: a headwall with a rectangular opening, lane signals and a name sign
+    zp = grade(portal)
+    tag(
+        box(
+            "headwall_l", (-40.0, portal, zp - 1.0), (-5.0, portal + 2.0, zp + 20.0), concrete, 3.0
+        ),
+        "wall",
+    )
+    tag(
+        box("headwall_r", (5.0, portal, zp - 1.0), (40.0, portal + 2.0, zp + 20.0), concrete, 3.0),
+        "wall",
+    )
+    tag(
+        box(
+            "headwall_top", (-5.0, portal, zp + 6.3), (5.0, portal + 2.0, zp + 20.0), concrete, 3.0
+        ),
+        "wall",
+    )
+    housing = mats.principled("signal_housing_i", (0.02, 0.02, 0.022), roughness=0.4)
+    for j, x in enumerate((-1.9, 1.9)):
+        tag(
+            box(
+                f"lane_signal{j}",
+                (x - 0.45, portal - 0.25, zp + 6.6),
+                (x + 0.45, portal, zp + 7.5),
+                housing,
+            ),
+            "traffic_light",
+        )
+        colour = SIGNAL_GREEN if x > 0 else RED
+        glow_box(
+            mats,
+            f"lane_signal_lamp{j}",
+            (x - 0.3, portal - 0.28, zp + 6.75),
+            (x + 0.3, portal - 0.25, zp + 7.35),
+            colour,
+            300.0,
+            "traffic_light",
+        )
+    tag(
+        box("name_board", (-3.2, portal - 0.2, zp + 8.0), (3.2, portal, zp + 9.0), housing),
+        "traffic_sign",
+    )
+    glow_box(
+        mats,
+        "name_sign",
+        (-3.0, portal - 0.23, zp + 8.15),
+        (3.0, portal - 0.2, zp + 8.85),
+        COOL_WHITE,
+        60.0,
+        "traffic_sign",
+    )
+    # the tunnel: walkways, light lined lower walls, a dark vault, luminaires, SOS niches
+    lining = mats.principled("lining_i", albedo="lining_i", roughness=0.3, coat=0.5)
+    vault = mats.principled("vault_i", (0.05, 0.05, 0.055), roughness=0.8)
+    ss = np.arange(portal, 340.01, 2.0)
+    walk = mats.principled("walkway_i", (0.2, 0.2, 0.19), roughness=0.7)
+    tag(
+        ribbon("walkway_r", line, ss, [(4.0, 0.0), (4.0, 0.25), (5.0, 0.25)], walk, 1.0), "sidewalk"
+    )
+    tag(
+        ribbon("walkway_l", line, ss, [(-5.0, 0.25), (-4.0, 0.25), (-4.0, 0.0)], walk, 1.0),
+        "sidewalk",
+    )
+    tag(
+        ribbon("lining_r", line, ss, [(5.0, 0.25), (5.0, 4.5)], lining, 2.0, along_first=True),
+        "wall",
+    )
+    tag(
+        ribbon("lining_l", line, ss, [(-5.0, 4.5), (-5.0, 0.25)], lining, 2.0, along_first=True),
+        "wall",
+    )
+    tag(
+        ribbon("vault", line, ss, [(5.0, 4.5), (5.0, 6.3), (-5.0, 6.3), (-5.0, 4.5)], vault, 2.0),
+        "wall",
+    )
+    tag(box("tunnel_end", (-60.0, 345.0, -5.0), (60.0, 346.0, 20.0), vault), "wall")
+    k = 0
+    for s in list(np.arange(portal + 2.0, portal + 42.0, 4.0)) + list(
+        np.arange(portal + 48.0, 335.0, 10.0)
+    ):
+        cd = 2200.0 if s < portal + 42.0 else 1000.0
+        for x in (-2.6, 2.6):
+            p = line.point(s) + x * line.right(s)
+            lamp_head(
+                mats,
+                f"tunnel_light{k}",
+                (float(p[0]), float(p[1]), float(p[2]) + 6.05),
+                (0.35, 1.2),
+                LED_4400,
+                cd,
+            )
+            k += 1
+    for j, s in enumerate(np.arange(portal + 60.0, 330.0, 90.0)):
+        p = line.point(s) + 4.97 * line.right(s)
+        glow_box(
+            mats,
+            f"sos{j}",
+            (float(p[0]) - 0.03, float(p[1]) - 0.6, float(p[2]) + 2.2),
+            (float(p[0]), float(p[1]) + 0.6, float(p[2]) + 2.8),
+            SOS_BLUE,
+            150.0,
+            "traffic_sign",
+        )
+    # approach lamps
+    metal = mats.principled("lamp_metal_i2", (0.3, 0.31, 0.32), roughness=0.45, metallic=0.7)
+    for j, (x, y, dx) in enumerate(((5.6, 18.0, -1.8), (-5.6, 40.0, 1.8), (5.6, 60.0, -1.8))):
+        post_lamp(mats, f"lamp{j}", (x, y, grade(y)), 10.0, [(dx, 0.0)], LED_4400, 2000.0, metal)
+    # cars: one entering the tunnel, one coming out of it
+    paints = car_paints(mats, "i2")
+    pitch = math.atan(0.012)
+    tw = sloped_car(mats, "car_ahead", (1.9, 58.0, grade(58.0) + 0.03), 0.0, pitch, paints[0], 1)
+    tail_lights(mats, "taillight", tw, 0.0, 1, cd=12.0)
+    tw = sloped_car(
+        mats, "oncoming", (-1.9, 92.0, grade(92.0) + 0.03), math.pi, -pitch, paints[2], 2
+    )
+    headlights(mats, "oncoming_head", tw, math.pi, 2, colour=XENON, cd=14000.0, pitch=1.0)
+    eye = (1.9, 24.0, grade(24.0) + crown(1.9, half + 0.25, 0.05) + 2.1)
+    camera("driver", eye, pitched(np.array([0.0, 1.0, 0.0]), 0.5), 34.0, 672, 384)
+
+
 SCENES = {
     "hill_bend": build_hill_bend,
     "crossing": build_crossing,
@@ -3850,10 +4407,13 @@ SCENES = {
     # the eighth set (made after the first seven had been looked at)
     "bus_station": build_bus_station,
     "car_park_deck": build_car_park_deck,
+    # the ninth set (made after the first eight had been looked at)
+    "hotel_front": build_hotel_front,
+    "tunnel_portal": build_tunnel_portal,
 }
 #: The scene sets: `--set a` (the default) builds the first, `--set b` the second, `--set c`
 #: the third, `--set d` the fourth, `--set e` the fifth, `--set f` the sixth, `--set g` the
-#: seventh, `--set h` the eighth.
+#: seventh, `--set h` the eighth, `--set i` the ninth.
 SETS = {
     "a": ("hill_bend", "crossing", "tabletop"),
     "b": ("roundabout", "avenue", "shelf"),
@@ -3863,6 +4423,7 @@ SETS = {
     "f": ("tramway", "forecourt"),
     "g": ("toll_plaza", "close"),
     "h": ("bus_station", "car_park_deck"),
+    "i": ("hotel_front", "tunnel_portal"),
 }
 #: The scenes with a wet road (the others have none).
 STREETS = (
@@ -3882,6 +4443,8 @@ STREETS = (
     "close",
     "bus_station",
     "car_park_deck",
+    "hotel_front",
+    "tunnel_portal",
 )
 #: The streets with a dry road (no streaks; their road material is `dry_asphalt`).
 DRY_STREETS = ("daylight_street",)

@@ -19,7 +19,8 @@
 # forecourt), made after the first five; with SET=g the seventh (heldback_g/, other_config_g/
 # and pairs_g/: toll_plaza, close), made after the first six; with SET=h the eighth
 # (heldback_h/, other_config_h/ and pairs_h/: bus_station, car_park_deck), made after the
-# first seven.
+# first seven; with SET=i the ninth (heldback_i/, other_config_i/ and pairs_i/: hotel_front,
+# tunnel_portal), made after the first eight.
 #
 # STREAKS: the binary (default target/release/streaks); OPENCV_PYTHON: a Python with
 # opencv-python-headless (tools/opencv/requirements.txt) to add OpenCV's StereoSGBM.
@@ -60,6 +61,9 @@ elif [[ "${SET:-a}" == g ]]; then
 elif [[ "${SET:-a}" == h ]]; then
     benches=(heldback_h other_config_h pairs_h)
     repairs=(heldback_h other_config_h pairs_h/bus_station pairs_h/car_park_deck)
+elif [[ "${SET:-a}" == i ]]; then
+    benches=(heldback_i other_config_i pairs_i)
+    repairs=(heldback_i other_config_i pairs_i/hotel_front pairs_i/tunnel_portal)
 else
     benches=(heldback other_config dry_config pairs)
     repairs=(heldback other_config dry_config pairs/hill_bend pairs/crossing)

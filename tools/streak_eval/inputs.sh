@@ -66,6 +66,14 @@
 #   OUT/heldback_h/                               24 default-config samples (seed 51900), an
 #                                                 eighth held-back split
 #
+# SET=i makes the ninth set (made after the first eight had been looked at):
+#
+#   OUT/scenes_i/{hotel_front,tunnel_portal}.glb  built in Blender, exported by its exporter
+#   OUT/pairs_i/{hotel_front,tunnel_portal}/      `streaks stereo` pairs of them
+#   OUT/other_config_i/                           3 samples of other_config_i.toml (seed 121)
+#   OUT/heldback_i/                               24 default-config samples (seed 52900), a
+#                                                 ninth held-back split
+#
 # BLENDER_PYTHON: the Python with bpy 5.0 (default target/blender-venv/bin/python);
 # STREAKS: the streaks binary (default target/release/streaks). Run from the repository root.
 # Evaluation-only inputs: no parameter may be tuned on them.
@@ -83,9 +91,9 @@ stamp() { date -u +%H:%M:%S; }
 suffix=""
 [[ "$set_name" == "a" ]] || suffix="_$set_name"
 case "$set_name" in
-    a | b | c | d | e | f | g | h) ;;
+    a | b | c | d | e | f | g | h | i) ;;
     *)
-        echo "SET must be a, b, c, d, e, f, g or h, not $set_name" >&2
+        echo "SET must be a, b, c, d, e, f, g, h or i, not $set_name" >&2
         exit 2
         ;;
 esac
@@ -184,6 +192,15 @@ case "$set_name" in
         samples other_config_h --config "$here/other_config_h.toml" --count 3 --seed 111 \
             --width 560 --height 304 --spp 24
         samples heldback_h --seed 51900 --count 24 --width 496 --height 288 --spp 16
+        ;;
+    i)
+        pair hotel_front --width 752 --height 400 --baseline 0.14 --exposure 2.75 --seed 9
+        # sensor_i.toml: a 12-bit camera with small low-noise pixels on a lorry.
+        pair tunnel_portal --width 672 --height 384 --baseline 0.42 \
+            --sensor "$here/sensor_i.toml" --seed 9
+        samples other_config_i --config "$here/other_config_i.toml" --count 3 --seed 121 \
+            --width 624 --height 336 --spp 24
+        samples heldback_i --seed 52900 --count 24 --width 512 --height 272 --spp 16
         ;;
 esac
 echo "$(stamp) done: $out (set $set_name)"

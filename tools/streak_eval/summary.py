@@ -31,6 +31,8 @@ INPUTS = [
     "other_config_g",
     "heldback_h",
     "other_config_h",
+    "heldback_i",
+    "other_config_i",
 ]
 PAIRS = [
     "hill_bend",
@@ -52,6 +54,8 @@ PAIRS = [
     "close",
     "bus_station",
     "car_park_deck",
+    "hotel_front",
+    "tunnel_portal",
 ]
 
 

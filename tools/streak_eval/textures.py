@@ -839,6 +839,55 @@ TEXTURES = {
         partial(lit_windows, seed=199, per_row=8, rows=6, lit=0.3, colour=(0.45, 0.45, 0.5)),
         True,
     ),
+    # ninth set (hotel frontage, tunnel portal)
+    "asphalt_i": (
+        partial(
+            asphalt_albedo,
+            seed=221,
+            level=0.048,
+            stone_px=1.6,
+            stone_cut=1.2,
+            tint=(1.0, 0.99, 0.98),
+        ),
+        True,
+    ),
+    "puddles_i": (
+        partial(puddle_roughness, seed=222, wet=0.13, puddle=0.022, share=0.26, blobs_per_tile=5.0),
+        False,
+    ),
+    "drive_i": (
+        partial(setts, seed=223, rows=12, per_row=6, colour=(1.0, 0.9, 0.86), shade=0.14),
+        True,
+    ),
+    "drive_wet_i": (
+        partial(cobbles_roughness, seed=224, rows=12, per_row=6, stone=0.22, joint=0.06),
+        False,
+    ),
+    "hotel_i": (
+        partial(lit_windows, seed=225, per_row=4, rows=3, lit=0.45, colour=(0.62, 0.56, 0.46)),
+        True,
+    ),
+    "showroom_i": (partial(facade_panels, seed=226), True),
+    "flags_i": (partial(paving, seed=227, n=224, flags=7, level=0.19, spread=0.035), True),
+    "asphalt_pass_i": (
+        partial(
+            asphalt_albedo,
+            seed=228,
+            level=0.04,
+            stone_px=1.4,
+            stone_cut=1.35,
+            tint=(0.98, 0.99, 1.02),
+        ),
+        True,
+    ),
+    "puddles_pass_i": (
+        partial(puddle_roughness, seed=229, wet=0.12, puddle=0.03, share=0.18, blobs_per_tile=9.0),
+        False,
+    ),
+    "tunnel_damp_i": (partial(dry_roughness, seed=230, mean=0.32, spread=0.06), False),
+    "lining_i": (partial(paving, seed=231, n=256, flags=8, level=0.5, spread=0.03), True),
+    "portal_i": (partial(board_concrete, seed=232, boards=5, level=0.26), True),
+    "slope_i": (partial(lawn, seed=233), True),
 }
 
 

@@ -415,10 +415,36 @@ def test_car_park_deck_is_stained_wet_concrete():
     assert not TEXTURES["deck_wet_h"][1] and not TEXTURES["puddles_h"][1]
 
 
+NINTH_SET = (
+    "asphalt_i",
+    "puddles_i",
+    "drive_i",
+    "drive_wet_i",
+    "hotel_i",
+    "showroom_i",
+    "flags_i",
+    "asphalt_pass_i",
+    "puddles_pass_i",
+    "tunnel_damp_i",
+    "lining_i",
+    "portal_i",
+    "slope_i",
+)
+
+
+def test_tunnel_lining_is_light_and_its_road_damp():
+    lin = srgb8_to_linear(TEXTURES["lining_i"][0]()).mean(axis=-1)
+    assert 0.35 < np.median(lin) < 0.65  # light wall panels, brighter than any facade
+    damp = TEXTURES["tunnel_damp_i"][0]()[..., 1] / 255.0
+    wet = TEXTURES["puddles_pass_i"][0]()[..., 1] / 255.0
+    assert damp.min() > 0.1 and np.median(damp) > 2.0 * np.median(wet)  # no puddles inside
+    assert not TEXTURES["tunnel_damp_i"][1] and not TEXTURES["drive_wet_i"][1]
+
+
 @pytest.mark.parametrize(
     "new_set",
-    [THIRD_SET, FOURTH_SET, FIFTH_SET, SIXTH_SET, SEVENTH_SET, EIGHTH_SET],
-    ids=["third", "fourth", "fifth", "sixth", "seventh", "eighth"],
+    [THIRD_SET, FOURTH_SET, FIFTH_SET, SIXTH_SET, SEVENTH_SET, EIGHTH_SET, NINTH_SET],
+    ids=["third", "fourth", "fifth", "sixth", "seventh", "eighth", "ninth"],
 )
 def test_a_later_set_differs_from_every_other_texture(new_set):
     names = list(TEXTURES)
