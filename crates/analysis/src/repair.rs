@@ -147,7 +147,7 @@ pub const FEATURES: [&str; 30] = [
 /// The names of the second stage's context features, in order ([`StereoFeatures::context`]):
 /// the first stage's probabilities at the pixel and pooled over its column, its row and
 /// squares, and the disparity against the surface of the values the first stage trusts.
-pub const CONTEXT_FEATURES: [&str; 18] = [
+pub const CONTEXT_FEATURES: [&str; 21] = [
     "wrong1",
     "streak1",
     "wrong1_column_r22",
@@ -166,17 +166,10 @@ pub const CONTEXT_FEATURES: [&str; 18] = [
     "trusted_share_row_r32",
     "d_minus_trusted_line_below",
     "trusted_line_below_slope",
+    "d_minus_trusted_line_far_below",
+    "trusted_line_far_below_slope",
+    "mirror_d_minus",
 ];
-
-/// The rows below a pixel whose trusted values the column's line is fitted to: from this many
-/// rows below it ...
-const LINE_GAP: usize = 6;
-
-/// ... over this many rows.
-const LINE_ROWS: usize = 64;
-
-/// The fewest trusted values a column's line is fitted to.
-const LINE_MIN: f64 = 12.0;
 
 /// A value the first stage's `wrong` probability puts below this is trusted by the second
 /// stage's surface features.
@@ -579,7 +572,10 @@ impl StereoFeatures {
             Axis::Rows,
             32,
         );
-        let (line_minus, line_slope) = trusted_line_below(&trusted, d);
+        let (line_minus, line_slope) = against_line(&trusted_line(&trusted, NEAR_LINE), w, d);
+        let far = trusted_line(&trusted, FAR_LINE);
+        let (far_minus, far_slope) = against_line(&far, w, d);
+        let mirror = mirror_minus(&far, w, d);
         // A streak hangs below its light: the most streak-like pixel a few columns wide above.
         let above = max(&max_above(streak), Axis::Rows, 4);
         let planes = vec![
@@ -601,58 +597,143 @@ impl StereoFeatures {
             trusted_share.data,
             line_minus,
             line_slope,
+            far_minus,
+            far_slope,
+            mirror,
         ];
         debug_assert_eq!(planes.len(), CONTEXT_FEATURES.len());
         planes
     }
 }
 
-/// The disparity `d(i)` of each pixel against the straight line fitted, down its column, to
-/// the `trusted` values (finite: trusted) of the [`LINE_ROWS`] rows from [`LINE_GAP`] below
-/// it, extrapolated to its row, and the line's slope (disparity per row): `(d minus line,
-/// slope)`, [`MISSING`] where the pixel has no value or fewer than [`LINE_MIN`] values fit.
+/// Where a pixel's road line is fitted ([`trusted_line`]): to the trusted values of `rows`
+/// rows from `gap` rows below the pixel, in the columns within `band` of its own, when at
+/// least `min` of them are there.
+#[derive(Clone, Copy, Debug)]
+struct LineSpan {
+    gap: usize,
+    rows: usize,
+    band: usize,
+    min: f64,
+}
+
+/// The near line: the pixel's own column, the 64 rows from 6 below it (at least 12 values).
+const NEAR_LINE: LineSpan = LineSpan {
+    gap: 6,
+    rows: 64,
+    band: 0,
+    min: 12.0,
+};
+
+/// The far line: 17 columns around the pixel's, the 192 rows from 6 below it (at least 64
+/// values). Where a wide reflection fools the road for dozens of rows below it too, the near
+/// line has nothing trusted to stand on; the road farther down and beside it often has.
+const FAR_LINE: LineSpan = LineSpan {
+    gap: 6,
+    rows: 192,
+    band: 8,
+    min: 64.0,
+};
+
+/// Per pixel, the straight line `c + k y` (disparity against row) fitted by least squares to
+/// the `trusted` values (finite: trusted) that `span` takes below it: `[c, k]`, NaN where
+/// fewer than `span.min` values fit or their rows do not vary.
 ///
 /// A road's disparity grows steadily toward the camera down a column, whatever its bends and
-/// slopes over a few dozen rows, and the nearer road below a reflection is seen by both eyes;
-/// a wide reflection that fools every value of its row is a plateau beneath that line.
-fn trusted_line_below(trusted: &GrayImage, d: impl Fn(usize) -> f32) -> (Vec<f32>, Vec<f32>) {
+/// slopes over a few dozen rows (on a plane, exactly linearly), and the nearer road below a
+/// reflection is seen by both eyes; a wide reflection that fools every value of its row is a
+/// plateau beneath that line. Computed from a summed-area table of the values' count, row,
+/// value, row squared and row times value, so a fit costs a few lookups whatever its span.
+fn trusted_line(trusted: &GrayImage, span: LineSpan) -> Vec<[f32; 2]> {
     let (w, h) = (trusted.width, trusted.height);
-    let mut minus = vec![MISSING; w * h];
-    let mut slope = vec![MISSING; w * h];
-    // Per column, prefix sums over rows of the trusted values' count, row, value, row
-    // squared and row times value.
-    let mut prefix = vec![[0f64; 5]; h + 1];
-    for x in 0..w {
-        for y in 0..h {
+    let stride = w + 1;
+    let mut table = vec![[0f64; 5]; (h + 1) * stride];
+    for y in 0..h {
+        let mut run = [0f64; 5];
+        for x in 0..w {
             let v = trusted.data[y * w + x];
-            let mut p = prefix[y];
             if v.is_finite() {
                 let (r, v) = (y as f64, f64::from(v));
-                p[0] += 1.0;
-                p[1] += r;
-                p[2] += v;
-                p[3] += r * r;
-                p[4] += r * v;
+                run[0] += 1.0;
+                run[1] += r;
+                run[2] += v;
+                run[3] += r * r;
+                run[4] += r * v;
             }
-            prefix[y + 1] = p;
+            let above = table[y * stride + x + 1];
+            table[(y + 1) * stride + x + 1] = std::array::from_fn(|k| above[k] + run[k]);
         }
-        for y in 0..h {
-            let i = y * w + x;
-            let dv = d(i);
-            let (a, b) = ((y + LINE_GAP).min(h), (y + LINE_GAP + LINE_ROWS).min(h));
-            let s: [f64; 5] = std::array::from_fn(|k| prefix[b][k] - prefix[a][k]);
+    }
+    let mut out = vec![[f32::NAN; 2]; w * h];
+    for y in 0..h {
+        let (a, b) = ((y + span.gap).min(h), (y + span.gap + span.rows).min(h));
+        for x in 0..w {
+            let (l, r) = (x.saturating_sub(span.band), (x + span.band + 1).min(w));
+            let at = |row: usize, col: usize| table[row * stride + col];
+            let (bb, ab, bl, al) = (at(b, r), at(a, r), at(b, l), at(a, l));
+            let s: [f64; 5] = std::array::from_fn(|k| bb[k] - ab[k] - bl[k] + al[k]);
             let n = s[0];
             let det = n * s[3] - s[1] * s[1];
-            if !dv.is_finite() || n < LINE_MIN || det <= 1e-9 {
+            if n < span.min || det <= 1e-9 * n * n {
                 continue;
             }
             let k = (n * s[4] - s[1] * s[2]) / det;
             let c = (s[2] - k * s[1]) / n;
-            minus[i] = (f64::from(dv) - (c + k * y as f64)) as f32;
-            slope[i] = k as f32;
+            out[y * w + x] = [c as f32, k as f32];
+        }
+    }
+    out
+}
+
+/// The disparity `d(i)` of each pixel against its `line` ([`trusted_line`]) extrapolated to
+/// its row, and the line's slope (disparity per row): `(d minus line, slope)`, [`MISSING`]
+/// where the pixel has no value or no line.
+fn against_line(line: &[[f32; 2]], w: usize, d: impl Fn(usize) -> f32) -> (Vec<f32>, Vec<f32>) {
+    let mut minus = vec![MISSING; line.len()];
+    let mut slope = vec![MISSING; line.len()];
+    for (i, &[c, k]) in line.iter().enumerate() {
+        let dv = d(i);
+        if dv.is_finite() && c.is_finite() {
+            minus[i] = dv - (c + k * (i / w) as f32);
+            slope[i] = k;
         }
     }
     (minus, slope)
+}
+
+/// The smallest slope (disparity per row) of a road line that [`mirror_minus`] reads as a
+/// road growing toward the camera.
+const MIRROR_MIN_SLOPE: f32 = 1.0e-3;
+
+/// For each pixel with a value `d` beneath its road `line` (the line reaches `d` at least a
+/// row above it): the disparity at its mirror row less `d`, [`MISSING`] where there is none
+/// to compare.
+///
+/// A wet road mirrors a lit surface standing on it at the surface's own distance, so the
+/// reflection's disparity is the surface's, and the reflection is the surface flipped about
+/// the row where the road's disparity equals it (where the surface stands). That row is
+/// where the line reaches `d`; the mirror row lies as far above it as the pixel lies below.
+/// There semi-global matching sees the lit surface itself, at about `d`, if the pixel's value
+/// is a reflection; noise or a wrong match has no such partner.
+fn mirror_minus(line: &[[f32; 2]], w: usize, d: impl Fn(usize) -> f32) -> Vec<f32> {
+    let h = line.len() / w.max(1);
+    let mut out = vec![MISSING; line.len()];
+    for (i, &[c, k]) in line.iter().enumerate() {
+        let dv = d(i);
+        if !(dv.is_finite() && c.is_finite() && k > MIRROR_MIN_SLOPE) {
+            continue;
+        }
+        let (x, y) = (i % w, (i / w) as f32);
+        let stands = (dv - c) / k;
+        let mirror = (2.0 * stands - y).round();
+        if (0.0..h as f32).contains(&mirror) && stands <= y - 1.0 {
+            let m = d(mirror as usize * w + x);
+            if m.is_finite() {
+                out[i] = m - dv;
+            }
+        }
+    }
+    out
 }
 
 /// The calibration of the confidence map: measured shares of right values on the
@@ -1697,7 +1778,7 @@ mod tests {
                 })
                 .collect(),
         };
-        let (minus, slope) = trusted_line_below(&trusted, d);
+        let (minus, slope) = against_line(&trusted_line(&trusted, NEAR_LINE), w, d);
         let at = |v: &[f32], y: usize| v[y * w + 1];
         assert!(at(&minus, 20).abs() < 1e-3 && (at(&slope, 20) - 0.25).abs() < 1e-3);
         // On the plateau the road below predicts 0.25 px a row: the reflection is beneath it.
@@ -1709,6 +1790,51 @@ mod tests {
         // Too few rows below: no line.
         assert_eq!(at(&minus, h - 10), MISSING);
         assert_eq!(at(&slope, h - 10), MISSING);
+    }
+
+    #[test]
+    fn the_far_line_and_the_mirror_see_a_reflection_over_a_fooled_road() {
+        // A flat road seen from above: disparity 0.25 (y - 20) px from the horizon at row 20,
+        // 41 columns. A lit wall stands on it at row 60 (disparity 10) and rises to row 30; on
+        // the wet road its reflection fills every column over rows 60..90 at the wall's
+        // disparity, and the road below is fooled or dropped too down to row 160.
+        let (w, h) = (41, 260);
+        let road = |y: usize| 0.25 * (y as f32 - 20.0);
+        let d = |i: usize| match i / w {
+            30..90 => 10.0,
+            y => road(y),
+        };
+        let trusted = GrayImage {
+            width: w,
+            height: h,
+            data: (0..w * h)
+                .map(|i| if i / w < 160 { f32::INFINITY } else { d(i) })
+                .collect(),
+        };
+        let at = |v: &[f32], x: usize, y: usize| v[y * w + x];
+        // The near line has no trusted value in the 64 rows from row 86; the far one has.
+        let (near, _) = against_line(&trusted_line(&trusted, NEAR_LINE), w, d);
+        assert_eq!(at(&near, 20, 80), MISSING);
+        let far = trusted_line(&trusted, FAR_LINE);
+        let (minus, slope) = against_line(&far, w, d);
+        for x in [0, 20, 40] {
+            assert!((at(&minus, x, 80) - (10.0 - road(80))).abs() < 1e-2);
+            assert!((at(&slope, x, 80) - 0.25).abs() < 1e-4);
+        }
+        // The reflection at row 80 stands at row 60 and mirrors row 40: the wall, at its
+        // disparity. A road value at row 150 is on its line, its own mirror.
+        let mirror = mirror_minus(&far, w, d);
+        assert!(at(&mirror, 20, 80).abs() < 1e-3, "{}", at(&mirror, 20, 80));
+        assert_eq!(at(&mirror, 20, 150), MISSING);
+        // A value beneath the line with no lit surface at its mirror row: no partner.
+        let noise = |i: usize| if i == 80 * w + 20 { 3.0 } else { road(i / w) };
+        let m = mirror_minus(&far, w, noise);
+        // It stands at row 32 and mirrors row -16: outside the image.
+        assert_eq!(at(&m, 20, 80), MISSING);
+        let noise = |i: usize| if i == 80 * w + 20 { 12.0 } else { road(i / w) };
+        let m = mirror_minus(&far, w, noise);
+        // It stands at row 68 and mirrors row 56, whose road value is 9 px: 3 px beneath it.
+        assert!((at(&m, 20, 80) + 3.0).abs() < 1e-3, "{}", at(&m, 20, 80));
     }
 
     /// Whether the second stage's streak probability differs from the first's somewhere.
