@@ -46,10 +46,13 @@
 //! streak is then decided pixel by pixel, each from too little. A **second stage**
 //! ([`RepairModel::context`], [`probabilities`]) decides both again from the features and
 //! the first stage's probabilities pooled down the column, along the row and over squares,
-//! with the disparity against the surface of the values the first stage trusts
-//! ([`StereoFeatures::context`], [`CONTEXT_FEATURES`]): a region's verdict seen as a whole
-//! (auto-context). Its trees learn from first-stage probabilities of streets those trees
-//! did not see, as they will meet them.
+//! with the disparity against the surface of the values the first stage trusts and against
+//! the line those values follow down the column below the pixel, near and, peeled of the
+//! values beneath it, far ([`StereoFeatures::context`], [`CONTEXT_FEATURES`]): a region's
+//! verdict seen as a whole (auto-context), and the road a wide reflection lies beneath. At
+//! its mirror row a reflection's value meets the lit surface it mirrors. The second
+//! stage's trees learn from first-stage probabilities of streets those trees did not see, as
+//! they will meet them.
 //!
 //! # Mask, repair, confidence ([`robust_disparity`])
 //!
@@ -146,7 +149,9 @@ pub const FEATURES: [&str; 30] = [
 
 /// The names of the second stage's context features, in order ([`StereoFeatures::context`]):
 /// the first stage's probabilities at the pixel and pooled over its column, its row and
-/// squares, and the disparity against the surface of the values the first stage trusts.
+/// squares, the disparity against the surface of the values the first stage trusts and
+/// against the lines they follow down the column below it, and the disparity at the mirror
+/// row.
 pub const CONTEXT_FEATURES: [&str; 21] = [
     "wrong1",
     "streak1",
@@ -573,7 +578,7 @@ impl StereoFeatures {
             32,
         );
         let (line_minus, line_slope) = against_line(&trusted_line(&trusted, NEAR_LINE), w, d);
-        let far = trusted_line(&trusted, FAR_LINE);
+        let far = peeled_line(&trusted, FAR_LINE);
         let (far_minus, far_slope) = against_line(&far, w, d);
         let mirror = mirror_minus(&far, w, d);
         // A streak hangs below its light: the most streak-like pixel a few columns wide above.
@@ -625,9 +630,10 @@ const NEAR_LINE: LineSpan = LineSpan {
     min: 12.0,
 };
 
-/// The far line: 17 columns around the pixel's, the 192 rows from 6 below it (at least 64
-/// values). Where a wide reflection fools the road for dozens of rows below it too, the near
-/// line has nothing trusted to stand on; the road farther down and beside it often has.
+/// The far line ([`peeled_line`]): 17 columns around the pixel's, the 192 rows from 6 below
+/// it (at least 64 values). Where a wide reflection fools the road for dozens of rows below
+/// it too, the near line has nothing right to stand on; the road farther down and beside it
+/// often has.
 const FAR_LINE: LineSpan = LineSpan {
     gap: 6,
     rows: 192,
@@ -683,6 +689,39 @@ fn trusted_line(trusted: &GrayImage, span: LineSpan) -> Vec<[f32; 2]> {
         }
     }
     out
+}
+
+/// The most times [`peeled_line`] refits the line (a bound; it stops when a refit removes
+/// nothing).
+const MAX_PEELS: usize = 32;
+
+/// [`trusted_line`], refitted without the trusted values that lie more than 1 px beneath
+/// their own line until none does (at most [`MAX_PEELS`] times).
+///
+/// A wide reflection that the first stage trusts is, row after row, part of the span that the
+/// line of the pixels above it is fitted to, and drags that line down to itself. Its lower
+/// rows, though, lie clearly beneath the line of the road farther below them; without them
+/// the rows above see that road too, and each refit peels the reflection further up. A road
+/// value is not beneath its own line, so the road keeps its values.
+fn peeled_line(trusted: &GrayImage, span: LineSpan) -> Vec<[f32; 2]> {
+    let w = trusted.width;
+    let mut line = trusted_line(trusted, span);
+    let mut kept = trusted.clone();
+    for _ in 0..MAX_PEELS {
+        let mut removed = false;
+        for (i, v) in kept.data.iter_mut().enumerate() {
+            let [c, k] = line[i];
+            if *v < c + k * (i / w) as f32 - 1.0 {
+                *v = f32::INFINITY;
+                removed = true;
+            }
+        }
+        if !removed {
+            break;
+        }
+        line = trusted_line(&kept, span);
+    }
+    line
 }
 
 /// The disparity `d(i)` of each pixel against its `line` ([`trusted_line`]) extrapolated to
@@ -808,7 +847,8 @@ impl ContextStage {
 
 /// The first stage's probabilities and, with a second stage, its context planes and the
 /// second stage's probabilities: `(wrong, unsmoothed streak)`, `wrong` at the pixels with a
-/// value of `disp` (1 elsewhere).
+/// value of `disp` (1 elsewhere). With a second stage, `wrong` is 1 where the value lies
+/// beneath the road ([`beneath_the_road`]).
 pub fn probabilities(
     features: &StereoFeatures,
     disp: &GrayImage,
@@ -821,12 +861,48 @@ pub fn probabilities(
         None => (wrong, streak),
         Some(stage) => {
             let extra = features.context(disp, &wrong, &streak);
+            let mut wrong = features.probability_with(&extra, &stage.wrong, valid, 1.0);
+            let plane = |name: &str| {
+                let k = CONTEXT_FEATURES.iter().position(|n| *n == name);
+                &extra[k.expect("a context feature of this version")]
+            };
+            let minus = plane("d_minus_trusted_line_far_below");
+            let slope = plane("trusted_line_far_below_slope");
+            for (i, p) in wrong.data.iter_mut().enumerate() {
+                if beneath_the_road(minus[i], slope[i]) {
+                    *p = 1.0;
+                }
+            }
             (
-                features.probability_with(&extra, &stage.wrong, valid, 1.0),
+                wrong,
                 features.probability_with(&extra, &stage.streak, |_| true, 0.0),
             )
         }
     }
+}
+
+/// A value further than this beneath the road's far line is wrong whatever the trees say
+/// ([`beneath_the_road`]): twice the phantom-hole margin, so that the line's own scatter
+/// (a few tenths of a pixel on a road) does not reach it.
+pub const BENEATH_ROAD_PX: f32 = 2.0;
+
+/// The smallest slope (disparity per row) of a far line that [`beneath_the_road`] reads as a
+/// road growing toward the camera.
+const BENEATH_ROAD_MIN_SLOPE: f32 = 0.02;
+
+/// Whether a value lies more than [`BENEATH_ROAD_PX`] beneath its far line (its context
+/// features `d_minus_trusted_line_far_below` and `trusted_line_far_below_slope`, the line
+/// peeled of the values beneath it and rising toward the camera).
+///
+/// Nothing that stands on a road or above it lies beneath the road's line: a car, a wall or a
+/// lamp post has the disparity of the road where it stands, above which the line is lower
+/// still. What lies beneath it is a mirror image, or a road falling away beyond a crest
+/// (whose values are then dropped, not made wrong). The trees learn their rules from the
+/// generator's streets, where a lit surface mirrored over the whole road near the camera is
+/// rare, and on streets where it is not they trusted such bands; the physics holds on every
+/// street.
+fn beneath_the_road(minus: f32, slope: f32) -> bool {
+    minus < -BENEATH_ROAD_PX && slope > BENEATH_ROAD_MIN_SLOPE && slope < MISSING
 }
 
 impl RepairModel {
@@ -1753,6 +1829,31 @@ mod tests {
     }
 
     #[test]
+    fn a_value_beneath_the_roads_far_line_is_wrong_whatever_the_trees_say() {
+        let (left, right, disp, truth) = scene(160, 100);
+        let f = StereoFeatures::new(&left, &right, &disp).unwrap();
+        // A second stage whose trees trust every value.
+        let mut m = model();
+        m.context = Some(ContextStage::new(
+            context_stump("wrong1", 2.0, -4.0, 4.0),
+            context_stump("streak1", 2.0, -4.0, 4.0),
+        ));
+        let (wrong, _) = probabilities(&f, &disp, &m);
+        // The streak reads 1 px where the road below it gives 6 to 12: beneath the road.
+        for y in [50, 65, 80] {
+            assert!(truth.get(61, y) - disp.get(61, y) > BENEATH_ROAD_PX + 1.0);
+            assert_eq!(wrong.get(61, y), 1.0, "row {y}");
+        }
+        // The road keeps the trees' verdict.
+        assert!(wrong.get(100, 60) < 0.1 && wrong.get(100, 80) < 0.1);
+        // Without a second stage the trees alone decide.
+        m.context = None;
+        m.wrong = stump("d_minus_q75_r32", 1.0e6, -4.0, 4.0);
+        let (wrong, _) = probabilities(&f, &disp, &m);
+        assert!(wrong.get(61, 80) < 0.1);
+    }
+
+    #[test]
     fn the_line_below_a_plateau_shows_it_beneath_the_road() {
         // One column: a road whose disparity grows by 0.25 px a row from row 0, with a
         // plateau of 5 px (a reflection) over rows 40..60 that nothing trusts.
@@ -1815,7 +1916,7 @@ mod tests {
         // The near line has no trusted value in the 64 rows from row 86; the far one has.
         let (near, _) = against_line(&trusted_line(&trusted, NEAR_LINE), w, d);
         assert_eq!(at(&near, 20, 80), MISSING);
-        let far = trusted_line(&trusted, FAR_LINE);
+        let far = peeled_line(&trusted, FAR_LINE);
         let (minus, slope) = against_line(&far, w, d);
         for x in [0, 20, 40] {
             assert!((at(&minus, x, 80) - (10.0 - road(80))).abs() < 1e-2);
@@ -1835,6 +1936,39 @@ mod tests {
         let m = mirror_minus(&far, w, noise);
         // It stands at row 68 and mirrors row 56, whose road value is 9 px: 3 px beneath it.
         assert!((at(&m, 20, 80) + 3.0).abs() < 1e-3, "{}", at(&m, 20, 80));
+    }
+
+    #[test]
+    fn the_peeled_line_sees_the_road_beneath_a_trusted_reflection() {
+        // The road of the test above, with a reflection at 5 px over rows 50..110 that the
+        // first stage trusts like the road below it.
+        let (w, h) = (41, 260);
+        let road = |y: usize| 0.25 * (y as f32 - 20.0);
+        let d = |i: usize| match i / w {
+            50..110 => 5.0,
+            y => road(y),
+        };
+        let trusted = GrayImage {
+            width: w,
+            height: h,
+            data: (0..w * h).map(d).collect(),
+        };
+        let at = |v: &[f32], y: usize| v[y * w + 20];
+        // Fitted to every trusted value, the line of row 60 stands partly on the reflection
+        // and sees it less than 4 px beneath; peeled, it is the road's: 5 px beneath.
+        let (raw, _) = against_line(&trusted_line(&trusted, FAR_LINE), w, d);
+        let (peeled, slope) = against_line(&peeled_line(&trusted, FAR_LINE), w, d);
+        assert!(at(&raw, 60) > -4.0, "{}", at(&raw, 60));
+        assert!(
+            (at(&peeled, 60) - (5.0 - road(60))).abs() < 0.05,
+            "{}",
+            at(&peeled, 60)
+        );
+        assert!((at(&slope, 60) - 0.25).abs() < 1e-3);
+        // The road keeps its line.
+        for y in [20, 45, 120, 200] {
+            assert!(at(&peeled, y).abs() < 1e-3, "{y}: {}", at(&peeled, y));
+        }
     }
 
     /// Whether the second stage's streak probability differs from the first's somewhere.
